@@ -1,0 +1,2 @@
+// Placeholder so that the library target exists before its first translation unit lands.
+namespace knit::macro {}

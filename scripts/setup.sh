@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs what knitscale needs from Debian 12 packages (idempotent; silent when all is there).
+# Needs root (or sudo) only when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build git pkg-config
+  libeigen3-dev          # linear algebra (3.4)
+  libceres-dev           # response-surface fitting (2.1)
+  nlohmann-json3-dev     # JSON input (3.11)
+  libhdf5-dev            # material database and results (1.10)
+  catch2                 # tests (2.13)
+  libcli11-dev           # command lines (2.1)
+  libopenmpi-dev openmpi-bin   # distributed database sweep
+  python3-matplotlib python3-h5py python3-numpy   # figures (Debian's /usr/bin/python3)
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "setup: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: need root to install: ${missing[*]}" >&2; exit 1; }
+  SUDO=sudo
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "setup: done"

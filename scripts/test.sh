@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The whole test suite: install what is missing, build (Release), run every CTest test, then
+# build the unit tests under AddressSanitizer + UndefinedBehaviorSanitizer and run them.
+# This is the README's second command and what CI runs (.ci/run).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/scripts/setup.sh"
+jobs="$(nproc)"
+
+echo "== build (Release) =="
+"$root/scripts/build.sh" "$root/build"
+echo "== tests (Release) =="
+(cd "$root/build" && ctest --output-on-failure --parallel "$jobs")
+
+echo "== unit tests under ASan + UBSan =="
+san="$root/build-sanitize"
+gen=()
+command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
+cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKNIT_SANITIZE=ON >/dev/null
+cmake --build "$san" --parallel "$jobs"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+(cd "$san" && ctest --output-on-failure --parallel "$jobs")
