@@ -1,0 +1,56 @@
+// The material interface of the shell: plane-stress 2nd Piola-Kirchhoff stress S and tangent
+// C = dS/dE at one through-thickness point, in the local Cartesian frame (e1, e2) of the
+// reference mid-surface (e1 = å1/|å1|, paper Sect. 2.2.1 step 2).
+//
+// Voigt notation (paper eq. 16 and A.9): E = (E11, E22, 2E12), S = (S11, S22, S12),
+// C (3x3) = dS/dE in that notation (eq. 18 form). Units: S and C in MPa.
+//
+// The shell integrates through the thickness with 3 Gauss points (paper eq. 14) by calling
+// evaluate() at each; a material may also offer an analytic thickness integration (the
+// St. Venant-Kirchhoff one does, to check the numerical path).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace knit::macro {
+
+/// Where a material is evaluated: the in-plane parametric point (theta1, theta2) in the
+/// shell's parameter domain, the index of that point among the points passed to
+/// bind_points() (or -1 for a point that was not bound, e.g. an output sample), and the
+/// through-thickness coordinate z (mm).
+struct MaterialPoint {
+  Eigen::Vector2d theta = Eigen::Vector2d::Zero();
+  int point_id = -1;
+  double z = 0.0;
+};
+
+struct MaterialResponse {
+  Eigen::Vector3d S = Eigen::Vector3d::Zero();  ///< (S11, S22, S12) in MPa
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();  ///< dS/dE, MPa
+};
+
+class Material {
+ public:
+  virtual ~Material() = default;
+  virtual std::string name() const = 0;
+
+  /// Called once before an analysis with the parametric coordinates of all in-plane
+  /// quadrature points, so a graded material can precompute per-point data (its design
+  /// fields, interpolated response surfaces). point_id in MaterialPoint indexes this list.
+  virtual void bind_points(const std::vector<Eigen::Vector2d>& theta) {}
+
+  /// S and C at strain E (Voigt, local Cartesian frame). Must be thread-safe (const):
+  /// assembly may run on several threads.
+  virtual MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const = 0;
+
+  /// True if the material provides the analytic thickness integration below.
+  virtual bool has_analytic_thickness_integration() const { return false; }
+  /// Analytic resultants for a linear material: n = A eps + B kappa, m = B eps + D kappa.
+  /// Only called when has_analytic_thickness_integration() is true.
+  virtual void thickness_matrices(double thickness, const MaterialPoint& where, Eigen::Matrix3d& A,
+                                  Eigen::Matrix3d& B, Eigen::Matrix3d& D) const {}
+};
+
+}  // namespace knit::macro
