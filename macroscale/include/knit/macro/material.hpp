@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace knit::macro {
@@ -51,6 +52,18 @@ class Material {
   /// Only called when has_analytic_thickness_integration() is true.
   virtual void thickness_matrices(double thickness, const MaterialPoint& where, Eigen::Matrix3d& A,
                                   Eigen::Matrix3d& B, Eigen::Matrix3d& D) const {}
+
+  /// Extra named scalar fields the material adds to the outputs at a sample point with
+  /// mid-surface strain E (local Cartesian Voigt), e.g. the design fields (stitch length,
+  /// knitting angle) and the strains in the material (course/wale) frame. Empty by default.
+  virtual std::vector<std::pair<std::string, double>> output_fields(const Eigen::Vector2d& theta,
+                                                                    const Eigen::Vector3d& E) const {
+    return {};
+  }
+
+  /// A human-readable summary for the end of a run (e.g. how often and where a response
+  /// surface was extrapolated). Empty by default.
+  virtual std::string report() const { return {}; }
 };
 
 }  // namespace knit::macro
