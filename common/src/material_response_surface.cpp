@@ -32,6 +32,45 @@ void check_knots(const std::vector<double>& U, int p, int n, const std::string& 
     throw std::invalid_argument("response surface: " + what + ": the domain must be [0, 1]");
 }
 
+/// Values N[0..p] and first derivatives D[0..p] of the non-zero B-splines at u (clamped to
+/// the domain), via A2.2 at degrees p-1 and p and N'_{i,p} = p (N_{i,p-1}/(u_{i+p}-u_i) -
+/// N_{i+1,p-1}/(u_{i+p+1}-u_{i+1})) (The NURBS Book eq. 2.9). Returns the first index.
+inline int basis_d1(const spline::BSplineBasis& b, double u, double* N, double* D) {
+  const int p = b.degree();
+  const double* U = b.knots().data();
+  const int span = b.find_span(u);
+  // Algorithm A2.2 (BasisFuns) up to degree p-1, kept, then its last step to degree p.
+  double left[spline::kMaxDegree + 1], right[spline::kMaxDegree + 1];
+  double Nm[spline::kMaxDegree + 2];
+  N[0] = 1.0;
+  for (int j = 1; j <= p; ++j) {
+    if (j == p)
+      for (int r = 0; r < p; ++r) Nm[r] = N[r];
+    left[j] = u - U[span + 1 - j];
+    right[j] = U[span + j] - u;
+    double saved = 0.0;
+    for (int r = 0; r < j; ++r) {
+      const double temp = N[r] / (right[r + 1] + left[j - r]);
+      N[r] = saved + right[r + 1] * temp;
+      saved = left[j - r] * temp;
+    }
+    N[j] = saved;
+  }
+  if (p == 0) {
+    D[0] = 0.0;
+    return span;
+  }
+  // Nm[r] = N_{span-p+1+r, p-1}, r = 0..p-1; N_{span-p, p-1} = N_{span+1, p-1} = 0.
+  for (int r = 0; r <= p; ++r) {
+    const int i = span - p + r;
+    double d = 0.0;
+    if (r >= 1) d += Nm[r - 1] / (U[i + p] - U[i]);
+    if (r <= p - 1) d -= Nm[r] / (U[i + p + 1] - U[i + 1]);
+    D[r] = p * d;
+  }
+  return span - p;
+}
+
 }  // namespace
 
 void validate(const ResponseSurfaceData& d) {
@@ -88,6 +127,14 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
   for (int a = 0; a < n; ++a)
     P_[a] << data_.E_ctrl(a, 0), data_.E_ctrl(a, 1), data_.S_ctrl(a, 0), data_.S_ctrl(a, 1);
   E12_max_ = data_.E12_ctrl(data_.E12_ctrl.size() - 1);
+  {
+    // E12(u) = u * E12_max exactly when the E12 control values sit at the Greville abscissae
+    // (linear precision of B-splines): then no Newton is needed for the shear curve.
+    const auto g = bs_.greville();
+    shear_linear_ = true;
+    for (std::size_t k = 0; k < g.size(); ++k)
+      if (std::abs(data_.E12_ctrl(k) - g[k] * E12_max_) > 1e-14 * E12_max_) shear_linear_ = false;
+  }
 
   // Initial-guess table along the outer edge xi2 = 1; the fan must turn counter-clockwise.
   const int m = 8 * (data_.n1() - 1) + 1;
@@ -152,23 +199,22 @@ void ResponseSurface::eval4(const Eigen::Vector2d& xi, Eigen::Matrix4d& V) const
   const int p1 = data_.degree1, p2 = data_.degree2, n1 = data_.n1();
   const double c1 = std::clamp(xi(0), 0.0, 1.0), c2 = std::clamp(xi(1), 0.0, 1.0);
   const double d1 = xi(0) - c1, d2 = xi(1) - c2;
-  double buf1[2 * (spline::kMaxDegree + 1)], buf2[2 * (spline::kMaxDegree + 1)];
-  Eigen::Map<Eigen::MatrixXd> N(buf1, 2, p1 + 1), M(buf2, 2, p2 + 1);
-  const int i0 = b1_.eval(c1, 1, N);
-  const int j0 = b2_.eval(c2, 1, M);
+  double N0[spline::kMaxDegree + 1], N1[spline::kMaxDegree + 1];
+  double M0[spline::kMaxDegree + 1], M1[spline::kMaxDegree + 1];
+  const int i0 = basis_d1(b1_, c1, N0, N1);
+  const int j0 = basis_d1(b2_, c2, M0, M1);
   Eigen::Vector4d V0 = Eigen::Vector4d::Zero(), V1 = V0, V2 = V0, V12 = V0;
   for (int b = 0; b <= p2; ++b) {
     Eigen::Vector4d r0 = Eigen::Vector4d::Zero(), r1 = r0;
-    const int base = (j0 + b) * n1 + i0;
+    const Eigen::Vector4d* P = &P_[(j0 + b) * n1 + i0];
     for (int a = 0; a <= p1; ++a) {
-      const Eigen::Vector4d& P = P_[base + a];
-      r0 += N(0, a) * P;
-      r1 += N(1, a) * P;
+      r0 += N0[a] * P[a];
+      r1 += N1[a] * P[a];
     }
-    V0 += M(0, b) * r0;
-    V1 += M(0, b) * r1;
-    V2 += M(1, b) * r0;
-    V12 += M(1, b) * r1;
+    V0 += M0[b] * r0;
+    V1 += M0[b] * r1;
+    V2 += M1[b] * r0;
+    V12 += M1[b] * r1;
   }
   V.col(0) = V0 + V1 * d1 + V2 * d2 + V12 * (d1 * d2);
   V.col(1) = V1 + V12 * d2;
@@ -197,16 +243,15 @@ void ResponseSurface::shear(double E12, double& S12, double& dS, std::uint8_t& f
   const double sign = E12 < 0.0 ? -1.0 : 1.0;
   const double x = std::abs(E12);
   const int p = data_.shear_degree;
-  double buf[2 * (spline::kMaxDegree + 1)];
-  Eigen::Map<Eigen::MatrixXd> N(buf, 2, p + 1);
   auto curve = [&](double u, Eigen::Vector2d& c, Eigen::Vector2d& dc) {
-    const int i0 = bs_.eval(u, 1, N);
+    double N0[spline::kMaxDegree + 1], N1[spline::kMaxDegree + 1];
+    const int i0 = basis_d1(bs_, u, N0, N1);
     c.setZero();
     dc.setZero();
     for (int a = 0; a <= p; ++a) {
       const Eigen::Vector2d P(data_.E12_ctrl(i0 + a), data_.S12_ctrl(i0 + a));
-      c += N(0, a) * P;
-      dc += N(1, a) * P;
+      c += N0[a] * P;
+      dc += N1[a] * P;
     }
   };
   Eigen::Vector2d c, dc;
@@ -218,7 +263,7 @@ void ResponseSurface::shear(double E12, double& S12, double& dS, std::uint8_t& f
     return;
   }
   double u = x / E12_max_;
-  for (int it = 0; it < kMaxIterations; ++it) {
+  for (int it = 0; it < kMaxIterations && !shear_linear_; ++it) {
     curve(u, c, dc);
     const double r = c(0) - x;
     if (std::abs(r) <= kTolAbs + kTolRel * x) break;

@@ -139,12 +139,15 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   bound_.reserve(theta.size());
   for (const auto& t : theta) {
     const double l = stitch_value(t);
-    bound_.push_back({surface_at(l).get(), l, knitting_angle(t)});
+    const double a = knitting_angle(t);
+    bound_.push_back({surface_at(l).get(), l, a, knit_T_E(a), knit_T_S(-a)});
   }
 }
 
 MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const ResponseSurface& rs,
-                                           double alpha, const Eigen::Vector2d& theta) const {
+                                           double alpha, const Eigen::Matrix3d& TE,
+                                           const Eigen::Matrix3d& TSinv,
+                                           const Eigen::Vector2d& theta) const {
   MaterialResponse out;
   evaluations_.fetch_add(1, std::memory_order_relaxed);
   if (alpha == 0.0) {
@@ -159,8 +162,7 @@ MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const Respo
     }
     return out;
   }
-  const Eigen::Matrix3d TE = knit_T_E(alpha);      // = T^-T   (eq. 21)
-  const Eigen::Matrix3d TSinv = knit_T_S(-alpha);  // = T^-1   (eq. 22)
+  // TE = T_E(alpha) = T^-T (eq. 21), TSinv = T_S(-alpha) = T^-1 (eq. 22).
   const Eigen::Vector3d Ehat = TE * E;
   const auto ev = rs.evaluate(Ehat);
   out.S = TSinv * ev.S;
@@ -178,10 +180,11 @@ MaterialResponse KnitMaterial::evaluate(const Eigen::Vector3d& E,
                                         const MaterialPoint& where) const {
   if (where.point_id >= 0 && where.point_id < static_cast<int>(bound_.size())) {
     const Bound& b = bound_[where.point_id];
-    return evaluate_at(E, *b.rs, b.alpha, where.theta);
+    return evaluate_at(E, *b.rs, b.alpha, b.TE, b.TSinv, where.theta);
   }
   const auto rs = surface_at(stitch_value(where.theta));
-  return evaluate_at(E, *rs, knitting_angle(where.theta), where.theta);
+  const double a = knitting_angle(where.theta);
+  return evaluate_at(E, *rs, a, knit_T_E(a), knit_T_S(-a), where.theta);
 }
 
 std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(

@@ -117,6 +117,7 @@ class ResponseSurface {
   std::vector<double> table_xi_, phi_, radius_;  ///< initial-guess table along xi1 at xi2 = 1
   Eigen::Matrix3d C0_ = Eigen::Matrix3d::Zero();
   double E12_max_ = 0.0;
+  bool shear_linear_ = false;
 };
 
 }  // namespace knit::material

@@ -108,10 +108,12 @@ class KnitMaterial : public Material {
   struct Bound {
     const material::ResponseSurface* rs;
     double l, alpha;
+    Eigen::Matrix3d TE, TSinv;  ///< T_E(alpha) = T^-T and T_S(-alpha) = T^-1, precomputed
   };
   std::shared_ptr<const material::ResponseSurface> surface_at(double l) const;
   MaterialResponse evaluate_at(const Eigen::Vector3d& E, const material::ResponseSurface& rs,
-                               double alpha, const Eigen::Vector2d& theta) const;
+                               double alpha, const Eigen::Matrix3d& TE,
+                               const Eigen::Matrix3d& TSinv, const Eigen::Vector2d& theta) const;
 
   std::shared_ptr<const material::LoopLengthFamily> family_;
   spline::SplineSurface l_field_, a_field_;
