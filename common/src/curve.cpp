@@ -29,6 +29,12 @@ SplineCurve::SplineCurve(BSplineBasis basis, Eigen::MatrixXd P, Eigen::VectorXd 
 }
 
 int SplineCurve::basis_derivatives(double u, int nder, Eigen::Ref<Eigen::MatrixXd> R) const {
+  // Cheap guards: the rational quotient rule uses stack buffers of kMaxDerivative + 1 entries.
+  if (nder < 0 || (rational_ && nder > kMaxDerivative))
+    throw std::invalid_argument("curve: derivative order " + std::to_string(nder) + " outside 0.." +
+                                std::to_string(kMaxDerivative));
+  if (R.rows() != nder + 1 || R.cols() != degree() + 1)
+    throw std::invalid_argument("curve: basis_derivatives needs a (nder+1) x (p+1) matrix");
   const int first = basis_.eval(u, nder, R);
   if (rational_) rationalize_1d(w_.data() + first, R);
   return first;

@@ -1,6 +1,5 @@
 #include "knit/spline/surface.hpp"
 
-#include <cassert>
 #include <stdexcept>
 
 #include "knit/spline/basis.hpp"
@@ -31,7 +30,9 @@ SplineSurface::SplineSurface(BSplineBasis bu, BSplineBasis bv, Eigen::MatrixXd P
 }
 
 void SplineSurface::basis(double u, double v, int nder, SurfaceBasis& out) const {
-  assert(nder >= 0 && nder <= 2);
+  if (nder < 0 || nder > 2)
+    throw std::invalid_argument("surface: derivative order " + std::to_string(nder) +
+                                " outside 0..2");
   const int pu = bu_.degree(), pv = bv_.degree();
   const int nloc = (pu + 1) * (pv + 1);
   if (out.R.cols() != nloc) out.R.resize(6, nloc);

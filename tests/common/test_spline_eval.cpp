@@ -174,3 +174,18 @@ TEST_CASE("evaluation exactly at both ends of the domain", "[unit][spline][eval]
   const Eigen::RowVectorXd fdu = (s.eval(5.0, 1.0) - s.eval(5.0 - h, 1.0)).transpose() / h;
   CHECK((d.row(1) - fdu).norm() < 1e-4 * (1.0 + d.row(1).norm()));
 }
+
+TEST_CASE("derivative orders outside the supported range are rejected", "[unit][spline][eval]") {
+  const BSplineBasis b(2, uniform_knots(2, 2));
+  const SplineCurve c(b, Eigen::MatrixXd::Zero(b.size(), 2), Eigen::VectorXd::Ones(b.size()));
+  CHECK_THROWS_AS(c.derivatives(0.5, kMaxDerivative + 1), std::invalid_argument);
+  CHECK_THROWS_AS(c.derivatives(0.5, -1), std::invalid_argument);
+  Eigen::MatrixXd R(2, 2);
+  CHECK_THROWS_AS(c.basis_derivatives(0.5, 1, R), std::invalid_argument);
+  // Non-rational curves have no such limit: derivatives above p vanish.
+  const SplineCurve nr(b, Eigen::MatrixXd::Ones(b.size(), 1));
+  CHECK(nr.derivatives(0.3, 6).bottomRows(4).norm() == 0.0);
+  const SplineSurface s(b, b, Eigen::MatrixXd::Zero(b.size() * b.size(), 1));
+  SurfaceBasis sb;
+  CHECK_THROWS_AS(s.basis(0.5, 0.5, 3, sb), std::invalid_argument);
+}
