@@ -17,7 +17,9 @@ namespace {
 using io::H5File;
 using io::H5Group;
 
-std::string loop_group(std::size_t k) { return "/loop_" + std::to_string(k); }
+std::string loop_group(std::size_t k) {
+  return "/loop_" + std::to_string(k);
+}
 std::string path_group(std::size_t q) {
   std::ostringstream os;
   os << "path_" << (q < 10 ? "0" : "") << q;
@@ -168,14 +170,14 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
   std::string where;  // HDF5 path being read, for messages
   try {
     if (!std::filesystem::exists(file)) throw InputError(fname, "", "file not found");
-    if (!io::is_hdf5_file(file))
-      throw InputError(fname, "", "not an HDF5 file (or truncated)");
+    if (!io::is_hdf5_file(file)) throw InputError(fname, "", "not an HDF5 file (or truncated)");
     const H5File f = H5File::open_read(file);
     Database db;
     where = "/";
     if (!f.has_attribute(".", "format") || f.attribute_string(".", "format") != kDatabaseFormatName)
-      throw InputError(fname, "/", std::string("not a material database (attribute format != \"") +
-                                       kDatabaseFormatName + "\")");
+      throw InputError(fname, "/",
+                       std::string("not a material database (attribute format != \"") +
+                           kDatabaseFormatName + "\")");
     db.format_version = f.attribute_int(".", "format_version");
     if (db.format_version != kDatabaseFormatVersion)
       throw InputError(fname, "/",
@@ -205,8 +207,9 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       LoopLengthEntry e;
       e.loop_length = f.attribute_double(g, "loop_length");
       if (e.loop_length != ls[k])
-        throw InputError(fname, g, "loop_length " + std::to_string(e.loop_length) +
-                                       " differs from /loop_lengths[" + std::to_string(k) + "]");
+        throw InputError(fname, g,
+                         "loop_length " + std::to_string(e.loop_length) +
+                             " differs from /loop_lengths[" + std::to_string(k) + "]");
       e.cell.wale_width = f.attribute_double(g, "wale_width");
       e.cell.course_height = f.attribute_double(g, "course_height");
       e.cell.thickness = f.attribute_double(g, "thickness");
@@ -218,8 +221,8 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           where = p;
           require_group(p);
           RawPath r;
-          r.path.kind = f.attribute_string(p, "kind") == "shear" ? PathKind::kShear
-                                                                  : PathKind::kBiaxial;
+          r.path.kind =
+              f.attribute_string(p, "kind") == "shear" ? PathKind::kShear : PathKind::kBiaxial;
           const auto t = f.attribute_doubles(p, "target");
           if (t.size() != 2) throw InputError(fname, p, "attribute target must have 2 values");
           r.path.target = {t[0], t[1]};

@@ -9,28 +9,12 @@
 #include <stdexcept>
 
 #include "knit/core/errors.hpp"
+#include "knit/mechanics/voigt.hpp"
+#include "knit/spline/fit.hpp"
 
 namespace knit::macro {
 
 using material::ResponseSurface;
-
-Eigen::Matrix3d knit_T_S(double alpha) {
-  const double c = std::cos(alpha), s = std::sin(alpha);
-  Eigen::Matrix3d T;
-  T << c * c, s * s, 2 * c * s,  //
-      s * s, c * c, -2 * c * s,  //
-      -c * s, c * s, c * c - s * s;
-  return T;
-}
-
-Eigen::Matrix3d knit_T_E(double alpha) {
-  const double c = std::cos(alpha), s = std::sin(alpha);
-  Eigen::Matrix3d T;
-  T << c * c, s * s, c * s,  //
-      s * s, c * c, -c * s,  //
-      -2 * c * s, 2 * c * s, c * c - s * s;
-  return T;
-}
 
 ScalarFieldSpec ScalarFieldSpec::constant(double value, double u0, double u1, double v0,
                                           double v1) {
@@ -82,15 +66,11 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
       while (ang - ref < -std::numbers::pi) ang += 2 * std::numbers::pi;
       A(i, j) = ang;
     }
-  // Tensor-product interpolation: alpha = Bu X Bv^T at the Greville points.
-  Eigen::MatrixXd Bu(nu, nu), Bv(nv, nv);
-  for (int i = 0; i < nu; ++i) Bu.row(i) = bu.eval_all(gu[i]).transpose();
-  for (int j = 0; j < nv; ++j) Bv.row(j) = bv.eval_all(gv[j]).transpose();
-  const Eigen::MatrixXd X =
-      Bv.partialPivLu().solve(Bu.partialPivLu().solve(A).transpose()).transpose();
-  Eigen::MatrixXd P(nu * nv, 1);
+  // Tensor-product interpolation at the Greville points (values a = i + nu*j).
+  Eigen::MatrixXd values(nu * nv, 1);
   for (int j = 0; j < nv; ++j)
-    for (int i = 0; i < nu; ++i) P(i + nu * j, 0) = X(i, j);
+    for (int i = 0; i < nu; ++i) values(i + nu * j, 0) = A(i, j);
+  const Eigen::MatrixXd P = spline::interpolate_at_greville(bu, bv, values);
   return spline::SplineSurface(bu, bv, P);
 }
 
@@ -140,7 +120,7 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   for (const auto& t : theta) {
     const double l = stitch_value(t);
     const double a = knitting_angle(t);
-    bound_.push_back({surface_at(l).get(), l, a, knit_T_E(a), knit_T_S(-a)});
+    bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a)});
   }
 }
 
@@ -184,13 +164,13 @@ MaterialResponse KnitMaterial::evaluate(const Eigen::Vector3d& E,
   }
   const auto rs = surface_at(stitch_value(where.theta));
   const double a = knitting_angle(where.theta);
-  return evaluate_at(E, *rs, a, knit_T_E(a), knit_T_S(-a), where.theta);
+  return evaluate_at(E, *rs, a, mech::T_E(a), mech::T_S_inv(a), where.theta);
 }
 
 std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(
     const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const {
   const double alpha = knitting_angle(theta);
-  const Eigen::Vector3d Ehat = knit_T_E(alpha) * E;
+  const Eigen::Vector3d Ehat = mech::T_E(alpha) * E;
   return {{"stitch_value", stitch_value(theta)},
           {"knitting_angle", alpha},
           {"E_course", Ehat(0)},

@@ -29,7 +29,9 @@ static knit::cli::SubcommandRegistrar reg_fit(
         using namespace knit::meso::fit;
         auto db = knit::material::read_database(o->db, true);
         const FitOptions fo =
-            o->options.empty() ? FitOptions{} : FitOptions::from_json(knit::meso::fit::read_text_file(o->options), o->options);
+            o->options.empty()
+                ? FitOptions{}
+                : FitOptions::from_json(knit::meso::fit::read_text_file(o->options), o->options);
         const auto fits = fit_database(db, fo);
         std::cout << "knit-meso fit: " << o->db << " (" << fits.size() << " loop lengths)\n";
         knit::meso::fit::print_fit_summaries(std::cout, db, fits);

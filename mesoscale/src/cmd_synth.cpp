@@ -43,15 +43,18 @@ static knit::cli::SubcommandRegistrar reg_synth(
         SyntheticOptions so;
         so.loop_lengths = o->loop_lengths;
         for (std::size_t k = 0; k < so.loop_lengths.size(); ++k)
-          if (!(so.loop_lengths[k] > 0.0) || (k > 0 && !(so.loop_lengths[k] > so.loop_lengths[k - 1])))
+          if (!(so.loop_lengths[k] > 0.0) ||
+              (k > 0 && !(so.loop_lengths[k] > so.loop_lengths[k - 1])))
             throw knit::InputError("", "--loop-lengths", "must be positive and increasing");
         so.paths = knit::material::default_load_paths(o->steps);
         auto db = synthetic_database(so);
         int rc = knit::kExitOk;
         if (!o->no_fit) {
-          const FitOptions fo = o->fit_options.empty()
-                                    ? FitOptions{}
-                                    : FitOptions::from_json(knit::meso::fit::read_text_file(o->fit_options), o->fit_options);
+          const FitOptions fo =
+              o->fit_options.empty()
+                  ? FitOptions{}
+                  : FitOptions::from_json(knit::meso::fit::read_text_file(o->fit_options),
+                                          o->fit_options);
           const auto fits = fit_database(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);

@@ -16,9 +16,9 @@ void print_fit_summaries(std::ostream& os, const material::Database& db,
       continue;
     }
     const auto& d = f.diagnostics;
-    os << "max |S error| S1 " << d.max(2) << ", S2 " << d.max(3) << ", S12 " << d.max(4)
-       << " MPa (" << 100 * d.max_relative << " % of the stress range); rms S1 " << d.rms(2)
-       << ", S2 " << d.rms(3) << ", S12 " << d.rms(4) << " MPa\n";
+    os << "max |S error| S1 " << d.max(2) << ", S2 " << d.max(3) << ", S12 " << d.max(4) << " MPa ("
+       << 100 * d.max_relative << " % of the stress range); rms S1 " << d.rms(2) << ", S2 "
+       << d.rms(3) << ", S12 " << d.rms(4) << " MPa\n";
   }
 }
 

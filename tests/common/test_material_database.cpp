@@ -113,8 +113,9 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
       auto f = knit::io::H5File::open_rw(bad);
       f.set_attribute(".", "format_version", 2);
     }
-    CHECK_THROWS_WITH(read_database(bad),
-                      Catch::Contains("format_version 2 is not supported (this build reads version 1)"));
+    CHECK_THROWS_WITH(
+        read_database(bad),
+        Catch::Contains("format_version 2 is not supported (this build reads version 1)"));
   }
   SECTION("missing group") {
     const auto bad = tmp("nogroup.h5");

@@ -7,6 +7,7 @@
 #include "../common/test_material_util.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/knit_material.hpp"
+#include "knit/mechanics/voigt.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;
@@ -84,10 +85,11 @@ TEST_CASE("knit material: rotating the frame together with alpha changes nothing
   const KnitMaterial m = graded(alpha), mr = graded(alpha - beta);
   const Eigen::Vector3d E(0.15, -0.03, 0.08);
   const auto r = m.evaluate(E, at(0.3, 0.2));
-  const auto rr = mr.evaluate(knit_T_E(beta) * E, at(0.3, 0.2));
-  CHECK((rr.S - knit_T_S(beta) * r.S).norm() < 1e-12);
-  CHECK((rr.C - knit_T_S(beta) * r.C * knit_T_E(beta).inverse()).norm() < 1e-10);
-  CHECK((knit_T_S(0.3) * knit_T_E(0.3).transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-15);
+  const auto rr = mr.evaluate(knit::mech::T_E(beta) * E, at(0.3, 0.2));
+  CHECK((rr.S - knit::mech::T_S(beta) * r.S).norm() < 1e-12);
+  CHECK((rr.C - knit::mech::T_S(beta) * r.C * knit::mech::T_E(beta).inverse()).norm() < 1e-10);
+  CHECK((knit::mech::T_S(0.3) * knit::mech::T_E(0.3).transpose() - Eigen::Matrix3d::Identity())
+            .norm() < 1e-15);
 }
 
 TEST_CASE("knit material: bound points interpolate l; fitted loop lengths are exact", "[unit]") {

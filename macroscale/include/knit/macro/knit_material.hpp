@@ -59,9 +59,6 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
                                         std::vector<double> knots_u, int degree_v,
                                         std::vector<double> knots_v, const Eigen::Vector3d& v);
 
-/// Voigt rotations of paper eq. (20) and Appendix A (private until knit/mechanics/voigt.hpp).
-Eigen::Matrix3d knit_T_S(double alpha);
-Eigen::Matrix3d knit_T_E(double alpha);
 
 /// Where the fields came from, for error messages (case file and JSON pointers).
 struct KnitMaterialSource {
