@@ -2,6 +2,7 @@
 // Target (issue #4): >= 1e6 evaluations of S and C per second per core.
 #include <catch2/catch.hpp>
 #include <cstdio>
+#include <chrono>
 #include <ctime>
 #include <random>
 
@@ -41,3 +42,43 @@ TEST_CASE("bench: response-surface evaluations per second", "[.bench]") {
       n / dt, static_cast<double>(iters) / n, sink);
   CHECK(n / dt > 0);
 }
+
+#if __has_include("knit/io/hdf5.hpp")
+#include <filesystem>
+
+#include "knit/material/database.hpp"
+
+TEST_CASE("bench: loading the material database", "[.bench]") {
+  // A database of the default size: 5 loop lengths x 13 paths x 20 steps, 11 x 11 surfaces.
+  Database db;
+  db.provenance = current_provenance();
+  for (double l : {4.5, 5.0, 5.5, 6.0, 6.5}) {
+    LoopLengthEntry e;
+    e.loop_length = l;
+    for (const auto& p : default_load_paths()) {
+      RawPath r;
+      r.path = p;
+      r.F = RowMatrixX::Random(20, 4);
+      r.P = RowMatrixX::Random(20, 4);
+      r.E = RowMatrixX::Random(20, 3);
+      r.S = RowMatrixX::Random(20, 3);
+      r.status.assign(20, 0);
+      e.raw.push_back(r);
+    }
+    e.surface = testing::make_test_surface(4.5 / l);
+    db.entries.push_back(e);
+  }
+  const auto file = std::filesystem::path(KNIT_BINARY_DIR) / "bench_database.h5";
+  write_database(file, db);
+  for (bool raw : {false, true}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto fam = read_database(file, raw).family();
+    const ResponseSurface rs(fam.at(5.25));
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("database load%s + family + one evaluator: %.1f ms (target <= 50 ms)\n",
+                raw ? " (with raw data)" : "", ms);
+    CHECK(rs.data().n1() == 11);
+  }
+}
+#endif
