@@ -59,7 +59,6 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
                                         std::vector<double> knots_u, int degree_v,
                                         std::vector<double> knots_v, const Eigen::Vector3d& v);
 
-
 /// Where the fields came from, for error messages (case file and JSON pointers).
 struct KnitMaterialSource {
   std::string file, stitch_pointer = "/material/stitch_value",
@@ -125,3 +124,14 @@ class KnitMaterial : public Material {
 };
 
 }  // namespace knit::macro
+
+#if __has_include("knit/macro/material_factory.hpp")
+#include "knit/macro/material_factory.hpp"
+namespace knit::macro {
+/// The "knit" branch of the case's material factory (knit_material_factory.cpp): reads the
+/// database and the stitch-value and knitting-angle fields; throws knit::InputError with
+/// JSON pointers below ctx.pointer.
+std::unique_ptr<Material> make_knit_material(const nlohmann::json& material,
+                                             const CaseContext& ctx);
+}  // namespace knit::macro
+#endif

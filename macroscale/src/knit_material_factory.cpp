@@ -1,0 +1,187 @@
+// Case input of the knit material (the "knit" branch of the material factory):
+//
+//   "material": {
+//     "type": "knit",
+//     "database": "db.h5",                        // relative to the case file's directory
+//     "stitch_value": 5.5 | {field},              // l(theta1, theta2), mm
+//     "knitting_angle": 0.0 | {field} | {"align_with": [vx, vy, vz], "degrees": [pu, pv],
+//                                         "knots_u": [...], "knots_v": [...]}
+//   }
+//   {field} = {"degrees": [pu, pv], "knots_u": [...], "knots_v": [...], "values": [...],
+//              "unit": "rad" | "deg" (knitting angle only)}
+// Control values run with the u index fastest; repeated knots give discontinuous grading.
+// A field's domain must equal the patch's parameter domain. A stitch value outside the
+// database's loop lengths is an error naming the field and the range.
+#if __has_include("knit/macro/material_factory.hpp")
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/macro/knit_material.hpp"
+#include "knit/macro/material_factory.hpp"
+#include "knit/material/database.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+std::vector<double> number_array(const nlohmann::json& j, const std::string& p,
+                                 const CaseContext& ctx) {
+  if (!j.is_array()) throw InputError(ctx.file, p, "must be an array of numbers");
+  std::vector<double> v;
+  for (std::size_t k = 0; k < j.size(); ++k) {
+    if (!j[k].is_number())
+      throw InputError(ctx.file, p + "/" + std::to_string(k), "must be a number");
+    v.push_back(j[k].get<double>());
+  }
+  return v;
+}
+
+void check_keys(const nlohmann::json& j, const std::string& p, const CaseContext& ctx,
+                const std::vector<std::string>& allowed) {
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw InputError(ctx.file, p + "/" + it.key(), "unknown key (allowed: " + list + ")");
+    }
+}
+
+struct Basis2 {
+  int pu = 0, pv = 0;
+  std::vector<double> U, V;
+};
+
+Basis2 read_basis(const nlohmann::json& j, const std::string& p, const CaseContext& ctx) {
+  Basis2 b;
+  for (const char* k : {"degrees", "knots_u", "knots_v"})
+    if (!j.contains(k))
+      throw InputError(ctx.file, p, std::string("missing required key \"") + k + "\"");
+  const auto d = number_array(j.at("degrees"), p + "/degrees", ctx);
+  if (d.size() != 2 || d[0] < 0 || d[1] < 0 || d[0] != std::floor(d[0]) || d[1] != std::floor(d[1]))
+    throw InputError(ctx.file, p + "/degrees", "must be two non-negative integers");
+  b.pu = static_cast<int>(d[0]);
+  b.pv = static_cast<int>(d[1]);
+  b.U = number_array(j.at("knots_u"), p + "/knots_u", ctx);
+  b.V = number_array(j.at("knots_v"), p + "/knots_v", ctx);
+  for (int dir = 0; dir < 2; ++dir) {
+    const std::string kp = p + (dir == 0 ? "/knots_u" : "/knots_v");
+    try {
+      const spline::BSplineBasis basis(dir == 0 ? b.pu : b.pv, dir == 0 ? b.U : b.V);
+      const auto& pb = dir == 0 ? ctx.patch->basis_u() : ctx.patch->basis_v();
+      if (std::abs(basis.lo() - pb.lo()) > 1e-12 || std::abs(basis.hi() - pb.hi()) > 1e-12)
+        throw InputError(ctx.file, kp,
+                         "the field's domain [" + std::to_string(basis.lo()) + ", " +
+                             std::to_string(basis.hi()) + "] differs from the patch's [" +
+                             std::to_string(pb.lo()) + ", " + std::to_string(pb.hi()) + "]");
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw InputError(ctx.file, kp, e.what());
+    }
+  }
+  return b;
+}
+
+spline::SplineSurface read_field(const nlohmann::json& j, const std::string& p,
+                                 const CaseContext& ctx, bool angle) {
+  const auto& pu = ctx.patch->basis_u();
+  const auto& pv = ctx.patch->basis_v();
+  double scale = 1.0;
+  if (j.is_number())
+    return make_scalar_field(
+        ScalarFieldSpec::constant(j.get<double>(), pu.lo(), pu.hi(), pv.lo(), pv.hi()));
+  if (!j.is_object()) throw InputError(ctx.file, p, "must be a number or a spline field object");
+  if (angle && j.contains("align_with")) {
+    check_keys(j, p, ctx, {"align_with", "degrees", "knots_u", "knots_v", "description"});
+    const auto v = number_array(j.at("align_with"), p + "/align_with", ctx);
+    if (v.size() != 3) throw InputError(ctx.file, p + "/align_with", "must have 3 components");
+    const Basis2 b = read_basis(j, p, ctx);
+    try {
+      return align_alpha_field(*ctx.patch, b.pu, b.U, b.pv, b.V, Eigen::Vector3d(v[0], v[1], v[2]));
+    } catch (const std::exception& e) {
+      throw InputError(ctx.file, p + "/align_with", e.what());
+    }
+  }
+  check_keys(
+      j, p, ctx,
+      angle ? std::vector<std::string>{"degrees", "knots_u", "knots_v", "values", "unit",
+                                       "description"}
+            : std::vector<std::string>{"degrees", "knots_u", "knots_v", "values", "description"});
+  if (angle && j.contains("unit")) {
+    const std::string u = j.at("unit").is_string() ? j.at("unit").get<std::string>() : "";
+    if (u == "deg")
+      scale = std::numbers::pi / 180.0;
+    else if (u != "rad")
+      throw InputError(ctx.file, p + "/unit", "must be \"rad\" or \"deg\"");
+  }
+  const Basis2 b = read_basis(j, p, ctx);
+  if (!j.contains("values")) throw InputError(ctx.file, p, "missing required key \"values\"");
+  ScalarFieldSpec s;
+  s.degree_u = b.pu;
+  s.degree_v = b.pv;
+  s.knots_u = b.U;
+  s.knots_v = b.V;
+  s.values = number_array(j.at("values"), p + "/values", ctx);
+  for (double& x : s.values) x *= scale;
+  try {
+    return make_scalar_field(s);
+  } catch (const std::exception& e) {
+    throw InputError(ctx.file, p + "/values", e.what());
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const CaseContext& ctx) {
+  const std::string& p = ctx.pointer;
+  check_keys(m, p, ctx, {"type", "database", "stitch_value", "knitting_angle", "description"});
+  for (const char* k : {"database", "stitch_value"})
+    if (!m.contains(k))
+      throw InputError(ctx.file, p, std::string("missing required key \"") + k + "\"");
+  if (!m.at("database").is_string())
+    throw InputError(ctx.file, p + "/database", "must be a file name");
+  if (!ctx.patch) throw InputError(ctx.file, p, "the knit material needs the patch");
+  std::filesystem::path db = m.at("database").get<std::string>();
+  if (db.is_relative() && !ctx.file.empty())
+    db = std::filesystem::path(ctx.file).parent_path() / db;
+  material::Database data;
+  try {
+    data = material::read_database(db, false);
+  } catch (const InputError& e) {
+    throw InputError(ctx.file, p + "/database", e.what());
+  }
+  std::shared_ptr<const material::LoopLengthFamily> family;
+  try {
+    family = std::make_shared<const material::LoopLengthFamily>(data.family());
+  } catch (const std::exception& e) {
+    throw InputError(ctx.file, p + "/database", db.string() + ": " + e.what());
+  }
+  const auto l = read_field(m.at("stitch_value"), p + "/stitch_value", ctx, false);
+  const auto a = m.contains("knitting_angle")
+                     ? read_field(m.at("knitting_angle"), p + "/knitting_angle", ctx, true)
+                     : read_field(nlohmann::json(0.0), p + "/knitting_angle", ctx, true);
+  KnitMaterialSource src;
+  src.file = ctx.file;
+  src.stitch_pointer = p + "/stitch_value";
+  src.angle_pointer = p + "/knitting_angle";
+  src.database = db.string();
+  if (m.at("stitch_value").is_number()) {
+    // A constant: name the value itself rather than a control value.
+    const double v = m.at("stitch_value").get<double>();
+    if (!family->contains(v)) {
+      std::ostringstream os;
+      os << v << " mm is outside the database's " << family->min() << "-" << family->max()
+         << " mm (" << db.string() << ")";
+      throw InputError(ctx.file, p + "/stitch_value", os.str());
+    }
+  }
+  return std::make_unique<KnitMaterial>(family, l, a, src);
+}
+
+}  // namespace knit::macro
+#endif
