@@ -1,6 +1,7 @@
 // Response-surface evaluation (paper eqs. 16-18): inversion, tangent, extrapolation, eq. 25.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <random>
 
 #include "knit/material/loop_length_family.hpp"
 #include "knit/material/response_surface.hpp"
@@ -118,4 +119,23 @@ TEST_CASE("loop-length family: reproduces each fitted loop length exactly (eq. 2
   CHECK(s > ResponseSurface(laws[2]).evaluate({0.2, 0.1, 0}).S(0));
   CHECK_THROWS_WITH(fam.weights(7.0), Catch::Contains("outside the database's range 4.5-6.5"));
   CHECK_THROWS_WITH(fam.weights(4.4), Catch::Contains("outside"));
+}
+
+TEST_CASE("response surface: inversion never fails in a large box, tangent consistent",
+          "[unit]") {
+  const ResponseSurface rs(make_test_surface());
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  int worst = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const Eigen::Vector3d E(u(gen), u(gen), u(gen));
+    const auto ev = rs.evaluate(E);
+    REQUIRE((ev.flags & kInversionFailed) == 0);
+    worst = std::max(worst, ev.iterations);
+    if (k % 30 == 0) {
+      const Eigen::Matrix3d Cfd = fd_tangent(rs, E);
+      CHECK((ev.C - Cfd).norm() <= 1e-5 * Cfd.norm());
+    }
+  }
+  CHECK(worst <= 8);
 }
