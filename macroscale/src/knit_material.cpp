@@ -124,6 +124,16 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   }
 }
 
+void KnitMaterial::record(const Eigen::Vector2d& theta, const Eigen::Vector3d& E_material,
+                          int flags) const {
+  std::lock_guard<std::mutex> lock(where_mutex_);
+  if (static_cast<int>(where_.size()) >= kMaxLocations) return;
+  // One entry per in-plane point (the 3 thickness points of a point share theta).
+  for (const auto& w : where_)
+    if (w.theta == theta && w.flags == flags) return;
+  where_.push_back({theta, E_material, flags});
+}
+
 MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const ResponseSurface& rs,
                                            double alpha, const Eigen::Matrix3d& TE,
                                            const Eigen::Matrix3d& TSinv,
@@ -137,8 +147,7 @@ MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const Respo
     if (ev.flags) {
       for (int k = 0; k < 5; ++k)
         if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
-      std::lock_guard<std::mutex> lock(where_mutex_);
-      if (static_cast<int>(where_.size()) < kMaxLocations) where_.push_back({theta, E, ev.flags});
+      record(theta, E, ev.flags);
     }
     return out;
   }
@@ -150,8 +159,7 @@ MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const Respo
   if (ev.flags) {
     for (int k = 0; k < 5; ++k)
       if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
-    std::lock_guard<std::mutex> lock(where_mutex_);
-    if (static_cast<int>(where_.size()) < kMaxLocations) where_.push_back({theta, Ehat, ev.flags});
+    record(theta, Ehat, ev.flags);
   }
   return out;
 }

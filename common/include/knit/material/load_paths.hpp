@@ -6,8 +6,10 @@
 //   * 12 proportional biaxial paths F* = diag(1 + eps11, 1 + eps22), eps scaled linearly with
 //     the step fraction t = k / n_steps (k = 1..n_steps). Their end points, given in
 //     Green-Lagrange strain E = (F^T F - I)/2, lie on the polyline
-//     (0.35, -0.15) -> (0.35, 0.35) -> (-0.15, 0.35), equally spaced by arc length, ordered
-//     counter-clockwise (increasing angle atan2(E22, E11)). This fan is the xi1 direction of
+//     (0.4, -0.15) -> (0.4, 0.4) -> (-0.15, 0.4), equally spaced by arc length, ordered
+//     counter-clockwise (increasing angle atan2(E22, E11)). e_max = 0.4 covers the paper's
+//     tensile tests (30 % applied strain gives E22 up to ~0.37, Sect. 3.1.2) without
+//     extrapolation. This fan is the xi1 direction of
 //     the response surface (eq. 17); the step fraction is xi2.
 //   * 1 pure-shear path F* = [[1, sin g], [0, cos g]] with g = t * gamma_max, gamma_max = 40 deg;
 //     there E11 = E22 = 0 and E12 = sin(g)/2 exactly. It feeds the S12(E12) curve.
@@ -31,7 +33,7 @@ struct LoadPath {
 };
 
 /// The 13 default paths (12 biaxial + 1 shear), `steps` increments each.
-std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = 0.35, double e_min = -0.15,
+std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = 0.40, double e_min = -0.15,
                                          double gamma_max = 0.6981317007977318 /*40 deg*/);
 
 /// Macroscopic deformation gradient F* (2x2) of path `path` at step fraction t in [0, 1].

@@ -107,6 +107,7 @@ class KnitMaterial : public Material {
     Eigen::Matrix3d TE, TSinv;  ///< T_E(alpha) = T^-T and T_S(-alpha) = T^-1, precomputed
   };
   std::shared_ptr<const material::ResponseSurface> surface_at(double l) const;
+  void record(const Eigen::Vector2d& theta, const Eigen::Vector3d& E_material, int flags) const;
   MaterialResponse evaluate_at(const Eigen::Vector3d& E, const material::ResponseSurface& rs,
                                double alpha, const Eigen::Matrix3d& TE,
                                const Eigen::Matrix3d& TSinv, const Eigen::Vector2d& theta) const;
