@@ -30,10 +30,9 @@
 #include <type_traits>
 #include <vector>
 
-namespace knit::io {
+#include "knit/io/matrix_types.hpp"
 
-using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-using RowMatrixXi = Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+namespace knit::io {
 
 /// Options for writing a dataset.
 struct H5WriteOptions {
