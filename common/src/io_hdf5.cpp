@@ -367,7 +367,8 @@ static std::vector<T> read_numeric(hid_t loc, const std::string& name, std::size
   if (std::is_same_v<T, int> && d.cls != H5T_INTEGER)
     fail(std::string("expected an integer dataset, found ") + class_name(d.cls));
   const std::size_t rank = d.dims.size();
-  if (!(rank == want_rank || (want_rank == 1 && rank == 0)))
+  constexpr std::size_t kAnyRank = static_cast<std::size_t>(-1);
+  if (want_rank != kAnyRank && !(rank == want_rank || (want_rank == 1 && rank == 0)))
     fail("expected a " + std::to_string(want_rank) + "-D dataset, found rank " +
          std::to_string(rank));
   dims_out = d.dims;
@@ -392,6 +393,15 @@ std::vector<int> H5Group::read_ints(const std::string& path) const {
   std::vector<std::size_t> dims;
   return read_numeric<int>(id_.get(), h5name(path), 1, dims,
                            [&](const std::string& w) { fail(path, w); });
+}
+
+H5Array H5Group::read_array(const std::string& path) const {
+  silence_hdf5();
+  if (!is_dataset(path)) fail(path, "dataset missing");
+  H5Array a;
+  a.data = read_numeric<double>(id_.get(), h5name(path), static_cast<std::size_t>(-1), a.shape,
+                                [&](const std::string& w) { fail(path, w); });
+  return a;
 }
 
 RowMatrixXd H5Group::read_matrix(const std::string& path) const {

@@ -164,6 +164,7 @@ struct JsonSchema::Impl {
   // alternatives of oneOf/anyOf into one message).
   struct Err {
     std::string pointer, message, expected_type;
+    std::string at;  // where the error is located in the text ("" = pointer)
   };
   using Errs = std::vector<Err>;
 
@@ -261,7 +262,7 @@ struct JsonSchema::Impl {
 
   void add(Errs& out, const std::string& ptr, std::string msg,
            std::string expected_type = {}) const {
-    out.push_back({ptr, std::move(msg), std::move(expected_type)});
+    out.push_back({ptr, std::move(msg), std::move(expected_type), {}});
   }
 
   Errs validate(const json& s, const json& v, const std::string& ptr, int depth) const {
@@ -419,8 +420,10 @@ struct JsonSchema::Impl {
       }
       if (matched || !additional) continue;
       if (additional->is_boolean()) {
-        if (!additional->get<bool>())
+        if (!additional->get<bool>()) {
           add(out, ptr, "unknown key " + short_dump(key) + allowed_keys(props));
+          out.back().at = child;  // locate the key itself, not its object
+        }
       } else {
         run(*additional, it.value(), child, depth + 1, out);
       }
@@ -566,7 +569,7 @@ std::vector<SchemaError> JsonSchema::errors(const nlohmann::json& instance) cons
   const auto errs = impl_->validate(impl_->root, instance, "", 0);
   std::vector<SchemaError> out;
   out.reserve(errs.size());
-  for (const auto& e : errs) out.push_back({e.pointer, e.message});
+  for (const auto& e : errs) out.push_back({e.pointer, e.message, e.at.empty() ? e.pointer : e.at});
   return out;
 }
 

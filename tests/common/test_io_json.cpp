@@ -252,3 +252,41 @@ TEST_CASE("embedded schemas match schemas/*.json and load", "[unit][io][json][sc
   CHECK_THROWS_WITH(knit::io::embedded_schema("no_such_schema"),
                     Catch::Contains("no embedded JSON schema \"no_such_schema\""));
 }
+
+TEST_CASE("json_pointer_lines locates values and keys in the text", "[unit][io][json]") {
+  const std::string text =
+      "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  },\n"
+      "  \"list\": [\n    1,\n    {\"a~/b\": \"x\\\"y\", \"\\u00e9\": 2}\n  ]\n}\n";
+  const auto lines = knit::io::json_pointer_lines(text);
+  CHECK(lines.at("") == 1);
+  CHECK(lines.at("/name") == 2);
+  CHECK(lines.at("/geometry") == 3);
+  CHECK(lines.at("/geometry/thickness") == 4);
+  CHECK(lines.at("/list/0") == 7);
+  CHECK(lines.at("/list/1") == 8);
+  CHECK(lines.at("/list/1/a~0~1b") == 8);
+  CHECK(lines.at("/list/1/\xc3\xa9") == 8);
+  CHECK(lines.size() == 9);
+}
+
+TEST_CASE("load_and_validate adds the line of the offending value", "[unit][io][json][schema]") {
+  const fs::path f = scratch(
+      "case.json", "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  }\n}\n");
+  try {
+    knit::io::load_and_validate(f, test_schema());
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/geometry/thickness");
+    CHECK(e.message() == "must be > 0, got -1 (line 4)");
+  }
+  const fs::path g = scratch("case2.json",
+                             "{\"name\": \"rod_1\",\n \"geometry\": {\"thickness\": 1},\n"
+                             " \"material\": {\"E\": 1,\n   \"Young\": 2}}");
+  CHECK_THROWS_WITH(
+      knit::io::load_and_validate(g, test_schema()),
+      g.string() + ": /material: unknown key \"Young\" (allowed: \"E\", \"nu\") (line 4)");
+  const fs::path ok = scratch("ok2.json", R"({"name": "ab", "geometry": {"thickness": 2}})");
+  CHECK(knit::io::load_and_validate(ok, test_schema())["geometry"]["thickness"] == 2);
+  CHECK_THROWS_WITH(knit::io::load_and_validate(ok, "no_such_schema"),
+                    Catch::Contains("no embedded JSON schema"));
+}

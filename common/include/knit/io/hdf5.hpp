@@ -34,6 +34,12 @@
 
 namespace knit::io {
 
+/// A numeric dataset of any rank: values in row-major (C) order.
+struct H5Array {
+  std::vector<std::size_t> shape;  ///< empty for a scalar dataset
+  std::vector<double> data;
+};
+
 /// Options for writing a dataset.
 struct H5WriteOptions {
   /// gzip (deflate) level 1..9; 0 = no compression. Ignored for empty datasets and when the
@@ -118,6 +124,8 @@ class H5Group {
   RowMatrixXd read_matrix(const std::string& path) const;
   /// Reads an integer 2-D dataset of shape (rows, cols).
   RowMatrixXi read_int_matrix(const std::string& path) const;
+  /// Reads a numeric dataset of any rank as doubles, with its shape.
+  H5Array read_array(const std::string& path) const;
   /// Reads a 1-D (or scalar) string dataset, variable or fixed length.
   std::vector<std::string> read_strings(const std::string& path) const;
 
