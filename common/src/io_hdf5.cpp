@@ -639,4 +639,14 @@ void H5File::close() {
   file_id_.reset();
 }
 
+// ---- AtomicH5File -------------------------------------------------------------------------
+
+AtomicH5File::AtomicH5File(const std::filesystem::path& target)
+    : atomic_(target), file_(H5File::create(atomic_.temp_path())) {}
+
+void AtomicH5File::commit() {
+  file_.close();
+  atomic_.commit();
+}
+
 }  // namespace knit::io

@@ -30,6 +30,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "knit/io/atomic.hpp"
 #include "knit/io/matrix_types.hpp"
 
 namespace knit::io {
@@ -184,6 +185,26 @@ class H5File : public H5Group {
 
  private:
   H5Handle file_id_;
+};
+
+/// An HDF5 file written atomically: created at a temporary path next to `target`, closed and
+/// renamed onto it by commit(); without commit() the temporary is removed and `target` is
+/// untouched.
+///   knit::io::AtomicH5File db("material.h5");
+///   db->write("/loop_4.50/fit/S", S);
+///   db.commit();
+class AtomicH5File {
+ public:
+  explicit AtomicH5File(const std::filesystem::path& target);
+  H5File& file() { return file_; }
+  H5File* operator->() { return &file_; }
+  const std::filesystem::path& target() const { return atomic_.target(); }
+  /// Closes the file, then fsync + rename (see AtomicFile::commit).
+  void commit();
+
+ private:
+  AtomicFile atomic_;  // declared first: destroyed after file_ (removes the closed temporary)
+  H5File file_;
 };
 
 /// True if `file` exists and carries an HDF5 signature.
