@@ -290,3 +290,17 @@ TEST_CASE("load_and_validate adds the line of the offending value", "[unit][io][
   CHECK_THROWS_WITH(knit::io::load_and_validate(ok, "no_such_schema"),
                     Catch::Contains("no embedded JSON schema"));
 }
+
+TEST_CASE("duplicate keys are input errors", "[unit][io][json]") {
+  const fs::path f =
+      scratch("dup.json", "{\"a\": {\"x\": 1,\n  \"y\": 2,\n  \"x\": 3}, \"b\": {\"x\": 4}}");
+  try {
+    knit::io::read_json_file(f);
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/a/x");
+    CHECK(e.message() == "duplicate key (lines 1 and 3)");
+  }
+  CHECK_NOTHROW(
+      knit::io::parse_json(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "t"));
+}
