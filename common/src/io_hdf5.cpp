@@ -609,8 +609,11 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
     : H5Group(H5Handle(), file.string(), "/") {
   silence_hdf5();
   const std::string name = file.string();
+  // File access: keep HDF5's file locking, but do not fail on file systems without locks (NFS).
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
+  H5Pset_file_locking(fapl.get(), 1, 1);
   if (mode == Mode::Truncate) {
-    file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+    file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
     if (!file_id_.valid())
       throw std::runtime_error(name +
                                ": cannot create HDF5 file (directory missing or not writable?)");
@@ -619,7 +622,7 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
     if (!std::filesystem::exists(file, ec)) throw std::runtime_error(name + ": file not found");
     if (!is_hdf5_file(file)) throw std::runtime_error(name + ": not an HDF5 file (or truncated)");
     const unsigned flags = mode == Mode::ReadOnly ? H5F_ACC_RDONLY : H5F_ACC_RDWR;
-    file_id_ = H5Handle(H5Fopen(name.c_str(), flags, H5P_DEFAULT));
+    file_id_ = H5Handle(H5Fopen(name.c_str(), flags, fapl.get()));
     if (!file_id_.valid())
       throw std::runtime_error(name + ": cannot open HDF5 file (truncated, corrupt or locked?)");
   }

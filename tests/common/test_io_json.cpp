@@ -123,6 +123,10 @@ TEST_CASE("schema validator: objects, arrays, $ref", "[unit][io][json][schema]")
         "/geometry: missing required key \"thickness\"");
   CHECK(first_error(with("/material", {{"E", 800}, {"Young", 1}})) ==
         "/material: unknown key \"Young\" (allowed: \"E\", \"nu\")");
+  CHECK(first_error(with("/geometry", {{"thickness", 1}, {"elemnts", 2}})) ==
+        "/geometry: unknown key \"elemnts\" (did you mean \"elements\"?)");
+  CHECK(first_error(with("/material", {{"E", 800}, {"Nu", 0.3}})) ==
+        "/material: unknown key \"Nu\" (did you mean \"nu\"?)");
   CHECK(first_error(with("/material", {{"E", 800}, {"nu", 0.5}})) ==
         "/material/nu: must be < 0.5, got 0.5");
   CHECK(first_error(with("/material", json::object())) == "/material: missing required key \"E\"");
