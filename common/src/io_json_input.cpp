@@ -214,6 +214,13 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
   return parse_json(read_text(file), file.string());
 }
 
+std::filesystem::path resolve_input_path(const std::filesystem::path& input_file,
+                                         const std::string& value) {
+  const std::filesystem::path v(value);
+  if (v.is_absolute()) return v;
+  return (input_file.parent_path() / v).lexically_normal();
+}
+
 std::string json_pointer_escape(std::string_view token) {
   std::string out;
   out.reserve(token.size());

@@ -308,3 +308,10 @@ TEST_CASE("duplicate keys are input errors", "[unit][io][json]") {
   CHECK_NOTHROW(
       knit::io::parse_json(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "t"));
 }
+
+TEST_CASE("paths inside input files are relative to the file", "[unit][io][json]") {
+  CHECK(knit::io::resolve_input_path("/cases/shell/a.json", "../db/m.h5") ==
+        fs::path("/cases/db/m.h5"));
+  CHECK(knit::io::resolve_input_path("/cases/a.json", "/abs/m.h5") == fs::path("/abs/m.h5"));
+  CHECK(knit::io::resolve_input_path("a.json", "m.h5") == fs::path("m.h5"));
+}

@@ -8,6 +8,7 @@
 //   case.json: /geometry/thickness: must be > 0, got -1 (line 7)
 //   case.json: /boundary_conditions/2/edge: must be one of "u0", "u1", "v0", "v1", got "u2"
 //   case.json: /material: unknown key "Young" (allowed: "E", "nu") (line 9)
+//   case.json: /geometry: unknown key "thicknes" (did you mean "thickness"?) (line 5)
 // (load_and_validate adds the line; JsonSchema::validate, which has no text, does not).
 //
 // Supported keywords: type (string or array; "integer" = number with no fraction), enum,
@@ -46,6 +47,11 @@ namespace knit::io {
 nlohmann::json read_json_file(const std::filesystem::path& file);
 /// Parses JSON text; `source` names it in errors.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
+
+/// A path written inside an input file: absolute as is, relative ones are taken relative to the
+/// directory of that input file (so a case runs the same from any working directory).
+std::filesystem::path resolve_input_path(const std::filesystem::path& input_file,
+                                         const std::string& value);
 
 // ---- JSON pointers (RFC 6901) ------------------------------------------------------------------
 
