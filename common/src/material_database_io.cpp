@@ -8,6 +8,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/io/hdf5.hpp"
+#include "knit/io/provenance.hpp"
 #include "knit/material/database.hpp"
 
 namespace knit::material {
@@ -86,6 +87,8 @@ void write_database(const std::filesystem::path& file, const Database& db) {
     f.set_attribute(".", "git_revision", db.provenance.git_revision);
     f.set_attribute(".", "created", db.provenance.created);
     f.set_attribute(".", "generator", db.generator);
+    // The writing process (program, host, command line) in the io module's common form.
+    io::write_provenance(f, io::Provenance::current(""));
     f.set_attribute(".", "units", "length mm, force N, stress MPa");
     f.set_attribute(".", "voigt_order", "E = (E11, E22, 2E12), S = (S11, S22, S12)");
     f.set_attribute(".", "frame", "material frame: 1 = course, 2 = wale");
