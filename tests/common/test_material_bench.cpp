@@ -1,8 +1,8 @@
 // Benchmark of the response-surface evaluation (hidden: run with "[.bench]").
 // Target (issue #4): >= 1e6 evaluations of S and C per second per core.
 #include <catch2/catch.hpp>
-#include <cstdio>
 #include <chrono>
+#include <cstdio>
 #include <ctime>
 #include <random>
 

@@ -121,8 +121,7 @@ TEST_CASE("loop-length family: reproduces each fitted loop length exactly (eq. 2
   CHECK_THROWS_WITH(fam.weights(4.4), Catch::Contains("outside"));
 }
 
-TEST_CASE("response surface: inversion never fails in a large box, tangent consistent",
-          "[unit]") {
+TEST_CASE("response surface: inversion never fails in a large box, tangent consistent", "[unit]") {
   const ResponseSurface rs(make_test_surface());
   std::mt19937 gen(7);
   std::uniform_real_distribution<double> u(-1.5, 1.5);

@@ -68,13 +68,16 @@ TEST_CASE("knit chain: uniform biaxial stretch gives the database's stresses at 
   std::ostringstream cs;
   cs << R"({"geometry": )" << square(0.0) << R"(,
     "refinement": {"degree": 2, "elements": [1, 1]},
-    "material": {"type": "knit", "database": ")" << db << R"(", "stitch_value": )" << l << R"(,
+    "material": {"type": "knit", "database": ")"
+     << db << R"(", "stitch_value": )" << l << R"(,
                  "knitting_angle": 0.0},
     "boundary_conditions": [
       {"all": true, "fix": ["z"]},
       {"edge": "u0", "fix": ["x"]}, {"edge": "v0", "fix": ["y"]},
-      {"edge": "u1", "prescribe": {"x": )" << dx << R"(}},
-      {"edge": "v1", "prescribe": {"y": )" << dy << R"(}}],
+      {"edge": "u1", "prescribe": {"x": )"
+     << dx << R"(}},
+      {"edge": "v1", "prescribe": {"y": )"
+     << dy << R"(}}],
     "solver": {"steps": 10, "tolerance": 1e-10, "max_iterations": 30},
     "output": {"vtk": false, "hdf5": false,
                "reactions": [{"name": "fx", "edge": "u1", "component": "x"},
@@ -95,8 +98,7 @@ TEST_CASE("knit chain: uniform biaxial stretch gives the database's stresses at 
   }
 }
 
-TEST_CASE("knit chain: rotating the patch with its parameterization keeps the curve",
-          "[case]") {
+TEST_CASE("knit chain: rotating the patch with its parameterization keeps the curve", "[case]") {
   // The same tensile problem (u0 held, u1 pulled along a1 with the lateral motion held),
   // with the whole patch rotated in its plane by beta: alpha (relative to e1) is unchanged,
   // so the reaction along the pull must be the same at every step.
@@ -107,14 +109,16 @@ TEST_CASE("knit chain: rotating the patch with its parameterization keeps the cu
     cs.precision(17);
     cs << R"({"geometry": )" << square(beta) << R"(,
       "refinement": {"degree": 3, "elements": [2, 2]},
-      "material": {"type": "knit", "database": ")" << db << R"(",
+      "material": {"type": "knit", "database": ")"
+       << db << R"(",
                    "stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
                                     "values": [4.5, 6.0]},
                    "knitting_angle": 0.5},
       "boundary_conditions": [
         {"all": true, "fix": ["z"]},
         {"edge": "u0", "fix": ["x", "y"]},
-        {"edge": "u1", "prescribe": {"x": )" << d * c << R"(, "y": )" << d * s << R"(}}],
+        {"edge": "u1", "prescribe": {"x": )"
+       << d * c << R"(, "y": )" << d * s << R"(}}],
       "solver": {"steps": 5, "tolerance": 1e-10, "max_iterations": 30},
       "output": {"vtk": false, "hdf5": false,
                  "reactions": [{"name": "fx", "edge": "u1", "component": "x"},
@@ -144,19 +148,29 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
                     Catch::Contains("bad.json: /material/stitch_value: 7 mm is outside the "
                                     "database's 4.5-6.5 mm"));
   CHECK_THROWS_WITH(
-      load(head + R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [5, 9.2]}})"),
+      load(
+          head +
+          R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [5, 9.2]}})"),
       Catch::Contains("/material/stitch_value/values/1: 9.2 mm is outside the database's"));
   CHECK_THROWS_WITH(
-      load(head + R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [5]}})"),
+      load(
+          head +
+          R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [5]}})"),
       Catch::Contains("/material/stitch_value/values: the knots and degrees define 2 x 1"));
   CHECK_THROWS_WITH(
-      load(head + R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 2, 2], "knots_v": [0, 1], "values": [5, 5]}})"),
+      load(
+          head +
+          R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 2, 2], "knots_v": [0, 1], "values": [5, 5]}})"),
       Catch::Contains("/material/stitch_value/knots_u: the field's domain"));
-  CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": {"align_with": [0, 0, 1], "degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1]}})"),
-                    Catch::Contains("/material/knitting_angle/align_with: "));
+  CHECK_THROWS_WITH(
+      load(
+          head +
+          R"("stitch_value": 5, "knitting_angle": {"align_with": [0, 0, 1], "degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1]}})"),
+      Catch::Contains("/material/knitting_angle/align_with: "));
   CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "colour": 1})"),
                     Catch::Contains("/material/colour: unknown key"));
-  CHECK_THROWS_WITH(load(R"({"type": "knit", "database": "/nonexistent/db.h5", "stitch_value": 5})"),
-                    Catch::Contains("bad.json: /material/database: /nonexistent/db.h5: file not found"));
+  CHECK_THROWS_WITH(
+      load(R"({"type": "knit", "database": "/nonexistent/db.h5", "stitch_value": 5})"),
+      Catch::Contains("bad.json: /material/database: /nonexistent/db.h5: file not found"));
 }
 #endif
