@@ -93,7 +93,8 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   const double h_nom = 1.0 / nsteps;
   Eigen::VectorXd ufree = Eigen::VectorXd::Zero(dofs.num_free());
   const Eigen::VectorXd fext_red = dofs.reduce(fext);
-  double lambda = 0.0, h = h_nom;
+  double lambda = 0.0, h = h_nom, lambda_prev = 0.0;
+  Eigen::VectorXd ufree_prev = ufree;
   int cutbacks = 0, step = 0;
   ShellModel::Evaluation ev, trial;
 
@@ -110,15 +111,19 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     return r.allFinite();
   };
 
+  // Newton iterations at load factor lam from uf. The residual of the accepted iterate comes
+  // from the line search's trial evaluation, so the tangent is only computed when needed.
   auto newton = [&](double lam, Eigen::VectorXd& uf) {
     StepOutcome o;
     Eigen::VectorXd r, rt;
     double ref = 0.0, reft = 0.0;
+    bool have_r = false;
     for (int it = 0;; ++it) {
-      if (!residual(uf, lam, true, ev, r, ref)) {
+      if (!have_r && !residual(uf, lam, false, trial, r, ref)) {
         o.why = "the configuration degenerated (zero Jacobian or non-finite strains)";
         return o;
       }
+      have_r = false;
       o.residual = r.norm();
       o.iterations = it;
       if (o.residual <= opt.tolerance * ref + opt.absolute_tolerance) {
@@ -132,6 +137,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         o.why = s.str();
         return o;
       }
+      model.evaluate(dofs.expand(uf, lam), true, ev);
       LinearSolve ls = solve_reduced(model, dofs, ev, -r, opt.dense_limit);
       if (!ls.ok) {
         o.why = ls.why;
@@ -147,25 +153,33 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         return o;
       }
       double alpha = 1.0;
-      if (opt.line_search) {
-        const double g0 = ls.x.dot(r);
-        if (residual(uf + ls.x, lam, false, trial, rt, reft)) {
-          double g1 = ls.x.dot(rt);
-          if (rt.norm() > o.residual && std::abs(g1) > 0.5 * std::abs(g0) && g0 < 0.0) {
-            // Secant iterations on g(alpha) = du . r(u + alpha du) between 0 and 1.
-            double a0 = 0.0, ga0 = g0, a1 = 1.0, ga1 = g1;
-            for (int k = 0; k < 6 && std::abs(ga1) > 0.5 * std::abs(g0); ++k) {
-              double a2 = a1 - ga1 * (a1 - a0) / (ga1 - ga0);
-              if (!std::isfinite(a2)) break;
-              a2 = std::clamp(a2, 0.05, 1.0);
-              if (!residual(uf + a2 * ls.x, lam, false, trial, rt, reft)) break;
-              a0 = a1, ga0 = ga1, a1 = a2, ga1 = ls.x.dot(rt);
-            }
-            alpha = a1;
+      const double g0 = ls.x.dot(r);
+      if (residual(uf + ls.x, lam, false, trial, rt, reft)) {
+        have_r = true;
+        const double g1 = ls.x.dot(rt);
+        if (opt.line_search && rt.norm() > o.residual && std::abs(g1) > 0.5 * std::abs(g0) &&
+            g0 < 0.0) {
+          // Secant iterations on g(alpha) = du . r(u + alpha du) between 0 and 1.
+          double a0 = 0.0, ga0 = g0, a1 = 1.0, ga1 = g1;
+          Eigen::VectorXd r1 = rt;
+          double ref1 = reft;
+          for (int k = 0; k < 6 && std::abs(ga1) > 0.5 * std::abs(g0); ++k) {
+            double a2 = a1 - ga1 * (a1 - a0) / (ga1 - ga0);
+            if (!std::isfinite(a2)) break;
+            a2 = std::clamp(a2, 0.05, 1.0);
+            if (!residual(uf + a2 * ls.x, lam, false, trial, rt, reft)) break;
+            a0 = a1, ga0 = ga1, a1 = a2, ga1 = ls.x.dot(rt);
+            r1 = rt;
+            ref1 = reft;
           }
-        } else {
-          alpha = 0.5;  // the full step degenerated the geometry: take half of it
+          alpha = a1;
+          rt = r1;
+          reft = ref1;
         }
+        r = rt;
+        ref = reft;
+      } else if (opt.line_search) {
+        alpha = 0.5;  // the full step degenerated the geometry: take half of it
       }
       uf += alpha * ls.x;
     }
@@ -175,9 +189,18 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     const double next_nominal = std::min(1.0, h_nom * std::floor(lambda / h_nom + 1.0 + 1e-9));
     const double lam1 = std::min(lambda + h, next_nominal);
     const auto t0 = clock::now();
+    // Secant predictor: extrapolate the last converged increment.
     Eigen::VectorXd uf = ufree;
-    const StepOutcome o = newton(lam1, uf);
+    if (step > 0 && lambda > lambda_prev)
+      uf += ((lam1 - lambda) / (lambda - lambda_prev)) * (ufree - ufree_prev);
+    StepOutcome o = newton(lam1, uf);
+    if (!o.converged && step > 0) {  // retry from the last converged state without the predictor
+      uf = ufree;
+      o = newton(lam1, uf);
+    }
     if (o.converged) {
+      lambda_prev = lambda;
+      ufree_prev = ufree;
       lambda = lam1;
       ufree = uf;
       ++step;
@@ -188,7 +211,8 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       sr.residual = o.residual;
       sr.seconds = std::chrono::duration<double>(clock::now() - t0).count();
       sr.u = dofs.expand(ufree, lambda);
-      sr.fint = ev.fint;
+      model.evaluate(sr.u, false, trial);
+      sr.fint = trial.fint;
       report.converged_steps = step;
       report.last_lambda = lambda;
       if (on_step) on_step(sr);

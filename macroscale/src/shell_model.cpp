@@ -1,6 +1,7 @@
 #include "knit/macro/shell_model.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/StdVector>
 #include <cmath>
 #include <thread>
 
@@ -62,6 +63,8 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
           pt.ref = reference_point(dX, Eigen::Vector2d(u, v), scale_);
           pt.dA = w * pt.ref.jacobian;
           R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 6, nloc_) = sb.R;
+          el.Phi.conservativeResize(el.Phi.rows() + 5, nloc_);
+          el.Phi.bottomRows(5) = sb.R.bottomRows(5);
           points_.push_back(pt);
           thetas.emplace_back(u, v);
         }
@@ -111,21 +114,17 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
                                 Evaluation& out, Eigen::VectorXd& fint) const {
   using Mat3 = Eigen::Matrix3d;
   using Vec3 = Eigen::Vector3d;
+  using Mat15 = Eigen::Matrix<double, 15, 15>;
   const Eigen::MatrixXd& P = surface_.control_points();
-  const int nl = nloc_, nd = 3 * nloc_;
+  const int nl = nloc_;
   int maxq = 0;
   for (int e = e0; e < e1; ++e) maxq = std::max(maxq, elements_[e].num_points);
   // Workspace (allocated once per call and thread, never inside the point loop).
-  Eigen::Matrix<double, Eigen::Dynamic, 3> xloc(nl, 3);
-  Eigen::Matrix<double, 6, Eigen::Dynamic> B(6, nd);
-  Eigen::VectorXd fe(nd);
-  Eigen::MatrixXd Bs, DBs, Phis, Ys[9], Kg(nl, nl);
-  if (tangent) {
-    Bs.resize(6 * maxq, nd);
-    DBs.resize(6 * maxq, nd);
-    Phis.resize(3 * maxq, nl);
-    for (auto& Y : Ys) Y.resize(3 * maxq, nl);
-  }
+  Eigen::Matrix<double, Eigen::Dynamic, 3> xloc(nl, 3), fe(nl, 3);
+  Eigen::Matrix<double, 6, 15> G = Eigen::Matrix<double, 6, 15>::Zero();
+  std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
+  Eigen::MatrixXd Y, Kij(nl, nl);
+  if (tangent) Y.resize(5 * maxq, nl);
   for (int e = e0; e < e1; ++e) {
     const Element& el = elements_[e];
     for (int l = 0; l < nl; ++l) {
@@ -133,51 +132,55 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       xloc.row(l) = P.row(a) + u.segment<3>(3 * a).transpose();
     }
     fe.setZero();
+    bool symmetric = true;
     for (int q = 0; q < el.num_points; ++q) {
       const int pid = el.first_point + q;
       const Point& pt = points_[pid];
       const auto R = R_.block(0, static_cast<Eigen::Index>(pid) * nl, 6, nl);
       const SurfaceDerivs dx = R * xloc;
       const CurrentPoint c = current_point(dx, pt.ref);
-      if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) {
+      if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite())
         return false;
-      }
       const Mat3& T = pt.ref.T;
       const SectionResponse sr = section(T * c.eps, T * c.kap, pt.ref.theta, pid);
       const Vec3 N = T.transpose() * sr.n, M = T.transpose() * sr.m;
-      // a3 derivatives: a3_,(l,i) = R1_l P1(:,i) + R2_l P2(:,i), P_alpha = (I - a3 a3^T) Q_alpha /
-      // j.
+      // a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i) with P_alpha = (I - a3 a3^T) Q_alpha / j,
+      // Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i.
       const Mat3 Q1 = -skew(c.a2), Q2 = skew(c.a1);
       const Mat3 Pr = Mat3::Identity() - c.a3 * c.a3.transpose();
       const Mat3 P1 = Pr * Q1 / c.j, P2 = Pr * Q2 / c.j;
-      const Eigen::RowVector3d g1_11 = c.a11.transpose() * P1, g2_11 = c.a11.transpose() * P2;
-      const Eigen::RowVector3d g1_22 = c.a22.transpose() * P1, g2_22 = c.a22.transpose() * P2;
-      const Eigen::RowVector3d g1_12 = c.a12.transpose() * P1, g2_12 = c.a12.transpose() * P2;
-      for (int l = 0; l < nl; ++l) {
-        const double R1 = R(1, l), R2 = R(2, l), R11 = R(3, l), R12 = R(4, l), R22 = R(5, l);
-        for (int i = 0; i < 3; ++i) {
-          const int r = 3 * l + i;
-          B(0, r) = R1 * c.a1(i);
-          B(1, r) = R2 * c.a2(i);
-          B(2, r) = R1 * c.a2(i) + R2 * c.a1(i);
-          B(3, r) = -(R11 * c.a3(i) + R1 * g1_11(i) + R2 * g2_11(i));
-          B(4, r) = -(R22 * c.a3(i) + R1 * g1_22(i) + R2 * g2_22(i));
-          B(5, r) = -2.0 * (R12 * c.a3(i) + R1 * g1_12(i) + R2 * g2_12(i));
-        }
-      }
+      // Strain derivatives B(:, 3l+i) = sum_f Phi_f(l) G(:, 3f+i), Phi = (R_1, R_2, R_11, R_12,
+      // R_22) (rows 1-5 of the basis), rows of B: eps11, eps22, 2eps12, kap11, kap22, 2kap12.
+      G.block<1, 3>(0, 0) = c.a1.transpose();
+      G.block<1, 3>(2, 0) = c.a2.transpose();
+      G.block<1, 3>(1, 3) = c.a2.transpose();
+      G.block<1, 3>(2, 3) = c.a1.transpose();
+      G.block<1, 3>(3, 0) = -c.a11.transpose() * P1;
+      G.block<1, 3>(4, 0) = -c.a22.transpose() * P1;
+      G.block<1, 3>(5, 0) = -2.0 * c.a12.transpose() * P1;
+      G.block<1, 3>(3, 3) = -c.a11.transpose() * P2;
+      G.block<1, 3>(4, 3) = -c.a22.transpose() * P2;
+      G.block<1, 3>(5, 3) = -2.0 * c.a12.transpose() * P2;
+      G.block<1, 3>(3, 6) = -c.a3.transpose();
+      G.block<1, 3>(5, 9) = -2.0 * c.a3.transpose();
+      G.block<1, 3>(4, 12) = -c.a3.transpose();
       Eigen::Matrix<double, 6, 1> NM;
       NM << N, M;
-      fe.noalias() += pt.dA * (B.transpose() * NM);
+      const Eigen::Matrix<double, 15, 1> g = pt.dA * (G.transpose() * NM);
+      const Eigen::Map<const Eigen::Matrix<double, 3, 5>> gm(g.data());
+      fe.noalias() += R.bottomRows(5).transpose() * gm.transpose();
       if (!tangent) continue;
-      // Material part: stack B and (D B) of all points, one GEMM per element.
+      // Material part H = G^T D G with D the covariant section tangent.
       Eigen::Matrix<double, 6, 6> D;
       D.block<3, 3>(0, 0) = T.transpose() * sr.A * T;
       D.block<3, 3>(0, 3) = T.transpose() * sr.B * T;
       D.block<3, 3>(3, 0) = D.block<3, 3>(0, 3);
       D.block<3, 3>(3, 3) = T.transpose() * sr.D * T;
-      Bs.middleRows(6 * q, 6) = B;
-      DBs.middleRows(6 * q, 6).noalias() = (pt.dA * D) * B;
-      // Geometric part: K(li, mj) = sum_fg Phi_f(l) H_fg(i, j) Phi_g(m), Phi = (R1, R2, Mr).
+      if ((D - D.transpose()).cwiseAbs().maxCoeff() > 1e-12 * D.cwiseAbs().maxCoeff())
+        symmetric = false;
+      Mat15& H = Hs[q];
+      H.noalias() = G.transpose() * (pt.dA * D) * G;
+      // Geometric part: n : eps_,rs + m : kappa_,rs (derivation in the header comment).
       const double c11 = M(0), c22 = M(1), c12 = 2.0 * M(2);
       const Vec3 v = c11 * c.a11 + c22 * c.a22 + c12 * c.a12;
       const double va3 = v.dot(c.a3);
@@ -189,44 +192,48 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       const Eigen::RowVector3d* hv[2] = {&h1, &h2};
       const Mat3* Qv[2] = {&Q1, &Q2};
       const Mat3* Pv[2] = {&P1, &P2};
-      Mat3 G[2][2];
-      for (int al = 0; al < 2; ++al)
-        for (int be = 0; be < 2; ++be)
-          G[al][be] = ij * (tv[al]->transpose() * (*hv[be]) + hv[al]->transpose() * (*tv[be]) +
-                            va3 * Qv[al]->transpose() * (*Pv[be]));
-      G[0][0].diagonal().array() += N(0);
-      G[1][1].diagonal().array() += N(1);
-      G[0][1].diagonal().array() += N(2);
-      G[1][0].diagonal().array() += N(2);
       const Mat3 W = -skew(w);  // W(i, j) = eps_ijk w_k
-      G[0][1] -= ij * W;
-      G[1][0] += ij * W;
-      for (int l = 0; l < nl; ++l) {
-        Phis(3 * q, l) = R(1, l);
-        Phis(3 * q + 1, l) = R(2, l);
-        Phis(3 * q + 2, l) = c11 * R(3, l) + c22 * R(5, l) + c12 * R(4, l);
+      for (int al = 0; al < 2; ++al) {
+        for (int be = 0; be < 2; ++be) {
+          Mat3 Gab = ij * (tv[al]->transpose() * (*hv[be]) + hv[al]->transpose() * (*tv[be]) +
+                           va3 * Qv[al]->transpose() * (*Pv[be]));
+          const double Nab = al == be ? N(al) : N(2);
+          Gab.diagonal().array() += Nab;
+          if (al == 0 && be == 1) Gab -= ij * W;
+          if (al == 1 && be == 0) Gab += ij * W;
+          H.block<3, 3>(3 * al, 3 * be) += pt.dA * Gab;
+        }
       }
-      const auto Phi = Phis.middleRows(3 * q, 3);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-          Eigen::Matrix3d H;
-          H << G[0][0](i, j), G[0][1](i, j), -P1(j, i),  //
-              G[1][0](i, j), G[1][1](i, j), -P2(j, i),   //
-              -P1(i, j), -P2(i, j), 0.0;
-          Ys[3 * i + j].middleRows(3 * q, 3).noalias() = (pt.dA * H) * Phi;
+      // m : (a_ab,r . a3_,s + a_ab,s . a3_,r): second-derivative functions f = 2, 3, 4.
+      const double cf[3] = {c11, c12, c22};
+      for (int f = 0; f < 3; ++f) {
+        for (int be = 0; be < 2; ++be) {
+          const Mat3 X = (-pt.dA * cf[f]) * (*Pv[be]);
+          H.block<3, 3>(3 * (f + 2), 3 * be) += X;
+          H.block<3, 3>(3 * be, 3 * (f + 2)) += X.transpose();
         }
       }
     }
-    for (int l = 0; l < nl; ++l) fint.segment<3>(3 * el.cp(l)) += fe.segment<3>(3 * l);
+    for (int l = 0; l < nl; ++l) fint.segment<3>(3 * el.cp(l)) += fe.row(l).transpose();
     if (!tangent) continue;
-    const int nr = el.num_points;
+    // K(3l+i, 3m+j) = sum_q Phi_q^T H_q(i-th, j-th components) Phi_q: one GEMM per (i, j).
+    const int nq = el.num_points;
+    const Eigen::MatrixXd& Phi = el.Phi;
     Eigen::MatrixXd& Ke = out.Ke[e];
-    Ke.noalias() = Bs.topRows(6 * nr).transpose() * DBs.topRows(6 * nr);
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        Kg.noalias() = Phis.topRows(3 * nr).transpose() * Ys[3 * i + j].topRows(3 * nr);
+      for (int j = symmetric ? i : 0; j < 3; ++j) {
+        for (int q = 0; q < nq; ++q) {
+          Eigen::Matrix<double, 5, 5> h;
+          for (int f = 0; f < 5; ++f)
+            for (int k = 0; k < 5; ++k) h(f, k) = Hs[q](3 * f + i, 3 * k + j);
+          Y.middleRows(5 * q, 5).noalias() = h * Phi.middleRows(5 * q, 5);
+        }
+        Kij.noalias() = Phi.topRows(5 * nq).transpose() * Y.topRows(5 * nq);
         for (int m = 0; m < nl; ++m)
-          for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) += Kg(l, m);
+          for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) = Kij(l, m);
+        if (symmetric && j != i)
+          for (int m = 0; m < nl; ++m)
+            for (int l = 0; l < nl; ++l) Ke(3 * m + j, 3 * l + i) = Kij(l, m);
       }
     }
   }

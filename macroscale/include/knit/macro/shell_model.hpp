@@ -80,6 +80,7 @@ class ShellModel {
   struct Element {
     Eigen::VectorXi cp;
     int first_point = 0, num_points = 0;
+    Eigen::MatrixXd Phi;  ///< (5 num_points) x nloc: R_1, R_2, R_11, R_12, R_22 at each point
   };
   struct Point {
     ReferencePoint ref;
