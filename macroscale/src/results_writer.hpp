@@ -1,0 +1,46 @@
+// Output directory of a run (private to run.cpp): CSV of the converged steps, VTU/PVD of the
+// sampled mid-surface, case copy, summary. Built in DIR.partial-<pid>, renamed on finish().
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "knit/macro/case.hpp"
+#include "knit/macro/run.hpp"
+#include "knit/macro/shell_model.hpp"
+
+namespace knit::macro {
+
+class ResultsWriter {
+ public:
+  ResultsWriter(const Case& c, const ShellModel& m, std::filesystem::path dir);
+  ~ResultsWriter();
+  void add_row(const StepRow& row);
+  /// Samples the mid-surface on the output grid and writes vtk/step_NNNN.vtu.
+  void add_step(int step, double lambda, const Eigen::VectorXd& u);
+  /// Writes the CSV, PVD, HDF5 and summary, then moves the directory into place.
+  void finish(const RunReport& report);
+
+ private:
+  struct Fields {
+    int step = 0;
+    double lambda = 0.0;
+    Eigen::MatrixXd X, x, u;         ///< n x 3
+    std::vector<std::string> names;  ///< scalar field names
+    Eigen::MatrixXd values;          ///< n x names.size()
+  };
+  Fields sample(int step, double lambda, const Eigen::VectorXd& u) const;
+  void write_vtu(const std::filesystem::path& file, const Fields& f) const;
+  void write_hdf5(const std::filesystem::path& file, const RunReport& report) const;
+
+  const Case& case_;
+  const ShellModel& model_;
+  std::filesystem::path target_, partial_;
+  std::vector<StepRow> rows_;
+  std::vector<Fields> steps_;  ///< kept for the HDF5 file
+  bool finished_ = false;
+};
+
+}  // namespace knit::macro
