@@ -369,10 +369,17 @@ void read_output(const Reader& r, const json& root, Case& c) {
     const json& rs = r.array(o.at("reactions"), "/output/reactions");
     for (size_t k = 0; k < rs.size(); ++k) {
       const std::string ptr = "/output/reactions/" + std::to_string(k);
-      r.keys(rs[k], ptr, {"name", "edge", "component", "rows"}, {"name", "edge", "component"});
+      r.keys(rs[k], ptr, {"name", "edge", "corner", "component", "rows"}, {"name", "component"});
+      if (rs[k].contains("edge") == rs[k].contains("corner"))
+        r.fail(ptr, "needs either \"edge\" or \"corner\"");
       ReactionOutput ro;
       ro.name = unique_name(rs[k].at("name"), ptr + "/name");
-      ro.edge = r.edge(rs[k].at("edge"), ptr + "/edge");
+      ro.at_edge = rs[k].contains("edge");
+      if (ro.at_edge)
+        ro.edge = r.edge(rs[k].at("edge"), ptr + "/edge");
+      else
+        ro.corner = r.corner(rs[k].at("corner"), ptr + "/corner");
+      if (!ro.at_edge && rs[k].contains("rows")) r.fail(ptr + "/rows", "rows apply to edges only");
       ro.component = r.component(rs[k].at("component"), ptr + "/component");
       if (rs[k].contains("rows")) ro.rows = r.integer(rs[k].at("rows"), ptr + "/rows", 1, 2);
       out.reactions.push_back(ro);

@@ -11,7 +11,8 @@ namespace knit::macro {
 
 spline::SplineSurface refine_patch(const spline::SplineSurface& s, int p, int eu, int ev) {
   if (p < s.basis_u().degree() || p < s.basis_v().degree())
-    throw std::invalid_argument("the refinement degree " + std::to_string(p) + " is below the patch's degree");
+    throw std::invalid_argument("the refinement degree " + std::to_string(p) +
+                                " is below the patch's degree");
   if (eu < 1 || ev < 1) throw std::invalid_argument("the number of elements must be at least 1");
   return spline::refine(s, p, eu, ev);
 }

@@ -110,8 +110,11 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
       row.applied = s.lambda * c.output.applied->value;
       row.strain = row.applied / c.output.applied->gauge_length;
     }
-    for (const ReactionOutput& r : c.output.reactions)
-      row.reactions.push_back(edge_reaction(m, s.fint, r.edge, r.component, r.rows));
+    for (const ReactionOutput& r : c.output.reactions) {
+      const int a = corner_control_point(c.surface.size_u(), c.surface.size_v(), r.corner);
+      row.reactions.push_back(r.at_edge ? edge_reaction(m, s.fint, r.edge, r.component, r.rows)
+                                        : s.fint(3 * a + r.component));
+    }
     for (const OutputPoint& op : c.output.points) row.points.push_back(m.displacement(s.u, op.at));
     row.iterations = s.iterations;
     row.residual = s.residual;

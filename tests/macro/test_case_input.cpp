@@ -245,3 +245,16 @@ TEST_CASE("case file: tensile test with an isotropic stand-in material", "[case]
   }
   CHECK(r.rows.back().strain == Approx(0.3));
 }
+
+TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagonal", "[case]") {
+  const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/diagonal_svk.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  for (const StepRow& row : r.rows) {
+    CHECK(row.reactions[0] > 0.0);
+    CHECK(row.reactions[0] == Approx(row.reactions[1]).epsilon(1e-8));
+    CHECK(row.points[0](0) ==
+          Approx(0.5 * row.applied).epsilon(1e-8));  // the center moves by Delta/2
+    CHECK(row.points[0](1) == Approx(0.5 * row.applied).epsilon(1e-8));
+  }
+}

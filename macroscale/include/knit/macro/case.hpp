@@ -47,10 +47,13 @@ struct OutputPoint {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();
 };
 
-/// Sum of the internal forces in `component` over the control points of `rows` rows of an edge.
+/// Sum of the internal forces in `component` over the control points of `rows` rows of an edge,
+/// or at a corner control point.
 struct ReactionOutput {
   std::string name;
+  bool at_edge = true;
   Edge edge = Edge::kU0;
+  Eigen::Vector2d corner = Eigen::Vector2d::Zero();
   int component = 0;
   int rows = 1;
 };
