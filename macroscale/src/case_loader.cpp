@@ -12,6 +12,10 @@
 #include "knit/macro/refinement.hpp"
 #include "knit/spline/basis.hpp"
 #include "knit/spline/knot_vector.hpp"
+#if __has_include("knit/io/json_input.hpp")
+#include "knit/io/json_input.hpp"
+#define KNIT_MACRO_HAVE_IO 1
+#endif
 
 namespace knit::macro {
 

@@ -7,6 +7,11 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#if __has_include("knit/io/hdf5.hpp")
+#include "knit/io/hdf5.hpp"
+#include "knit/io/provenance.hpp"
+#define KNIT_MACRO_HAVE_IO 1
+#endif
 
 namespace knit::macro {
 
@@ -132,7 +137,61 @@ void ResultsWriter::write_vtu(const fs::path& file, const Fields& f) const {
   write_text(file, o.str());
 }
 
+#ifdef KNIT_MACRO_HAVE_IO
+void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) const {
+  auto h5 = io::H5File::create(file);
+  io::write_provenance(h5, io::Provenance::current(case_.file));
+  h5.set_attribute(".", "status", report.status == RunStatus::kCompleted ? "completed" : "stopped");
+  h5.set_attribute(".", "message", report.message);
+  h5.set_attribute(".", "units", "mm, N, MPa");
+  h5.write_strings("case_json", {case_.text});
+  // The CSV columns.
+  const int n = static_cast<int>(rows_.size());
+  Eigen::VectorXd lam(n), app(n), eps(n), res(n), sec(n);
+  Eigen::VectorXi step(n), its(n);
+  for (int k = 0; k < n; ++k) {
+    const StepRow& r = rows_[k];
+    step(k) = r.step, lam(k) = r.lambda, app(k) = r.applied, eps(k) = r.strain;
+    its(k) = r.iterations, res(k) = r.residual, sec(k) = r.seconds;
+  }
+  h5.write("steps/step", step);
+  h5.write("steps/load_factor", lam);
+  if (case_.output.applied) {
+    h5.write("steps/applied_displacement", app);
+    h5.write("steps/strain", eps);
+  }
+  h5.write("steps/iterations", its);
+  h5.write("steps/residual", res);
+  h5.write("steps/seconds", sec);
+  for (size_t c = 0; c < case_.output.reactions.size(); ++c) {
+    Eigen::VectorXd f(n);
+    for (int k = 0; k < n; ++k) f(k) = rows_[k].reactions[c];
+    h5.write("steps/reactions/" + case_.output.reactions[c].name, f);
+  }
+  for (size_t c = 0; c < case_.output.points.size(); ++c) {
+    Eigen::MatrixXd d(n, 3);
+    for (int k = 0; k < n; ++k) d.row(k) = rows_[k].points[c].transpose();
+    h5.write("steps/points/" + case_.output.points[c].name, d);
+  }
+  // Sampled fields of each output step.
+  for (const Fields& f : steps_) {
+    char g[64];
+    std::snprintf(g, sizeof g, "fields/step_%04d", f.step);
+    const std::string grp(g);
+    h5.create_group(grp);
+    h5.set_attribute(grp, "load_factor", f.lambda);
+    h5.set_attribute(grp, "grid_u", case_.output.grid_u);
+    h5.set_attribute(grp, "grid_v", case_.output.grid_v);
+    h5.write(grp + "/X", f.X);
+    h5.write(grp + "/x", f.x);
+    h5.write(grp + "/displacement", f.u);
+    for (size_t c = 0; c < f.names.size(); ++c) h5.write(grp + "/" + f.names[c], Eigen::VectorXd(f.values.col(c)));
+  }
+  h5.close();
+}
+#else
 void ResultsWriter::write_hdf5(const fs::path&, const RunReport&) const {}
+#endif
 
 void ResultsWriter::finish(const RunReport& report) {
   // load_strain.csv
