@@ -454,6 +454,10 @@ Case parse_case(const std::string& text, const std::string& file) {
       !c.material->has_analytic_thickness_integration())
     r.fail("/solver/thickness_integration",
            "the material \"" + c.material->name() + "\" has no analytic thickness integration");
+#ifdef KNIT_MACRO_HAVE_IO
+  // The schema as the last word: the checks above are more specific, it catches what they miss.
+  io::JsonSchema::embedded("case").validate(root, file);
+#endif
   return c;
 }
 
