@@ -180,7 +180,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
         symmetric = false;
       Mat15& H = Hs[q];
       H.noalias() = G.transpose() * (pt.dA * D) * G;
-      // Geometric part: n : eps_,rs + m : kappa_,rs (derivation in the header comment).
+      // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
       const double c11 = M(0), c22 = M(1), c12 = 2.0 * M(2);
       const Vec3 v = c11 * c.a11 + c22 * c.a22 + c12 * c.a12;
       const double va3 = v.dot(c.a3);

@@ -10,6 +10,19 @@
 // section integration (section.hpp). Reference quantities are precomputed at all quadrature
 // points ((p+1) Gauss points per direction and element) once; the loops do not allocate.
 // DOF r = 3 a + i: component i of the displacement of control point a.
+//
+// Variations (r = (l, i): control point l, component i; R_l the basis, e_i the unit vector):
+//   a_alpha,r = R_l,alpha e_i,   a3~ = a1 x a2,  j = |a3~|,  a3 = a3~ / j
+//   a3,r   = (a3~,r - a3 j,r)/j,  a3~,r = R_l,1 e_i x a2 + R_l,2 a1 x e_i,  j,r = a3 . a3~,r
+//   a3,rs  = (a3~,rs - a3,s j,r - a3 j,rs - a3,r j,s)/j,   j,rs = a3,s . a3~,r + a3 . a3~,rs
+//   a3~,rs = (R_l,1 R_m,2 - R_l,2 R_m,1) e_i x e_j
+//   eps_ab,r  = (a_a,r . a_b + a_a . a_b,r)/2,      eps_ab,rs = (a_a,r . a_b,s + a_a,s . a_b,r)/2
+//   kap_ab,r  = -(a_a,b,r . a3 + a_a,b . a3,r),     kap_ab,rs = -(a_a,b,r . a3,s + a_a,b,s . a3,r + a_a,b . a3,rs)
+// Every term is a bilinear form in Phi = (R_1, R_2, R_11, R_12, R_22) of the two control points,
+// so per quadrature point a 15 x 15 matrix H (Phi-index x component) holds the whole tangent:
+//   K(3l+i, 3m+j) = sum_q sum_fg Phi_f(l) H_q(3f+i, 3g+j) Phi_g(m)
+// which is evaluated per element as 9 (6 if the material tangent is symmetric) matrix products
+// Phi^T (H Phi) over all its quadrature points.
 #pragma once
 
 #include <Eigen/Core>
