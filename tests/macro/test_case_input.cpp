@@ -258,3 +258,17 @@ TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagona
     CHECK(row.points[0](1) == Approx(0.5 * row.applied).epsilon(1e-8));
   }
 }
+
+TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load", "[unit]") {
+  json j = read_json("sze_cantilever.json");
+  j["solver"]["steps"] = 1;
+  j["solver"]["max_iterations"] = 12;
+  j["refinement"]["elements"] = {8, 1};
+  const Case c = parse_case(j.dump(), "one_step.json");
+  const RunResult r = run_case(c, {});
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(r.rows.size() > 1);  // the increment was cut
+  CHECK(r.rows.back().lambda == 1.0);
+  CHECK(r.rows.back().points[0](2) == Approx(6.698).epsilon(0.02));
+}
