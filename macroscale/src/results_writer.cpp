@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
 #if __has_include("knit/io/hdf5.hpp")
 #include "knit/io/hdf5.hpp"
@@ -196,7 +197,8 @@ void ResultsWriter::write_hdf5(const fs::path&, const RunReport&) const {}
 void ResultsWriter::finish(const RunReport& report) {
   // load_strain.csv
   std::ostringstream csv;
-  csv << "# knit-macro results of " << case_.file << "\n";
+  csv << "# knit-macro results of " << case_.file << " (knitscale " << project_version() << ", git " << git_revision()
+      << ")\n";
   if (report.status != RunStatus::kCompleted)
     csv << "# run stopped early: " << report.message << "\n";
   csv << "step,load_factor";
