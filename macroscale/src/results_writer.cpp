@@ -145,6 +145,8 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "status", report.status == RunStatus::kCompleted ? "completed" : "stopped");
   h5.set_attribute(".", "message", report.message);
   h5.set_attribute(".", "units", "mm, N, MPa");
+  h5.set_attribute(".", "material", case_.material->name());
+  h5.set_attribute(".", "material_report", material_report_);
   h5.write_strings("case_json", {case_.text});
   // The CSV columns.
   const int n = static_cast<int>(rows_.size());
@@ -233,6 +235,8 @@ void ResultsWriter::finish(const RunReport& report) {
       << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
   if (!report.message.empty()) sum << "message: " << report.message << "\n";
+  sum << "material: " << case_.material->name() << "\n";
+  if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
   write_text(partial_ / "summary.txt", sum.str());
   // Put the directory in place: an existing one is moved aside first, then removed.
   fs::path old;

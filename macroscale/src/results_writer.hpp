@@ -22,6 +22,8 @@ class ResultsWriter {
   void add_step(int step, double lambda, const Eigen::VectorXd& u);
   /// Writes the CSV, PVD, HDF5 and summary, then moves the directory into place.
   void finish(const RunReport& report);
+  /// The material's end-of-run summary (Material::report()), written to summary.txt and HDF5.
+  void set_material_report(std::string r) { material_report_ = std::move(r); }
 
  private:
   struct Fields {
@@ -40,6 +42,7 @@ class ResultsWriter {
   std::filesystem::path target_, partial_;
   std::vector<StepRow> rows_;
   std::vector<Fields> steps_;  ///< kept for the HDF5 file
+  std::string material_report_;
   bool finished_ = false;
 };
 

@@ -136,7 +136,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
         last_written = s.u;
     }
   });
+  const std::string material_report = c.material->report();
+  if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
   if (writer) {
+    writer->set_material_report(material_report);
     // A stopped run still writes its last converged state.
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)
