@@ -8,11 +8,10 @@
 
 #include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
-#if __has_include("knit/io/hdf5.hpp")
+#include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/provenance.hpp"
-#define KNIT_MACRO_HAVE_IO 1
-#endif
+#include "knit/io/vtk.hpp"
 
 namespace knit::macro {
 
@@ -35,22 +34,12 @@ void write_text(const fs::path& file, const std::string& text) {
 }  // namespace
 
 ResultsWriter::ResultsWriter(const Case& c, const ShellModel& m, fs::path dir)
-    : case_(c), model_(m), target_(std::move(dir)) {
-  partial_ = target_;
-  partial_ += ".partial-" + std::to_string(::getpid());
-  if (fs::exists(target_) && !fs::is_directory(target_))
-    throw InputError("", "--output", target_.string() + " exists and is not a directory");
-  fs::remove_all(partial_);
-  fs::create_directories(partial_ / "vtk");
-  write_text(partial_ / "case.json", c.text);
+    : case_(c), model_(m), dir_(std::move(dir)), pvd_(dir_.path() / "results.pvd") {
+  fs::create_directories(dir_.path() / "vtk");
+  write_text(dir_.path() / "case.json", c.text);
 }
 
-ResultsWriter::~ResultsWriter() {
-  if (!finished_) {
-    std::error_code ec;
-    fs::remove_all(partial_, ec);
-  }
-}
+ResultsWriter::~ResultsWriter() = default;
 
 void ResultsWriter::add_row(const StepRow& row) {
   rows_.push_back(row);
@@ -96,49 +85,26 @@ void ResultsWriter::add_step(int step, double lambda, const Eigen::VectorXd& u) 
   Fields f = sample(step, lambda, u);
   char name[64];
   std::snprintf(name, sizeof name, "step_%04d.vtu", step);
-  write_vtu(partial_ / "vtk" / name, f);
+  write_vtu(dir_.path() / "vtk" / name, f);
+  pvd_.add(lambda, dir_.path() / "vtk" / name);
+  pvd_.write();  // valid after every step
   steps_.push_back(std::move(f));
 }
 
 void ResultsWriter::write_vtu(const fs::path& file, const Fields& f) const {
-  const int gu = case_.output.grid_u, gv = case_.output.grid_v, n = gu * gv;
-  const int nc = (gu - 1) * (gv - 1);
-  std::ostringstream o;
-  o << "<?xml version=\"1.0\"?>\n<!-- knit-macro: deformed mid-surface, load factor "
-    << fmt(f.lambda) << "; strains in the local Cartesian frame of the reference surface -->\n"
-    << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-       "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
-    << "<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << nc << "\">\n<Points>\n"
-    << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (int k = 0; k < n; ++k)
-    o << fmt(f.x(k, 0)) << ' ' << fmt(f.x(k, 1)) << ' ' << fmt(f.x(k, 2)) << '\n';
-  o << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
-       "format=\"ascii\">\n";
-  for (int j = 0; j + 1 < gv; ++j)
-    for (int i = 0; i + 1 < gu; ++i) {
-      const int a = i + gu * j;
-      o << a << ' ' << a + 1 << ' ' << a + 1 + gu << ' ' << a + gu << '\n';
-    }
-  o << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (int c = 1; c <= nc; ++c) o << 4 * c << '\n';
-  o << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (int c = 0; c < nc; ++c) o << "9\n";
-  o << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n"
-    << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
-       "format=\"ascii\">\n";
-  for (int k = 0; k < n; ++k)
-    o << fmt(f.u(k, 0)) << ' ' << fmt(f.u(k, 1)) << ' ' << fmt(f.u(k, 2)) << '\n';
-  o << "</DataArray>\n";
+  io::QuadMesh mesh = io::structured_quad_mesh(case_.output.grid_u, case_.output.grid_v, f.x);
+  mesh.point_data.push_back(io::vector_field("displacement", f.u));
   for (size_t c = 0; c < f.names.size(); ++c) {
-    o << "<DataArray type=\"Float64\" Name=\"" << f.names[c] << "\" format=\"ascii\">\n";
-    for (int k = 0; k < n; ++k) o << fmt(f.values(k, c)) << '\n';
-    o << "</DataArray>\n";
+    const Eigen::VectorXd col = f.values.col(c);
+    mesh.point_data.push_back(
+        io::scalar_field(f.names[c], std::vector<double>(col.data(), col.data() + col.size())));
   }
-  o << "</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  write_text(file, o.str());
+  io::write_vtu(file, mesh, io::VtkEncoding::Base64,
+                "knit-macro: deformed mid-surface at load factor " + fmt(f.lambda) +
+                    "; strains in the local Cartesian frame of the reference surface; " +
+                    io::Provenance::current(case_.file).to_json_string());
 }
 
-#ifdef KNIT_MACRO_HAVE_IO
 void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) const {
   auto h5 = io::H5File::create(file);
   io::write_provenance(h5, io::Provenance::current(case_.file));
@@ -188,48 +154,35 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
     h5.write(grp + "/X", f.X);
     h5.write(grp + "/x", f.x);
     h5.write(grp + "/displacement", f.u);
-    for (size_t c = 0; c < f.names.size(); ++c) h5.write(grp + "/" + f.names[c], Eigen::VectorXd(f.values.col(c)));
+    for (size_t c = 0; c < f.names.size(); ++c)
+      h5.write(grp + "/" + f.names[c], Eigen::VectorXd(f.values.col(c)));
   }
   h5.close();
 }
-#else
-void ResultsWriter::write_hdf5(const fs::path&, const RunReport&) const {}
-#endif
 
 void ResultsWriter::finish(const RunReport& report) {
-  // load_strain.csv
-  std::ostringstream csv;
-  csv << "# knit-macro results of " << case_.file << " (knitscale " << project_version() << ", git " << git_revision()
-      << ")\n";
-  if (report.status != RunStatus::kCompleted)
-    csv << "# run stopped early: " << report.message << "\n";
-  csv << "step,load_factor";
-  if (case_.output.applied) csv << ",applied_displacement_mm,strain";
-  for (const ReactionOutput& r : case_.output.reactions) csv << "," << r.name << "_N";
+  std::vector<std::string> header = {"step", "load_factor"};
+  if (case_.output.applied) header.insert(header.end(), {"applied_displacement_mm", "strain"});
+  for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + "_N");
   for (const OutputPoint& p : case_.output.points)
-    csv << "," << p.name << "_ux_mm," << p.name << "_uy_mm," << p.name << "_uz_mm";
-  csv << ",iterations,residual,seconds\n";
+    header.insert(header.end(), {p.name + "_ux_mm", p.name + "_uy_mm", p.name + "_uz_mm"});
+  header.insert(header.end(), {"iterations", "residual", "seconds"});
+  io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
+  csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
+                  ", git " + git_revision() + ")");
+  if (report.status != RunStatus::kCompleted)
+    csv.add_comment("run stopped early: " + report.message);
   for (const StepRow& r : rows_) {
-    csv << r.step << "," << fmt(r.lambda);
-    if (case_.output.applied) csv << "," << fmt(r.applied) << "," << fmt(r.strain);
-    for (double f : r.reactions) csv << "," << fmt(f);
-    for (const auto& d : r.points) csv << "," << fmt(d(0)) << "," << fmt(d(1)) << "," << fmt(d(2));
-    csv << "," << r.iterations << "," << fmt(r.residual) << "," << fmt(r.seconds) << "\n";
+    std::vector<io::CsvCell> row = {r.step, r.lambda};
+    if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
+    for (double f : r.reactions) row.emplace_back(f);
+    for (const auto& d : r.points) row.insert(row.end(), {d(0), d(1), d(2)});
+    row.insert(row.end(), {r.iterations, r.residual, r.seconds});
+    csv.add_row(row);
   }
-  write_text(partial_ / "load_strain.csv", csv.str());
-  // results.pvd
-  std::ostringstream pvd;
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
-         "byte_order=\"LittleEndian\">\n<Collection>\n";
-  for (const Fields& f : steps_) {
-    char name[64];
-    std::snprintf(name, sizeof name, "vtk/step_%04d.vtu", f.step);
-    pvd << "<DataSet timestep=\"" << fmt(f.lambda) << "\" group=\"\" part=\"0\" file=\"" << name
-        << "\"/>\n";
-  }
-  pvd << "</Collection>\n</VTKFile>\n";
-  write_text(partial_ / "results.pvd", pvd.str());
-  if (case_.output.hdf5) write_hdf5(partial_ / "results.h5", report);
+  csv.commit();
+  if (pvd_.size() == 0) pvd_.write();
+  if (case_.output.hdf5) write_hdf5(dir_.path() / "results.h5", report);
   std::ostringstream sum;
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n"
       << "converged steps: " << report.converged_steps
@@ -237,17 +190,8 @@ void ResultsWriter::finish(const RunReport& report) {
   if (!report.message.empty()) sum << "message: " << report.message << "\n";
   sum << "material: " << case_.material->name() << "\n";
   if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
-  write_text(partial_ / "summary.txt", sum.str());
-  // Put the directory in place: an existing one is moved aside first, then removed.
-  fs::path old;
-  if (fs::exists(target_)) {
-    old = target_;
-    old += ".old-" + std::to_string(::getpid());
-    fs::rename(target_, old);
-  }
-  fs::rename(partial_, target_);
-  if (!old.empty()) fs::remove_all(old);
-  finished_ = true;
+  write_text(dir_.path() / "summary.txt", sum.str());
+  dir_.commit();  // DIR.partial-<pid> -> DIR
 }
 
 }  // namespace knit::macro

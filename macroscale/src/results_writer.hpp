@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "knit/io/atomic.hpp"
+#include "knit/io/vtk.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/shell_model.hpp"
@@ -39,11 +41,11 @@ class ResultsWriter {
 
   const Case& case_;
   const ShellModel& model_;
-  std::filesystem::path target_, partial_;
+  io::AtomicDirectory dir_;  ///< DIR.partial-<pid> until finish(); removed if abandoned
+  io::PvdCollection pvd_;
   std::vector<StepRow> rows_;
   std::vector<Fields> steps_;  ///< kept for the HDF5 file
   std::string material_report_;
-  bool finished_ = false;
 };
 
 }  // namespace knit::macro

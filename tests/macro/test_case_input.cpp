@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/run.hpp"
 
@@ -259,7 +260,8 @@ TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagona
   }
 }
 
-TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load", "[unit]") {
+TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load",
+          "[unit]") {
   json j = read_json("sze_cantilever.json");
   j["solver"]["steps"] = 1;
   j["solver"]["max_iterations"] = 12;
@@ -271,4 +273,34 @@ TEST_CASE("cut-back: one load step for the large-deflection cantilever still rea
   CHECK(r.rows.size() > 1);  // the increment was cut
   CHECK(r.rows.back().lambda == 1.0);
   CHECK(r.rows.back().points[0](2) == Approx(6.698).epsilon(0.02));
+}
+
+TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provenance", "[unit]") {
+  const fs::path d = temp_dir("out");
+  json j = read_json("tensile_svk.json");
+  j["solver"]["steps"] = 4;
+  j["output"]["grid"] = {5, 7};
+  std::ofstream(d / "t.json") << j.dump(2);
+  REQUIRE(run_exe((d / "t.json").string() + " --output " + (d / "out").string(), d / "log.txt") ==
+          0);
+  const std::string log = slurp(d / "log.txt");
+  CHECK(std::count(log.begin(), log.end(), '\n') == 5);  // 4 progress lines + "wrote"
+  CHECK(log.find("step    4  load factor 1.000000") != std::string::npos);
+  const std::string csv = slurp(d / "out" / "load_strain.csv");
+  CHECK(csv.find("step,load_factor,applied_displacement_mm,strain,jaw_force_N") !=
+        std::string::npos);
+  CHECK(csv.find("\n4,1,15,0.3,") != std::string::npos);
+  const std::string pvd = slurp(d / "out" / "results.pvd");
+  for (int s = 1; s <= 4; ++s) {
+    const std::string f = "vtk/step_000" + std::to_string(s) + ".vtu";
+    CHECK(pvd.find("file=\"" + f + "\"") != std::string::npos);
+    CHECK(fs::exists(d / "out" / f));
+  }
+  auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+  CHECK(h5.attribute_string(".", "status") == "completed");
+  CHECK(!h5.attribute_string(".", "git_revision").empty());
+  CHECK(json::parse(h5.read_strings("case_json").at(0)) == j);
+  CHECK(h5.read_doubles("fields/step_0004/E22").size() == 35u);
+  CHECK(h5.read_doubles("steps/reactions/jaw_force").size() == 4u);
+  fs::remove_all(d);
 }

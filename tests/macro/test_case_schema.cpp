@@ -20,7 +20,9 @@ TEST_CASE("every macroscale case file validates against the case schema", "[unit
     const json j = json::parse(in);
     if (!j.contains("geometry") || !j.contains("material")) continue;  // not a shell case
     const auto errors = schema.errors(j);
-    INFO(e.path().string() << (errors.empty() ? "" : ": " + errors[0].pointer + ": " + errors[0].message));
+    INFO(e.path().string() << (errors.empty()
+                                   ? ""
+                                   : ": " + errors[0].pointer + ": " + errors[0].message));
     CHECK(errors.empty());
     ++n;
   }

@@ -17,7 +17,8 @@
 //   a3,rs  = (a3~,rs - a3,s j,r - a3 j,rs - a3,r j,s)/j,   j,rs = a3,s . a3~,r + a3 . a3~,rs
 //   a3~,rs = (R_l,1 R_m,2 - R_l,2 R_m,1) e_i x e_j
 //   eps_ab,r  = (a_a,r . a_b + a_a . a_b,r)/2,      eps_ab,rs = (a_a,r . a_b,s + a_a,s . a_b,r)/2
-//   kap_ab,r  = -(a_a,b,r . a3 + a_a,b . a3,r),     kap_ab,rs = -(a_a,b,r . a3,s + a_a,b,s . a3,r + a_a,b . a3,rs)
+//   kap_ab,r  = -(a_a,b,r . a3 + a_a,b . a3,r),     kap_ab,rs = -(a_a,b,r . a3,s + a_a,b,s . a3,r +
+//   a_a,b . a3,rs)
 // Every term is a bilinear form in Phi = (R_1, R_2, R_11, R_12, R_22) of the two control points,
 // so per quadrature point a 15 x 15 matrix H (Phi-index x component) holds the whole tangent:
 //   K(3l+i, 3m+j) = sum_q sum_fg Phi_f(l) H_q(3f+i, 3g+j) Phi_g(m)
