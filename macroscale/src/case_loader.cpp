@@ -7,15 +7,12 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/material_factory.hpp"
 #include "knit/macro/refinement.hpp"
 #include "knit/spline/basis.hpp"
 #include "knit/spline/knot_vector.hpp"
-#if __has_include("knit/io/json_input.hpp")
-#include "knit/io/json_input.hpp"
-#define KNIT_MACRO_HAVE_IO 1
-#endif
 
 namespace knit::macro {
 
@@ -123,17 +120,6 @@ class Reader {
  private:
   std::string file_;
 };
-
-std::string line_col(const std::string& text, size_t byte) {
-  size_t line = 1, col = 1;
-  for (size_t i = 0; i < std::min(byte, text.size()); ++i) {
-    if (text[i] == '\n')
-      ++line, col = 1;
-    else
-      ++col;
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(col);
-}
 
 spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const char* key) {
   const std::string ptr = std::string("/geometry/") + key;
@@ -423,13 +409,8 @@ void read_output(const Reader& r, const json& root, Case& c) {
 
 Case parse_case(const std::string& text, const std::string& file) {
   Reader r(file);
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
-    r.fail("", "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) + ": " +
-                   std::string(e.what()).substr(std::string(e.what()).find(':') + 2));
-  }
+  // Parse errors name the line and column; duplicate keys are errors (knit/io).
+  const json root = io::parse_json(text, file);
   r.keys(root, "",
          {"$schema", "description", "units", "geometry", "refinement", "material",
           "boundary_conditions", "loads", "solver", "output"},
@@ -454,10 +435,8 @@ Case parse_case(const std::string& text, const std::string& file) {
       !c.material->has_analytic_thickness_integration())
     r.fail("/solver/thickness_integration",
            "the material \"" + c.material->name() + "\" has no analytic thickness integration");
-#ifdef KNIT_MACRO_HAVE_IO
   // The schema as the last word: the checks above are more specific, it catches what they miss.
   io::JsonSchema::embedded("case").validate(root, file);
-#endif
   return c;
 }
 

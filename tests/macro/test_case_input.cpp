@@ -133,15 +133,17 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
   }
 }
 
-TEST_CASE("malformed JSON reports the line and column", "[unit]") {
+TEST_CASE("malformed JSON reports the line and column; duplicate keys are errors", "[unit]") {
   std::string text = read_json("tensile_svk.json").dump(2);
   text.insert(text.find("\"geometry\""), "oops ");
   try {
     parse_case(text, "broken.json");
     FAIL("no error");
   } catch (const knit::InputError& e) {
-    CHECK(std::string(e.what()).rfind("broken.json: malformed JSON at line ", 0) == 0);
+    CHECK(std::string(e.what()).rfind("broken.json: invalid JSON at line ", 0) == 0);
   }
+  const std::string dup = R"({"geometry": {}, "geometry": {}, "material": {}})";
+  CHECK_THROWS_AS(parse_case(dup, "dup.json"), knit::InputError);
 }
 
 TEST_CASE("a missing support is reported as such, not as NaNs", "[unit]") {
