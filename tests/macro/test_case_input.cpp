@@ -184,21 +184,31 @@ TEST_CASE("knit-macro run: bad input exits with 2 and writes no output directory
 }
 
 TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
+  // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
+  // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with
+  // q = -0.3 the load factor is limited to 0.6415: steps 1-6 converge, the 7th cannot.
   const fs::path d = temp_dir("stop");
-  json j = read_json("sze_cantilever.json");
-  j["solver"]["steps"] = 4;
-  j["solver"]["max_iterations"] = 4;
-  j["solver"]["max_cutbacks"] = 0;
-  j["refinement"]["elements"] = {8, 1};
+  const json j = json::parse(R"({
+    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}],
+    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [-0.3, 0, 0]}],
+    "solver": {"steps": 10, "max_cutbacks": 1, "max_iterations": 8},
+    "output": {"points": [{"name": "tip", "at": [1, 0.5]}]}})");
   std::ofstream(d / "stop.json") << j.dump(2);
-  const int rc =
-      run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
+  const int rc = run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
   CHECK(rc == 1);
   const std::string log = slurp(d / "log.txt");
-  CHECK(log.find("failed after 0 cut-backs") != std::string::npos);
+  CHECK(log.find("failed after 1 cut-backs") != std::string::npos);
+  CHECK(log.find("6 converged steps kept, last lambda = 0.6") != std::string::npos);
   REQUIRE(fs::exists(d / "out" / "load_strain.csv"));
   const std::string csv = slurp(d / "out" / "load_strain.csv");
   CHECK(csv.find("# run stopped early") != std::string::npos);
+  CHECK(csv.find("\n6,0.6,") != std::string::npos);
+  CHECK(fs::exists(d / "out" / "vtk" / "step_0006.vtu"));
+  CHECK(slurp(d / "out" / "summary.txt").find("status: stopped") != std::string::npos);
   fs::remove_all(d);
 }
 
