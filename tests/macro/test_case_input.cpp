@@ -198,7 +198,8 @@ TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged 
     "solver": {"steps": 10, "max_cutbacks": 1, "max_iterations": 8},
     "output": {"points": [{"name": "tip", "at": [1, 0.5]}]}})");
   std::ofstream(d / "stop.json") << j.dump(2);
-  const int rc = run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
+  const int rc =
+      run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
   CHECK(rc == 1);
   const std::string log = slurp(d / "log.txt");
   CHECK(log.find("failed after 1 cut-backs") != std::string::npos);

@@ -109,3 +109,52 @@ TEST_CASE("Sze, Liu & Lo (2004) cantilever subjected to end shear force", "[veri
     }
   }
 }
+
+TEST_CASE("symmetry planes: a quarter of the Scordelis-Lo roof gives the full roof's 0.3006",
+          "[verification]") {
+  // Quarter model: x in [0, 25] (diaphragm at u0, symmetry plane x = 25 at u1), arc from the
+  // crown (phi = 0, symmetry plane y = 0 at v0) to the free edge (phi = 40 deg, v1).
+  const double R = 25, phi = 40 * M_PI / 180, h = 0.5 * phi;
+  spline::BSplineBasis bu(1, {0, 0, 1, 1}), bv(2, {0, 0, 0, 1, 1, 1});
+  Eigen::MatrixXd P(6, 3);
+  Eigen::VectorXd w(6);
+  const double yz[3][2] = {{0.0, R}, {R * std::tan(h), R}, {R * std::sin(phi), R * std::cos(phi)}};
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 2; ++i) {
+      P.row(i + 2 * j) << 25.0 * i, yz[j][0], yz[j][1];
+      w(i + 2 * j) = j == 1 ? std::cos(h) : 1.0;
+    }
+  const auto surf = refine_patch(spline::SplineSurface(bu, bv, P, w), 4, 4, 4);
+  CHECK(std::hypot(surf.eval(0.3, 0.6)(1), surf.eval(0.3, 0.6)(2)) == Approx(R).epsilon(1e-12));
+  ShellModel model(surf, 0.25, std::make_shared<SaintVenantKirchhoff>(4.32e8, 0.0));
+  Constraints c(model.num_dofs());
+  const int nu = surf.size_u(), nv = surf.size_v();
+  for (int a : edge_row(nu, nv, Edge::kU0, 0)) c.fix(3 * a + 1), c.fix(3 * a + 2);
+  // Symmetry plane with normal n at an edge: u_n = 0 on the edge row, the other components of
+  // the second row tied to the edge row (the same rule as the case files' "symmetry").
+  auto symmetry = [&](Edge e, int n) {
+    const auto r0 = edge_row(nu, nv, e, 0), r1 = edge_row(nu, nv, e, 1);
+    for (size_t k = 0; k < r0.size(); ++k)
+      for (int i = 0; i < 3; ++i) {
+        if (i == n)
+          c.fix(3 * r0[k] + i);
+        else
+          c.tie(3 * r1[k] + i, 3 * r0[k] + i);
+      }
+  };
+  symmetry(Edge::kU1, 0);
+  symmetry(Edge::kV0, 1);
+  const DofMap dofs(c);
+  REQUIRE(!dofs.unconstrained_rigid_mode(surf.control_points()));
+  const double scale = 1e-4;
+  SolverOptions opt;
+  opt.steps = 1;
+  Eigen::VectorXd u;
+  const RunReport rep =
+      solve_load_steps(model, dofs, model.area_force(Eigen::Vector3d(0, 0, -90.0 * scale)), opt,
+                       [&](const StepResult& s) { u = s.u; });
+  REQUIRE(rep.status == RunStatus::kCompleted);
+  const double wz = -model.displacement(u, Eigen::Vector2d(1.0, 1.0))(2) / scale;
+  INFO("quarter model w = " << wz);
+  CHECK(wz == Approx(0.3006).epsilon(0.01));
+}
