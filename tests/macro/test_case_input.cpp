@@ -281,7 +281,7 @@ TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagona
 }
 
 TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load",
-          "[unit]") {
+          "[verification]") {
   json j = read_json("sze_cantilever.json");
   j["solver"]["steps"] = 1;
   j["solver"]["max_iterations"] = 12;
