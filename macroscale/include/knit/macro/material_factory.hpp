@@ -16,7 +16,8 @@ namespace knit::macro {
 struct CaseContext {
   std::string file;                              ///< the case file (messages, relative paths)
   std::string pointer;                           ///< JSON pointer of the material object
-  const spline::SplineSurface* patch = nullptr;  ///< the refined patch (parameter domain)
+  /// The refined patch (parameter domain). Valid only during make_material: copy what you need.
+  const spline::SplineSurface* patch = nullptr;
 };
 
 std::unique_ptr<Material> make_material(const nlohmann::json& material, const CaseContext& ctx);
