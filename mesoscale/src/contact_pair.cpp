@@ -65,6 +65,7 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
   const int nz = 3 + 3 * (p + 1);
   out.u = pr.u;
   out.master_first = cp.first;
+  out.Nm = cp.N.topRows(2);
   out.u_anchor_new = hist.u_anchor;
   const Vector3d r = xs - cp.x;
   const double rho = r.norm();
@@ -137,6 +138,7 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
   for (int j = 0; j < nz; ++j)
     dnxt.col(j) = Vector3d(dn.col(j)).cross(tau) + n.cross(Vector3d(dtau.col(j)));
   out.dm_dz = -0.5 * d * (nxt * dfT + out.f_T * dnxt);
+  out.du_dz = du;
   return out;
 }
 

@@ -12,26 +12,24 @@ namespace knit::meso::contact {
 ContactSet::ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions& opt)
     : rod_(rod), opt_(opt), basis_(sys.spec(rod).basis) {
   const int n = basis_.size(), p = basis_.degree();
-  xi_ = basis_.greville();
-  first_.resize(n);
-  Nc_.resize(n, p + 1);
-  Eigen::MatrixXd B(1, p + 1);
-  for (int j = 0; j < n; ++j) {
-    first_[j] = basis_.eval(xi_[j], 0, B);
-    Nc_.row(j) = B.row(0);
-  }
-  // Tributary lengths W_j = int N_j |r0_xi| dxi.
-  weight_.assign(n, 0.0);
-  const auto rule = spline::gauss_legendre_on_spans(p + 2, basis_.knots());
+  const auto rule =
+      spline::gauss_legendre_on_spans(std::max(1, opt_.slave_points_per_element), basis_.knots());
+  const int ns = static_cast<int>(rule.points.size());
+  xi_ = rule.points;
+  first_.resize(ns);
+  Nc_.resize(ns, p + 1);
+  weight_.resize(ns);
+  W_.assign(n, 0.0);
   const Eigen::MatrixXd& r0 = sys.spec(rod).r0;
   Eigen::MatrixXd D(2, p + 1);
-  for (std::size_t g = 0; g < rule.points.size(); ++g) {
-    const int f = basis_.eval(rule.points[g], 1, D);
-    const double jac = (D.row(1) * r0.middleRows(f, p + 1)).norm();
-    for (int a = 0; a <= p; ++a) weight_[f + a] += rule.weights[g] * D(0, a) * jac;
+  for (int g = 0; g < ns; ++g) {
+    first_[g] = basis_.eval(xi_[g], 1, D);
+    Nc_.row(g) = D.row(0);
+    weight_[g] = rule.weights[g] * (D.row(1) * r0.middleRows(first_[g], p + 1)).norm();
+    for (int a = 0; a <= p; ++a) W_[first_[g] + a] += weight_[g] * D(0, a);
   }
-  history_.assign(3 * n, {});
-  pending_.assign(3 * n, {});
+  history_.assign(3 * ns, {});
+  pending_.assign(3 * ns, {});
 }
 
 Eigen::MatrixXd ContactSet::positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const {
@@ -63,7 +61,9 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) cons
   }
   const double inflate = opt_.d + opt_.margin;
   std::vector<Found> out;
-  for (int j = 1; j < n - 1; ++j) {  // end points carry the periodicity rows
+  const int ns = static_cast<int>(xi_.size());
+  (void)n;
+  for (int j = 0; j < ns; ++j) {
     const Eigen::Vector3d xs = (Nc_.row(j) * Q.middleRows(first_[j], p + 1)).transpose();
     for (int course = -1; course <= 1; ++course) {
       const Chain ch = chain(Q, course);
@@ -72,8 +72,8 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) cons
         const Eigen::Vector3d shift = k * a1_ + course * a2_;
         for (int e = 0; e < ne; ++e) {
           const double ua = k + br[e], ub = k + br[e + 1];
-          if (course == 0 && std::max(std::abs(ua - xi_[j]), std::abs(ub - xi_[j])) <
-                                 opt_.self_exclusion)
+          if (course == 0 &&
+              std::max(std::abs(ua - xi_[j]), std::abs(ub - xi_[j])) < opt_.self_exclusion)
             continue;
           const Eigen::Vector3d l = lo[e] + shift, h = hi[e] + shift;
           if ((xs.array() < l.array() - inflate).any() || (xs.array() > h.array() + inflate).any())
@@ -121,7 +121,8 @@ void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool
   for (const Found& f : search(Q)) {
     const Chain ch = chain(Q, f.course);
     const int p = basis_.degree();
-    const Eigen::Vector3d xs = (Nc_.row(f.point) * Q.middleRows(first_[f.point], p + 1)).transpose();
+    const Eigen::Vector3d xs =
+        (Nc_.row(f.point) * Q.middleRows(first_[f.point], p + 1)).transpose();
     // Quick gap test before touching the history: inactive pairs create no anchors.
     if (f.pr.distance >= opt_.d) continue;
     PairHistory h{anchor_for(f, true)};
@@ -133,24 +134,55 @@ void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool
 void ContactSet::add(const rod::RodSystem& sys, const Eigen::VectorXd& x, double /*lambda*/,
                      Eigen::VectorXd& F, std::vector<Eigen::Triplet<double>>& jac) {
   const int p = basis_.degree();
+  const int n = basis_.size();
   visit(sys, x, true, [&](const Found& f, const PairResult& r) {
-    const int rf = sys.row(rod_, f.point, rod::kRowForce);
-    const int rm = sys.row(rod_, f.point, rod::kRowMoment);
-    F.segment<3>(rf) += r.f;
-    F.segment<3>(rm) += r.m;
-    for (int i = 0; i < 3; ++i)
-      for (int c = 0; c < 3; ++c) {
-        for (int a = 0; a <= p; ++a) {
-          const int col = sys.dof(rod_, first_[f.point] + a, rod::kFieldR, c);
-          jac.emplace_back(rf + i, col, Nc_(f.point, a) * r.df_dz(i, c));
-          jac.emplace_back(rm + i, col, Nc_(f.point, a) * r.dm_dz(i, c));
-        }
-        for (int b = 0; b <= p; ++b) {
-          const int col = sys.dof(rod_, r.master_first + b, rod::kFieldR, c);
-          jac.emplace_back(rf + i, col, r.df_dz(i, 3 + 3 * b + c));
-          jac.emplace_back(rm + i, col, r.dm_dz(i, 3 + 3 * b + c));
-        }
+    const int g = f.point;
+    const double half = 0.5 * weight_[g];  // two passes: half the load of each
+    // Columns of z = [x_s, Q_master]: x_s = sum_a N_a(xi_g) r_a.
+    auto col_of = [&](int zi, auto&& emit) {
+      if (zi < 3) {
+        for (int a = 0; a <= p; ++a)
+          emit(sys.dof(rod_, first_[g] + a, rod::kFieldR, zi), Nc_(g, a));
+      } else {
+        const int b = (zi - 3) / 3, c = (zi - 3) % 3;
+        emit(sys.dof(rod_, r.master_first + b, rod::kFieldR, c), 1.0);
       }
+    };
+    const int nz = static_cast<int>(r.df_dz.cols());
+    // Slave side: +f/2 projected on the rows of xi_g.
+    for (int jl = 0; jl <= p; ++jl) {
+      const int j = first_[g] + jl;
+      if (j == 0 || j == n - 1) continue;  // periodicity rows
+      const double c_j = half * Nc_(g, jl) / W_[j];
+      if (c_j == 0) continue;
+      const int rf = sys.row(rod_, j, rod::kRowForce), rm = sys.row(rod_, j, rod::kRowMoment);
+      F.segment<3>(rf) += c_j * r.f;
+      F.segment<3>(rm) += c_j * r.m;
+      for (int zi = 0; zi < nz; ++zi)
+        col_of(zi, [&](int col, double s) {
+          for (int i = 0; i < 3; ++i) {
+            jac.emplace_back(rf + i, col, s * c_j * r.df_dz(i, zi));
+            jac.emplace_back(rm + i, col, s * c_j * r.dm_dz(i, zi));
+          }
+        });
+    }
+    // Master side: -f/2 (and the same moment m/2) at u, projected with N_j(u).
+    for (int bl = 0; bl <= p; ++bl) {
+      const int j = r.master_first + bl;
+      if (j == 0 || j == n - 1) continue;
+      const double c_j = half * r.Nm(0, bl) / W_[j], cu = half * r.Nm(1, bl) / W_[j];
+      if (c_j == 0 && cu == 0) continue;
+      const int rf = sys.row(rod_, j, rod::kRowForce), rm = sys.row(rod_, j, rod::kRowMoment);
+      F.segment<3>(rf) -= c_j * r.f;
+      F.segment<3>(rm) += c_j * r.m;
+      for (int zi = 0; zi < nz; ++zi)
+        col_of(zi, [&](int col, double s) {
+          for (int i = 0; i < 3; ++i) {
+            jac.emplace_back(rf + i, col, -s * (c_j * r.df_dz(i, zi) + cu * r.f(i) * r.du_dz(zi)));
+            jac.emplace_back(rm + i, col, s * (c_j * r.dm_dz(i, zi) + cu * r.m(i) * r.du_dz(zi)));
+          }
+        });
+    }
   });
 }
 
@@ -160,6 +192,7 @@ std::vector<ActivePair> ContactSet::active_pairs(const rod::RodSystem& sys,
   visit(sys, x, false, [&](const Found& f, const PairResult& r) {
     ActivePair a;
     a.point = f.point;
+    a.xi = xi_[f.point];
     a.course = f.course;
     a.u = r.u;
     a.gap = r.gap;

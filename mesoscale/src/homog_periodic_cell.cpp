@@ -79,7 +79,8 @@ PeriodicCell::PeriodicCell(double loop_length, const CellOptions& opt) : opt_(op
   dim_ = cell::cell_dimensions(loop_length);
   opt_.geometry.d = opt_.section.d;
   opt_.contact.d = opt_.section.d;
-  const cell::AnalysisCurve ac = cell::analysis_curve(dim_, opt_.elements, opt_.degree, opt_.geometry);
+  const cell::AnalysisCurve ac =
+      cell::analysis_curve(dim_, opt_.elements, opt_.degree, opt_.geometry);
   rod::RodSpec spec;
   spec.name = "loop";
   spec.basis = ac.curve.basis();

@@ -46,15 +46,17 @@ void eval_at(const Fixture& F0, const Vector3d& xs, const MatrixXd& Q, double u0
 
 TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
   PenaltyLaw law;
-  for (double g : {-0.5, -0.2 - 1e-9, -0.2 + 1e-9, -0.1, -1e-6, 0.0, 0.1}) {
+  for (double gh : {-0.5, -0.1 - 1e-9, -0.1 + 1e-9, -0.05, -1e-6, 0.0, 0.1}) {
+    const double g = gh - law.g0;
     const auto v = law.eval(g);
     const double h = 1e-7;
-    CHECK(v.dp_dg == Approx((law.eval(g + h).p - law.eval(g - h).p) / (2 * h)).margin(1e-5));
-    CHECK(-v.p == Approx((law.eval(g + h).energy - law.eval(g - h).energy) / (2 * h)).margin(1e-5));
+    CHECK(v.dp_dg == Approx((law.eval(g + h).p - law.eval(g - h).p) / (2 * h)).margin(1e-4));
+    CHECK(-v.p == Approx((law.eval(g + h).energy - law.eval(g - h).energy) / (2 * h)).margin(1e-4));
     CHECK(v.p >= 0);
   }
-  // Mild for small penetrations: at a 0.08 mm overlap the force is 20 % of the linear law's.
-  CHECK(law.eval(-0.08).p == Approx(0.2 * law.k_N * 0.08));
+  // Mild for small penetrations: nothing within the allowance, a quadratic onset beyond it.
+  CHECK(law.eval(-0.9 * law.g0).p == 0);
+  CHECK(law.eval(-law.g0 - 0.2 * law.delta).p == Approx(0.1 * law.k_N * 0.2 * law.delta));
 }
 
 TEST_CASE("closest point on the periodic chain", "[unit]") {
@@ -73,7 +75,7 @@ TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]
   Fixture F;
   PenaltyLaw law;
   FrictionLaw fr;
-  const Vector3d xs(0.9, 0.12, 0.25);  // about 0.25 mm from the master: penetration ~0.13
+  const Vector3d xs(0.9, 0.1, 0.12);  // ~0.15 mm from the master: penetration ~0.23
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
   REQUIRE(pr.ok);
   for (int mode = 0; mode < 3; ++mode) {
@@ -116,7 +118,7 @@ TEST_CASE("friction return mapping: slip puts the force on the Coulomb cone", "[
   Fixture F;
   PenaltyLaw law;
   FrictionLaw fr;
-  const Vector3d xs(0.9, 0.12, 0.25);
+  const Vector3d xs(0.9, 0.1, 0.12);
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
   PairHistory h{pr.u - 0.1};
   const PairResult r = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, false);

@@ -3,13 +3,14 @@
 // Coulomb friction with mu = 0.15).
 //
 // Normal law (choice, documented in docs/unit-cell.md): quadratic-linear penalty on the gap
-// g = |x_s - x_m| - d (d = yarn diameter; g < 0 is a penetration), as a line load [N/mm]:
-//   p(g) = 0                          g >= 0
-//   p(g) = k_N g^2 / (2 delta)        -delta < g < 0     (soft onset: the initial overlaps of the
-//                                                         compact loop, up to ~0.16 mm for 4.5 mm,
-//                                                         are only mildly penalized)
-//   p(g) = k_N (-g - delta/2)         g <= -delta        (linear, stiffness k_N)
-// C1 at g = 0 and g = -delta. Energy Pi(g) = int_g^0 p.
+// g = |x_s - x_m| - d (d = yarn diameter; g < 0 is a penetration), shifted by an allowance g0
+// for the flattening of the soft yarn cross-sections (a heuristic of the kind the paper describes:
+// the initial overlaps of the compact loops, up to ~0.16 mm for 4.5 mm, cost little), as a line
+// load [N/mm], with gh = g + g0:
+//   p = 0                          gh >= 0
+//   p = k_N gh^2 / (2 delta)       -delta < gh < 0     (soft onset)
+//   p = k_N (-gh - delta/2)        gh <= -delta        (linear, stiffness k_N)
+// C1 at gh = 0 and gh = -delta. Energy Pi(g) = int_g^{-g0} p.
 //
 // Friction (choice): regularized Coulomb law along the master tangent with an elastic stick
 // penalty k_T [N/mm^2] and the return mapping of elastoplasticity (Wriggers, Computational
@@ -22,16 +23,18 @@
 namespace knit::meso::contact {
 
 struct PenaltyLaw {
-  double k_N = 20.0;   ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
-  double delta = 0.2;  ///< penetration at which the law becomes linear [mm]
+  double k_N = 100.0;  ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
+  double delta = 0.1;  ///< penetration beyond g0 at which the law becomes linear [mm]
+  double g0 = 0.12;    ///< penetration allowance (cross-section flattening) [mm]
 
   struct Value {
     double p = 0;       ///< line load magnitude [N/mm], >= 0
     double dp_dg = 0;   ///< derivative w.r.t. the gap (<= 0)
     double energy = 0;  ///< Pi(g) = int_g^0 p(s) ds [N]
   };
-  Value eval(double g) const {
+  Value eval(double g_in) const {
     Value v;
+    const double g = g_in + g0;
     if (g >= 0) return v;
     if (g > -delta) {
       v.p = k_N * g * g / (2 * delta);

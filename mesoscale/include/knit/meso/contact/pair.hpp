@@ -10,6 +10,8 @@
 // Line load on the slave [N/mm]: f = p(g) n + f_T tau,  tau = x_m,u / |x_m,u|;
 // moment line load of the friction force acting at the slave surface x_s - (d/2) n:
 //   m = -(d/2) n x (f_T tau) = -(d/2) f_T (n x tau).
+// The reaction -f acts on the master at u (with the same friction moment m: the master surface
+// point is x_m + (d/2) n and (d/2) n x (-f_T tau) = m), see contact_set.hpp.
 // Linearization w.r.t. z = [x_s (3), Q_0 .. Q_p (3 each)] with du from d(phi) = 0:
 //   du = -(1/phi_u) [x_m,u . dx_s - x_m,u . dx_m|_u + r . dx_m,u|_u],  r = x_s - x_m,
 //   phi_u = -|x_m,u|^2 + r . x_m,uu.
@@ -70,6 +72,8 @@ struct PairResult {
   int master_first = 0;
   /// d f / d z and d m / d z, z = [x_s, Q_first .. Q_first+p] (3 + 3(p+1) columns).
   Eigen::MatrixXd df_dz, dm_dz;
+  Eigen::RowVectorXd du_dz;  ///< derivative of the closest-point parameter
+  Eigen::MatrixXd Nm;        ///< 2 x (p+1): master basis functions and derivatives at u
 };
 
 /// Evaluates the pair at the projection `pr` (which must be a converged closest point of x_s on

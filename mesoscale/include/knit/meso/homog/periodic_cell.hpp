@@ -67,7 +67,7 @@ struct StepResult {
   Eigen::Matrix2d P = Eigen::Matrix2d::Zero(), E = Eigen::Matrix2d::Zero(),
                   S = Eigen::Matrix2d::Zero();
   Eigen::Vector3d n1 = Eigen::Vector3d::Zero(), n2 = Eigen::Vector3d::Zero();
-  int iterations = 0;   ///< Newton iterations (all increments of the step)
+  int iterations = 0;  ///< Newton iterations (all increments of the step)
   int cutbacks = 0;
   double seconds = 0;
   int active_contacts = 0;
@@ -94,6 +94,7 @@ class PeriodicCell {
   double thickness() const { return 2 * opt_.section.d; }
   const rod::RodSystem& system() const { return sys_; }
   const Eigen::VectorXd& state() const { return x_; }
+  contact::ContactSet& contacts() { return *contact_; }
   /// Centerline sampled at `n`+1 points (current state), shifted by F*(i w, j c).
   std::vector<Eigen::Vector3d> centerline(int n, int i = 0, int j = 0) const;
   /// Homogenized quantities of the current state at F (no solve).
