@@ -206,6 +206,13 @@ std::vector<ActivePair> ContactSet::active_pairs(const rod::RodSystem& sys,
   return out;
 }
 
+double ContactSet::energy(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  double U = 0;
+  visit(sys, x, false,
+        [&](const Found& f, const PairResult& r) { U += 0.5 * weight_[f.point] * r.energy; });
+  return U;
+}
+
 void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   std::vector<std::vector<double>> next(history_.size());
   double D = 0;

@@ -75,6 +75,8 @@ class ContactSet : public rod::ExternalContribution {
 
   /// Evaluates the contacts at x without touching the residual (for output).
   std::vector<ActivePair> active_pairs(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Stored contact energy (penalty + elastic stick) [N mm], each contact counted once.
+  double energy(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   /// Accepts the state x as converged: histories and dissipation are updated.
   void commit(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   /// Drops the pending (in-increment) pairs, e.g. after a failed increment.
