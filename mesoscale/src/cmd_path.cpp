@@ -29,7 +29,7 @@ struct Options {
   double shear = std::nan("");
   int steps = 20;
   std::string out = "path";
-  int elements = 24;
+  int elements = 32;
   double k_N = -1, g0 = -1, delta = -1, mu = -1, k_T = -1;
   bool no_vtp = false;
 };
@@ -117,7 +117,7 @@ knit::cli::SubcommandRegistrar reg(
       b->excludes(s);
       sub.add_option("--steps", o->steps, "load steps (default 20)");
       sub.add_option("--out", o->out, "output directory");
-      sub.add_option("--elements", o->elements, "analysis-curve elements (default 24)");
+      sub.add_option("--elements", o->elements, "analysis-curve elements (default 32)");
       sub.add_option("--penalty", o->k_N, "normal penalty stiffness k_N (MPa)");
       sub.add_option("--allowance", o->g0, "penetration allowance g0 (mm)");
       sub.add_option("--delta", o->delta, "quadratic onset width delta (mm)");

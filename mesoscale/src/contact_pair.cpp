@@ -78,13 +78,17 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
     out.u_anchor_new = pr.u;  // contact released: the anchor follows
     return out;
   }
+  const auto nv = law.eval(out.gap);
+  if (nv.p <= 0) {  // within the allowance g0: no force, no friction, the anchor follows
+    out.u_anchor_new = pr.u;
+    return out;
+  }
   out.active = true;
   const Vector3d n = r / rho;
   const double ell = cp.x_u.norm();
   const Vector3d tau = cp.x_u / ell;
   out.n = n;
   out.tau = tau;
-  const auto nv = law.eval(out.gap);
   out.p = nv.p;
   // Friction: return mapping from the anchor of the last converged state.
   const double e = ell * (pr.u - hist.u_anchor);

@@ -113,6 +113,10 @@ void PeriodicCell::set_F(const Matrix2d& F) {
   contact_->set_periods(F3 * Vector3d(dim_.w, 0, 0), F3 * Vector3d(0, dim_.c, 0));
 }
 
+std::vector<rod::ExternalContribution*> PeriodicCell::contributions() {
+  return {periodic_.get(), contact_.get()};
+}
+
 void PeriodicCell::residual_and_jacobian(Eigen::VectorXd& R, Eigen::SparseMatrix<double>& J) {
   rod::assemble_all(sys_, x_, 1.0, {periodic_.get(), contact_.get()}, R, J);
 }

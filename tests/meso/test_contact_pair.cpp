@@ -45,7 +45,7 @@ void eval_at(const Fixture& F0, const Vector3d& xs, const MatrixXd& Q, double u0
 }  // namespace
 
 TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
-  PenaltyLaw law;
+  PenaltyLaw law{100.0, 0.1, 0.1};
   for (double gh : {-0.5, -0.1 - 1e-9, -0.1 + 1e-9, -0.05, -1e-6, 0.0, 0.1}) {
     const double g = gh - law.g0;
     const auto v = law.eval(g);
@@ -73,7 +73,7 @@ TEST_CASE("closest point on the periodic chain", "[unit]") {
 
 TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]") {
   Fixture F;
-  PenaltyLaw law;
+  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
   FrictionLaw fr;
   const Vector3d xs(0.9, 0.1, 0.12);  // ~0.15 mm from the master: penetration ~0.23
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
@@ -116,7 +116,7 @@ TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]
 
 TEST_CASE("friction return mapping: slip puts the force on the Coulomb cone", "[unit]") {
   Fixture F;
-  PenaltyLaw law;
+  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
   FrictionLaw fr;
   const Vector3d xs(0.9, 0.1, 0.12);
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
@@ -129,4 +129,41 @@ TEST_CASE("friction return mapping: slip puts the force on the Coulomb cone", "[
   CHECK(r2.dissipation == 0);
   CHECK(r.f_T < 0);  // opposes e > 0
   CHECK(r.f.dot(r.n) == Approx(r.p));
+}
+
+TEST_CASE("closest-point parameter derivative and the reaction load match FD", "[unit]") {
+  Fixture F;
+  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
+  FrictionLaw fr;
+  const Vector3d xs(0.9, 0.1, 0.12);
+  const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
+  REQUIRE(pr.ok);
+  PairHistory h{pr.u + 1e-4};
+  const PairResult r = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, true);
+  const int p = F.basis.degree(), nz = 3 + 3 * (p + 1);
+  const double eps = 1e-6;
+  for (int j = 0; j < nz; ++j) {
+    double up[2];
+    Eigen::MatrixXd Rb[2];
+    for (int s = 0; s < 2; ++s) {
+      Vector3d x = xs;
+      MatrixXd Q = F.Q;
+      const double d = s == 0 ? eps : -eps;
+      if (j < 3)
+        x(j) += d;
+      else
+        Q(r.master_first + (j - 3) / 3, (j - 3) % 3) += d;
+      Chain c = F.chain;
+      c.Q = &Q;
+      const Projection q = project(c, x, 0, 0.0, 1.0, pr.u);
+      const PairResult rr = evaluate_pair(x, c, q, 0.38, law, fr, h, false);
+      up[s] = q.u;
+      REQUIRE(rr.master_first == r.master_first);
+      Rb[s] = rr.f * rr.Nm.row(0);  // 3 x (p+1) reaction pattern
+    }
+    CHECK((up[0] - up[1]) / (2 * eps) == Approx(r.du_dz(j)).margin(1e-7));
+    const MatrixXd fd = (Rb[0] - Rb[1]) / (2 * eps);
+    const MatrixXd an = r.df_dz.col(j) * r.Nm.row(0) + r.f * r.Nm.row(1) * r.du_dz(j);
+    CHECK((fd - an).norm() < 1e-6 * (1 + fd.norm()));
+  }
 }

@@ -23,9 +23,9 @@
 namespace knit::meso::contact {
 
 struct PenaltyLaw {
-  double k_N = 100.0;  ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
-  double delta = 0.1;  ///< penetration beyond g0 at which the law becomes linear [mm]
-  double g0 = 0.12;    ///< penetration allowance (cross-section flattening) [mm]
+  double k_N = 1000.0;  ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
+  double delta = 0.05;  ///< penetration beyond g0 at which the law becomes linear [mm]
+  double g0 = 0.14;     ///< penetration allowance (cross-section flattening) [mm]
 
   struct Value {
     double p = 0;       ///< line load magnitude [N/mm], >= 0

@@ -61,7 +61,7 @@ struct PairHistory {
 
 struct PairResult {
   double u = 0, gap = 0, p = 0, f_T = 0, e = 0;
-  bool active = false;  ///< g < 0
+  bool active = false;  ///< p(g) > 0 (penetration beyond the allowance g0)
   bool slip = false;
   Eigen::Vector3d n = Eigen::Vector3d::Zero(), tau = Eigen::Vector3d::Zero();
   Eigen::Vector3d f = Eigen::Vector3d::Zero();  ///< line load on the slave [N/mm]

@@ -42,7 +42,7 @@
 namespace knit::meso::homog {
 
 struct CellOptions {
-  int elements = 16;  ///< analysis curve elements (convergence study: docs/unit-cell.md)
+  int elements = 32;  ///< analysis curve elements (convergence study: docs/unit-cell.md)
   int degree = 4;
   rod::Section section;  ///< yarn: d = 0.38, E = 800, nu = 0.3
   cell::GeometryOptions geometry;
@@ -95,6 +95,8 @@ class PeriodicCell {
   const rod::RodSystem& system() const { return sys_; }
   const Eigen::VectorXd& state() const { return x_; }
   contact::ContactSet& contacts() { return *contact_; }
+  /// The caller terms of the rod system (periodic rows, contact), for custom assembly.
+  std::vector<rod::ExternalContribution*> contributions();
   /// Centerline sampled at `n`+1 points (current state), shifted by F*(i w, j c).
   std::vector<Eigen::Vector3d> centerline(int n, int i = 0, int j = 0) const;
   /// Homogenized quantities of the current state at F (no solve).
