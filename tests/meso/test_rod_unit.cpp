@@ -138,3 +138,40 @@ TEST_CASE("rod: rigid-body motions of a stressed state give zero residual", "[un
   sys.residual(y, 1.0, F);
   CHECK(F.cwiseProduct(sys.row_scales()).cwiseAbs().maxCoeff() < 1e-12);
 }
+
+TEST_CASE("rod: load stepping cuts back a too large increment; failure is a status", "[unit]") {
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0);
+  auto make = [&](RodSystem& sys) {
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
+    s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);  // almost a full circle
+    sys.add_rod(s);
+  };
+  {
+    RodSystem sys;
+    make(sys);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.newton.max_iterations = 8;
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK(rep.completed);
+    CHECK(rep.cutbacks > 0);
+    CHECK(rep.lambda_reached == 1.0);
+  }
+  {
+    RodSystem sys;
+    make(sys);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.max_cutbacks = 0;
+    po.newton.max_iterations = 3;
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK_FALSE(rep.completed);
+    CHECK(rep.lambda_reached == 0.0);
+    CHECK(!rep.message.empty());
+    // x is restored to the last converged state
+    CHECK((x - sys.initial_state()).norm() < 1e-12);
+  }
+}
