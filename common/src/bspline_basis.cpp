@@ -8,12 +8,14 @@ namespace knit::spline {
 BSplineBasis::BSplineBasis(int p, std::vector<double> U) : p_(p), U_(std::move(U)) {
   validate_knots(U_, p_, -1, true);
   if (p_ > kMaxDegree)
-    throw KnotVectorError(KnotError::kNegativeDegree,
-                          "degree " + std::to_string(p_) + " exceeds the supported maximum " +
-                              std::to_string(kMaxDegree));
+    throw KnotVectorError(KnotError::kDegreeTooHigh, "degree " + std::to_string(p_) +
+                                                         " exceeds the supported maximum " +
+                                                         std::to_string(kMaxDegree));
 }
 
-int BSplineBasis::find_span(double u) const { return spline::find_span(size(), p_, u, U_); }
+int BSplineBasis::find_span(double u) const {
+  return spline::find_span(size(), p_, u, U_);
+}
 
 int BSplineBasis::eval(double u, int nder, Eigen::Ref<Eigen::MatrixXd> ders) const {
   const int span = find_span(u);

@@ -16,11 +16,14 @@ std::string fmt(double x) {
 }  // namespace
 
 void validate_knots(const std::vector<double>& U, int p, int n_ctrl, bool require_clamped) {
-  if (p < 0) throw KnotVectorError(KnotError::kNegativeDegree, "degree " + std::to_string(p) + " is negative");
+  if (p < 0)
+    throw KnotVectorError(KnotError::kNegativeDegree,
+                          "degree " + std::to_string(p) + " is negative");
   const int m = static_cast<int>(U.size());
   for (int i = 0; i < m; ++i)
     if (!std::isfinite(U[i]))
-      throw KnotVectorError(KnotError::kNotFinite, "knot " + std::to_string(i) + " is not a finite number");
+      throw KnotVectorError(KnotError::kNotFinite,
+                            "knot " + std::to_string(i) + " is not a finite number");
   if (m < 2 * (p + 1))
     throw KnotVectorError(KnotError::kTooFewKnots,
                           std::to_string(m) + " knots are too few for degree " + std::to_string(p) +
@@ -28,10 +31,16 @@ void validate_knots(const std::vector<double>& U, int p, int n_ctrl, bool requir
   for (int i = 0; i + 1 < m; ++i)
     if (U[i] > U[i + 1])
       throw KnotVectorError(KnotError::kDecreasing, "knots must be non-decreasing, but knot " +
-                                                        std::to_string(i) + " (" + fmt(U[i]) + ") > knot " +
-                                                        std::to_string(i + 1) + " (" + fmt(U[i + 1]) + ")");
+                                                        std::to_string(i) + " (" + fmt(U[i]) +
+                                                        ") > knot " + std::to_string(i + 1) + " (" +
+                                                        fmt(U[i + 1]) + ")");
+  const int n = m - p - 1;
+  if (!(U[p] < U[n]))
+    throw KnotVectorError(KnotError::kEmptyDomain, "the parametric domain [" + fmt(U[p]) + ", " +
+                                                       fmt(U[n]) + "] has zero length");
   // Multiplicities: at most p+1 anywhere. An interior multiplicity of p+1 makes the spline
-  // discontinuous there (C^{-1}), which the graded design fields use on purpose (paper Sect. 3.1.3).
+  // discontinuous there (C^{-1}), which the graded design fields use on purpose (paper
+  // Sect. 3.1.3).
   for (int i = 0; i < m;) {
     int j = i;
     while (j < m && U[j] == U[i]) ++j;
@@ -39,33 +48,33 @@ void validate_knots(const std::vector<double>& U, int p, int n_ctrl, bool requir
     const bool end = (i == 0) || (j == m);
     const int allowed = p + 1;
     if (mult > allowed)
-      throw KnotVectorError(KnotError::kMultiplicityTooHigh,
-                            "knot value " + fmt(U[i]) + " (knots " + std::to_string(i) + ".." +
-                                std::to_string(j - 1) + ") has multiplicity " + std::to_string(mult) +
-                                ", more than the " + std::to_string(allowed) + " allowed " +
-                                (end ? "at an end" : "inside the domain") + " for degree " + std::to_string(p));
+      throw KnotVectorError(
+          KnotError::kMultiplicityTooHigh,
+          "knot value " + fmt(U[i]) + " (knots " + std::to_string(i) + ".." +
+              std::to_string(j - 1) + ") has multiplicity " + std::to_string(mult) +
+              ", more than the " + std::to_string(allowed) + " allowed " +
+              (end ? "at an end" : "inside the domain") + " for degree " + std::to_string(p));
     i = j;
   }
   if (require_clamped) {
     for (int i = 1; i <= p; ++i) {
       if (U[i] != U[0])
-        throw KnotVectorError(KnotError::kNotClamped, "the knot vector is not clamped at its start: the first " +
-                                                          std::to_string(p + 1) + " knots must be equal");
+        throw KnotVectorError(KnotError::kNotClamped,
+                              "the knot vector is not clamped at its start: the first " +
+                                  std::to_string(p + 1) + " knots must be equal");
       if (U[m - 1 - i] != U[m - 1])
-        throw KnotVectorError(KnotError::kNotClamped, "the knot vector is not clamped at its end: the last " +
-                                                          std::to_string(p + 1) + " knots must be equal");
+        throw KnotVectorError(KnotError::kNotClamped,
+                              "the knot vector is not clamped at its end: the last " +
+                                  std::to_string(p + 1) + " knots must be equal");
     }
   }
-  const int n = m - p - 1;
-  if (!(U[p] < U[n]))
-    throw KnotVectorError(KnotError::kEmptyDomain, "the parametric domain [" + fmt(U[p]) + ", " + fmt(U[n]) +
-                                                       "] has zero length");
   if (n_ctrl >= 0 && n != n_ctrl)
-    throw KnotVectorError(KnotError::kCountMismatch,
-                          std::to_string(m) + " knots of degree " + std::to_string(p) + " define " +
-                              std::to_string(n) + " basis functions, but " + std::to_string(n_ctrl) +
-                              " control points were given (knots must number control points + degree + 1 = " +
-                              std::to_string(n_ctrl + p + 1) + ")");
+    throw KnotVectorError(
+        KnotError::kCountMismatch,
+        std::to_string(m) + " knots of degree " + std::to_string(p) + " define " +
+            std::to_string(n) + " basis functions, but " + std::to_string(n_ctrl) +
+            " control points were given (knots must number control points + degree + 1 = " +
+            std::to_string(n_ctrl + p + 1) + ")");
 }
 
 int find_span(int n, int p, double u, const std::vector<double>& U) {

@@ -1,9 +1,9 @@
 #include "knit/spline/surface.hpp"
 
-#include <cassert>
 #include <stdexcept>
 
 #include "knit/spline/basis.hpp"
+#include "knit/spline/knot_vector.hpp"
 
 namespace knit::spline {
 
@@ -11,23 +11,28 @@ SplineSurface::SplineSurface(BSplineBasis bu, BSplineBasis bv, Eigen::MatrixXd P
     : bu_(std::move(bu)), bv_(std::move(bv)), P_(std::move(P)), w_(std::move(w)) {
   const int n = bu_.size() * bv_.size();
   if (P_.rows() != n)
-    throw std::invalid_argument("surface: " + std::to_string(P_.rows()) + " control points but the knot vectors define " +
-                                std::to_string(bu_.size()) + " x " + std::to_string(bv_.size()) + " = " +
-                                std::to_string(n) + " basis functions");
+    throw KnotVectorError(KnotError::kCountMismatch,
+                          "surface: " + std::to_string(P_.rows()) +
+                              " control points but the knot vectors define " +
+                              std::to_string(bu_.size()) + " x " + std::to_string(bv_.size()) +
+                              " = " + std::to_string(n) + " basis functions");
   rational_ = w_.size() > 0;
   if (!rational_) {
     w_ = Eigen::VectorXd::Ones(n);
   } else {
     if (w_.size() != n)
-      throw std::invalid_argument("surface: " + std::to_string(w_.size()) + " weights for " + std::to_string(n) +
-                                  " control points");
+      throw std::invalid_argument("surface: " + std::to_string(w_.size()) + " weights for " +
+                                  std::to_string(n) + " control points");
     for (int i = 0; i < n; ++i)
-      if (!(w_(i) > 0.0)) throw std::invalid_argument("surface: weight " + std::to_string(i) + " is not positive");
+      if (!(w_(i) > 0.0))
+        throw std::invalid_argument("surface: weight " + std::to_string(i) + " is not positive");
   }
 }
 
 void SplineSurface::basis(double u, double v, int nder, SurfaceBasis& out) const {
-  assert(nder >= 0 && nder <= 2);
+  if (nder < 0 || nder > 2)
+    throw std::invalid_argument("surface: derivative order " + std::to_string(nder) +
+                                " outside 0..2");
   const int pu = bu_.degree(), pv = bv_.degree();
   const int nloc = (pu + 1) * (pv + 1);
   if (out.R.cols() != nloc) out.R.resize(6, nloc);
@@ -94,6 +99,8 @@ Eigen::MatrixXd SplineSurface::derivatives(double u, double v, int nder) const {
   return out;
 }
 
-Eigen::VectorXd SplineSurface::eval(double u, double v) const { return derivatives(u, v, 0).row(0).transpose(); }
+Eigen::VectorXd SplineSurface::eval(double u, double v) const {
+  return derivatives(u, v, 0).row(0).transpose();
+}
 
 }  // namespace knit::spline

@@ -23,15 +23,18 @@ enum class KnotError {
   kNotFinite,            ///< a knot is NaN or infinite
   kTooFewKnots,          ///< fewer than 2(p+1) knots: not even one non-empty span of degree p
   kDecreasing,           ///< U[i] > U[i+1]
-  kMultiplicityTooHigh,  ///< an interior knot repeated more than p times or an end knot more than p+1
-  kNotClamped,           ///< the first or last p+1 knots are not equal (required for open/clamped splines)
-  kEmptyDomain,          ///< U[p] == U[n]: the parametric domain has zero length
-  kCountMismatch,        ///< U.size() != n + p + 1 for the given number of control points
+  kMultiplicityTooHigh,  ///< a knot value repeated more than p+1 times (an interior multiplicity of
+                         ///< exactly p+1 is allowed: a C^{-1} break, used by graded design fields)
+  kNotClamped,   ///< the first or last p+1 knots are not equal (required for open/clamped splines)
+  kEmptyDomain,  ///< U[p] == U[n]: the parametric domain has zero length
+  kCountMismatch,  ///< U.size() != n + p + 1 for the given number of control points
+  kDegreeTooHigh,  ///< p > kMaxDegree, the largest degree of the allocation-free kernels
 };
 
 class KnotVectorError : public std::invalid_argument {
  public:
-  KnotVectorError(KnotError code, const std::string& what) : std::invalid_argument(what), code_(code) {}
+  KnotVectorError(KnotError code, const std::string& what)
+      : std::invalid_argument(what), code_(code) {}
   KnotError code() const { return code_; }
 
  private:
@@ -39,11 +42,17 @@ class KnotVectorError : public std::invalid_argument {
 };
 
 /// Validates U for degree p. If n_ctrl >= 0 also checks U.size() == n_ctrl + p + 1.
-/// Throws KnotVectorError with the first problem found (the message names the knot index).
-void validate_knots(const std::vector<double>& U, int p, int n_ctrl = -1, bool require_clamped = true);
+/// Throws KnotVectorError with the first problem found (the message names the knot index), in
+/// this order: kNegativeDegree, kNotFinite, kTooFewKnots, kDecreasing, kEmptyDomain,
+/// kMultiplicityTooHigh, kNotClamped (if require_clamped), kCountMismatch (if n_ctrl >= 0).
+/// (kDegreeTooHigh is raised by BSplineBasis, whose kernels have a fixed maximum degree.)
+void validate_knots(const std::vector<double>& U, int p, int n_ctrl = -1,
+                    bool require_clamped = true);
 
 /// Number of basis functions defined by U and p: U.size() - p - 1.
-inline int num_basis(const std::vector<double>& U, int p) { return static_cast<int>(U.size()) - p - 1; }
+inline int num_basis(const std::vector<double>& U, int p) {
+  return static_cast<int>(U.size()) - p - 1;
+}
 
 /// Algorithm A2.1 (FindSpan), The NURBS Book p. 68, with n = number of basis functions.
 /// Returns the span index i such that U[i] <= u < U[i+1]; at u = U[n] (the last knot of the
@@ -59,6 +68,7 @@ std::vector<double> unique_knots(const std::vector<double>& U);
 
 /// Open (clamped) uniform knot vector on [a, b] with `elements` equal spans, degree p and
 /// interior knot multiplicity `mult` (1 gives C^{p-1} continuity).
-std::vector<double> uniform_knots(int p, int elements, double a = 0.0, double b = 1.0, int mult = 1);
+std::vector<double> uniform_knots(int p, int elements, double a = 0.0, double b = 1.0,
+                                  int mult = 1);
 
 }  // namespace knit::spline
