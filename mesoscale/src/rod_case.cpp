@@ -14,6 +14,7 @@
 #include "knit/meso/rod/builders.hpp"
 #include "knit/meso/rod/output.hpp"
 #include "knit/spline/knot_vector.hpp"
+#include "knit/spline/refine.hpp"
 
 namespace knit::meso::rod {
 
@@ -143,7 +144,7 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
     if (p > 12) R.fail(ptr + "/degree", "must be <= 12, got " + std::to_string(p));
     return straight_rod(a, b, p, ne, sec);
   }
-  R.object(j, ptr, {"type", "degree", "knots", "control_points", "weights"},
+  R.object(j, ptr, {"type", "degree", "knots", "control_points", "weights", "refine"},
            {"type", "degree", "knots", "control_points"});
   const int p = R.integer(j["degree"], ptr + "/degree", 1);
   const json& jk = j["knots"];
@@ -173,6 +174,21 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
     s.weights.resize(jw.size());
     for (size_t i = 0; i < jw.size(); ++i)
       s.weights(i) = R.positive(jw[i], ptr + "/weights/" + std::to_string(i));
+  }
+  if (j.contains("refine")) {
+    // k-refinement of the exact geometry for the analysis: elevate to `degree`, then insert
+    // uniform breakpoints up to `elements` spans (knot insertion keeps the curve unchanged).
+    const json& jr = j["refine"];
+    R.object(jr, ptr + "/refine", {"degree", "elements"}, {"degree", "elements"});
+    const int pr = R.integer(jr["degree"], ptr + "/refine/degree", 1);
+    const int ne = R.integer(jr["elements"], ptr + "/refine/elements", 1);
+    if (pr < p) R.fail(ptr + "/refine/degree", "must be >= the curve degree " + std::to_string(p));
+    if (pr > 12) R.fail(ptr + "/refine/degree", "must be <= 12, got " + std::to_string(pr));
+    const spline::SplineCurve fine =
+        spline::refine(spline::SplineCurve(s.basis, s.r0, s.weights), pr, ne);
+    s.basis = fine.basis();
+    s.r0 = fine.control_points();
+    s.weights = fine.rational() ? Eigen::VectorXd(fine.weights()) : Eigen::VectorXd();
   }
   return s;
 }

@@ -140,3 +140,14 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
     CHECK_FALSE(fs::exists(out));
   }
 }
+
+TEST_CASE("rod case: arc_unbend.json straightens a NURBS quarter circle exactly", "[case]") {
+  const fs::path out = kTmp / "arc_unbend";
+  REQUIRE(run("rod " + (kCases / "arc_unbend.json").string() + " -q -o " + out.string()) == 0);
+  const auto rows = read_csv(out / "load_displacement.csv");
+  REQUIRE(rows.size() == 11);
+  const double R = 5.0;
+  CHECK(rows.back()[3] == Approx(R).epsilon(1e-5));
+  CHECK(rows.back()[4] == Approx(std::numbers::pi * R / 2 - R).epsilon(1e-5));
+  CHECK(std::abs(rows.back()[5]) < 1e-8);
+}
