@@ -154,3 +154,40 @@ TEST_CASE("rod: optimal h- and p-convergence on the roll-up", "[verification]") 
     prev = e;
   }
 }
+
+TEST_CASE("rod: prescribed end rotation and end displacement", "[verification]") {
+  const Section sec = slender();
+  {
+    // End rotation theta about -y, end position free and unloaded: pure bending into an arc of
+    // curvature theta/L with the end moment EI theta / L.
+    RodSystem sys;
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(kL, 0, 0), 4, 16, sec);
+    const double theta = 1.5 * std::numbers::pi;
+    s.end.fix_rotation = true;
+    s.end.rotation = Vector3d(0, -theta, 0);
+    sys.add_rod(s);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 10;
+    REQUIRE(solve_path(sys, x, po).completed);
+    CHECK(rollup_error(sys, x, theta) < 1e-4);
+    const PointState st = sys.state(0, 1.0, x);
+    CHECK(st.m.y() == Approx(-theta * sec.C_K()(0) / kL).epsilon(1e-4));
+  }
+  {
+    // Axial end displacement delta with both ends clamped: n = EA delta / L (linear elastic
+    // in the Biot-type strain Gamma_3 = |r'| - 1 for a straight rod).
+    RodSystem sys;
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(kL, 0, 0), 3, 4, sec);
+    const double delta = 0.05 * kL;
+    s.end = EndCondition::clamped();
+    s.end.displacement = Vector3d(delta, 0, 0);
+    sys.add_rod(s);
+    Eigen::VectorXd x = sys.initial_state();
+    REQUIRE(solve_newton(sys, x, 1.0).converged);
+    const double EA = sec.C_Gamma()(2);
+    for (double xi : {0.0, 0.3, 1.0})
+      CHECK(sys.state(0, xi, x).n.x() == Approx(EA * delta / kL).epsilon(1e-10));
+    CHECK(sys.position(0, 0.5, x).x() == Approx(0.5 * (kL + delta)).epsilon(1e-12));
+  }
+}
