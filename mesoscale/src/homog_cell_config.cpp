@@ -90,10 +90,13 @@ CellOptions read_cell_options(const std::string& file, CellOptions o) {
   if (j.contains("contact")) {
     const json& c = j["contact"];
     R.object(c, "/contact",
-             {"penalty", "allowance", "delta", "mu", "stick_penalty", "margin", "self_exclusion"});
+             {"penalty", "allowance", "delta", "soft_penalty", "soft_delta", "mu", "stick_penalty",
+              "margin", "self_exclusion"});
     R.num(c, "/contact", "penalty", o.contact.penalty.k_N, 0, inf, true);
     R.num(c, "/contact", "allowance", o.contact.penalty.g0, 0, inf, false);
     R.num(c, "/contact", "delta", o.contact.penalty.delta, 0, inf, true);
+    R.num(c, "/contact", "soft_penalty", o.contact.penalty.k_0, 0, inf, false);
+    R.num(c, "/contact", "soft_delta", o.contact.penalty.delta_0, 0, inf, true);
     R.num(c, "/contact", "mu", o.contact.friction.mu, 0, inf, false);
     R.num(c, "/contact", "stick_penalty", o.contact.friction.k_T, 0, inf, true);
     R.num(c, "/contact", "margin", o.contact.margin, 0, inf, false);

@@ -45,7 +45,7 @@ void eval_at(const Fixture& F0, const Vector3d& xs, const MatrixXd& Q, double u0
 }  // namespace
 
 TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
-  PenaltyLaw law{100.0, 0.1, 0.1};
+  PenaltyLaw law{100.0, 0.1, 0.1, 0.0};
   for (double gh : {-0.5, -0.1 - 1e-9, -0.1 + 1e-9, -0.05, -1e-6, 0.0, 0.1}) {
     const double g = gh - law.g0;
     const auto v = law.eval(g);
@@ -56,6 +56,15 @@ TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
   }
   // Mild for small penetrations: nothing within the allowance, a quadratic onset beyond it.
   CHECK(law.eval(-0.9 * law.g0).p == 0);
+  PenaltyLaw soft;  // defaults: a soft slope k_0 inside the allowance, C1 everywhere
+  CHECK(soft.eval(-0.1).p == Approx(soft.k_0 * (0.1 - 0.5 * soft.delta_0)));
+  for (double g : {-0.3, -0.19, -0.15, -0.139, -0.05, -0.01, -0.001, 0.0}) {
+    const double h = 1e-7;
+    CHECK(soft.eval(g).dp_dg ==
+          Approx((soft.eval(g + h).p - soft.eval(g - h).p) / (2 * h)).margin(1e-3));
+    CHECK(-soft.eval(g).p ==
+          Approx((soft.eval(g + h).energy - soft.eval(g - h).energy) / (2 * h)).margin(1e-6));
+  }
   CHECK(law.eval(-law.g0 - 0.2 * law.delta).p == Approx(0.1 * law.k_N * 0.2 * law.delta));
 }
 
@@ -73,7 +82,7 @@ TEST_CASE("closest point on the periodic chain", "[unit]") {
 
 TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]") {
   Fixture F;
-  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
+  PenaltyLaw law{100.0, 0.1, 0.1, 0.0};  // fixed here, independent of the defaults
   FrictionLaw fr;
   const Vector3d xs(0.9, 0.1, 0.12);  // ~0.15 mm from the master: penetration ~0.23
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
@@ -116,7 +125,7 @@ TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]
 
 TEST_CASE("friction return mapping: slip puts the force on the Coulomb cone", "[unit]") {
   Fixture F;
-  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
+  PenaltyLaw law{100.0, 0.1, 0.1, 0.0};  // fixed here, independent of the defaults
   FrictionLaw fr;
   const Vector3d xs(0.9, 0.1, 0.12);
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
@@ -133,7 +142,7 @@ TEST_CASE("friction return mapping: slip puts the force on the Coulomb cone", "[
 
 TEST_CASE("closest-point parameter derivative and the reaction load match FD", "[unit]") {
   Fixture F;
-  PenaltyLaw law{100.0, 0.1, 0.1};  // fixed here, independent of the defaults
+  PenaltyLaw law{100.0, 0.1, 0.1, 0.0};  // fixed here, independent of the defaults
   FrictionLaw fr;
   const Vector3d xs(0.9, 0.1, 0.12);
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);

@@ -10,7 +10,10 @@
 //   p = 0                          gh >= 0
 //   p = k_N gh^2 / (2 delta)       -delta < gh < 0     (soft onset)
 //   p = k_N (-gh - delta/2)        gh <= -delta        (linear, stiffness k_N)
-// C1 at gh = 0 and gh = -delta. Energy Pi(g) = int_g^{-g0} p.
+// C1 at gh = 0 and gh = -delta. Inside the allowance a soft branch of the same form with slope
+// k_0 << k_N (onset width delta_0) is added: touching yarns stay coupled, so a course cannot
+// rotate freely about its axis when the stiff branch is released (e.g. under compression), and
+// the initial overlaps are penalized, mildly. Energy Pi(g) = int_g^0 p.
 //
 // Friction (choice): regularized Coulomb law along the master tangent with an elastic stick
 // penalty k_T [N/mm^2] and the return mapping of elastoplasticity (Wriggers, Computational
@@ -23,29 +26,36 @@
 namespace knit::meso::contact {
 
 struct PenaltyLaw {
-  double k_N = 1000.0;  ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
-  double delta = 0.05;  ///< penetration beyond g0 at which the law becomes linear [mm]
-  double g0 = 0.14;     ///< penetration allowance (cross-section flattening) [mm]
+  double k_N = 1000.0;    ///< linear penalty stiffness [N/mm per mm of yarn = MPa]
+  double delta = 0.05;    ///< penetration beyond g0 at which the law becomes linear [mm]
+  double g0 = 0.14;       ///< penetration allowance (cross-section flattening) [mm]
+  double k_0 = 0.5;       ///< soft slope inside the allowance [MPa] (keeps touching yarns coupled)
+  double delta_0 = 0.02;  ///< onset width of the soft branch [mm]
 
   struct Value {
     double p = 0;       ///< line load magnitude [N/mm], >= 0
     double dp_dg = 0;   ///< derivative w.r.t. the gap (<= 0)
     double energy = 0;  ///< Pi(g) = int_g^0 p(s) ds [N]
   };
-  Value eval(double g_in) const {
+  /// The quadratic-linear branch q(gh; k, dl) and its energy.
+  static Value branch(double gh, double k, double dl) {
     Value v;
-    const double g = g_in + g0;
-    if (g >= 0) return v;
-    if (g > -delta) {
-      v.p = k_N * g * g / (2 * delta);
-      v.dp_dg = k_N * g / delta;
-      v.energy = -k_N * g * g * g / (6 * delta);
+    if (gh >= 0 || k == 0) return v;
+    if (gh > -dl) {
+      v.p = k * gh * gh / (2 * dl);
+      v.dp_dg = k * gh / dl;
+      v.energy = -k * gh * gh * gh / (6 * dl);
     } else {
-      v.p = k_N * (-g - 0.5 * delta);
-      v.dp_dg = -k_N;
-      v.energy = k_N * delta * delta / 6 + k_N * (0.5 * g * g + 0.5 * delta * g);
+      v.p = k * (-gh - 0.5 * dl);
+      v.dp_dg = -k;
+      v.energy = k * dl * dl / 6 + k * (0.5 * gh * gh + 0.5 * dl * gh);
     }
     return v;
+  }
+  /// p(g) = q(g; k_0, delta_0) + q(g + g0; k_N, delta).
+  Value eval(double g) const {
+    const Value a = branch(g, k_0, delta_0), b = branch(g + g0, k_N, delta);
+    return {a.p + b.p, a.dp_dg + b.dp_dg, a.energy + b.energy};
   }
 };
 
