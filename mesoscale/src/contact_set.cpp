@@ -92,7 +92,7 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) cons
   return out;
 }
 
-double& ContactSet::anchor_for(const Found& f, bool create) {
+double ContactSet::anchor_for(const Found& f) {
   const int key = 3 * f.point + f.course + 1;
   double* best = nullptr;
   double bd = opt_.match_tol;
@@ -103,13 +103,9 @@ double& ContactSet::anchor_for(const Found& f, bool create) {
         best = &a;
       }
   if (best) return *best;
-  static thread_local double scratch;
-  if (!create) {
-    scratch = f.pr.u;
-    return scratch;
-  }
+  // A new contact sticks where it is first found, for the rest of the increment.
   pending_[key].push_back(f.pr.u);
-  return pending_[key].back();
+  return f.pr.u;
 }
 
 template <class Visit>
@@ -125,7 +121,7 @@ void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool
         (Nc_.row(f.point) * Q.middleRows(first_[f.point], p + 1)).transpose();
     // Quick gap test before touching the history: inactive pairs create no anchors.
     if (f.pr.distance >= opt_.d) continue;
-    PairHistory h{anchor_for(f, true)};
+    PairHistory h{anchor_for(f)};
     const PairResult r = evaluate_pair(xs, ch, f.pr, opt_.d, law, opt_.friction, h, want_jac);
     if (r.active) v(f, r);
   }

@@ -94,7 +94,7 @@ class ContactSet : public rod::ExternalContribution {
   };
   std::vector<Found> search(const Eigen::MatrixXd& Q) const;
   Chain chain(const Eigen::MatrixXd& Q, int course) const;
-  double& anchor_for(const Found& f, bool create);
+  double anchor_for(const Found& f);
   Eigen::MatrixXd positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const;
   template <class Visit>
   void visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool want_jac, Visit&& v);
