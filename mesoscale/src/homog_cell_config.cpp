@@ -1,12 +1,12 @@
 // JSON reader of the unit-cell parameters: see knit/meso/homog/cell_config.hpp.
 #include "knit/meso/homog/cell_config.hpp"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 
 namespace knit::meso::homog {
 
@@ -56,16 +56,9 @@ struct Reader {
 
 CellOptions read_cell_options(const std::string& file, CellOptions o) {
   Reader R{file};
-  json j;
-  {
-    std::ifstream in(file);
-    if (!in) throw InputError(file, "", "cannot read file");
-    try {
-      j = json::parse(in);
-    } catch (const json::parse_error& e) {
-      throw InputError(file, "", std::string("invalid JSON: ") + e.what());
-    }
-  }
+  // Schema first (schemas/cell.schema.json, embedded): types, ranges, unknown keys with
+  // "did you mean"; the reader below keeps its own checks so that it is safe on its own.
+  const json j = io::load_and_validate(file, "cell");
   R.object(j, "", {"$schema", "description", "yarn", "loop", "analysis", "contact", "solver"});
   constexpr double inf = 1e300;
   if (j.contains("yarn")) {

@@ -1,7 +1,7 @@
-// Minimal output of the unit cell for viewing in ParaView: VTK XML PolyData (.vtp) polylines
+// Output of the unit cell for viewing in ParaView: VTK XML PolyData (.vtp) polylines
 // with a "radius" point array (use the Tube filter with "Vary radius by scalar" / radius
 // factor 1), an integer "piece" and "image" cell array, and PVD collections for paths.
-// Kept behind these functions until knit/io/vtk.hpp lands on main (then they forward to it).
+// These functions forward to the shared writers of knit/io/vtk.hpp (base64 data).
 // Files are written atomically (temporary file, then rename).
 #pragma once
 
@@ -18,7 +18,7 @@ struct Polyline {
   int image = 0;  ///< 0: the cell itself, k > 0: a periodic neighbour
 };
 
-/// Writes the polylines to `path` (ASCII .vtp), every point carrying radius r.
+/// Writes the polylines to `path` (.vtp), every point carrying radius r.
 void write_polylines_vtp(const std::string& path, const std::vector<Polyline>& lines, double r);
 
 /// Writes a ParaView collection (.pvd) listing (time, file) pairs; files relative to the pvd.
