@@ -4,6 +4,7 @@
 //    (Mattiasson 1981, Int. J. Numer. Meth. Eng. 17, Table 1: w/L = 0.67, -u/L = 0.329)
 //  * shear locking at d/L = 0.01 (Timoshenko tip deflection PL^3/3EI + PL/(kappa G A))
 //  * h- and p-convergence on the roll-up (smooth, exact solution known everywhere)
+#include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
@@ -190,4 +191,36 @@ TEST_CASE("rod: prescribed end rotation and end displacement", "[verification]")
       CHECK(sys.state(0, xi, x).n.x() == Approx(EA * delta / kL).epsilon(1e-10));
     CHECK(sys.position(0, 0.5, x).x() == Approx(0.5 * (kL + delta)).epsilon(1e-12));
   }
+}
+
+TEST_CASE("rod: helical spring under an axial force (torsion-dominated 3-D response)",
+          "[verification]") {
+  // Wahl, "Mechanical Springs" (1963), open-coiled spring loaded along its axis:
+  //   delta = P R^2 L (cos^2 a / GJ + sin^2 a / EI),  L = wire length, a = pitch angle.
+  // The force acts on the axis: a dead force P e_z at the wire end plus the moment of its
+  // offset, M = (c - r_end) x P (linear regime, small load).
+  Section sec;
+  sec.d = 0.1;
+  const double R = 1.0, turns = 5.0, pitch = 0.5;
+  const double a = std::atan(pitch / (2 * std::numbers::pi * R));
+  const double L = turns * std::hypot(2 * std::numbers::pi * R, pitch);
+  auto helix = [&](double t) -> Vector3d {
+    const double phi = 2 * std::numbers::pi * turns * t;
+    return Vector3d(R * std::cos(phi), R * std::sin(phi), pitch * turns * t);
+  };
+  RodSpec s = interpolated_rod(helix, 4, 80, sec);
+  const double P = 1e-6;
+  const Vector3d end = helix(1.0), c(0, 0, end.z());
+  s.end.force = Vector3d(0, 0, P);
+  s.end.moment = (c - end).cross(s.end.force);
+  RodSystem sys;
+  sys.add_rod(s);
+  Eigen::VectorXd x = sys.initial_state();
+  REQUIRE(solve_newton(sys, x, 1.0).converged);
+  const double delta = sys.position(0, 1.0, x).z() - end.z();
+  const double EI = sec.C_K()(0), GJ = sec.C_K()(2);
+  const double wahl =
+      P * R * R * L * (std::cos(a) * std::cos(a) / GJ + std::sin(a) * std::sin(a) / EI);
+  INFO("delta = " << delta << ", Wahl " << wahl);
+  CHECK(delta == Approx(wahl).epsilon(0.01));
 }
