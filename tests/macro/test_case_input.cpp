@@ -220,8 +220,10 @@ TEST_CASE("case file: Scordelis-Lo roof", "[case][verification]") {
   CHECK(-r.rows.back().points[0](2) * 1e4 == Approx(0.3006).epsilon(0.01));
 }
 
-TEST_CASE("case file: Scordelis-Lo roof, quarter model with symmetry planes", "[case][verification]") {
-  const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/scordelis_lo_quarter.json");
+TEST_CASE("case file: Scordelis-Lo roof, quarter model with symmetry planes",
+          "[case][verification]") {
+  const Case c =
+      load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/scordelis_lo_quarter.json");
   const RunResult r = run_case(c, {});
   REQUIRE(r.report.status == RunStatus::kCompleted);
   CHECK(-r.rows.back().points[0](2) * 1e4 == Approx(0.3006).epsilon(0.01));

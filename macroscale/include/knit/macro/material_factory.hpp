@@ -14,8 +14,8 @@
 namespace knit::macro {
 
 struct CaseContext {
-  std::string file;                              ///< the case file (messages, relative paths)
-  std::string pointer;                           ///< JSON pointer of the material object
+  std::string file;     ///< the case file (messages, relative paths)
+  std::string pointer;  ///< JSON pointer of the material object
   /// The refined patch (parameter domain). Valid only during make_material: copy what you need.
   const spline::SplineSurface* patch = nullptr;
 };
