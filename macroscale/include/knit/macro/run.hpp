@@ -1,0 +1,67 @@
+// Running a case (`knit-macro run CASE.json [--output DIR]`): set up the shell, the DOF map
+// and the loads, solve with load stepping, and write one output directory:
+//   load_strain.csv   one row per converged step (load factor, applied displacement and
+//                     strain, reactions, displacements of named points, iterations, residual)
+//   results.pvd       ParaView collection of vtk/step_NNNN.vtu (deformed mid-surface grid with
+//                     displacement, E11/E22/E12, curvature change, n, m, material fields)
+//   results.h5        the same fields, the case JSON and provenance (when HDF5 is available)
+//   case.json         the case as read
+// The directory is built as DIR.partial-<pid> and renamed to DIR at the end, so it is never
+// half-written; a run that stops early still writes every converged step (status in the
+// summary) and the caller returns exit code 1.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "knit/macro/case.hpp"
+#include "knit/macro/constraints.hpp"
+#include "knit/macro/newton.hpp"
+#include "knit/macro/shell_model.hpp"
+
+namespace knit::macro {
+
+struct Problem {
+  std::unique_ptr<ShellModel> model;
+  DofMap dofs;
+  Eigen::VectorXd fext;  ///< dead loads at load factor 1
+};
+
+/// Builds the model, constraints and loads. Throws knit::InputError for a degenerate geometry
+/// (zero Jacobian, with its location), contradictory constraints and missing supports (an
+/// unconstrained rigid-body motion).
+Problem setup_problem(const Case& c);
+
+/// One row of load_strain.csv.
+struct StepRow {
+  int step = 0;
+  double lambda = 0.0;
+  double applied = 0.0, strain = 0.0;   ///< if the case names an applied displacement
+  std::vector<double> reactions;        ///< one per output.reactions entry (N)
+  std::vector<Eigen::Vector3d> points;  ///< displacement of each output point (mm)
+  int iterations = 0;
+  double residual = 0.0, seconds = 0.0;
+};
+
+/// Reaction force: sum of f_int over the control points of the first `rows` rows of an edge.
+double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge, int component,
+                     int rows);
+
+struct RunOptions {
+  std::filesystem::path output_dir;  ///< empty: no files are written (tests)
+  std::ostream* progress = nullptr;  ///< one line per converged step
+};
+
+struct RunResult {
+  RunReport report;
+  std::vector<StepRow> rows;
+  Eigen::VectorXd u;  ///< displacement of the last converged step
+};
+
+RunResult run_case(const Case& c, const RunOptions& options);
+
+}  // namespace knit::macro

@@ -1,0 +1,119 @@
+// The nonlinear isogeometric Kirchhoff-Love shell on one NURBS patch: internal forces and
+// the exact consistent tangent (paper eqs. 10-15; Kiendl et al., CMAME 198 (2009), eqs. 21-27;
+// Kiendl et al., CMAME 291 (2015) for the through-thickness integration of general materials).
+//
+//   f_int,r = int  n : eps_,r + m : kappa_,r  dA
+//   K_rs    = int  eps_,r D_mm eps_,s + eps_,r D_mb kappa_,s + kappa_,r D_mb eps_,s
+//                  + kappa_,r D_bb kappa_,s + n : eps_,rs + m : kappa_,rs  dA
+//
+// with covariant resultants (n, m) = T^T (n_cart, m_cart) and tangents T^T (A, B, D) T from the
+// section integration (section.hpp). Reference quantities are precomputed at all quadrature
+// points ((p+1) Gauss points per direction and element) once; the loops do not allocate.
+// DOF r = 3 a + i: component i of the displacement of control point a.
+//
+// Variations (r = (l, i): control point l, component i; R_l the basis, e_i the unit vector):
+//   a_alpha,r = R_l,alpha e_i,   a3~ = a1 x a2,  j = |a3~|,  a3 = a3~ / j
+//   a3,r   = (a3~,r - a3 j,r)/j,  a3~,r = R_l,1 e_i x a2 + R_l,2 a1 x e_i,  j,r = a3 . a3~,r
+//   a3,rs  = (a3~,rs - a3,s j,r - a3 j,rs - a3,r j,s)/j,   j,rs = a3,s . a3~,r + a3 . a3~,rs
+//   a3~,rs = (R_l,1 R_m,2 - R_l,2 R_m,1) e_i x e_j
+//   eps_ab,r  = (a_a,r . a_b + a_a . a_b,r)/2,      eps_ab,rs = (a_a,r . a_b,s + a_a,s . a_b,r)/2
+//   kap_ab,r  = -(a_a,b,r . a3 + a_a,b . a3,r),     kap_ab,rs = -(a_a,b,r . a3,s + a_a,b,s . a3,r +
+//   a_a,b . a3,rs)
+// Every term is a bilinear form in Phi = (R_1, R_2, R_11, R_12, R_22) of the two control points,
+// so per quadrature point a 15 x 15 matrix H (Phi-index x component) holds the whole tangent:
+//   K(3l+i, 3m+j) = sum_q sum_fg Phi_f(l) H_q(3f+i, 3g+j) Phi_g(m)
+// which is evaluated per element as 9 (6 if the material tangent is symmetric) matrix products
+// Phi^T (H Phi) over all its quadrature points.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "knit/macro/material.hpp"
+#include "knit/macro/patch.hpp"
+#include "knit/macro/section.hpp"
+#include "knit/macro/shell_kinematics.hpp"
+#include "knit/spline/surface.hpp"
+
+namespace knit::macro {
+
+struct ShellOptions {
+  ThicknessIntegration integration = ThicknessIntegration::kGauss3;
+  int threads = 1;             ///< assembly threads (elements are split between them)
+  int quadrature_points = -1;  ///< per direction and element; -1: p + 1
+};
+
+/// Fields at one sample point of the mid-surface (outputs), all in the local Cartesian frame
+/// of the reference configuration.
+struct ShellSample {
+  Eigen::Vector3d X, x, u;                      ///< reference and current position, displacement
+  Eigen::Vector3d E = Eigen::Vector3d::Zero();  ///< membrane strain (E11, E22, 2E12)
+  Eigen::Vector3d kappa = Eigen::Vector3d::Zero();  ///< curvature change (k11, k22, 2k12)
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();      ///< membrane forces N/mm
+  Eigen::Vector3d m = Eigen::Vector3d::Zero();      ///< bending moments N mm/mm
+};
+
+class ShellModel {
+ public:
+  /// Throws DegenerateGeometryError if the Jacobian vanishes at a quadrature point.
+  ShellModel(spline::SplineSurface surface, double thickness, std::shared_ptr<Material> material,
+             ShellOptions options = {});
+
+  const spline::SplineSurface& surface() const { return surface_; }
+  double thickness() const { return t_; }
+  const Material& material() const { return *material_; }
+  int num_control_points() const { return surface_.size(); }
+  int num_dofs() const { return 3 * surface_.size(); }
+  int num_elements() const { return static_cast<int>(elements_.size()); }
+  int num_quadrature_points() const { return static_cast<int>(points_.size()); }
+  /// Control points of element e (the (pu+1)(pv+1) functions non-zero on it).
+  const Eigen::VectorXi& element_control_points(int e) const { return elements_[e].cp; }
+  void set_threads(int n) { opt_.threads = n < 1 ? 1 : n; }
+
+  struct Evaluation {
+    Eigen::VectorXd fint;             ///< internal force vector (num_dofs)
+    std::vector<Eigen::MatrixXd> Ke;  ///< element tangents (3 nloc square, local DOF 3 l + i)
+    bool ok = true;                   ///< false if the current configuration degenerated
+  };
+  /// Internal forces at displacement u (num_dofs), with the element tangents if `tangent`.
+  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const;
+
+  /// Output fields at (theta1, theta2) for displacement u.
+  ShellSample sample(const Eigen::VectorXd& u, const Eigen::Vector2d& theta) const;
+  /// Displacement of the mid-surface at theta.
+  Eigen::Vector3d displacement(const Eigen::VectorXd& u, const Eigen::Vector2d& theta) const;
+
+  /// Consistent nodal forces (num_dofs) of dead loads: a point force F (N) at theta, a line
+  /// force q (N/mm of reference length) along an edge, an area force q (N/mm^2 of reference area).
+  Eigen::VectorXd point_force(const Eigen::Vector2d& theta, const Eigen::Vector3d& F) const;
+  Eigen::VectorXd edge_force(Edge edge, const Eigen::Vector3d& q) const;
+  Eigen::VectorXd area_force(const Eigen::Vector3d& q) const;
+
+ private:
+  struct Element {
+    Eigen::VectorXi cp;
+    int first_point = 0, num_points = 0;
+    Eigen::MatrixXd Phi;  ///< (5 num_points) x nloc: R_1, R_2, R_11, R_12, R_22 at each point
+  };
+  struct Point {
+    ReferencePoint ref;
+    double dA = 0.0;  ///< quadrature weight x Jacobian
+  };
+  bool evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent, Evaluation& out,
+                      Eigen::VectorXd& fint) const;
+  SectionResponse section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
+                          const Eigen::Vector2d& theta, int point_id) const;
+
+  spline::SplineSurface surface_;
+  double t_;
+  std::shared_ptr<Material> material_;
+  ShellOptions opt_;
+  int nloc_ = 0;
+  std::vector<Element> elements_;
+  std::vector<Point> points_;
+  Eigen::MatrixXd R_;  ///< 6 x (nloc * num points): basis derivatives at every quadrature point
+  double scale_ = 1.0;
+};
+
+}  // namespace knit::macro

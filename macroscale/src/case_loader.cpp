@@ -1,0 +1,451 @@
+// Case JSON -> Case (case.hpp). Every check names the file and the JSON pointer; unknown keys
+// are errors at every level (the same rules as schemas/case.schema.json).
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
+#include "knit/macro/case.hpp"
+#include "knit/macro/material_factory.hpp"
+#include "knit/macro/refinement.hpp"
+#include "knit/spline/basis.hpp"
+#include "knit/spline/knot_vector.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+using nlohmann::json;
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+  const std::string& file() const { return file_; }
+
+  [[noreturn]] void fail(const std::string& ptr, const std::string& msg) const {
+    throw InputError(file_, ptr, msg);
+  }
+
+  const json& object(const json& j, const std::string& ptr) const {
+    if (!j.is_object()) fail(ptr, "must be an object, got " + std::string(j.type_name()));
+    return j;
+  }
+  const json& array(const json& j, const std::string& ptr) const {
+    if (!j.is_array()) fail(ptr, "must be an array, got " + std::string(j.type_name()));
+    return j;
+  }
+  /// Unknown keys are errors; required keys must be present.
+  void keys(const json& j, const std::string& ptr, std::initializer_list<const char*> allowed,
+            std::initializer_list<const char*> required = {}) const {
+    object(j, ptr);
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (std::none_of(allowed.begin(), allowed.end(),
+                       [&](const char* k) { return it.key() == k; })) {
+        std::string list;
+        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
+        fail(ptr + "/" + it.key(), "unknown key (allowed here: " + list + ")");
+      }
+    }
+    for (const char* k : required)
+      if (!j.contains(k)) fail(ptr, std::string("missing required key \"") + k + "\"");
+  }
+  double number(const json& j, const std::string& ptr) const {
+    if (!j.is_number()) fail(ptr, "must be a number, got " + std::string(j.type_name()));
+    const double x = j.get<double>();
+    if (!std::isfinite(x)) fail(ptr, "must be finite");
+    return x;
+  }
+  double positive(const json& j, const std::string& ptr) const {
+    const double x = number(j, ptr);
+    if (!(x > 0.0)) fail(ptr, "must be positive, got " + j.dump());
+    return x;
+  }
+  int integer(const json& j, const std::string& ptr, int lo, int hi) const {
+    if (!j.is_number_integer()) fail(ptr, "must be an integer, got " + j.dump());
+    const long long v = j.get<long long>();
+    if (v < lo || v > hi)
+      fail(ptr,
+           "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + j.dump());
+    return static_cast<int>(v);
+  }
+  bool boolean(const json& j, const std::string& ptr) const {
+    if (!j.is_boolean()) fail(ptr, "must be true or false, got " + j.dump());
+    return j.get<bool>();
+  }
+  std::string string(const json& j, const std::string& ptr) const {
+    if (!j.is_string()) fail(ptr, "must be a string, got " + std::string(j.type_name()));
+    return j.get<std::string>();
+  }
+  Eigen::Vector3d vec3(const json& j, const std::string& ptr) const {
+    if (!j.is_array() || j.size() != 3) fail(ptr, "must be an array of 3 numbers");
+    return {number(j[0], ptr + "/0"), number(j[1], ptr + "/1"), number(j[2], ptr + "/2")};
+  }
+  /// A parametric point in [0,1]^2.
+  Eigen::Vector2d param(const json& j, const std::string& ptr) const {
+    if (!j.is_array() || j.size() != 2) fail(ptr, "must be a parametric point [theta1, theta2]");
+    Eigen::Vector2d t(number(j[0], ptr + "/0"), number(j[1], ptr + "/1"));
+    if (t.minCoeff() < 0.0 || t.maxCoeff() > 1.0)
+      fail(ptr, "parametric point (" + j[0].dump() + ", " + j[1].dump() +
+                    ") is outside the domain [0,1]^2");
+    return t;
+  }
+  Edge edge(const json& j, const std::string& ptr) const {
+    const std::string s = string(j, ptr);
+    const auto e = parse_edge(s);
+    if (!e) fail(ptr, "no edge \"" + s + "\" (the patch's edges are u0, u1, v0, v1)");
+    return *e;
+  }
+  Eigen::Vector2d corner(const json& j, const std::string& ptr) const {
+    const std::string s = string(j, ptr);
+    const auto c = parse_corner(s);
+    if (!c) fail(ptr, "no corner \"" + s + "\" (the corners are u0v0, u1v0, u0v1, u1v1)");
+    return *c;
+  }
+  int component(const json& j, const std::string& ptr) const {
+    const std::string s = string(j, ptr);
+    const int c = parse_component(s);
+    if (c < 0) fail(ptr, "no component \"" + s + "\" (use x, y or z)");
+    return c;
+  }
+  std::vector<double> numbers(const json& j, const std::string& ptr) const {
+    array(j, ptr);
+    std::vector<double> v;
+    for (size_t i = 0; i < j.size(); ++i) v.push_back(number(j[i], ptr + "/" + std::to_string(i)));
+    return v;
+  }
+
+ private:
+  std::string file_;
+};
+
+spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const char* key) {
+  const std::string ptr = std::string("/geometry/") + key;
+  const std::vector<double> U = r.numbers(g.at(key), ptr);
+  try {
+    spline::validate_knots(U, p);
+  } catch (const spline::KnotVectorError& e) {
+    r.fail(ptr, e.what());
+  }
+  if (U.front() != 0.0 || U.back() != 1.0)
+    r.fail(ptr,
+           "the knot vector must run from 0 to 1 (parametric points and edges refer to [0,1]^2)");
+  return spline::BSplineBasis(p, U);
+}
+
+void read_geometry(const Reader& r, const json& root, Case& c) {
+  if (!root.contains("geometry")) r.fail("", "missing required key \"geometry\"");
+  const json& g = root.at("geometry");
+  r.keys(g, "/geometry",
+         {"degrees", "knots_u", "knots_v", "control_points", "weights", "thickness", "description"},
+         {"degrees", "knots_u", "knots_v", "control_points", "thickness"});
+  const json& d = g.at("degrees");
+  if (!d.is_array() || d.size() != 2) r.fail("/geometry/degrees", "must be [p_u, p_v]");
+  const int pu = r.integer(d[0], "/geometry/degrees/0", 1, spline::kMaxDegree);
+  const int pv = r.integer(d[1], "/geometry/degrees/1", 1, spline::kMaxDegree);
+  spline::BSplineBasis bu = read_basis(r, g, pu, "knots_u"), bv = read_basis(r, g, pv, "knots_v");
+  const json& cp = r.array(g.at("control_points"), "/geometry/control_points");
+  const int n = bu.size() * bv.size();
+  if (static_cast<int>(cp.size()) != n)
+    r.fail("/geometry/control_points",
+           std::to_string(cp.size()) + " control points, but the knot vectors and degrees define " +
+               std::to_string(bu.size()) + " x " + std::to_string(bv.size()) + " = " +
+               std::to_string(n) + " (u index fastest)");
+  Eigen::MatrixXd P(n, 3);
+  for (int a = 0; a < n; ++a)
+    P.row(a) = r.vec3(cp[a], "/geometry/control_points/" + std::to_string(a)).transpose();
+  Eigen::VectorXd w;
+  if (g.contains("weights")) {
+    const std::vector<double> wv = r.numbers(g.at("weights"), "/geometry/weights");
+    if (static_cast<int>(wv.size()) != n)
+      r.fail("/geometry/weights",
+             std::to_string(wv.size()) + " weights for " + std::to_string(n) + " control points");
+    w.resize(n);
+    for (int a = 0; a < n; ++a) {
+      if (!(wv[a] > 0.0))
+        r.fail("/geometry/weights/" + std::to_string(a), "weights must be positive");
+      w(a) = wv[a];
+    }
+  }
+  c.thickness = r.positive(g.at("thickness"), "/geometry/thickness");
+  c.input_surface = spline::SplineSurface(bu, bv, P, w);
+  c.surface = c.input_surface;
+  if (root.contains("refinement")) {
+    const json& rf = root.at("refinement");
+    r.keys(rf, "/refinement", {"degree", "elements", "description"}, {"degree", "elements"});
+    const int p = r.integer(rf.at("degree"), "/refinement/degree", 1, spline::kMaxDegree);
+    if (p < std::max(pu, pv))
+      r.fail("/refinement/degree", "degree " + std::to_string(p) + " is below the patch's degree " +
+                                       std::to_string(std::max(pu, pv)) +
+                                       " (degree elevation only)");
+    const json& el = rf.at("elements");
+    if (!el.is_array() || el.size() != 2)
+      r.fail("/refinement/elements", "must be [elements_u, elements_v]");
+    const int eu = r.integer(el[0], "/refinement/elements/0", 1, 256);
+    const int ev = r.integer(el[1], "/refinement/elements/1", 1, 256);
+    c.surface = refine_patch(c.input_surface, p, eu, ev);
+  }
+}
+
+void read_bcs(const Reader& r, const json& root, Case& c) {
+  if (!root.contains("boundary_conditions")) return;
+  const json& bcs = r.array(root.at("boundary_conditions"), "/boundary_conditions");
+  for (size_t k = 0; k < bcs.size(); ++k) {
+    const std::string ptr = "/boundary_conditions/" + std::to_string(k);
+    const json& j = bcs[k];
+    r.keys(
+        j, ptr,
+        {"edge", "corner", "point", "all", "fix", "prescribe", "clamp", "symmetry", "description"});
+    BoundaryCondition bc;
+    bc.pointer = ptr;
+    const int targets = int(j.contains("edge")) + int(j.contains("corner")) +
+                        int(j.contains("point")) + int(j.contains("all"));
+    if (targets != 1)
+      r.fail(ptr, "needs exactly one target: \"edge\", \"corner\", \"point\" or \"all\"");
+    if (j.contains("edge")) {
+      bc.target = BoundaryCondition::Target::kEdge;
+      bc.edge = r.edge(j.at("edge"), ptr + "/edge");
+    } else if (j.contains("corner")) {
+      bc.target = BoundaryCondition::Target::kCorner;
+      bc.corner = r.corner(j.at("corner"), ptr + "/corner");
+    } else if (j.contains("point")) {
+      // Choice: a point constraint acts on a control point, which interpolates the surface only
+      // at the corners of an open-knot patch; interior points would need a penalty (not done).
+      const Eigen::Vector2d t = r.param(j.at("point"), ptr + "/point");
+      if ((t.array() * (1.0 - t.array())).abs().maxCoeff() > 0.0)
+        r.fail(
+            ptr + "/point",
+            "displacement conditions at parametric points are supported at the corners only (the "
+            "control net interpolates the surface there); use an edge or a corner");
+      bc.target = BoundaryCondition::Target::kCorner;
+      bc.corner = t;
+    } else {
+      if (!r.boolean(j.at("all"), ptr + "/all"))
+        r.fail(ptr + "/all", "must be true (every control point)");
+      bc.target = BoundaryCondition::Target::kAll;
+    }
+    if (j.contains("fix")) {
+      const json& f = r.array(j.at("fix"), ptr + "/fix");
+      for (size_t i = 0; i < f.size(); ++i)
+        bc.fix[r.component(f[i], ptr + "/fix/" + std::to_string(i))] = true;
+    }
+    if (j.contains("prescribe")) {
+      const json& p = r.object(j.at("prescribe"), ptr + "/prescribe");
+      r.keys(p, ptr + "/prescribe", {"x", "y", "z"});
+      for (auto it = p.begin(); it != p.end(); ++it) {
+        const int comp = parse_component(it.key());
+        if (bc.fix[comp]) r.fail(ptr + "/prescribe/" + it.key(), "component is also in \"fix\"");
+        bc.prescribe[comp] = r.number(it.value(), ptr + "/prescribe/" + it.key());
+      }
+    }
+    if (j.contains("clamp")) {
+      bc.clamp = r.boolean(j.at("clamp"), ptr + "/clamp");
+      if (bc.clamp && bc.target != BoundaryCondition::Target::kEdge)
+        r.fail(ptr + "/clamp", "only an edge can be clamped");
+    }
+    if (j.contains("symmetry")) {
+      if (bc.target != BoundaryCondition::Target::kEdge)
+        r.fail(ptr + "/symmetry", "a symmetry plane needs an edge");
+      bc.symmetry = r.component(j.at("symmetry"), ptr + "/symmetry");
+    }
+    const bool any = bc.fix[0] || bc.fix[1] || bc.fix[2] || bc.prescribe[0] || bc.prescribe[1] ||
+                     bc.prescribe[2] || bc.clamp || bc.symmetry >= 0;
+    if (!any)
+      r.fail(ptr, "constrains nothing (give \"fix\", \"prescribe\", \"clamp\" or \"symmetry\")");
+    c.bcs.push_back(bc);
+  }
+}
+
+void read_loads(const Reader& r, const json& root, Case& c) {
+  if (!root.contains("loads")) return;
+  const json& loads = r.array(root.at("loads"), "/loads");
+  for (size_t k = 0; k < loads.size(); ++k) {
+    const std::string ptr = "/loads/" + std::to_string(k);
+    const json& j = r.object(loads[k], ptr);
+    if (!j.contains("type")) r.fail(ptr, "missing required key \"type\" (point, edge or area)");
+    const std::string type = r.string(j.at("type"), ptr + "/type");
+    Load l;
+    if (type == "point") {
+      r.keys(j, ptr, {"type", "at", "corner", "force", "description"}, {"force"});
+      if (j.contains("at") == j.contains("corner"))
+        r.fail(ptr, "a point load needs either \"at\" or \"corner\"");
+      l.kind = Load::Kind::kPoint;
+      l.at = j.contains("at") ? r.param(j.at("at"), ptr + "/at")
+                              : r.corner(j.at("corner"), ptr + "/corner");
+      l.value = r.vec3(j.at("force"), ptr + "/force");
+    } else if (type == "edge") {
+      r.keys(j, ptr, {"type", "edge", "force_per_length", "description"},
+             {"edge", "force_per_length"});
+      l.kind = Load::Kind::kEdge;
+      l.edge = r.edge(j.at("edge"), ptr + "/edge");
+      l.value = r.vec3(j.at("force_per_length"), ptr + "/force_per_length");
+    } else if (type == "area") {
+      r.keys(j, ptr, {"type", "force_per_area", "description"}, {"force_per_area"});
+      l.kind = Load::Kind::kArea;
+      l.value = r.vec3(j.at("force_per_area"), ptr + "/force_per_area");
+    } else {
+      r.fail(ptr + "/type", "unknown load type \"" + type + "\" (point, edge or area)");
+    }
+    c.loads.push_back(l);
+  }
+}
+
+void read_solver(const Reader& r, const json& root, Case& c) {
+  if (!root.contains("solver")) return;
+  const json& s = root.at("solver");
+  r.keys(s, "/solver",
+         {"steps", "tolerance", "absolute_tolerance", "max_iterations", "max_cutbacks",
+          "line_search", "threads", "thickness_integration", "description"});
+  SolverOptions& o = c.solver;
+  if (s.contains("steps")) o.steps = r.integer(s.at("steps"), "/solver/steps", 1, 100000);
+  if (s.contains("tolerance")) o.tolerance = r.positive(s.at("tolerance"), "/solver/tolerance");
+  if (s.contains("absolute_tolerance"))
+    o.absolute_tolerance = r.positive(s.at("absolute_tolerance"), "/solver/absolute_tolerance");
+  if (s.contains("max_iterations"))
+    o.max_iterations = r.integer(s.at("max_iterations"), "/solver/max_iterations", 1, 1000);
+  if (s.contains("max_cutbacks"))
+    o.max_cutbacks = r.integer(s.at("max_cutbacks"), "/solver/max_cutbacks", 0, 40);
+  if (s.contains("line_search"))
+    o.line_search = r.boolean(s.at("line_search"), "/solver/line_search");
+  if (s.contains("threads")) c.threads = r.integer(s.at("threads"), "/solver/threads", 1, 64);
+  if (s.contains("thickness_integration")) {
+    const std::string ti = r.string(s.at("thickness_integration"), "/solver/thickness_integration");
+    if (ti == "gauss3")
+      c.integration = ThicknessIntegration::kGauss3;
+    else if (ti == "analytic")
+      c.integration = ThicknessIntegration::kAnalytic;
+    else
+      r.fail("/solver/thickness_integration",
+             "must be \"gauss3\" or \"analytic\", got \"" + ti + "\"");
+  }
+}
+
+void read_output(const Reader& r, const json& root, Case& c) {
+  if (!root.contains("output")) return;
+  const json& o = root.at("output");
+  r.keys(o, "/output",
+         {"grid", "every", "vtk", "hdf5", "points", "reactions", "applied_displacement",
+          "description"});
+  OutputOptions& out = c.output;
+  if (o.contains("grid")) {
+    const json& g = o.at("grid");
+    if (!g.is_array() || g.size() != 2) r.fail("/output/grid", "must be [samples_u, samples_v]");
+    out.grid_u = r.integer(g[0], "/output/grid/0", 2, 1001);
+    out.grid_v = r.integer(g[1], "/output/grid/1", 2, 1001);
+  }
+  if (o.contains("every")) out.every = r.integer(o.at("every"), "/output/every", 1, 100000);
+  if (o.contains("vtk")) out.vtk = r.boolean(o.at("vtk"), "/output/vtk");
+  if (o.contains("hdf5")) out.hdf5 = r.boolean(o.at("hdf5"), "/output/hdf5");
+  std::set<std::string> names;
+  auto unique_name = [&](const json& j, const std::string& ptr) {
+    const std::string n = r.string(j, ptr);
+    if (n.empty() || n.find_first_of(",\"\n/") != std::string::npos)
+      r.fail(ptr, "names must be non-empty without commas, quotes, slashes or newlines");
+    if (!names.insert(n).second) r.fail(ptr, "the name \"" + n + "\" is used twice");
+    return n;
+  };
+  if (o.contains("points")) {
+    const json& ps = r.array(o.at("points"), "/output/points");
+    for (size_t k = 0; k < ps.size(); ++k) {
+      const std::string ptr = "/output/points/" + std::to_string(k);
+      r.keys(ps[k], ptr, {"name", "at"}, {"name", "at"});
+      out.points.push_back(
+          {unique_name(ps[k].at("name"), ptr + "/name"), r.param(ps[k].at("at"), ptr + "/at")});
+    }
+  }
+  if (o.contains("reactions")) {
+    const json& rs = r.array(o.at("reactions"), "/output/reactions");
+    for (size_t k = 0; k < rs.size(); ++k) {
+      const std::string ptr = "/output/reactions/" + std::to_string(k);
+      r.keys(rs[k], ptr, {"name", "edge", "corner", "component", "rows"}, {"name", "component"});
+      if (rs[k].contains("edge") == rs[k].contains("corner"))
+        r.fail(ptr, "needs either \"edge\" or \"corner\"");
+      ReactionOutput ro;
+      ro.name = unique_name(rs[k].at("name"), ptr + "/name");
+      ro.at_edge = rs[k].contains("edge");
+      if (ro.at_edge)
+        ro.edge = r.edge(rs[k].at("edge"), ptr + "/edge");
+      else
+        ro.corner = r.corner(rs[k].at("corner"), ptr + "/corner");
+      if (!ro.at_edge && rs[k].contains("rows")) r.fail(ptr + "/rows", "rows apply to edges only");
+      ro.component = r.component(rs[k].at("component"), ptr + "/component");
+      if (rs[k].contains("rows")) ro.rows = r.integer(rs[k].at("rows"), ptr + "/rows", 1, 2);
+      out.reactions.push_back(ro);
+    }
+  }
+  if (o.contains("applied_displacement")) {
+    const std::string ptr = "/output/applied_displacement";
+    const json& a = o.at(ptr.substr(8));
+    r.keys(a, ptr, {"edge", "corner", "component", "gauge_length"}, {"component", "gauge_length"});
+    if (a.contains("edge") == a.contains("corner"))
+      r.fail(ptr, "needs either \"edge\" or \"corner\"");
+    AppliedDisplacement ad;
+    ad.at_edge = a.contains("edge");
+    if (ad.at_edge)
+      ad.edge = r.edge(a.at("edge"), ptr + "/edge");
+    else
+      ad.corner = r.corner(a.at("corner"), ptr + "/corner");
+    ad.component = r.component(a.at("component"), ptr + "/component");
+    ad.gauge_length = r.positive(a.at("gauge_length"), ptr + "/gauge_length");
+    bool found = false;
+    for (const BoundaryCondition& bc : c.bcs) {
+      const bool same =
+          ad.at_edge ? (bc.target == BoundaryCondition::Target::kEdge && bc.edge == ad.edge)
+                     : (bc.target == BoundaryCondition::Target::kCorner && bc.corner == ad.corner);
+      if (same && bc.prescribe[ad.component]) {
+        ad.value = *bc.prescribe[ad.component];
+        found = true;
+      }
+    }
+    if (!found)
+      r.fail(ptr, "no boundary condition prescribes this component on that edge or corner");
+    out.applied = ad;
+  }
+}
+
+}  // namespace
+
+Case parse_case(const std::string& text, const std::string& file) {
+  Reader r(file);
+  // Parse errors name the line and column; duplicate keys are errors (knit/io).
+  const json root = io::parse_json(text, file);
+  r.keys(root, "",
+         {"$schema", "description", "units", "geometry", "refinement", "material",
+          "boundary_conditions", "loads", "solver", "output"},
+         {"geometry", "material"});
+  Case c;
+  c.file = file;
+  c.text = text;
+  if (root.contains("description"))
+    c.description = r.string(root.at("description"), "/description");
+  if (root.contains("units")) r.string(root.at("units"), "/units");
+  read_geometry(r, root, c);
+  CaseContext ctx;
+  ctx.file = file;
+  ctx.pointer = "/material";
+  ctx.patch = &c.surface;
+  c.material = make_material(root.at("material"), ctx);
+  read_bcs(r, root, c);
+  read_loads(r, root, c);
+  read_solver(r, root, c);
+  read_output(r, root, c);
+  if (c.integration == ThicknessIntegration::kAnalytic &&
+      !c.material->has_analytic_thickness_integration())
+    r.fail("/solver/thickness_integration",
+           "the material \"" + c.material->name() + "\" has no analytic thickness integration");
+  // The schema as the last word: the checks above are more specific, it catches what they miss.
+  io::JsonSchema::embedded("case").validate(root, file);
+  return c;
+}
+
+Case load_case(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open the case file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return parse_case(s.str(), path);
+}
+
+}  // namespace knit::macro

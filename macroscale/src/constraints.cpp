@@ -1,0 +1,124 @@
+#include "knit/macro/constraints.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace knit::macro {
+
+Constraints::Constraints(int n) : n_(n), value_(n) {}
+
+void Constraints::prescribe(int dof, double value) {
+  if (value_[dof] && std::abs(*value_[dof] - value) > 1e-14 * (1.0 + std::abs(value)))
+    throw ConstraintConflict(dof, "DOF " + std::to_string(dof) + " (control point " +
+                                      std::to_string(dof / 3) + ", component " + "xyz"[dof % 3] +
+                                      ") is prescribed twice with different values");
+  value_[dof] = value;
+}
+
+void Constraints::tie(int a, int b) {
+  ties_.emplace_back(a, b);
+}
+
+namespace {
+int find(std::vector<int>& p, int a) {
+  while (p[a] != a) a = p[a] = p[p[a]];
+  return a;
+}
+}  // namespace
+
+DofMap::DofMap(const Constraints& c)
+    : free_(c.n_, -1), root_(c.n_), value_(Eigen::VectorXd::Zero(c.n_)) {
+  std::iota(root_.begin(), root_.end(), 0);
+  for (auto [a, b] : c.ties_) {
+    const int ra = find(root_, a), rb = find(root_, b);
+    if (ra != rb) root_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  for (int d = 0; d < c.n_; ++d) root_[d] = find(root_, d);
+  // Group values: a group is constrained if any member is.
+  std::vector<std::optional<double>> gv(c.n_);
+  for (int d = 0; d < c.n_; ++d) {
+    if (!c.value_[d]) continue;
+    auto& g = gv[root_[d]];
+    if (g && std::abs(*g - *c.value_[d]) > 1e-14 * (1.0 + std::abs(*g)))
+      throw ConstraintConflict(d, "DOF " + std::to_string(d) + " (control point " +
+                                      std::to_string(d / 3) + ", component " + "xyz"[d % 3] +
+                                      ") is tied to a DOF with a different prescribed value");
+    g = c.value_[d];
+  }
+  std::vector<int> group_index(c.n_, -1);
+  for (int d = 0; d < c.n_; ++d) {
+    const int r = root_[d];
+    if (gv[r]) {
+      value_(d) = *gv[r];
+      continue;
+    }
+    if (group_index[r] < 0) group_index[r] = nfree_++;
+    free_[d] = group_index[r];
+  }
+}
+
+Eigen::VectorXd DofMap::expand(const Eigen::VectorXd& ufree, double lambda) const {
+  Eigen::VectorXd u(num_dofs());
+  for (int d = 0; d < num_dofs(); ++d) u(d) = free_[d] >= 0 ? ufree(free_[d]) : lambda * value_(d);
+  return u;
+}
+
+Eigen::VectorXd DofMap::reduce(const Eigen::VectorXd& full) const {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(nfree_);
+  for (int d = 0; d < num_dofs(); ++d)
+    if (free_[d] >= 0) r(free_[d]) += full(d);
+  return r;
+}
+
+Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(nfree_);
+  for (int d = num_dofs() - 1; d >= 0; --d)
+    if (free_[d] >= 0) r(free_[d]) = full(d);
+  return r;
+}
+
+std::optional<std::string> DofMap::unconstrained_rigid_mode(const Eigen::MatrixXd& X) const {
+  const Eigen::RowVector3d c = X.colwise().mean();
+  const double L = std::max(1e-300, (X.rowwise() - c).rowwise().norm().maxCoeff());
+  // Mode k at DOF 3a+i: translations e_k, rotations (omega_k x (X_a - c)) / L.
+  auto mode = [&](int d) {
+    Eigen::Matrix<double, 1, 6> m = Eigen::Matrix<double, 1, 6>::Zero();
+    const int a = d / 3, i = d % 3;
+    m(i) = 1.0;
+    const Eigen::Vector3d r = (X.row(a) - c).transpose() / L;
+    for (int k = 0; k < 3; ++k) m(3 + k) = Eigen::Vector3d::Unit(k).cross(r)(i);
+    return m;
+  };
+  std::vector<Eigen::Matrix<double, 1, 6>> rows;
+  for (int d = 0; d < num_dofs(); ++d) {
+    if (free_[d] < 0)
+      rows.push_back(mode(d));
+    else if (root_[d] != d)
+      rows.push_back(mode(d) - mode(root_[d]));
+  }
+  Eigen::MatrixXd A(rows.size() + 1, 6);
+  A.setZero();
+  for (size_t k = 0; k < rows.size(); ++k) A.row(k) = rows[k];
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  const auto& s = svd.singularValues();
+  if (s(5) > 1e-8 * std::max(1.0, s(0))) return std::nullopt;
+  const Eigen::Matrix<double, 6, 1> v = svd.matrixV().col(5);
+  std::ostringstream o;
+  o.precision(3);
+  const Eigen::Vector3d t = v.head<3>(), w = v.tail<3>();
+  if (w.norm() < 1e-6) {
+    const Eigen::Vector3d d = t.normalized();
+    o << "translation along (" << d(0) << ", " << d(1) << ", " << d(2) << ")";
+  } else {
+    const Eigen::Vector3d d = w.normalized();
+    o << "rotation about the direction (" << (std::abs(d(0)) < 1e-9 ? 0.0 : d(0)) << ", "
+      << (std::abs(d(1)) < 1e-9 ? 0.0 : d(1)) << ", " << (std::abs(d(2)) < 1e-9 ? 0.0 : d(2))
+      << ")";
+  }
+  return o.str();
+}
+
+}  // namespace knit::macro

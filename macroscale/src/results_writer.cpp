@@ -1,0 +1,197 @@
+#include "results_writer.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "knit/core/build_info.hpp"
+#include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/io/provenance.hpp"
+#include "knit/io/vtk.hpp"
+
+namespace knit::macro {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fmt(double x) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", x);
+  return b;
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+}
+
+}  // namespace
+
+ResultsWriter::ResultsWriter(const Case& c, const ShellModel& m, fs::path dir)
+    : case_(c), model_(m), dir_(std::move(dir)), pvd_(dir_.path() / "results.pvd") {
+  fs::create_directories(dir_.path() / "vtk");
+  write_text(dir_.path() / "case.json", c.text);
+}
+
+ResultsWriter::~ResultsWriter() = default;
+
+void ResultsWriter::add_row(const StepRow& row) {
+  rows_.push_back(row);
+}
+
+ResultsWriter::Fields ResultsWriter::sample(int step, double lambda,
+                                            const Eigen::VectorXd& u) const {
+  const int gu = case_.output.grid_u, gv = case_.output.grid_v, n = gu * gv;
+  Fields f;
+  f.step = step;
+  f.lambda = lambda;
+  f.X.resize(n, 3);
+  f.x.resize(n, 3);
+  f.u.resize(n, 3);
+  f.names = {"E11", "E22", "E12", "kappa11", "kappa22", "kappa12",
+             "n11", "n22", "n12", "m11",     "m22",     "m12"};
+  std::vector<std::pair<std::string, double>> extra;
+  for (int j = 0; j < gv; ++j) {
+    for (int i = 0; i < gu; ++i) {
+      const int k = i + gu * j;
+      const Eigen::Vector2d t(double(i) / (gu - 1), double(j) / (gv - 1));
+      const ShellSample s = model_.sample(u, t);
+      extra = model_.material().output_fields(t, s.E);
+      if (k == 0) {
+        for (const auto& [name, v] : extra) f.names.push_back(name);
+        f.values.resize(n, f.names.size());
+      }
+      f.X.row(k) = s.X.transpose();
+      f.x.row(k) = s.x.transpose();
+      f.u.row(k) = s.u.transpose();
+      // Voigt shear components (2E12, 2k12) are stored as tensor components E12, k12.
+      const double v[12] = {s.E(0), s.E(1), 0.5 * s.E(2), s.kappa(0), s.kappa(1), 0.5 * s.kappa(2),
+                            s.n(0), s.n(1), s.n(2),       s.m(0),     s.m(1),     s.m(2)};
+      for (int c = 0; c < 12; ++c) f.values(k, c) = v[c];
+      for (size_t c = 0; c < extra.size() && 12 + c < f.names.size(); ++c)
+        f.values(k, 12 + c) = extra[c].second;
+    }
+  }
+  return f;
+}
+
+void ResultsWriter::add_step(int step, double lambda, const Eigen::VectorXd& u) {
+  Fields f = sample(step, lambda, u);
+  char name[64];
+  std::snprintf(name, sizeof name, "step_%04d.vtu", step);
+  write_vtu(dir_.path() / "vtk" / name, f);
+  pvd_.add(lambda, dir_.path() / "vtk" / name);
+  pvd_.write();  // valid after every step
+  steps_.push_back(std::move(f));
+}
+
+void ResultsWriter::write_vtu(const fs::path& file, const Fields& f) const {
+  io::QuadMesh mesh = io::structured_quad_mesh(case_.output.grid_u, case_.output.grid_v, f.x);
+  mesh.point_data.push_back(io::vector_field("displacement", f.u));
+  for (size_t c = 0; c < f.names.size(); ++c) {
+    const Eigen::VectorXd col = f.values.col(c);
+    mesh.point_data.push_back(
+        io::scalar_field(f.names[c], std::vector<double>(col.data(), col.data() + col.size())));
+  }
+  io::write_vtu(file, mesh, io::VtkEncoding::Base64,
+                "knit-macro: deformed mid-surface at load factor " + fmt(f.lambda) +
+                    "; strains in the local Cartesian frame of the reference surface; " +
+                    io::Provenance::current(case_.file).to_json_string());
+}
+
+void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) const {
+  auto h5 = io::H5File::create(file);
+  io::write_provenance(h5, io::Provenance::current(case_.file));
+  h5.set_attribute(".", "status", report.status == RunStatus::kCompleted ? "completed" : "stopped");
+  h5.set_attribute(".", "message", report.message);
+  h5.set_attribute(".", "units", "mm, N, MPa");
+  h5.set_attribute(".", "material", case_.material->name());
+  h5.set_attribute(".", "material_report", material_report_);
+  h5.write_strings("case_json", {case_.text});
+  // The CSV columns.
+  const int n = static_cast<int>(rows_.size());
+  Eigen::VectorXd lam(n), app(n), eps(n), res(n), sec(n);
+  Eigen::VectorXi step(n), its(n);
+  for (int k = 0; k < n; ++k) {
+    const StepRow& r = rows_[k];
+    step(k) = r.step, lam(k) = r.lambda, app(k) = r.applied, eps(k) = r.strain;
+    its(k) = r.iterations, res(k) = r.residual, sec(k) = r.seconds;
+  }
+  h5.write("steps/step", step);
+  h5.write("steps/load_factor", lam);
+  if (case_.output.applied) {
+    h5.write("steps/applied_displacement", app);
+    h5.write("steps/strain", eps);
+  }
+  h5.write("steps/iterations", its);
+  h5.write("steps/residual", res);
+  h5.write("steps/seconds", sec);
+  for (size_t c = 0; c < case_.output.reactions.size(); ++c) {
+    Eigen::VectorXd f(n);
+    for (int k = 0; k < n; ++k) f(k) = rows_[k].reactions[c];
+    h5.write("steps/reactions/" + case_.output.reactions[c].name, f);
+  }
+  for (size_t c = 0; c < case_.output.points.size(); ++c) {
+    Eigen::MatrixXd d(n, 3);
+    for (int k = 0; k < n; ++k) d.row(k) = rows_[k].points[c].transpose();
+    h5.write("steps/points/" + case_.output.points[c].name, d);
+  }
+  // Sampled fields of each output step.
+  for (const Fields& f : steps_) {
+    char g[64];
+    std::snprintf(g, sizeof g, "fields/step_%04d", f.step);
+    const std::string grp(g);
+    h5.create_group(grp);
+    h5.set_attribute(grp, "load_factor", f.lambda);
+    h5.set_attribute(grp, "grid_u", case_.output.grid_u);
+    h5.set_attribute(grp, "grid_v", case_.output.grid_v);
+    h5.write(grp + "/X", f.X);
+    h5.write(grp + "/x", f.x);
+    h5.write(grp + "/displacement", f.u);
+    for (size_t c = 0; c < f.names.size(); ++c)
+      h5.write(grp + "/" + f.names[c], Eigen::VectorXd(f.values.col(c)));
+  }
+  h5.close();
+}
+
+void ResultsWriter::finish(const RunReport& report) {
+  std::vector<std::string> header = {"step", "load_factor"};
+  if (case_.output.applied) header.insert(header.end(), {"applied_displacement_mm", "strain"});
+  for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + "_N");
+  for (const OutputPoint& p : case_.output.points)
+    header.insert(header.end(), {p.name + "_ux_mm", p.name + "_uy_mm", p.name + "_uz_mm"});
+  header.insert(header.end(), {"iterations", "residual", "seconds"});
+  io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
+  csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
+                  ", git " + git_revision() + ")");
+  if (report.status != RunStatus::kCompleted)
+    csv.add_comment("run stopped early: " + report.message);
+  for (const StepRow& r : rows_) {
+    std::vector<io::CsvCell> row = {r.step, r.lambda};
+    if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
+    for (double f : r.reactions) row.emplace_back(f);
+    for (const auto& d : r.points) row.insert(row.end(), {d(0), d(1), d(2)});
+    row.insert(row.end(), {r.iterations, r.residual, r.seconds});
+    csv.add_row(row);
+  }
+  csv.commit();
+  if (pvd_.size() == 0) pvd_.write();
+  if (case_.output.hdf5) write_hdf5(dir_.path() / "results.h5", report);
+  std::ostringstream sum;
+  sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n"
+      << "converged steps: " << report.converged_steps
+      << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
+  if (!report.message.empty()) sum << "message: " << report.message << "\n";
+  sum << "material: " << case_.material->name() << "\n";
+  if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
+  write_text(dir_.path() / "summary.txt", sum.str());
+  dir_.commit();  // DIR.partial-<pid> -> DIR
+}
+
+}  // namespace knit::macro

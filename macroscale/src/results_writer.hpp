@@ -1,0 +1,51 @@
+// Output directory of a run (private to run.cpp): CSV of the converged steps, VTU/PVD of the
+// sampled mid-surface, case copy, summary. Built in DIR.partial-<pid>, renamed on finish().
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "knit/io/atomic.hpp"
+#include "knit/io/vtk.hpp"
+#include "knit/macro/case.hpp"
+#include "knit/macro/run.hpp"
+#include "knit/macro/shell_model.hpp"
+
+namespace knit::macro {
+
+class ResultsWriter {
+ public:
+  ResultsWriter(const Case& c, const ShellModel& m, std::filesystem::path dir);
+  ~ResultsWriter();
+  void add_row(const StepRow& row);
+  /// Samples the mid-surface on the output grid and writes vtk/step_NNNN.vtu.
+  void add_step(int step, double lambda, const Eigen::VectorXd& u);
+  /// Writes the CSV, PVD, HDF5 and summary, then moves the directory into place.
+  void finish(const RunReport& report);
+  /// The material's end-of-run summary (Material::report()), written to summary.txt and HDF5.
+  void set_material_report(std::string r) { material_report_ = std::move(r); }
+
+ private:
+  struct Fields {
+    int step = 0;
+    double lambda = 0.0;
+    Eigen::MatrixXd X, x, u;         ///< n x 3
+    std::vector<std::string> names;  ///< scalar field names
+    Eigen::MatrixXd values;          ///< n x names.size()
+  };
+  Fields sample(int step, double lambda, const Eigen::VectorXd& u) const;
+  void write_vtu(const std::filesystem::path& file, const Fields& f) const;
+  void write_hdf5(const std::filesystem::path& file, const RunReport& report) const;
+
+  const Case& case_;
+  const ShellModel& model_;
+  io::AtomicDirectory dir_;  ///< DIR.partial-<pid> until finish(); removed if abandoned
+  io::PvdCollection pvd_;
+  std::vector<StepRow> rows_;
+  std::vector<Fields> steps_;  ///< kept for the HDF5 file
+  std::string material_report_;
+};
+
+}  // namespace knit::macro

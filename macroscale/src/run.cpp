@@ -1,0 +1,152 @@
+#include "knit/macro/run.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <ostream>
+
+#include "knit/core/errors.hpp"
+#include "results_writer.hpp"
+
+namespace knit::macro {
+
+Problem setup_problem(const Case& c) {
+  Problem p;
+  ShellOptions so;
+  so.integration = c.integration;
+  so.threads = c.threads;
+  try {
+    p.model = std::make_unique<ShellModel>(c.surface, c.thickness, c.material, so);
+  } catch (const DegenerateGeometryError& e) {
+    throw InputError(c.file, "/geometry/control_points", e.what());
+  }
+  const ShellModel& m = *p.model;
+  const int nu = c.surface.size_u(), nv = c.surface.size_v();
+  Constraints con(m.num_dofs());
+  for (const BoundaryCondition& bc : c.bcs) {
+    try {
+      std::vector<int> row0, row1;
+      switch (bc.target) {
+        case BoundaryCondition::Target::kEdge:
+          row0 = edge_row(nu, nv, bc.edge, 0);
+          row1 = edge_row(nu, nv, bc.edge, 1);
+          break;
+        case BoundaryCondition::Target::kCorner:
+          row0 = {corner_control_point(nu, nv, bc.corner)};
+          break;
+        case BoundaryCondition::Target::kAll:
+          for (int a = 0; a < m.num_control_points(); ++a) row0.push_back(a);
+          break;
+      }
+      for (int a : row0)
+        for (int i = 0; i < 3; ++i) {
+          if (bc.fix[i]) con.fix(3 * a + i);
+          if (bc.prescribe[i]) con.prescribe(3 * a + i, *bc.prescribe[i]);
+        }
+      if (bc.clamp)  // zero rotation: the second row moves with the edge row
+        for (size_t k = 0; k < row0.size(); ++k)
+          for (int i = 0; i < 3; ++i) con.tie(3 * row1[k] + i, 3 * row0[k] + i);
+      if (bc.symmetry >=
+          0) {  // u_s = 0 on the edge, the cross-edge slope stays normal to the plane
+        for (size_t k = 0; k < row0.size(); ++k)
+          for (int i = 0; i < 3; ++i) {
+            if (i == bc.symmetry)
+              con.fix(3 * row0[k] + i);
+            else
+              con.tie(3 * row1[k] + i, 3 * row0[k] + i);
+          }
+      }
+    } catch (const ConstraintConflict& e) {
+      throw InputError(c.file, bc.pointer, e.what());
+    }
+  }
+  try {
+    p.dofs = DofMap(con);
+  } catch (const ConstraintConflict& e) {
+    throw InputError(c.file, "/boundary_conditions", e.what());
+  }
+  if (const auto mode = p.dofs.unconstrained_rigid_mode(c.surface.control_points()))
+    throw InputError(c.file, "/boundary_conditions",
+                     "missing support: the boundary conditions do not prevent a rigid-body " +
+                         *mode + " (the tangent stiffness would be singular); add supports");
+  p.fext = Eigen::VectorXd::Zero(m.num_dofs());
+  for (const Load& l : c.loads) {
+    switch (l.kind) {
+      case Load::Kind::kPoint:
+        p.fext += m.point_force(l.at, l.value);
+        break;
+      case Load::Kind::kEdge:
+        p.fext += m.edge_force(l.edge, l.value);
+        break;
+      case Load::Kind::kArea:
+        p.fext += m.area_force(l.value);
+        break;
+    }
+  }
+  return p;
+}
+
+double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge, int component,
+                     int rows) {
+  const int nu = m.surface().size_u(), nv = m.surface().size_v();
+  double f = 0.0;
+  for (int r = 0; r < rows; ++r)
+    for (int a : edge_row(nu, nv, edge, r)) f += fint(3 * a + component);
+  return f;
+}
+
+RunResult run_case(const Case& c, const RunOptions& opt) {
+  Problem p = setup_problem(c);
+  const ShellModel& m = *p.model;
+  std::unique_ptr<ResultsWriter> writer;
+  if (!opt.output_dir.empty()) writer = std::make_unique<ResultsWriter>(c, m, opt.output_dir);
+  RunResult res;
+  int outputs = 0;
+  Eigen::VectorXd last_written;
+  res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
+    StepRow row;
+    row.step = s.step;
+    row.lambda = s.lambda;
+    if (c.output.applied) {
+      row.applied = s.lambda * c.output.applied->value;
+      row.strain = row.applied / c.output.applied->gauge_length;
+    }
+    for (const ReactionOutput& r : c.output.reactions) {
+      const int a = corner_control_point(c.surface.size_u(), c.surface.size_v(), r.corner);
+      row.reactions.push_back(r.at_edge ? edge_reaction(m, s.fint, r.edge, r.component, r.rows)
+                                        : s.fint(3 * a + r.component));
+    }
+    for (const OutputPoint& op : c.output.points) row.points.push_back(m.displacement(s.u, op.at));
+    row.iterations = s.iterations;
+    row.residual = s.residual;
+    row.seconds = s.seconds;
+    res.rows.push_back(row);
+    res.u = s.u;
+    if (opt.progress) {
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "step %4d  load factor %.6f  iterations %2d  residual %.3e  time %.3f s",
+                    s.step, s.lambda, s.iterations, s.residual, s.seconds);
+      *opt.progress << line << std::endl;
+    }
+    if (writer) {
+      writer->add_row(row);
+      if (++outputs % c.output.every == 0 || s.lambda >= 1.0 - 1e-12)
+        writer->add_step(s.step, s.lambda, s.u);
+      else
+        last_written = s.u;
+    }
+  });
+  const std::string material_report = c.material->report();
+  if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
+  if (writer) {
+    writer->set_material_report(material_report);
+    // A stopped run still writes its last converged state.
+    if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
+        outputs % c.output.every != 0)
+      writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
+    writer->finish(res.report);
+  }
+  return res;
+}
+
+}  // namespace knit::macro

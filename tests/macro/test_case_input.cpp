@@ -1,0 +1,328 @@
+// Case files: bad input gives one error line with the file and the JSON pointer (exit code 2,
+// no output directory); the verification cases run and match their references.
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/macro/case.hpp"
+#include "knit/macro/run.hpp"
+
+using namespace knit::macro;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json read_json(const std::string& name) {
+  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
+  return json::parse(in);
+}
+
+/// The error message of parsing (and setting up) a modified tensile case, or "" if it passed.
+std::string error_of(const json& j) {
+  try {
+    const Case c = parse_case(j.dump(), "bad.json");
+    setup_problem(c);
+  } catch (const knit::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+fs::path temp_dir(const std::string& tag) {
+  fs::path d =
+      fs::temp_directory_path() / ("knit_macro_test_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+int run_exe(const std::string& args, const fs::path& log) {
+  const std::string cmd =
+      std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " + log.string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
+  const json base = read_json("tensile_svk.json");
+  CHECK(error_of(base).empty());
+  {
+    json j = base;
+    j["geometry"]["thickness"] = -1;
+    CHECK(error_of(j) == "bad.json: /geometry/thickness: must be positive, got -1");
+  }
+  {
+    json j = base;
+    j["geometry"]["thickness"] = "thin";
+    CHECK(error_of(j).rfind("bad.json: /geometry/thickness: must be a number", 0) == 0);
+  }
+  {
+    json j = base;
+    j["geometry"]["knots_u"] = {0, 0, 0.5, 1, 1};
+    CHECK(error_of(j).rfind(
+              "bad.json: /geometry/control_points: 4 control points, but the knot vectors", 0) ==
+          0);
+  }
+  {
+    json j = base;
+    j["geometry"]["knots_u"] = {0, 0, 1, 0.5};
+    CHECK(error_of(j).rfind("bad.json: /geometry/knots_u: ", 0) == 0);
+  }
+  {
+    json j = base;
+    j["boundary_conditions"][1]["edge"] = "u2";
+    CHECK(error_of(j) ==
+          "bad.json: /boundary_conditions/1/edge: no edge \"u2\" (the patch's edges are u0, u1, "
+          "v0, v1)");
+  }
+  {
+    json j = base;
+    j["output"]["points"][0]["at"] = {0.5, 1.2};
+    CHECK(
+        error_of(j) ==
+        "bad.json: /output/points/0/at: parametric point (0.5, 1.2) is outside the domain [0,1]^2");
+  }
+  {
+    json j = base;
+    j["solver"]["stepz"] = 3;
+    CHECK(error_of(j).rfind("bad.json: /solver/stepz: unknown key", 0) == 0);
+  }
+  {
+    json j = base;
+    j["material"]["type"] = "rubber";
+    CHECK(error_of(j).rfind("bad.json: /material/type: unknown material type", 0) == 0);
+  }
+  {
+    json j = base;
+    j["boundary_conditions"][0]["point"] = {0.5, 0.5};
+    CHECK(error_of(j).rfind("bad.json: /boundary_conditions/0: needs exactly one target", 0) == 0);
+  }
+  {
+    json j = base;
+    j["boundary_conditions"] = json::array({{{"point", {0.5, 0.5}}, {"fix", {"x"}}}});
+    CHECK(error_of(j).rfind("bad.json: /boundary_conditions/0/point: displacement conditions at "
+                            "parametric points are "
+                            "supported at the corners only",
+                            0) == 0);
+  }
+  {
+    json j = base;
+    j["boundary_conditions"][1]["prescribe"]["x"] = 1.0;
+    CHECK(error_of(j) ==
+          "bad.json: /boundary_conditions/1/prescribe/x: component is also in \"fix\"");
+  }
+  {
+    json j = base;
+    j["refinement"]["degree"] = 0;
+    CHECK(error_of(j).rfind("bad.json: /refinement/degree: must lie in [1, 15]", 0) == 0);
+  }
+}
+
+TEST_CASE("malformed JSON reports the line and column; duplicate keys are errors", "[unit]") {
+  std::string text = read_json("tensile_svk.json").dump(2);
+  text.insert(text.find("\"geometry\""), "oops ");
+  try {
+    parse_case(text, "broken.json");
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(std::string(e.what()).rfind("broken.json: invalid JSON at line ", 0) == 0);
+  }
+  const std::string dup = R"({"geometry": {}, "geometry": {}, "material": {}})";
+  CHECK_THROWS_AS(parse_case(dup, "dup.json"), knit::InputError);
+}
+
+TEST_CASE("a missing support is reported as such, not as NaNs", "[unit]") {
+  json j = read_json("tensile_svk.json");
+  j["boundary_conditions"][0]["fix"] = {"y", "z"};  // nothing holds x on the fixed jaw...
+  j["boundary_conditions"][1]["fix"] = {"z"};       // ...nor on the moving one
+  const std::string e = error_of(j);
+  CHECK(e.rfind("bad.json: /boundary_conditions: missing support: the boundary conditions do not "
+                "prevent a rigid-body "
+                "translation along (1, 0, 0)",
+                0) == 0);
+}
+
+TEST_CASE("a degenerate geometry is reported with where it is", "[unit]") {
+  json j = read_json("tensile_svk.json");
+  j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 0, 0}, {50, 0, 0}};  // zero height
+  const std::string e = error_of(j);
+  CHECK(e.rfind("bad.json: /geometry/control_points: degenerate geometry: the surface Jacobian",
+                0) == 0);
+  CHECK(e.find("at (theta1, theta2) = (") != std::string::npos);
+}
+
+TEST_CASE("knit-macro run: bad input exits with 2 and writes no output directory", "[unit]") {
+  const fs::path d = temp_dir("bad");
+  json j = read_json("tensile_svk.json");
+  j["geometry"]["thickness"] = -0.5;
+  std::ofstream(d / "neg.json") << j.dump(2);
+  const int rc =
+      run_exe((d / "neg.json").string() + " --output " + (d / "out").string(), d / "log.txt");
+  CHECK(rc == 2);
+  const std::string log = slurp(d / "log.txt");
+  CHECK(log.find("neg.json: /geometry/thickness: must be positive, got -0.5") != std::string::npos);
+  CHECK(std::count(log.begin(), log.end(), '\n') == 1);
+  CHECK(!fs::exists(d / "out"));
+  for (const auto& e : fs::directory_iterator(d))
+    CHECK(e.path().filename().string().find("partial") == std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
+  // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
+  // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with
+  // q = -0.3 the load factor is limited to 0.6415: steps 1-6 converge, the 7th cannot.
+  const fs::path d = temp_dir("stop");
+  const json j = json::parse(R"({
+    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}],
+    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [-0.3, 0, 0]}],
+    "solver": {"steps": 10, "max_cutbacks": 1, "max_iterations": 8},
+    "output": {"points": [{"name": "tip", "at": [1, 0.5]}]}})");
+  std::ofstream(d / "stop.json") << j.dump(2);
+  const int rc =
+      run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
+  CHECK(rc == 1);
+  const std::string log = slurp(d / "log.txt");
+  CHECK(log.find("failed after 1 cut-backs") != std::string::npos);
+  CHECK(log.find("6 converged steps kept, last lambda = 0.6") != std::string::npos);
+  REQUIRE(fs::exists(d / "out" / "load_strain.csv"));
+  const std::string csv = slurp(d / "out" / "load_strain.csv");
+  CHECK(csv.find("# run stopped early") != std::string::npos);
+  CHECK(csv.find("\n6,0.6,") != std::string::npos);
+  CHECK(fs::exists(d / "out" / "vtk" / "step_0006.vtu"));
+  CHECK(slurp(d / "out" / "summary.txt").find("status: stopped") != std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST_CASE("case file: Scordelis-Lo roof", "[case][verification]") {
+  const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/scordelis_lo.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(-r.rows.back().points[0](2) * 1e4 == Approx(0.3006).epsilon(0.01));
+}
+
+TEST_CASE("case file: Scordelis-Lo roof, quarter model with symmetry planes",
+          "[case][verification]") {
+  const Case c =
+      load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/scordelis_lo_quarter.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(-r.rows.back().points[0](2) * 1e4 == Approx(0.3006).epsilon(0.01));
+}
+
+TEST_CASE("case file: Sze cantilever", "[case][verification]") {
+  const Case c =
+      load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/sze_cantilever.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  int checked = 0;
+  for (const StepRow& row : r.rows) {
+    const Eigen::Vector3d d = row.points[0];
+    if (std::abs(row.lambda - 0.5) < 1e-12) {
+      CHECK(-d(0) == Approx(1.604).epsilon(0.015));
+      CHECK(d(2) == Approx(4.933).epsilon(0.015));
+      ++checked;
+    }
+    if (std::abs(row.lambda - 1.0) < 1e-12) {
+      CHECK(-d(0) == Approx(3.286).epsilon(0.015));
+      CHECK(d(2) == Approx(6.698).epsilon(0.015));
+      CHECK(row.reactions[0] == Approx(-4.0).epsilon(1e-6));  // the clamp carries the tip force
+      ++checked;
+    }
+  }
+  CHECK(checked == 2);
+}
+
+TEST_CASE("case file: tensile test with an isotropic stand-in material", "[case]") {
+  const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/tensile_svk.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  REQUIRE(r.rows.size() == 20);
+  double prev = 0.0;
+  for (const StepRow& row : r.rows) {
+    CHECK(row.strain == Approx(row.applied / 50.0));
+    CHECK(row.reactions[0] > prev);  // monotonic load-strain curve
+    prev = row.reactions[0];
+    CHECK(row.points[0](1) ==
+          Approx(0.5 * row.applied).epsilon(1e-9));  // symmetry: the center moves by Delta/2
+    CHECK(row.points[1](0) > 0.0);                   // lateral contraction
+  }
+  CHECK(r.rows.back().strain == Approx(0.3));
+}
+
+TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagonal", "[case]") {
+  const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/diagonal_svk.json");
+  const RunResult r = run_case(c, {});
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  for (const StepRow& row : r.rows) {
+    CHECK(row.reactions[0] > 0.0);
+    CHECK(row.reactions[0] == Approx(row.reactions[1]).epsilon(1e-8));
+    CHECK(row.points[0](0) ==
+          Approx(0.5 * row.applied).epsilon(1e-8));  // the center moves by Delta/2
+    CHECK(row.points[0](1) == Approx(0.5 * row.applied).epsilon(1e-8));
+  }
+}
+
+TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load",
+          "[verification]") {
+  json j = read_json("sze_cantilever.json");
+  j["solver"]["steps"] = 1;
+  j["solver"]["max_iterations"] = 12;
+  j["refinement"]["elements"] = {8, 1};
+  const Case c = parse_case(j.dump(), "one_step.json");
+  const RunResult r = run_case(c, {});
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(r.rows.size() > 1);  // the increment was cut
+  CHECK(r.rows.back().lambda == 1.0);
+  CHECK(r.rows.back().points[0](2) == Approx(6.698).epsilon(0.02));
+}
+
+TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provenance", "[unit]") {
+  const fs::path d = temp_dir("out");
+  json j = read_json("tensile_svk.json");
+  j["solver"]["steps"] = 4;
+  j["output"]["grid"] = {5, 7};
+  std::ofstream(d / "t.json") << j.dump(2);
+  REQUIRE(run_exe((d / "t.json").string() + " --output " + (d / "out").string(), d / "log.txt") ==
+          0);
+  const std::string log = slurp(d / "log.txt");
+  CHECK(std::count(log.begin(), log.end(), '\n') == 5);  // 4 progress lines + "wrote"
+  CHECK(log.find("step    4  load factor 1.000000") != std::string::npos);
+  const std::string csv = slurp(d / "out" / "load_strain.csv");
+  CHECK(csv.find("step,load_factor,applied_displacement_mm,strain,jaw_force_N") !=
+        std::string::npos);
+  CHECK(csv.find("\n4,1,15,0.3,") != std::string::npos);
+  const std::string pvd = slurp(d / "out" / "results.pvd");
+  for (int s = 1; s <= 4; ++s) {
+    const std::string f = "vtk/step_000" + std::to_string(s) + ".vtu";
+    CHECK(pvd.find("file=\"" + f + "\"") != std::string::npos);
+    CHECK(fs::exists(d / "out" / f));
+  }
+  auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+  CHECK(h5.attribute_string(".", "status") == "completed");
+  CHECK(!h5.attribute_string(".", "git_revision").empty());
+  CHECK(json::parse(h5.read_strings("case_json").at(0)) == j);
+  CHECK(h5.read_doubles("fields/step_0004/E22").size() == 35u);
+  CHECK(h5.read_doubles("steps/reactions/jaw_force").size() == 4u);
+  fs::remove_all(d);
+}

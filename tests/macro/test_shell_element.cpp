@@ -1,0 +1,178 @@
+// Shell element: the tangent against finite differences of the residual at a deformed
+// state, rigid-body invariance, the membrane patch test, the two thickness integrations.
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "shell_test_util.hpp"
+
+using namespace knit::macro;
+namespace spline = knit::spline;
+using knit::macro::test::curved_patch;
+using knit::macro::test::dense_tangent;
+
+namespace {
+
+Eigen::VectorXd random_displacement(int n, double amp, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> d(-amp, amp);
+  Eigen::VectorXd u(n);
+  for (int i = 0; i < n; ++i) u(i) = d(gen);
+  return u;
+}
+
+/// Max relative deviation of K from central differences of f_int.
+double fd_tangent_error(const ShellModel& m, const Eigen::VectorXd& u) {
+  ShellModel::Evaluation ev;
+  m.evaluate(u, true, ev);
+  const Eigen::MatrixXd K = dense_tangent(m, ev);
+  Eigen::MatrixXd Kfd(m.num_dofs(), m.num_dofs());
+  const double h = 1e-6;
+  ShellModel::Evaluation ep, em;
+  for (int s = 0; s < m.num_dofs(); ++s) {
+    Eigen::VectorXd up = u, um = u;
+    up(s) += h;
+    um(s) -= h;
+    m.evaluate(up, false, ep);
+    m.evaluate(um, false, em);
+    Kfd.col(s) = (ep.fint - em.fint) / (2 * h);
+  }
+  return (K - Kfd).cwiseAbs().maxCoeff() / K.cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+TEST_CASE("shell tangent matches finite differences of the residual at a deformed state",
+          "[unit]") {
+  const bool rational = GENERATE(false, true);
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  ShellModel m(curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, rational), 0.1, mat);
+  const Eigen::VectorXd u = random_displacement(m.num_dofs(), 0.1, 7);
+  CHECK(fd_tangent_error(m, u) < 1e-6);
+}
+
+TEST_CASE("shell tangent of a graded, unsymmetric material matches finite differences", "[unit]") {
+  // A nonlinear, unsymmetric plane-stress law exercising the Gauss-3 path with z-dependence.
+  struct Nonlinear final : Material {
+    std::string name() const override { return "test"; }
+    MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& w) const override {
+      MaterialResponse r;
+      const double k = 1.0 + 0.3 * w.theta(0);
+      r.S << k * (100 * E(0) + 30 * E(1) + 500 * E(0) * E(0)),
+          20 * E(0) + 80 * E(1) + 200 * E(1) * E(1) * E(1), 25 * E(2) + 10 * E(0) * E(2);
+      r.C << k * (100 + 1000 * E(0)), k * 30, 0, 20, 80 + 600 * E(1) * E(1), 0, 10 * E(2), 0,
+          25 + 10 * E(0);
+      return r;
+    }
+  };
+  ShellModel m(curved_patch(2, 2, 1, 2, 1.0, 1.0, 0.3, true), 0.2, std::make_shared<Nonlinear>());
+  CHECK(fd_tangent_error(m, random_displacement(m.num_dofs(), 0.08, 3)) < 1e-6);
+}
+
+TEST_CASE("rigid-body motions give zero internal forces", "[unit]") {
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  ShellModel m(curved_patch(3, 2, 2, 2, 2.0, 1.0, 0.5, true), 0.1, mat);
+  const Eigen::MatrixXd& P = m.surface().control_points();
+  const Eigen::Matrix3d Q =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d c(0.3, -2.0, 1.0);
+  Eigen::VectorXd u(m.num_dofs());
+  for (int a = 0; a < m.num_control_points(); ++a)
+    u.segment<3>(3 * a) = Q * P.row(a).transpose() + c - P.row(a).transpose();
+  ShellModel::Evaluation ev;
+  m.evaluate(u, false, ev);
+  ShellModel::Evaluation ref;
+  m.evaluate(random_displacement(m.num_dofs(), 0.05, 1), false, ref);
+  CHECK(ev.fint.norm() < 1e-10 * ref.fint.norm());
+}
+
+TEST_CASE("membrane patch test: a homogeneous deformation of a flat patch gives uniform strain",
+          "[unit]") {
+  // Flat, distorted (rational) patch; an affine map x = F X gives E = (F^T F - I)/2 everywhere
+  // and no curvature change; interior nodal forces vanish (patch test).
+  auto surf = curved_patch(3, 3, 2, 2, 2.0, 1.0, 0.0, true);
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.25);
+  ShellModel m(surf, 0.1, mat);
+  Eigen::Matrix3d F;
+  F << 1.1, 0.05, 0, -0.02, 0.95, 0, 0, 0, 1;
+  const Eigen::MatrixXd& P = m.surface().control_points();
+  Eigen::VectorXd u(m.num_dofs());
+  for (int a = 0; a < m.num_control_points(); ++a)
+    u.segment<3>(3 * a) = (F - Eigen::Matrix3d::Identity()) * P.row(a).transpose();
+  const Eigen::Matrix3d Eg = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
+  for (double s : {0.1, 0.5, 0.93}) {
+    for (double t : {0.0, 0.37, 1.0}) {
+      const ShellSample smp = m.sample(u, Eigen::Vector2d(s, t));
+      // Local frame of a flat patch in the x-y plane: rotate the global strain into (e1, e2).
+      const auto d = m.surface().derivatives(s, t, 1);
+      const Eigen::Vector3d e1 = d.row(1).transpose().normalized(), e3(0, 0, 1), e2 = e3.cross(e1);
+      CHECK(smp.E(0) == Approx(e1.dot(Eg * e1)).margin(1e-12));
+      CHECK(smp.E(1) == Approx(e2.dot(Eg * e2)).margin(1e-12));
+      CHECK(smp.E(2) == Approx(2 * e1.dot(Eg * e2)).margin(1e-12));
+      CHECK(smp.kappa.norm() < 1e-10);
+    }
+  }
+  // Interior nodal forces vanish exactly on an affinely parameterized (parallelogram) patch,
+  // where Gauss quadrature with p+1 points integrates the polynomial integrands exactly.
+  spline::BSplineBasis bu(3, spline::uniform_knots(3, 3)), bv(3, spline::uniform_knots(3, 2));
+  const auto gu = bu.greville(), gv = bv.greville();
+  const int nu = bu.size(), nv = bv.size();
+  Eigen::MatrixXd Pa(nu * nv, 3);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) Pa.row(i + nu * j) << 2.0 * gu[i] + 0.4 * gv[j], 1.2 * gv[j], 0.0;
+  ShellModel ma(spline::SplineSurface(bu, bv, Pa), 0.1, mat);
+  Eigen::VectorXd ua(ma.num_dofs());
+  for (int a = 0; a < ma.num_control_points(); ++a)
+    ua.segment<3>(3 * a) = (F - Eigen::Matrix3d::Identity()) * Pa.row(a).transpose();
+  ShellModel::Evaluation ev;
+  ma.evaluate(ua, false, ev);
+  for (int j = 1; j + 1 < nv; ++j)
+    for (int i = 1; i + 1 < nu; ++i)
+      CHECK(ev.fint.segment<3>(3 * (i + nu * j)).norm() < 1e-12 * ev.fint.norm());
+}
+
+TEST_CASE("3-point thickness integration equals the analytic one for St. Venant-Kirchhoff",
+          "[unit]") {
+  auto mat = std::make_shared<SaintVenantKirchhoff>(2100.0, 0.3);
+  const auto surf = curved_patch(2, 2, 2, 1, 1.0, 1.0, 0.4, false);
+  ShellOptions a, g;
+  a.integration = ThicknessIntegration::kAnalytic;
+  g.integration = ThicknessIntegration::kGauss3;
+  ShellModel ma(surf, 0.1, mat, a), mg(surf, 0.1, mat, g);
+  const Eigen::VectorXd u = random_displacement(ma.num_dofs(), 0.05, 11);
+  ShellModel::Evaluation ea, eg;
+  ma.evaluate(u, true, ea);
+  mg.evaluate(u, true, eg);
+  CHECK((ea.fint - eg.fint).norm() < 1e-12 * ea.fint.norm());
+  CHECK((dense_tangent(ma, ea) - dense_tangent(mg, eg)).norm() <
+        1e-12 * dense_tangent(ma, ea).norm());
+}
+
+TEST_CASE("two assembly threads give the same result as one", "[unit]") {
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  ShellModel m(curved_patch(2, 2, 3, 2, 2.0, 1.0, 0.3, true), 0.1, mat);
+  const Eigen::VectorXd u = random_displacement(m.num_dofs(), 0.05, 5);
+  ShellModel::Evaluation e1, e2;
+  m.evaluate(u, true, e1);
+  m.set_threads(2);
+  m.evaluate(u, true, e2);
+  CHECK((e1.fint - e2.fint).norm() < 1e-13 * e1.fint.norm());
+  CHECK((dense_tangent(m, e1) - dense_tangent(m, e2)).norm() == 0.0);
+}
+
+TEST_CASE("a degenerate reference geometry is reported with its location", "[unit]") {
+  // Collapse the u1 edge to a point: the Jacobian vanishes along theta1 = 1.
+  spline::BSplineBasis b(1, {0, 0, 1, 1});
+  Eigen::MatrixXd P(4, 3);
+  P << 0, 0, 0, 1, 0.5, 0, 0, 1, 0, 1, 0.5, 0;
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  // Quadrature points do not hit theta1 = 1 exactly, so use a surface degenerate everywhere.
+  Eigen::MatrixXd Q(4, 3);
+  Q << 0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0;
+  try {
+    ShellModel m(spline::SplineSurface(b, b, Q), 0.1, mat);
+    FAIL("no error");
+  } catch (const DegenerateGeometryError& e) {
+    CHECK(std::string(e.what()).find("theta1, theta2") != std::string::npos);
+  }
+}
