@@ -1,6 +1,5 @@
 // HDF5 reading and writing of the material database (layout: schemas/database.layout.json,
 // docs/database.md). HDF5 is reached only through knit/io/hdf5.hpp.
-#if __has_include("knit/io/hdf5.hpp") && __has_include("knit/io/atomic.hpp")
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -283,4 +282,3 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
 }
 
 }  // namespace knit::material
-#endif

@@ -12,7 +12,6 @@
 // Control values run with the u index fastest; repeated knots give discontinuous grading.
 // A field's domain must equal the patch's parameter domain. A stitch value outside the
 // database's loop lengths is an error naming the field and the range.
-#if __has_include("knit/macro/material_factory.hpp")
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -184,4 +183,3 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
 }
 
 }  // namespace knit::macro
-#endif

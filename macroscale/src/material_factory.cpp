@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "knit/core/errors.hpp"
+#include "knit/macro/knit_material.hpp"
 #include "knit/macro/svk_material.hpp"
 
 namespace knit::macro {
@@ -32,8 +33,9 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
     throw InputError(ctx.file, ctx.pointer, "must be an object, got " + std::string(m.type_name()));
   if (!m.contains("type") || !m.at("type").is_string())
     throw InputError(ctx.file, ctx.pointer + (m.contains("type") ? "/type" : ""),
-                     "needs a string \"type\" (one of: \"saint_venant_kirchhoff\")");
+                     "needs a string \"type\" (one of: \"saint_venant_kirchhoff\", \"knit\")");
   const std::string type = m.at("type").get<std::string>();
+  if (type == "knit") return make_knit_material(m, ctx);
   if (type == "saint_venant_kirchhoff") {
     for (auto it = m.begin(); it != m.end(); ++it)
       if (it.key() != "type" && it.key() != "youngs_modulus" && it.key() != "poisson_ratio" &&
@@ -55,7 +57,7 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
     return std::make_unique<SaintVenantKirchhoff>(E, v);
   }
   throw InputError(ctx.file, ctx.pointer + "/type",
-                   "unknown material type \"" + type + "\" (known: \"saint_venant_kirchhoff\")");
+                   "unknown material type \"" + type + "\" (known: \"saint_venant_kirchhoff\", \"knit\")");
 }
 
 }  // namespace knit::macro

@@ -4,7 +4,6 @@
 //
 //   knit-meso fit db.h5
 //   knit-meso fit db.h5 --options fit.json --out refit.h5
-#if __has_include("knit/io/hdf5.hpp")
 #include <iostream>
 #include <memory>
 
@@ -42,4 +41,3 @@ static knit::cli::SubcommandRegistrar reg_fit(
         return knit::kExitOk;
       };
     });
-#endif

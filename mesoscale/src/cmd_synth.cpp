@@ -5,7 +5,6 @@
 //
 //   knit-meso synth --out synthetic.h5
 //   knit-meso synth --out db.h5 --loop-lengths 4.5,5.5,6.5 --steps 20 --fit-options fit.json
-#if __has_include("knit/io/hdf5.hpp")
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -66,5 +65,3 @@ static knit::cli::SubcommandRegistrar reg_synth(
         return rc;
       };
     });
-
-#endif

@@ -43,7 +43,6 @@ TEST_CASE("bench: response-surface evaluations per second", "[.bench]") {
   CHECK(n / dt > 0);
 }
 
-#if __has_include("knit/io/hdf5.hpp")
 #include <filesystem>
 
 #include "knit/material/database.hpp"
@@ -81,4 +80,3 @@ TEST_CASE("bench: loading the material database", "[.bench]") {
     CHECK(rs.data().n1() == 11);
   }
 }
-#endif

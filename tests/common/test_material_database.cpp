@@ -1,5 +1,4 @@
 // Material database file: round trip, atomic write, and the errors for bad files.
-#if __has_include("knit/io/hdf5.hpp")
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <filesystem>
@@ -144,4 +143,3 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
                       Catch::Contains("6.500000 mm has no fitted response surface"));
   }
 }
-#endif

@@ -1,7 +1,6 @@
 // The chain database -> knit material -> shell: a homogeneous patch under a uniform biaxial
 // stretch reproduces the database's stresses at every step; a rotated problem with the
 // material rotated along gives the same load-strain curve; bad knit inputs name the field.
-#if __has_include("knit/macro/run.hpp") && __has_include("knit/io/hdf5.hpp")
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -173,4 +172,3 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
       load(R"({"type": "knit", "database": "/nonexistent/db.h5", "stitch_value": 5})"),
       Catch::Contains("bad.json: /material/database: /nonexistent/db.h5: file not found"));
 }
-#endif

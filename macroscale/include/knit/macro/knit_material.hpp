@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "knit/macro/material.hpp"
+#include "knit/macro/material_factory.hpp"
 #include "knit/material/loop_length_family.hpp"
 #include "knit/spline/surface.hpp"
 
@@ -124,15 +125,9 @@ class KnitMaterial : public Material {
   mutable std::vector<Stats::Where> where_;
 };
 
-}  // namespace knit::macro
-
-#if __has_include("knit/macro/material_factory.hpp")
-#include "knit/macro/material_factory.hpp"
-namespace knit::macro {
 /// The "knit" branch of the case's material factory (knit_material_factory.cpp): reads the
 /// database and the stitch-value and knitting-angle fields; throws knit::InputError with
 /// JSON pointers below ctx.pointer.
 std::unique_ptr<Material> make_knit_material(const nlohmann::json& material,
                                              const CaseContext& ctx);
 }  // namespace knit::macro
-#endif
