@@ -56,8 +56,9 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
                        "must lie in (-1, 0.5), got " + nu.dump());
     return std::make_unique<SaintVenantKirchhoff>(E, v);
   }
-  throw InputError(ctx.file, ctx.pointer + "/type",
-                   "unknown material type \"" + type + "\" (known: \"saint_venant_kirchhoff\", \"knit\")");
+  throw InputError(
+      ctx.file, ctx.pointer + "/type",
+      "unknown material type \"" + type + "\" (known: \"saint_venant_kirchhoff\", \"knit\")");
 }
 
 }  // namespace knit::macro
