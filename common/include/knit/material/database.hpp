@@ -1,0 +1,109 @@
+// The material database: the only contract between knit-meso and knit-macro.
+//
+// An HDF5 file (layout in schemas/database.layout.json and docs/database.md) holding, per
+// loop length, the raw homogenized data of every load path and step (F*, P*, E, S, status),
+// the fitted response surfaces of eq. (17) and the S12(E12) curve, and the fit diagnostics;
+// globally the loop lengths, the yarn and cell parameters, the sweep input, the strain
+// domain covered by the data, the format version and the provenance.
+//
+// Writing (the sweep, `knit-meso synth`, `knit-meso fit`): fill a Database, then
+// write_database(path, db) (atomic: temporary file, then rename). Reading:
+// read_database(path) validates the layout and throws knit::InputError naming the file and
+// the HDF5 path of what is wrong (another format version, a truncated file, a missing group).
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "knit/material/load_paths.hpp"
+#include "knit/material/loop_length_family.hpp"
+#include "knit/material/response_surface.hpp"
+
+namespace knit::material {
+
+inline constexpr int kDatabaseFormatVersion = 1;
+inline constexpr const char* kDatabaseFormatName = "knitscale-material-database";
+
+using RowMatrixX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Homogenized results of one load path, one row per load step k = 1..steps (the undeformed
+/// state k = 0 is implicit: F = I, P = 0). Row layouts:
+///   F, P: (F11, F12, F21, F22) -- P* of eq. (8), MPa
+///   E:    (E11, E22, E12)      -- tensor components (not Voigt 2E12)
+///   S:    (S11, S22, S12)      -- MPa
+/// status: 0 = converged, anything else = the step did not converge (the fit skips it).
+struct RawPath {
+  LoadPath path;
+  RowMatrixX F, P, E, S;
+  std::vector<int> status;
+  int steps() const { return static_cast<int>(status.size()); }
+};
+
+/// Unit-cell parameters of one loop length (paper Sect. 3.1.1), mm.
+struct CellParameters {
+  double wale_width = 0.0;     ///< w
+  double course_height = 0.0;  ///< c
+  double thickness = 0.0;      ///< t = 2d
+};
+
+/// RMS and max error of a fit per component (E1, E2, S1, S2, S12): E1, E2 are the
+/// E-surface's distance to the data strains; S1, S2, S12 are the law's stress errors
+/// |S_fit(E_data) - S_data| (MPa).
+struct FitDiagnostics {
+  static constexpr int kComponents = 5;
+  static constexpr const char* kNames[kComponents] = {"E1", "E2", "S1", "S2", "S12"};
+  Eigen::Matrix<double, kComponents, 1> rms = Eigen::Matrix<double, kComponents, 1>::Zero();
+  Eigen::Matrix<double, kComponents, 1> max = Eigen::Matrix<double, kComponents, 1>::Zero();
+  /// Largest stress error relative to the data's stress range (max |S| over all components).
+  double max_relative = 0.0;
+  int points_used = 0, points_skipped = 0;
+  std::string options_json;  ///< the fit options used (JSON text)
+};
+
+struct LoopLengthEntry {
+  double loop_length = 0.0;  ///< l, mm
+  CellParameters cell;
+  std::vector<RawPath> raw;
+  std::optional<ResponseSurfaceData> surface;  ///< absent until fitted
+  FitDiagnostics diagnostics;
+};
+
+/// The strain domain covered by the data (min/max over all converged steps).
+struct StrainDomain {
+  double E11_min = 0, E11_max = 0, E22_min = 0, E22_max = 0, E12_max = 0;
+};
+
+struct Provenance {
+  std::string software_version, git_revision, created;  ///< created: ISO 8601 UTC
+};
+
+struct Database {
+  int format_version = kDatabaseFormatVersion;
+  Provenance provenance;
+  std::string generator;                 ///< "sweep", "synth" (synthetic stand-in), ...
+  std::string sweep_input;               ///< the sweep's input (JSON text)
+  std::map<std::string, double> yarn;    ///< e.g. diameter, youngs_modulus, poisson_ratio
+  std::vector<LoopLengthEntry> entries;  ///< increasing loop length
+
+  std::vector<double> loop_lengths() const;
+  StrainDomain domain() const;
+  /// The loop-length family of the fitted laws; throws std::invalid_argument if any entry is
+  /// not fitted.
+  LoopLengthFamily family() const;
+};
+
+/// Provenance of this build, now.
+Provenance current_provenance();
+
+/// Writes atomically (temporary file next to `file`, then rename). Throws std::runtime_error.
+void write_database(const std::filesystem::path& file, const Database& db);
+
+/// Reads and validates. Throws knit::InputError(file, hdf5_path, what) on a bad file.
+/// raw = false skips the raw path data (faster for the macroscale).
+Database read_database(const std::filesystem::path& file, bool raw = true);
+
+}  // namespace knit::material

@@ -1,0 +1,280 @@
+// HDF5 reading and writing of the material database (layout: schemas/database.layout.json,
+// docs/database.md). HDF5 is reached only through knit/io/hdf5.hpp.
+#if __has_include("knit/io/hdf5.hpp") && __has_include("knit/io/atomic.hpp")
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/material/database.hpp"
+
+namespace knit::material {
+
+namespace {
+
+using io::H5File;
+using io::H5Group;
+
+std::string loop_group(std::size_t k) { return "/loop_" + std::to_string(k); }
+std::string path_group(std::size_t q) {
+  std::ostringstream os;
+  os << "path_" << (q < 10 ? "0" : "") << q;
+  return os.str();
+}
+
+void write_surface(H5Group& g, const ResponseSurfaceData& d) {
+  g.set_attribute(".", "degree_1", d.degree1);
+  g.set_attribute(".", "degree_2", d.degree2);
+  g.set_attribute(".", "parameters",
+                  "xi1 = biaxial path index / (paths - 1) (paths ordered by angle of the end "
+                  "strain), xi2 = load-step fraction; domain [0, 1]^2");
+  g.write("knots_1", d.knots1);
+  g.write("knots_2", d.knots2);
+  g.write("E_ctrl", RowMatrixX(d.E_ctrl));
+  g.write("S_ctrl", RowMatrixX(d.S_ctrl));
+  for (const char* n : {"E_ctrl", "S_ctrl"}) {
+    g.set_attribute(n, "index", "row a = i + n1 * j (i: xi1 index, j: xi2 index)");
+    g.set_attribute(n, "columns", n[0] == 'E' ? "E11, E22 (Green-Lagrange)" : "S11, S22 (MPa)");
+  }
+  g.set_attribute(".", "n1", d.n1());
+  g.set_attribute(".", "n2", d.n2());
+  H5Group s = g.create_group("shear");
+  s.set_attribute(".", "degree", d.shear_degree);
+  s.write("knots", d.shear_knots);
+  s.write("E12_ctrl", d.E12_ctrl);
+  s.write("S12_ctrl", d.S12_ctrl);
+  s.set_attribute("E12_ctrl", "units", "tensor shear strain E12 (not 2E12)");
+  s.set_attribute("S12_ctrl", "units", "MPa");
+}
+
+ResponseSurfaceData read_surface(const H5Group& g) {
+  ResponseSurfaceData d;
+  d.degree1 = g.attribute_int(".", "degree_1");
+  d.degree2 = g.attribute_int(".", "degree_2");
+  d.knots1 = g.read_doubles("knots_1");
+  d.knots2 = g.read_doubles("knots_2");
+  d.E_ctrl = g.read_matrix("E_ctrl");
+  d.S_ctrl = g.read_matrix("S_ctrl");
+  const H5Group s = g.open_group("shear");
+  d.shear_degree = s.attribute_int(".", "degree");
+  d.shear_knots = s.read_doubles("knots");
+  const auto e = s.read_doubles("E12_ctrl"), t = s.read_doubles("S12_ctrl");
+  d.E12_ctrl = Eigen::Map<const Eigen::VectorXd>(e.data(), static_cast<Eigen::Index>(e.size()));
+  d.S12_ctrl = Eigen::Map<const Eigen::VectorXd>(t.data(), static_cast<Eigen::Index>(t.size()));
+  return d;
+}
+
+/// "file: rest" -> "rest" (the io adapter's messages start with the file name).
+std::string strip_file(const std::string& msg, const std::string& file) {
+  const std::string prefix = file + ": ";
+  return msg.rfind(prefix, 0) == 0 ? msg.substr(prefix.size()) : msg;
+}
+
+}  // namespace
+
+void write_database(const std::filesystem::path& file, const Database& db) {
+  io::AtomicFile out(file);
+  {
+    H5File f = H5File::create(out.temp_path());
+    f.set_attribute(".", "format", kDatabaseFormatName);
+    f.set_attribute(".", "format_version", db.format_version);
+    f.set_attribute(".", "software_version", db.provenance.software_version);
+    f.set_attribute(".", "git_revision", db.provenance.git_revision);
+    f.set_attribute(".", "created", db.provenance.created);
+    f.set_attribute(".", "generator", db.generator);
+    f.set_attribute(".", "units", "length mm, force N, stress MPa");
+    f.set_attribute(".", "voigt_order", "E = (E11, E22, 2E12), S = (S11, S22, S12)");
+    f.set_attribute(".", "frame", "material frame: 1 = course, 2 = wale");
+    H5Group sw = f.create_group("/sweep");
+    sw.set_attribute(".", "input_json", db.sweep_input);
+    // The load paths of the first loop length (the sweep uses the same set for all).
+    std::vector<int> kind, steps;
+    RowMatrixX target(0, 2);
+    if (!db.entries.empty()) {
+      const auto& raw = db.entries.front().raw;
+      target.resize(static_cast<Eigen::Index>(raw.size()), 2);
+      for (std::size_t q = 0; q < raw.size(); ++q) {
+        kind.push_back(static_cast<int>(raw[q].path.kind));
+        steps.push_back(raw[q].path.steps);
+        target.row(static_cast<Eigen::Index>(q)) = raw[q].path.target.transpose();
+      }
+    }
+    sw.write("load_path_kind", kind);
+    sw.write("load_path_steps", steps);
+    sw.write("load_path_target", target);
+    sw.set_attribute("load_path_kind", "values", "0 = biaxial, 1 = pure shear");
+    sw.set_attribute("load_path_target", "columns",
+                     "biaxial: end (E11, E22) Green-Lagrange; shear: (gamma rad, 0)");
+    H5Group yarn = f.create_group("/yarn");
+    for (const auto& [k, v] : db.yarn) yarn.set_attribute(".", k, v);
+    f.write("/loop_lengths", db.loop_lengths());
+    f.set_attribute("/loop_lengths", "units", "mm");
+    const StrainDomain dom = db.domain();
+    H5Group dg = f.create_group("/domain");
+    dg.set_attribute(".", "E11_min", dom.E11_min);
+    dg.set_attribute(".", "E11_max", dom.E11_max);
+    dg.set_attribute(".", "E22_min", dom.E22_min);
+    dg.set_attribute(".", "E22_max", dom.E22_max);
+    dg.set_attribute(".", "E12_max", dom.E12_max);
+    for (std::size_t k = 0; k < db.entries.size(); ++k) {
+      const LoopLengthEntry& e = db.entries[k];
+      H5Group g = f.create_group(loop_group(k));
+      g.set_attribute(".", "loop_length", e.loop_length);
+      g.set_attribute(".", "wale_width", e.cell.wale_width);
+      g.set_attribute(".", "course_height", e.cell.course_height);
+      g.set_attribute(".", "thickness", e.cell.thickness);
+      g.set_attribute(".", "fitted", e.surface ? 1 : 0);
+      H5Group raw = g.create_group("raw");
+      raw.set_attribute(".", "paths", static_cast<int>(e.raw.size()));
+      for (std::size_t q = 0; q < e.raw.size(); ++q) {
+        const RawPath& r = e.raw[q];
+        H5Group p = raw.create_group(path_group(q));
+        p.set_attribute(".", "kind", to_string(r.path.kind));
+        p.set_attribute(".", "target", std::vector<double>{r.path.target(0), r.path.target(1)});
+        p.set_attribute(".", "steps", r.path.steps);
+        p.write("F", r.F);
+        p.write("P", r.P);
+        p.write("E", r.E);
+        p.write("S", r.S);
+        p.write("status", r.status);
+        p.set_attribute("F", "columns", "F11, F12, F21, F22; rows: load steps 1..steps");
+        p.set_attribute("P", "columns", "P11, P12, P21, P22 (MPa); rows: load steps 1..steps");
+        p.set_attribute("E", "columns", "E11, E22, E12 (tensor); rows: load steps 1..steps");
+        p.set_attribute("S", "columns", "S11, S22, S12 (MPa); rows: load steps 1..steps");
+        p.set_attribute("status", "values", "0 = converged");
+      }
+      if (e.surface) {
+        H5Group fg = g.create_group("fit");
+        write_surface(fg, *e.surface);
+        H5Group d = fg.create_group("diagnostics");
+        d.write("rms", e.diagnostics.rms);
+        d.write("max", e.diagnostics.max);
+        d.set_attribute(".", "components", "E1, E2, S1, S2, S12");
+        d.set_attribute(".", "max_relative", e.diagnostics.max_relative);
+        d.set_attribute(".", "points_used", e.diagnostics.points_used);
+        d.set_attribute(".", "points_skipped", e.diagnostics.points_skipped);
+        d.set_attribute(".", "options_json", e.diagnostics.options_json);
+      }
+    }
+    f.close();
+  }
+  out.commit();
+}
+
+Database read_database(const std::filesystem::path& file, bool with_raw) {
+  const std::string fname = file.string();
+  std::string where;  // HDF5 path being read, for messages
+  try {
+    if (!std::filesystem::exists(file)) throw InputError(fname, "", "file not found");
+    if (!io::is_hdf5_file(file))
+      throw InputError(fname, "", "not an HDF5 file (or truncated)");
+    const H5File f = H5File::open_read(file);
+    Database db;
+    where = "/";
+    if (!f.has_attribute(".", "format") || f.attribute_string(".", "format") != kDatabaseFormatName)
+      throw InputError(fname, "/", std::string("not a material database (attribute format != \"") +
+                                       kDatabaseFormatName + "\")");
+    db.format_version = f.attribute_int(".", "format_version");
+    if (db.format_version != kDatabaseFormatVersion)
+      throw InputError(fname, "/",
+                       "format_version " + std::to_string(db.format_version) +
+                           " is not supported (this build reads version " +
+                           std::to_string(kDatabaseFormatVersion) + ")");
+    auto require_group = [&](const std::string& p) {
+      if (!f.is_group(p)) throw InputError(fname, p, "group missing");
+    };
+    auto require_dataset = [&](const std::string& p) {
+      if (!f.is_dataset(p)) throw InputError(fname, p, "dataset missing");
+    };
+    db.provenance.software_version = f.attribute_string(".", "software_version");
+    db.provenance.git_revision = f.attribute_string(".", "git_revision");
+    db.provenance.created = f.attribute_string(".", "created");
+    db.generator = f.attribute_string(".", "generator");
+    require_group("/sweep");
+    db.sweep_input = f.attribute_string("/sweep", "input_json");
+    require_group("/yarn");
+    for (const auto& n : f.attribute_names("/yarn")) db.yarn[n] = f.attribute_double("/yarn", n);
+    require_dataset("/loop_lengths");
+    const auto ls = f.read_doubles("/loop_lengths");
+    for (std::size_t k = 0; k < ls.size(); ++k) {
+      const std::string g = loop_group(k);
+      where = g;
+      require_group(g);
+      LoopLengthEntry e;
+      e.loop_length = f.attribute_double(g, "loop_length");
+      if (e.loop_length != ls[k])
+        throw InputError(fname, g, "loop_length " + std::to_string(e.loop_length) +
+                                       " differs from /loop_lengths[" + std::to_string(k) + "]");
+      e.cell.wale_width = f.attribute_double(g, "wale_width");
+      e.cell.course_height = f.attribute_double(g, "course_height");
+      e.cell.thickness = f.attribute_double(g, "thickness");
+      require_group(g + "/raw");
+      if (with_raw) {
+        const int np = f.attribute_int(g + "/raw", "paths");
+        for (int q = 0; q < np; ++q) {
+          const std::string p = g + "/raw/" + path_group(static_cast<std::size_t>(q));
+          where = p;
+          require_group(p);
+          RawPath r;
+          r.path.kind = f.attribute_string(p, "kind") == "shear" ? PathKind::kShear
+                                                                  : PathKind::kBiaxial;
+          const auto t = f.attribute_doubles(p, "target");
+          if (t.size() != 2) throw InputError(fname, p, "attribute target must have 2 values");
+          r.path.target = {t[0], t[1]};
+          r.path.steps = f.attribute_int(p, "steps");
+          for (const char* d : {"F", "P", "E", "S", "status"}) require_dataset(p + "/" + d);
+          r.F = f.read_matrix(p + "/F");
+          r.P = f.read_matrix(p + "/P");
+          r.E = f.read_matrix(p + "/E");
+          r.S = f.read_matrix(p + "/S");
+          r.status = f.read_ints(p + "/status");
+          const auto n = static_cast<Eigen::Index>(r.status.size());
+          if (r.F.rows() != n || r.F.cols() != 4 || r.P.rows() != n || r.P.cols() != 4 ||
+              r.E.rows() != n || r.E.cols() != 3 || r.S.rows() != n || r.S.cols() != 3)
+            throw InputError(fname, p,
+                             "F, P must be steps x 4 and E, S steps x 3 with steps = " +
+                                 std::to_string(n) + " (the length of status)");
+          e.raw.push_back(std::move(r));
+        }
+      }
+      where = g;
+      if (f.attribute_int(g, "fitted") != 0) {
+        const std::string fg = g + "/fit";
+        require_group(fg);
+        require_group(fg + "/shear");
+        require_group(fg + "/diagnostics");
+        where = fg;
+        const H5Group fit = f.open_group(fg);
+        e.surface = read_surface(fit);
+        try {
+          validate(*e.surface);
+        } catch (const std::exception& ex) {
+          throw InputError(fname, fg, ex.what());
+        }
+        const auto rms = f.read_doubles(fg + "/diagnostics/rms");
+        const auto mx = f.read_doubles(fg + "/diagnostics/max");
+        if (rms.size() != 5 || mx.size() != 5)
+          throw InputError(fname, fg + "/diagnostics", "rms and max need 5 components");
+        for (int c = 0; c < 5; ++c) {
+          e.diagnostics.rms(c) = rms[c];
+          e.diagnostics.max(c) = mx[c];
+        }
+        e.diagnostics.max_relative = f.attribute_double(fg + "/diagnostics", "max_relative");
+        e.diagnostics.points_used = f.attribute_int(fg + "/diagnostics", "points_used");
+        e.diagnostics.points_skipped = f.attribute_int(fg + "/diagnostics", "points_skipped");
+        e.diagnostics.options_json = f.attribute_string(fg + "/diagnostics", "options_json");
+      }
+      db.entries.push_back(std::move(e));
+    }
+    return db;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(fname, where == "/" ? "" : where, strip_file(e.what(), fname));
+  }
+}
+
+}  // namespace knit::material
+#endif

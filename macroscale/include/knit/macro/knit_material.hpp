@@ -1,0 +1,130 @@
+// The graded, rotated knit material of the shell (paper Sect. 2.2): the response-surface law
+// of the material database, evaluated at the stitch value l(theta) (eqs. 23-25) in the
+// material frame rotated by the knitting angle alpha(theta) (eqs. 19-22).
+//
+// Per integration point, the paper's steps (Sect. 2.2.1): the shell gives E in the local
+// Cartesian frame (e1 = a1/|a1|); then
+//   Ehat = T_E(alpha) E = T^-T E                                   (21)
+//   (Shat, Chat) = response surface at (Ehat, l)                   (16-18, 24-25)
+//   S = T^-1 Shat,  C = T^-1 Chat T^-T                            (22)
+// with T = T_S(alpha) of eq. (20). The shell integrates through the thickness with 3 points
+// (eq. 14) by calling evaluate() at each.
+//
+// l and alpha are scalar spline fields on the shell's parameter domain, each with its own
+// degrees, knots and control values; repeated knots give the paper's discontinuous grading.
+// bind_points() precomputes l, alpha and the l-interpolated surfaces per quadrature point
+// (evaluators are shared between points with the same l). The alpha field may instead be
+// computed to "align the course direction with a vector v": alpha interpolates, at the
+// Greville abscissae of its basis, the signed angle (about the normal) from e1 to the
+// projection of v on the tangent plane (paper Sect. 3.2.2).
+//
+// Extrapolation of the response surface (see knit/material/response_surface.hpp) is counted
+// per kind and the first locations are kept; report() summarizes them at the end of a run.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "knit/macro/material.hpp"
+#include "knit/material/loop_length_family.hpp"
+#include "knit/spline/surface.hpp"
+
+namespace knit::macro {
+
+/// A scalar spline field on the shell's parameter domain (degrees, knots, control values
+/// with the u index fastest).
+struct ScalarFieldSpec {
+  int degree_u = 0, degree_v = 0;
+  std::vector<double> knots_u = {0.0, 1.0}, knots_v = {0.0, 1.0};
+  std::vector<double> values = {0.0};
+  /// A constant field on [u0, u1] x [v0, v1].
+  static ScalarFieldSpec constant(double value, double u0 = 0, double u1 = 1, double v0 = 0,
+                                  double v1 = 1);
+};
+
+/// Builds the field; throws std::invalid_argument with the reason (knots, count).
+spline::SplineSurface make_scalar_field(const ScalarFieldSpec& spec);
+
+/// The alpha field that aligns the course direction with v: interpolation at the Greville
+/// abscissae of (degree_u, knots_u) x (degree_v, knots_v) of the angle from e1 = a1/|a1| of
+/// the reference surface `geometry` (3-D) to v projected on the tangent plane. Angles are
+/// unwrapped to be continuous from one Greville point to the next.
+spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, int degree_u,
+                                        std::vector<double> knots_u, int degree_v,
+                                        std::vector<double> knots_v, const Eigen::Vector3d& v);
+
+/// Voigt rotations of paper eq. (20) and Appendix A (private until knit/mechanics/voigt.hpp).
+Eigen::Matrix3d knit_T_S(double alpha);
+Eigen::Matrix3d knit_T_E(double alpha);
+
+/// Where the fields came from, for error messages (case file and JSON pointers).
+struct KnitMaterialSource {
+  std::string file, stitch_pointer = "/material/stitch_value",
+                    angle_pointer = "/material/knitting_angle", database;
+};
+
+class KnitMaterial : public Material {
+ public:
+  using Source = KnitMaterialSource;
+  /// Checks that the stitch-value field stays inside the family's loop-length range
+  /// (its control values, by the convex-hull property); throws knit::InputError naming the
+  /// field, the control value and the range.
+  KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
+               spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
+               Source source = {});
+
+  std::string name() const override { return "knit"; }
+  void bind_points(const std::vector<Eigen::Vector2d>& theta) override;
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override;
+  std::vector<std::pair<std::string, double>> output_fields(
+      const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const override;
+  std::string report() const override;
+
+  double stitch_value(const Eigen::Vector2d& theta) const;
+  double knitting_angle(const Eigen::Vector2d& theta) const;
+
+  /// Extrapolation statistics (kinds as in material::ExtrapolationFlag).
+  struct Stats {
+    long evaluations = 0;
+    std::array<long, 5> count{};  ///< beyond paths, outside fan, compression, beyond shear, failed
+    struct Where {
+      Eigen::Vector2d theta;
+      Eigen::Vector3d E_material;
+      int flags;
+    };
+    std::vector<Where> first;  ///< up to kMaxLocations locations
+  };
+  Stats stats() const;
+  void reset_stats();
+  static constexpr int kMaxLocations = 10;
+
+ private:
+  struct Bound {
+    const material::ResponseSurface* rs;
+    double l, alpha;
+    Eigen::Matrix3d TE, TSinv;  ///< T_E(alpha) = T^-T and T_S(-alpha) = T^-1, precomputed
+  };
+  std::shared_ptr<const material::ResponseSurface> surface_at(double l) const;
+  MaterialResponse evaluate_at(const Eigen::Vector3d& E, const material::ResponseSurface& rs,
+                               double alpha, const Eigen::Matrix3d& TE,
+                               const Eigen::Matrix3d& TSinv, const Eigen::Vector2d& theta) const;
+
+  std::shared_ptr<const material::LoopLengthFamily> family_;
+  spline::SplineSurface l_field_, a_field_;
+  Source source_;
+  std::vector<Bound> bound_;
+  mutable std::mutex cache_mutex_;
+  mutable std::map<double, std::shared_ptr<const material::ResponseSurface>> cache_;
+  mutable std::atomic<long> evaluations_{0};
+  mutable std::array<std::atomic<long>, 5> counts_{};
+  mutable std::mutex where_mutex_;
+  mutable std::vector<Stats::Where> where_;
+};
+
+}  // namespace knit::macro

@@ -1,0 +1,239 @@
+// The graded, rotated knit material (paper Sect. 2.2); see knit/macro/knit_material.hpp.
+#include "knit/macro/knit_material.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "knit/core/errors.hpp"
+
+namespace knit::macro {
+
+using material::ResponseSurface;
+
+Eigen::Matrix3d knit_T_S(double alpha) {
+  const double c = std::cos(alpha), s = std::sin(alpha);
+  Eigen::Matrix3d T;
+  T << c * c, s * s, 2 * c * s,  //
+      s * s, c * c, -2 * c * s,  //
+      -c * s, c * s, c * c - s * s;
+  return T;
+}
+
+Eigen::Matrix3d knit_T_E(double alpha) {
+  const double c = std::cos(alpha), s = std::sin(alpha);
+  Eigen::Matrix3d T;
+  T << c * c, s * s, c * s,  //
+      s * s, c * c, -c * s,  //
+      -2 * c * s, 2 * c * s, c * c - s * s;
+  return T;
+}
+
+ScalarFieldSpec ScalarFieldSpec::constant(double value, double u0, double u1, double v0,
+                                          double v1) {
+  ScalarFieldSpec s;
+  s.knots_u = {u0, u1};
+  s.knots_v = {v0, v1};
+  s.values = {value};
+  return s;
+}
+
+spline::SplineSurface make_scalar_field(const ScalarFieldSpec& spec) {
+  const spline::BSplineBasis bu(spec.degree_u, spec.knots_u), bv(spec.degree_v, spec.knots_v);
+  const std::size_t n = static_cast<std::size_t>(bu.size()) * bv.size();
+  if (spec.values.size() != n)
+    throw std::invalid_argument("the knots and degrees define " + std::to_string(bu.size()) +
+                                " x " + std::to_string(bv.size()) + " = " + std::to_string(n) +
+                                " control values, got " + std::to_string(spec.values.size()));
+  Eigen::MatrixXd P(n, 1);
+  for (std::size_t a = 0; a < n; ++a) {
+    if (!std::isfinite(spec.values[a]))
+      throw std::invalid_argument("control value " + std::to_string(a) + " is not finite");
+    P(a, 0) = spec.values[a];
+  }
+  return spline::SplineSurface(bu, bv, P);
+}
+
+spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, int degree_u,
+                                        std::vector<double> knots_u, int degree_v,
+                                        std::vector<double> knots_v, const Eigen::Vector3d& v) {
+  if (geometry.dim() != 3) throw std::invalid_argument("align: the geometry must be 3-D");
+  const spline::BSplineBasis bu(degree_u, std::move(knots_u)), bv(degree_v, std::move(knots_v));
+  const auto gu = bu.greville(), gv = bv.greville();
+  const int nu = bu.size(), nv = bv.size();
+  // Angles at the Greville points (u fastest), unwrapped along u and then along v.
+  Eigen::MatrixXd A(nu, nv);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const Eigen::MatrixXd D = geometry.derivatives(gu[i], gv[j], 1);
+      const Eigen::Vector3d a1 = D.row(1).transpose(), a2 = D.row(2).transpose();
+      const Eigen::Vector3d a3 = a1.cross(a2).normalized();
+      const Eigen::Vector3d e1 = a1.normalized();
+      const Eigen::Vector3d vt = v - v.dot(a3) * a3;
+      if (vt.norm() < 1e-12 * std::max(1.0, v.norm()))
+        throw std::invalid_argument(
+            "align: the vector v is normal to the surface at a Greville point");
+      double ang = std::atan2(e1.cross(vt).dot(a3), e1.dot(vt));
+      const double ref = i > 0 ? A(i - 1, j) : (j > 0 ? A(0, j - 1) : ang);
+      while (ang - ref > std::numbers::pi) ang -= 2 * std::numbers::pi;
+      while (ang - ref < -std::numbers::pi) ang += 2 * std::numbers::pi;
+      A(i, j) = ang;
+    }
+  // Tensor-product interpolation: alpha = Bu X Bv^T at the Greville points.
+  Eigen::MatrixXd Bu(nu, nu), Bv(nv, nv);
+  for (int i = 0; i < nu; ++i) Bu.row(i) = bu.eval_all(gu[i]).transpose();
+  for (int j = 0; j < nv; ++j) Bv.row(j) = bv.eval_all(gv[j]).transpose();
+  const Eigen::MatrixXd X =
+      Bv.partialPivLu().solve(Bu.partialPivLu().solve(A).transpose()).transpose();
+  Eigen::MatrixXd P(nu * nv, 1);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) P(i + nu * j, 0) = X(i, j);
+  return spline::SplineSurface(bu, bv, P);
+}
+
+KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
+                           spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
+                           Source source)
+    : family_(std::move(family)),
+      l_field_(std::move(stitch_value)),
+      a_field_(std::move(knitting_angle)),
+      source_(std::move(source)) {
+  if (!family_) throw std::invalid_argument("knit material: no database");
+  if (l_field_.dim() != 1 || a_field_.dim() != 1)
+    throw std::invalid_argument("knit material: the fields must be scalar");
+  const Eigen::MatrixXd& L = l_field_.control_points();
+  for (int a = 0; a < L.rows(); ++a)
+    if (!family_->contains(L(a, 0))) {
+      std::ostringstream os;
+      os << L(a, 0) << " mm is outside the database's " << family_->min() << "-" << family_->max()
+         << " mm";
+      if (!source_.database.empty()) os << " (" << source_.database << ")";
+      throw InputError(source_.file, source_.stitch_pointer + "/values/" + std::to_string(a),
+                       os.str());
+    }
+}
+
+double KnitMaterial::stitch_value(const Eigen::Vector2d& t) const {
+  return l_field_.eval(t(0), t(1))(0);
+}
+double KnitMaterial::knitting_angle(const Eigen::Vector2d& t) const {
+  return a_field_.eval(t(0), t(1))(0);
+}
+
+std::shared_ptr<const ResponseSurface> KnitMaterial::surface_at(double l) const {
+  // The field is a convex combination of in-range control values; clamp round-off.
+  l = std::clamp(l, family_->min(), family_->max());
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  auto it = cache_.find(l);
+  if (it != cache_.end()) return it->second;
+  auto rs = family_->surface(l);
+  cache_.emplace(l, rs);
+  return rs;
+}
+
+void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
+  bound_.clear();
+  bound_.reserve(theta.size());
+  for (const auto& t : theta) {
+    const double l = stitch_value(t);
+    const double a = knitting_angle(t);
+    bound_.push_back({surface_at(l).get(), l, a, knit_T_E(a), knit_T_S(-a)});
+  }
+}
+
+MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const ResponseSurface& rs,
+                                           double alpha, const Eigen::Matrix3d& TE,
+                                           const Eigen::Matrix3d& TSinv,
+                                           const Eigen::Vector2d& theta) const {
+  MaterialResponse out;
+  evaluations_.fetch_add(1, std::memory_order_relaxed);
+  if (alpha == 0.0) {
+    const auto ev = rs.evaluate(E);
+    out.S = ev.S;
+    out.C = ev.C;
+    if (ev.flags) {
+      for (int k = 0; k < 5; ++k)
+        if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
+      std::lock_guard<std::mutex> lock(where_mutex_);
+      if (static_cast<int>(where_.size()) < kMaxLocations) where_.push_back({theta, E, ev.flags});
+    }
+    return out;
+  }
+  // TE = T_E(alpha) = T^-T (eq. 21), TSinv = T_S(-alpha) = T^-1 (eq. 22).
+  const Eigen::Vector3d Ehat = TE * E;
+  const auto ev = rs.evaluate(Ehat);
+  out.S = TSinv * ev.S;
+  out.C = TSinv * ev.C * TE;
+  if (ev.flags) {
+    for (int k = 0; k < 5; ++k)
+      if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
+    std::lock_guard<std::mutex> lock(where_mutex_);
+    if (static_cast<int>(where_.size()) < kMaxLocations) where_.push_back({theta, Ehat, ev.flags});
+  }
+  return out;
+}
+
+MaterialResponse KnitMaterial::evaluate(const Eigen::Vector3d& E,
+                                        const MaterialPoint& where) const {
+  if (where.point_id >= 0 && where.point_id < static_cast<int>(bound_.size())) {
+    const Bound& b = bound_[where.point_id];
+    return evaluate_at(E, *b.rs, b.alpha, b.TE, b.TSinv, where.theta);
+  }
+  const auto rs = surface_at(stitch_value(where.theta));
+  const double a = knitting_angle(where.theta);
+  return evaluate_at(E, *rs, a, knit_T_E(a), knit_T_S(-a), where.theta);
+}
+
+std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(
+    const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const {
+  const double alpha = knitting_angle(theta);
+  const Eigen::Vector3d Ehat = knit_T_E(alpha) * E;
+  return {{"stitch_value", stitch_value(theta)},
+          {"knitting_angle", alpha},
+          {"E_course", Ehat(0)},
+          {"E_wale", Ehat(1)},
+          {"E_course_wale", 0.5 * Ehat(2)}};
+}
+
+KnitMaterial::Stats KnitMaterial::stats() const {
+  Stats s;
+  s.evaluations = evaluations_.load();
+  for (int k = 0; k < 5; ++k) s.count[k] = counts_[k].load();
+  std::lock_guard<std::mutex> lock(where_mutex_);
+  s.first = where_;
+  return s;
+}
+
+void KnitMaterial::reset_stats() {
+  evaluations_ = 0;
+  for (auto& c : counts_) c = 0;
+  std::lock_guard<std::mutex> lock(where_mutex_);
+  where_.clear();
+}
+
+std::string KnitMaterial::report() const {
+  const Stats s = stats();
+  static const char* names[5] = {"beyond the last load step", "outside the fan of load paths",
+                                 "biaxial compression (linear initial law)",
+                                 "beyond the shear data", "inversion failed"};
+  std::ostringstream os;
+  long total = 0;
+  for (long c : s.count) total += c;
+  os << "knit material: " << s.evaluations << " evaluations";
+  if (total == 0) {
+    os << ", all inside the fitted response-surface domain";
+    return os.str();
+  }
+  os << "; extrapolated:";
+  for (int k = 0; k < 5; ++k)
+    if (s.count[k]) os << "\n  " << s.count[k] << " x " << names[k];
+  os << "\n  first locations (theta1, theta2; material strains E_course, E_wale, 2E_cw):";
+  for (const auto& w : s.first)
+    os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();
+  return os.str();
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,78 @@
+// Least-squares fit of the response surfaces of one loop length (paper eq. 17, Sect. 3.1.1:
+// cubic, 11 x 11 control points, C2) and of the S12(E12) curve, with Ceres.
+//
+// Data parameterization (documented choice). The biaxial paths are sorted by the angle of
+// their last converged strain, atan2(E22, E11); path i of m gets xi1_i = i / (m - 1), step k
+// of n gets xi2 = k / n. The E-surface and the S-surface share these parameters, so the edge
+// xi2 = 0 is the undeformed state: its control points are held at E = S = 0 (a hard
+// constraint, Ceres "constant" part of the parameter blocks), which makes the law pass
+// through S(0) = 0.
+//
+// Objective (per loop length), all residuals dimensionless:
+//   sum_data rho( |(E(xi_d) - E_d)/sE|^2 + |(S(xi_d) - S_d)/sS|^2 )        data (rho: loss)
+// + lambda * sum |second differences of the control net / (sE, sS)|^2     smoothness
+// with sE, sS the largest |E|, |S| of the data; rho = identity, Huber or Cauchy (robust loss,
+// scale in the same units). Optional foot-point optimization: the xi_d become unknowns
+// (bounded to [0, 1]^2, kept close to their grid values by a weak penalty mu), solved with
+// the Schur complement over the foot points.
+//
+// The shear curve: E12 control values at the Greville abscissae times the largest data E12
+// (so E12(u) = u * E12_max exactly), S12 control values fitted with S12(0) = 0 held, the same
+// smoothness penalty and loss.
+//
+// Refusals (status != kOk, with the reason): fewer biaxial paths or steps than degree + 1,
+// fewer than n_ctrl distinct data values in a direction without smoothing, non-finite data, a
+// path without converged steps, two paths in the same direction, a fan of 180 degrees or
+// more, no shear path, and a fitted E-surface that cannot be inverted.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "knit/material/database.hpp"
+
+namespace knit::meso::fit {
+
+enum class Loss { kNone, kHuber, kCauchy };
+
+struct FitOptions {
+  int degree1 = 3, degree2 = 3;  ///< xi1 (path fan), xi2 (step fraction)
+  int n_ctrl1 = 11, n_ctrl2 = 11;
+  int shear_degree = 3, shear_n_ctrl = 11;
+  double smoothing = 1e-7;  ///< lambda (relative to the data term)
+  Loss loss = Loss::kNone;
+  double loss_scale = 0.05;  ///< in units of the scaled residual
+  bool optimize_foot_points = false;
+  double foot_point_penalty = 1e-4;  ///< mu: keeps xi_d near its grid value
+  int max_iterations = 100;
+
+  /// Empty if valid, else the reason.
+  std::string validate() const;
+  std::string to_json() const;
+  /// Parses the options JSON (the same keys as to_json()); throws knit::InputError.
+  static FitOptions from_json(const std::string& text, const std::string& file = "<options>");
+};
+
+enum class FitStatus { kOk, kRefused, kSolverFailed };
+
+struct FitSummary {
+  FitStatus status = FitStatus::kOk;
+  std::string reason;  ///< why it was refused / failed
+  material::ResponseSurfaceData surface;
+  material::FitDiagnostics diagnostics;
+  int ceres_iterations = 0;
+  bool ok() const { return status == FitStatus::kOk; }
+};
+
+/// Fits one loop length's raw data.
+FitSummary fit_loop_length(const std::vector<material::RawPath>& raw, const FitOptions& options);
+
+/// Fits every loop length of db in place; returns one summary per entry (stops at nothing:
+/// refused entries keep no surface).
+std::vector<FitSummary> fit_database(material::Database& db, const FitOptions& options);
+
+/// Computes the diagnostics of a fitted law against raw data (used by the fitter).
+material::FitDiagnostics diagnose(const material::ResponseSurfaceData& surface,
+                                  const std::vector<material::RawPath>& raw);
+
+}  // namespace knit::meso::fit

@@ -1,0 +1,33 @@
+#include <fstream>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/fit/report.hpp"
+
+namespace knit::meso::fit {
+
+void print_fit_summaries(std::ostream& os, const material::Database& db,
+                         const std::vector<FitSummary>& fits) {
+  for (std::size_t k = 0; k < fits.size(); ++k) {
+    const auto& f = fits[k];
+    os << "  l = " << db.entries[k].loop_length << " mm: ";
+    if (!f.ok()) {
+      os << "REFUSED: " << f.reason << "\n";
+      continue;
+    }
+    const auto& d = f.diagnostics;
+    os << "max |S error| S1 " << d.max(2) << ", S2 " << d.max(3) << ", S12 " << d.max(4)
+       << " MPa (" << 100 * d.max_relative << " % of the stress range); rms S1 " << d.rms(2)
+       << ", S2 " << d.rms(3) << ", S12 " << d.rms(4) << " MPa\n";
+  }
+}
+
+std::string read_text_file(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw knit::InputError(file, "", "cannot open");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace knit::meso::fit

@@ -1,0 +1,526 @@
+// Response-surface fit with Ceres (see knit/meso/fit/response_fit.hpp). Ceres is included in
+// this file only (design/style.md habit 6).
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/fit/response_fit.hpp"
+#include "knit/spline/knot_vector.hpp"
+#include "knit/spline/surface.hpp"
+
+namespace knit::meso::fit {
+
+using material::RawPath;
+using material::ResponseSurfaceData;
+
+namespace {
+
+/// r = (sum_l c_l P_l - target) ./ scale for parameter blocks P_l of size D. Linear, so the
+/// Jacobian blocks are c_l diag(1/scale).
+class LinearCombinationCost : public ceres::CostFunction {
+ public:
+  LinearCombinationCost(std::vector<double> c, Eigen::VectorXd target, Eigen::VectorXd inv_scale)
+      : c_(std::move(c)), target_(std::move(target)), inv_scale_(std::move(inv_scale)) {
+    const int D = static_cast<int>(target_.size());
+    set_num_residuals(D);
+    for (std::size_t l = 0; l < c_.size(); ++l) mutable_parameter_block_sizes()->push_back(D);
+  }
+  bool Evaluate(double const* const* P, double* r, double** J) const override {
+    const int D = static_cast<int>(target_.size());
+    for (int d = 0; d < D; ++d) {
+      double s = -target_(d);
+      for (std::size_t l = 0; l < c_.size(); ++l) s += c_[l] * P[l][d];
+      r[d] = s * inv_scale_(d);
+    }
+    if (J)
+      for (std::size_t l = 0; l < c_.size(); ++l) {
+        if (!J[l]) continue;
+        for (int a = 0; a < D * D; ++a) J[l][a] = 0.0;
+        for (int d = 0; d < D; ++d) J[l][d * D + d] = c_[l] * inv_scale_(d);
+      }
+    return true;
+  }
+
+ private:
+  std::vector<double> c_;
+  Eigen::VectorXd target_, inv_scale_;
+};
+
+/// Foot-point problem of one data point: r = ((X(xi) - X_d) ./ scale, sqrt(mu)(xi - xi0)).
+class FootPointCost : public ceres::SizedCostFunction<6, 2> {
+ public:
+  FootPointCost(const spline::SplineSurface& s, Eigen::Vector4d Xd, Eigen::Vector4d inv_scale,
+                Eigen::Vector2d xi0, double mu)
+      : s_(s), Xd_(Xd), inv_(inv_scale), xi0_(xi0), smu_(std::sqrt(mu)) {}
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    const Eigen::MatrixXd D = s_.derivatives(x[0][0], x[0][1], 1);
+    for (int d = 0; d < 4; ++d) r[d] = (D(0, d) - Xd_(d)) * inv_(d);
+    r[4] = smu_ * (x[0][0] - xi0_(0));
+    r[5] = smu_ * (x[0][1] - xi0_(1));
+    if (J && J[0]) {
+      for (int d = 0; d < 4; ++d) {
+        J[0][2 * d] = D(1, d) * inv_(d);
+        J[0][2 * d + 1] = D(2, d) * inv_(d);
+      }
+      J[0][8] = smu_;
+      J[0][9] = 0.0;
+      J[0][10] = 0.0;
+      J[0][11] = smu_;
+    }
+    return true;
+  }
+
+ private:
+  const spline::SplineSurface& s_;
+  Eigen::Vector4d Xd_, inv_;
+  Eigen::Vector2d xi0_;
+  double smu_;
+};
+
+ceres::LossFunction* make_loss(const FitOptions& o) {
+  switch (o.loss) {
+    case Loss::kHuber:
+      return new ceres::HuberLoss(o.loss_scale);
+    case Loss::kCauchy:
+      return new ceres::CauchyLoss(o.loss_scale);
+    default:
+      return nullptr;
+  }
+}
+
+void configure_solver(ceres::Solver::Options& so, const FitOptions& o) {
+  so.max_num_iterations = o.max_iterations;
+  so.function_tolerance = 1e-14;
+  so.gradient_tolerance = 1e-16;
+  so.parameter_tolerance = 1e-14;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  std::string err;
+  if (!so.IsValid(&err)) so.linear_solver_type = ceres::DENSE_QR;
+}
+
+struct DataPoint {
+  Eigen::Vector2d xi;
+  Eigen::Vector4d X;  // E1, E2, S1, S2
+};
+
+std::string loss_name(Loss l) {
+  return l == Loss::kHuber ? "huber" : (l == Loss::kCauchy ? "cauchy" : "none");
+}
+
+}  // namespace
+
+std::string FitOptions::validate() const {
+  if (degree1 < 1 || degree2 < 1 || shear_degree < 1) return "degrees must be >= 1";
+  if (degree1 > 9 || degree2 > 9 || shear_degree > 9) return "degrees must be <= 9";
+  if (n_ctrl1 < degree1 + 1 || n_ctrl2 < degree2 + 1 || shear_n_ctrl < shear_degree + 1)
+    return "the number of control points must be at least degree + 1";
+  if (!(smoothing >= 0.0)) return "smoothing must be >= 0";
+  if (!(loss_scale > 0.0)) return "loss_scale must be positive";
+  if (!(foot_point_penalty >= 0.0)) return "foot_point_penalty must be >= 0";
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  return {};
+}
+
+std::string FitOptions::to_json() const {
+  nlohmann::json j = {{"degree_1", degree1},
+                      {"degree_2", degree2},
+                      {"control_points_1", n_ctrl1},
+                      {"control_points_2", n_ctrl2},
+                      {"shear_degree", shear_degree},
+                      {"shear_control_points", shear_n_ctrl},
+                      {"smoothing", smoothing},
+                      {"loss", loss_name(loss)},
+                      {"loss_scale", loss_scale},
+                      {"optimize_foot_points", optimize_foot_points},
+                      {"foot_point_penalty", foot_point_penalty},
+                      {"max_iterations", max_iterations}};
+  return j.dump();
+}
+
+FitOptions FitOptions::from_json(const std::string& text, const std::string& file) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(file, "", std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw InputError(file, "", "fit options must be a JSON object");
+  FitOptions o;
+  auto get_int = [&](const char* k, int& v) {
+    if (!j.contains(k)) return;
+    if (!j[k].is_number_integer())
+      throw InputError(file, std::string("/") + k, "must be an integer");
+    v = j[k].get<int>();
+  };
+  auto get_double = [&](const char* k, double& v) {
+    if (!j.contains(k)) return;
+    if (!j[k].is_number()) throw InputError(file, std::string("/") + k, "must be a number");
+    v = j[k].get<double>();
+  };
+  static const char* known[] = {"degree_1",           "degree_2",
+                                "control_points_1",   "control_points_2",
+                                "shear_degree",       "shear_control_points",
+                                "smoothing",          "loss",
+                                "loss_scale",         "optimize_foot_points",
+                                "foot_point_penalty", "max_iterations"};
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (std::find_if(std::begin(known), std::end(known),
+                     [&](const char* k) { return it.key() == k; }) == std::end(known))
+      throw InputError(file, "/" + it.key(), "unknown fit option");
+  get_int("degree_1", o.degree1);
+  get_int("degree_2", o.degree2);
+  get_int("control_points_1", o.n_ctrl1);
+  get_int("control_points_2", o.n_ctrl2);
+  get_int("shear_degree", o.shear_degree);
+  get_int("shear_control_points", o.shear_n_ctrl);
+  get_double("smoothing", o.smoothing);
+  get_double("loss_scale", o.loss_scale);
+  get_double("foot_point_penalty", o.foot_point_penalty);
+  get_int("max_iterations", o.max_iterations);
+  if (j.contains("optimize_foot_points")) {
+    if (!j["optimize_foot_points"].is_boolean())
+      throw InputError(file, "/optimize_foot_points", "must be true or false");
+    o.optimize_foot_points = j["optimize_foot_points"].get<bool>();
+  }
+  if (j.contains("loss")) {
+    const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
+    if (l == "none")
+      o.loss = Loss::kNone;
+    else if (l == "huber")
+      o.loss = Loss::kHuber;
+    else if (l == "cauchy")
+      o.loss = Loss::kCauchy;
+    else
+      throw InputError(file, "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
+  }
+  if (const std::string why = o.validate(); !why.empty()) throw InputError(file, "", why);
+  return o;
+}
+
+FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o) {
+  FitSummary out;
+  auto refuse = [&](const std::string& why) {
+    out.status = FitStatus::kRefused;
+    out.reason = why;
+    return out;
+  };
+  if (const std::string why = o.validate(); !why.empty()) return refuse("invalid options: " + why);
+
+  // ---- collect and order the biaxial paths -------------------------------------------------
+  struct Path {
+    const RawPath* p;
+    double phi;
+    int last;
+  };
+  std::vector<Path> fan;
+  const RawPath* shear = nullptr;
+  int skipped = 0;
+  for (std::size_t q = 0; q < raw.size(); ++q) {
+    const RawPath& r = raw[q];
+    const int n = r.steps();
+    if (r.E.rows() != n || r.S.rows() != n || r.E.cols() != 3 || r.S.cols() != 3)
+      return refuse("path " + std::to_string(q) + ": E and S need one row of 3 per step");
+    if (!r.E.allFinite() || !r.S.allFinite())
+      return refuse("path " + std::to_string(q) + ": non-finite strain or stress data");
+    int last = -1;
+    for (int k = 0; k < n; ++k) {
+      if (r.status[k] == 0)
+        last = k;
+      else
+        ++skipped;
+    }
+    if (last < 0) return refuse("path " + std::to_string(q) + " has no converged step");
+    if (r.path.kind == material::PathKind::kShear) {
+      if (!shear) shear = &r;
+      continue;
+    }
+    fan.push_back({&r, std::atan2(r.E(last, 1), r.E(last, 0)), last});
+  }
+  const int m = static_cast<int>(fan.size());
+  if (m < o.degree1 + 1)
+    return refuse(std::to_string(m) + " biaxial paths cannot determine a degree-" +
+                  std::to_string(o.degree1) +
+                  " surface across the paths (need >= " + std::to_string(o.degree1 + 1) + ")");
+  if (!shear) return refuse("no pure-shear path: the S12(E12) curve cannot be fitted");
+  std::sort(fan.begin(), fan.end(), [](const Path& a, const Path& b) { return a.phi < b.phi; });
+  for (int i = 1; i < m; ++i)
+    if (fan[i].phi - fan[i - 1].phi < 1e-6)
+      return refuse("two biaxial paths point in the same strain direction (" +
+                    std::to_string(fan[i].phi * 180 / M_PI) + " deg)");
+  if (fan.back().phi - fan.front().phi >= M_PI)
+    return refuse("the biaxial paths span 180 degrees or more; the fan cannot be inverted");
+  int min_steps = 1 << 30;
+  for (const auto& f : fan) min_steps = std::min(min_steps, f.p->steps());
+  if (min_steps < o.degree2 + 1)
+    return refuse("paths with " + std::to_string(min_steps) + " steps cannot determine a degree-" +
+                  std::to_string(o.degree2) + " surface along the paths");
+  if (o.smoothing == 0.0 && (o.n_ctrl1 > m || o.n_ctrl2 > min_steps + 1))
+    return refuse("without smoothing, " + std::to_string(o.n_ctrl1) + " x " +
+                  std::to_string(o.n_ctrl2) + " control points need at least as many paths (" +
+                  std::to_string(m) + ") and steps + 1 (" + std::to_string(min_steps + 1) + ")");
+
+  std::vector<DataPoint> data;
+  double sE = 0.0, sS = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const RawPath& r = *fan[i].p;
+    const int n = r.steps();
+    for (int k = 0; k < n; ++k) {
+      if (r.status[k] != 0) continue;
+      DataPoint d;
+      d.xi = {m > 1 ? static_cast<double>(i) / (m - 1) : 0.0, static_cast<double>(k + 1) / n};
+      d.X << r.E(k, 0), r.E(k, 1), r.S(k, 0), r.S(k, 1);
+      sE = std::max(sE, d.X.head<2>().cwiseAbs().maxCoeff());
+      sS = std::max(sS, d.X.tail<2>().cwiseAbs().maxCoeff());
+      data.push_back(d);
+    }
+  }
+  if (!(sE > 0.0)) return refuse("all biaxial strains are zero");
+  if (!(sS > 0.0)) sS = 1.0;
+
+  // ---- the surface fit (xi fixed; alternated with foot-point updates if asked) ----------------
+  ResponseSurfaceData& sf = out.surface;
+  sf.degree1 = o.degree1;
+  sf.degree2 = o.degree2;
+  sf.knots1 = spline::uniform_knots(o.degree1, o.n_ctrl1 - o.degree1);
+  sf.knots2 = spline::uniform_knots(o.degree2, o.n_ctrl2 - o.degree2);
+  const spline::BSplineBasis b1(o.degree1, sf.knots1), b2(o.degree2, sf.knots2);
+  const int n1 = o.n_ctrl1, n2 = o.n_ctrl2, N = n1 * n2;
+  std::vector<double> P(static_cast<std::size_t>(4 * N), 0.0);
+  // Start from a bilinear-ish guess: the data of the nearest path scaled by xi2.
+  const Eigen::Vector4d inv_scale(1 / sE, 1 / sE, 1 / sS, 1 / sS);
+  const double reg_weight =
+      std::sqrt(o.smoothing * static_cast<double>(data.size()) / std::max(1, 2 * N));
+
+  const int rounds = o.optimize_foot_points ? 6 : 1;
+  for (int round = 0; round < rounds; ++round) {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    for (int a = 0; a < N; ++a) problem.AddParameterBlock(&P[4 * a], 4);
+    double buf1[64], buf2[64];
+    for (const DataPoint& d : data) {
+      Eigen::Map<Eigen::MatrixXd> N1(buf1, 1, o.degree1 + 1), N2(buf2, 1, o.degree2 + 1);
+      const int i0 = b1.eval(d.xi(0), 0, N1), j0 = b2.eval(d.xi(1), 0, N2);
+      std::vector<double> c;
+      std::vector<double*> blocks;
+      for (int b = 0; b <= o.degree2; ++b)
+        for (int a = 0; a <= o.degree1; ++a) {
+          c.push_back(N1(0, a) * N2(0, b));
+          blocks.push_back(&P[4 * ((i0 + a) + n1 * (j0 + b))]);
+        }
+      problem.AddResidualBlock(new LinearCombinationCost(c, d.X, inv_scale), make_loss(o), blocks);
+    }
+    if (reg_weight > 0.0) {
+      const std::vector<double> c = {reg_weight, -2 * reg_weight, reg_weight};
+      for (int j = 0; j < n2; ++j)
+        for (int i = 1; i + 1 < n1; ++i)
+          problem.AddResidualBlock(
+              new LinearCombinationCost(c, Eigen::Vector4d::Zero(), inv_scale), nullptr,
+              {&P[4 * (i - 1 + n1 * j)], &P[4 * (i + n1 * j)], &P[4 * (i + 1 + n1 * j)]});
+      for (int i = 0; i < n1; ++i)
+        for (int j = 1; j + 1 < n2; ++j)
+          problem.AddResidualBlock(
+              new LinearCombinationCost(c, Eigen::Vector4d::Zero(), inv_scale), nullptr,
+              {&P[4 * (i + n1 * (j - 1))], &P[4 * (i + n1 * j)], &P[4 * (i + n1 * (j + 1))]});
+    }
+    // Hard constraint: the edge xi2 = 0 is the undeformed, stress-free state.
+    for (int i = 0; i < n1; ++i) problem.SetParameterBlockConstant(&P[4 * i]);
+    ceres::Solver::Options so;
+    configure_solver(so, o);
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    out.ceres_iterations += static_cast<int>(summary.iterations.size());
+    if (!summary.IsSolutionUsable()) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = "Ceres: " + summary.message;
+      return out;
+    }
+    if (round + 1 == rounds) break;
+    // Foot-point update: each data point's xi minimizes its distance to the current surfaces.
+    Eigen::MatrixXd Pm(N, 4);
+    for (int a = 0; a < N; ++a)
+      for (int d = 0; d < 4; ++d) Pm(a, d) = P[4 * a + d];
+    const spline::SplineSurface surf(b1, b2, Pm);
+    for (DataPoint& d : data) {
+      const Eigen::Vector2d xi0 = d.xi;
+      double x[2] = {d.xi(0), d.xi(1)};
+      ceres::Problem fp;
+      fp.AddResidualBlock(new FootPointCost(surf, d.X, inv_scale, xi0, o.foot_point_penalty),
+                          nullptr, x);
+      fp.SetParameterLowerBound(x, 0, 0.0);
+      fp.SetParameterUpperBound(x, 0, 1.0);
+      fp.SetParameterLowerBound(x, 1, 1e-6);
+      fp.SetParameterUpperBound(x, 1, 1.0);
+      ceres::Solver::Options fo;
+      fo.max_num_iterations = 20;
+      fo.logging_type = ceres::SILENT;
+      fo.linear_solver_type = ceres::DENSE_QR;
+      ceres::Solver::Summary fs;
+      ceres::Solve(fo, &fp, &fs);
+      if (fs.IsSolutionUsable()) d.xi = {x[0], x[1]};
+    }
+  }
+  sf.E_ctrl.resize(N, 2);
+  sf.S_ctrl.resize(N, 2);
+  for (int a = 0; a < N; ++a) {
+    sf.E_ctrl.row(a) << P[4 * a], P[4 * a + 1];
+    sf.S_ctrl.row(a) << P[4 * a + 2], P[4 * a + 3];
+  }
+
+  // ---- the shear curve -----------------------------------------------------------------------
+  sf.shear_degree = o.shear_degree;
+  sf.shear_knots = spline::uniform_knots(o.shear_degree, o.shear_n_ctrl - o.shear_degree);
+  const spline::BSplineBasis bs(o.shear_degree, sf.shear_knots);
+  const int ns = o.shear_n_ctrl;
+  double E12max = 0.0, S12s = 0.0;
+  for (int k = 0; k < shear->steps(); ++k)
+    if (shear->status[k] == 0) {
+      E12max = std::max(E12max, std::abs(shear->E(k, 2)));
+      S12s = std::max(S12s, std::abs(shear->S(k, 2)));
+    }
+  if (!(E12max > 0.0)) return refuse("the shear path has no shear strain");
+  if (!(S12s > 0.0)) S12s = 1.0;
+  int shear_points = 0;
+  for (int k = 0; k < shear->steps(); ++k) shear_points += shear->status[k] == 0;
+  if (shear_points < o.shear_degree + 1 && o.smoothing == 0.0)
+    return refuse("the shear path has too few converged steps for the S12 curve");
+  sf.E12_ctrl.resize(ns);
+  {
+    const std::vector<double> g = bs.greville();
+    for (int k = 0; k < ns; ++k) sf.E12_ctrl(k) = g[k] * E12max;
+    sf.E12_ctrl(0) = 0.0;
+  }
+  std::vector<double> Q(ns, 0.0);
+  {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    for (int a = 0; a < ns; ++a) problem.AddParameterBlock(&Q[a], 1);
+    const Eigen::VectorXd inv = Eigen::VectorXd::Constant(1, 1.0 / S12s);
+    double buf[64];
+    for (int k = 0; k < shear->steps(); ++k) {
+      if (shear->status[k] != 0) continue;
+      Eigen::Map<Eigen::MatrixXd> Nb(buf, 1, o.shear_degree + 1);
+      const double sign = shear->E(k, 2) < 0 ? -1.0 : 1.0;
+      const int i0 = bs.eval(std::abs(shear->E(k, 2)) / E12max, 0, Nb);
+      std::vector<double> c;
+      std::vector<double*> blocks;
+      for (int a = 0; a <= o.shear_degree; ++a) {
+        c.push_back(Nb(0, a));
+        blocks.push_back(&Q[i0 + a]);
+      }
+      problem.AddResidualBlock(
+          new LinearCombinationCost(c, Eigen::VectorXd::Constant(1, sign * shear->S(k, 2)), inv),
+          make_loss(o), blocks);
+    }
+    const double rw = std::sqrt(o.smoothing * shear_points / std::max(1, ns));
+    if (rw > 0.0)
+      for (int a = 1; a + 1 < ns; ++a)
+        problem.AddResidualBlock(
+            new LinearCombinationCost({rw, -2 * rw, rw}, Eigen::VectorXd::Zero(1), inv), nullptr,
+            {&Q[a - 1], &Q[a], &Q[a + 1]});
+    problem.SetParameterBlockConstant(&Q[0]);
+    ceres::Solver::Options so;
+    configure_solver(so, o);
+    so.linear_solver_type = ceres::DENSE_QR;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    if (!summary.IsSolutionUsable()) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = "Ceres (shear curve): " + summary.message;
+      return out;
+    }
+  }
+  sf.S12_ctrl = Eigen::Map<Eigen::VectorXd>(Q.data(), ns);
+
+  // ---- check and diagnose ----------------------------------------------------------------------
+  try {
+    out.diagnostics = diagnose(sf, raw);
+  } catch (const std::exception& e) {
+    return refuse(std::string("the fitted law is not usable: ") + e.what());
+  }
+  out.diagnostics.points_skipped = skipped;
+  out.diagnostics.options_json = o.to_json();
+  return out;
+}
+
+material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
+                                  const std::vector<RawPath>& raw) {
+  const material::ResponseSurface law(surface);  // throws if not invertible
+  material::FitDiagnostics dg;
+  Eigen::Matrix<double, 5, 1> sum2 = Eigen::Matrix<double, 5, 1>::Zero();
+  Eigen::Matrix<int, 5, 1> count = Eigen::Matrix<int, 5, 1>::Zero();
+  double srange = 0.0;
+  auto add = [&](int c, double e) {
+    sum2(c) += e * e;
+    dg.max(c) = std::max(dg.max(c), std::abs(e));
+    ++count(c);
+  };
+  for (const RawPath& r : raw)
+    for (int k = 0; k < r.steps(); ++k) {
+      if (r.status[k] != 0) continue;
+      ++dg.points_used;
+      srange = std::max(srange, r.S.row(k).cwiseAbs().maxCoeff());
+      if (r.path.kind == material::PathKind::kShear) {
+        const auto ev = law.evaluate({0.0, 0.0, 2.0 * r.E(k, 2)});
+        add(4, ev.S(2) - r.S(k, 2));
+      } else {
+        const auto ev = law.evaluate({r.E(k, 0), r.E(k, 1), 0.0});
+        add(2, ev.S(0) - r.S(k, 0));
+        add(3, ev.S(1) - r.S(k, 1));
+      }
+    }
+  // E-surface errors at the grid parameters (path index, step fraction), as in the fit.
+  std::vector<std::pair<double, const RawPath*>> fan;
+  for (const RawPath& r : raw)
+    if (r.path.kind == material::PathKind::kBiaxial) {
+      int last = -1;
+      for (int k = 0; k < r.steps(); ++k)
+        if (r.status[k] == 0) last = k;
+      if (last >= 0) fan.push_back({std::atan2(r.E(last, 1), r.E(last, 0)), &r});
+    }
+  std::sort(fan.begin(), fan.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  const int m = static_cast<int>(fan.size());
+  for (int i = 0; i < m; ++i) {
+    const RawPath& r = *fan[i].second;
+    for (int k = 0; k < r.steps(); ++k) {
+      if (r.status[k] != 0) continue;
+      const Eigen::Vector4d X = law.point(
+          {m > 1 ? static_cast<double>(i) / (m - 1) : 0.0, static_cast<double>(k + 1) / r.steps()});
+      add(0, X(0) - r.E(k, 0));
+      add(1, X(1) - r.E(k, 1));
+    }
+  }
+  for (int c = 0; c < 5; ++c) dg.rms(c) = count(c) ? std::sqrt(sum2(c) / count(c)) : 0.0;
+  dg.max_relative = srange > 0.0 ? dg.max.tail<3>().maxCoeff() / srange : 0.0;
+  return dg;
+}
+
+std::vector<FitSummary> fit_database(material::Database& db, const FitOptions& options) {
+  std::vector<FitSummary> out;
+  for (auto& e : db.entries) {
+    out.push_back(fit_loop_length(e.raw, options));
+    if (out.back().ok()) {
+      e.surface = out.back().surface;
+      e.diagnostics = out.back().diagnostics;
+    } else {
+      e.surface.reset();
+      e.diagnostics = {};
+    }
+  }
+  return out;
+}
+
+}  // namespace knit::meso::fit

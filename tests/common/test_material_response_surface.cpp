@@ -1,0 +1,121 @@
+// Response-surface evaluation (paper eqs. 16-18): inversion, tangent, extrapolation, eq. 25.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "knit/material/loop_length_family.hpp"
+#include "knit/material/response_surface.hpp"
+#include "test_material_util.hpp"
+
+using namespace knit::material;
+using knit::material::testing::make_test_surface;
+
+namespace {
+Eigen::Matrix3d fd_tangent(const ResponseSurface& rs, const Eigen::Vector3d& E, double h = 1e-7) {
+  Eigen::Matrix3d C;
+  for (int c = 0; c < 3; ++c) {
+    Eigen::Vector3d Ep = E, Em = E;
+    Ep(c) += h;
+    Em(c) -= h;
+    C.col(c) = (rs.evaluate(Ep).S - rs.evaluate(Em).S) / (2 * h);
+  }
+  return C;
+}
+}  // namespace
+
+TEST_CASE("response surface: inversion reproduces the E-surface", "[unit]") {
+  const ResponseSurface rs(make_test_surface());
+  for (double x1 : {0.0, 0.13, 0.5, 0.77, 1.0})
+    for (double x2 : {1e-6, 0.01, 0.3, 0.8, 1.0}) {
+      const Eigen::Vector4d X = rs.point({x1, x2});
+      const auto ev = rs.evaluate({X(0), X(1), 0.0});
+      INFO("xi = " << x1 << ", " << x2);
+      CHECK((ev.flags & kInversionFailed) == 0);
+      CHECK(ev.S(0) == Approx(X(2)).margin(1e-12));
+      CHECK(ev.S(1) == Approx(X(3)).margin(1e-12));
+      CHECK(ev.xi(0) == Approx(x1).margin(1e-6));
+      CHECK(ev.iterations <= 8);
+    }
+}
+
+TEST_CASE("response surface: tangent equals finite differences on and off the domain", "[unit]") {
+  const ResponseSurface rs(make_test_surface());
+  const std::vector<Eigen::Vector3d> pts = {
+      {0.1, 0.05, 0.02},   {0.3, -0.1, 0.1},  {0.02, 0.3, -0.05},  // inside
+      {0.5, 0.1, 0.0},     {0.4, 0.5, 0.4},                        // beyond the last step
+      {-0.15, 0.05, 0.01}, {0.3, -0.25, 0.0},                      // outside the fan
+      {-0.05, -0.04, 0.0},                                         // biaxial compression
+      {1e-5, 2e-5, 1e-5}};                                         // near the collapsed edge
+  for (const auto& E : pts) {
+    const auto ev = rs.evaluate(E);
+    INFO("E = " << E.transpose() << " flags " << int(ev.flags) << " xi " << ev.xi.transpose());
+    CHECK((ev.flags & kInversionFailed) == 0);
+    const Eigen::Matrix3d Cfd = fd_tangent(rs, E, std::max(1e-9, 1e-6 * E.norm()));
+    CHECK((ev.C - Cfd).norm() <= 1e-5 * std::max(1.0, Cfd.norm()));
+  }
+  CHECK((rs.evaluate({0.5, 0.1, 0}).flags & kBeyondPaths) != 0);
+  CHECK((rs.evaluate({0.3, -0.25, 0}).flags & kOutsideFan) != 0);
+  CHECK((rs.evaluate({-0.2, 0.3, 0}).flags & kOutsideFan) != 0);
+  CHECK((rs.evaluate({-0.05, -0.04, 0}).flags & kCompression) != 0);
+  CHECK((rs.evaluate({0, 0, 0.8}).flags & kBeyondShear) != 0);
+  CHECK(rs.evaluate({0.1, 0.05, 0.02}).flags == kInside);
+}
+
+TEST_CASE("response surface: origin is stress free with a finite initial stiffness", "[unit]") {
+  const ResponseSurface rs(make_test_surface());
+  const auto ev = rs.evaluate(Eigen::Vector3d::Zero());
+  CHECK(ev.S.norm() == 0.0);
+  // The test law's linear part: [[0.5, 0.1], [0.1, 1.0]], shear 0.3/2.
+  CHECK(ev.C(0, 0) == Approx(0.5).epsilon(0.05));
+  CHECK(ev.C(1, 1) == Approx(1.0).epsilon(0.05));
+  CHECK(ev.C(2, 2) == Approx(0.15).epsilon(0.02));
+  // The tangent is continuous at the origin along the fan (limit of the direction-dependent
+  // stiffness); the odd shear curve is smooth through 0.
+  const auto ev2 = rs.evaluate({1e-9, 1e-9, 0.0});
+  CHECK(ev2.S.norm() < 1e-8);
+  CHECK((ev2.C - ev.C).norm() < 0.1);
+  CHECK(rs.evaluate({0, 0, -0.2}).S(2) == Approx(-rs.evaluate({0, 0, 0.2}).S(2)));
+}
+
+TEST_CASE("response surface: bad data are refused with a reason", "[unit]") {
+  auto d = make_test_surface();
+  SECTION("edge xi2 = 0 not at the origin") {
+    d.E_ctrl(3, 0) = 0.01;
+    CHECK_THROWS_WITH(ResponseSurface(d), Catch::Contains("stress-free origin"));
+  }
+  SECTION("wrong control point count") {
+    d.S_ctrl.conservativeResize(10, 2);
+    CHECK_THROWS_WITH(ResponseSurface(d), Catch::Contains("S_ctrl must be 121 x 2"));
+  }
+  SECTION("folded fan") {
+    const int n = d.n1();
+    for (int j = 1; j < d.n2(); ++j) d.E_ctrl.row(5 + n * j).swap(d.E_ctrl.row(7 + n * j));
+    CHECK_THROWS_WITH(ResponseSurface(d), Catch::Contains("counter-clockwise"));
+  }
+  SECTION("non-monotone shear curve") {
+    d.E12_ctrl(4) = d.E12_ctrl(2);
+    CHECK_THROWS_WITH(ResponseSurface(d), Catch::Contains("must increase"));
+  }
+}
+
+TEST_CASE("loop-length family: reproduces each fitted loop length exactly (eq. 25)", "[unit]") {
+  const std::vector<double> l = {4.5, 5.0, 5.5, 6.0, 6.5};
+  std::vector<ResponseSurfaceData> laws;
+  for (double li : l) laws.push_back(make_test_surface(std::pow(4.5 / li, 2)));
+  const LoopLengthFamily fam(l, laws);
+  for (std::size_t k = 0; k < l.size(); ++k) {
+    const auto d = fam.at(l[k]);
+    CHECK((d.S_ctrl - laws[k].S_ctrl).norm() == 0.0);
+    CHECK((d.E_ctrl - laws[k].E_ctrl).norm() == 0.0);
+    const Eigen::VectorXd w = fam.weights(l[k] + 1e-12 > 6.5 ? l[k] : l[k] + 1e-12);
+    CHECK(w.sum() == Approx(1.0));
+  }
+  // Between the sites: partition of unity, and a value between the neighbours.
+  const auto w = fam.weights(5.25);
+  CHECK(w.sum() == Approx(1.0).epsilon(1e-14));
+  const ResponseSurface mid(fam.at(5.25));
+  const double s = mid.evaluate({0.2, 0.1, 0}).S(0);
+  CHECK(s < ResponseSurface(laws[1]).evaluate({0.2, 0.1, 0}).S(0));
+  CHECK(s > ResponseSurface(laws[2]).evaluate({0.2, 0.1, 0}).S(0));
+  CHECK_THROWS_WITH(fam.weights(7.0), Catch::Contains("outside the database's range 4.5-6.5"));
+  CHECK_THROWS_WITH(fam.weights(4.4), Catch::Contains("outside"));
+}

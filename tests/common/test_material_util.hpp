@@ -1,0 +1,58 @@
+// Test helper: a valid response surface without the fitter (Schoenberg quasi-interpolation of
+// a known law on the default fan of load paths: control point (i, j) takes the strain of the
+// fan at the Greville abscissae (g_i, g_j) and the law's stress there). Shared by the common
+// and macro material tests.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "knit/material/load_paths.hpp"
+#include "knit/material/response_surface.hpp"
+#include "knit/spline/bspline_basis.hpp"
+#include "knit/spline/knot_vector.hpp"
+
+namespace knit::material::testing {
+
+/// Orthotropic stiffening test law (tensor strains -> S11, S22, S12), scaled by k.
+inline Eigen::Vector3d test_law(const Eigen::Vector3d& E, double k = 1.0) {
+  return k * Eigen::Vector3d(0.5 * E(0) + 0.1 * E(1) + 8.0 * E(0) * E(0) * E(0),
+                             0.1 * E(0) + 1.0 * E(1) + 12.0 * E(1) * E(1) * E(1),
+                             0.3 * E(2) + 4.0 * E(2) * E(2) * E(2));
+}
+
+/// Strain of the default fan at (xi1, xi2): end point on the L polyline, proportional F.
+inline Eigen::Vector2d fan_strain(double xi1, double xi2) {
+  const double leg = 0.5, s = 2 * leg * xi1;
+  Eigen::Vector2d end =
+      s <= leg ? Eigen::Vector2d(0.35, -0.15 + s) : Eigen::Vector2d(0.35 - (s - leg), 0.35);
+  LoadPath p;
+  p.target = end;
+  const Eigen::Matrix2d E = green_lagrange(deformation_gradient(p, xi2));
+  return {E(0, 0), E(1, 1)};
+}
+
+inline ResponseSurfaceData make_test_surface(double k = 1.0, int n = 11, int p = 3) {
+  ResponseSurfaceData d;
+  d.degree1 = d.degree2 = d.shear_degree = p;
+  d.knots1 = d.knots2 = d.shear_knots = spline::uniform_knots(p, n - p);
+  const auto g = spline::BSplineBasis(p, d.knots1).greville();
+  d.E_ctrl.resize(n * n, 2);
+  d.S_ctrl.resize(n * n, 2);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d E = fan_strain(g[i], g[j]);
+      const Eigen::Vector3d S = test_law({E(0), E(1), 0.0}, k);
+      d.E_ctrl.row(i + n * j) = E.transpose();
+      d.S_ctrl.row(i + n * j) << S(0), S(1);
+    }
+  d.E12_ctrl.resize(n);
+  d.S12_ctrl.resize(n);
+  for (int i = 0; i < n; ++i) {
+    d.E12_ctrl(i) = 0.3 * g[i];
+    d.S12_ctrl(i) = test_law({0, 0, d.E12_ctrl(i)}, k)(2);
+  }
+  return d;
+}
+
+}  // namespace knit::material::testing

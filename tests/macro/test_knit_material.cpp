@@ -1,0 +1,152 @@
+// The graded, rotated knit material (paper Sect. 2.2, eqs. 19-25) against its definition.
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+
+#include "../common/test_material_util.hpp"
+#include "knit/core/errors.hpp"
+#include "knit/macro/knit_material.hpp"
+
+using namespace knit::macro;
+using namespace knit::material;
+using knit::material::testing::make_test_surface;
+
+namespace {
+std::shared_ptr<const LoopLengthFamily> test_family() {
+  const std::vector<double> l = {4.5, 5.0, 5.5, 6.0, 6.5};
+  std::vector<ResponseSurfaceData> laws;
+  for (double li : l) laws.push_back(make_test_surface(std::pow(4.5 / li, 2)));
+  return std::make_shared<const LoopLengthFamily>(l, laws);
+}
+// l graded linearly 4.5 -> 6.5 in theta1, alpha constant.
+KnitMaterial graded(double alpha, double l0 = 4.5, double l1 = 6.5) {
+  ScalarFieldSpec l;
+  l.degree_u = 1;
+  l.knots_u = {0, 0, 1, 1};
+  l.values = {l0, l1};
+  return KnitMaterial(test_family(), make_scalar_field(l),
+                      make_scalar_field(ScalarFieldSpec::constant(alpha)));
+}
+MaterialPoint at(double t1, double t2) {
+  MaterialPoint p;
+  p.theta = {t1, t2};
+  return p;
+}
+}  // namespace
+
+TEST_CASE("knit material: tangent equals finite differences of S (graded, rotated)", "[unit]") {
+  const KnitMaterial m = graded(0.4);
+  for (const Eigen::Vector3d E : {Eigen::Vector3d(0.1, 0.05, 0.04), Eigen::Vector3d(0.3, -0.1, 0.2),
+                                  Eigen::Vector3d(0.6, 0.2, 0.1), Eigen::Vector3d(-0.1, -0.05, 0.0),
+                                  Eigen::Vector3d(0.02, 0.4, -0.5)}) {
+    const auto p = at(0.37, 0.5);
+    const auto r = m.evaluate(E, p);
+    Eigen::Matrix3d Cfd;
+    const double h = 1e-7;
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d Ep = E, Em = E;
+      Ep(c) += h;
+      Em(c) -= h;
+      Cfd.col(c) = (m.evaluate(Ep, p).S - m.evaluate(Em, p).S) / (2 * h);
+    }
+    INFO("E = " << E.transpose());
+    CHECK((r.C - Cfd).norm() <= 1e-5 * Cfd.norm());
+  }
+  CHECK(m.report().find("extrapolated") != std::string::npos);
+}
+
+TEST_CASE("knit material: alpha = 0 is the identity, alpha = pi/2 swaps course and wale",
+          "[unit]") {
+  const auto fam = test_family();
+  const ResponseSurface rs(fam->at(5.0));
+  const KnitMaterial m0 = graded(0.0, 5.0, 5.0);
+  const KnitMaterial m90 = graded(std::numbers::pi / 2, 5.0, 5.0);
+  const Eigen::Vector3d E(0.2, 0.05, 0.06);
+  const auto a = m0.evaluate(E, at(0.5, 0.5));
+  const auto ref = rs.evaluate(E);
+  CHECK((a.S - ref.S).norm() == 0.0);
+  CHECK((a.C - ref.C).norm() == 0.0);
+  const auto b = m90.evaluate(E, at(0.5, 0.5));
+  const auto sw = rs.evaluate({E(1), E(0), -E(2)});
+  CHECK(b.S(0) == Approx(sw.S(1)).margin(1e-13));
+  CHECK(b.S(1) == Approx(sw.S(0)).margin(1e-13));
+  CHECK(b.S(2) == Approx(-sw.S(2)).margin(1e-13));
+  CHECK(b.C(0, 0) == Approx(sw.C(1, 1)).margin(1e-12));
+  CHECK(b.C(1, 1) == Approx(sw.C(0, 0)).margin(1e-12));
+}
+
+TEST_CASE("knit material: rotating the frame together with alpha changes nothing physical",
+          "[unit]") {
+  // A frame rotated by beta sees E' = T_E(beta) E and the angle alpha - beta; then
+  // S' = T_S(beta) S and C' = T_S(beta) C T_E(beta)^-1.
+  const double alpha = 0.7, beta = -0.45;
+  const KnitMaterial m = graded(alpha), mr = graded(alpha - beta);
+  const Eigen::Vector3d E(0.15, -0.03, 0.08);
+  const auto r = m.evaluate(E, at(0.3, 0.2));
+  const auto rr = mr.evaluate(knit_T_E(beta) * E, at(0.3, 0.2));
+  CHECK((rr.S - knit_T_S(beta) * r.S).norm() < 1e-12);
+  CHECK((rr.C - knit_T_S(beta) * r.C * knit_T_E(beta).inverse()).norm() < 1e-10);
+  CHECK((knit_T_S(0.3) * knit_T_E(0.3).transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-15);
+}
+
+TEST_CASE("knit material: bound points interpolate l; fitted loop lengths are exact", "[unit]") {
+  KnitMaterial m = graded(0.0);
+  const std::vector<Eigen::Vector2d> pts = {{0.0, 0.5}, {0.25, 0.5}, {0.6, 0.1}, {1.0, 0.9}};
+  m.bind_points(pts);
+  const auto fam = test_family();
+  const Eigen::Vector3d E(0.2, 0.1, 0.05);
+  for (int k = 0; k < 4; ++k) {
+    MaterialPoint p = at(pts[k](0), pts[k](1));
+    p.point_id = k;
+    const double l = 4.5 + 2.0 * pts[k](0);
+    CHECK(m.stitch_value(pts[k]) == Approx(l));
+    const auto ref = ResponseSurface(fam->at(l)).evaluate(E);
+    CHECK((m.evaluate(E, p).S - ref.S).norm() < 1e-13);
+  }
+  // l = 5.0 at theta1 = 0.25 is a fitted loop length: the law there is the fitted law.
+  const auto exact = ResponseSurface(make_test_surface(std::pow(4.5 / 5.0, 2))).evaluate(E);
+  MaterialPoint p = at(0.25, 0.5);
+  p.point_id = 1;
+  CHECK((m.evaluate(E, p).S - exact.S).norm() < 1e-13);
+  const auto f = m.output_fields({0.25, 0.5}, E);
+  REQUIRE(f.size() == 5);
+  CHECK(f[0].second == Approx(5.0));
+  CHECK(f[2].second == Approx(E(0)));
+}
+
+TEST_CASE("knit material: a stitch value outside the database is an error naming the field",
+          "[unit]") {
+  ScalarFieldSpec l;
+  l.degree_u = 1;
+  l.knots_u = {0, 0, 1, 1};
+  l.values = {4.5, 9.2};
+  KnitMaterial::Source src;
+  src.file = "case.json";
+  src.database = "db.h5";
+  CHECK_THROWS_WITH(KnitMaterial(test_family(), make_scalar_field(l),
+                                 make_scalar_field(ScalarFieldSpec::constant(0.0)), src),
+                    "case.json: /material/stitch_value/values/1: 9.2 mm is outside the "
+                    "database's 4.5-6.5 mm (db.h5)");
+  l.values = {4.5};
+  CHECK_THROWS_WITH(make_scalar_field(l), Catch::Contains("control values, got 1"));
+}
+
+TEST_CASE("knit material: alpha aligned with a vector at the Greville points", "[unit]") {
+  // A flat square patch whose a1 points at angle beta: alpha = -beta aligns the course
+  // direction with x.
+  const double beta = 0.6;
+  const Eigen::Vector3d a1(std::cos(beta), std::sin(beta), 0),
+      a2(-std::sin(beta), std::cos(beta), 0);
+  Eigen::MatrixXd P(4, 3);
+  P.row(0) = Eigen::Vector3d::Zero();
+  P.row(1) = 50 * a1;
+  P.row(2) = 50 * a2;
+  P.row(3) = 50 * (a1 + a2);
+  const knit::spline::SplineSurface geo(knit::spline::BSplineBasis(1, {0, 0, 1, 1}),
+                                        knit::spline::BSplineBasis(1, {0, 0, 1, 1}), P);
+  const auto alpha =
+      align_alpha_field(geo, 2, {0, 0, 0, 0.5, 1, 1, 1}, 1, {0, 0, 1, 1}, Eigen::Vector3d(1, 0, 0));
+  for (double u : {0.0, 0.3, 1.0})
+    for (double v : {0.0, 0.7}) CHECK(alpha.eval(u, v)(0) == Approx(-beta).margin(1e-12));
+}

@@ -1,0 +1,108 @@
+// Ceres fit of the response surfaces (eq. 17) against a synthetic, known law.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "knit/meso/fit/response_fit.hpp"
+#include "knit/meso/fit/synthetic.hpp"
+
+using namespace knit::meso::fit;
+using namespace knit::material;
+
+TEST_CASE("fit: synthetic orthotropic stiffening law reproduced within 1% of its range", "[unit]") {
+  SyntheticOptions so;
+  const double l = 5.5;
+  const auto raw = synthetic_paths(so, l);
+  const FitSummary fs = fit_loop_length(raw, FitOptions{});
+  REQUIRE(fs.ok());
+  INFO("rms " << fs.diagnostics.rms.transpose() << " max " << fs.diagnostics.max.transpose()
+              << " relative " << fs.diagnostics.max_relative);
+  CHECK(fs.diagnostics.max_relative < 0.01);
+  // Independently of the diagnostics: the law at strains inside the data domain (between the
+  // paths and the steps), against the known law.
+  const ResponseSurface rs(fs.surface);
+  double srange = 0.0, err = 0.0;
+  for (const auto& r : raw)
+    for (int k = 0; k < r.steps(); ++k) srange = std::max(srange, r.S.row(k).cwiseAbs().maxCoeff());
+  for (double a = -20.0; a <= 110.0; a += 7.3)
+    for (double t = 0.05; t <= 0.95; t += 0.1) {
+      // Points inside the fan: scale the direction to a fraction of the data's reach.
+      const double c = std::cos(a * M_PI / 180), s = std::sin(a * M_PI / 180);
+      const double reach = 0.3 / std::max(std::abs(c), std::abs(s));
+      const Eigen::Vector3d E(t * reach * c * 0.9, t * reach * s * 0.9, 0.0);
+      const auto ev = rs.evaluate(
+          2.0 * Eigen::Vector3d(E(0), E(1), 0.0).cwiseProduct(Eigen::Vector3d(0.5, 0.5, 1)));
+      if (ev.flags != kInside) continue;
+      const Eigen::Vector3d S = so.law.stress(E, l);
+      err = std::max(err, (ev.S.head<2>() - S.head<2>()).cwiseAbs().maxCoeff());
+    }
+  for (double e12 = 0.01; e12 < 0.3; e12 += 0.03)
+    err = std::max(err,
+                   std::abs(rs.evaluate({0, 0, 2 * e12}).S(2) - so.law.stress({0, 0, e12}, l)(2)));
+  CHECK(err < 0.01 * srange);
+}
+
+TEST_CASE("fit: robust loss and foot-point optimization run and stay accurate", "[unit]") {
+  SyntheticOptions so;
+  auto raw = synthetic_paths(so, 4.5);
+  // One outlier step: the Huber loss keeps it from spoiling the fit.
+  raw[3].S(10, 0) += 5.0;
+  FitOptions o;
+  o.loss = Loss::kHuber;
+  o.loss_scale = 0.01;
+  const FitSummary huber = fit_loop_length(raw, o);
+  REQUIRE(huber.ok());
+  o.loss = Loss::kNone;
+  const FitSummary plain = fit_loop_length(raw, o);
+  REQUIRE(plain.ok());
+  const ResponseSurface a(huber.surface), b(plain.surface);
+  const Eigen::Vector3d E(raw[4].E(10, 0), raw[4].E(10, 1), 0);
+  const double exact = so.law.stress({E(0), E(1), 0}, 4.5)(0);
+  CHECK(std::abs(a.evaluate(E).S(0) - exact) < std::abs(b.evaluate(E).S(0) - exact));
+  raw = synthetic_paths(so, 4.5);
+  o.optimize_foot_points = true;
+  const FitSummary fp = fit_loop_length(raw, o);
+  REQUIRE(fp.ok());
+  CHECK(fp.diagnostics.max_relative < 0.01);
+}
+
+TEST_CASE("fit: data that cannot determine the surface are refused with the reason", "[unit]") {
+  SyntheticOptions so;
+  auto raw = synthetic_paths(so, 5.0);
+  SECTION("too few paths") {
+    raw.erase(raw.begin() + 2, raw.begin() + 11);
+    const auto fs = fit_loop_length(raw, FitOptions{});
+    CHECK(fs.status == FitStatus::kRefused);
+    CHECK_THAT(fs.reason, Catch::Contains("3 biaxial paths cannot determine a degree-3"));
+  }
+  SECTION("no shear path") {
+    raw.pop_back();
+    CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("no pure-shear path"));
+  }
+  SECTION("duplicate direction") {
+    raw[4] = raw[5];
+    CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("same strain direction"));
+  }
+  SECTION("non-finite data") {
+    raw[2].S(3, 1) = std::nan("");
+    CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("non-finite"));
+  }
+  SECTION("a path without a converged step") {
+    std::fill(raw[1].status.begin(), raw[1].status.end(), 1);
+    CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("no converged step"));
+  }
+  SECTION("too many control points without smoothing") {
+    FitOptions o;
+    o.smoothing = 0.0;
+    o.n_ctrl1 = 15;
+    CHECK_THAT(fit_loop_length(raw, o).reason, Catch::Contains("need at least as many paths"));
+  }
+  SECTION("bad options") {
+    FitOptions o;
+    o.n_ctrl1 = 2;
+    CHECK_THAT(fit_loop_length(raw, o).reason, Catch::Contains("at least degree + 1"));
+    CHECK_THROWS_WITH(FitOptions::from_json("{\"loss\": \"l1\"}", "opts.json"),
+                      Catch::Contains("opts.json: /loss: must be"));
+    CHECK_THROWS_WITH(FitOptions::from_json("{\"smoth\": 1}", "opts.json"),
+                      Catch::Contains("/smoth: unknown fit option"));
+  }
+}
