@@ -1,0 +1,117 @@
+// Frictional self-contact of a periodic yarn with its periodic images, as collocated line loads
+// (paper Sect. 2.1.2; Weeger et al.: contact forces as point loads within collocation).
+//
+// Two-pass, point-to-curve: the slaves are Gauss points xi_g (`slave_points_per_element` per
+// element) of the cell's yarn;
+// the masters are the yarn's three courses j_c = -1, 0, +1 as periodic chains (contact/pair.hpp),
+// shifted by j_c F*(0, c). For the own course (j_c = 0) the part of the yarn within
+// `self_exclusion` of xi_j in the loop parameter is not a contact partner. The mirror pair (the
+// image's point against the cell's yarn) is the same contact seen from the other side. Each
+// pass applies half the load: +f/2 at the slave point and the reaction -f/2 at the master's
+// closest point u, which by periodicity is the material point u - k of the cell's own yarn. So
+// action equals reaction exactly and the net contact force on the course vanishes (a plain
+// two-pass point-to-curve law does not balance: the normals from the two sides of curved yarns
+// differ, which left a net force as large as the yarn force).
+// Broad phase: axis-aligned boxes of the control polygons of the elements of the three copies
+// k = -1, 0, 1 of each course chain (convex-hull property), inflated by d + margin; the closest
+// point is searched on every candidate element and kept if it is a true stationary point.
+// Collocated line load (choice): the contact line load f(xi) evaluated at the Gauss points is
+// projected on the collocation rows, nbar_j = (1/W_j) sum_g w_g |r0_xi| N_j(xi_g) f(xi_g) with
+// the tributary lengths W_j = int N_j ds. By the partition of unity sum_j W_j nbar_j = int f ds,
+// so the total contact force is integrated, not sampled at the few collocation points (sampling
+// them made the net force on the course, which must vanish, as large as the yarn force). The
+// same for the friction moment. The end points' balance rows carry the periodicity: loads on them
+// are dropped (the seam is the head top, free of contact).
+// History: per (slave point, course) the list of sticking anchors of the last converged state;
+// a pair found in an iteration takes the nearest anchor within `match_tol` in u, else it starts
+// sticking where it is found (kept for the rest of the increment). commit() accepts the
+// return-mapped anchors and the dissipation of the increment.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "knit/meso/contact/law.hpp"
+#include "knit/meso/contact/pair.hpp"
+#include "knit/meso/rod/rod_system.hpp"
+
+namespace knit::meso::contact {
+
+struct ContactOptions {
+  PenaltyLaw penalty;
+  FrictionLaw friction;
+  double d = 0.38;              ///< yarn diameter [mm]
+  double margin = 0.05;         ///< broad-phase inflation beyond d [mm]
+  double self_exclusion = 0.3;  ///< loop-parameter distance below which the own yarn is skipped
+  double match_tol = 0.08;      ///< history matching tolerance in u
+  int slave_points_per_element = 4;  ///< Gauss points per element that act as slaves
+};
+
+/// One active contact of the current state (for output and homogenization).
+struct ActivePair {
+  int point = 0;   ///< slave (Gauss) point
+  double xi = 0;   ///< its parameter
+  int course = 0;  ///< -1, 0, +1
+  double u = 0, gap = 0, p = 0, f_T = 0;
+  bool slip = false;
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();  ///< line load on the slave [N/mm]
+  double weight = 0;  ///< quadrature weight of the slave point (w_g |r0_xi|) [mm]
+};
+
+class ContactSet : public rod::ExternalContribution {
+ public:
+  ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions& opt);
+
+  /// Periods: a1 = F*(w,0,0), a2 = F*(0,c,0).
+  void set_periods(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2) {
+    a1_ = a1;
+    a2_ = a2;
+  }
+  /// Scales the penalty (0..1) for the equilibration ramp.
+  void set_penalty_scale(double s) { scale_ = s; }
+
+  void add(const rod::RodSystem& sys, const Eigen::VectorXd& x, double lambda,
+           Eigen::VectorXd& residual, std::vector<Eigen::Triplet<double>>& jac) override;
+
+  /// Evaluates the contacts at x without touching the residual (for output).
+  std::vector<ActivePair> active_pairs(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Stored contact energy (penalty + elastic stick) [N mm], each contact counted once.
+  double energy(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Accepts the state x as converged: histories and dissipation are updated.
+  void commit(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Drops the pending (in-increment) pairs, e.g. after a failed increment.
+  void reset_increment() { pending_.assign(pending_.size(), {}); }
+
+  double dissipation() const { return dissipation_; }  ///< cumulative friction work [N mm]
+  double last_increment_dissipation() const { return last_dissipation_; }
+  const std::vector<double>& tributary() const { return W_; }
+  int num_slave_points() const { return static_cast<int>(xi_.size()); }
+
+ private:
+  struct Found {
+    int point, course;
+    Projection pr;
+  };
+  std::vector<Found> search(const Eigen::MatrixXd& Q) const;
+  Chain chain(const Eigen::MatrixXd& Q, int course) const;
+  double& anchor_for(const Found& f, bool create);
+  Eigen::MatrixXd positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const;
+  template <class Visit>
+  void visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool want_jac, Visit&& v);
+
+  int rod_ = 0;
+  ContactOptions opt_;
+  spline::BSplineBasis basis_;
+  std::vector<double> xi_;      // slave (Gauss) points
+  std::vector<int> first_;      // first basis function at each slave point
+  Eigen::MatrixXd Nc_;          // ns x (p+1) basis values at the slave points
+  std::vector<double> weight_;  // quadrature weights w_g |r0_xi| [mm]
+  std::vector<double> W_;       // tributary lengths of the collocation points
+  Eigen::Vector3d a1_ = Eigen::Vector3d::Zero(), a2_ = Eigen::Vector3d::Zero();
+  double scale_ = 1.0;
+  // history_[slave*3 + course+1]: anchors of the last converged state; pending_: new in step
+  std::vector<std::vector<double>> history_, pending_;
+  double dissipation_ = 0, last_dissipation_ = 0;
+};
+
+}  // namespace knit::meso::contact

@@ -1,0 +1,124 @@
+// The single-jersey unit cell under a prescribed macroscopic deformation gradient, and its
+// homogenized stresses (paper Sect. 2.1.2, eqs. 6-9).
+//
+// One yarn (the cell's loop, an open quartic B-spline over s in [0,1]: analysis_curve()) is a
+// mixed Simo-Reissner collocation rod (knit/meso/rod). Its two end points are the same material
+// point of the infinite course, so the 12 balance rows of the end collocation points are replaced
+// by (PeriodicRows):
+//   start, force rows    r(1) - r(0) - a1 = 0,        a1 = F*(w, 0, 0)   (periodic position;
+//                                                      z periodic: free out-of-plane contraction
+//                                                      of the fabric, no z constraint otherwise)
+//   start, moment rows   vec( conj(q(0) q0(0)^-1) (q(1) q0(1)^-1) ) = 0  (equal rotation
+//                                                      increments: R(1) R0(1)^T = R(0) R0(0)^T)
+//   end, force rows      r(0) - r0(0) = 0             (rigid-body translation removed: the seam
+//                                                      point, the head top, is held)
+//   end, moment rows     m(1) - m(0) = 0              (moment continuity)
+// Force continuity n(1) = n(0) is then not imposed: n(1) - n(0) = -(net contact load), zero in
+// the continuum (the course is in equilibrium) and a discretization error here; it is reported
+// as the "imbalance" and n1 = (n(0) + n(1))/2.
+// In-plane F* (eq. 7, biaxial or pure shear) enters through a1 and the course shift
+// a2 = F*(0, c, 0) of the contact images (contact/contact_set.hpp).
+//
+// Homogenization (eq. 8-9): n1 = force through the face x = const (the yarn's end force);
+// n2 = force on the cell's course from the course above (two-pass average
+// n2 = 1/2 [sum_{j, course +1} W_j f_j - sum_{j, course -1} W_j f_j], W_j tributary lengths);
+// P* = [n1/A1, n2/A2] (2x2 in-plane), A1 = c t, A2 = w t, t = 2 d; E = (F^T F - I)/2, S = F^-1 P.
+//
+// Initial equilibrium (choice): at F* = I the penalty is ramped from 0 to k_N in
+// `equilibration_steps` increments (friction active), so the initial overlaps push the yarns apart
+// gradually; the P* that remains is the residual stress reported at step 0.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "knit/meso/cell/geometry.hpp"
+#include "knit/meso/contact/contact_set.hpp"
+#include "knit/meso/rod/rod_system.hpp"
+#include "knit/meso/rod/solver.hpp"
+
+namespace knit::meso::homog {
+
+struct CellOptions {
+  int elements = 32;  ///< analysis curve elements (convergence study: docs/unit-cell.md)
+  int degree = 4;
+  rod::Section section;  ///< yarn: d = 0.38, E = 800, nu = 0.3
+  cell::GeometryOptions geometry;
+  contact::ContactOptions contact;
+  rod::NewtonOptions newton;
+  int equilibration_steps = 4;
+  int max_cutbacks = 6;
+};
+
+/// Green-Lagrange strain (eq. 9).
+inline Eigen::Matrix2d green_lagrange(const Eigen::Matrix2d& F) {
+  return 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+}
+/// Second Piola-Kirchhoff stress S = F^-1 P (eq. 9).
+inline Eigen::Matrix2d second_pk(const Eigen::Matrix2d& F, const Eigen::Matrix2d& P) {
+  return F.inverse() * P;
+}
+
+struct StepResult {
+  bool converged = false;
+  Eigen::Matrix2d F = Eigen::Matrix2d::Identity();
+  Eigen::Matrix2d P = Eigen::Matrix2d::Zero(), E = Eigen::Matrix2d::Zero(),
+                  S = Eigen::Matrix2d::Zero();
+  Eigen::Vector3d n1 = Eigen::Vector3d::Zero(), n2 = Eigen::Vector3d::Zero();
+  int iterations = 0;  ///< Newton iterations (all increments of the step)
+  int cutbacks = 0;
+  double seconds = 0;
+  int active_contacts = 0;
+  double min_gap = 0;
+  double dissipation = 0;  ///< cumulative friction work [N mm]
+  double imbalance = 0;    ///< |n(1) - n(0)| [N]
+  std::string message;
+};
+
+class PeriodicCell {
+ public:
+  PeriodicCell(double loop_length, const CellOptions& opt = {});
+  ~PeriodicCell();
+  PeriodicCell(const PeriodicCell&) = delete;
+  PeriodicCell& operator=(const PeriodicCell&) = delete;
+
+  /// Ramps the contact penalty at F* = I (see above). Returns the residual-stress state.
+  StepResult equilibrate();
+  /// Solves for F* (2x2 in-plane) starting from the last converged state (affine warm start,
+  /// halving of the increment on failure). Contact histories are committed on success.
+  StepResult solve(const Eigen::Matrix2d& F);
+
+  const cell::CellDimensions& dimensions() const { return dim_; }
+  double thickness() const { return 2 * opt_.section.d; }
+  const rod::RodSystem& system() const { return sys_; }
+  const Eigen::VectorXd& state() const { return x_; }
+  contact::ContactSet& contacts() { return *contact_; }
+  /// The caller terms of the rod system (periodic rows, contact), for custom assembly.
+  std::vector<rod::ExternalContribution*> contributions();
+  /// Centerline sampled at `n`+1 points (current state), shifted by F*(i w, j c).
+  std::vector<Eigen::Vector3d> centerline(int n, int i = 0, int j = 0) const;
+  /// Homogenized quantities of the current state at F (no solve).
+  StepResult homogenize(const Eigen::Matrix2d& F);
+  /// Full residual and Jacobian at the current state (for checks).
+  void residual_and_jacobian(Eigen::VectorXd& R, Eigen::SparseMatrix<double>& J);
+  /// Strain energy of the yarn [N mm] (Gauss quadrature of the compliance form).
+  double strain_energy() const;
+
+ private:
+  class PeriodicRows;
+  bool try_solve(const Eigen::Matrix2d& F, StepResult& res);
+  void set_F(const Eigen::Matrix2d& F);
+
+  CellOptions opt_;
+  cell::CellDimensions dim_;
+  rod::RodSystem sys_;
+  std::unique_ptr<contact::ContactSet> contact_;
+  std::unique_ptr<PeriodicRows> periodic_;
+  Eigen::VectorXd x_;
+  Eigen::Matrix2d F_ = Eigen::Matrix2d::Identity();
+  Eigen::Vector3d r_fix_;
+};
+
+}  // namespace knit::meso::homog

@@ -1,0 +1,149 @@
+// Point-to-curve contact with friction: see knit/meso/contact/pair.hpp.
+#include "knit/meso/contact/pair.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace knit::meso::contact {
+
+ChainPoint eval_chain(const Chain& c, double u, int k) {
+  const int p = c.basis->degree();
+  ChainPoint cp;
+  cp.u = u;
+  cp.k = k;
+  cp.N.resize(3, p + 1);
+  const double ut = std::clamp(u - k, c.basis->lo(), c.basis->hi());
+  cp.first = c.basis->eval(ut, std::min(2, p), cp.N.topRows(std::min(2, p) + 1));
+  if (p < 2) cp.N.row(2).setZero();
+  const auto Q = c.Q->middleRows(cp.first, p + 1);
+  cp.x = (cp.N.row(0) * Q).transpose() + k * c.a1 + c.t;
+  cp.x_u = (cp.N.row(1) * Q).transpose();
+  cp.x_uu = (cp.N.row(2) * Q).transpose();
+  return cp;
+}
+
+Projection project(const Chain& c, const Eigen::Vector3d& xs, int k, double lo, double hi,
+                   double u0) {
+  Projection pr;
+  pr.k = k;
+  double u = std::clamp(u0, lo, hi);
+  for (int it = 0; it < 30; ++it) {
+    pr.iterations = it + 1;
+    const ChainPoint cp = eval_chain(c, u, k);
+    const Eigen::Vector3d r = xs - cp.x;
+    const double phi = r.dot(cp.x_u);
+    const double phiu = -cp.x_u.squaredNorm() + r.dot(cp.x_uu);
+    // d(|r|^2)/du = -2 phi: a descent direction is sign(phi).
+    double du = (phiu < 0) ? -phi / phiu : (phi > 0 ? 1 : -1) * 0.25 * (hi - lo);
+    const double lim = 0.5 * (hi - lo);
+    du = std::clamp(du, -lim, lim);
+    const double un = std::clamp(u + du, lo, hi);
+    const double step = std::abs(un - u);
+    u = un;
+    if (step < 1e-14 * std::max(1.0, std::abs(u))) break;
+  }
+  const ChainPoint cp = eval_chain(c, u, k);
+  const Eigen::Vector3d r = xs - cp.x;
+  pr.u = u;
+  pr.distance = r.norm();
+  const double phi = r.dot(cp.x_u);
+  pr.ok = std::abs(phi) <= 1e-9 * std::max(1e-12, r.norm() * cp.x_u.norm()) &&
+          (-cp.x_u.squaredNorm() + r.dot(cp.x_uu)) < 0;
+  return pr;
+}
+
+PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projection& pr, double d,
+                         const PenaltyLaw& law, const FrictionLaw& fr, const PairHistory& hist,
+                         bool want_jac) {
+  using Eigen::Matrix3d;
+  using Eigen::MatrixXd;
+  using Eigen::Vector3d;
+  PairResult out;
+  const ChainPoint cp = eval_chain(c, pr.u, pr.k);
+  const int p = c.basis->degree();
+  const int nz = 3 + 3 * (p + 1);
+  out.u = pr.u;
+  out.master_first = cp.first;
+  out.Nm = cp.N.topRows(2);
+  out.u_anchor_new = hist.u_anchor;
+  const Vector3d r = xs - cp.x;
+  const double rho = r.norm();
+  out.gap = rho - d;
+  if (want_jac) {
+    out.df_dz = MatrixXd::Zero(3, nz);
+    out.dm_dz = MatrixXd::Zero(3, nz);
+  }
+  if (out.gap >= 0 || !(rho > 0)) {
+    out.u_anchor_new = pr.u;  // contact released: the anchor follows
+    return out;
+  }
+  const auto nv = law.eval(out.gap);
+  if (nv.p <= 0) {  // within the allowance g0: no force, no friction, the anchor follows
+    out.u_anchor_new = pr.u;
+    return out;
+  }
+  out.active = true;
+  const Vector3d n = r / rho;
+  const double ell = cp.x_u.norm();
+  const Vector3d tau = cp.x_u / ell;
+  out.n = n;
+  out.tau = tau;
+  out.p = nv.p;
+  // Friction: return mapping from the anchor of the last converged state.
+  const double e = ell * (pr.u - hist.u_anchor);
+  out.e = e;
+  const double ftr = -fr.k_T * e;
+  const double lim = fr.mu * nv.p;
+  const double sgn = e >= 0 ? 1.0 : -1.0;
+  if (std::abs(ftr) <= lim) {
+    out.f_T = ftr;
+    out.energy = nv.energy + 0.5 * fr.k_T * e * e;
+  } else {
+    out.slip = true;
+    out.f_T = -lim * sgn;
+    out.u_anchor_new = pr.u - sgn * lim / (fr.k_T * ell);
+    // Friction work of this increment: |f_T| times the slip length |anchor shift| ell.
+    out.dissipation = lim * ell * std::abs(out.u_anchor_new - hist.u_anchor);
+    out.energy = nv.energy + 0.5 * lim * lim / fr.k_T;
+  }
+  out.f = out.p * n + out.f_T * tau;
+  const Vector3d nxt = n.cross(tau);
+  out.m = -0.5 * d * out.f_T * nxt;
+  if (!want_jac) return out;
+
+  // ---- linearization ----
+  MatrixXd Dxs = MatrixXd::Zero(3, nz), Dxm = MatrixXd::Zero(3, nz), Dxmu = MatrixXd::Zero(3, nz);
+  Dxs.leftCols(3).setIdentity();
+  for (int b = 0; b <= p; ++b) {
+    Dxm.block(0, 3 + 3 * b, 3, 3) = cp.N(0, b) * Matrix3d::Identity();
+    Dxmu.block(0, 3 + 3 * b, 3, 3) = cp.N(1, b) * Matrix3d::Identity();
+  }
+  const double phiu = -cp.x_u.squaredNorm() + r.dot(cp.x_uu);
+  const Eigen::RowVectorXd du =
+      -(cp.x_u.transpose() * Dxs - cp.x_u.transpose() * Dxm + r.transpose() * Dxmu) / phiu;
+  const MatrixXd dr = Dxs - Dxm - cp.x_u * du;
+  const Eigen::RowVectorXd drho = n.transpose() * dr;
+  const MatrixXd dn = (Matrix3d::Identity() - n * n.transpose()) / rho * dr;
+  const MatrixXd dxu = Dxmu + cp.x_uu * du;  // total derivative of x_m,u
+  const Eigen::RowVectorXd dell = tau.transpose() * dxu;
+  const MatrixXd dtau = (Matrix3d::Identity() - tau * tau.transpose()) / ell * dxu;
+  const Eigen::RowVectorXd dp = nv.dp_dg * drho;
+  Eigen::RowVectorXd dfT;
+  if (!out.slip) {
+    const Eigen::RowVectorXd de = ell * du + (pr.u - hist.u_anchor) * dell;
+    dfT = -fr.k_T * de;
+  } else {
+    dfT = -fr.mu * sgn * dp;
+  }
+  out.df_dz = n * dp + out.p * dn + tau * dfT + out.f_T * dtau;
+  // m = -(d/2) f_T (n x tau)
+  MatrixXd dnxt(3, nz);
+  for (int j = 0; j < nz; ++j)
+    dnxt.col(j) = Vector3d(dn.col(j)).cross(tau) + n.cross(Vector3d(dtau.col(j)));
+  out.dm_dz = -0.5 * d * (nxt * dfT + out.f_T * dnxt);
+  out.du_dz = du;
+  return out;
+}
+
+}  // namespace knit::meso::contact

@@ -1,0 +1,229 @@
+// Frictional self-contact of the periodic yarn: see knit/meso/contact/contact_set.hpp.
+#include "knit/meso/contact/contact_set.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "knit/spline/knot_vector.hpp"
+#include "knit/spline/quadrature.hpp"
+
+namespace knit::meso::contact {
+
+ContactSet::ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions& opt)
+    : rod_(rod), opt_(opt), basis_(sys.spec(rod).basis) {
+  const int n = basis_.size(), p = basis_.degree();
+  const auto rule =
+      spline::gauss_legendre_on_spans(std::max(1, opt_.slave_points_per_element), basis_.knots());
+  const int ns = static_cast<int>(rule.points.size());
+  xi_ = rule.points;
+  first_.resize(ns);
+  Nc_.resize(ns, p + 1);
+  weight_.resize(ns);
+  W_.assign(n, 0.0);
+  const Eigen::MatrixXd& r0 = sys.spec(rod).r0;
+  Eigen::MatrixXd D(2, p + 1);
+  for (int g = 0; g < ns; ++g) {
+    first_[g] = basis_.eval(xi_[g], 1, D);
+    Nc_.row(g) = D.row(0);
+    weight_[g] = rule.weights[g] * (D.row(1) * r0.middleRows(first_[g], p + 1)).norm();
+    for (int a = 0; a <= p; ++a) W_[first_[g] + a] += weight_[g] * D(0, a);
+  }
+  history_.assign(3 * ns, {});
+  pending_.assign(3 * ns, {});
+}
+
+Eigen::MatrixXd ContactSet::positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const {
+  const int n = basis_.size();
+  Eigen::MatrixXd Q(n, 3);
+  for (int a = 0; a < n; ++a) Q.row(a) = x.segment<3>(sys.dof(rod_, a, rod::kFieldR)).transpose();
+  return Q;
+}
+
+Chain ContactSet::chain(const Eigen::MatrixXd& Q, int course) const {
+  Chain c;
+  c.basis = &basis_;
+  c.Q = &Q;
+  c.a1 = a1_;
+  c.t = course * a2_;
+  return c;
+}
+
+std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) const {
+  const int n = basis_.size(), p = basis_.degree();
+  const std::vector<double> br = spline::unique_knots(basis_.knots());
+  const int ne = static_cast<int>(br.size()) - 1;
+  // Element boxes of the base copy (control polygon hull).
+  std::vector<Eigen::Vector3d> lo(ne), hi(ne);
+  for (int e = 0; e < ne; ++e) {
+    const int f = basis_.find_span(0.5 * (br[e] + br[e + 1])) - p;
+    lo[e] = Q.middleRows(f, p + 1).colwise().minCoeff().transpose();
+    hi[e] = Q.middleRows(f, p + 1).colwise().maxCoeff().transpose();
+  }
+  const double inflate = opt_.d + opt_.margin;
+  std::vector<Found> out;
+  const int ns = static_cast<int>(xi_.size());
+  (void)n;
+  for (int j = 0; j < ns; ++j) {
+    const Eigen::Vector3d xs = (Nc_.row(j) * Q.middleRows(first_[j], p + 1)).transpose();
+    for (int course = -1; course <= 1; ++course) {
+      const Chain ch = chain(Q, course);
+      const std::size_t start = out.size();
+      for (int k = -1; k <= 1; ++k) {
+        const Eigen::Vector3d shift = k * a1_ + course * a2_;
+        for (int e = 0; e < ne; ++e) {
+          const double ua = k + br[e], ub = k + br[e + 1];
+          if (course == 0 &&
+              std::max(std::abs(ua - xi_[j]), std::abs(ub - xi_[j])) < opt_.self_exclusion)
+            continue;
+          const Eigen::Vector3d l = lo[e] + shift, h = hi[e] + shift;
+          if ((xs.array() < l.array() - inflate).any() || (xs.array() > h.array() + inflate).any())
+            continue;
+          const Projection pr = project(ch, xs, k, ua, ub, 0.5 * (ua + ub));
+          if (!pr.ok || pr.distance >= inflate) continue;
+          if (course == 0 && std::abs(pr.u - xi_[j]) < opt_.self_exclusion) continue;
+          bool dup = false;
+          for (std::size_t q = start; q < out.size(); ++q)
+            if (std::abs(out[q].pr.u - pr.u) < 1e-7) dup = true;
+          if (!dup) out.push_back({j, course, pr});
+        }
+      }
+    }
+  }
+  return out;
+}
+
+double& ContactSet::anchor_for(const Found& f, bool create) {
+  const int key = 3 * f.point + f.course + 1;
+  double* best = nullptr;
+  double bd = opt_.match_tol;
+  for (auto* list : {&history_[key], &pending_[key]})
+    for (double& a : *list)
+      if (std::abs(a - f.pr.u) < bd) {
+        bd = std::abs(a - f.pr.u);
+        best = &a;
+      }
+  if (best) return *best;
+  static thread_local double scratch;
+  if (!create) {
+    scratch = f.pr.u;
+    return scratch;
+  }
+  pending_[key].push_back(f.pr.u);
+  return pending_[key].back();
+}
+
+template <class Visit>
+void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool want_jac,
+                       Visit&& v) {
+  const Eigen::MatrixXd Q = positions(sys, x);
+  PenaltyLaw law = opt_.penalty;
+  law.k_N *= scale_;
+  for (const Found& f : search(Q)) {
+    const Chain ch = chain(Q, f.course);
+    const int p = basis_.degree();
+    const Eigen::Vector3d xs =
+        (Nc_.row(f.point) * Q.middleRows(first_[f.point], p + 1)).transpose();
+    // Quick gap test before touching the history: inactive pairs create no anchors.
+    if (f.pr.distance >= opt_.d) continue;
+    PairHistory h{anchor_for(f, true)};
+    const PairResult r = evaluate_pair(xs, ch, f.pr, opt_.d, law, opt_.friction, h, want_jac);
+    if (r.active) v(f, r);
+  }
+}
+
+void ContactSet::add(const rod::RodSystem& sys, const Eigen::VectorXd& x, double /*lambda*/,
+                     Eigen::VectorXd& F, std::vector<Eigen::Triplet<double>>& jac) {
+  const int p = basis_.degree();
+  const int n = basis_.size();
+  visit(sys, x, true, [&](const Found& f, const PairResult& r) {
+    const int g = f.point;
+    const double half = 0.5 * weight_[g];  // two passes: half the load of each
+    // Columns of z = [x_s, Q_master]: x_s = sum_a N_a(xi_g) r_a.
+    auto col_of = [&](int zi, auto&& emit) {
+      if (zi < 3) {
+        for (int a = 0; a <= p; ++a)
+          emit(sys.dof(rod_, first_[g] + a, rod::kFieldR, zi), Nc_(g, a));
+      } else {
+        const int b = (zi - 3) / 3, c = (zi - 3) % 3;
+        emit(sys.dof(rod_, r.master_first + b, rod::kFieldR, c), 1.0);
+      }
+    };
+    const int nz = static_cast<int>(r.df_dz.cols());
+    // Slave side: +f/2 projected on the rows of xi_g.
+    for (int jl = 0; jl <= p; ++jl) {
+      const int j = first_[g] + jl;
+      if (j == 0 || j == n - 1) continue;  // periodicity rows
+      const double c_j = half * Nc_(g, jl) / W_[j];
+      if (c_j == 0) continue;
+      const int rf = sys.row(rod_, j, rod::kRowForce), rm = sys.row(rod_, j, rod::kRowMoment);
+      F.segment<3>(rf) += c_j * r.f;
+      F.segment<3>(rm) += c_j * r.m;
+      for (int zi = 0; zi < nz; ++zi)
+        col_of(zi, [&](int col, double s) {
+          for (int i = 0; i < 3; ++i) {
+            jac.emplace_back(rf + i, col, s * c_j * r.df_dz(i, zi));
+            jac.emplace_back(rm + i, col, s * c_j * r.dm_dz(i, zi));
+          }
+        });
+    }
+    // Master side: -f/2 (and the same moment m/2) at u, projected with N_j(u).
+    for (int bl = 0; bl <= p; ++bl) {
+      const int j = r.master_first + bl;
+      if (j == 0 || j == n - 1) continue;
+      const double c_j = half * r.Nm(0, bl) / W_[j], cu = half * r.Nm(1, bl) / W_[j];
+      if (c_j == 0 && cu == 0) continue;
+      const int rf = sys.row(rod_, j, rod::kRowForce), rm = sys.row(rod_, j, rod::kRowMoment);
+      F.segment<3>(rf) -= c_j * r.f;
+      F.segment<3>(rm) += c_j * r.m;
+      for (int zi = 0; zi < nz; ++zi)
+        col_of(zi, [&](int col, double s) {
+          for (int i = 0; i < 3; ++i) {
+            jac.emplace_back(rf + i, col, -s * (c_j * r.df_dz(i, zi) + cu * r.f(i) * r.du_dz(zi)));
+            jac.emplace_back(rm + i, col, s * (c_j * r.dm_dz(i, zi) + cu * r.m(i) * r.du_dz(zi)));
+          }
+        });
+    }
+  });
+}
+
+std::vector<ActivePair> ContactSet::active_pairs(const rod::RodSystem& sys,
+                                                 const Eigen::VectorXd& x) {
+  std::vector<ActivePair> out;
+  visit(sys, x, false, [&](const Found& f, const PairResult& r) {
+    ActivePair a;
+    a.point = f.point;
+    a.xi = xi_[f.point];
+    a.course = f.course;
+    a.u = r.u;
+    a.gap = r.gap;
+    a.p = r.p;
+    a.f_T = r.f_T;
+    a.slip = r.slip;
+    a.f = r.f;
+    a.weight = weight_[f.point];
+    out.push_back(a);
+  });
+  return out;
+}
+
+double ContactSet::energy(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  double U = 0;
+  visit(sys, x, false,
+        [&](const Found& f, const PairResult& r) { U += 0.5 * weight_[f.point] * r.energy; });
+  return U;
+}
+
+void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  std::vector<std::vector<double>> next(history_.size());
+  double D = 0;
+  visit(sys, x, false, [&](const Found& f, const PairResult& r) {
+    next[3 * f.point + f.course + 1].push_back(r.u_anchor_new);
+    D += weight_[f.point] * r.dissipation;
+  });
+  history_ = std::move(next);
+  pending_.assign(history_.size(), {});
+  last_dissipation_ = D;
+  dissipation_ += D;
+}
+
+}  // namespace knit::meso::contact

@@ -1,0 +1,86 @@
+// Unit-cell geometry: dimensions, exact loop length, crossing order and clearance
+// (notes.md "Mesoscale": the checks any loop geometry must pass).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "knit/meso/cell/geometry.hpp"
+
+using namespace knit::meso::cell;
+
+TEST_CASE("cell dimensions: published cells exactly, rule in between", "[unit]") {
+  auto a = cell_dimensions(4.5), b = cell_dimensions(6.5), m = cell_dimensions(5.5);
+  CHECK(a.w == 1.26);
+  CHECK(a.c == 0.88);
+  CHECK(b.w == 1.41);
+  CHECK(b.c == 1.64);
+  CHECK(m.w == Approx(1.335));
+  CHECK(5.5 * 5.5 / (m.w * m.c) == Approx(18.27));
+  CHECK_THROWS(cell_dimensions(-1));
+}
+
+TEST_CASE("four quartic curves with 12 control points, length l exactly, C0 joins", "[unit]") {
+  for (double l : {4.5, 5.0, 6.5}) {
+    const auto g = make_cell_geometry(l);
+    REQUIRE(g.pieces.size() == 4);
+    for (const auto& c : g.pieces) {
+      CHECK(c.degree() == 4);
+      CHECK(c.size() == 12);
+    }
+    CHECK(std::abs(g.measured_length - l) < 1e-10);
+    double L = 0;
+    for (const auto& c : g.pieces) L += spline_length(c, 20);  // independent quadrature
+    CHECK(std::abs(L - l) < 1e-10);
+    for (int k = 0; k < 4; ++k) {
+      const auto& a = g.pieces[k];
+      const auto& b = g.pieces[(k + 1) % 4];
+      Eigen::Vector3d end = a.eval(1.0), start = b.eval(0.0);
+      if (k == 3) start.x() += g.dim.w;  // periodic: loop end = start + (w, 0, 0)
+      CHECK((end - start).norm() < 1e-13);
+    }
+    // Interpolation error against the closed form (piece fit at 12 points: small).
+    double err = 0;
+    for (int k = 0; k < 4; ++k)
+      for (int i = 0; i <= 50; ++i) {
+        const double xi = i / 50.0;
+        err = std::max(err, (g.pieces[k].eval(xi) - g.shape.point((k + xi) / 4)).norm());
+      }
+    CHECK(err < 2e-3);
+  }
+}
+
+TEST_CASE("analysis curve: periodic ends, length l", "[unit]") {
+  const auto dim = cell_dimensions(4.5);
+  const auto a = analysis_curve(dim, 16);
+  CHECK(std::abs(a.length - 4.5) < 1e-10);
+  Eigen::Vector3d d = a.curve.eval(1.0) - a.curve.eval(0.0);
+  CHECK(std::abs(d.x() - dim.w) < 1e-13);
+  CHECK(std::abs(d.y()) < 1e-13);
+  CHECK(std::abs(d.z()) < 1e-13);
+}
+
+TEST_CASE("interlocking: crossing order with the next course and clearance", "[unit]") {
+  for (double l : {4.5, 5.5, 6.5}) {
+    const auto g = make_cell_geometry(l);
+    const auto xs = crossings_with_next_course(g.shape, g.dim.c);
+    INFO("l = " << l);
+    // Four crossings per loop: the head in front of the next course's legs, the legs behind the
+    // next course's feet.
+    REQUIRE(xs.size() == 4);
+    int head_legs = 0, legs_feet = 0;
+    for (const auto& x : xs) {
+      const std::string a = x.part_self, b = x.part_other;
+      if (a == "head" && b == "leg") {
+        CHECK(x.dz > 0.1);
+        ++head_legs;
+      } else if (a == "leg" && b == "foot") {
+        CHECK(x.dz < -0.1);
+        ++legs_feet;
+      }
+    }
+    CHECK(head_legs == 2);
+    CHECK(legs_feet == 2);
+    const auto cl = minimum_clearance(g.shape, g.dim.c);
+    CHECK(cl.min_distance > 0.15);  // overlaps exist but are moderate (notes: 0.22 mm at 4.5)
+    CHECK(cl.min_distance < 0.38);
+  }
+}
