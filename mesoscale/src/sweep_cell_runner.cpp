@@ -71,6 +71,7 @@ PathRunner cell_runner(const SweepInput& in) {
       out.message = "initial equilibrium did not converge: " + eq.message;
       return out;
     }
+    out.residual << eq.S(0, 0), eq.S(1, 1), 0.5 * (eq.S(0, 1) + eq.S(1, 0));
     for (int k = 0; k < n; ++k) {
       const Eigen::Matrix2d F =
           material::deformation_gradient(path, static_cast<double>(k + 1) / n);

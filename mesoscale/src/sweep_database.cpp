@@ -55,7 +55,22 @@ material::Database assemble_database(const SweepInput& in, const std::vector<Job
     bool have_cell = false;
     for (std::size_t p = 0; p < np; ++p) {
       const JobResult& r = results.at(l * np + p);
-      e.raw.push_back(r.raw);
+      material::RawPath raw = r.raw;
+      if (in.subtract_residual && !r.residual.isZero()) {
+        Eigen::Matrix2d S0;
+        S0 << r.residual(0), r.residual(2), r.residual(2), r.residual(1);
+        for (Eigen::Index k = 0; k < raw.F.rows(); ++k) {
+          if (raw.status[static_cast<std::size_t>(k)] != kStepConverged) continue;
+          Eigen::Matrix2d F, S;
+          F << raw.F(k, 0), raw.F(k, 1), raw.F(k, 2), raw.F(k, 3);
+          S << raw.S(k, 0), raw.S(k, 2), raw.S(k, 2), raw.S(k, 1);
+          S -= S0;
+          const Eigen::Matrix2d P = material::first_piola_kirchhoff(F, S);
+          raw.S.row(k) << S(0, 0), S(1, 1), S(0, 1);
+          raw.P.row(k) << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
+        }
+      }
+      e.raw.push_back(std::move(raw));
       if (!have_cell && r.cell.wale_width > 0) {
         e.cell = r.cell;
         have_cell = true;
@@ -111,7 +126,7 @@ void write_sweep_database(const fs::path& output, const fs::path& scratch_dir,
     const auto np = static_cast<Eigen::Index>(in.paths.size());
     Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> status(nl, np),
         attempts(nl, np), factor(nl, np), conv(nl, np);
-    material::RowMatrixX seconds(nl, np);
+    material::RowMatrixX seconds(nl, np), residual(nl * np, 3);
     std::vector<std::string> messages;
     for (Eigen::Index l = 0; l < nl; ++l)
       for (Eigen::Index p = 0; p < np; ++p) {
@@ -121,6 +136,7 @@ void write_sweep_database(const fs::path& output, const fs::path& scratch_dir,
         factor(l, p) = r.step_factor;
         conv(l, p) = r.converged_steps();
         seconds(l, p) = r.seconds;
+        residual.row(l * np + p) = r.residual.transpose();
         messages.push_back(r.message);
       }
     g.write("case_status", status);
@@ -130,6 +146,13 @@ void write_sweep_database(const fs::path& output, const fs::path& scratch_dir,
     g.write("case_converged_steps", conv);
     g.write("case_seconds", seconds);
     g.write_strings("case_messages", messages);
+    g.write("residual_S", residual);
+    g.set_attribute("residual_S", "columns",
+                    "S11, S22, S12 (MPa) of the equilibrated cell at F* = I; rows: loop length "
+                    "index * cases + case index");
+    g.set_attribute(
+        "residual_S", "treatment",
+        in.subtract_residual ? "subtracted from raw S (and P = F S)" : "kept in raw S and P");
     g.set_attribute(".", "rows_columns", "rows: loop lengths, columns: load cases");
     g.set_attribute(".", "failed_cases", report.failed_cases());
     g.set_attribute(".", "seconds_cases", report.seconds_cases);

@@ -101,6 +101,7 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
   if (j.contains("runner"))
     in.runner = j.at("runner") == "synthetic" ? RunnerKind::kSynthetic : RunnerKind::kCell;
   if (j.contains("cell")) in.cell_json = j.at("cell").dump();
+  in.subtract_residual = j.value("residual_stress", std::string("subtract")) == "subtract";
   if (j.contains("retry")) {
     in.retry.max_retries = j.at("retry").value("max_retries", in.retry.max_retries);
     in.retry.step_factor = j.at("retry").value("step_factor", in.retry.step_factor);

@@ -102,6 +102,7 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
         best_steps = conv;
         best.raw = std::move(r);
         best.cell = out.cell;
+        best.residual = out.residual;
         best.step_factor = m;
         best.message = out.message;
       }
@@ -124,7 +125,7 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
 // ---- serialization --------------------------------------------------------------------------
 
 namespace {
-constexpr const char* kMagic = "knit-sweep-job 1";
+constexpr const char* kMagic = "knit-sweep-job 2";
 
 void put(std::ostringstream& os, double v) {
   char b[40];
@@ -164,6 +165,8 @@ std::string serialize(const JobResult& r) {
   put(os, r.cell.wale_width);
   put(os, r.cell.course_height);
   put(os, r.cell.thickness);
+  os << "\nresidual";
+  for (int c = 0; c < 3; ++c) put(os, r.residual(c));
   os << "\nkind " << static_cast<int>(r.raw.path.kind) << "\ntarget";
   put(os, r.raw.path.target(0));
   put(os, r.raw.path.target(1));
@@ -206,6 +209,8 @@ JobResult deserialize(const std::string& text) {
   r.cell.wale_width = get_double(is);
   r.cell.course_height = get_double(is);
   r.cell.thickness = get_double(is);
+  expect(is, "residual");
+  for (int c = 0; c < 3; ++c) r.residual(c) = get_double(is);
   expect(is, "kind");
   r.raw.path.kind = get_int(is) == 1 ? material::PathKind::kShear : material::PathKind::kBiaxial;
   expect(is, "target");

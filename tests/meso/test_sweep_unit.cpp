@@ -266,3 +266,40 @@ TEST_CASE("sweep: resume recomputes only the missing cases and gives the same da
                                        knit::material::read_database(dir / "full.h5")) == 0.0);
   CHECK_FALSE(std::filesystem::exists(CheckpointStore::parts_dir(out)));
 }
+
+TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consistently", "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_residual");
+  const Eigen::Vector3d S0(0.15, 0.07, 0.01);
+  const PathRunner prestressed = [&](double l, const LoadPath& p) {
+    PathOutcome o = synthetic_runner()(l, p);
+    o.residual = S0;
+    for (Eigen::Index k = 0; k < o.raw.S.rows(); ++k) {
+      o.raw.S.row(k) += S0.transpose();
+      Eigen::Matrix2d F, S;
+      F << o.raw.F(k, 0), o.raw.F(k, 1), o.raw.F(k, 2), o.raw.F(k, 3);
+      S << o.raw.S(k, 0), o.raw.S(k, 2), o.raw.S(k, 2), o.raw.S(k, 1);
+      const Eigen::Matrix2d P = F * S;
+      o.raw.P.row(k) << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
+    }
+    return o;
+  };
+  const std::string text = R"({"loop_lengths": [5.0], "steps": 5, "runner": "synthetic",
+      "load_paths": {"preset": "default", "select": [0, 12]}, "fit": false)";
+  const auto sub = parse_sweep_input(text + "}", "sub.json");
+  const auto keep = parse_sweep_input(text + R"(, "residual_stress": "keep"})", "keep.json");
+  CHECK(sub.subtract_residual);
+  CHECK_FALSE(keep.subtract_residual);
+  CHECK(sub.job_definition() == keep.job_definition());  // a post-processing choice
+  run_sweep(sub, quiet(dir / "sub.h5"), prestressed);
+  run_sweep(keep, quiet(dir / "keep.h5"), prestressed);
+  run_sweep(sub, quiet(dir / "plain.h5"), synthetic_runner());
+  const auto ds = knit::material::read_database(dir / "sub.h5");
+  const auto dk = knit::material::read_database(dir / "keep.h5");
+  const auto dp = knit::material::read_database(dir / "plain.h5");
+  for (std::size_t p = 0; p < 2; ++p) {
+    const auto &rs = ds.entries[0].raw[p], &rk = dk.entries[0].raw[p], &rp = dp.entries[0].raw[p];
+    CHECK((rs.S - rp.S).cwiseAbs().maxCoeff() < 1e-14);
+    CHECK((rs.P - rp.P).cwiseAbs().maxCoeff() < 1e-14);  // P = F (S - S0)
+    CHECK((rk.S.rowwise() - S0.transpose() - rp.S).cwiseAbs().maxCoeff() < 1e-14);
+  }
+}

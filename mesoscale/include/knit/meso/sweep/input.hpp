@@ -40,6 +40,9 @@ struct SweepInput {
   RunnerKind runner = RunnerKind::kCell;
   std::string cell_json = "{}";  ///< the "cell" object (passed to the cell runner)
   RetryPolicy retry;
+  /// Subtract the residual stress of the cell at F* = I from every step (choice, see
+  /// schemas/sweep.schema.json "residual_stress"); applied when the database is assembled.
+  bool subtract_residual = true;
   bool fit = true;
   fit::FitOptions fit_options;
 

@@ -37,6 +37,9 @@ std::vector<Job> make_jobs(const SweepInput& in);
 struct PathOutcome {
   material::RawPath raw;
   material::CellParameters cell;
+  /// Residual stress (S11, S22, S12) of the equilibrated cell at F* = I (MPa): the initial
+  /// penetrations push the yarns apart (design/notes.md); zero for the synthetic runner.
+  Eigen::Vector3d residual = Eigen::Vector3d::Zero();
   std::string message;
   int iterations = 0;  ///< Newton iterations (information)
 };
@@ -59,9 +62,10 @@ struct JobResult {
   JobStatus status = JobStatus::kFailed;
   material::RawPath raw;  ///< at the requested steps (subsampled from the refined run)
   material::CellParameters cell;
-  int attempts = 0;     ///< runs made (1 = no retry)
-  int step_factor = 1;  ///< refinement of the run that was kept
-  double seconds = 0;   ///< wall time of all attempts
+  Eigen::Vector3d residual = Eigen::Vector3d::Zero();  ///< see PathOutcome
+  int attempts = 0;                                    ///< runs made (1 = no retry)
+  int step_factor = 1;                                 ///< refinement of the run that was kept
+  double seconds = 0;                                  ///< wall time of all attempts
   std::string message;
   int converged_steps() const;
 };
