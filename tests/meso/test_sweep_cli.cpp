@@ -57,7 +57,7 @@ TEST_CASE("knit-meso sweep: bad input exits with 2 and names the JSON pointer", 
 }
 
 TEST_CASE(
-    "knit-meso sweep: killed midway, resumed, recomputes nothing and equals an "
+    "knit-meso sweep: killed midway then resumed recomputes nothing and equals an "
     "uninterrupted run",
     "[case]") {
   const auto dir = knit_test::scratch("sweep_cli_kill");

@@ -10,6 +10,7 @@
 
 #include "knit/material/database.hpp"
 #include "knit/material/response_surface.hpp"
+#include "knit/meso/sweep/mpi.hpp"
 #include "test_sweep_util.hpp"
 
 using namespace knit::material;
@@ -84,4 +85,21 @@ TEST_CASE("reduced sweep on the unit cell: cell -> fit -> database the macroscal
   const auto ev = at.evaluate({0.1, 0.0, 0.0});
   CHECK(std::isfinite(ev.S(0)));
   CHECK(ev.C(0, 0) > 0);  // stiff in tension
+
+  // Under MPI (2 ranks, one thread each) the same database to 1e-12: the cell runs are
+  // deterministic and independent of where they run.
+  if (!knit::meso::sweep::MpiSession::compiled() ||
+      std::system("command -v mpirun > /dev/null 2>&1") != 0) {
+    WARN("MPI or mpirun missing: the 2-rank reduced sweep is skipped");
+    return;
+  }
+  const auto mpi_file = dir / "reduced_mpi.h5";
+  const std::string mcmd = "mpirun --allow-run-as-root --oversubscribe -np 2 " +
+                           std::string(KNIT_BIN_DIR) + "/knit-meso sweep " + KNIT_SOURCE_DIR +
+                           "/cases/sweep/reduced.json --output " + mpi_file.string() +
+                           " --threads 1 > " + (dir / "mpi.txt").string() + " 2>&1";
+  const int mrc = std::system(mcmd.c_str());
+  REQUIRE(WIFEXITED(mrc));
+  REQUIRE(WEXITSTATUS(mrc) == 0);
+  CHECK(knit_test::database_difference(db, read_database(mpi_file)) <= 1e-12);
 }

@@ -138,7 +138,7 @@ TEST_CASE("sweep job: exact serialization round trip", "[unit]") {
   CHECK_THROWS(deserialize("garbage"));
 }
 
-TEST_CASE("sweep job: non-convergence retried with smaller steps, recorded steps unchanged",
+TEST_CASE("sweep job: non-convergence retried with smaller steps and the recorded steps unchanged",
           "[unit]") {
   const auto in = synthetic_input(6);
   const auto jobs = make_jobs(in);
@@ -187,8 +187,8 @@ TEST_CASE("sweep job: non-convergence retried with smaller steps, recorded steps
 }
 
 TEST_CASE(
-    "sweep: any number of threads gives the same database; failed cases kept, reported, "
-    "not fitted",
+    "sweep: any number of threads gives the same database and failed cases are kept and "
+    "reported but not fitted",
     "[unit]") {
   const auto dir = knit_test::scratch("sweep_unit_threads");
   const auto in = synthetic_input();
