@@ -367,7 +367,8 @@ static std::vector<T> read_numeric(hid_t loc, const std::string& name, std::size
   if (std::is_same_v<T, int> && d.cls != H5T_INTEGER)
     fail(std::string("expected an integer dataset, found ") + class_name(d.cls));
   const std::size_t rank = d.dims.size();
-  if (!(rank == want_rank || (want_rank == 1 && rank == 0)))
+  constexpr std::size_t kAnyRank = static_cast<std::size_t>(-1);
+  if (want_rank != kAnyRank && !(rank == want_rank || (want_rank == 1 && rank == 0)))
     fail("expected a " + std::to_string(want_rank) + "-D dataset, found rank " +
          std::to_string(rank));
   dims_out = d.dims;
@@ -392,6 +393,15 @@ std::vector<int> H5Group::read_ints(const std::string& path) const {
   std::vector<std::size_t> dims;
   return read_numeric<int>(id_.get(), h5name(path), 1, dims,
                            [&](const std::string& w) { fail(path, w); });
+}
+
+H5Array H5Group::read_array(const std::string& path) const {
+  silence_hdf5();
+  if (!is_dataset(path)) fail(path, "dataset missing");
+  H5Array a;
+  a.data = read_numeric<double>(id_.get(), h5name(path), static_cast<std::size_t>(-1), a.shape,
+                                [&](const std::string& w) { fail(path, w); });
+  return a;
 }
 
 RowMatrixXd H5Group::read_matrix(const std::string& path) const {
@@ -599,8 +609,11 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
     : H5Group(H5Handle(), file.string(), "/") {
   silence_hdf5();
   const std::string name = file.string();
+  // File access: keep HDF5's file locking, but do not fail on file systems without locks (NFS).
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
+  H5Pset_file_locking(fapl.get(), 1, 1);
   if (mode == Mode::Truncate) {
-    file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+    file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
     if (!file_id_.valid())
       throw std::runtime_error(name +
                                ": cannot create HDF5 file (directory missing or not writable?)");
@@ -609,7 +622,7 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
     if (!std::filesystem::exists(file, ec)) throw std::runtime_error(name + ": file not found");
     if (!is_hdf5_file(file)) throw std::runtime_error(name + ": not an HDF5 file (or truncated)");
     const unsigned flags = mode == Mode::ReadOnly ? H5F_ACC_RDONLY : H5F_ACC_RDWR;
-    file_id_ = H5Handle(H5Fopen(name.c_str(), flags, H5P_DEFAULT));
+    file_id_ = H5Handle(H5Fopen(name.c_str(), flags, fapl.get()));
     if (!file_id_.valid())
       throw std::runtime_error(name + ": cannot open HDF5 file (truncated, corrupt or locked?)");
   }
@@ -627,6 +640,16 @@ void H5File::close() {
   flush();
   id_.reset();
   file_id_.reset();
+}
+
+// ---- AtomicH5File -------------------------------------------------------------------------
+
+AtomicH5File::AtomicH5File(const std::filesystem::path& target)
+    : atomic_(target), file_(H5File::create(atomic_.temp_path())) {}
+
+void AtomicH5File::commit() {
+  file_.close();
+  atomic_.commit();
 }
 
 }  // namespace knit::io

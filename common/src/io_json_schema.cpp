@@ -1,5 +1,6 @@
 // JSON Schema validation (draft 2020-12 subset; see knit/io/json_input.hpp for the keywords).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -164,6 +165,7 @@ struct JsonSchema::Impl {
   // alternatives of oneOf/anyOf into one message).
   struct Err {
     std::string pointer, message, expected_type;
+    std::string at;  // where the error is located in the text ("" = pointer)
   };
   using Errs = std::vector<Err>;
 
@@ -261,7 +263,7 @@ struct JsonSchema::Impl {
 
   void add(Errs& out, const std::string& ptr, std::string msg,
            std::string expected_type = {}) const {
-    out.push_back({ptr, std::move(msg), std::move(expected_type)});
+    out.push_back({ptr, std::move(msg), std::move(expected_type), {}});
   }
 
   Errs validate(const json& s, const json& v, const std::string& ptr, int depth) const {
@@ -419,15 +421,47 @@ struct JsonSchema::Impl {
       }
       if (matched || !additional) continue;
       if (additional->is_boolean()) {
-        if (!additional->get<bool>())
-          add(out, ptr, "unknown key " + short_dump(key) + allowed_keys(props));
+        if (!additional->get<bool>()) {
+          add(out, ptr, "unknown key " + short_dump(key) + allowed_keys(props, key));
+          out.back().at = child;  // locate the key itself, not its object
+        }
       } else {
         run(*additional, it.value(), child, depth + 1, out);
       }
     }
   }
 
-  static std::string allowed_keys(const json* props) {
+  /// Levenshtein distance (for "did you mean").
+  static std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      cur[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j)
+        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1,
+                           prev[j - 1] + (std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                                                  std::tolower(static_cast<unsigned char>(b[j - 1]))
+                                              ? 0
+                                              : 1)});
+      std::swap(prev, cur);
+    }
+    return prev[b.size()];
+  }
+
+  /// " (did you mean "x"?)" for a close known key, else " (allowed: ...)" for short lists.
+  static std::string allowed_keys(const json* props, const std::string& key) {
+    if (props) {
+      std::string best;
+      std::size_t best_d = std::max<std::size_t>(1, std::min<std::size_t>(2, key.size() / 3));
+      for (auto it = props->begin(); it != props->end(); ++it) {
+        const std::size_t d = edit_distance(key, it.key());
+        if (d <= best_d && (best.empty() || d < best_d)) {
+          best = it.key();
+          best_d = d;
+        }
+      }
+      if (!best.empty()) return " (did you mean \"" + best + "\"?)";
+    }
     if (!props || props->empty() || props->size() > 16) return "";
     std::string s = " (allowed: ";
     bool first = true;
@@ -566,7 +600,7 @@ std::vector<SchemaError> JsonSchema::errors(const nlohmann::json& instance) cons
   const auto errs = impl_->validate(impl_->root, instance, "", 0);
   std::vector<SchemaError> out;
   out.reserve(errs.size());
-  for (const auto& e : errs) out.push_back({e.pointer, e.message});
+  for (const auto& e : errs) out.push_back({e.pointer, e.message, e.at.empty() ? e.pointer : e.at});
   return out;
 }
 

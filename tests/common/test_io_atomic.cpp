@@ -79,6 +79,18 @@ TEST_CASE("AtomicFile replaces the target only on commit", "[unit][io][atomic]")
     f.commit();
   }
   CHECK(knit::io::H5File::open_read(dir / "x.h5").read_doubles("/v").size() == 3);
+  {  // AtomicH5File: abandoned leaves the old file, committed replaces it
+    knit::io::AtomicH5File db(dir / "x.h5");
+    db->write("/v", std::vector<double>{1});
+  }
+  CHECK(knit::io::H5File::open_read(dir / "x.h5").read_doubles("/v").size() == 3);
+  CHECK(entries(dir) == 3);  // out.txt, b.txt, x.h5: no temporary left behind
+  {
+    knit::io::AtomicH5File db(dir / "x.h5");
+    db->write("/v", std::vector<double>{1});
+    db.commit();
+  }
+  CHECK(knit::io::H5File::open_read(dir / "x.h5").read_doubles("/v").size() == 1);
 
   CHECK_THROWS_WITH(knit::io::AtomicFile(dir / "missing_dir" / "y.txt"),
                     Catch::Contains("missing_dir/y.txt: cannot write: directory"));

@@ -58,6 +58,10 @@ TEST_CASE("HDF5 datasets round-trip with row-major shapes", "[unit][io][hdf5]") 
     f.write("/imat", I);
     f.write("empty", std::vector<double>{});
     f.write_strings("/names", {"u0", "v1", "ünïcode"});
+    const std::vector<double> cube{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
+    f.write_dataset("/tensor3", std::span<const double>(cube), {2, 3, 2});
+    const double scalar = 2.5;
+    f.write_dataset("/scalar", std::span<const double>(&scalar, 1), {});
     f.close();
   }
   H5File f = H5File::open_read(file);
@@ -80,7 +84,13 @@ TEST_CASE("HDF5 datasets round-trip with row-major shapes", "[unit][io][hdf5]") 
   CHECK(f.read_matrix("imat")(1, 0) == 3.0);  // integer data readable as double
   CHECK(f.read_doubles("empty").empty());
   CHECK(f.read_strings("names") == std::vector<std::string>{"u0", "v1", "ünïcode"});
-  CHECK(f.children("/") == std::vector<std::string>{"empty", "imat", "ints", "loop_4.50", "names"});
+  const auto t3 = f.read_array("/tensor3");
+  CHECK(t3.shape == std::vector<std::size_t>{2, 3, 2});
+  CHECK(t3.data[1 * 6 + 2 * 2 + 1] == 11.0);  // [1][2][1], row-major
+  CHECK(f.shape("/scalar").empty());
+  CHECK(f.read_doubles("/scalar") == std::vector<double>{2.5});
+  CHECK(f.children("/") == std::vector<std::string>{"empty", "imat", "ints", "loop_4.50", "names",
+                                                    "scalar", "tensor3"});
 }
 
 TEST_CASE("HDF5 attributes on files, groups and datasets", "[unit][io][hdf5]") {

@@ -123,6 +123,10 @@ TEST_CASE("schema validator: objects, arrays, $ref", "[unit][io][json][schema]")
         "/geometry: missing required key \"thickness\"");
   CHECK(first_error(with("/material", {{"E", 800}, {"Young", 1}})) ==
         "/material: unknown key \"Young\" (allowed: \"E\", \"nu\")");
+  CHECK(first_error(with("/geometry", {{"thickness", 1}, {"elemnts", 2}})) ==
+        "/geometry: unknown key \"elemnts\" (did you mean \"elements\"?)");
+  CHECK(first_error(with("/material", {{"E", 800}, {"Nu", 0.3}})) ==
+        "/material: unknown key \"Nu\" (did you mean \"nu\"?)");
   CHECK(first_error(with("/material", {{"E", 800}, {"nu", 0.5}})) ==
         "/material/nu: must be < 0.5, got 0.5");
   CHECK(first_error(with("/material", json::object())) == "/material: missing required key \"E\"");
@@ -251,4 +255,63 @@ TEST_CASE("embedded schemas match schemas/*.json and load", "[unit][io][json][sc
   CHECK(knit::io::embedded_schema_names() == on_disk);
   CHECK_THROWS_WITH(knit::io::embedded_schema("no_such_schema"),
                     Catch::Contains("no embedded JSON schema \"no_such_schema\""));
+}
+
+TEST_CASE("json_pointer_lines locates values and keys in the text", "[unit][io][json]") {
+  const std::string text =
+      "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  },\n"
+      "  \"list\": [\n    1,\n    {\"a~/b\": \"x\\\"y\", \"\\u00e9\": 2}\n  ]\n}\n";
+  const auto lines = knit::io::json_pointer_lines(text);
+  CHECK(lines.at("") == 1);
+  CHECK(lines.at("/name") == 2);
+  CHECK(lines.at("/geometry") == 3);
+  CHECK(lines.at("/geometry/thickness") == 4);
+  CHECK(lines.at("/list/0") == 7);
+  CHECK(lines.at("/list/1") == 8);
+  CHECK(lines.at("/list/1/a~0~1b") == 8);
+  CHECK(lines.at("/list/1/\xc3\xa9") == 8);
+  CHECK(lines.size() == 9);
+}
+
+TEST_CASE("load_and_validate adds the line of the offending value", "[unit][io][json][schema]") {
+  const fs::path f = scratch(
+      "case.json", "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  }\n}\n");
+  try {
+    knit::io::load_and_validate(f, test_schema());
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/geometry/thickness");
+    CHECK(e.message() == "must be > 0, got -1 (line 4)");
+  }
+  const fs::path g = scratch("case2.json",
+                             "{\"name\": \"rod_1\",\n \"geometry\": {\"thickness\": 1},\n"
+                             " \"material\": {\"E\": 1,\n   \"Young\": 2}}");
+  CHECK_THROWS_WITH(
+      knit::io::load_and_validate(g, test_schema()),
+      g.string() + ": /material: unknown key \"Young\" (allowed: \"E\", \"nu\") (line 4)");
+  const fs::path ok = scratch("ok2.json", R"({"name": "ab", "geometry": {"thickness": 2}})");
+  CHECK(knit::io::load_and_validate(ok, test_schema())["geometry"]["thickness"] == 2);
+  CHECK_THROWS_WITH(knit::io::load_and_validate(ok, "no_such_schema"),
+                    Catch::Contains("no embedded JSON schema"));
+}
+
+TEST_CASE("duplicate keys are input errors", "[unit][io][json]") {
+  const fs::path f =
+      scratch("dup.json", "{\"a\": {\"x\": 1,\n  \"y\": 2,\n  \"x\": 3}, \"b\": {\"x\": 4}}");
+  try {
+    knit::io::read_json_file(f);
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/a/x");
+    CHECK(e.message() == "duplicate key (lines 1 and 3)");
+  }
+  CHECK_NOTHROW(
+      knit::io::parse_json(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "t"));
+}
+
+TEST_CASE("paths inside input files are relative to the file", "[unit][io][json]") {
+  CHECK(knit::io::resolve_input_path("/cases/shell/a.json", "../db/m.h5") ==
+        fs::path("/cases/db/m.h5"));
+  CHECK(knit::io::resolve_input_path("/cases/a.json", "/abs/m.h5") == fs::path("/abs/m.h5"));
+  CHECK(knit::io::resolve_input_path("a.json", "m.h5") == fs::path("m.h5"));
 }

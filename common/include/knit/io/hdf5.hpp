@@ -30,9 +30,16 @@
 #include <type_traits>
 #include <vector>
 
+#include "knit/io/atomic.hpp"
 #include "knit/io/matrix_types.hpp"
 
 namespace knit::io {
+
+/// A numeric dataset of any rank: values in row-major (C) order.
+struct H5Array {
+  std::vector<std::size_t> shape;  ///< empty for a scalar dataset
+  std::vector<double> data;
+};
 
 /// Options for writing a dataset.
 struct H5WriteOptions {
@@ -118,6 +125,8 @@ class H5Group {
   RowMatrixXd read_matrix(const std::string& path) const;
   /// Reads an integer 2-D dataset of shape (rows, cols).
   RowMatrixXi read_int_matrix(const std::string& path) const;
+  /// Reads a numeric dataset of any rank as doubles, with its shape.
+  H5Array read_array(const std::string& path) const;
   /// Reads a 1-D (or scalar) string dataset, variable or fixed length.
   std::vector<std::string> read_strings(const std::string& path) const;
 
@@ -176,6 +185,26 @@ class H5File : public H5Group {
 
  private:
   H5Handle file_id_;
+};
+
+/// An HDF5 file written atomically: created at a temporary path next to `target`, closed and
+/// renamed onto it by commit(); without commit() the temporary is removed and `target` is
+/// untouched.
+///   knit::io::AtomicH5File db("material.h5");
+///   db->write("/loop_4.50/fit/S", S);
+///   db.commit();
+class AtomicH5File {
+ public:
+  explicit AtomicH5File(const std::filesystem::path& target);
+  H5File& file() { return file_; }
+  H5File* operator->() { return &file_; }
+  const std::filesystem::path& target() const { return atomic_.target(); }
+  /// Closes the file, then fsync + rename (see AtomicFile::commit).
+  void commit();
+
+ private:
+  AtomicFile atomic_;  // declared first: destroyed after file_ (removes the closed temporary)
+  H5File file_;
 };
 
 /// True if `file` exists and carries an HDF5 signature.

@@ -5,9 +5,11 @@
 //
 // Errors are knit::InputError(file, json_pointer, message), one line each:
 //   case.json: invalid JSON at line 3, column 14: syntax error ... (pointer "")
-//   case.json: /geometry/thickness: must be > 0, got -1
+//   case.json: /geometry/thickness: must be > 0, got -1 (line 7)
 //   case.json: /boundary_conditions/2/edge: must be one of "u0", "u1", "v0", "v1", got "u2"
-//   case.json: /material: unknown key "Young" (allowed: "E", "nu")
+//   case.json: /material: unknown key "Young" (allowed: "E", "nu") (line 9)
+//   case.json: /geometry: unknown key "thicknes" (did you mean "thickness"?) (line 5)
+// (load_and_validate adds the line; JsonSchema::validate, which has no text, does not).
 //
 // Supported keywords: type (string or array; "integer" = number with no fraction), enum,
 // const, properties, required, additionalProperties (bool or schema), patternProperties,
@@ -29,6 +31,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
@@ -44,6 +47,11 @@ namespace knit::io {
 nlohmann::json read_json_file(const std::filesystem::path& file);
 /// Parses JSON text; `source` names it in errors.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
+
+/// A path written inside an input file: absolute as is, relative ones are taken relative to the
+/// directory of that input file (so a case runs the same from any working directory).
+std::filesystem::path resolve_input_path(const std::filesystem::path& input_file,
+                                         const std::string& value);
 
 // ---- JSON pointers (RFC 6901) ------------------------------------------------------------------
 
@@ -66,6 +74,9 @@ std::vector<std::string> embedded_schema_names();
 struct SchemaError {
   std::string pointer;  ///< JSON pointer into the instance ("" = the whole document)
   std::string message;  ///< what is expected and what was found
+  /// Pointer of the value the error is about: = pointer, except for an unknown key, where it
+  /// is the key's own pointer (used to find the line in the input text).
+  std::string at;
 };
 
 class JsonSchema {
@@ -92,7 +103,14 @@ class JsonSchema {
   std::unique_ptr<Impl> impl_;
 };
 
-/// read_json_file + validation against the embedded schema `schema_name`.
+/// Line (1-based) where each value starts in JSON text, by JSON pointer ("" = the root). For
+/// object members, the line of the key. The text must be valid JSON.
+std::map<std::string, int> json_pointer_lines(std::string_view text);
+
+/// read_json_file + validation against the embedded schema `schema_name`. A validation error
+/// is InputError(path, pointer, message + " (line N)").
 nlohmann::json load_and_validate(const std::filesystem::path& path, const std::string& schema_name);
+/// The same with a schema object (tests, tools).
+nlohmann::json load_and_validate(const std::filesystem::path& path, const JsonSchema& schema);
 
 }  // namespace knit::io
