@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "knit/io/atomic.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 #include "knit/meso/sweep/sweep.hpp"
@@ -112,12 +113,14 @@ std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
   return out;
 }
 
-void write_sweep_database(const fs::path& output, const fs::path& scratch_dir,
-                          const material::Database& db, const SweepInput& in,
-                          const std::vector<JobResult>& results, const SweepReport& report) {
+void write_sweep_database(const fs::path& output, const material::Database& db,
+                          const SweepInput& in, const std::vector<JobResult>& results,
+                          const SweepReport& report) {
   if (output.has_parent_path()) fs::create_directories(output.parent_path());
-  fs::create_directories(scratch_dir);
-  const fs::path tmp = scratch_dir / "database.h5.tmp";
+  // The database goes to a temporary next to `output` (write_database is itself atomic onto
+  // it), gets the report, and is fsynced and renamed onto `output` by commit().
+  io::AtomicFile out(output);
+  const fs::path tmp = out.temp_path();
   material::write_database(tmp, db);
   {
     io::H5File f = io::H5File::open_rw(tmp);
@@ -169,7 +172,7 @@ void write_sweep_database(const fs::path& output, const fs::path& scratch_dir,
     if (!fit_status.empty()) g.write_strings("fit_status", fit_status);
     f.close();
   }
-  fs::rename(tmp, output);  // same directory tree: atomic
+  out.commit();
 }
 
 // ---- runners ----------------------------------------------------------------------------------

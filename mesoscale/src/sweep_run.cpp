@@ -193,7 +193,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   if (in.fit) rep.fits = fit_sweep_database(db, in.fit_options, rep.threads);
   rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
   rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_sweep_database(opt.output, store->dir(), db, in, rep.results, rep);
+  write_sweep_database(opt.output, db, in, rep.results, rep);
   rep.wrote_database = true;
   if (!opt.keep_parts) store->remove();
   return rep;

@@ -61,10 +61,9 @@ std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
                                                 const fit::FitOptions& options, int threads);
 
 /// Writes db atomically to `output`, with the per-case report (/sweep/report: status,
-/// attempts, step factor, converged steps, seconds, messages) -- via a temporary file in
-/// `scratch_dir`, renamed onto `output` when complete.
-void write_sweep_database(const std::filesystem::path& output,
-                          const std::filesystem::path& scratch_dir, const material::Database& db,
+/// attempts, step factor, converged steps, seconds, messages, residual stresses) -- via a
+/// temporary file next to `output`, fsynced and renamed onto it when complete.
+void write_sweep_database(const std::filesystem::path& output, const material::Database& db,
                           const SweepInput& in, const std::vector<JobResult>& results,
                           const SweepReport& report);
 
