@@ -28,7 +28,18 @@ std::string Progress::clock(double s) {
 
 void Progress::finished(const std::string& line) {
   ++count_;
-  if (!out_) return;
+  last_ = line;
+  if (out_) draw();
+}
+
+void Progress::tick() {
+  if (!out_ || !tty_) return;
+  if (std::chrono::steady_clock::now() - drawn_ >= std::chrono::seconds(1)) draw();
+}
+
+void Progress::draw() {
+  drawn_ = std::chrono::steady_clock::now();
+  const std::string& line = last_;
   const double el = elapsed();
   const double eta = count_ > 0 ? el / count_ * (total_ - count_) : NAN;
   const int all = total_ + already_, now = count_ + already_;

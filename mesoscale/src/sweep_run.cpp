@@ -179,6 +179,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
         std::string m;
         while (mpi->try_receive(m)) accept(deserialize(m));
       }
+      progress.tick();
     }
     rep.computed = root ? static_cast<int>(pending.size()) : local_total;
     progress.done();

@@ -17,6 +17,8 @@ class Progress {
   Progress(int total, int already, std::FILE* out, int tty = -1);
   /// One case finished; `line` describes it (shown in plain mode, and as "last:" on the bar).
   void finished(const std::string& line);
+  /// On a terminal: redraws the bar (elapsed time, ETA) if the last draw is older than 1 s.
+  void tick();
   /// Clears the bar (before other output).
   void done();
   double elapsed() const;
@@ -27,7 +29,9 @@ class Progress {
   int total_, already_, count_ = 0;
   std::FILE* out_;
   bool tty_;
-  std::chrono::steady_clock::time_point t0_;
+  std::chrono::steady_clock::time_point t0_, drawn_;
+  std::string last_;
+  void draw();
 };
 
 }  // namespace knit::meso::sweep
