@@ -13,6 +13,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/meso/cell/geometry.hpp"
 #include "knit/meso/cell/output.hpp"
+#include "knit/meso/homog/cell_config.hpp"
 
 namespace {
 
@@ -22,6 +23,7 @@ struct Options {
   double d = 0.38;
   double gamma_over_w = 0.25 / 1.26;
   int samples = 60;
+  std::string config;
 };
 
 int run(const Options& o) {
@@ -33,6 +35,11 @@ int run(const Options& o) {
   GeometryOptions go;
   go.d = o.d;
   go.gamma_over_w = o.gamma_over_w;
+  if (!o.config.empty()) {  // yarn diameter and loop shape from the cell parameters
+    const auto co = knit::meso::homog::read_cell_options(o.config);
+    go.d = co.section.d;
+    go.gamma_over_w = co.geometry.gamma_over_w;
+  }
   const CellGeometry g = make_cell_geometry(o.loop_length, go);
   std::filesystem::create_directories(o.out);
 

@@ -1,6 +1,6 @@
 // knit-meso path --loop-length L (--biaxial EPS11 EPS22 | --shear GAMMA_DEG) [--steps N]
 //                [--out DIR] [--elements NE] [--penalty K_N] [--allowance G0] [--delta D]
-//                [--mu MU] [--stick K_T] [--no-vtp]
+//                [--mu MU] [--stick K_T] [--no-vtp] [--config CELL.json]
 //   Runs one macroscopic deformation path on the single-jersey unit cell (paper Sect. 2.1.2,
 //   eqs. 7-9): equilibrates the initial geometry (step 0: residual stress), then N steps.
 //   --biaxial gives the strains of F* = diag(1+eps11, 1+eps22); --shear the shear angle gamma in
@@ -19,6 +19,7 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/cell/output.hpp"
+#include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/path.hpp"
 
 namespace {
@@ -29,9 +30,10 @@ struct Options {
   double shear = std::nan("");
   int steps = 20;
   std::string out = "path";
-  int elements = 32;
+  int elements = -1;
   double k_N = -1, g0 = -1, delta = -1, mu = -1, k_T = -1;
   bool no_vtp = false;
+  std::string config;
 };
 
 void write_step_vtp(knit::meso::homog::PeriodicCell& cell, const std::string& file) {
@@ -55,10 +57,9 @@ int run(const Options& o) {
   if (bi == sh) throw knit::InputError("", "", "give exactly one of --biaxial or --shear");
   if (bi && o.biaxial.size() != 2) throw knit::InputError("", "--biaxial", "needs EPS11 EPS22");
   if (o.steps < 1) throw knit::InputError("", "--steps", "must be >= 1");
-  if (o.elements < 4) throw knit::InputError("", "--elements", "must be >= 4");
-  CellOptions co;
-  co.elements = o.elements;
-  co.newton.tol = 1e-8;
+  if (o.elements >= 0 && o.elements < 4) throw knit::InputError("", "--elements", "must be >= 4");
+  CellOptions co = o.config.empty() ? CellOptions{} : read_cell_options(o.config);
+  if (o.elements > 0) co.elements = o.elements;
   if (o.k_N > 0) co.contact.penalty.k_N = o.k_N;
   if (o.g0 >= 0) co.contact.penalty.g0 = o.g0;
   if (o.delta > 0) co.contact.penalty.delta = o.delta;
@@ -124,6 +125,8 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_option("--mu", o->mu, "Coulomb friction coefficient (default 0.15)");
       sub.add_option("--stick", o->k_T, "stick penalty k_T (MPa)");
       sub.add_flag("--no-vtp", o->no_vtp, "skip the per-step VTP files");
+      sub.add_option("--config", o->config,
+                     "JSON cell parameters (schemas/cell.schema.json); flags override it");
       return [o]() { return run(*o); };
     });
 

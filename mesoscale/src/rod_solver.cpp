@@ -9,6 +9,29 @@ namespace knit::meso::rod {
 
 namespace {
 
+// The symbolic analysis (column ordering, elimination tree) depends on the sparsity pattern
+// only; it is reused across Newton iterations and load steps while the pattern is unchanged
+// (contact may change it: then it is redone). One workspace per thread.
+struct LinearWorkspace {
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  std::vector<int> outer, inner;
+  bool analyzed = false;
+
+  bool same_pattern(const Eigen::SparseMatrix<double>& J) const {
+    if (!analyzed || static_cast<Eigen::Index>(outer.size()) != J.outerSize() + 1 ||
+        static_cast<Eigen::Index>(inner.size()) != J.nonZeros())
+      return false;
+    return std::equal(outer.begin(), outer.end(), J.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), J.innerIndexPtr());
+  }
+  void analyze(const Eigen::SparseMatrix<double>& J) {
+    lu.analyzePattern(J);
+    outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
+    inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
+    analyzed = true;
+  }
+};
+
 double scaled_norm(const RodSystem& sys, const Eigen::VectorXd& F) {
   const double v = F.cwiseProduct(sys.row_scales()).cwiseAbs().maxCoeff();
   return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
@@ -34,9 +57,9 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
   Eigen::VectorXd F(N);
   Eigen::SparseMatrix<double> J(N, N);
   std::vector<Eigen::Triplet<double>> trip;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
-  bool analyzed = false;
-  Eigen::Index nnz_pattern = -1;
+  thread_local LinearWorkspace ws;
+  auto& lu = ws.lu;
+  trip.reserve(static_cast<size_t>(N) * 40);
   for (int it = 0;; ++it) {
     trip.clear();
     sys.assemble(x, lambda, F, trip);
@@ -65,11 +88,7 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
     }
     J.setFromTriplets(trip.begin(), trip.end());
     J.makeCompressed();
-    if (!analyzed || J.nonZeros() != nnz_pattern) {
-      lu.analyzePattern(J);
-      analyzed = true;
-      nnz_pattern = J.nonZeros();
-    }
+    if (!ws.same_pattern(J)) ws.analyze(J);
     lu.factorize(J);
     if (lu.info() != Eigen::Success) {
       rep.message = "singular Jacobian";
@@ -104,7 +123,9 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
   const double nominal = (opt.lambda_end - opt.lambda_start) / steps;
   double inc = nominal;
   int halvings = 0;
-  Eigen::VectorXd x_prev = x;
+  Eigen::VectorXd x_prev = x, x_last = x;
+  bool have_last = false;
+  double last_inc = 0.0;
   for (int s = 1; s <= steps; ++s) {
     const double target = opt.lambda_start + nominal * s;
     while (std::abs(target - lam) > 1e-14 * std::max(1.0, std::abs(target))) {
@@ -113,9 +134,15 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
           std::abs(target - next) < 1e-9 * std::abs(nominal))
         next = target;
       x_prev = x;
+      // Secant predictor from the last converged increment (saves about one iteration).
+      if (opt.predictor && have_last && std::abs(last_inc) > 0.0)
+        x += ((next - lam) / last_inc) * (x - x_last);
       const NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
       rep.total_iterations += r.iterations;
       if (r.converged) {
+        x_last = x_prev;
+        last_inc = next - lam;
+        have_last = true;
         lam = next;
         rep.lambda_reached = lam;
         ++rep.increments;

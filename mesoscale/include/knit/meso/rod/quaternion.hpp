@@ -39,6 +39,24 @@ Quat<T> qconj(const Quat<T>& a) {
   return Quat<T>(a(0), -a(1), -a(2), -a(3));
 }
 
+/// Left multiplication matrix: a * b = qleft(a) b.
+template <class T>
+Eigen::Matrix<T, 4, 4> qleft(const Quat<T>& a) {
+  Eigen::Matrix<T, 4, 4> L;
+  L << a(0), -a(1), -a(2), -a(3), a(1), a(0), -a(3), a(2), a(2), a(3), a(0), -a(1), a(3), -a(2),
+      a(1), a(0);
+  return L;
+}
+
+/// Right multiplication matrix: a * b = qright(b) a.
+template <class T>
+Eigen::Matrix<T, 4, 4> qright(const Quat<T>& b) {
+  Eigen::Matrix<T, 4, 4> R;
+  R << b(0), -b(1), -b(2), -b(3), b(1), b(0), b(3), -b(2), b(2), -b(3), b(0), b(1), b(3), b(2),
+      -b(1), b(0);
+  return R;
+}
+
 /// R(q) of the normalized quaternion q/|q| (q need not be unit).
 template <class T>
 Mat3<T> rotation(const Quat<T>& q) {

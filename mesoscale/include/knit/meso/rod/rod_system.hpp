@@ -171,6 +171,10 @@ class RodSystem {
   // ---- evaluation (any parameter, any state) ------------------------------------------------
   /// Non-zero (rational) basis functions and derivatives 0..nder at xi.
   PointBasis basis(int rod, double xi, int nder) const;
+  /// Allocation-free variant: N must be (nder+1) x (p+1); returns the first control point.
+  int basis(int rod, double xi, int nder, Eigen::Ref<Eigen::MatrixXd> N) const {
+    return rods_[rod].geo.basis_derivatives(xi, nder, N);
+  }
   /// Row k = d^k r / dxi^k, k = 0..nder.
   Eigen::MatrixXd position_derivatives(int rod, double xi, const Eigen::VectorXd& x,
                                        int nder) const;

@@ -48,6 +48,7 @@ struct PathOptions {
   double lambda_start = 0.0;
   double lambda_end = 1.0;
   int max_cutbacks = 10;  ///< successive halvings of an increment before giving up
+  bool predictor = true;  ///< secant extrapolation from the previous increment
   NewtonOptions newton;
 };
 

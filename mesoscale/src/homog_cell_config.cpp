@@ -1,0 +1,113 @@
+// JSON reader of the unit-cell parameters: see knit/meso/homog/cell_config.hpp.
+#include "knit/meso/homog/cell_config.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+
+namespace knit::meso::homog {
+
+namespace {
+
+using nlohmann::json;
+
+struct Reader {
+  std::string file;
+  [[noreturn]] void fail(const std::string& ptr, const std::string& msg) const {
+    throw InputError(file, ptr, msg);
+  }
+  void object(const json& j, const std::string& ptr, const std::set<std::string>& allowed) const {
+    if (!j.is_object()) fail(ptr, "must be an object");
+    for (const auto& [k, v] : j.items())
+      if (!allowed.count(k)) fail(ptr + "/" + k, "unknown field");
+  }
+  // Reads j[key] into v if present; checks lo < v (strict) or lo <= v and v <= hi.
+  void num(const json& j, const std::string& ptr, const char* key, double& v, double lo, double hi,
+           bool strict_lo) const {
+    if (!j.contains(key)) return;
+    const json& x = j[key];
+    const std::string p = ptr + "/" + key;
+    if (!x.is_number()) fail(p, "must be a number");
+    const double d = x.get<double>();
+    if ((strict_lo ? !(d > lo) : !(d >= lo)) || !(d <= hi)) {
+      std::ostringstream m;
+      m << "must be " << (strict_lo ? "> " : ">= ") << lo;
+      if (hi < 1e299) m << " and <= " << hi;
+      m << ", got " << d;
+      fail(p, m.str());
+    }
+    v = d;
+  }
+  void integer(const json& j, const std::string& ptr, const char* key, int& v, int lo) const {
+    if (!j.contains(key)) return;
+    const json& x = j[key];
+    const std::string p = ptr + "/" + key;
+    if (!x.is_number_integer()) fail(p, "must be an integer");
+    const int i = x.get<int>();
+    if (i < lo) fail(p, "must be >= " + std::to_string(lo) + ", got " + std::to_string(i));
+    v = i;
+  }
+};
+
+}  // namespace
+
+CellOptions read_cell_options(const std::string& file, CellOptions o) {
+  Reader R{file};
+  json j;
+  {
+    std::ifstream in(file);
+    if (!in) throw InputError(file, "", "cannot read file");
+    try {
+      j = json::parse(in);
+    } catch (const json::parse_error& e) {
+      throw InputError(file, "", std::string("invalid JSON: ") + e.what());
+    }
+  }
+  R.object(j, "", {"$schema", "description", "yarn", "loop", "analysis", "contact", "solver"});
+  constexpr double inf = 1e300;
+  if (j.contains("yarn")) {
+    const json& y = j["yarn"];
+    R.object(y, "/yarn", {"E", "nu", "d"});
+    R.num(y, "/yarn", "E", o.section.E, 0, inf, true);
+    R.num(y, "/yarn", "nu", o.section.nu, -1, 0.4999999, true);
+    R.num(y, "/yarn", "d", o.section.d, 0, inf, true);
+  }
+  if (j.contains("loop")) {
+    const json& l = j["loop"];
+    R.object(l, "/loop", {"gamma_over_w"});
+    R.num(l, "/loop", "gamma_over_w", o.geometry.gamma_over_w, 0, 1, false);
+  }
+  if (j.contains("analysis")) {
+    const json& a = j["analysis"];
+    R.object(a, "/analysis", {"elements", "degree", "slave_points_per_element"});
+    R.integer(a, "/analysis", "elements", o.elements, 4);
+    R.integer(a, "/analysis", "degree", o.degree, 2);
+    R.integer(a, "/analysis", "slave_points_per_element", o.contact.slave_points_per_element, 1);
+  }
+  if (j.contains("contact")) {
+    const json& c = j["contact"];
+    R.object(c, "/contact",
+             {"penalty", "allowance", "delta", "mu", "stick_penalty", "margin", "self_exclusion"});
+    R.num(c, "/contact", "penalty", o.contact.penalty.k_N, 0, inf, true);
+    R.num(c, "/contact", "allowance", o.contact.penalty.g0, 0, inf, false);
+    R.num(c, "/contact", "delta", o.contact.penalty.delta, 0, inf, true);
+    R.num(c, "/contact", "mu", o.contact.friction.mu, 0, inf, false);
+    R.num(c, "/contact", "stick_penalty", o.contact.friction.k_T, 0, inf, true);
+    R.num(c, "/contact", "margin", o.contact.margin, 0, inf, false);
+    R.num(c, "/contact", "self_exclusion", o.contact.self_exclusion, 0, 1, true);
+  }
+  if (j.contains("solver")) {
+    const json& s = j["solver"];
+    R.object(s, "/solver", {"tolerance", "max_iterations", "equilibration_steps", "max_cutbacks"});
+    R.num(s, "/solver", "tolerance", o.newton.tol, 0, 1, true);
+    R.integer(s, "/solver", "max_iterations", o.newton.max_iterations, 1);
+    R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1);
+    R.integer(s, "/solver", "max_cutbacks", o.max_cutbacks, 0);
+  }
+  return o;
+}
+
+}  // namespace knit::meso::homog

@@ -1,0 +1,46 @@
+// JSON input of the cell parameters: values land in CellOptions, bad fields name their pointer.
+#include <catch2/catch.hpp>
+#include <fstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/homog/cell_config.hpp"
+
+using namespace knit::meso::homog;
+
+namespace {
+std::string write_tmp(const std::string& name, const std::string& text) {
+  const std::string path = std::string(KNIT_BINARY_DIR) + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+}  // namespace
+
+TEST_CASE("cell config: fields are read, defaults kept", "[unit]") {
+  const auto f = write_tmp("cell_cfg_ok.json",
+                           R"({"contact": {"penalty": 500, "mu": 0.2, "allowance": 0.1},
+                               "analysis": {"elements": 24}, "yarn": {"d": 0.4}})");
+  const CellOptions o = read_cell_options(f);
+  CHECK(o.contact.penalty.k_N == 500);
+  CHECK(o.contact.friction.mu == 0.2);
+  CHECK(o.contact.penalty.g0 == 0.1);
+  CHECK(o.elements == 24);
+  CHECK(o.section.d == 0.4);
+  CHECK(o.contact.penalty.delta == CellOptions{}.contact.penalty.delta);
+}
+
+TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
+  auto pointer_of = [](const std::string& text) {
+    try {
+      read_cell_options(write_tmp("cell_cfg_bad.json", text));
+    } catch (const knit::InputError& e) {
+      return e.pointer();
+    }
+    return std::string("<no error>");
+  };
+  CHECK(pointer_of(R"({"contact": {"penalty": -5}})") == "/contact/penalty");
+  CHECK(pointer_of(R"({"contact": {"friction": 0.1}})") == "/contact/friction");
+  CHECK(pointer_of(R"({"analysis": {"elements": 2}})") == "/analysis/elements");
+  CHECK(pointer_of(R"({"yarn": {"nu": 0.7}})") == "/yarn/nu");
+  CHECK(pointer_of(R"({"bogus": 1})") == "/bogus");
+  CHECK(pointer_of(R"({not json)") == "");
+}
