@@ -3,13 +3,16 @@
 // recording F*, P*, E, S of every step (eqs. 8-9). Each call builds its own cell, equilibrates
 // it at F* = I and then follows the path step by step from the last converged state; it is
 // deterministic and shares nothing with concurrent calls.
-#include <chrono>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
-#if __has_include("knit/meso/homog/periodic_cell.hpp")
+#if __has_include("knit/meso/homog/cell_config.hpp")
+#include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
 #define KNIT_SWEEP_HAVE_CELL 1
 #endif
@@ -20,37 +23,29 @@ namespace knit::meso::sweep {
 
 namespace {
 
-homog::CellOptions cell_options(const nlohmann::json& c) {
-  homog::CellOptions co;
-  co.newton.tol = 1e-8;  // as knit-meso path
-  co.elements = c.value("elements", co.elements);
-  co.degree = c.value("degree", co.degree);
-  co.equilibration_steps = c.value("equilibration_steps", co.equilibration_steps);
-  co.max_cutbacks = c.value("max_cutbacks", co.max_cutbacks);
-  co.newton.tol = c.value("newton_tolerance", co.newton.tol);
-  co.newton.max_iterations = c.value("newton_max_iterations", co.newton.max_iterations);
-  if (c.contains("yarn")) {
-    const auto& y = c["yarn"];
-    co.section.d = y.value("diameter", co.section.d);
-    co.section.E = y.value("youngs_modulus", co.section.E);
-    co.section.nu = y.value("poisson_ratio", co.section.nu);
+/// The cell parameters through the cell's own reader (knit/meso/homog/cell_config.hpp), which
+/// reads files: the inline object is handed to it as a private temporary file.
+homog::CellOptions cell_options(const SweepInput& in) {
+  if (!in.cell_file.empty()) return homog::read_cell_options(in.cell_file);
+  if (in.cell_json == "{}") return {};
+  namespace fs = std::filesystem;
+  const fs::path tmp =
+      fs::temp_directory_path() / ("knit-sweep-cell-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(tmp) << in.cell_json;
+  try {
+    homog::CellOptions co = homog::read_cell_options(tmp.string());
+    fs::remove(tmp);
+    return co;
+  } catch (const InputError& e) {
+    fs::remove(tmp);
+    throw InputError(in.file, "/cell" + e.pointer(), e.message());
   }
-  co.contact.d = co.section.d;
-  if (c.contains("contact")) {
-    const auto& k = c["contact"];
-    co.contact.penalty.k_N = k.value("penalty", co.contact.penalty.k_N);
-    co.contact.penalty.g0 = k.value("allowance", co.contact.penalty.g0);
-    co.contact.penalty.delta = k.value("delta", co.contact.penalty.delta);
-    co.contact.friction.mu = k.value("friction", co.contact.friction.mu);
-    co.contact.friction.k_T = k.value("stick", co.contact.friction.k_T);
-  }
-  return co;
 }
 
 }  // namespace
 
 PathRunner cell_runner(const SweepInput& in) {
-  const homog::CellOptions co = cell_options(nlohmann::json::parse(in.cell_json));
+  const homog::CellOptions co = cell_options(in);
   return [co](double l, const material::LoadPath& path) {
     const int n = path.steps;
     PathOutcome out;

@@ -28,8 +28,10 @@ material::CellParameters notes_cell(double l, double d) {
   return c;
 }
 
-double yarn_value(const nlohmann::json& cell, const char* key, double dflt) {
-  if (cell.contains("yarn") && cell["yarn"].contains(key)) return cell["yarn"][key].get<double>();
+/// cell["group"]["key"] of the cell parameters (schemas/cell.schema.json), or the default.
+double cell_value(const nlohmann::json& cell, const char* group, const char* key, double dflt) {
+  if (cell.is_object() && cell.contains(group) && cell[group].contains(key))
+    return cell[group][key].get<double>();
   return dflt;
 }
 }  // namespace
@@ -40,14 +42,12 @@ material::Database assemble_database(const SweepInput& in, const std::vector<Job
   db.generator = in.runner == RunnerKind::kCell ? "sweep" : "sweep (synthetic runner)";
   db.sweep_input = in.json;
   const nlohmann::json cell = nlohmann::json::parse(in.cell_json);
-  const double d = yarn_value(cell, "diameter", 0.38);
+  // The cell's defaults (docs/unit-cell.md) where the input says nothing.
+  const double d = cell_value(cell, "yarn", "d", 0.38);
   db.yarn = {{"diameter", d},
-             {"youngs_modulus", yarn_value(cell, "youngs_modulus", 800.0)},
-             {"poisson_ratio", yarn_value(cell, "poisson_ratio", 0.3)}};
-  if (cell.contains("contact") && cell["contact"].contains("friction"))
-    db.yarn["friction"] = cell["contact"]["friction"].get<double>();
-  else
-    db.yarn["friction"] = 0.15;
+             {"youngs_modulus", cell_value(cell, "yarn", "E", 800.0)},
+             {"poisson_ratio", cell_value(cell, "yarn", "nu", 0.3)},
+             {"friction", cell_value(cell, "contact", "mu", 0.15)}};
   const std::size_t np = in.paths.size();
   for (std::size_t l = 0; l < in.loop_lengths.size(); ++l) {
     material::LoopLengthEntry e;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -100,7 +101,25 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
 
   if (j.contains("runner"))
     in.runner = j.at("runner") == "synthetic" ? RunnerKind::kSynthetic : RunnerKind::kCell;
-  if (j.contains("cell")) in.cell_json = j.at("cell").dump();
+  if (j.contains("cell")) {
+    nlohmann::json c = j.at("cell");
+    std::string source = file, prefix = "/cell";
+    if (c.is_string()) {
+      const auto path = io::resolve_input_path(file, c.get<std::string>());
+      c = io::read_json_file(path);
+      in.cell_file = source = path.string();
+      prefix.clear();
+    }
+    // The cell's own schema, when this build has it (the cell module embeds it).
+    const auto names = io::embedded_schema_names();
+    if (std::find(names.begin(), names.end(), "cell") != names.end()) {
+      const auto errs = io::JsonSchema::embedded("cell").errors(c);
+      if (!errs.empty()) throw InputError(source, prefix + errs[0].pointer, errs[0].message);
+    } else if (!c.is_object()) {
+      throw InputError(source, prefix, "must be an object");
+    }
+    in.cell_json = c.dump();
+  }
   in.subtract_residual = j.value("residual_stress", std::string("subtract")) == "subtract";
   if (j.contains("retry")) {
     in.retry.max_retries = j.at("retry").value("max_retries", in.retry.max_retries);

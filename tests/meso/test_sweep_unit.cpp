@@ -93,9 +93,34 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
         "/load_paths/0/gamma_deg");
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "fit": {"control_points_1": 2}})").rfind("/fit", 0) ==
         0);
-  CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": {"contact": {"friction": -1}}})") ==
-        "/cell/contact/friction");
+  // the cell parameters follow the cell's own schema (schemas/cell.schema.json)
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": {"contact": {"mu": -1}}})") ==
+        "/cell/contact/mu");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": 3})") == "/cell");
   CHECK(pointer_of(R"({"steps": 4})") == "");  // required loop_lengths: the document itself
+}
+
+TEST_CASE("sweep input: cell parameters inline or from a file relative to the sweep file",
+          "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_cellfile");
+  knit_test::write_text(dir / "cell.json",
+                        R"({"analysis": {"elements": 20}, "contact": {"mu": 0.2}})");
+  knit_test::write_text(dir / "s.json", R"({"loop_lengths": [4.5], "cell": "cell.json"})");
+  const auto a = load_sweep_input(dir / "s.json");
+  CHECK(a.cell_file == (dir / "cell.json").string());
+  const auto b = parse_sweep_input(
+      R"({"loop_lengths": [4.5], "cell": {"analysis": {"elements": 20}, "contact": {"mu": 0.2}}})",
+      "b.json");
+  CHECK(a.job_definition() == b.job_definition());  // the content counts, not where it is
+  knit_test::write_text(dir / "bad.json", R"({"contact": {"mu": -1}})");
+  knit_test::write_text(dir / "s2.json", R"({"loop_lengths": [4.5], "cell": "bad.json"})");
+  try {
+    load_sweep_input(dir / "s2.json");
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == (dir / "bad.json").string());
+    CHECK(e.pointer() == "/contact/mu");
+  }
 }
 
 TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {

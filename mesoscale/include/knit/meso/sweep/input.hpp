@@ -38,7 +38,10 @@ struct SweepInput {
   /// Indices of `paths` in the shared default set (-1 for explicitly listed paths).
   std::vector<int> path_ids;
   RunnerKind runner = RunnerKind::kCell;
-  std::string cell_json = "{}";  ///< the "cell" object (passed to the cell runner)
+  /// The cell parameters (schemas/cell.schema.json) as JSON text: the inline "cell" object or
+  /// the content of the file it names; "{}" = the cell's defaults.
+  std::string cell_json = "{}";
+  std::string cell_file;  ///< the cell parameter file, if "cell" named one (messages)
   RetryPolicy retry;
   /// Subtract the residual stress of the cell at F* = I from every step (choice, see
   /// schemas/sweep.schema.json "residual_stress"); applied when the database is assembled.
