@@ -3,7 +3,8 @@
 # load cases x 20 steps, fit included) on 2 cores, against the target of <= 5 minutes (the
 # paper's code: ~30 min per loop length on 6 cores). Prints the time per case and the total.
 #   scripts/bench/sweep.sh BUILD_DIR [SWEEP.json] [THREADS]
-# Set KNIT_BENCH_SWEEP_SKIP=1 to skip it (it takes minutes and all the cores).
+# Set KNIT_BENCH_SWEEP_SKIP=1 to skip it (it takes minutes and all the cores);
+# KNIT_BENCH_SWEEP_KEEP=FILE keeps the database it wrote.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${1:-$root/build}"
@@ -26,6 +27,9 @@ start=$(date +%s.%N)
 rc=$?
 end=$(date +%s.%N)
 cat "$out/log.txt"
+if [[ -n "${KNIT_BENCH_SWEEP_KEEP:-}" && -f "$out/db.h5" ]]; then
+  cp "$out/db.h5" "$KNIT_BENCH_SWEEP_KEEP" && echo "kept the database as $KNIT_BENCH_SWEEP_KEEP"
+fi
 wall=$(echo "$end - $start" | bc)
 echo "sweep benchmark: $(basename "$input"), $threads threads: wall $wall s (exit code $rc)"
 echo "target: full default database (5 x 13 x 20, fit included) <= 300 s on 2 cores" \
