@@ -128,7 +128,7 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
     const auto nl = static_cast<Eigen::Index>(in.loop_lengths.size());
     const auto np = static_cast<Eigen::Index>(in.paths.size());
     Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> status(nl, np),
-        attempts(nl, np), factor(nl, np), conv(nl, np);
+        attempts(nl, np), factor(nl, np), conv(nl, np), in_fit(nl, np);
     material::RowMatrixX seconds(nl, np), residual(nl * np, 3);
     std::vector<std::string> messages;
     for (Eigen::Index l = 0; l < nl; ++l)
@@ -138,6 +138,8 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
         attempts(l, p) = r.attempts;
         factor(l, p) = r.step_factor;
         conv(l, p) = r.converged_steps();
+        // the fit (fit_sweep_database) uses a case's converged steps, if it has any
+        in_fit(l, p) = in.fit && r.converged_steps() > 0 ? 1 : 0;
         seconds(l, p) = r.seconds;
         residual.row(l * np + p) = r.residual.transpose();
         messages.push_back(r.message);
@@ -147,6 +149,9 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
     g.write("case_attempts", attempts);
     g.write("case_step_factor", factor);
     g.write("case_converged_steps", conv);
+    g.write("case_in_fit", in_fit);
+    g.set_attribute("case_in_fit", "values",
+                    "1 = its converged steps entered the fit (non-converged steps never do)");
     g.write("case_seconds", seconds);
     g.write_strings("case_messages", messages);
     g.write("residual_S", residual);

@@ -1,10 +1,12 @@
 // Sweep orchestration (issue #7): input, jobs and retries, exact checkpoints, thread pool,
 // resume, failed cases -- with injected fake runners (no unit cell).
+#include <algorithm>
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 #include "knit/meso/sweep/checkpoint.hpp"
 #include "knit/meso/sweep/sweep.hpp"
@@ -253,6 +255,17 @@ TEST_CASE(
   CHECK(raw.status[0] == 0);
   CHECK(raw.status.back() == kStepNotReached);
   CHECK(raw.S.bottomRows(1).isZero());  // the failed steps carry no garbage
+  {
+    const auto f = knit::io::H5File::open_read(dir / "flaky.h5");
+    const auto st = f.read_int_matrix("/sweep/report/case_status");
+    REQUIRE(st.rows() == 2);
+    CHECK(st(1, 5) == static_cast<int>(JobStatus::kPartial));
+    CHECK(st.sum() == st(1, 5));
+    CHECK(f.read_int_matrix("/sweep/report/case_converged_steps")(1, 5) ==
+          std::count(raw.status.begin(), raw.status.end(), 0));
+    CHECK(f.read_int_matrix("/sweep/report/case_in_fit").minCoeff() == 1);
+    CHECK(f.read_strings("/sweep/report/case_messages").size() == 26);
+  }
   // Every other case is as in the clean run.
   for (std::size_t p = 0; p < 13; ++p)
     if (p != 5) CHECK((df.entries[1].raw[p].S - d1.entries[1].raw[p].S).isZero());
