@@ -10,8 +10,6 @@
 namespace knit::meso::sweep {
 
 namespace {
-[[maybe_unused]] constexpr int kTagResult = 7;
-
 bool launched_by_mpirun() {
   return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
 }
@@ -54,26 +52,29 @@ void MpiSession::broadcast([[maybe_unused]] std::string& s) const {
 #endif
 }
 
-void MpiSession::send_to_root([[maybe_unused]] const std::string& msg) const {
+void MpiSession::send([[maybe_unused]] int dest, [[maybe_unused]] Tag tag,
+                      [[maybe_unused]] const std::string& msg) const {
 #if defined(KNIT_HAVE_MPI)
-  if (!active_) throw std::logic_error("MpiSession::send_to_root without MPI");
-  MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kTagResult, MPI_COMM_WORLD);
+  if (!active_) throw std::logic_error("MpiSession::send without MPI");
+  MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, dest, tag, MPI_COMM_WORLD);
 #else
-  throw std::logic_error("MpiSession::send_to_root without MPI");
+  throw std::logic_error("MpiSession::send without MPI");
 #endif
 }
 
-bool MpiSession::try_receive([[maybe_unused]] std::string& msg) const {
+bool MpiSession::try_receive([[maybe_unused]] Tag tag, [[maybe_unused]] int& source,
+                             [[maybe_unused]] std::string& msg) const {
 #if defined(KNIT_HAVE_MPI)
   if (!active_ || size_ == 1) return false;
   int flag = 0;
   MPI_Status st;
-  MPI_Iprobe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &flag, &st);
+  MPI_Iprobe(MPI_ANY_SOURCE, tag, MPI_COMM_WORLD, &flag, &st);
   if (!flag) return false;
   int n = 0;
   MPI_Get_count(&st, MPI_CHAR, &n);
   msg.assign(static_cast<std::size_t>(n), '\0');
-  MPI_Recv(msg.data(), n, MPI_CHAR, st.MPI_SOURCE, kTagResult, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  source = st.MPI_SOURCE;
+  MPI_Recv(msg.data(), n, MPI_CHAR, st.MPI_SOURCE, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
   return true;
 #else
   return false;

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -29,19 +30,50 @@ bool SweepReport::fits_ok() const {
 
 namespace {
 
-/// A pool of `threads` workers pulling jobs in order; finished results are handed to the
-/// calling thread through a queue (drain()).
+/// Jobs waiting to run: filled up front (rank 0) or as rank 0 hands them out (other ranks).
+class JobQueue {
+ public:
+  void push(const Job& j) {
+    {
+      std::lock_guard<std::mutex> lk(m_);
+      q_.push_back(j);
+    }
+    cv_.notify_one();
+  }
+  /// No more jobs will come: waiting workers return.
+  void close() {
+    {
+      std::lock_guard<std::mutex> lk(m_);
+      closed_ = true;
+    }
+    cv_.notify_all();
+  }
+  /// The next job; waits while the queue is empty and open; nullopt when empty and closed.
+  std::optional<Job> pop() {
+    std::unique_lock<std::mutex> lk(m_);
+    cv_.wait(lk, [this] { return !q_.empty() || closed_; });
+    if (q_.empty()) return std::nullopt;
+    Job j = q_.front();
+    q_.pop_front();
+    return j;
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<Job> q_;
+  bool closed_ = false;
+};
+
+/// A pool of `threads` workers taking jobs from a queue; finished results are handed to the
+/// calling thread (drain()).
 class Pool {
  public:
-  Pool(std::vector<Job> jobs, int threads, const RetryPolicy& retry, const PathRunner& runner)
-      : jobs_(std::move(jobs)) {
-    const int n = std::max(1, std::min<int>(threads, static_cast<int>(jobs_.size())));
-    for (int t = 0; t < n && !jobs_.empty(); ++t)
-      workers_.emplace_back([this, &retry, &runner] {
-        for (;;) {
-          const std::size_t i = next_++;
-          if (i >= jobs_.size()) return;
-          JobResult r = run_job(jobs_[i], retry, runner);
+  Pool(JobQueue& queue, int threads, const RetryPolicy& retry, const PathRunner& runner) {
+    for (int t = 0; t < std::max(1, threads); ++t)
+      workers_.emplace_back([this, &queue, &retry, &runner] {
+        while (const std::optional<Job> j = queue.pop()) {
+          JobResult r = run_job(*j, retry, runner);
           {
             std::lock_guard<std::mutex> lk(m_);
             done_.push_back(std::move(r));
@@ -62,11 +94,8 @@ class Pool {
     done_.clear();
     return out;
   }
-  int workers() const { return static_cast<int>(workers_.size()); }
 
  private:
-  std::vector<Job> jobs_;
-  std::atomic<std::size_t> next_{0};
   std::mutex m_;
   std::condition_variable cv_;
   std::deque<JobResult> done_;
@@ -138,10 +167,6 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   for (const Job& j : jobs)
     if (!done[static_cast<std::size_t>(j.index)]) pending.push_back(j);
   rep.resumed = static_cast<int>(jobs.size() - pending.size());
-  std::vector<Job> mine;
-  for (std::size_t i = 0; i < pending.size(); ++i)
-    if (static_cast<int>(i % static_cast<std::size_t>(size)) == rank) mine.push_back(pending[i]);
-
   if (root && opt.log) {
     std::fprintf(opt.log, "knit-meso sweep: %zu loop lengths x %zu load cases = %zu cases -> %s\n",
                  in.loop_lengths.size(), in.paths.size(), jobs.size(), opt.output.c_str());
@@ -154,34 +179,77 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   }
 
   // ---- run -----------------------------------------------------------------------------------
+  // Rank 0 (and a serial run): every pending job is queued here; its own threads take them in
+  // order and the other ranks ask for them one by one. Other ranks: a local queue fed by rank 0.
+  const bool distributed = mpi && size > 1;
   {
     Progress progress(static_cast<int>(pending.size()), rep.resumed, root ? opt.progress : nullptr,
                       opt.tty);
-    Pool pool(mine, rep.threads, in.retry, runner);
-    const int local_total = static_cast<int>(mine.size());
-    int local_done = 0, received = 0;
-    const int expect = root ? static_cast<int>(pending.size()) : 0;
-    auto accept = [&](JobResult r) {  // rank 0
-      store->store(r);
-      progress.finished(describe(jobs[static_cast<std::size_t>(r.index)], r));
-      finished[r.index] = std::move(r);
-      ++received;
-    };
-    while (local_done < local_total || (root && received < expect)) {
-      for (JobResult& r : pool.drain(std::chrono::milliseconds(20))) {
-        ++local_done;
-        if (root)
-          accept(std::move(r));
-        else
-          mpi->send_to_root(serialize(r));
-      }
-      if (root && mpi) {
-        std::string m;
-        while (mpi->try_receive(m)) accept(deserialize(m));
-      }
-      progress.tick();
+    JobQueue queue;  // rank 0: all pending jobs; others: the jobs rank 0 handed out
+    if (root) {
+      for (const Job& j : pending) queue.push(j);
+      queue.close();
     }
-    rep.computed = root ? static_cast<int>(pending.size()) : local_total;
+    if (root) {
+      int received = 0, retired = 0;
+      const int expect = static_cast<int>(pending.size());
+      // The root queue is shared with the other ranks: a request takes the next job from it.
+      // (pop() on a closed queue never waits.)
+      auto hand_out = [&](int dest) {
+        const std::optional<Job> j = queue.pop();
+        mpi->send(dest, MpiSession::kJob, std::to_string(j ? j->index : -1));
+      };
+      auto accept = [&](JobResult r) {
+        store->store(r);
+        progress.finished(describe(jobs[static_cast<std::size_t>(r.index)], r));
+        finished[r.index] = std::move(r);
+        ++received;
+      };
+      Pool pool(queue, rep.threads, in.retry, runner);
+      while (received < expect || (distributed && retired < size - 1)) {
+        for (JobResult& r : pool.drain(std::chrono::milliseconds(distributed ? 5 : 20))) {
+          accept(std::move(r));
+        }
+        if (distributed) {
+          std::string m;
+          int src = 0;
+          while (mpi->try_receive(MpiSession::kRequest, src, m)) hand_out(src);
+          while (mpi->try_receive(MpiSession::kResult, src, m)) {
+            accept(deserialize(m));
+            hand_out(src);  // a result asks for the next job
+          }
+          while (mpi->try_receive(MpiSession::kDone, src, m)) ++retired;
+        }
+        progress.tick();
+      }
+      rep.computed = expect;
+    } else {
+      // Ask for one job per thread; each result asks for one more; -1 answers a request with
+      // nothing left. Done when no request is outstanding and every job given here finished.
+      for (int t = 0; t < rep.threads; ++t) mpi->send(0, MpiSession::kRequest, "");
+      int outstanding = rep.threads, given = 0, finished_here = 0;
+      Pool pool(queue, rep.threads, in.retry, runner);
+      while (outstanding > 0 || finished_here < given) {
+        std::string m;
+        int src = 0;
+        while (mpi->try_receive(MpiSession::kJob, src, m)) {
+          --outstanding;
+          const int idx = std::stoi(m);
+          if (idx >= 0) {
+            queue.push(jobs[static_cast<std::size_t>(idx)]);
+            ++given;
+          }
+        }
+        for (JobResult& r : pool.drain(std::chrono::milliseconds(5))) {
+          ++finished_here;
+          mpi->send(0, MpiSession::kResult, serialize(r));
+          ++outstanding;
+        }
+      }
+      queue.close();
+      rep.computed = finished_here;
+      mpi->send(0, MpiSession::kDone, "");
+    }
     progress.done();
   }
   rep.seconds_cases = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

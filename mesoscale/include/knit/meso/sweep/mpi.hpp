@@ -3,10 +3,12 @@
 // launcher (mpirun / srun set OMPI_COMM_WORLD_SIZE, PMI_SIZE or PMIX_RANK), so a plain
 // `knit-meso sweep` never touches MPI.
 //
-// Distribution (choice): static round robin -- pending job i runs on rank i mod size, each rank
-// runs its share on its own thread pool. Rank 0 receives every result, writes the checkpoints,
-// fits and writes the database. Jobs are deterministic and independent, so the database equals
-// the serial one. Only the main thread of a rank calls MPI (MPI_THREAD_FUNNELED).
+// Distribution: dynamic. Rank 0 holds the queue of pending jobs and runs some of them on its
+// own threads; every other rank asks for one job per thread (kRequest), gets a job index or -1
+// (kJob), returns each result (kResult, which also asks for the next job) and says kDone when
+// it got -1 for every request. Rank 0 writes the checkpoints, fits and writes the database.
+// Jobs are deterministic and independent, so the database equals the serial one whichever rank
+// ran what. Only the main thread of a rank calls MPI (MPI_THREAD_FUNNELED).
 #pragma once
 
 #include <string>
@@ -29,10 +31,12 @@ class MpiSession {
 
   /// Broadcasts s from rank 0 to all ranks.
   void broadcast(std::string& s) const;
-  /// Sends one message to rank 0 (blocking).
-  void send_to_root(const std::string& msg) const;
-  /// Rank 0: receives one pending message if there is one (non-blocking).
-  bool try_receive(std::string& msg) const;
+  enum Tag { kRequest = 7, kResult = 8, kJob = 9, kDone = 10 };
+  /// Sends one message (blocking send).
+  void send(int dest, Tag tag, const std::string& msg) const;
+  /// Receives one pending message with this tag from any rank, if there is one (non-blocking);
+  /// `source` gets the sender.
+  bool try_receive(Tag tag, int& source, std::string& msg) const;
   /// Terminates all ranks (after a failure on one of them, so that none waits forever).
   void abort(int code) const;
 
