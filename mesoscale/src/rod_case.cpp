@@ -1,16 +1,17 @@
 // JSON case reader and runner of `knit-meso rod` (see rod_case.hpp, schemas/rod.schema.json).
 #include "knit/meso/rod/rod_case.hpp"
 
-#include <unistd.h>
-
-#include <fstream>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
-#include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
+#include "knit/io/csv.hpp"
+#include "knit/io/json_input.hpp"
+#include "knit/io/provenance.hpp"
 #include "knit/meso/rod/builders.hpp"
 #include "knit/meso/rod/output.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -198,16 +199,10 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
 RodCase load_rod_case(const std::filesystem::path& path) {
   const std::string file = path.string();
   Reader R{file};
-  json j;
-  {
-    std::ifstream in(path);
-    if (!in) throw InputError(file, "", "cannot read file");
-    try {
-      j = json::parse(in);
-    } catch (const json::parse_error& e) {
-      throw InputError(file, "", std::string("invalid JSON: ") + e.what());
-    }
-  }
+  // Structure, types and ranges: the embedded schemas/rod.schema.json (errors with JSON pointer
+  // and line); the Reader below re-checks what it reads and adds the semantic checks (names,
+  // knot vectors, parameter ranges, load/support combinations).
+  const json j = io::load_and_validate(path, "rod");
   R.object(j, "", {"$schema", "description", "section", "rods", "steps", "output"}, {"rods"});
   RodCase c;
   c.file = file;
@@ -290,15 +285,13 @@ RodCase load_rod_case(const std::filesystem::path& path) {
 }
 
 PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, std::ostream* log) {
-  namespace fs = std::filesystem;
   const RodSystem& sys = c.system;
-  const std::string provenance = std::string("knitscale ") + knit::project_version() + " (git " +
-                                 knit::git_revision() + "), knit-meso rod " + c.file;
-  if (!outdir.parent_path().empty()) fs::create_directories(outdir.parent_path());
-  const fs::path partial = outdir.string() + ".partial-" + std::to_string(::getpid());
-  fs::remove_all(partial);
-  fs::create_directories(partial);
+  const std::string provenance = io::Provenance::current(c.file).to_json_string();
+  io::AtomicDirectory dir(outdir);  // OUT.partial-<pid>, renamed onto OUT by commit()
 
+  std::vector<std::string> header{"step", "lambda", "iterations"};
+  for (const auto& p : c.points)
+    for (const char* comp : {"_ux", "_uy", "_uz"}) header.push_back(p.name + comp);
   struct CsvRow {
     int step;
     double lambda;
@@ -316,7 +309,7 @@ PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, s
     if (c.write_vtp) {
       char name[64];
       std::snprintf(name, sizeof name, "centerline_%04d.vtp", step);
-      write_vtp(partial / name, sample_centerlines(sys, x, c.samples_per_element), provenance);
+      write_vtp(dir / name, sample_centerlines(sys, x, c.samples_per_element), provenance);
       pvd.emplace_back(lambda, name);
     }
   };
@@ -337,22 +330,17 @@ PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, s
       if (std::abs(st.lambda - rows[r].lambda) <= 1e-12 * std::max(1.0, std::abs(st.lambda))) ++r;
     }
   }
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "# " << provenance << "\n# displacements u = r - r0 [mm] of the named points; "
-      << rep.message << "\nstep,lambda,iterations";
-  for (const auto& p : c.points)
-    csv << ',' << p.name << "_ux," << p.name << "_uy," << p.name << "_uz";
-  csv << '\n';
+  io::CsvWriter csv(dir / "load_displacement.csv", header);
+  csv.add_comment("provenance: " + provenance);
+  csv.add_comment("displacements u = r - r0 [mm] of the named points; path: " + rep.message);
   for (size_t r = 0; r < rows.size(); ++r) {
-    csv << rows[r].step << ',' << rows[r].lambda << ',' << iters[r];
-    for (double v : rows[r].u) csv << ',' << v;
-    csv << '\n';
+    std::vector<io::CsvCell> cells{rows[r].step, rows[r].lambda, iters[r]};
+    for (double v : rows[r].u) cells.emplace_back(v);
+    csv.add_row(cells);
   }
-  write_text_atomically(partial / "load_displacement.csv", csv.str());
-  if (c.write_vtp) write_pvd(partial / "centerline.pvd", pvd);
-  fs::remove_all(outdir);
-  fs::rename(partial, outdir);
+  csv.commit();
+  if (c.write_vtp) write_pvd(dir / "centerline.pvd", pvd);
+  dir.commit();
   return rep;
 }
 

@@ -128,6 +128,8 @@ int RodSystem::add_rod(RodSpec spec) {
     c.gamma0 = rotation(q).transpose() * r_xi / c.jac;
     c.kappa0 = material_curvature(q, q_xi) / c.jac;
   }
+  R.r_start = R.geo.eval(xi.front());
+  R.r_end = R.geo.eval(xi.back());
   R.spec = std::move(spec);
   rods_.push_back(std::move(R));
   ndofs_ += kDofsPerPoint * n;
@@ -362,7 +364,8 @@ void RodSystem::assemble_impl(const Eigen::VectorXd& x, double lambda, Eigen::Ve
       if (bc.kind == EndCondition::Kind::kCustom) continue;
       const double sgn = at_end ? 1.0 : -1.0;
       if (bc.fix_position) {
-        F.segment<3>(row0 + kRowForce) = r - Rd.geo.eval(c.xi) - lambda * bc.displacement;
+        F.segment<3>(row0 + kRowForce) =
+            r - (at_start ? Rd.r_start : Rd.r_end) - lambda * bc.displacement;
       } else {
         F.segment<3>(row0 + kRowForce) = sgn * nn - lambda * bc.force;
       }

@@ -192,3 +192,15 @@ TEST_CASE("rod: load stepping cuts back a too large increment; failure is a stat
     CHECK((x - sys.initial_state()).norm() < 1e-12);
   }
 }
+
+TEST_CASE("section: yarn defaults reproduce the values of design/notes.md", "[unit]") {
+  const Section s;  // d = 0.38 mm, E = 800 MPa, nu = 0.3
+  CHECK(s.A() == Approx(0.1134).epsilon(1e-3));
+  CHECK(s.I() == Approx(1.024e-3).epsilon(1e-3));
+  CHECK(s.J() == Approx(2.047e-3).epsilon(1e-3));
+  CHECK(s.C_Gamma()(2) == Approx(90.7).epsilon(1e-3));
+  CHECK(s.C_K()(0) == Approx(0.819).epsilon(1e-3));
+  CHECK(s.shear_factor() == Approx(6 * 1.3 / 8.8));
+  CHECK(s.C_Gamma()(0) == Approx(800.0 / 2.6 * (6 * 1.3 / 8.8) * s.A()));
+  CHECK(s.C_K()(2) == Approx(800.0 / 2.6 * s.J()));
+}

@@ -1,8 +1,7 @@
 // Output of rod states: sampled centerlines as VTK PolyData (.vtp) polylines with a "radius"
 // point array (ParaView: Tube filter, "Vary Radius: By Absolute Scalar" on radius, draws the
 // yarn), the spatial internal force n, moment m and director d1; and a PVD collection.
-// The writer is private to the rod module until knit/io/vtk.hpp is available; files are
-// written atomically (temporary + rename).
+// Written through knit/io/vtk.hpp (base64 XML), atomically (temporary + rename).
 #pragma once
 
 #include <Eigen/Core>
@@ -29,7 +28,7 @@ struct Polyline {
 std::vector<Polyline> sample_centerlines(const RodSystem& sys, const Eigen::VectorXd& x,
                                          int samples_per_element = 8);
 
-/// Writes the polylines as one ASCII .vtp file (one VTK line cell per rod). `comment` (e.g.
+/// Writes the polylines as one .vtp file (one VTK line cell per rod). `comment` (e.g.
 /// provenance) goes into an XML comment at the top.
 void write_vtp(const std::filesystem::path& file, const std::vector<Polyline>& lines,
                const std::string& comment = "");

@@ -202,6 +202,7 @@ class RodSystem {
     spline::SplineCurve geo;  // reference centerline (carries the rational basis)
     int offset = 0;           // first DOF == first row
     double length = 0.0;
+    Eigen::Vector3d r_start, r_end;  // reference end positions (no allocation in assembly)
     std::vector<CollocationPoint> points;
     Eigen::MatrixXd Nc;  // collocation basis: rows 2j, 2j+1 = N, N_xi at point j ((2n) x (p+1))
   };
