@@ -1,0 +1,44 @@
+// Checkpoints of a sweep (issue #7, "resumable"): every finished job is persisted atomically as
+// one small file DB.h5.parts/job_NNNNN.txt (serialize() of job.hpp: hex floats, bit-exact), next
+// to a manifest that holds the fingerprint of the job definition. A sweep killed at any moment
+// leaves only complete job files (temporary file + rename), so `--resume` recomputes nothing
+// that finished and loses nothing. The database itself is assembled from the job files and
+// written atomically at the end; the parts directory is then removed.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "knit/meso/sweep/job.hpp"
+
+namespace knit::meso::sweep {
+
+class CheckpointStore {
+ public:
+  /// DB.h5 -> DB.h5.parts
+  static std::filesystem::path parts_dir(const std::filesystem::path& database);
+
+  /// Opens the parts directory of `database` for the given job definition.
+  ///  resume = false: the directory must not exist (throws knit::InputError telling to use
+  ///                  --resume or --force), unless force = true (then it is discarded);
+  ///  resume = true:  an existing directory must carry the same fingerprint (InputError
+  ///                  otherwise); a missing one starts fresh.
+  CheckpointStore(const std::filesystem::path& database, const std::string& job_definition,
+                  int job_count, bool resume, bool force);
+
+  const std::filesystem::path& dir() const { return dir_; }
+  /// Finished results found on opening, validated against the jobs (unreadable or foreign
+  /// files are ignored and recomputed).
+  std::map<int, JobResult> load_finished(const std::vector<Job>& jobs) const;
+  /// Persists one result atomically.
+  void store(const JobResult& r) const;
+  /// Removes the directory (after the database is in place).
+  void remove() const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+}  // namespace knit::meso::sweep

@@ -1,0 +1,66 @@
+// The sweep input (issue #7; paper Sect. 2.1.2 and 3.1.1): which loop lengths, which load paths
+// (eq. 7) with how many steps, how the unit cell is set up, how non-converged cases are retried
+// and how the response surfaces are fitted (eq. 17). Schema: schemas/sweep.schema.json;
+// the default sweep is cases/sweep/default.json (5 loop lengths x 13 paths x 20 steps).
+//
+//   auto in = knit::meso::sweep::load_sweep_input("cases/sweep/default.json");
+//
+// Bad input throws knit::InputError(file, json_pointer, message) (exit code 2).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "knit/material/load_paths.hpp"
+#include "knit/meso/fit/response_fit.hpp"
+
+namespace knit::meso::sweep {
+
+enum class RunnerKind {
+  kCell,      ///< the periodic unit cell (knit/meso/homog)
+  kSynthetic  ///< the synthetic law of `knit-meso synth` (tests/demos of the orchestration)
+};
+
+/// Retry policy for a load case that does not converge: rerun with step_factor^a times more
+/// steps (a = 1..max_retries); the recorded steps (every step_factor^a-th) are unchanged,
+/// because F* is linear in the step fraction along every path.
+struct RetryPolicy {
+  int max_retries = 2;
+  int step_factor = 2;
+};
+
+struct SweepInput {
+  std::string file;                  ///< where it was read from (messages)
+  std::string json;                  ///< the whole input, as given (stored in the database)
+  std::vector<double> loop_lengths;  ///< mm, strictly increasing
+  std::vector<material::LoadPath> paths;
+  /// Indices of `paths` in the shared default set (-1 for explicitly listed paths).
+  std::vector<int> path_ids;
+  RunnerKind runner = RunnerKind::kCell;
+  /// The cell parameters (schemas/cell.schema.json) as JSON text: the inline "cell" object or
+  /// the content of the file it names; "{}" = the cell's defaults.
+  std::string cell_json = "{}";
+  std::string cell_file;  ///< the cell parameter file, if "cell" named one (messages)
+  RetryPolicy retry;
+  /// Subtract the residual stress of the cell at F* = I from every step (choice, see
+  /// schemas/sweep.schema.json "residual_stress"); applied when the database is assembled.
+  bool subtract_residual = true;
+  bool fit = true;
+  fit::FitOptions fit_options;
+
+  /// Canonical JSON of everything that determines the job results (loop lengths, paths,
+  /// runner, cell, retry) -- not the fit options: a resumed sweep may refit differently.
+  std::string job_definition() const;
+};
+
+/// Reads, validates against schemas/sweep.schema.json and checks what the schema cannot
+/// (increasing loop lengths, fit options) -- errors name the file and the JSON pointer.
+SweepInput load_sweep_input(const std::filesystem::path& file);
+/// The same from JSON text (`file` names it in errors).
+SweepInput parse_sweep_input(const std::string& text, const std::string& file);
+
+/// 64-bit FNV-1a hash as 16 hex digits (fingerprint of a job definition).
+std::string fingerprint(const std::string& text);
+
+}  // namespace knit::meso::sweep

@@ -1,0 +1,82 @@
+// The mesoscale database sweep (issue #7; paper Sect. 2.1.2 and 3.1.1): loop lengths x load
+// cases x steps on the unit cell, then the response-surface fit (eq. 17), written as the
+// material database (knit/material/database.hpp).
+//
+//   run()      = load the checkpoints (resume) -> run the pending jobs on a thread pool (and MPI
+//                ranks) -> persist each result as it finishes -> assemble -> fit -> write
+//                atomically -> remove the checkpoints.
+// A case that does not converge (after the retries of job.hpp) stays in the database with the
+// status of every step and of the case (/sweep/report), is left out of the fit, and is listed
+// at the end; SweepReport::ok() is then false (exit code 1).
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "knit/material/database.hpp"
+#include "knit/meso/fit/response_fit.hpp"
+#include "knit/meso/sweep/input.hpp"
+#include "knit/meso/sweep/job.hpp"
+#include "knit/meso/sweep/mpi.hpp"
+
+namespace knit::meso::sweep {
+
+struct SweepOptions {
+  std::filesystem::path output = "database.h5";
+  bool resume = false;           ///< continue from DB.h5.parts
+  bool force = false;            ///< discard existing checkpoints
+  bool keep_parts = false;       ///< keep DB.h5.parts after writing the database
+  int threads = 0;               ///< workers per rank; 0 = all cores (divided among local ranks)
+  std::FILE* progress = stderr;  ///< progress bar / lines (nullptr: silent)
+  int tty = -1;                  ///< -1 detect, 0 plain lines, 1 bar
+  std::FILE* log = stdout;       ///< summary, time per case (nullptr: silent)
+};
+
+struct SweepReport {
+  std::vector<JobResult> results;  ///< every job, in job order (rank 0 only)
+  int computed = 0;  ///< jobs run in this session (rank 0: by all ranks; others: by this rank)
+  int resumed = 0;   ///< jobs taken from the checkpoints
+  std::vector<fit::FitSummary> fits;  ///< one per loop length (empty if no fit)
+  double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
+  int threads = 1, ranks = 1;
+  bool wrote_database = false;  ///< false on ranks other than 0
+  int failed_cases() const;
+  bool fits_ok() const;
+  bool ok() const { return failed_cases() == 0 && fits_ok(); }
+};
+
+/// Runs the sweep; rank 0 writes the database. `mpi` may be nullptr (serial).
+SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
+                      const MpiSession* mpi = nullptr);
+
+/// The database of the finished jobs (raw data of every case, failed ones included; cell
+/// parameters; yarn; the input), not fitted yet.
+material::Database assemble_database(const SweepInput& in, const std::vector<JobResult>& results);
+
+/// Fits every loop length from its usable cases (those with at least one converged step; the
+/// fitter skips non-converged steps); stores the surfaces in db. Fits run in parallel.
+std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
+                                                const fit::FitOptions& options, int threads);
+
+/// Writes db atomically to `output`, with the per-case report (/sweep/report: status,
+/// attempts, step factor, converged steps, seconds, messages, residual stresses) -- via a
+/// temporary file next to `output`, fsynced and renamed onto it when complete.
+void write_sweep_database(const std::filesystem::path& output, const material::Database& db,
+                          const SweepInput& in, const std::vector<JobResult>& results,
+                          const SweepReport& report);
+
+/// The synthetic runner (knit-meso synth's law on the sweep's paths): deterministic, instant.
+/// Test hooks (environment): KNIT_SWEEP_TEST_DELAY_MS sleeps per case; KNIT_SWEEP_TEST_COUNT_FILE
+/// gets one line appended per case computed.
+PathRunner synthetic_runner();
+
+/// The unit-cell runner (knit/meso/homog), configured by the input's "cell" object.
+/// Throws knit::InputError for cell parameters the cell rejects.
+PathRunner cell_runner(const SweepInput& in);
+
+/// The runner selected by the input.
+PathRunner make_runner(const SweepInput& in);
+
+}  // namespace knit::meso::sweep

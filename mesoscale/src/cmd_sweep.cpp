@@ -1,0 +1,135 @@
+// knit-meso sweep SWEEP.json [--output DB.h5] [--resume | --force] [--threads N] [--keep-parts]
+//                [--no-progress] [--plain]
+//   The mesoscale database sweep (issue #7; paper Sect. 2.1.2, 3.1.1): every loop length x
+//   load case of SWEEP.json on the unit cell (one case per worker thread; across machines with
+//   `mpirun -np N knit-meso sweep ...`), then the response-surface fit, written as the material
+//   database. Killed at any moment, it continues with --resume (DB.h5.parts holds the finished
+//   cases). Prints the time per case and the total; cases that did not converge are listed at
+//   the end (exit code 1). Bad input: exit code 2.
+// Examples:
+//   knit-meso sweep cases/sweep/default.json --output db.h5
+//   knit-meso sweep cases/sweep/reduced.json --output reduced.h5 --threads 2
+//   mpirun -np 4 knit-meso sweep cases/sweep/default.json --output db.h5
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "knit/core/cli.hpp"
+#include "knit/core/errors.hpp"
+#include "knit/meso/sweep/sweep.hpp"
+
+namespace {
+
+struct Cli {
+  std::string input, output = "database.h5";
+  bool resume = false, force = false, keep_parts = false, no_progress = false, plain = false;
+  int threads = 0;
+};
+
+void print_summary(const knit::meso::sweep::SweepInput& in,
+                   const knit::meso::sweep::SweepReport& rep, const std::string& output) {
+  using namespace knit::meso::sweep;
+  const auto jobs = make_jobs(in);
+  std::printf("\ntime per case (s), rows: loop length, columns: load case\n   l [mm]");
+  for (std::size_t p = 0; p < in.paths.size(); ++p) std::printf(" %6zu", p);
+  std::printf("\n");
+  double sum = 0;
+  for (std::size_t l = 0; l < in.loop_lengths.size(); ++l) {
+    std::printf("   %6.2f", in.loop_lengths[l]);
+    for (std::size_t p = 0; p < in.paths.size(); ++p) {
+      const auto& r = rep.results[l * in.paths.size() + p];
+      std::printf(" %6.2f", r.seconds);
+      sum += r.seconds;
+    }
+    std::printf("\n");
+  }
+  const double n = static_cast<double>(rep.results.size());
+  std::printf(
+      "cases: %zu (%d computed now, %d from checkpoints); mean %.3f s/case (CPU-busy sum "
+      "%.1f s)\n",
+      rep.results.size(), rep.computed, rep.resumed, n > 0 ? sum / n : 0.0, sum);
+  for (std::size_t k = 0; k < rep.fits.size(); ++k) {
+    const auto& f = rep.fits[k];
+    if (f.ok())
+      std::printf(
+          "fit l=%.2f mm: ok, max |dS| %.4g MPa (%.2f%% of the range), %d points used, "
+          "%d skipped\n",
+          in.loop_lengths[k], f.diagnostics.max.tail<3>().maxCoeff(),
+          100 * f.diagnostics.max_relative, f.diagnostics.points_used,
+          f.diagnostics.points_skipped);
+    else
+      std::printf("fit l=%.2f mm: NOT FITTED: %s\n", in.loop_lengths[k], f.reason.c_str());
+  }
+  std::printf("time: cases %.2f s, fit %.2f s, total %.2f s (%d rank%s x %d thread%s)\n",
+              rep.seconds_cases, rep.seconds_fit, rep.seconds_total, rep.ranks,
+              rep.ranks == 1 ? "" : "s", rep.threads, rep.threads == 1 ? "" : "s");
+  const int failed = rep.failed_cases();
+  if (failed > 0) {
+    std::printf(
+        "%d case%s did not converge (kept in the database with their status, left out "
+        "of the fit where no step converged):\n",
+        failed, failed == 1 ? "" : "s");
+    for (std::size_t i = 0; i < rep.results.size(); ++i) {
+      const auto& r = rep.results[i];
+      if (r.status == JobStatus::kConverged) continue;
+      std::printf("  l=%.2f mm case %d: %s, %d/%d steps after %d attempts: %s\n",
+                  jobs[i].loop_length, jobs[i].path, to_string(r.status).c_str(),
+                  r.converged_steps(), jobs[i].load_path.steps, r.attempts, r.message.c_str());
+    }
+  }
+  std::printf("wrote %s\n", output.c_str());
+  std::fflush(stdout);
+}
+
+int run(const Cli& c) {
+  using namespace knit::meso::sweep;
+  MpiSession mpi;
+  try {
+    const SweepInput in = load_sweep_input(c.input);
+    if (c.resume && c.force)
+      throw knit::InputError("", "--force", "cannot be combined with --resume");
+    if (c.threads < 0) throw knit::InputError("", "--threads", "must be >= 0");
+    SweepOptions o;
+    o.output = c.output;
+    o.resume = c.resume;
+    o.force = c.force;
+    o.keep_parts = c.keep_parts;
+    o.threads = c.threads;
+    o.progress = c.no_progress ? nullptr : stderr;
+    o.tty = c.plain ? 0 : -1;
+    o.log = mpi.rank() == 0 ? stdout : nullptr;
+    const PathRunner runner = make_runner(in);
+    const SweepReport rep = run_sweep(in, o, runner, &mpi);
+    if (mpi.rank() != 0) return knit::kExitOk;
+    print_summary(in, rep, c.output);
+    return rep.ok() ? knit::kExitOk : knit::kExitFailure;
+  } catch (const knit::InputError&) {
+    throw;  // every rank reads the same input and fails the same way
+  } catch (const std::exception& e) {
+    if (mpi.active() && mpi.size() > 1) {
+      std::fprintf(stderr, "knit-meso sweep (rank %d): %s\n", mpi.rank(), e.what());
+      mpi.abort(knit::kExitFailure);
+    }
+    throw;
+  }
+}
+
+knit::cli::SubcommandRegistrar reg(
+    "sweep",
+    "Mesoscale database sweep: loop lengths x load cases on the unit cell, fit, database "
+    "(resumable; MPI under mpirun)",
+    [](CLI::App& sub) {
+      auto c = std::make_shared<Cli>();
+      sub.add_option("input", c->input, "sweep input (JSON, schemas/sweep.schema.json)")
+          ->required();
+      sub.add_option("--output,-o", c->output, "material database to write (default database.h5)");
+      sub.add_flag("--resume", c->resume, "continue an interrupted sweep from OUTPUT.parts");
+      sub.add_flag("--force", c->force, "discard checkpoints of an unfinished earlier sweep");
+      sub.add_option("--threads", c->threads, "worker threads per rank (default: all cores)");
+      sub.add_flag("--keep-parts", c->keep_parts, "keep OUTPUT.parts after writing the database");
+      sub.add_flag("--no-progress", c->no_progress, "no progress output");
+      sub.add_flag("--plain", c->plain, "plain progress lines even on a terminal");
+      return [c]() { return run(*c); };
+    });
+
+}  // namespace

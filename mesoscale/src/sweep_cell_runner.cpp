@@ -1,0 +1,102 @@
+// The unit-cell runner of the sweep: one load path (paper eq. 7, the shared definition of
+// knit/material/load_paths.hpp) on the periodic cell of a loop length (knit/meso/homog),
+// recording F*, P*, E, S of every step (eqs. 8-9). Each call builds its own cell, equilibrates
+// it at F* = I and then follows the path step by step from the last converged state; it is
+// deterministic and shares nothing with concurrent calls.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/sweep/sweep.hpp"
+
+#if __has_include("knit/meso/homog/cell_config.hpp")
+#include "knit/meso/homog/cell_config.hpp"
+#include "knit/meso/homog/periodic_cell.hpp"
+#define KNIT_SWEEP_HAVE_CELL 1
+#endif
+
+namespace knit::meso::sweep {
+
+#if defined(KNIT_SWEEP_HAVE_CELL)
+
+namespace {
+
+/// The cell parameters through the cell's own reader (knit/meso/homog/cell_config.hpp), which
+/// reads files: the inline object is handed to it as a private temporary file.
+homog::CellOptions cell_options(const SweepInput& in) {
+  if (!in.cell_file.empty()) return homog::read_cell_options(in.cell_file);
+  if (in.cell_json == "{}") return {};
+  namespace fs = std::filesystem;
+  const fs::path tmp =
+      fs::temp_directory_path() / ("knit-sweep-cell-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(tmp) << in.cell_json;
+  try {
+    homog::CellOptions co = homog::read_cell_options(tmp.string());
+    fs::remove(tmp);
+    return co;
+  } catch (const InputError& e) {
+    fs::remove(tmp);
+    throw InputError(in.file, "/cell" + e.pointer(), e.message());
+  }
+}
+
+}  // namespace
+
+PathRunner cell_runner(const SweepInput& in) {
+  const homog::CellOptions co = cell_options(in);
+  return [co](double l, const material::LoadPath& path) {
+    const int n = path.steps;
+    PathOutcome out;
+    material::RawPath& r = out.raw;
+    r.path = path;
+    r.F = material::RowMatrixX::Zero(n, 4);
+    r.P = material::RowMatrixX::Zero(n, 4);
+    r.E = material::RowMatrixX::Zero(n, 3);
+    r.S = material::RowMatrixX::Zero(n, 3);
+    r.status.assign(static_cast<std::size_t>(n), kStepNotReached);
+    homog::PeriodicCell cell(l, co);
+    out.cell.wale_width = cell.dimensions().w;
+    out.cell.course_height = cell.dimensions().c;
+    out.cell.thickness = cell.thickness();
+    const homog::StepResult eq = cell.equilibrate();
+    if (!eq.converged) {
+      r.status[0] = kStepFailed;
+      out.message = "initial equilibrium did not converge: " + eq.message;
+      return out;
+    }
+    out.residual << eq.S(0, 0), eq.S(1, 1), 0.5 * (eq.S(0, 1) + eq.S(1, 0));
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Matrix2d F =
+          material::deformation_gradient(path, static_cast<double>(k + 1) / n);
+      const homog::StepResult s = cell.solve(F);
+      out.iterations += s.iterations;
+      if (!s.converged) {
+        r.status[static_cast<std::size_t>(k)] = kStepFailed;
+        out.message = "step " + std::to_string(k + 1) + " did not converge: " + s.message;
+        return out;
+      }
+      const Eigen::Matrix2d E = material::green_lagrange(s.F);
+      const Eigen::Matrix2d S = material::second_piola_kirchhoff(s.F, s.P);
+      r.F.row(k) << s.F(0, 0), s.F(0, 1), s.F(1, 0), s.F(1, 1);
+      r.P.row(k) << s.P(0, 0), s.P(0, 1), s.P(1, 0), s.P(1, 1);
+      r.E.row(k) << E(0, 0), E(1, 1), E(0, 1);
+      r.S.row(k) << S(0, 0), S(1, 1), S(0, 1);
+      r.status[static_cast<std::size_t>(k)] = kStepConverged;
+    }
+    out.message = "converged, " + std::to_string(out.iterations) + " Newton iterations";
+    return out;
+  };
+}
+
+#else
+
+PathRunner cell_runner(const SweepInput& in) {
+  throw InputError(in.file, "/runner",
+                   "the unit-cell runner is not part of this build yet (use \"synthetic\")");
+}
+
+#endif
+
+}  // namespace knit::meso::sweep

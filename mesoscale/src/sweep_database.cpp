@@ -1,0 +1,209 @@
+// Assembly of the sweep's results into the material database, the fit, the atomic write, and
+// the synthetic runner (see sweep.hpp).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "knit/io/atomic.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/meso/fit/synthetic.hpp"
+#include "knit/meso/sweep/sweep.hpp"
+
+namespace knit::meso::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+/// design/notes.md: w linear in l between (4.5, 1.26) and (6.5, 1.41); c = l^2/(18.27 w); t = 2d.
+material::CellParameters notes_cell(double l, double d) {
+  material::CellParameters c;
+  c.wale_width = 1.26 + (l - 4.5) * (1.41 - 1.26) / 2.0;
+  c.course_height = l * l / (18.27 * c.wale_width);
+  c.thickness = 2 * d;
+  return c;
+}
+
+/// cell["group"]["key"] of the cell parameters (schemas/cell.schema.json), or the default.
+double cell_value(const nlohmann::json& cell, const char* group, const char* key, double dflt) {
+  if (cell.is_object() && cell.contains(group) && cell[group].contains(key))
+    return cell[group][key].get<double>();
+  return dflt;
+}
+}  // namespace
+
+material::Database assemble_database(const SweepInput& in, const std::vector<JobResult>& results) {
+  material::Database db;
+  db.provenance = material::current_provenance();
+  db.generator = in.runner == RunnerKind::kCell ? "sweep" : "sweep (synthetic runner)";
+  db.sweep_input = in.json;
+  const nlohmann::json cell = nlohmann::json::parse(in.cell_json);
+  // The cell's defaults (docs/unit-cell.md) where the input says nothing.
+  const double d = cell_value(cell, "yarn", "d", 0.38);
+  db.yarn = {{"diameter", d},
+             {"youngs_modulus", cell_value(cell, "yarn", "E", 800.0)},
+             {"poisson_ratio", cell_value(cell, "yarn", "nu", 0.3)},
+             {"friction", cell_value(cell, "contact", "mu", 0.15)}};
+  const std::size_t np = in.paths.size();
+  for (std::size_t l = 0; l < in.loop_lengths.size(); ++l) {
+    material::LoopLengthEntry e;
+    e.loop_length = in.loop_lengths[l];
+    e.cell = notes_cell(e.loop_length, d);
+    bool have_cell = false;
+    for (std::size_t p = 0; p < np; ++p) {
+      const JobResult& r = results.at(l * np + p);
+      material::RawPath raw = r.raw;
+      if (in.subtract_residual && !r.residual.isZero()) {
+        Eigen::Matrix2d S0;
+        S0 << r.residual(0), r.residual(2), r.residual(2), r.residual(1);
+        for (Eigen::Index k = 0; k < raw.F.rows(); ++k) {
+          if (raw.status[static_cast<std::size_t>(k)] != kStepConverged) continue;
+          Eigen::Matrix2d F, S;
+          F << raw.F(k, 0), raw.F(k, 1), raw.F(k, 2), raw.F(k, 3);
+          S << raw.S(k, 0), raw.S(k, 2), raw.S(k, 2), raw.S(k, 1);
+          S -= S0;
+          const Eigen::Matrix2d P = material::first_piola_kirchhoff(F, S);
+          raw.S.row(k) << S(0, 0), S(1, 1), S(0, 1);
+          raw.P.row(k) << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
+        }
+      }
+      e.raw.push_back(std::move(raw));
+      if (!have_cell && r.cell.wale_width > 0) {
+        e.cell = r.cell;
+        have_cell = true;
+      }
+    }
+    db.entries.push_back(std::move(e));
+  }
+  return db;
+}
+
+std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
+                                                const fit::FitOptions& options, int threads) {
+  const std::size_t n = db.entries.size();
+  std::vector<fit::FitSummary> out(n);
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (;;) {
+      const std::size_t k = next++;
+      if (k >= n) return;
+      std::vector<material::RawPath> usable;
+      for (const auto& r : db.entries[k].raw)
+        if (std::count(r.status.begin(), r.status.end(), 0) > 0) usable.push_back(r);
+      out[k] = fit::fit_loop_length(usable, options);
+    }
+  };
+  std::vector<std::thread> pool;
+  const int nt = std::max(1, std::min<int>(threads, static_cast<int>(n)));
+  for (int t = 1; t < nt; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  for (std::size_t k = 0; k < n; ++k) {
+    if (out[k].ok()) {
+      db.entries[k].surface = out[k].surface;
+      db.entries[k].diagnostics = out[k].diagnostics;
+    } else {
+      db.entries[k].surface.reset();
+    }
+  }
+  return out;
+}
+
+void write_sweep_database(const fs::path& output, const material::Database& db,
+                          const SweepInput& in, const std::vector<JobResult>& results,
+                          const SweepReport& report) {
+  if (output.has_parent_path()) fs::create_directories(output.parent_path());
+  // The database goes to a temporary next to `output` (write_database is itself atomic onto
+  // it), gets the report, and is fsynced and renamed onto `output` by commit().
+  io::AtomicFile out(output);
+  const fs::path tmp = out.temp_path();
+  material::write_database(tmp, db);
+  {
+    io::H5File f = io::H5File::open_rw(tmp);
+    io::H5Group g = f.create_group("/sweep/report");
+    const auto nl = static_cast<Eigen::Index>(in.loop_lengths.size());
+    const auto np = static_cast<Eigen::Index>(in.paths.size());
+    Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> status(nl, np),
+        attempts(nl, np), factor(nl, np), conv(nl, np), in_fit(nl, np);
+    material::RowMatrixX seconds(nl, np), residual(nl * np, 3);
+    std::vector<std::string> messages;
+    for (Eigen::Index l = 0; l < nl; ++l)
+      for (Eigen::Index p = 0; p < np; ++p) {
+        const JobResult& r = results.at(static_cast<std::size_t>(l * np + p));
+        status(l, p) = static_cast<int>(r.status);
+        attempts(l, p) = r.attempts;
+        factor(l, p) = r.step_factor;
+        conv(l, p) = r.converged_steps();
+        // the fit (fit_sweep_database) uses a case's converged steps, if it has any
+        in_fit(l, p) = in.fit && r.converged_steps() > 0 ? 1 : 0;
+        seconds(l, p) = r.seconds;
+        residual.row(l * np + p) = r.residual.transpose();
+        messages.push_back(r.message);
+      }
+    g.write("case_status", status);
+    g.set_attribute("case_status", "values", "0 = converged, 1 = partial, 2 = failed, 3 = error");
+    g.write("case_attempts", attempts);
+    g.write("case_step_factor", factor);
+    g.write("case_converged_steps", conv);
+    g.write("case_in_fit", in_fit);
+    g.set_attribute("case_in_fit", "values",
+                    "1 = its converged steps entered the fit (non-converged steps never do)");
+    g.write("case_seconds", seconds);
+    g.write_strings("case_messages", messages);
+    g.write("residual_S", residual);
+    g.set_attribute("residual_S", "columns",
+                    "S11, S22, S12 (MPa) of the equilibrated cell at F* = I; rows: loop length "
+                    "index * cases + case index");
+    g.set_attribute(
+        "residual_S", "treatment",
+        in.subtract_residual ? "subtracted from raw S (and P = F S)" : "kept in raw S and P");
+    g.set_attribute(".", "rows_columns", "rows: loop lengths, columns: load cases");
+    g.set_attribute(".", "failed_cases", report.failed_cases());
+    g.set_attribute(".", "seconds_cases", report.seconds_cases);
+    g.set_attribute(".", "seconds_fit", report.seconds_fit);
+    g.set_attribute(".", "ranks", report.ranks);
+    g.set_attribute(".", "threads", report.threads);
+    g.set_attribute(".", "step_status_values",
+                    "raw/path_NN/status: 0 = converged, 1 = did not converge, 2 = not reached");
+    std::vector<int> ids = in.path_ids;
+    g.write("default_path_index", ids);
+    std::vector<std::string> fit_status;
+    for (const auto& fs_ : report.fits)
+      fit_status.push_back(fs_.ok() ? "ok" : "not fitted: " + fs_.reason);
+    if (!fit_status.empty()) g.write_strings("fit_status", fit_status);
+    f.close();
+  }
+  out.commit();
+}
+
+// ---- runners ----------------------------------------------------------------------------------
+
+PathRunner synthetic_runner() {
+  return [](double l, const material::LoadPath& path) {
+    if (const char* d = std::getenv("KNIT_SWEEP_TEST_DELAY_MS"))
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::atoi(d)));
+    fit::SyntheticOptions so;
+    so.paths = {path};
+    PathOutcome out;
+    out.raw = fit::synthetic_paths(so, l).front();
+    out.cell = notes_cell(l, 0.38);
+    out.message = "synthetic law";
+    if (const char* f = std::getenv("KNIT_SWEEP_TEST_COUNT_FILE")) {
+      static std::mutex m;
+      std::lock_guard<std::mutex> lk(m);
+      std::ofstream(f, std::ios::app)
+          << l << ' ' << path.target(0) << ' ' << path.target(1) << '\n';
+    }
+    return out;
+  };
+}
+
+PathRunner make_runner(const SweepInput& in) {
+  return in.runner == RunnerKind::kSynthetic ? synthetic_runner() : cell_runner(in);
+}
+
+}  // namespace knit::meso::sweep

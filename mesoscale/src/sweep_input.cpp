@@ -1,0 +1,147 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
+#include "knit/meso/sweep/input.hpp"
+
+namespace knit::meso::sweep {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "", "cannot read file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+std::string fingerprint(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string SweepInput::job_definition() const {
+  nlohmann::json j;
+  j["loop_lengths"] = loop_lengths;
+  nlohmann::json p = nlohmann::json::array();
+  for (const auto& q : paths)
+    p.push_back({{"kind", material::to_string(q.kind)},
+                 {"target", {q.target(0), q.target(1)}},
+                 {"steps", q.steps}});
+  j["paths"] = p;
+  j["runner"] = runner == RunnerKind::kCell ? "cell" : "synthetic";
+  j["cell"] = nlohmann::json::parse(cell_json);
+  j["retry"] = {{"max_retries", retry.max_retries}, {"step_factor", retry.step_factor}};
+  return j.dump();  // keys sorted (std::map): canonical
+}
+
+SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
+  nlohmann::json j = io::parse_json(text, file);
+  io::JsonSchema::embedded("sweep").validate(j, file);
+
+  SweepInput in;
+  in.file = file;
+  in.json = text;
+  in.loop_lengths = j.at("loop_lengths").get<std::vector<double>>();
+  for (std::size_t k = 1; k < in.loop_lengths.size(); ++k)
+    if (!(in.loop_lengths[k] > in.loop_lengths[k - 1]))
+      throw InputError(file, io::json_pointer_append("/loop_lengths", k),
+                       "loop lengths must be strictly increasing, got " +
+                           std::to_string(in.loop_lengths[k]) + " after " +
+                           std::to_string(in.loop_lengths[k - 1]));
+  const int steps = j.value("steps", 20);
+
+  const nlohmann::json lp = j.value("load_paths", nlohmann::json{{"preset", "default"}});
+  if (lp.is_object()) {
+    const double e_max = lp.value("e_max", 0.35), e_min = lp.value("e_min", -0.15);
+    const double g_max = lp.value("gamma_max_deg", 40.0) * kPi / 180.0;
+    if (!(e_min < e_max)) throw InputError(file, "/load_paths/e_min", "must be smaller than e_max");
+    const auto all = material::default_load_paths(steps, e_max, e_min, g_max);
+    if (lp.contains("select")) {
+      for (int id : lp.at("select").get<std::vector<int>>()) {
+        in.paths.push_back(all.at(static_cast<std::size_t>(id)));
+        in.path_ids.push_back(id);
+      }
+    } else {
+      in.paths = all;
+      for (std::size_t i = 0; i < all.size(); ++i) in.path_ids.push_back(static_cast<int>(i));
+    }
+  } else {
+    for (const auto& q : lp) {
+      material::LoadPath p;
+      p.steps = q.value("steps", steps);
+      if (q.at("kind") == "biaxial") {
+        p.kind = material::PathKind::kBiaxial;
+        p.target = {q.at("E11").get<double>(), q.at("E22").get<double>()};
+      } else {
+        p.kind = material::PathKind::kShear;
+        p.target = {q.at("gamma_deg").get<double>() * kPi / 180.0, 0.0};
+      }
+      in.paths.push_back(p);
+      in.path_ids.push_back(-1);
+    }
+  }
+
+  if (j.contains("runner"))
+    in.runner = j.at("runner") == "synthetic" ? RunnerKind::kSynthetic : RunnerKind::kCell;
+  if (j.contains("cell")) {
+    nlohmann::json c = j.at("cell");
+    std::string source = file, prefix = "/cell";
+    if (c.is_string()) {
+      const auto path = io::resolve_input_path(file, c.get<std::string>());
+      c = io::read_json_file(path);
+      in.cell_file = source = path.string();
+      prefix.clear();
+    }
+    // The cell's own schema, when this build has it (the cell module embeds it).
+    const auto names = io::embedded_schema_names();
+    if (std::find(names.begin(), names.end(), "cell") != names.end()) {
+      const auto errs = io::JsonSchema::embedded("cell").errors(c);
+      if (!errs.empty()) throw InputError(source, prefix + errs[0].pointer, errs[0].message);
+    } else if (!c.is_object()) {
+      throw InputError(source, prefix, "must be an object");
+    }
+    in.cell_json = c.dump();
+  }
+  in.subtract_residual = j.value("residual_stress", std::string("subtract")) == "subtract";
+  if (j.contains("retry")) {
+    in.retry.max_retries = j.at("retry").value("max_retries", in.retry.max_retries);
+    in.retry.step_factor = j.at("retry").value("step_factor", in.retry.step_factor);
+  }
+  if (j.contains("fit")) {
+    const auto& f = j.at("fit");
+    if (f.is_boolean()) {
+      in.fit = f.get<bool>();
+    } else {
+      try {
+        in.fit_options = fit::FitOptions::from_json(f.dump(), file);
+      } catch (const InputError& e) {
+        throw InputError(file, "/fit" + e.pointer(), e.message());
+      }
+    }
+  }
+  return in;
+}
+
+SweepInput load_sweep_input(const std::filesystem::path& file) {
+  return parse_sweep_input(read_text(file), file.string());
+}
+
+}  // namespace knit::meso::sweep

@@ -1,0 +1,271 @@
+// The sweep driver: checkpoints, thread pool, MPI ranks, progress, assembly (see sweep.hpp).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/sweep/checkpoint.hpp"
+#include "knit/meso/sweep/progress.hpp"
+#include "knit/meso/sweep/sweep.hpp"
+
+namespace knit::meso::sweep {
+
+namespace fs = std::filesystem;
+
+int SweepReport::failed_cases() const {
+  int n = 0;
+  for (const auto& r : results) n += r.status == JobStatus::kConverged ? 0 : 1;
+  return n;
+}
+
+bool SweepReport::fits_ok() const {
+  return std::all_of(fits.begin(), fits.end(), [](const auto& f) { return f.ok(); });
+}
+
+namespace {
+
+/// Jobs waiting to run: filled up front (rank 0) or as rank 0 hands them out (other ranks).
+class JobQueue {
+ public:
+  void push(const Job& j) {
+    {
+      std::lock_guard<std::mutex> lk(m_);
+      q_.push_back(j);
+    }
+    cv_.notify_one();
+  }
+  /// No more jobs will come: waiting workers return.
+  void close() {
+    {
+      std::lock_guard<std::mutex> lk(m_);
+      closed_ = true;
+    }
+    cv_.notify_all();
+  }
+  /// The next job; waits while the queue is empty and open; nullopt when empty and closed.
+  std::optional<Job> pop() {
+    std::unique_lock<std::mutex> lk(m_);
+    cv_.wait(lk, [this] { return !q_.empty() || closed_; });
+    if (q_.empty()) return std::nullopt;
+    Job j = q_.front();
+    q_.pop_front();
+    return j;
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<Job> q_;
+  bool closed_ = false;
+};
+
+/// A pool of `threads` workers taking jobs from a queue; finished results are handed to the
+/// calling thread (drain()).
+class Pool {
+ public:
+  Pool(JobQueue& queue, int threads, const RetryPolicy& retry, const PathRunner& runner) {
+    for (int t = 0; t < std::max(1, threads); ++t)
+      workers_.emplace_back([this, &queue, &retry, &runner] {
+        while (const std::optional<Job> j = queue.pop()) {
+          JobResult r = run_job(*j, retry, runner);
+          {
+            std::lock_guard<std::mutex> lk(m_);
+            done_.push_back(std::move(r));
+          }
+          cv_.notify_one();
+        }
+      });
+  }
+  ~Pool() {
+    for (auto& w : workers_) w.join();
+  }
+  /// Waits up to `wait` for results; returns those available.
+  std::vector<JobResult> drain(std::chrono::milliseconds wait) {
+    std::unique_lock<std::mutex> lk(m_);
+    cv_.wait_for(lk, wait, [this] { return !done_.empty(); });
+    std::vector<JobResult> out(std::make_move_iterator(done_.begin()),
+                               std::make_move_iterator(done_.end()));
+    done_.clear();
+    return out;
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<JobResult> done_;
+  std::vector<std::thread> workers_;
+};
+
+std::string describe(const Job& j, const JobResult& r) {
+  char b[256];
+  const auto& p = j.load_path;
+  if (p.kind == material::PathKind::kShear)
+    std::snprintf(b, sizeof b, "l=%.2f mm case %2d shear gamma=%.1f deg", j.loop_length, j.path,
+                  p.target(0) * 180.0 / 3.14159265358979323846);
+  else
+    std::snprintf(b, sizeof b, "l=%.2f mm case %2d biaxial E=(%+.3f,%+.3f)", j.loop_length, j.path,
+                  p.target(0), p.target(1));
+  char c[160];
+  std::snprintf(c, sizeof c, ": %s, %d/%d steps, %d attempt%s, %.2f s", to_string(r.status).c_str(),
+                r.converged_steps(), p.steps, r.attempts, r.attempts == 1 ? "" : "s", r.seconds);
+  return std::string(b) + c;
+}
+
+int default_threads(const MpiSession* mpi) {
+  const int hw = std::max(1u, std::thread::hardware_concurrency());
+  const int local = mpi ? mpi->local_size() : 1;
+  return std::max(1, hw / std::max(1, local));
+}
+
+}  // namespace
+
+SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
+                      const MpiSession* mpi) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rank = mpi ? mpi->rank() : 0, size = mpi ? mpi->size() : 1;
+  const bool root = rank == 0;
+  SweepReport rep;
+  rep.ranks = size;
+  rep.threads = opt.threads > 0 ? opt.threads : default_threads(mpi);
+  const std::vector<Job> jobs = make_jobs(in);
+
+  // ---- checkpoints (rank 0), the list of pending jobs (broadcast) ---------------------------
+  std::unique_ptr<CheckpointStore> store;
+  std::map<int, JobResult> finished;
+  std::string msg;  // "OK i j k ..." or "ERR <file>\n<message>"
+  if (root) {
+    try {
+      store = std::make_unique<CheckpointStore>(
+          opt.output, in.job_definition(), static_cast<int>(jobs.size()), opt.resume, opt.force);
+      finished = store->load_finished(jobs);
+      std::ostringstream os;
+      os << "OK";
+      for (const auto& [i, r] : finished) os << ' ' << i;
+      msg = os.str();
+    } catch (const InputError& e) {
+      msg = "ERR " + e.file() + "\n" + e.message();
+    }
+  }
+  if (mpi) mpi->broadcast(msg);
+  if (msg.rfind("ERR ", 0) == 0) {
+    const auto nl = msg.find('\n');
+    throw InputError(msg.substr(4, nl - 4), "", msg.substr(nl + 1));
+  }
+  std::vector<bool> done(jobs.size(), false);
+  {
+    std::istringstream is(msg.substr(2));
+    int i = 0;
+    while (is >> i) done[static_cast<std::size_t>(i)] = true;
+  }
+  std::vector<Job> pending;
+  for (const Job& j : jobs)
+    if (!done[static_cast<std::size_t>(j.index)]) pending.push_back(j);
+  rep.resumed = static_cast<int>(jobs.size() - pending.size());
+  if (root && opt.log) {
+    std::fprintf(opt.log, "knit-meso sweep: %zu loop lengths x %zu load cases = %zu cases -> %s\n",
+                 in.loop_lengths.size(), in.paths.size(), jobs.size(), opt.output.c_str());
+    if (opt.resume)
+      std::fprintf(opt.log, "resume: %d of %zu cases already finished, %zu to run\n", rep.resumed,
+                   jobs.size(), pending.size());
+    std::fprintf(opt.log, "workers: %d rank%s x %d thread%s\n", size, size == 1 ? "" : "s",
+                 rep.threads, rep.threads == 1 ? "" : "s");
+    std::fflush(opt.log);
+  }
+
+  // ---- run -----------------------------------------------------------------------------------
+  // Rank 0 (and a serial run): every pending job is queued here; its own threads take them in
+  // order and the other ranks ask for them one by one. Other ranks: a local queue fed by rank 0.
+  const bool distributed = mpi && size > 1;
+  {
+    Progress progress(static_cast<int>(pending.size()), rep.resumed, root ? opt.progress : nullptr,
+                      opt.tty);
+    JobQueue queue;  // rank 0: all pending jobs; others: the jobs rank 0 handed out
+    if (root) {
+      for (const Job& j : pending) queue.push(j);
+      queue.close();
+    }
+    if (root) {
+      int received = 0, retired = 0;
+      const int expect = static_cast<int>(pending.size());
+      // The root queue is shared with the other ranks: a request takes the next job from it.
+      // (pop() on a closed queue never waits.)
+      auto hand_out = [&](int dest) {
+        const std::optional<Job> j = queue.pop();
+        mpi->send(dest, MpiSession::kJob, std::to_string(j ? j->index : -1));
+      };
+      auto accept = [&](JobResult r) {
+        store->store(r);
+        progress.finished(describe(jobs[static_cast<std::size_t>(r.index)], r));
+        finished[r.index] = std::move(r);
+        ++received;
+      };
+      Pool pool(queue, rep.threads, in.retry, runner);
+      while (received < expect || (distributed && retired < size - 1)) {
+        for (JobResult& r : pool.drain(std::chrono::milliseconds(distributed ? 5 : 20))) {
+          accept(std::move(r));
+        }
+        if (distributed) {
+          std::string m;
+          int src = 0;
+          while (mpi->try_receive(MpiSession::kRequest, src, m)) hand_out(src);
+          while (mpi->try_receive(MpiSession::kResult, src, m)) {
+            accept(deserialize(m));
+            hand_out(src);  // a result asks for the next job
+          }
+          while (mpi->try_receive(MpiSession::kDone, src, m)) ++retired;
+        }
+        progress.tick();
+      }
+      rep.computed = expect;
+    } else {
+      // Ask for one job per thread; each result asks for one more; -1 answers a request with
+      // nothing left. Done when no request is outstanding and every job given here finished.
+      for (int t = 0; t < rep.threads; ++t) mpi->send(0, MpiSession::kRequest, "");
+      int outstanding = rep.threads, given = 0, finished_here = 0;
+      Pool pool(queue, rep.threads, in.retry, runner);
+      while (outstanding > 0 || finished_here < given) {
+        std::string m;
+        int src = 0;
+        while (mpi->try_receive(MpiSession::kJob, src, m)) {
+          --outstanding;
+          const int idx = std::stoi(m);
+          if (idx >= 0) {
+            queue.push(jobs[static_cast<std::size_t>(idx)]);
+            ++given;
+          }
+        }
+        for (JobResult& r : pool.drain(std::chrono::milliseconds(5))) {
+          ++finished_here;
+          mpi->send(0, MpiSession::kResult, serialize(r));
+          ++outstanding;
+        }
+      }
+      queue.close();
+      rep.computed = finished_here;
+      mpi->send(0, MpiSession::kDone, "");
+    }
+    progress.done();
+  }
+  rep.seconds_cases = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!root) return rep;
+
+  // ---- assemble, fit, write (rank 0) -----------------------------------------------------
+  for (const Job& j : jobs) rep.results.push_back(finished.at(j.index));
+  material::Database db = assemble_database(in, rep.results);
+  const auto tf = std::chrono::steady_clock::now();
+  if (in.fit) rep.fits = fit_sweep_database(db, in.fit_options, rep.threads);
+  rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
+  rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_sweep_database(opt.output, db, in, rep.results, rep);
+  rep.wrote_database = true;
+  if (!opt.keep_parts) store->remove();
+  return rep;
+}
+
+}  // namespace knit::meso::sweep

@@ -1,0 +1,343 @@
+// Sweep orchestration (issue #7): input, jobs and retries, exact checkpoints, thread pool,
+// resume, failed cases -- with injected fake runners (no unit cell).
+#include <algorithm>
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/meso/fit/synthetic.hpp"
+#include "knit/meso/sweep/checkpoint.hpp"
+#include "knit/meso/sweep/sweep.hpp"
+#include "test_sweep_util.hpp"
+
+using namespace knit::meso::sweep;
+using knit::material::LoadPath;
+using knit::material::RawPath;
+
+namespace {
+
+/// Synthetic law, but only steps with F* increment <= max_increment converge (a stand-in for
+/// a cell that needs small steps); steps after a failure are not reached.
+PathRunner picky_runner(double max_df, std::atomic<int>* calls = nullptr) {
+  return [max_df, calls](double l, const LoadPath& path) {
+    if (calls) ++*calls;
+    PathOutcome out = synthetic_runner()(l, path);
+    const Eigen::Matrix2d dF =
+        knit::material::deformation_gradient(path, 1.0 / path.steps) - Eigen::Matrix2d::Identity();
+    if (dF.cwiseAbs().maxCoeff() > max_df) {
+      for (int k = 0; k < path.steps; ++k) {
+        out.raw.status[static_cast<std::size_t>(k)] = k < 2 ? 0 : (k == 2 ? 1 : 2);
+        if (k >= 2) {
+          out.raw.F.row(k).setZero();
+          out.raw.S.row(k).setConstant(99.0);  // garbage that must not reach the database
+        }
+      }
+    }
+    return out;
+  };
+}
+
+SweepInput synthetic_input(int steps = 6) {
+  return parse_sweep_input(knit_test::synthetic_sweep_json(steps), "test.json");
+}
+
+SweepOptions quiet(const std::filesystem::path& out) {
+  SweepOptions o;
+  o.output = out;
+  o.progress = nullptr;
+  o.log = nullptr;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
+  const auto d = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/default.json");
+  CHECK(d.loop_lengths == std::vector<double>{4.5, 5.0, 5.5, 6.0, 6.5});
+  REQUIRE(d.paths.size() == 13);
+  CHECK(make_jobs(d).size() == 65);
+  for (const auto& p : d.paths) CHECK(p.steps == 20);
+  // the shared definition (knit/material/load_paths.hpp) is used, not a copy
+  const auto shared = knit::material::default_load_paths(20);
+  for (std::size_t i = 0; i < 13; ++i) {
+    CHECK(d.paths[i].kind == shared[i].kind);
+    CHECK((d.paths[i].target - shared[i].target).norm() < 1e-15);
+  }
+  CHECK(d.runner == RunnerKind::kCell);
+  CHECK(d.fit_options.n_ctrl1 == 11);
+  const auto r = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/reduced.json");
+  CHECK(r.loop_lengths.size() == 1);
+  CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12});
+  CHECK(r.paths.back().kind == knit::material::PathKind::kShear);
+}
+
+TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
+  auto pointer_of = [](const std::string& text) {
+    try {
+      parse_sweep_input(text, "s.json");
+    } catch (const knit::InputError& e) {
+      return e.pointer() + (e.message().find("stepz") != std::string::npos ? "|stepz" : "");
+    }
+    return std::string("<no error>");
+  };
+  CHECK(pointer_of(R"({"loop_lengths": [4.5, 4.0]})") == "/loop_lengths/1");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5, -1]})") == "/loop_lengths/1");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "steps": 0})") == "/steps");
+  // unknown keys: reported on the object that holds them, naming the key
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "stepz": 3})") == "|stepz");
+  CHECK(pointer_of(
+            R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", "select": [13]}})") ==
+        "/load_paths/select/0");
+  CHECK(pointer_of(
+            R"({"loop_lengths": [4.5], "load_paths": [{"kind": "shear", "gamma_deg": 95}]})") ==
+        "/load_paths/0/gamma_deg");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "fit": {"control_points_1": 2}})").rfind("/fit", 0) ==
+        0);
+  // the cell parameters follow the cell's own schema (schemas/cell.schema.json)
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": {"contact": {"mu": -1}}})") ==
+        "/cell/contact/mu");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": 3})") == "/cell");
+  CHECK(pointer_of(R"({"steps": 4})") == "");  // required loop_lengths: the document itself
+}
+
+TEST_CASE("sweep input: cell parameters inline or from a file relative to the sweep file",
+          "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_cellfile");
+  knit_test::write_text(dir / "cell.json",
+                        R"({"analysis": {"elements": 20}, "contact": {"mu": 0.2}})");
+  knit_test::write_text(dir / "s.json", R"({"loop_lengths": [4.5], "cell": "cell.json"})");
+  const auto a = load_sweep_input(dir / "s.json");
+  CHECK(a.cell_file == (dir / "cell.json").string());
+  const auto b = parse_sweep_input(
+      R"({"loop_lengths": [4.5], "cell": {"analysis": {"elements": 20}, "contact": {"mu": 0.2}}})",
+      "b.json");
+  CHECK(a.job_definition() == b.job_definition());  // the content counts, not where it is
+  knit_test::write_text(dir / "bad.json", R"({"contact": {"mu": -1}})");
+  knit_test::write_text(dir / "s2.json", R"({"loop_lengths": [4.5], "cell": "bad.json"})");
+  try {
+    load_sweep_input(dir / "s2.json");
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == (dir / "bad.json").string());
+    CHECK(e.pointer() == "/contact/mu");
+  }
+}
+
+TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {
+  const auto a = parse_sweep_input(R"({"loop_lengths": [4.5], "fit": {"smoothing": 1e-3}})", "a");
+  const auto b = parse_sweep_input(R"({"loop_lengths": [4.5], "fit": false})", "b");
+  const auto c = parse_sweep_input(R"({"loop_lengths": [4.5], "steps": 19})", "c");
+  CHECK(a.job_definition() == b.job_definition());
+  CHECK(fingerprint(a.job_definition()) != fingerprint(c.job_definition()));
+  CHECK_FALSE(b.fit);
+  // explicit paths
+  const auto e = parse_sweep_input(
+      R"({"loop_lengths": [5], "steps": 7, "load_paths": [{"kind": "biaxial", "E11": 0.3, "E22": 0},
+          {"kind": "shear", "gamma_deg": 30, "steps": 4}]})",
+      "e");
+  REQUIRE(e.paths.size() == 2);
+  CHECK(e.paths[0].steps == 7);
+  CHECK(e.paths[1].steps == 4);
+  CHECK(e.paths[1].target(0) == Approx(M_PI / 6));
+}
+
+TEST_CASE("sweep job: exact serialization round trip", "[unit]") {
+  const auto in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  JobResult r = run_job(jobs[3], in.retry, synthetic_runner());
+  r.raw.S(2, 1) = 1.0 / 3.0;
+  r.raw.P(0, 0) = -std::nextafter(1e-300, 1.0);
+  r.message = "multi\nline";
+  const JobResult q = deserialize(serialize(r));
+  CHECK(q.index == r.index);
+  CHECK(q.status == r.status);
+  CHECK(q.raw.status == r.raw.status);
+  CHECK((q.raw.S.array() == r.raw.S.array()).all());
+  CHECK((q.raw.P.array() == r.raw.P.array()).all());
+  CHECK((q.raw.F.array() == r.raw.F.array()).all());
+  CHECK(q.cell.course_height == r.cell.course_height);
+  CHECK(q.message == "multi line");
+  CHECK(matches(q, jobs[3]));
+  CHECK_FALSE(matches(q, jobs[4]));
+  CHECK_THROWS(deserialize(serialize(r).substr(0, 200)));
+  CHECK_THROWS(deserialize("garbage"));
+}
+
+TEST_CASE("sweep job: non-convergence retried with smaller steps and the recorded steps unchanged",
+          "[unit]") {
+  const auto in = synthetic_input(6);
+  const auto jobs = make_jobs(in);
+  const Job& j = jobs[0];  // biaxial (0.35, -0.15): dF per step ~0.05 with 6 steps
+  const JobResult plain = run_job(j, in.retry, synthetic_runner());
+  REQUIRE(plain.status == JobStatus::kConverged);
+  CHECK(plain.attempts == 1);
+  // Converges only with half the step: one retry (factor 2) succeeds.
+  const double dF = plain.raw.F.row(0).cwiseAbs().maxCoeff() - 1.0;  // first step's |F - 1|
+  std::atomic<int> calls{0};
+  const JobResult retried = run_job(j, in.retry, picky_runner(std::abs(dF) * 0.75, &calls));
+  CHECK(calls == 2);
+  CHECK(retried.status == JobStatus::kConverged);
+  CHECK(retried.attempts == 2);
+  CHECK(retried.step_factor == 2);
+  CHECK((retried.raw.F - plain.raw.F).cwiseAbs().maxCoeff() < 1e-14);
+  CHECK((retried.raw.S - plain.raw.S).cwiseAbs().maxCoeff() < 1e-12);
+  // Never converges beyond step 2: partial after 1 + max_retries attempts, statuses recorded.
+  calls = 0;
+  const JobResult bad = run_job(j, in.retry, picky_runner(1e-9, &calls));
+  CHECK(calls == 1 + in.retry.max_retries);
+  CHECK(bad.status == JobStatus::kPartial);
+  // best attempt: the refined one reaches sub-step 2 -> recorded step 1 only (rows 0..1)
+  CHECK(bad.raw.status[0] == kStepConverged);
+  CHECK(bad.raw.status.back() == kStepNotReached);
+  CHECK(bad.converged_steps() >= 1);
+  CHECK(bad.converged_steps() < 6);
+  for (int k = 0; k < 6; ++k)
+    if (bad.raw.status[static_cast<std::size_t>(k)] != 0) CHECK(bad.raw.S.row(k).isZero());
+  // A runner that throws: recorded as an error, not thrown.
+  const JobResult err = run_job(j, in.retry, [](double, const LoadPath&) -> PathOutcome {
+    throw std::runtime_error("boom");
+  });
+  CHECK(err.status == JobStatus::kError);
+  CHECK(err.message.find("boom") != std::string::npos);
+  CHECK(err.converged_steps() == 0);
+  // First step never converges: failed.
+  const JobResult none = run_job(j, in.retry, [](double l, const LoadPath& p) {
+    PathOutcome o = synthetic_runner()(l, p);
+    std::fill(o.raw.status.begin(), o.raw.status.end(), kStepNotReached);
+    o.raw.status[0] = kStepFailed;
+    return o;
+  });
+  CHECK(none.status == JobStatus::kFailed);
+  CHECK(none.raw.status[0] == kStepFailed);
+}
+
+TEST_CASE(
+    "sweep: any number of threads gives the same database and failed cases are kept and "
+    "reported but not fitted",
+    "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_threads");
+  const auto in = synthetic_input();
+  auto o1 = quiet(dir / "one.h5");
+  o1.threads = 1;
+  const SweepReport r1 = run_sweep(in, o1, synthetic_runner());
+  CHECK(r1.ok());
+  CHECK(r1.computed == 26);
+  CHECK_FALSE(std::filesystem::exists(dir / "one.h5.parts"));
+  auto o3 = quiet(dir / "three.h5");
+  o3.threads = 3;
+  const SweepReport r3 = run_sweep(in, o3, synthetic_runner());
+  const auto d1 = knit::material::read_database(dir / "one.h5");
+  const auto d3 = knit::material::read_database(dir / "three.h5");
+  CHECK(knit_test::database_difference(d1, d3) == 0.0);
+  REQUIRE(d1.entries.size() == 2);
+  CHECK(d1.entries[0].surface.has_value());
+  CHECK(d1.generator.find("synthetic") != std::string::npos);
+
+  // Case 5 of the second loop length never gets past its first steps.
+  const int bad = 13 + 5;
+  const auto jobs = make_jobs(in);
+  const PathRunner flaky = [&](double l, const LoadPath& p) {
+    if (l == jobs[bad].loop_length && p.target == jobs[bad].load_path.target)
+      return picky_runner(1e-9)(l, p);
+    return synthetic_runner()(l, p);
+  };
+  auto of = quiet(dir / "flaky.h5");
+  of.threads = 2;
+  const SweepReport rf = run_sweep(in, of, flaky);
+  CHECK(rf.failed_cases() == 1);
+  CHECK_FALSE(rf.ok());
+  CHECK(rf.results[bad].status == JobStatus::kPartial);
+  CHECK(rf.fits_ok());
+  const auto df = knit::material::read_database(dir / "flaky.h5");
+  const auto& raw = df.entries[1].raw[5];
+  CHECK(raw.status[0] == 0);
+  CHECK(raw.status.back() == kStepNotReached);
+  CHECK(raw.S.bottomRows(1).isZero());  // the failed steps carry no garbage
+  {
+    const auto f = knit::io::H5File::open_read(dir / "flaky.h5");
+    const auto st = f.read_int_matrix("/sweep/report/case_status");
+    REQUIRE(st.rows() == 2);
+    CHECK(st(1, 5) == static_cast<int>(JobStatus::kPartial));
+    CHECK(st.sum() == st(1, 5));
+    CHECK(f.read_int_matrix("/sweep/report/case_converged_steps")(1, 5) ==
+          std::count(raw.status.begin(), raw.status.end(), 0));
+    CHECK(f.read_int_matrix("/sweep/report/case_in_fit").minCoeff() == 1);
+    CHECK(f.read_strings("/sweep/report/case_messages").size() == 26);
+  }
+  // Every other case is as in the clean run.
+  for (std::size_t p = 0; p < 13; ++p)
+    if (p != 5) CHECK((df.entries[1].raw[p].S - d1.entries[1].raw[p].S).isZero());
+}
+
+TEST_CASE("sweep: resume recomputes only the missing cases and gives the same database", "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_resume");
+  const auto in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  const auto out = dir / "db.h5";
+  {  // a "killed" sweep: the checkpoints of 9 cases exist
+    CheckpointStore store(out, in.job_definition(), static_cast<int>(jobs.size()), false, false);
+    for (int i : {0, 1, 2, 3, 7, 8, 13, 20, 25})
+      store.store(run_job(jobs[static_cast<std::size_t>(i)], in.retry, synthetic_runner()));
+  }
+  // without --resume or --force: refused (bad input, exit 2)
+  CHECK_THROWS_AS(run_sweep(in, quiet(out), synthetic_runner()), knit::InputError);
+  // a different sweep cannot resume these checkpoints
+  auto other = synthetic_input(7);
+  auto ro = quiet(out);
+  ro.resume = true;
+  CHECK_THROWS_AS(run_sweep(other, ro, synthetic_runner()), knit::InputError);
+  std::atomic<int> calls{0};
+  const PathRunner counting = [&](double l, const LoadPath& p) {
+    ++calls;
+    return synthetic_runner()(l, p);
+  };
+  ro.threads = 2;
+  const SweepReport r = run_sweep(in, ro, counting);
+  CHECK(calls == 26 - 9);
+  CHECK(r.resumed == 9);
+  CHECK(r.computed == 17);
+  auto full = quiet(dir / "full.h5");
+  run_sweep(in, full, synthetic_runner());
+  CHECK(knit_test::database_difference(knit::material::read_database(out),
+                                       knit::material::read_database(dir / "full.h5")) == 0.0);
+  CHECK_FALSE(std::filesystem::exists(CheckpointStore::parts_dir(out)));
+}
+
+TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consistently", "[unit]") {
+  const auto dir = knit_test::scratch("sweep_unit_residual");
+  const Eigen::Vector3d S0(0.15, 0.07, 0.01);
+  const PathRunner prestressed = [&](double l, const LoadPath& p) {
+    PathOutcome o = synthetic_runner()(l, p);
+    o.residual = S0;
+    for (Eigen::Index k = 0; k < o.raw.S.rows(); ++k) {
+      o.raw.S.row(k) += S0.transpose();
+      Eigen::Matrix2d F, S;
+      F << o.raw.F(k, 0), o.raw.F(k, 1), o.raw.F(k, 2), o.raw.F(k, 3);
+      S << o.raw.S(k, 0), o.raw.S(k, 2), o.raw.S(k, 2), o.raw.S(k, 1);
+      const Eigen::Matrix2d P = F * S;
+      o.raw.P.row(k) << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
+    }
+    return o;
+  };
+  const std::string text = R"({"loop_lengths": [5.0], "steps": 5, "runner": "synthetic",
+      "load_paths": {"preset": "default", "select": [0, 12]}, "fit": false)";
+  const auto sub = parse_sweep_input(text + "}", "sub.json");
+  const auto keep = parse_sweep_input(text + R"(, "residual_stress": "keep"})", "keep.json");
+  CHECK(sub.subtract_residual);
+  CHECK_FALSE(keep.subtract_residual);
+  CHECK(sub.job_definition() == keep.job_definition());  // a post-processing choice
+  run_sweep(sub, quiet(dir / "sub.h5"), prestressed);
+  run_sweep(keep, quiet(dir / "keep.h5"), prestressed);
+  run_sweep(sub, quiet(dir / "plain.h5"), synthetic_runner());
+  const auto ds = knit::material::read_database(dir / "sub.h5");
+  const auto dk = knit::material::read_database(dir / "keep.h5");
+  const auto dp = knit::material::read_database(dir / "plain.h5");
+  for (std::size_t p = 0; p < 2; ++p) {
+    const auto &rs = ds.entries[0].raw[p], &rk = dk.entries[0].raw[p], &rp = dp.entries[0].raw[p];
+    CHECK((rs.S - rp.S).cwiseAbs().maxCoeff() < 1e-14);
+    CHECK((rs.P - rp.P).cwiseAbs().maxCoeff() < 1e-14);  // P = F (S - S0)
+    CHECK((rk.S.rowwise() - S0.transpose() - rp.S).cwiseAbs().maxCoeff() < 1e-14);
+  }
+}
