@@ -1,0 +1,96 @@
+// Atomic outputs (design/style.md: "outputs are written atomically").
+//
+// A reader (or a crash) never sees a half-written result: files are written to a temporary
+// next to the target and renamed over it on commit(); output directories are built as
+// DIR.partial-<pid> and swapped in on commit(). Without commit() (an exception unwound the
+// writer), the target is left exactly as it was.
+//
+//   knit::io::AtomicFile out("result.h5");
+//   { auto f = knit::io::H5File::create(out.temp_path()); ...; f.close(); }
+//   out.commit();
+//
+//   knit::io::AtomicFile csv("curve.csv");
+//   csv.stream() << "a,b\n1,2\n";
+//   csv.commit();
+//
+//   knit::io::AtomicDirectory dir("out/rod_case");
+//   write things into dir.path() / "...";   // = out/rod_case.partial-<pid>
+//   dir.commit();                           // out/rod_case now holds exactly the new files
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+namespace knit::io {
+
+/// One output file written to "<dir>/.<name>.tmp-<pid>-<n>" and renamed over the target on
+/// commit(). Not copyable; movable.
+class AtomicFile {
+ public:
+  /// The target's directory must exist (throws std::runtime_error otherwise).
+  explicit AtomicFile(std::filesystem::path target);
+  AtomicFile(AtomicFile&& o) noexcept;
+  AtomicFile& operator=(AtomicFile&&) = delete;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  /// Removes the temporary file unless committed.
+  ~AtomicFile();
+
+  const std::filesystem::path& target() const { return target_; }
+  /// Where to write (e.g. with a library that opens files by name, like HDF5).
+  const std::filesystem::path& temp_path() const { return temp_; }
+  /// A binary output stream on temp_path(), opened on first use.
+  std::ofstream& stream();
+  /// Closes the stream (if used), fsyncs the temporary, renames it onto the target and
+  /// fsyncs the directory. Throws std::runtime_error naming the target on any failure (the
+  /// temporary is then removed by the destructor).
+  void commit();
+  bool committed() const { return committed_; }
+
+ private:
+  std::filesystem::path target_, temp_;
+  std::ofstream stream_;
+  bool committed_ = false;
+};
+
+/// Writes `content` to `target` atomically.
+void write_file_atomically(const std::filesystem::path& target, std::string_view content);
+
+/// An output directory built as "<DIR>.partial-<pid>" and put in place on commit(). An existing
+/// DIR stays untouched until the new one is complete.
+class AtomicDirectory {
+ public:
+  /// What happens to the partial directory when the object dies without commit().
+  enum class OnAbandon {
+    Remove,  ///< delete it (default)
+    Keep     ///< keep it for inspection, with a file INCOMPLETE inside saying so
+  };
+  /// Creates the partial directory (and the parents of DIR). A stale partial directory of the
+  /// same name (same pid, earlier run) is removed first.
+  explicit AtomicDirectory(std::filesystem::path target, OnAbandon on_abandon = OnAbandon::Remove);
+  AtomicDirectory(AtomicDirectory&& o) noexcept;
+  AtomicDirectory& operator=(AtomicDirectory&&) = delete;
+  AtomicDirectory(const AtomicDirectory&) = delete;
+  AtomicDirectory& operator=(const AtomicDirectory&) = delete;
+  ~AtomicDirectory();
+
+  const std::filesystem::path& target() const { return target_; }
+  /// The directory to write into until commit() (after commit(): the target).
+  const std::filesystem::path& path() const { return committed_ ? target_ : partial_; }
+  std::filesystem::path operator/(const std::filesystem::path& name) const { return path() / name; }
+  /// fsyncs the files, then replaces DIR by the partial directory: atomically where the file
+  /// system supports renameat2(RENAME_EXCHANGE), otherwise by two renames (DIR is moved
+  /// aside to DIR.old-<pid> first, then removed). Throws std::runtime_error on failure.
+  void commit();
+  bool committed() const { return committed_; }
+
+ private:
+  std::filesystem::path target_, partial_;
+  OnAbandon on_abandon_;
+  bool committed_ = false;
+  bool active_ = true;
+};
+
+}  // namespace knit::io

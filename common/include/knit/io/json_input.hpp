@@ -1,0 +1,116 @@
+// JSON input: reading files with precise parse errors, and validation against JSON Schemas
+// (a subset of draft 2020-12) embedded into the binary at build time.
+//
+//   nlohmann::json c = knit::io::load_and_validate(path, "case");   // schemas/case.schema.json
+//
+// Errors are knit::InputError(file, json_pointer, message), one line each:
+//   case.json: invalid JSON at line 3, column 14: syntax error ... (pointer "")
+//   case.json: /geometry/thickness: must be > 0, got -1 (line 7)
+//   case.json: /boundary_conditions/2/edge: must be one of "u0", "u1", "v0", "v1", got "u2"
+//   case.json: /material: unknown key "Young" (allowed: "E", "nu") (line 9)
+//   case.json: /geometry: unknown key "thicknes" (did you mean "thickness"?) (line 5)
+// (load_and_validate adds the line; JsonSchema::validate, which has no text, does not).
+//
+// Supported keywords: type (string or array; "integer" = number with no fraction), enum,
+// const, properties, required, additionalProperties (bool or schema), patternProperties,
+// minProperties, maxProperties, items (schema, or the draft-07 array form), prefixItems,
+// minItems, maxItems, uniqueItems, minimum, maximum, exclusiveMinimum, exclusiveMaximum,
+// multipleOf, minLength, maxLength, pattern (ECMAScript, unanchored search), allOf, anyOf,
+// oneOf, not, if/then/else, $ref to "#", "#/$defs/..." or "#/definitions/..." (other keywords
+// next to $ref apply too), boolean schemas. Annotations are ignored: title, description,
+// default, examples, $schema, $id, $comment, $anchor, format, deprecated, readOnly, writeOnly,
+// and any key starting with "x-" (use e.g. "x-unit": "mm"). Any other keyword makes the SCHEMA
+// invalid (std::logic_error when it is loaded), so a schema never silently means less than
+// its author thought.
+//
+// oneOf/anyOf with no matching branch report the most relevant branch: the one whose `const`
+// on a property (a discriminator such as "type") matches the instance; with a discriminator
+// that matches no branch, "must be one of <the consts>"; otherwise the branch whose first
+// error lies deepest. If every branch fails only on its type, the types are merged ("must be
+// a number or an object, got ...").
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace knit::io {
+
+// ---- reading ---------------------------------------------------------------------------------
+
+/// Parses a JSON file. Throws knit::InputError(file, "", "cannot read file") or
+/// (file, "", "invalid JSON at line L, column C: <what>").
+nlohmann::json read_json_file(const std::filesystem::path& file);
+/// Parses JSON text; `source` names it in errors.
+nlohmann::json parse_json(std::string_view text, const std::string& source);
+
+/// A path written inside an input file: absolute as is, relative ones are taken relative to the
+/// directory of that input file (so a case runs the same from any working directory).
+std::filesystem::path resolve_input_path(const std::filesystem::path& input_file,
+                                         const std::string& value);
+
+// ---- JSON pointers (RFC 6901) ------------------------------------------------------------------
+
+/// Escapes one reference token: "~" -> "~0", "/" -> "~1".
+std::string json_pointer_escape(std::string_view token);
+/// parent + "/" + escaped token.
+std::string json_pointer_append(const std::string& parent, std::string_view token);
+std::string json_pointer_append(const std::string& parent, std::size_t index);
+
+// ---- embedded schemas --------------------------------------------------------------------------
+
+/// Text of schemas/<name>.schema.json (or schemas/<name>.json) as embedded at build time.
+/// Throws std::out_of_range naming the available schemas if there is none.
+const std::string& embedded_schema(const std::string& name);
+/// Names of all embedded schemas, sorted.
+std::vector<std::string> embedded_schema_names();
+
+// ---- validation --------------------------------------------------------------------------------
+
+struct SchemaError {
+  std::string pointer;  ///< JSON pointer into the instance ("" = the whole document)
+  std::string message;  ///< what is expected and what was found
+  /// Pointer of the value the error is about: = pointer, except for an unknown key, where it
+  /// is the key's own pointer (used to find the line in the input text).
+  std::string at;
+};
+
+class JsonSchema {
+ public:
+  /// `name` appears in schema-definition errors. Checks the schema itself (supported
+  /// keywords, resolvable $refs, regexes); throws std::logic_error if it is not usable.
+  JsonSchema(const nlohmann::json& schema, std::string name);
+  /// The embedded schema `name` (parsed and checked once, then cached).
+  static const JsonSchema& embedded(const std::string& name);
+  /// Reads a schema from a file (tests, tools).
+  static JsonSchema from_file(const std::filesystem::path& file);
+  JsonSchema(JsonSchema&&) noexcept;
+  JsonSchema& operator=(JsonSchema&&) noexcept;
+  ~JsonSchema();
+
+  const std::string& name() const;
+  /// All violations, in document order (empty = valid).
+  std::vector<SchemaError> errors(const nlohmann::json& instance) const;
+  /// Throws knit::InputError(file, pointer, message) for the first violation.
+  void validate(const nlohmann::json& instance, const std::string& file) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Line (1-based) where each value starts in JSON text, by JSON pointer ("" = the root). For
+/// object members, the line of the key. The text must be valid JSON.
+std::map<std::string, int> json_pointer_lines(std::string_view text);
+
+/// read_json_file + validation against the embedded schema `schema_name`. A validation error
+/// is InputError(path, pointer, message + " (line N)").
+nlohmann::json load_and_validate(const std::filesystem::path& path, const std::string& schema_name);
+/// The same with a schema object (tests, tools).
+nlohmann::json load_and_validate(const std::filesystem::path& path, const JsonSchema& schema);
+
+}  // namespace knit::io

@@ -1,0 +1,191 @@
+// Atomic files and directories (see knit/io/atomic.hpp). POSIX (Linux) only.
+#include "knit/io/atomic.hpp"
+
+#include <fcntl.h>
+#include <stdio.h>  // renameat2 (glibc >= 2.28, _GNU_SOURCE is defined by g++)
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace knit::io {
+
+namespace {
+
+std::atomic<unsigned> g_counter{0};
+
+[[noreturn]] void fail(const fs::path& p, const std::string& what, int err = 0) {
+  std::string msg = p.string() + ": " + what;
+  if (err != 0) msg += std::string(" (") + std::strerror(err) + ")";
+  throw std::runtime_error(msg);
+}
+
+/// fsync a file or a directory by name; returns errno or 0.
+int fsync_path(const fs::path& p, bool directory) {
+  const int fd = ::open(p.c_str(), (directory ? O_DIRECTORY : 0) | O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  const int rc = ::fsync(fd);
+  const int err = rc == 0 ? 0 : errno;
+  ::close(fd);
+  return err;
+}
+
+fs::path strip_trailing_slash(fs::path p) {
+  if (!p.has_filename() && p.has_parent_path()) p = p.parent_path();
+  return p;
+}
+
+fs::path parent_or_dot(const fs::path& p) {
+  return p.has_parent_path() ? p.parent_path() : fs::path(".");
+}
+
+}  // namespace
+
+// ---- AtomicFile -----------------------------------------------------------------------------
+
+AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
+  if (!target_.has_filename()) fail(target_, "not a file name");
+  const fs::path dir = parent_or_dot(target_);
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    fail(target_, "cannot write: directory " + dir.string() + " missing");
+  std::string name(".");  // built step by step: GCC 12 warns falsely on "." + std::string
+  name += target_.filename().string();
+  name += ".tmp-";
+  name += std::to_string(::getpid());
+  name += '-';
+  name += std::to_string(g_counter++);
+  temp_ = dir / name;
+}
+
+AtomicFile::AtomicFile(AtomicFile&& o) noexcept
+    : target_(std::move(o.target_)),
+      temp_(std::move(o.temp_)),
+      stream_(std::move(o.stream_)),
+      committed_(o.committed_) {
+  o.temp_.clear();
+  o.committed_ = true;
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_ || temp_.empty()) return;
+  if (stream_.is_open()) stream_.close();
+  std::error_code ec;
+  fs::remove(temp_, ec);
+}
+
+std::ofstream& AtomicFile::stream() {
+  if (committed_) fail(target_, "stream() after commit()");
+  if (!stream_.is_open()) {
+    stream_.open(temp_, std::ios::binary | std::ios::trunc);
+    if (!stream_) fail(temp_, "cannot open for writing", errno);
+  }
+  return stream_;
+}
+
+void AtomicFile::commit() {
+  if (committed_) return;
+  if (stream_.is_open()) {
+    stream_.flush();
+    const bool ok = static_cast<bool>(stream_);
+    stream_.close();
+    if (!ok || stream_.fail()) fail(target_, "write failed (disk full?)");
+  }
+  std::error_code ec;
+  if (!fs::exists(temp_, ec)) fail(target_, "nothing was written to " + temp_.string());
+  if (int err = fsync_path(temp_, false)) fail(target_, "fsync failed", err);
+  if (::rename(temp_.c_str(), target_.c_str()) != 0)
+    fail(target_, "cannot rename temporary", errno);
+  committed_ = true;
+  fsync_path(parent_or_dot(target_), true);  // best effort: makes the rename durable
+}
+
+void write_file_atomically(const fs::path& target, std::string_view content) {
+  AtomicFile f(target);
+  f.stream().write(content.data(), static_cast<std::streamsize>(content.size()));
+  f.commit();
+}
+
+// ---- AtomicDirectory ------------------------------------------------------------------------
+
+AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon)
+    : target_(strip_trailing_slash(std::move(target))), on_abandon_(on_abandon) {
+  if (!target_.has_filename()) fail(target_, "not a directory name");
+  partial_ = target_;
+  partial_ += ".partial-";
+  partial_ += std::to_string(::getpid());
+  std::error_code ec;
+  fs::remove_all(partial_, ec);
+  fs::create_directories(partial_, ec);
+  if (ec) fail(partial_, "cannot create directory: " + ec.message());
+}
+
+AtomicDirectory::AtomicDirectory(AtomicDirectory&& o) noexcept
+    : target_(std::move(o.target_)),
+      partial_(std::move(o.partial_)),
+      on_abandon_(o.on_abandon_),
+      committed_(o.committed_),
+      active_(o.active_) {
+  o.active_ = false;
+}
+
+AtomicDirectory::~AtomicDirectory() {
+  if (!active_ || committed_) return;
+  std::error_code ec;
+  if (on_abandon_ == OnAbandon::Remove) {
+    fs::remove_all(partial_, ec);
+  } else {
+    std::ofstream(partial_ / "INCOMPLETE")
+        << "This directory is the incomplete output for " << target_.string()
+        << ": the run stopped before committing it. " << target_.string()
+        << " (if it exists) was left untouched.\n";
+  }
+}
+
+void AtomicDirectory::commit() {
+  if (committed_) return;
+  if (!active_) fail(target_, "commit() on a moved-from AtomicDirectory");
+  std::error_code ec;
+  // Make the contents durable before they become visible under the final name.
+  for (auto it = fs::recursive_directory_iterator(partial_, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it->is_regular_file(ec))
+      fsync_path(it->path(), false);
+    else if (it->is_directory(ec))
+      fsync_path(it->path(), true);
+  }
+  fsync_path(partial_, true);
+
+  if (!fs::exists(target_, ec)) {
+    if (::rename(partial_.c_str(), target_.c_str()) != 0)
+      fail(target_, "cannot rename " + partial_.string(), errno);
+  } else {
+    if (!fs::is_directory(target_, ec)) fail(target_, "exists and is not a directory");
+    if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
+      fs::remove_all(partial_, ec);  // now holds the old contents
+    } else {
+      // File system without RENAME_EXCHANGE: move the old directory aside first.
+      fs::path old = target_;
+      old += ".old-";
+      old += std::to_string(::getpid());
+      fs::remove_all(old, ec);
+      if (::rename(target_.c_str(), old.c_str()) != 0)
+        fail(target_, "cannot move the previous output aside", errno);
+      if (::rename(partial_.c_str(), target_.c_str()) != 0) {
+        const int err = errno;
+        ::rename(old.c_str(), target_.c_str());  // put the old output back
+        fail(target_, "cannot rename " + partial_.string(), err);
+      }
+      fs::remove_all(old, ec);
+    }
+  }
+  committed_ = true;
+  fsync_path(parent_or_dot(target_), true);
+}
+
+}  // namespace knit::io

@@ -1,0 +1,317 @@
+// JSON input: parse errors with line/column, the schema validator keyword by keyword (on
+// tests/data/io_test.schema.json), JSON pointer escaping, and the embedded schemas.
+#include <unistd.h>
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+const knit::io::JsonSchema& test_schema() {
+  static const auto s = knit::io::JsonSchema::from_file(fs::path(KNIT_SOURCE_DIR) / "tests" /
+                                                        "data" / "io_test.schema.json");
+  return s;
+}
+
+json base() {
+  return json::parse(R"({"name": "rod_1", "geometry": {"thickness": 0.76}})");
+}
+
+/// "<pointer>: <message>" of the first error, or "" if valid.
+std::string first_error(const json& doc) {
+  const auto errs = test_schema().errors(doc);
+  if (errs.empty()) return "";
+  return errs.front().pointer + ": " + errs.front().message;
+}
+
+json with(const std::string& pointer, const json& value) {
+  json d = base();
+  d[json::json_pointer(pointer)] = value;
+  return d;
+}
+
+struct Scratch {
+  fs::path dir =
+      fs::path(KNIT_BINARY_DIR) / "test_scratch" / ("io_json_" + std::to_string(getpid()));
+  Scratch() { fs::create_directories(dir); }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+fs::path scratch(const std::string& name, const std::string& content) {
+  static Scratch s;
+  std::ofstream(s.dir / name) << content;
+  return s.dir / name;
+}
+}  // namespace
+
+TEST_CASE("read_json_file reports file, line and column", "[unit][io][json]") {
+  const fs::path bad = scratch("bad.json", "{\n  \"a\": 1,\n  \"b\": [1, 2,, 3]\n}\n");
+  try {
+    knit::io::read_json_file(bad);
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == bad.string());
+    CHECK(e.pointer().empty());
+    CHECK_THAT(e.message(), Catch::StartsWith("invalid JSON at line 3, column 14: "));
+    CHECK_THAT(e.what(), Catch::StartsWith(bad.string() + ": invalid JSON at line 3"));
+  }
+  const fs::path cut = scratch("cut.json", "{\"a\": {\"b\": 1");
+  CHECK_THROWS_WITH(knit::io::read_json_file(cut), Catch::Contains("invalid JSON at line 1"));
+  CHECK_THROWS_WITH(knit::io::read_json_file(scratch("empty.json", "")),
+                    Catch::Contains("invalid JSON at line 1, column 1"));
+  CHECK_THROWS_AS(knit::io::read_json_file("/nonexistent/x.json"), knit::InputError);
+  CHECK_THROWS_WITH(knit::io::read_json_file("/nonexistent/x.json"),
+                    "/nonexistent/x.json: file not found");
+  CHECK(knit::io::read_json_file(scratch("ok.json", R"({"x": [1, 2.5]})"))["x"][1] == 2.5);
+}
+
+TEST_CASE("JSON pointers escape per RFC 6901", "[unit][io][json]") {
+  CHECK(knit::io::json_pointer_escape("a/b~c") == "a~1b~0c");
+  CHECK(knit::io::json_pointer_append("/x", "~/") == "/x/~0~1");
+  CHECK(knit::io::json_pointer_append("", std::size_t{3}) == "/3");
+  CHECK(first_error(with("/weird~1key~0name", 3)) == "/weird~1key~0name: must be a boolean, got 3");
+}
+
+TEST_CASE("schema validator: types, numbers, strings", "[unit][io][json][schema]") {
+  CHECK(first_error(base()).empty());
+  CHECK(first_error(with("/geometry/thickness", -1)) == "/geometry/thickness: must be > 0, got -1");
+  CHECK(first_error(with("/geometry/thickness", 0)) == "/geometry/thickness: must be > 0, got 0");
+  CHECK(first_error(with("/geometry/thickness", "thick")) ==
+        "/geometry/thickness: must be a number, got string \"thick\"");
+  CHECK(first_error(with("/geometry/angle", 90)).empty());
+  CHECK(first_error(with("/geometry/angle", 90.5)) == "/geometry/angle: must be <= 90, got 90.5");
+  CHECK(first_error(with("/geometry/angle", -91)) == "/geometry/angle: must be >= -90, got -91");
+  CHECK(first_error(with("/geometry/fraction", 1)) == "/geometry/fraction: must be < 1, got 1");
+  CHECK(first_error(with("/geometry/fraction", 0.75)).empty());
+  CHECK(first_error(with("/geometry/fraction", 0.3)) ==
+        "/geometry/fraction: must be a multiple of 0.25, got 0.3");
+  CHECK(first_error(with("/geometry/elements", 4.0)).empty());  // 4.0 is an integer
+  CHECK(first_error(with("/geometry/elements", 2.5)) ==
+        "/geometry/elements: must be an integer, got 2.5");
+  CHECK(first_error(with("/geometry/elements", 0)) == "/geometry/elements: must be >= 1, got 0");
+  CHECK(first_error(with("/nullable", nullptr)).empty());
+  CHECK(first_error(with("/nullable", true)) == "/nullable: must be a number or null, got true");
+  CHECK(first_error(with("/geometry", json::array())) ==
+        "/geometry: must be an object, got an array of 0 items");
+
+  CHECK(first_error(with("/name", "a")) == "/name: must have at least 2 characters, got \"a\"");
+  CHECK(first_error(with("/name", "abcdefghi")) ==
+        "/name: must have at most 8 characters, got \"abcdefghi\"");
+  CHECK(first_error(with("/name", "Rod")) ==
+        "/name: must match the pattern \"^[a-z][a-z0-9_]*$\", got \"Rod\"");
+  CHECK(first_error(with("/version", 2.0)).empty());
+  CHECK(first_error(with("/version", 3)) == "/version: must be 2, got 3");
+  CHECK(first_error(with("/allof", 11)) == "/allof: must be <= 10, got 11");
+  CHECK(first_error(with("/allof", -1)) == "/allof: must be >= 0, got -1");
+}
+
+TEST_CASE("schema validator: objects, arrays, $ref", "[unit][io][json][schema]") {
+  json d = base();
+  d.erase("geometry");
+  CHECK(first_error(d) == ": missing required key \"geometry\"");
+  CHECK(first_error(with("/geometry", json::object())) ==
+        "/geometry: missing required key \"thickness\"");
+  CHECK(first_error(with("/material", {{"E", 800}, {"Young", 1}})) ==
+        "/material: unknown key \"Young\" (allowed: \"E\", \"nu\")");
+  CHECK(first_error(with("/geometry", {{"thickness", 1}, {"elemnts", 2}})) ==
+        "/geometry: unknown key \"elemnts\" (did you mean \"elements\"?)");
+  CHECK(first_error(with("/material", {{"E", 800}, {"Nu", 0.3}})) ==
+        "/material: unknown key \"Nu\" (did you mean \"nu\"?)");
+  CHECK(first_error(with("/material", {{"E", 800}, {"nu", 0.5}})) ==
+        "/material/nu: must be < 0.5, got 0.5");
+  CHECK(first_error(with("/material", json::object())) == "/material: missing required key \"E\"");
+
+  CHECK(first_error(with("/boundary_conditions", json::array())) ==
+        "/boundary_conditions: must have at least 1 items, got 0");
+  CHECK(first_error(with("/boundary_conditions", json::parse(R"([{"edge":"u0"},{"edge":"u0"},
+    {"edge":"u0"},{"edge":"u0"},{"edge":"u0"}])"))) ==
+        "/boundary_conditions: must have at most 4 items, got 5");
+  CHECK(first_error(with("/boundary_conditions",
+                         json::parse(R"([{"edge":"u0"},{"edge":"v1"},{"edge":"u2"}])"))) ==
+        "/boundary_conditions/2/edge: must be one of \"u0\", \"u1\", \"v0\", \"v1\", got \"u2\"");
+  CHECK(first_error(with("/boundary_conditions", json::parse(R"([{"edge":"u0","clamped":1}])"))) ==
+        "/boundary_conditions/0/clamped: must be a boolean, got 1");
+
+  CHECK(first_error(with("/point", {1.0, 2.0})).empty());
+  CHECK(first_error(with("/point", {1.0, "x"})) == "/point/1: must be a number, got string \"x\"");
+  CHECK(first_error(with("/point", {1.0, 2.0, 3.0})) == "/point/2: is not allowed here, got 3.0");
+  CHECK(first_error(with("/tags", {"a", "b", "a"})) ==
+        "/tags/2: must be unique, but equals item 0: string \"a\"");
+  CHECK(first_error(with("/limits", json::object())) ==
+        "/limits: must have at least 1 keys, got 0");
+  CHECK(first_error(with("/limits", {{"a", 1}, {"b", 2}, {"c", 3}})) ==
+        "/limits: must have at most 2 keys, got 3");
+  CHECK(first_error(with("/limits", {{"a", "x"}})) ==
+        "/limits/a: must be a number, got string \"x\"");
+  CHECK(first_error(with("/fields", {{"f_1", 1.5}})).empty());
+  CHECK(first_error(with("/fields", {{"f_1", true}})) == "/fields/f_1: must be a number, got true");
+  CHECK(first_error(with("/fields", {{"g", 1}})) == "/fields: unknown key \"g\"");
+
+  // All errors are collected, in document order.
+  json many = base();
+  many["geometry"]["thickness"] = -1;
+  many["name"] = "X";
+  many["extra"] = 1;
+  const auto errs = test_schema().errors(many);
+  REQUIRE(errs.size() == 4);  // unknown key, thickness, name too short, name pattern
+  CHECK(errs[0].pointer == "");
+}
+
+TEST_CASE("schema validator: oneOf/anyOf report the relevant branch, if/then/else, not",
+          "[unit][io][json][schema]") {
+  // Discriminator by const: the matching branch's own errors are reported.
+  CHECK(first_error(with("/solver", {{"type", "newton"}, {"tolerance", 1e-8}})).empty());
+  CHECK(first_error(with("/solver", {{"type", "arclength"}, {"steps", 0}})) ==
+        "/solver/steps: must be >= 1, got 0");
+  CHECK(first_error(with("/solver", {{"type", "newton"}, {"steps", 3}})) ==
+        "/solver: missing required key \"tolerance\"");
+  CHECK(first_error(with("/solver", {{"type", "bfgs"}})) ==
+        "/solver/type: must be one of \"newton\", \"arclength\", got \"bfgs\"");
+  CHECK(first_error(with("/solver", {{"steps", 3}})) ==
+        "/solver: missing required key \"type\" (one of \"newton\", \"arclength\")");
+  // Pure type alternatives are merged.
+  CHECK(first_error(with("/value", 1.5)).empty());
+  CHECK(first_error(with("/value", {1.0, 2.0})).empty());
+  CHECK(first_error(with("/value", "x")) ==
+        "/value: must be a number or an array, got string \"x\"");
+  // Otherwise the deepest error wins.
+  CHECK(first_error(with("/value", {1.0, "x"})) == "/value/1: must be a number, got string \"x\"");
+  CHECK(first_error(with("/load", {{"force", 2}})).empty());
+  CHECK(first_error(with("/load", {{"displacement", {{"u", -1}}}})) ==
+        "/load/displacement/u: must be >= 0, got -1");
+  // oneOf matching twice.
+  json both =
+      knit::io::JsonSchema(json::parse(R"({"oneOf": [{"type": "number"}, {"minimum": 0}]})"), "t")
+          .errors(3)
+          .at(0)
+          .message;
+  CHECK(both == "must match exactly one alternative of oneOf, but matches #0 and #1");
+  // if/then/else and not.
+  CHECK(first_error(with("/output", {{"format", "vtu"}, {"every", 2}})).empty());
+  CHECK(first_error(with("/output", {{"format", "vtu"}})) ==
+        "/output: missing required key \"every\"");
+  CHECK(first_error(with("/output", {{"format", "csv"}})).empty());
+  CHECK(first_error(with("/output", {{"format", "csv"}, {"every", 2}})) ==
+        "/output: must not match the schema under \"not\", got an object");
+}
+
+TEST_CASE("validate() throws InputError with file and pointer", "[unit][io][json][schema]") {
+  try {
+    test_schema().validate(with("/geometry/thickness", -1), "case.json");
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(std::string(e.what()) == "case.json: /geometry/thickness: must be > 0, got -1");
+    CHECK(e.pointer() == "/geometry/thickness");
+  }
+  CHECK_NOTHROW(test_schema().validate(base(), "case.json"));
+}
+
+TEST_CASE("schemas using unsupported keywords or bad $refs are rejected",
+          "[unit][io][json][schema]") {
+  using knit::io::JsonSchema;
+  CHECK_THROWS_WITH(JsonSchema(json::parse(R"({"properties": {"a": {"unit": "mm"}}})"), "s"),
+                    Catch::Contains("schema s: /properties/a/unit: unsupported keyword \"unit\""));
+  CHECK_THROWS_WITH(JsonSchema(json::parse(R"({"$ref": "#/$defs/missing"})"), "s"),
+                    Catch::Contains("$ref \"#/$defs/missing\" does not resolve"));
+  CHECK_THROWS_WITH(JsonSchema(json::parse(R"({"$ref": "other.json#/a"})"), "s"),
+                    Catch::Contains("not supported"));
+  CHECK_THROWS_WITH(JsonSchema(json::parse(R"({"type": "float"})"), "s"),
+                    Catch::Contains("unknown type \"float\""));
+  CHECK_THROWS_WITH(JsonSchema(json::parse(R"({"pattern": "(["})"), "s"),
+                    Catch::Contains("invalid regular expression"));
+  CHECK_NOTHROW(JsonSchema(json::parse(R"({"x-unit": "mm", "format": "uri", "$ref": "#"})"), "s"));
+}
+
+TEST_CASE("embedded schemas match schemas/*.json and load", "[unit][io][json][schema]") {
+  const fs::path dir = fs::path(KNIT_SOURCE_DIR) / "schemas";
+  std::vector<std::string> on_disk;
+  if (fs::exists(dir))
+    for (const auto& e : fs::directory_iterator(dir)) {
+      const std::string f = e.path().filename().string();
+      if (e.path().extension() != ".json") continue;
+      const std::string name = f.size() > 12 && f.ends_with(".schema.json")
+                                   ? f.substr(0, f.size() - 12)
+                                   : f.substr(0, f.size() - 5);
+      on_disk.push_back(name);
+      std::ifstream in(e.path());
+      std::stringstream ss;
+      ss << in.rdbuf();
+      INFO(f);
+      CHECK(knit::io::embedded_schema(name) == ss.str());
+      // Every schema shipped with the project is valid JSON within the supported subset.
+      CHECK_NOTHROW(knit::io::JsonSchema::embedded(name));
+    }
+  std::sort(on_disk.begin(), on_disk.end());
+  CHECK(knit::io::embedded_schema_names() == on_disk);
+  CHECK_THROWS_WITH(knit::io::embedded_schema("no_such_schema"),
+                    Catch::Contains("no embedded JSON schema \"no_such_schema\""));
+}
+
+TEST_CASE("json_pointer_lines locates values and keys in the text", "[unit][io][json]") {
+  const std::string text =
+      "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  },\n"
+      "  \"list\": [\n    1,\n    {\"a~/b\": \"x\\\"y\", \"\\u00e9\": 2}\n  ]\n}\n";
+  const auto lines = knit::io::json_pointer_lines(text);
+  CHECK(lines.at("") == 1);
+  CHECK(lines.at("/name") == 2);
+  CHECK(lines.at("/geometry") == 3);
+  CHECK(lines.at("/geometry/thickness") == 4);
+  CHECK(lines.at("/list/0") == 7);
+  CHECK(lines.at("/list/1") == 8);
+  CHECK(lines.at("/list/1/a~0~1b") == 8);
+  CHECK(lines.at("/list/1/\xc3\xa9") == 8);
+  CHECK(lines.size() == 9);
+}
+
+TEST_CASE("load_and_validate adds the line of the offending value", "[unit][io][json][schema]") {
+  const fs::path f = scratch(
+      "case.json", "{\n  \"name\": \"rod_1\",\n  \"geometry\": {\n    \"thickness\": -1\n  }\n}\n");
+  try {
+    knit::io::load_and_validate(f, test_schema());
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/geometry/thickness");
+    CHECK(e.message() == "must be > 0, got -1 (line 4)");
+  }
+  const fs::path g = scratch("case2.json",
+                             "{\"name\": \"rod_1\",\n \"geometry\": {\"thickness\": 1},\n"
+                             " \"material\": {\"E\": 1,\n   \"Young\": 2}}");
+  CHECK_THROWS_WITH(
+      knit::io::load_and_validate(g, test_schema()),
+      g.string() + ": /material: unknown key \"Young\" (allowed: \"E\", \"nu\") (line 4)");
+  const fs::path ok = scratch("ok2.json", R"({"name": "ab", "geometry": {"thickness": 2}})");
+  CHECK(knit::io::load_and_validate(ok, test_schema())["geometry"]["thickness"] == 2);
+  CHECK_THROWS_WITH(knit::io::load_and_validate(ok, "no_such_schema"),
+                    Catch::Contains("no embedded JSON schema"));
+}
+
+TEST_CASE("duplicate keys are input errors", "[unit][io][json]") {
+  const fs::path f =
+      scratch("dup.json", "{\"a\": {\"x\": 1,\n  \"y\": 2,\n  \"x\": 3}, \"b\": {\"x\": 4}}");
+  try {
+    knit::io::read_json_file(f);
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/a/x");
+    CHECK(e.message() == "duplicate key (lines 1 and 3)");
+  }
+  CHECK_NOTHROW(
+      knit::io::parse_json(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "t"));
+}
+
+TEST_CASE("paths inside input files are relative to the file", "[unit][io][json]") {
+  CHECK(knit::io::resolve_input_path("/cases/shell/a.json", "../db/m.h5") ==
+        fs::path("/cases/db/m.h5"));
+  CHECK(knit::io::resolve_input_path("/cases/a.json", "/abs/m.h5") == fs::path("/abs/m.h5"));
+  CHECK(knit::io::resolve_input_path("a.json", "m.h5") == fs::path("m.h5"));
+}
