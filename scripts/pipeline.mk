@@ -47,10 +47,15 @@ st = $(addprefix $(RES)/,$(addsuffix .status,$(1)))
 
 .PHONY: all database cases figures report clean
 .DELETE_ON_ERROR:
+# Keep the intermediate files (resolved cases, unit cells): a second run must find them.
+.SECONDARY:
 
 all: report
 database: $(DB)
 cases: $(STATUS)
+
+$(MESO) $(MACRO):
+	@echo "pipeline: $@ is missing: build first (scripts/build.sh $(BUILD))"; exit 1
 
 # ---- material database ------------------------------------------------------------------------
 # database.source holds the mode; it is rewritten only when the mode changes, so switching from

@@ -130,12 +130,12 @@ class Report:
             self.add("3.1.3", "course-wise: E11 much higher in the right (6.5 mm) half",
                      "right > left", f"mean E11 right {fmt(right)} vs left {fmt(left)}",
                      right > left)
-        v, _ = self.field_at("s314_linear_course", "E11", 0.3)
+        v, _ = self.field_at("s314_linear_wale", "E22", 0.3)
         if v is not None:
             nv = v.shape[0]
             bot, top = float(np.mean(v[: nv // 3, :])), float(np.mean(v[nv - nv // 3:, :]))
-            self.add("3.1.4", "course-wise: larger strains where the stitch value is higher (top)",
-                     "top > bottom", f"mean E11 top third {fmt(top)} vs bottom third {fmt(bot)}",
+            self.add("3.1.4", "wale-wise: larger strains where the stitch value is higher (top)",
+                     "top > bottom", f"mean E22 top third {fmt(top)} vs bottom third {fmt(bot)}",
                      top > bot)
         # 3.2.1
         q = self.stiffening_ratio("s321_bilinear_diagonal")
