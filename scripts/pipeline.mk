@@ -32,8 +32,10 @@ LOGS := $(OUT)/logs
 
 export MPLBACKEND := Agg
 
-HAVE_SWEEP := $(shell test -f "$(SWEEP_INPUT)" && "$(MESO)" sweep --help >/dev/null 2>&1 && echo yes)
-HAVE_CELL := $(shell "$(MESO)" cell --help >/dev/null 2>&1 && echo yes)
+# A subcommand exists when `knit-meso --help` lists it.
+MESO_SUBCOMMANDS := $(shell "$(MESO)" --help 2>/dev/null | sed -n 's/^  \([a-z][a-z-]*\)  .*/\1/p')
+HAVE_SWEEP := $(if $(and $(filter sweep,$(MESO_SUBCOMMANDS)),$(wildcard $(SWEEP_INPUT))),yes)
+HAVE_CELL := $(if $(filter cell,$(MESO_SUBCOMMANDS)),yes)
 ifeq ($(DB_SOURCE),auto)
   DB_MODE := $(if $(HAVE_SWEEP),sweep,synth)
 else
@@ -94,7 +96,7 @@ $(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO)
 
 # ---- unit cells (Fig. 5) ----------------------------------------------------------------------
 $(OUT)/cells/%/cell.json: $(MESO)
-	@mkdir -p $(OUT)/cells
+	@mkdir -p $(OUT)/cells $(LOGS)
 	@"$(MESO)" cell --loop-length $* --out $(OUT)/cells/$* > $(LOGS)/cell_$*.log 2>&1
 
 # ---- figures ----------------------------------------------------------------------------------

@@ -156,7 +156,7 @@ def cmd_fields(a):
     sl = (slice(None, None, sk), slice(None, None, sk))
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.6))
     for ax, val, lab, cmap in ((axs[0], l, "stitch value l [mm]", "viridis"),
-                               (axs[1], alpha, "knitting angle alpha [rad]", "plasma")):
+                               (axs[1], alpha, "knitting angle alpha [rad]", "coolwarm")):
         pc = ax.pcolormesh(X[..., 0], X[..., 1], val, shading="gouraud", cmap=cmap)
         fig.colorbar(pc, ax=ax, shrink=0.85).set_label(lab)
         if ax is axs[1]:

@@ -2,8 +2,8 @@
 
 A result directory holds load_strain.csv (one row per converged step), results.pvd +
 vtk/step_NNNN.vtu (the deformed mid-surface sampled on an n_u x n_v grid of parameter points,
-u index fastest) and results.h5 (the same fields). Fields are read from results.h5 when it holds
-them and from the VTU files otherwise (both carry the same sampled grid).
+u index fastest) and results.h5 (the same fields under fields/step_NNNN). Fields are read from
+results.h5 when it holds the step and from the VTU file otherwise.
 """
 import json
 import math
@@ -94,7 +94,7 @@ class Result:
     def _read_pvd(self):
         p = os.path.join(self.dir, "results.pvd")
         if not os.path.exists(p):
-            return []
+            return self._h5_steps()
         root = ET.parse(p).getroot()
         out = []
         for ds in root.iter("DataSet"):
@@ -102,6 +102,16 @@ class Result:
             step = int(os.path.splitext(os.path.basename(f))[0].split("_")[-1])
             out.append((step, float(ds.get("timestep")), os.path.join(self.dir, f)))
         return out
+
+    def _h5_steps(self):
+        h = os.path.join(self.dir, "results.h5")
+        try:
+            import h5py
+            with h5py.File(h, "r") as f:
+                return sorted((int(k.split("_")[-1]), float(f["fields"][k].attrs.get("load_factor", 0)),
+                               None) for k in f.get("fields", {}))
+        except (ImportError, OSError, KeyError, ValueError):
+            return []
 
     def steps(self):
         return [s for s, _, _ in self._steps]
@@ -137,13 +147,13 @@ class Result:
         """Sampled fields of an output step: dict with x (deformed), X (reference), u and
         every scalar field, each reshaped to the (n_v, n_u) grid."""
         path = [p for s, _, p in self._steps if s == step]
-        if not path:
-            raise KeyError(f"{self.name}: no output for step {step}")
         h5 = _fields_from_h5(os.path.join(self.dir, "results.h5"), step)
         if h5 is not None:
             pts, f = h5
-        else:
+        elif path and path[0]:
             pts, f = read_vtu(path[0])
+        else:
+            raise KeyError(f"{self.name}: no output for step {step}")
         nu, nv = self.grid
         if pts.shape[0] != nu * nv:  # grid not recorded: assume square
             n = int(round(math.sqrt(pts.shape[0])))
@@ -160,44 +170,34 @@ class Result:
 
 
 def _fields_from_h5(path, step):
-    """Best effort: a group per step holding the point arrays (names as in the VTU). Returns
-    None when results.h5 is missing or does not hold this step's fields."""
+    """results.h5 of knit-macro: group fields/step_NNNN with X, x, displacement ((n, 3)) and
+    one (n,) dataset per scalar field (E11, E22, E12, ..., the material's fields), attributes
+    grid_u, grid_v. Returns None when the file or the step is missing (then the VTU is read)."""
     if not os.path.exists(path):
         return None
     try:
         import h5py
     except ImportError:
         return None
-    found = {}
-
-    def visit(name, obj):
-        if isinstance(obj, h5py.Group) and "E11" in obj and (
-                "x" in obj or "points" in obj or "deformed" in obj):
-            found[name] = obj
-
     try:
         with h5py.File(path, "r") as f:
-            f.visititems(visit)
-            for name, g in found.items():
-                tail = name.rstrip("/").split("/")[-1]
-                digits = "".join(ch for ch in tail if ch.isdigit())
-                if not digits or int(digits) != step:
+            name = f"fields/step_{step:04d}"
+            if name not in f:
+                return None
+            g = f[name]
+            pts = np.array(g["x"], dtype=float).reshape(-1, 3)
+            fields = {}
+            for k in g:
+                if k in ("x", "X") or not isinstance(g[k], h5py.Dataset):
                     continue
-                key = "x" if "x" in g else ("points" if "points" in g else "deformed")
-                pts = np.array(g[key], dtype=float).reshape(-1, 3)
-                fields = {}
-                for k in g:
-                    if k == key or not isinstance(g[k], h5py.Dataset):
-                        continue
-                    a = np.array(g[k], dtype=float)
-                    if a.size == pts.shape[0]:
-                        fields[k] = a.reshape(-1)
-                    elif a.size == 3 * pts.shape[0]:
-                        fields[k] = a.reshape(-1, 3)
-                return pts, fields
-    except Exception:  # a layout we do not know: fall back to the VTU files
+                a = np.array(g[k], dtype=float)
+                if a.size == pts.shape[0]:
+                    fields[k] = a.reshape(-1)
+                elif a.size == 3 * pts.shape[0]:
+                    fields[k] = a.reshape(-1, 3)
+            return pts, fields
+    except (OSError, KeyError):  # unreadable: fall back to the VTU files
         return None
-    return None
 
 
 def load_results(results_dir, names):
