@@ -17,6 +17,7 @@ L = 50.0          # patch size and gauge length (mm)
 T = 0.76          # thickness t = 2d (mm)
 DB = "../../out/database.h5"
 STEPS = 20        # the paper uses 15-20 load steps (Sect. 3)
+CONV_STEPS = 10   # the convergence studies compare load-strain curves: 10 points (3 % apart)
 PI = math.pi
 
 SQUARE = {
@@ -242,15 +243,16 @@ for p in (3, 5, 7):
         out["vtk"] = False  # the convergence plots need the load-strain curves only
         cases[f"conv7c_p{p}h{h}"] = case(
             f"Paper Fig. 7c convergence study: uniform 4.5 mm, wale-wise tensile test with "
-            f"p = {p} x {p}, h = {h} x {h} elements. {TENSILE} {PLANAR}",
-            SQUARE, knit(4.5, 0.0), bcs, out, degree=p, elements=(h, h))
+            f"p = {p} x {p}, h = {h} x {h} elements, {CONV_STEPS} load steps. {TENSILE} {PLANAR}",
+            SQUARE, knit(4.5, 0.0), bcs, out, degree=p, elements=(h, h), steps=CONV_STEPS)
 for p in (3, 5, 7):
     bcs, out = tensile("wale")
     out["vtk"] = False
     cases[f"conv9e_p{p}h1"] = case(
         f"Paper Fig. 9e convergence study: discontinuous 4.5 | 6.5 mm grading (Sect. 3.1.3), "
-        f"wale-wise tensile test with p = {p} x {p}, h = 1. {TENSILE} {PLANAR}",
-        SQUARE, knit(DISC_FIELD, 0.0), bcs, out, degree=p, elements=(1, 1))
+        f"wale-wise tensile test with p = {p} x {p}, h = 1, {CONV_STEPS} load steps. {TENSILE} "
+        f"{PLANAR}",
+        SQUARE, knit(DISC_FIELD, 0.0), bcs, out, degree=p, elements=(1, 1), steps=CONV_STEPS)
 
 for name, c in cases.items():
     with open(os.path.join(HERE, name + ".json"), "w") as f:
