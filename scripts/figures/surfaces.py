@@ -86,7 +86,8 @@ def main():
         return B2 @ C[:, c].reshape(n2, n1) @ B1.T  # (xi2, xi1)
 
     E1, E2, S1, S2 = surf(Ec, 0), surf(Ec, 1), surf(Sc, 0), surf(Sc, 1)
-    fig = plt.figure(figsize=(15, 4.8))
+    fig = plt.figure(figsize=(17, 5))
+    fig.subplots_adjust(wspace=0.35)
     for c, (S, lab) in enumerate(((S1, "S11"), (S2, "S22"))):
         ax = fig.add_subplot(1, 3, c + 1, projection="3d")
         ax.plot_surface(E1, E2, S, cmap="viridis", alpha=0.75, linewidth=0)
