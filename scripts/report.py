@@ -216,6 +216,13 @@ class Report:
         L.append(f"Generated {datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M UTC')} by "
                  f"`scripts/report.py` (git {rev}); regenerate with `scripts/run.sh` "
                  "(see docs/reproduction.md).\n")
+        npass = sum(1 for r in self.rows if r[4] == "**pass**")
+        nfail = sum(1 for r in self.rows if r[4] == "**FAIL**")
+        ndone = sum(1 for n in names if self.r(n).completed)
+        L.append(f"**Summary:** {npass} of the paper's checkable statements pass, {nfail} fail "
+                 f"({len(self.rows) - npass - nfail} listed without a number); {ndone} of "
+                 f"{len(names)} cases completed; material database: "
+                 f"{'SYNTHETIC stand-in' if mode == 'synth' or generator == 'synth' else 'mesoscale sweep'}.\n")
         L.append("## Material database\n")
         if mode == "synth" or generator == "synth":
             L.append("> **The SYNTHETIC stand-in database was used** (`knit-meso synth`: a known "
@@ -240,8 +247,6 @@ class Report:
         L.append("|---|---|---|---|---|")
         for s, st, p, o, v in self.rows:
             L.append(f"| {s} | {st} | {p} | {o} | {v} |")
-        npass = sum(1 for r in self.rows if r[4] == "**pass**")
-        nfail = sum(1 for r in self.rows if r[4] == "**FAIL**")
         L.append(f"\n{npass} pass, {nfail} fail, {len(self.rows) - npass - nfail} without a "
                  "number to compare. The paper's load-strain curves are compared with "
                  "experiments we do not have, so the load values themselves have no pass/fail.\n")
