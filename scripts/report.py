@@ -299,7 +299,9 @@ class Report:
                  "(sum over the runs; target <= 30 s), against ~15 min each in the paper.\n")
         failed = [n for n in names if not self.r(n).completed]
         for n in failed:
-            summ = "; ".join(self.r(n).summary().splitlines()) or "no output"
+            lines = self.r(n).summary().splitlines()
+            msg = [l for l in lines if l.startswith("message:")]
+            summ = (msg[0] if msg else "; ".join(lines[:3])) or "no output"
             L.append(f"- `{n}`: {summ} (log: logs/{n}.log)")
         if failed:
             L.append("")
