@@ -21,3 +21,6 @@ cmake --build "$san" --parallel "$jobs"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 (cd "$san" && ctest --output-on-failure --parallel "$jobs")
+
+echo "== formatting (.clang-format) =="
+"$root/scripts/check_format.sh"

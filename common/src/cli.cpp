@@ -27,7 +27,8 @@ SubcommandRegistrar::SubcommandRegistrar(std::string name, std::string descripti
 
 int run_main(int argc, char** argv, const std::string& program, const std::string& description) {
   CLI::App app{description, program};
-  app.set_version_flag("--version", program + " " + project_version() + " (git " + git_revision() + ")");
+  app.set_version_flag("--version",
+                       program + " " + project_version() + " (git " + git_revision() + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, Runner>> subs;
   for (auto& e : registry()) {

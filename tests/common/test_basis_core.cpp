@@ -84,7 +84,8 @@ TEST_CASE("rational surface derivatives match finite differences", "[unit][splin
   }
 }
 
-TEST_CASE("Gauss-Legendre rules integrate polynomials of degree 2n-1 exactly", "[unit][quadrature]") {
+TEST_CASE("Gauss-Legendre rules integrate polynomials of degree 2n-1 exactly",
+          "[unit][quadrature]") {
   const int n = GENERATE(1, 2, 3, 5, 8, 12);
   const QuadratureRule q = gauss_legendre(n, 0.0, 2.0);
   for (int k = 0; k <= 2 * n - 1; ++k) {

@@ -31,10 +31,12 @@ std::vector<std::string> offending_includes(const fs::path& dir, const std::rege
 
 TEST_CASE("mesoscale and macroscale do not include each other", "[unit][layering]") {
   const fs::path root = KNIT_SOURCE_DIR;
-  const auto meso_hits = offending_includes(root / "mesoscale", std::regex(R"(knit/macro/|macroscale/)"));
-  const auto macro_hits = offending_includes(root / "macroscale", std::regex(R"(knit/meso/|mesoscale/)"));
-  const auto common_hits =
-      offending_includes(root / "common", std::regex(R"(knit/macro/|knit/meso/|macroscale/|mesoscale/)"));
+  const auto meso_hits =
+      offending_includes(root / "mesoscale", std::regex(R"(knit/macro/|macroscale/)"));
+  const auto macro_hits =
+      offending_includes(root / "macroscale", std::regex(R"(knit/meso/|mesoscale/)"));
+  const auto common_hits = offending_includes(
+      root / "common", std::regex(R"(knit/macro/|knit/meso/|macroscale/|mesoscale/)"));
   for (const auto& h : meso_hits) UNSCOPED_INFO(h);
   for (const auto& h : macro_hits) UNSCOPED_INFO(h);
   for (const auto& h : common_hits) UNSCOPED_INFO(h);

@@ -1,0 +1,47 @@
+// A rod problem read from a JSON case file (schema: schemas/rod.schema.json) and its run:
+//   knit-meso rod CASE.json [-o OUTDIR]
+// Outputs in OUTDIR (built as OUTDIR.partial-<pid>, then renamed: never half-written):
+//   load_displacement.csv   step, lambda, Newton iterations, then <point>_ux,_uy,_uz [mm] for
+//                           every named output point (displacement from the reference)
+//   centerline_NNNN.vtp     sampled centerlines per converged step (radius, force, moment, d1)
+//   centerline.pvd          ParaView collection over the load factor
+// Bad input: knit::InputError with the JSON pointer of the offending field (exit code 2),
+// nothing written.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "knit/meso/rod/rod_system.hpp"
+#include "knit/meso/rod/solver.hpp"
+
+namespace knit::meso::rod {
+
+struct NamedPoint {
+  std::string name;
+  int rod = 0;
+  double xi = 1.0;
+};
+
+struct RodCase {
+  std::string file;
+  std::string description;
+  RodSystem system;
+  PathOptions path;
+  std::vector<NamedPoint> points;
+  int samples_per_element = 8;
+  bool write_vtp = true;
+};
+
+/// Reads and checks a case file; throws knit::InputError(file, pointer, message).
+RodCase load_rod_case(const std::filesystem::path& file);
+
+/// Solves the case along its load path and writes the outputs into outdir (atomically, also
+/// when the path stops early: then the outputs hold the converged steps). Progress lines go
+/// to `log` if given.
+PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,
+                        std::ostream* log = nullptr);
+
+}  // namespace knit::meso::rod

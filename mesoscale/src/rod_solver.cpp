@@ -1,0 +1,171 @@
+// Newton-Raphson with SparseLU and load stepping with cut-back (see solver.hpp).
+#include "knit/meso/rod/solver.hpp"
+
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+
+namespace knit::meso::rod {
+
+namespace {
+
+// The symbolic analysis (column ordering, elimination tree) depends on the sparsity pattern
+// only; it is reused across Newton iterations and load steps while the pattern is unchanged
+// (contact may change it: then it is redone). One workspace per thread.
+struct LinearWorkspace {
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  std::vector<int> outer, inner;
+  bool analyzed = false;
+
+  bool same_pattern(const Eigen::SparseMatrix<double>& J) const {
+    if (!analyzed || static_cast<Eigen::Index>(outer.size()) != J.outerSize() + 1 ||
+        static_cast<Eigen::Index>(inner.size()) != J.nonZeros())
+      return false;
+    return std::equal(outer.begin(), outer.end(), J.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), J.innerIndexPtr());
+  }
+  void analyze(const Eigen::SparseMatrix<double>& J) {
+    lu.analyzePattern(J);
+    outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
+    inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
+    analyzed = true;
+  }
+};
+
+double scaled_norm(const RodSystem& sys, const Eigen::VectorXd& F) {
+  const double v = F.cwiseProduct(sys.row_scales()).cwiseAbs().maxCoeff();
+  return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+void assemble_all(const RodSystem& sys, const Eigen::VectorXd& x, double lambda,
+                  const std::vector<ExternalContribution*>& extra, Eigen::VectorXd& F,
+                  Eigen::SparseMatrix<double>& J) {
+  std::vector<Eigen::Triplet<double>> trip;
+  sys.assemble(x, lambda, F, trip);
+  for (ExternalContribution* c : extra) c->add(sys, x, lambda, F, trip);
+  J.resize(sys.num_dofs(), sys.num_dofs());
+  J.setFromTriplets(trip.begin(), trip.end());
+}
+
+NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambda,
+                          const std::vector<ExternalContribution*>& extra,
+                          const NewtonOptions& opt) {
+  NewtonReport rep;
+  const int N = sys.num_dofs();
+  Eigen::VectorXd F(N);
+  Eigen::SparseMatrix<double> J(N, N);
+  std::vector<Eigen::Triplet<double>> trip;
+  thread_local LinearWorkspace ws;
+  auto& lu = ws.lu;
+  trip.reserve(static_cast<size_t>(N) * 40);
+  for (int it = 0;; ++it) {
+    trip.clear();
+    sys.assemble(x, lambda, F, trip);
+    for (ExternalContribution* c : extra) c->add(sys, x, lambda, F, trip);
+    const double res = scaled_norm(sys, F);
+    rep.history.push_back(res);
+    rep.residual_final = res;
+    if (it == 0) rep.residual_initial = res;
+    rep.iterations = it;
+    if (!std::isfinite(res)) {
+      rep.message = "residual is not finite";
+      return rep;
+    }
+    if (res <= opt.tol) {
+      rep.converged = true;
+      rep.message = "converged";
+      return rep;
+    }
+    if (it > 0 && res > opt.divergence_factor * std::max(rep.residual_initial, opt.tol)) {
+      rep.message = "diverged";
+      return rep;
+    }
+    if (it >= opt.max_iterations) {
+      rep.message = "maximum number of iterations reached";
+      return rep;
+    }
+    J.setFromTriplets(trip.begin(), trip.end());
+    J.makeCompressed();
+    if (!ws.same_pattern(J)) ws.analyze(J);
+    lu.factorize(J);
+    if (lu.info() != Eigen::Success) {
+      rep.message = "singular Jacobian";
+      return rep;
+    }
+    const Eigen::VectorXd dx = lu.solve(F);
+    if (lu.info() != Eigen::Success || !dx.allFinite()) {
+      rep.message = "linear solve failed";
+      return rep;
+    }
+    x -= dx;
+  }
+}
+
+PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOptions& opt,
+                      const StepCallback& on_step,
+                      const std::vector<ExternalContribution*>& extra) {
+  PathReport rep;
+  double lam = opt.lambda_start;
+  rep.lambda_reached = lam;
+  // Make sure the start state satisfies the equations (e.g. the quaternion gauge).
+  {
+    const NewtonReport r0 = solve_newton(sys, x, lam, extra, opt.newton);
+    rep.total_iterations += r0.iterations;
+    if (!r0.converged) {
+      rep.message =
+          "start state at lambda = " + std::to_string(lam) + " did not converge: " + r0.message;
+      return rep;
+    }
+  }
+  const int steps = std::max(1, opt.steps);
+  const double nominal = (opt.lambda_end - opt.lambda_start) / steps;
+  double inc = nominal;
+  int halvings = 0;
+  Eigen::VectorXd x_prev = x, x_last = x;
+  bool have_last = false;
+  double last_inc = 0.0;
+  for (int s = 1; s <= steps; ++s) {
+    const double target = opt.lambda_start + nominal * s;
+    while (std::abs(target - lam) > 1e-14 * std::max(1.0, std::abs(target))) {
+      double next = lam + inc;
+      if ((nominal > 0 && next > target) || (nominal < 0 && next < target) ||
+          std::abs(target - next) < 1e-9 * std::abs(nominal))
+        next = target;
+      x_prev = x;
+      // Secant predictor from the last converged increment (saves about one iteration).
+      if (opt.predictor && have_last && std::abs(last_inc) > 0.0)
+        x += ((next - lam) / last_inc) * (x - x_last);
+      const NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
+      rep.total_iterations += r.iterations;
+      if (r.converged) {
+        x_last = x_prev;
+        last_inc = next - lam;
+        have_last = true;
+        lam = next;
+        rep.lambda_reached = lam;
+        ++rep.increments;
+        rep.steps.push_back({lam, r.iterations, r.residual_final});
+        halvings = 0;
+        // Grow back towards the nominal increment after an easy step.
+        if (r.iterations <= 6) inc = std::abs(inc * 2.0) > std::abs(nominal) ? nominal : inc * 2.0;
+      } else {
+        x = x_prev;
+        ++rep.cutbacks;
+        if (++halvings > opt.max_cutbacks) {
+          rep.message = "increment to lambda = " + std::to_string(next) + " failed after " +
+                        std::to_string(opt.max_cutbacks) + " cut-backs: " + r.message;
+          return rep;
+        }
+        inc = 0.5 * (next - lam);
+      }
+    }
+    if (on_step) on_step(s, lam, x);
+  }
+  rep.completed = true;
+  rep.message = "completed";
+  return rep;
+}
+
+}  // namespace knit::meso::rod

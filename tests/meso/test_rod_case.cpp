@@ -1,0 +1,153 @@
+// The rod driver: every case in cases/rod/ runs and is compared with its reference numbers;
+// bad input gives exit code 2, a JSON-pointer message and no output.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kBin = fs::path(KNIT_BIN_DIR) / "knit-meso";
+const fs::path kCases = fs::path(KNIT_SOURCE_DIR) / "cases" / "rod";
+const fs::path kTmp = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "rod";
+
+int run(const std::string& args, std::string* output = nullptr) {
+  fs::create_directories(kTmp);
+  const fs::path log = kTmp / "log.txt";
+  const int rc = std::system((kBin.string() + " " + args + " > " + log.string() + " 2>&1").c_str());
+  if (output) {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *output = ss.str();
+  }
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+/// Numeric rows of a CSV with '#' comments and one header line.
+std::vector<std::vector<double>> read_csv(const fs::path& f,
+                                          std::vector<std::string>* header = nullptr) {
+  std::ifstream in(f);
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    if (!have_header) {
+      have_header = true;
+      if (header) *header = cells;
+      continue;
+    }
+    std::vector<double> r;
+    for (const auto& c : cells) r.push_back(std::stod(c));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+void write(const fs::path& f, const std::string& text) {
+  fs::create_directories(f.parent_path());
+  std::ofstream(f) << text;
+}
+
+}  // namespace
+
+TEST_CASE("rod case: rollup.json follows the exact circle at every step", "[case]") {
+  const fs::path out = kTmp / "rollup";
+  REQUIRE(run("rod " + (kCases / "rollup.json").string() + " -q -o " + out.string()) == 0);
+  std::vector<std::string> h;
+  const auto rows = read_csv(out / "load_displacement.csv", &h);
+  REQUIRE(h.size() == 6);
+  CHECK(h[3] == "tip_ux");
+  REQUIRE(rows.size() == 21);
+  const double L = 10.0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const double th = rows[i][1] * 2 * std::numbers::pi;
+    const double u = L * (std::sin(th) / th - 1.0), w = L * (1.0 - std::cos(th)) / th;
+    const double err = std::hypot(rows[i][3] - u, rows[i][5] - w) / std::hypot(u, w);
+    INFO("step " << i << ": u = " << rows[i][3] << " (" << u << "), w = " << rows[i][5] << " (" << w
+                 << ")");
+    CHECK(err < 0.005);
+  }
+  CHECK(fs::exists(out / "centerline.pvd"));
+  CHECK(fs::exists(out / "centerline_0020.vtp"));
+}
+
+TEST_CASE("rod case: elastica.json matches the elastica PL^2/EI = 4", "[case]") {
+  const fs::path out = kTmp / "elastica";
+  REQUIRE(run("rod " + (kCases / "elastica.json").string() + " -q -o " + out.string()) == 0);
+  const auto rows = read_csv(out / "load_displacement.csv");
+  REQUIRE(rows.size() == 9);
+  CHECK(rows.back()[5] / 10.0 == Approx(0.670).epsilon(0.01));
+  CHECK(-rows.back()[3] / 10.0 == Approx(0.329).epsilon(0.01));
+}
+
+TEST_CASE("rod case: every case file in cases/rod runs to lambda = 1", "[case]") {
+  for (const auto& e : fs::directory_iterator(kCases)) {
+    if (e.path().extension() != ".json") continue;
+    const fs::path out = kTmp / ("all_" + e.path().stem().string());
+    INFO(e.path());
+    CHECK(run("rod " + e.path().string() + " -q -o " + out.string()) == 0);
+  }
+}
+
+TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output", "[case]") {
+  const std::string good_rod =
+      R"({"name": "b", "curve": {"type": "line", "from": [0,0,0], "to": [1,0,0], "degree": 3, "elements": 2},
+          "start": {"position": "fixed", "rotation": "fixed"}, "end": {"position": "free", "rotation": "free"}})";
+  struct Bad {
+    std::string json, pointer;
+  };
+  const std::vector<Bad> bad = {
+      {R"({"rods": []})", "/rods"},
+      {R"({"section": {"d": -1}, "rods": [)" + good_rod + "]}", "/section/d"},
+      {R"({"rods": [)" + good_rod + R"(], "steps": {"count": 0}})", "/steps/count"},
+      {R"({"rods": [{"name": "b", "curve": {"type": "spiral"}, "start": {}, "end": {}}]})",
+       "/rods/0/curve/type"},
+      {R"({"rods": [)" + good_rod +
+           R"(], "output": {"points": [{"name": "t", "rod": "x", "xi": 1}]}})",
+       "/output/points/0/rod"},
+      {R"({"rods": [{"name": "b", "curve": {"type": "bspline", "degree": 2, "knots": [0,0,0,1,1],
+          "control_points": [[0,0,0],[1,0,0],[2,0,0]]}, "start": {"position": "fixed", "rotation": "fixed",
+          "force": [1,0,0]}, "end": {"position": "free", "rotation": "free"}}]})",
+       "/rods/0/curve/knots"},
+      {R"({"rods": [)" + good_rod + R"(], "typo": 1})", ""},
+      {R"({"rods": [ )", ""},
+  };
+  int k = 0;
+  for (const auto& b : bad) {
+    const fs::path f = kTmp / ("bad_" + std::to_string(k) + ".json");
+    const fs::path out = kTmp / ("bad_out_" + std::to_string(k++));
+    fs::remove_all(out);
+    write(f, b.json);
+    std::string msg;
+    const int rc = run("rod " + f.string() + " -q -o " + out.string(), &msg);
+    INFO(b.json << "\n-> " << msg);
+    CHECK(rc == 2);
+    CHECK(msg.find(f.string() + ": " + b.pointer + (b.pointer.empty() ? "" : ": ")) !=
+          std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+}
+
+TEST_CASE("rod case: arc_unbend.json straightens a NURBS quarter circle exactly", "[case]") {
+  const fs::path out = kTmp / "arc_unbend";
+  REQUIRE(run("rod " + (kCases / "arc_unbend.json").string() + " -q -o " + out.string()) == 0);
+  const auto rows = read_csv(out / "load_displacement.csv");
+  REQUIRE(rows.size() == 11);
+  const double R = 5.0;
+  CHECK(rows.back()[3] == Approx(R).epsilon(1e-5));
+  CHECK(rows.back()[4] == Approx(std::numbers::pi * R / 2 - R).epsilon(1e-5));
+  CHECK(std::abs(rows.back()[5]) < 1e-8);
+}

@@ -1,0 +1,206 @@
+// Unit tests of the rod collocation: quaternion identities, Jacobian vs finite differences,
+// rigid-body invariance.
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+
+#include "knit/meso/rod/builders.hpp"
+#include "knit/meso/rod/quaternion.hpp"
+#include "knit/meso/rod/rod_system.hpp"
+#include "knit/meso/rod/solver.hpp"
+
+using namespace knit::meso::rod;
+using Eigen::Vector3d;
+
+namespace {
+
+RodSpec helix_rod(int p, int elements) {
+  auto c = [](double t) -> Vector3d {
+    return Vector3d(std::cos(3 * t), std::sin(3 * t), 0.8 * t) * 2.0;
+  };
+  RodSpec s = interpolated_rod(c, p, elements);
+  s.name = "helix";
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("quaternion: rotation is orthogonal and scale-invariant; log/exp round trip", "[unit]") {
+  const Vector3d th(0.3, -1.1, 2.0);
+  const Quat<double> q = quat_from_rotation_vector(th);
+  const Eigen::Matrix3d R = rotation(q);
+  CHECK((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-14);
+  CHECK(R.determinant() == Approx(1.0));
+  CHECK((rotation(Quat<double>(3.7 * q)) - R).norm() < 1e-14);
+  CHECK((rotation_vector(q) - th).norm() < 1e-12);
+  const Quat<double> q2 = quat_from_matrix(R);
+  CHECK(std::min((q2 - q).norm(), (q2 + q).norm()) < 1e-12);
+  // Rodrigues formula for the rotation vector
+  const double a = th.norm();
+  const Eigen::Matrix3d Rr = Eigen::AngleAxisd(a, th / a).toRotationMatrix();
+  CHECK((Rr - R).norm() < 1e-13);
+}
+
+TEST_CASE("quaternion: material curvature equals axial(R^T R') and is gauge invariant", "[unit]") {
+  auto qf = [](double s) {
+    const Quat<double> q = quat_from_rotation_vector(Vector3d(0.4 * s, std::sin(s), 0.2 + s * s));
+    return Quat<double>((1.0 + 0.3 * s * s) * q);  // non-unit scale
+  };
+  const double s = 0.7, h = 1e-6;
+  const Quat<double> q = qf(s);
+  const Quat<double> dq = (qf(s + h) - qf(s - h)) / (2 * h);
+  const Eigen::Matrix3d dR = (rotation(qf(s + h)) - rotation(qf(s - h))) / (2 * h);
+  const Eigen::Matrix3d W = rotation(q).transpose() * dR;
+  const Vector3d K(W(2, 1), W(0, 2), W(1, 0));
+  CHECK((material_curvature(q, dq) - K).norm() < 1e-8);
+  CHECK((W + W.transpose()).norm() < 1e-8);
+}
+
+TEST_CASE("rod: reference state is an exact equilibrium (stress free)", "[unit]") {
+  RodSystem sys;
+  RodSpec s = helix_rod(4, 8);
+  sys.add_rod(s);
+  const Eigen::VectorXd x = sys.initial_state();
+  Eigen::VectorXd F;
+  sys.residual(x, 0.0, F);
+  CHECK(F.cwiseProduct(sys.row_scales()).cwiseAbs().maxCoeff() < 1e-12);
+  // reference frame: d3 is the tangent
+  for (double xi : {0.0, 0.37, 1.0}) {
+    const PointState st = sys.state(0, xi, x);
+    CHECK((st.R.col(2) - st.r_xi.normalized()).norm() < 1e-3);
+  }
+}
+
+TEST_CASE("rod: Jacobian matches central finite differences", "[unit]") {
+  RodSystem sys;
+  RodSpec s = helix_rod(3, 5);
+  s.start = EndCondition::clamped();
+  s.start.displacement = Vector3d(0.1, -0.2, 0.05);
+  s.start.rotation = Vector3d(0.3, 0.1, -0.2);
+  s.end = EndCondition::free();
+  s.end.force = Vector3d(0.3, 0.1, -0.5);
+  s.end.moment = Vector3d(-0.1, 0.2, 0.3);
+  s.line_force = Vector3d(0.01, 0.02, 0.0);
+  s.line_moment = Vector3d(0.0, 0.01, 0.03);
+  sys.add_rod(s);
+  RodSpec s2 = helix_rod(4, 4);
+  s2.start = EndCondition::free();
+  s2.start.force = Vector3d(1, 2, 3);
+  s2.end = EndCondition::clamped();
+  sys.add_rod(s2);
+  Eigen::VectorXd x = sys.initial_state();
+  Eigen::VectorXd pert = Eigen::VectorXd::Random(x.size());
+  x += 0.05 * pert;
+  for (int i = 0; i < x.size(); i += kDofsPerPoint) x.segment<6>(i + kFieldN) *= 1.0;
+  const double lambda = 0.7;
+  Eigen::VectorXd F;
+  std::vector<Eigen::Triplet<double>> trip;
+  sys.assemble(x, lambda, F, trip);
+  Eigen::SparseMatrix<double> J(x.size(), x.size());
+  J.setFromTriplets(trip.begin(), trip.end());
+  const Eigen::MatrixXd Jd = J;
+  Eigen::MatrixXd Jfd(x.size(), x.size());
+  const double h = 1e-6;
+  Eigen::VectorXd Fp, Fm;
+  for (int c = 0; c < x.size(); ++c) {
+    Eigen::VectorXd xp = x, xm = x;
+    xp(c) += h;
+    xm(c) -= h;
+    sys.residual(xp, lambda, Fp);
+    sys.residual(xm, lambda, Fm);
+    Jfd.col(c) = (Fp - Fm) / (2 * h);
+  }
+  const double err = (Jd - Jfd).cwiseAbs().maxCoeff();
+  INFO("max |J - J_fd| = " << err << ", max |J| = " << Jd.cwiseAbs().maxCoeff());
+  CHECK(err < 1e-6 * std::max(1.0, Jd.cwiseAbs().maxCoeff()));
+}
+
+TEST_CASE("rod: rigid-body motions of a stressed state give zero residual", "[unit]") {
+  // A loaded cantilever in equilibrium, then the whole state moved rigidly (r -> Q r + c,
+  // q -> q_Q q, n -> Q n, m -> Q m): all field equations (balance, constitutive, gauge) stay
+  // satisfied; only the end rows (support and dead loads are not co-rotated) change.
+  RodSystem sys;
+  RodSpec s = helix_rod(3, 6);
+  const double EI = s.section.C_K()(0);
+  s.end.force = Vector3d(0.2, -0.1, 0.3) * EI;
+  s.end.moment = Vector3d(0.1, 0.1, -0.2) * EI;
+  sys.add_rod(s);
+  Eigen::VectorXd x = sys.initial_state();
+  PathOptions po;
+  po.steps = 4;
+  REQUIRE(solve_path(sys, x, po).completed);
+  const Quat<double> qQ = quat_from_rotation_vector(Vector3d(0.5, -0.3, 1.2));
+  const Eigen::Matrix3d Q = rotation(qQ);
+  const Vector3d c(1.0, -2.0, 0.5);
+  Eigen::VectorXd y = x;
+  for (int a = 0; a < sys.num_control_points(0); ++a) {
+    y.segment<3>(sys.dof(0, a, kFieldR)) = Q * x.segment<3>(sys.dof(0, a, kFieldR)) + c;
+    y.segment<4>(sys.dof(0, a, kFieldQ)) =
+        qmul(qQ, Quat<double>(x.segment<4>(sys.dof(0, a, kFieldQ))));
+    y.segment<3>(sys.dof(0, a, kFieldN)) = Q * x.segment<3>(sys.dof(0, a, kFieldN));
+    y.segment<3>(sys.dof(0, a, kFieldM)) = Q * x.segment<3>(sys.dof(0, a, kFieldM));
+  }
+  Eigen::VectorXd F;
+  sys.residual(y, 1.0, F);
+  const Eigen::VectorXd Fs = F.cwiseProduct(sys.row_scales());
+  const int n = sys.num_control_points(0);
+  double worst = 0.0;
+  for (int j = 0; j < n; ++j)
+    for (int k = 0; k < kRowsPerPoint; ++k) {
+      const bool end_row = (j == 0 || j == n - 1) && k < kRowStrain;
+      if (!end_row) worst = std::max(worst, std::abs(Fs(sys.row(0, j, kRowForce) + k)));
+    }
+  CHECK(worst < 1e-10);
+  // the stressed state is far from the reference: the check is not trivial
+  CHECK(x.segment<3>(sys.dof(0, n - 1, kFieldN)).norm() > 0.1 * EI);
+}
+
+TEST_CASE("rod: load stepping cuts back a too large increment; failure is a status", "[unit]") {
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0);
+  auto make = [&](RodSystem& sys) {
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
+    s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);  // almost a full circle
+    sys.add_rod(s);
+  };
+  {
+    RodSystem sys;
+    make(sys);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.newton.max_iterations = 8;
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK(rep.completed);
+    CHECK(rep.cutbacks > 0);
+    CHECK(rep.lambda_reached == 1.0);
+  }
+  {
+    RodSystem sys;
+    make(sys);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.max_cutbacks = 0;
+    po.newton.max_iterations = 3;
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK_FALSE(rep.completed);
+    CHECK(rep.lambda_reached == 0.0);
+    CHECK(!rep.message.empty());
+    // x is restored to the last converged state
+    CHECK((x - sys.initial_state()).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("section: yarn defaults reproduce the values of design/notes.md", "[unit]") {
+  const Section s;  // d = 0.38 mm, E = 800 MPa, nu = 0.3
+  CHECK(s.A() == Approx(0.1134).epsilon(1e-3));
+  CHECK(s.I() == Approx(1.024e-3).epsilon(1e-3));
+  CHECK(s.J() == Approx(2.047e-3).epsilon(1e-3));
+  CHECK(s.C_Gamma()(2) == Approx(90.7).epsilon(1e-3));
+  CHECK(s.C_K()(0) == Approx(0.819).epsilon(1e-3));
+  CHECK(s.shear_factor() == Approx(6 * 1.3 / 8.8));
+  CHECK(s.C_Gamma()(0) == Approx(800.0 / 2.6 * (6 * 1.3 / 8.8) * s.A()));
+  CHECK(s.C_K()(2) == Approx(800.0 / 2.6 * s.J()));
+}
