@@ -49,12 +49,13 @@ st = $(addprefix $(RES)/,$(addsuffix .status,$(1)))
 
 .PHONY: all database cases figures report clean
 .DELETE_ON_ERROR:
-# Keep the intermediate files (resolved cases, unit cells): a second run must find them.
-.SECONDARY:
 
 all: report
 database: $(DB)
-cases: $(STATUS)
+# The resolved case files are named here so that make does not treat them as intermediate
+# (deleted after the run, remade by the next one).
+RESOLVED := $(CASES:%=$(OUT)/cases/%.json)
+cases: $(RESOLVED) $(STATUS)
 
 $(MESO) $(MACRO):
 	@echo "pipeline: $@ is missing: build first (scripts/build.sh $(BUILD))"; exit 1
@@ -102,41 +103,43 @@ $(OUT)/cells/%/cell.json: $(MESO)
 # ---- figures ----------------------------------------------------------------------------------
 PLOT := $(PY) $(FIGPY)/plots.py --results $(RES)
 FIGURES :=
+# $(call draw,COMMAND,OUT.png): a figure script that fails does not stop the pipeline: the
+# error goes to logs/figures/NAME.log and the PNG says the figure is missing; the placeholder is
+# dated 1970 so that the next run tries the figure again.
+draw = mkdir -p $(FIG) $(LOGS)/figures; $(1) > $(LOGS)/figures/$(notdir $(basename $(2))).log 2>&1 || { \
+  echo "figure: $(notdir $(2)) failed, see $(LOGS)/figures/$(notdir $(basename $(2))).log"; \
+  $(PY) $(FIGPY)/plots.py --results $(RES) placeholder --title "$(notdir $(2))" --message "the figure script failed (logs/figures)" --out $(2) \
+  && touch -d @0 $(2); }
 
 define deformed # name, case, field, step-strain (or "last"), title
 FIGURES += $(FIG)/$(1).png
 $(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@mkdir -p $(FIG)
-	@$(PLOT) deformed --case $(2) --field $(3) --at $(4) --title "$(5)" --out $$@
+	@$$(call draw,$(PLOT) deformed --case $(2) --field $(3) --at $(4) --title "$(5)" --out $$@,$$@)
 endef
 
 define fields # name, case, title
 FIGURES += $(FIG)/$(1).png
 $(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@mkdir -p $(FIG)
-	@$(PLOT) fields --case $(2) --title "$(3)" --out $$@
+	@$$(call draw,$(PLOT) fields --case $(2) --title "$(3)" --out $$@,$$@)
 endef
 
 define load # name, title, cases...
 FIGURES += $(FIG)/$(1).png
 $(FIG)/$(1).png: $(call st,$(3)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@mkdir -p $(FIG)
-	@$(PLOT) load --title "$(2)" --out $$@ $(3)
+	@$$(call draw,$(PLOT) load --title "$(2)" --out $$@ $(3),$$@)
 endef
 
 # Fig. 5: unit cells (needs `knit-meso cell`).
 ifeq ($(HAVE_CELL),yes)
 FIGURES += $(FIG)/fig05_cells.png
 $(FIG)/fig05_cells.png: $(OUT)/cells/4.5/cell.json $(OUT)/cells/6.5/cell.json $(FIGPY)/cells.py
-	@mkdir -p $(FIG)
-	@$(PY) $(FIGPY)/cells.py --out $@ $(OUT)/cells/4.5 $(OUT)/cells/6.5
+	@$(call draw,$(PY) $(FIGPY)/cells.py --out $@ $(OUT)/cells/4.5 $(OUT)/cells/6.5,$@)
 endif
 
 # Fig. 6: response surfaces at 6.5 mm with the data points.
 FIGURES += $(FIG)/fig06_response_surfaces.png
 $(FIG)/fig06_response_surfaces.png: $(DB) $(FIGPY)/surfaces.py
-	@mkdir -p $(FIG)
-	@$(PY) $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5 --out $@
+	@$(call draw,$(PY) $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5 --out $@,$@)
 
 # Sect. 3.1.2 (Fig. 7)
 $(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22)))

@@ -4,6 +4,7 @@
   plots.py --results DIR load --title T --out F.png CASE...      load (N) vs applied strain
   plots.py --results DIR deformed --case C --field E22 --at 0.3 --title T --out F.png
   plots.py --results DIR fields --case C --title T --out F.png   stitch value / knitting angle
+  plots.py --results DIR placeholder --title T --message M --out F.png
 
 Deformed shapes are drawn in the x1-x2 plane (the 3-D hyperbolic paraboloid is projected),
 coloured by a Green-Lagrange strain component of the local Cartesian frame (E11, E22, E12 as
@@ -192,7 +193,14 @@ def main():
     s.add_argument("--case", required=True)
     s.add_argument("--title", default="")
     s.add_argument("--out", required=True)
+    s = sub.add_parser("placeholder", help="a PNG that says why a figure is missing")
+    s.add_argument("--title", default="")
+    s.add_argument("--message", default="")
+    s.add_argument("--out", required=True)
     a = p.parse_args()
+    if a.cmd == "placeholder":
+        placeholder(a.out, a.title, a.message)
+        return
     {"load": cmd_load, "deformed": cmd_deformed, "fields": cmd_fields}[a.cmd](a)
 
 
