@@ -147,9 +147,11 @@ bcs, out = tensile("wale")
 cases["s315_diagonal_45deg_vertical"] = case(
     "Paper Sect. 3.1.5, Fig. 12: 4.5 mm in the bottom-left half, 6.5 mm in the top-right half, "
     "constant knitting angle alpha = pi/4 (course direction at 45 deg to theta1), vertical "
-    f"tensile test. {TENSILE} CHOICE (the paper is silent): p = 5 x 5 with h = 4 x 4 elements so "
-    f"that the quadrature resolves the diagonal interface. {PLANAR}",
-    SQUARE, knit(DIAG_FIELD, PI / 4), bcs, out, elements=(4, 4))
+    f"tensile test. {TENSILE} CHOICE (the paper is silent): p = 5 x 5 with h = 2 x 2 elements (the "
+    f"diagonal interface runs through the element corners). With the sweep database h = 3 and 4 "
+    f"stop within the first steps (the strain localizes in the 2.5 mm transition band and the "
+    f"response-surface inversion fails there), h = 2 completes. {PLANAR}",
+    SQUARE, knit(DIAG_FIELD, PI / 4), bcs, out, elements=(2, 2))
 
 # --- 3.2.1 bilinear l and alpha, diagonal test ------------------------------------------------
 BIL_L = field([1, 1], [0, 0, 1, 1], [0, 0, 1, 1], [4.5, 6.5, 6.5, 4.5],
@@ -197,7 +199,9 @@ cases["s322_curved_horizontal"] = case(
     "stitch value cubic in theta1, knitting direction aligned with x1. Left edge (u0) fixed, "
     "right edge (u1) displaced horizontally by 20 mm (40 % of L = 50 mm) with its vertical "
     "displacement held; the load is the edge reaction in x. CHOICE (the paper is silent): "
-    "refinement p = 5 x 5, h = 2 x 2; edges not clamped. 20 steps, so step 15 is 30 %. "
+    "refinement p = 5 x 5, h = 1 x 1 as in the validation cases (with the sweep database, "
+    "h = 2 and 4 stop early: the response-surface inversion fails at the extreme strains of the "
+    "fixed corners); edges not clamped. 20 steps, so step 15 is 30 %. "
     f"{PLANAR}",
     CURVED, knit(CUBIC_L, ALIGN),
     [{"all": True, "fix": ["z"]},
@@ -206,7 +210,7 @@ cases["s322_curved_horizontal"] = case(
     {"grid": [41, 41], "every": 5,
      "reactions": [{"name": "load", "edge": "u1", "component": "x"}],
      "applied_displacement": {"edge": "u1", "component": "x", "gauge_length": L}},
-    elements=(2, 2))
+    elements=(1, 1))
 
 # --- 3.2.3 hyperbolic paraboloid ---------------------------------------------------------------
 # The paper prints x3 = 0.24 (x1 - 2.5)(x2 - 2.5) in cm (corners at +-1.5 cm); in mm:
