@@ -9,7 +9,8 @@ out="${KNIT_OUT:-$root/out}"
 mkdir -p "$out"
 if [ -f "$root/scripts/pipeline.mk" ]; then
   make -f "$root/scripts/pipeline.mk" ROOT="$root" BUILD="$root/build" OUT="$out" -j"$(nproc)" all
-  echo "run: report in $out/report.md"
+  grep -m1 '^\*\*Summary' "$out/report.md" | sed 's/\*\*//g; s/^/run: /' || true
+  echo "run: report in $out/report.md (figures in $out/figures, results in $out/results)"
 else
   echo "run: the reproduction pipeline has not landed yet; built executables:"
   ls -1 "$root/build/bin"

@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""Fig. 5: the single-jersey unit cells (from `knit-meso cell --loop-length L --out DIR`:
+DIR/cell.vtp polylines with cell arrays "piece" and "image", DIR/cell.json with w and c), seen
+in the x-y plane with the neighbouring images in grey and the w x c bounding box in blue.
+
+Usage: cells.py --out fig05.png DIR_4.5 DIR_6.5
+"""
+import argparse
+import json
+import os
+import xml.etree.ElementTree as ET
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def read_vtp(path):
+    piece = ET.parse(path).getroot().find("./PolyData/Piece")
+    pts = np.array(piece.find("./Points/DataArray").text.split(), dtype=float).reshape(-1, 3)
+    cell = {da.get("Name"): np.array(da.text.split(), dtype=int)
+            for da in piece.findall("./CellData/DataArray")}
+    lines = {da.get("Name"): np.array(da.text.split(), dtype=int)
+             for da in piece.findall("./Lines/DataArray")}
+    conn, offs = lines["connectivity"], lines["offsets"]
+    polys, start = [], 0
+    for o in offs:
+        polys.append(pts[conn[start:o]])
+        start = o
+    return polys, cell.get("image", np.zeros(len(polys), dtype=int))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", required=True)
+    ap.add_argument("dirs", nargs="+")
+    a = ap.parse_args()
+    fig, axs = plt.subplots(1, len(a.dirs), figsize=(5 * len(a.dirs), 5))
+    axs = np.atleast_1d(axs)
+    for ax, d in zip(axs, a.dirs):
+        with open(os.path.join(d, "cell.json")) as f:
+            info = json.load(f)
+        polys, image = read_vtp(os.path.join(d, "cell.vtp"))
+        for P, im in zip(polys, image):
+            ax.plot(P[:, 0], P[:, 1], color="0.75" if im else "C1", lw=2.5 if im == 0 else 1.5,
+                    zorder=1 if im else 2)
+        w, c = info["w"], info["c"]
+        own = np.concatenate([P for P, im in zip(polys, image) if im == 0])
+        cx, cy = 0.5 * (own[:, 0].min() + own[:, 0].max()), 0.5 * (own[:, 1].min() + own[:, 1].max())
+        ax.add_patch(plt.Rectangle((cx - 0.5 * w, cy - 0.5 * c), w, c, fill=False, ec="b", lw=1.5, zorder=3))
+        ax.set_aspect("equal")
+        ax.set_title(f"l = {info['loop_length']} mm: w = {w:.2f} mm, c = {c:.2f} mm\n"
+                     f"measured length {info.get('measured_length', float('nan')):.3f} mm, "
+                     f"min clearance {info.get('min_clearance', float('nan')):.3f} mm", fontsize=9)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+    fig.suptitle("Fig. 5: unit cells with their w x c bounding boxes (blue)", fontsize=11)
+    tmp = a.out + ".tmp.png"
+    fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    os.replace(tmp, a.out)
+
+
+if __name__ == "__main__":
+    main()

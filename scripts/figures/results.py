@@ -1,0 +1,204 @@
+"""Reading knit-macro output directories (docs/case-format.md, "Output directory").
+
+A result directory holds load_strain.csv (one row per converged step), results.pvd +
+vtk/step_NNNN.vtu (the deformed mid-surface sampled on an n_u x n_v grid of parameter points,
+u index fastest) and results.h5 (the same fields under fields/step_NNNN). Fields are read from
+results.h5 when it holds the step and from the VTU file otherwise.
+"""
+import json
+import math
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+
+def read_csv(path):
+    """load_strain.csv -> dict column -> numpy array (comment lines start with '#')."""
+    with open(path) as f:
+        lines = [l.strip() for l in f if l.strip() and not l.startswith("#")]
+    if not lines:
+        return {}
+    head = lines[0].split(",")
+    rows = [[float(v) for v in l.split(",")] for l in lines[1:]]
+    data = np.array(rows, dtype=float).reshape(len(rows), len(head))
+    return {h: data[:, k] for k, h in enumerate(head)}
+
+
+def read_vtu(path):
+    """ASCII VTU of the shell writer -> (points (n,3), {name: (n,) or (n,3)})."""
+    root = ET.parse(path).getroot()
+    piece = root.find("./UnstructuredGrid/Piece")
+    pts = np.array(piece.find("./Points/DataArray").text.split(), dtype=float).reshape(-1, 3)
+    fields = {}
+    for da in piece.findall("./PointData/DataArray"):
+        v = np.array(da.text.split(), dtype=float)
+        nc = int(da.get("NumberOfComponents", "1"))
+        fields[da.get("Name")] = v.reshape(-1, nc) if nc > 1 else v
+    return pts, fields
+
+
+class Result:
+    """One case's output directory plus the pipeline's status file next to it."""
+
+    def __init__(self, results_dir, name):
+        self.name = name
+        self.dir = os.path.join(results_dir, name)
+        self.status = {}
+        sp = os.path.join(results_dir, name + ".status")
+        if os.path.exists(sp):
+            with open(sp) as f:
+                self.status = json.load(f)
+        self.ok = os.path.isdir(self.dir) and os.path.exists(os.path.join(self.dir, "load_strain.csv"))
+        self.csv = read_csv(os.path.join(self.dir, "load_strain.csv")) if self.ok else {}
+        self.case = {}
+        cp = os.path.join(self.dir, "case.json")
+        if os.path.exists(cp):
+            with open(cp) as f:
+                self.case = json.load(f)
+        grid = self.case.get("output", {}).get("grid", [21, 21])
+        self.grid = (int(grid[0]), int(grid[1]))
+        self._steps = self._read_pvd()
+
+    # -- run facts ----------------------------------------------------------------------------
+    @property
+    def completed(self):
+        return self.ok and self.status.get("exit_code", 1) == 0
+
+    @property
+    def seconds(self):
+        return self.status.get("seconds", float("nan"))
+
+    def summary(self):
+        p = os.path.join(self.dir, "summary.txt")
+        return open(p).read().strip() if os.path.exists(p) else ""
+
+    # -- load-strain curve --------------------------------------------------------------------
+    def strain(self):
+        return np.concatenate([[0.0], self.csv.get("strain", np.array([]))])
+
+    def load(self):
+        """Load in N: the jaw/edge reaction, or for the corner-driven diagonal tests the
+        reaction's component along the diagonal, (Fx + Fy)/sqrt(2)."""
+        c = self.csv
+        if "load_N" in c:
+            f = c["load_N"]
+        elif "load_x_N" in c and "load_y_N" in c:
+            f = (c["load_x_N"] + c["load_y_N"]) / math.sqrt(2.0)
+        else:
+            cols = [k for k in c if k.endswith("_N")]
+            f = c[cols[0]] if cols else np.array([])
+        return np.concatenate([[0.0], f])
+
+    # -- fields -------------------------------------------------------------------------------
+    def _read_pvd(self):
+        p = os.path.join(self.dir, "results.pvd")
+        if not os.path.exists(p):
+            return self._h5_steps()
+        root = ET.parse(p).getroot()
+        out = []
+        for ds in root.iter("DataSet"):
+            f = ds.get("file")
+            step = int(os.path.splitext(os.path.basename(f))[0].split("_")[-1])
+            out.append((step, float(ds.get("timestep")), os.path.join(self.dir, f)))
+        return out
+
+    def _h5_steps(self):
+        h = os.path.join(self.dir, "results.h5")
+        try:
+            import h5py
+            with h5py.File(h, "r") as f:
+                return sorted((int(k.split("_")[-1]), float(f["fields"][k].attrs.get("load_factor", 0)),
+                               None) for k in f.get("fields", {}))
+        except (ImportError, OSError, KeyError, ValueError):
+            return []
+
+    def steps(self):
+        return [s for s, _, _ in self._steps]
+
+    def step_at(self, at):
+        """The output step nearest to the applied strain `at` ("last" = the last step)."""
+        if not self._steps:
+            return None
+        if at == "last":
+            return self._steps[-1][0]
+        target = float(at)
+        steps = self.csv.get("step")
+        strain = self.csv.get("strain")
+        if steps is None or strain is None:
+            return self._steps[-1][0]
+        by_step = dict(zip(steps.astype(int), strain))
+        have = [s for s in self.steps() if s in by_step]
+        if not have:
+            return self._steps[-1][0]
+        return min(have, key=lambda s: abs(by_step[s] - target))
+
+    def strain_of_step(self, step):
+        steps = self.csv.get("step")
+        strain = self.csv.get("strain")
+        if steps is None or strain is None:
+            return float("nan")
+        for s, e in zip(steps.astype(int), strain):
+            if s == step:
+                return float(e)
+        return float("nan")
+
+    def fields(self, step):
+        """Sampled fields of an output step: dict with x (deformed), X (reference), u and
+        every scalar field, each reshaped to the (n_v, n_u) grid."""
+        path = [p for s, _, p in self._steps if s == step]
+        h5 = _fields_from_h5(os.path.join(self.dir, "results.h5"), step)
+        if h5 is not None:
+            pts, f = h5
+        elif path and path[0]:
+            pts, f = read_vtu(path[0])
+        else:
+            raise KeyError(f"{self.name}: no output for step {step}")
+        nu, nv = self.grid
+        if pts.shape[0] != nu * nv:  # grid not recorded: assume square
+            n = int(round(math.sqrt(pts.shape[0])))
+            nu, nv = n, n
+        out = {"x": pts.reshape(nv, nu, 3)}
+        u = f.get("displacement")
+        if u is not None:
+            out["u"] = u.reshape(nv, nu, 3)
+            out["X"] = out["x"] - out["u"]
+        for k, v in f.items():
+            if v.ndim == 1:
+                out[k] = v.reshape(nv, nu)
+        return out
+
+
+def _fields_from_h5(path, step):
+    """results.h5 of knit-macro: group fields/step_NNNN with X, x, displacement ((n, 3)) and
+    one (n,) dataset per scalar field (E11, E22, E12, ..., the material's fields), attributes
+    grid_u, grid_v. Returns None when the file or the step is missing (then the VTU is read)."""
+    if not os.path.exists(path):
+        return None
+    try:
+        import h5py
+    except ImportError:
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            name = f"fields/step_{step:04d}"
+            if name not in f:
+                return None
+            g = f[name]
+            pts = np.array(g["x"], dtype=float).reshape(-1, 3)
+            fields = {}
+            for k in g:
+                if k in ("x", "X") or not isinstance(g[k], h5py.Dataset):
+                    continue
+                a = np.array(g[k], dtype=float)
+                if a.size == pts.shape[0]:
+                    fields[k] = a.reshape(-1)
+                elif a.size == 3 * pts.shape[0]:
+                    fields[k] = a.reshape(-1, 3)
+            return pts, fields
+    except (OSError, KeyError):  # unreadable: fall back to the VTU files
+        return None
+
+
+def load_results(results_dir, names):
+    return [Result(results_dir, n) for n in names]

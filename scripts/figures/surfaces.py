@@ -1,0 +1,122 @@
+#!/usr/bin/python3
+"""Fig. 6: the stress response surfaces S11(E11, E22), S22(E11, E22) and the curve S12(E12)
+of one loop length, with the homogenized data points (black dots), from the material database
+(schemas/database.layout.json: /loop_k/fit/{knots_1, knots_2, E_ctrl, S_ctrl}, /loop_k/fit/shear,
+/loop_k/raw/path_qq/{E, S, status}).
+
+The surfaces are drawn as the paper defines them (eq. 17): E(xi) and S(xi) evaluated on a grid
+of the shared parameter domain [0, 1]^2, plotted as S over E.
+
+Usage: surfaces.py --database DB.h5 --loop-length 6.5 --out fig06.png
+"""
+import argparse
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import h5py  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def basis(p, U, x):
+    """All B-spline basis values N_{i,p}(x) (Cox-de Boor), x in [U[0], U[-1]]."""
+    U = np.asarray(U, dtype=float)
+    n = len(U) - p - 1
+    x = np.clip(np.atleast_1d(x), U[0], U[-1])
+    N = np.zeros((len(x), len(U) - 1))
+    for k in range(len(U) - 1):
+        N[:, k] = (U[k] <= x) & (x < U[k + 1])
+    last = np.max(np.nonzero(U < U[-1])[0])
+    N[x >= U[-1], :] = 0.0
+    N[x >= U[-1], last] = 1.0
+    for d in range(1, p + 1):
+        M = np.zeros((len(x), len(U) - 1 - d))
+        for k in range(len(U) - 1 - d):
+            a = U[k + d] - U[k]
+            b = U[k + d + 1] - U[k + 1]
+            if a > 0:
+                M[:, k] += (x - U[k]) / a * N[:, k]
+            if b > 0:
+                M[:, k] += (U[k + d + 1] - x) / b * N[:, k + 1]
+        N = M
+    return N[:, :n]
+
+
+def pick_loop(f, l):
+    ls = np.array(f["loop_lengths"])
+    k = int(np.argmin(abs(ls - l)))
+    return k, float(ls[k])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--database", required=True)
+    ap.add_argument("--loop-length", type=float, default=6.5)
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    with h5py.File(a.database, "r") as f:
+        k, l = pick_loop(f, a.loop_length)
+        g = f[f"loop_{k}"]
+        gen = f.attrs.get("generator", b"?")
+        gen = gen.decode() if isinstance(gen, bytes) else str(gen)
+        fit = g["fit"]
+        p1, p2 = int(fit.attrs["degree_1"]), int(fit.attrs["degree_2"])
+        n1 = int(fit.attrs["n1"])
+        U1, U2 = np.array(fit["knots_1"]), np.array(fit["knots_2"])
+        Ec, Sc = np.array(fit["E_ctrl"]), np.array(fit["S_ctrl"])
+        sh = fit["shear"]
+        ps, Us = int(sh.attrs["degree"]), np.array(sh["knots"])
+        E12c, S12c = np.array(sh["E12_ctrl"]), np.array(sh["S12_ctrl"])
+        data = []
+        if "raw" in g:
+            for name in g["raw"]:
+                pg = g["raw"][name]
+                E, S = np.array(pg["E"]), np.array(pg["S"])
+                st = np.array(pg["status"]) if "status" in pg else np.zeros(len(E))
+                kind = pg.attrs.get("kind", b"biaxial")
+                kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+                data.append((kind, E[st == 0], S[st == 0]))
+    n2 = Ec.shape[0] // n1
+    xi = np.linspace(0, 1, 41)
+    B1, B2 = basis(p1, U1, xi), basis(p2, U2, xi)  # (41, n1), (41, n2)
+
+    def surf(C, c):
+        return B2 @ C[:, c].reshape(n2, n1) @ B1.T  # (xi2, xi1)
+
+    E1, E2, S1, S2 = surf(Ec, 0), surf(Ec, 1), surf(Sc, 0), surf(Sc, 1)
+    fig = plt.figure(figsize=(17, 5))
+    fig.subplots_adjust(wspace=0.35)
+    for c, (S, lab) in enumerate(((S1, "S11"), (S2, "S22"))):
+        ax = fig.add_subplot(1, 3, c + 1, projection="3d")
+        ax.plot_surface(E1, E2, S, cmap="viridis", alpha=0.75, linewidth=0)
+        for kind, E, Sd in data:
+            if kind == "biaxial" and len(E):
+                ax.scatter(E[:, 0], E[:, 1], Sd[:, c], color="k", s=4)
+        ax.set_xlabel("E11")
+        ax.set_ylabel("E22")
+        ax.set_zlabel(f"{lab} [MPa]")
+        ax.set_title(f"({'ab'[c]}) {lab}(E11, E22)", fontsize=10)
+    ax = fig.add_subplot(1, 3, 3)
+    t = np.linspace(0, 1, 200)
+    Bs = basis(ps, Us, t)
+    ax.plot(Bs @ E12c, Bs @ S12c, "-", label="response curve")
+    for kind, E, Sd in data:
+        if kind == "shear" and len(E):
+            ax.plot(E[:, 2], Sd[:, 2], "k.", label="data")
+    ax.set_xlabel("E12")
+    ax.set_ylabel("S12 [MPa]")
+    ax.set_title("(c) S12(E12)", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    note = " - SYNTHETIC stand-in database" if gen == "synth" else ""
+    fig.suptitle(f"Fig. 6: response surfaces, l = {l} mm (database generator: {gen}){note}",
+                 fontsize=11)
+    tmp = a.out + ".tmp.png"
+    fig.savefig(tmp, dpi=100, bbox_inches="tight")
+    os.replace(tmp, a.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,196 @@
+# Reproduction pipeline of the paper (issue #8): material database -> every case of the paper
+# (cases/paper/*.json) -> figures -> validation report ($(OUT)/report.md).
+#
+#   make -f scripts/pipeline.mk ROOT=$PWD BUILD=$PWD/build OUT=$PWD/out -j2 all
+#
+# Real dependencies: the database depends on the sweep input and knit-meso; each case result
+# on its case file, the database and knit-macro; each figure on the results it draws; the
+# report on everything. A second run does nothing; -j2 runs independent cases side by side.
+#
+# DB_SOURCE = auto | sweep | synth. auto uses `knit-meso sweep $(SWEEP_INPUT)` when knit-meso has
+# the sweep subcommand and the input exists, and otherwise the SYNTHETIC stand-in
+# `knit-meso synth` (the report says which one was used, from $(OUT)/database.source).
+# Outputs: $(OUT)/database.h5, $(OUT)/cases/NAME.json (the case with the database path set),
+# $(OUT)/results/NAME/ (knit-macro's output directory), $(OUT)/results/NAME.status (exit code
+# and wall time), $(OUT)/logs/, $(OUT)/figures/*.png, $(OUT)/report.md.
+
+ROOT ?= $(abspath $(dir $(lastword $(MAKEFILE_LIST)))/..)
+BUILD ?= $(ROOT)/build
+OUT ?= $(ROOT)/out
+PY ?= /usr/bin/python3
+MESO := $(BUILD)/bin/knit-meso
+MACRO := $(BUILD)/bin/knit-macro
+SWEEP_INPUT ?= $(ROOT)/cases/sweep/default.json
+SWEEP_THREADS ?= 2
+DB_SOURCE ?= auto
+CASEDIR := $(ROOT)/cases/paper
+FIGPY := $(ROOT)/scripts/figures
+DB := $(OUT)/database.h5
+RES := $(OUT)/results
+FIG := $(OUT)/figures
+LOGS := $(OUT)/logs
+
+export MPLBACKEND := Agg
+
+# A subcommand exists when `knit-meso --help` lists it.
+MESO_SUBCOMMANDS := $(shell "$(MESO)" --help 2>/dev/null | sed -n 's/^  \([a-z][a-z-]*\)  .*/\1/p')
+HAVE_SWEEP := $(if $(and $(filter sweep,$(MESO_SUBCOMMANDS)),$(wildcard $(SWEEP_INPUT))),yes)
+HAVE_CELL := $(if $(filter cell,$(MESO_SUBCOMMANDS)),yes)
+ifeq ($(DB_SOURCE),auto)
+  DB_MODE := $(if $(HAVE_SWEEP),sweep,synth)
+else
+  DB_MODE := $(DB_SOURCE)
+endif
+DB_INPUTS := $(if $(filter sweep,$(DB_MODE)),$(SWEEP_INPUT))
+
+CASES := $(sort $(basename $(notdir $(wildcard $(CASEDIR)/*.json))))
+STATUS := $(CASES:%=$(RES)/%.status)
+st = $(addprefix $(RES)/,$(addsuffix .status,$(1)))
+
+.PHONY: all database cases figures report clean
+.DELETE_ON_ERROR:
+
+all: report
+database: $(DB)
+# The resolved case files are named here so that make does not treat them as intermediate
+# (deleted after the run, remade by the next one).
+RESOLVED := $(CASES:%=$(OUT)/cases/%.json)
+cases: $(RESOLVED) $(STATUS)
+
+$(MESO) $(MACRO):
+	@echo "pipeline: $@ is missing: build first (scripts/build.sh $(BUILD))"; exit 1
+
+# ---- material database ------------------------------------------------------------------------
+# database.source holds the mode; it is rewritten only when the mode changes, so switching from
+# the stand-in to the sweep rebuilds the database (and everything after it).
+$(OUT)/database.source: FORCE
+	@mkdir -p $(OUT)
+	@echo "$(DB_MODE) $(DB_INPUTS)" | cmp -s - $@ || echo "$(DB_MODE) $(DB_INPUTS)" > $@
+
+$(DB): $(OUT)/database.source $(MESO) $(DB_INPUTS)
+	@mkdir -p $(LOGS)
+	@echo "database: $(DB_MODE) -> $@"
+	@start=$$(date +%s.%N); \
+	if [ "$(DB_MODE)" = sweep ]; then \
+	  "$(MESO)" sweep "$(SWEEP_INPUT)" --output $@ --threads $(SWEEP_THREADS) --force --plain > $(LOGS)/database.log 2>&1; \
+	else \
+	  "$(MESO)" synth --out $@ > $(LOGS)/database.log 2>&1; \
+	fi || { echo "database: failed, see $(LOGS)/database.log"; tail -5 $(LOGS)/database.log; exit 1; }; \
+	end=$$(date +%s.%N); \
+	echo "{\"mode\": \"$(DB_MODE)\", \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $(OUT)/database.time
+
+# ---- cases ------------------------------------------------------------------------------------
+$(OUT)/cases/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
+	@mkdir -p $(OUT)/cases
+	@$(PY) $(FIGPY)/resolve_case.py $< $(DB) $@
+
+# knit-macro exits 1 when a load step fails (the converged steps are kept): the pipeline goes on
+# and the report shows the failure; the status file records the exit code and the wall time.
+$(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO)
+	@mkdir -p $(RES) $(LOGS)
+	@echo "case: $*"
+	@start=$$(date +%s.%N); rc=0; \
+	"$(MACRO)" run $< --output $(RES)/$* > $(LOGS)/$*.log 2>&1 || rc=$$?; \
+	end=$$(date +%s.%N); \
+	echo "{\"case\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+	if [ $$rc -ne 0 ]; then echo "case: $* exited with $$rc (see $(LOGS)/$*.log)"; fi
+
+# ---- unit cells (Fig. 5) ----------------------------------------------------------------------
+$(OUT)/cells/%/cell.json: $(MESO)
+	@mkdir -p $(OUT)/cells $(LOGS)
+	@"$(MESO)" cell --loop-length $* --out $(OUT)/cells/$* > $(LOGS)/cell_$*.log 2>&1
+
+# ---- figures ----------------------------------------------------------------------------------
+PLOT := $(PY) $(FIGPY)/plots.py --results $(RES)
+FIGURES :=
+# $(call draw,COMMAND,OUT.png): a figure script that fails does not stop the pipeline: the
+# error goes to logs/figures/NAME.log and the PNG says the figure is missing; the placeholder is
+# dated 1970 so that the next run tries the figure again.
+draw = mkdir -p $(FIG) $(LOGS)/figures; $(1) > $(LOGS)/figures/$(notdir $(basename $(2))).log 2>&1 || { \
+  echo "figure: $(notdir $(2)) failed, see $(LOGS)/figures/$(notdir $(basename $(2))).log"; \
+  $(PY) $(FIGPY)/plots.py --results $(RES) placeholder --title "$(notdir $(2))" --message "the figure script failed (logs/figures)" --out $(2) \
+  && touch -d @0 $(2); }
+
+define deformed # name, case, field, step-strain (or "last"), title
+FIGURES += $(FIG)/$(1).png
+$(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
+	@$$(call draw,$(PLOT) deformed --case $(2) --field $(3) --at $(4) --title "$(5)" --out $$@,$$@)
+endef
+
+define fields # name, case, title
+FIGURES += $(FIG)/$(1).png
+$(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
+	@$$(call draw,$(PLOT) fields --case $(2) --title "$(3)" --out $$@,$$@)
+endef
+
+define load # name, title, cases...
+FIGURES += $(FIG)/$(1).png
+$(FIG)/$(1).png: $(call st,$(3)) $(FIGPY)/plots.py $(FIGPY)/results.py
+	@$$(call draw,$(PLOT) load --title "$(2)" --out $$@ $(3),$$@)
+endef
+
+# Fig. 5: unit cells (needs `knit-meso cell`).
+ifeq ($(HAVE_CELL),yes)
+FIGURES += $(FIG)/fig05_cells.png
+$(FIG)/fig05_cells.png: $(OUT)/cells/4.5/cell.json $(OUT)/cells/6.5/cell.json $(FIGPY)/cells.py
+	@$(call draw,$(PY) $(FIGPY)/cells.py --out $@ $(OUT)/cells/4.5 $(OUT)/cells/6.5,$@)
+endif
+
+# Fig. 6: response surfaces at 6.5 mm with the data points.
+FIGURES += $(FIG)/fig06_response_surfaces.png
+$(FIG)/fig06_response_surfaces.png: $(DB) $(FIGPY)/surfaces.py
+	@$(call draw,$(PY) $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5 --out $@,$@)
+
+# Sect. 3.1.2 (Fig. 7)
+$(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22)))
+$(eval $(call deformed,fig07b_uniform65_wale_E22,s312_uniform_65_wale,E22,0.3,Fig. 7b: l = 6.5 mm wale-wise at 30 % (E22)))
+$(eval $(call load,fig07c_convergence,Fig. 7c: convergence wale-wise l = 4.5 mm,conv7c_p3h1 conv7c_p5h1 conv7c_p7h1 conv7c_p3h4 conv7c_p5h4 conv7c_p7h4))
+$(eval $(call load,fig07d_load_strain,Fig. 7d: uniform stitch values,s312_uniform_45_course s312_uniform_45_wale s312_uniform_65_course s312_uniform_65_wale))
+# Sect. 3.1.3 (Figs. 8-9)
+$(eval $(call fields,fig08a_discontinuous_field,s313_discontinuous_course,Fig. 8a: stitch value 4.5 | 6.5 mm))
+$(eval $(call deformed,fig09b_discontinuous_course_E11,s313_discontinuous_course,E11,0.3,Fig. 9b: course-wise at 30 % (E11)))
+$(eval $(call deformed,fig09d_discontinuous_wale_E22,s313_discontinuous_wale,E22,0.3,Fig. 9d: wale-wise at 30 % (E22)))
+$(eval $(call load,fig09e_convergence,Fig. 9e: convergence wale-wise 4.5 | 6.5 mm,conv9e_p3h1 conv9e_p5h1 conv9e_p7h1))
+$(eval $(call load,fig09f_load_strain,Fig. 9f: discontinuous grading,s313_discontinuous_course s313_discontinuous_wale))
+# Sect. 3.1.4 (Figs. 10-11)
+$(eval $(call fields,fig10a_linear_field,s314_linear_course,Fig. 10a: stitch value 4.5 -> 6.5 mm along the wale))
+$(eval $(call deformed,fig11b_linear_course_E11,s314_linear_course,E11,0.3,Fig. 11b: course-wise at 30 % (E11)))
+$(eval $(call deformed,fig11d_linear_wale_E22,s314_linear_wale,E22,0.3,Fig. 11d: wale-wise at 30 % (E22)))
+$(eval $(call load,fig11e_load_strain,Fig. 11e: linear grading,s314_linear_course s314_linear_wale))
+# Sect. 3.1.5 (Fig. 12)
+$(eval $(call fields,fig12a_diagonal_field,s315_diagonal_45deg_vertical,Fig. 12a: stitch value and knitting direction (alpha = pi/4)))
+$(eval $(call deformed,fig12c_diagonal_E11,s315_diagonal_45deg_vertical,E11,0.3,Fig. 12c: vertical test at 30 % (E11)))
+$(eval $(call deformed,fig12d_diagonal_E22,s315_diagonal_45deg_vertical,E22,0.3,Fig. 12d: vertical test at 30 % (E22)))
+$(eval $(call load,fig12f_load_strain,Fig. 12f: 45 deg knitting direction,s315_diagonal_45deg_vertical))
+# Sect. 3.2.1 (Figs. 13-14)
+$(eval $(call fields,fig13_bilinear_fields,s321_bilinear_diagonal,Fig. 13: bilinear stitch value and knitting direction))
+$(eval $(call deformed,fig14a_bilinear_E11,s321_bilinear_diagonal,E11,last,Fig. 14a: diagonal test u1 = u2 = 10 mm (E11)))
+$(eval $(call deformed,fig14b_bilinear_E22,s321_bilinear_diagonal,E22,last,Fig. 14b: diagonal test u1 = u2 = 10 mm (E22)))
+$(eval $(call deformed,fig14c_bilinear_E12,s321_bilinear_diagonal,E12,last,Fig. 14c: diagonal test u1 = u2 = 10 mm (E12)))
+$(eval $(call load,fig14d_load_strain,Fig. 14d: diagonal tensile test,s321_bilinear_diagonal))
+# Sect. 3.2.2 (Fig. 15)
+$(eval $(call fields,fig15ab_curved_fields,s322_curved_horizontal,Fig. 15a/b: stitch value and knitting direction))
+$(eval $(call deformed,fig15c_curved_E11,s322_curved_horizontal,E11,0.3,Fig. 15c: horizontal test at 30 % (E11)))
+$(eval $(call deformed,fig15d_curved_E22,s322_curved_horizontal,E22,0.3,Fig. 15d: horizontal test at 30 % (E22)))
+$(eval $(call deformed,fig15e_curved_E12,s322_curved_horizontal,E12,0.3,Fig. 15e: horizontal test at 30 % (E12)))
+$(eval $(call load,fig15f_load_strain,Fig. 15f: curved patch horizontal test,s322_curved_horizontal))
+# Sect. 3.2.3 (Fig. 16)
+$(eval $(call fields,fig16b_hypar_fields,s323_hypar_tension,Fig. 16b: stitch value and knitting direction))
+$(eval $(call deformed,fig16c_hypar_tension_E12,s323_hypar_tension,E12,last,Fig. 16c: diagonal tension ~21 % (E12)))
+$(eval $(call deformed,fig16d_hypar_compression_E12,s323_hypar_compression,E12,last,Fig. 16d: diagonal compression ~14 % (E12)))
+
+figures: $(FIGURES)
+
+# ---- report -----------------------------------------------------------------------------------
+$(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py $(FIGPY)/results.py
+	@$(PY) $(ROOT)/scripts/report.py --out-dir $(OUT) --database $(DB) --cells "$(HAVE_CELL)" > $(LOGS)/report.log 2>&1 \
+	  || { cat $(LOGS)/report.log; exit 1; }
+	@echo "report: $@"
+
+report: $(OUT)/report.md
+
+clean:
+	rm -rf $(OUT)/database.h5 $(OUT)/database.source $(OUT)/database.time $(OUT)/cases \
+	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/report.md
+
+FORCE:
