@@ -56,8 +56,8 @@ class Material {
   /// Extra named scalar fields the material adds to the outputs at a sample point with
   /// mid-surface strain E (local Cartesian Voigt), e.g. the design fields (stitch length,
   /// knitting angle) and the strains in the material (course/wale) frame. Empty by default.
-  virtual std::vector<std::pair<std::string, double>> output_fields(const Eigen::Vector2d& theta,
-                                                                    const Eigen::Vector3d& E) const {
+  virtual std::vector<std::pair<std::string, double>> output_fields(
+      const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const {
     return {};
   }
 
