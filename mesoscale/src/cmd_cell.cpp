@@ -95,7 +95,7 @@ knit::cli::SubcommandRegistrar reg(
     "cell", "Write the single-jersey unit-cell geometry (VTP + JSON)", [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")->required();
-      sub.add_option("--out", o->out, "output directory");
+      sub.add_option("-o,--output,--out", o->out, "output directory");
       sub.add_option("--diameter", o->d, "yarn diameter d (mm)");
       sub.add_option("--gamma-over-w", o->gamma_over_w, "loop bulge gamma / w");
       return [o]() { return run(*o); };

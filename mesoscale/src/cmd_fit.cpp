@@ -23,7 +23,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
       auto o = std::make_shared<FitCli>();
       sub.add_option("database", o->db, "material database (.h5)")->required();
       sub.add_option("--options", o->options, "fit options (JSON file; defaults otherwise)");
-      sub.add_option("--out", o->out, "write here instead of replacing the input");
+      sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       return [o]() -> int {
         using namespace knit::meso::fit;
         auto db = knit::material::read_database(o->db, true);

@@ -117,7 +117,7 @@ knit::cli::SubcommandRegistrar reg(
       auto* s = sub.add_option("--shear", o->shear, "pure-shear angle gamma (degrees)");
       b->excludes(s);
       sub.add_option("--steps", o->steps, "load steps (default 20)");
-      sub.add_option("--out", o->out, "output directory");
+      sub.add_option("-o,--output,--out", o->out, "output directory");
       sub.add_option("--elements", o->elements, "analysis-curve elements (default 32)");
       sub.add_option("--penalty", o->k_N, "normal penalty stiffness k_N (MPa)");
       sub.add_option("--allowance", o->g0, "penetration allowance g0 (mm)");

@@ -31,7 +31,7 @@ static knit::cli::SubcommandRegistrar reg_synth(
     "orthotropic stiffening law on the default load paths), fitted unless --no-fit",
     [](CLI::App& sub) {
       auto o = std::make_shared<SynthCli>();
-      sub.add_option("--out", o->out, "output database (.h5)")->required();
+      sub.add_option("-o,--output,--out", o->out, "output database (.h5)")->required();
       sub.add_option("--loop-lengths", o->loop_lengths, "loop lengths in mm (increasing)")
           ->delimiter(',');
       sub.add_option("--steps", o->steps, "load steps per path")->check(CLI::Range(4, 1000));
