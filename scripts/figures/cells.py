@@ -6,6 +6,7 @@ in the x-y plane with the neighbouring images in grey and the w x c bounding box
 Usage: cells.py --out fig05.png DIR_4.5 DIR_6.5
 """
 import argparse
+import base64
 import json
 import os
 import xml.etree.ElementTree as ET
@@ -17,13 +18,25 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+_VTK_TYPES = {"Float64": np.float64, "Float32": np.float32, "Int64": np.int64, "Int32": np.int32,
+              "UInt64": np.uint64, "UInt32": np.uint32, "UInt8": np.uint8, "Int8": np.int8}
+
+
+def _array(da, dtype):
+    """A VTK XML DataArray, ASCII or base64 'binary' (UInt64 byte-count header + data)."""
+    if da.get("format") == "binary":
+        raw = base64.b64decode("".join(da.text.split()))
+        header = np.dtype(np.uint64).itemsize  # header_type="UInt64" (knit/io/vtk.hpp)
+        data = np.frombuffer(raw[header:], dtype=_VTK_TYPES[da.get("type")])
+        return data.astype(dtype)
+    return np.array(da.text.split(), dtype=dtype)
+
+
 def read_vtp(path):
     piece = ET.parse(path).getroot().find("./PolyData/Piece")
-    pts = np.array(piece.find("./Points/DataArray").text.split(), dtype=float).reshape(-1, 3)
-    cell = {da.get("Name"): np.array(da.text.split(), dtype=int)
-            for da in piece.findall("./CellData/DataArray")}
-    lines = {da.get("Name"): np.array(da.text.split(), dtype=int)
-             for da in piece.findall("./Lines/DataArray")}
+    pts = _array(piece.find("./Points/DataArray"), float).reshape(-1, 3)
+    cell = {da.get("Name"): _array(da, int) for da in piece.findall("./CellData/DataArray")}
+    lines = {da.get("Name"): _array(da, int) for da in piece.findall("./Lines/DataArray")}
     conn, offs = lines["connectivity"], lines["offsets"]
     polys, start = [], 0
     for o in offs:
