@@ -16,8 +16,9 @@ using nlohmann::json;
 
 struct Reader {
   std::string file;
+  std::string prefix;  ///< pointer of the cell object inside its document
   [[noreturn]] void fail(const std::string& ptr, const std::string& msg) const {
-    throw InputError(file, ptr, msg);
+    throw InputError(file, prefix + ptr, msg);
   }
   void object(const json& j, const std::string& ptr, const std::set<std::string>& allowed) const {
     if (!j.is_object()) fail(ptr, "must be an object");
@@ -55,10 +56,18 @@ struct Reader {
 }  // namespace
 
 CellOptions read_cell_options(const std::string& file, CellOptions o) {
-  Reader R{file};
   // Schema first (schemas/cell.schema.json, embedded): types, ranges, unknown keys with
-  // "did you mean"; the reader below keeps its own checks so that it is safe on its own.
+  // "did you mean", and line numbers from the file's text.
   const json j = io::load_and_validate(file, "cell");
+  return cell_options_from_json(j, file, "", o);
+}
+
+CellOptions cell_options_from_json(const json& j, const std::string& file,
+                                   const std::string& pointer, CellOptions o) {
+  Reader R{file, pointer};
+  if (const auto errors = io::JsonSchema::embedded("cell").errors(j); !errors.empty())
+    R.fail(errors.front().pointer, errors.front().message);
+  // The reader keeps its own checks so that it is safe on its own.
   R.object(j, "", {"$schema", "description", "yarn", "loop", "analysis", "contact", "solver"});
   constexpr double inf = 1e300;
   if (j.contains("yarn")) {

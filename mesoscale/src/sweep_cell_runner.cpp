@@ -3,43 +3,21 @@
 // recording F*, P*, E, S of every step (eqs. 8-9). Each call builds its own cell, equilibrates
 // it at F* = I and then follows the path step by step from the last converged state; it is
 // deterministic and shares nothing with concurrent calls.
-#include <unistd.h>
-
-#include <filesystem>
-#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "knit/core/errors.hpp"
-#include "knit/meso/sweep/sweep.hpp"
-
-#if __has_include("knit/meso/homog/cell_config.hpp")
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
-#define KNIT_SWEEP_HAVE_CELL 1
-#endif
+#include "knit/meso/sweep/sweep.hpp"
 
 namespace knit::meso::sweep {
 
-#if defined(KNIT_SWEEP_HAVE_CELL)
-
 namespace {
 
-/// The cell parameters through the cell's own reader (knit/meso/homog/cell_config.hpp), which
-/// reads files: the inline object is handed to it as a private temporary file.
+/// The cell parameters: the sweep's inline "cell" object, or the file it names.
 homog::CellOptions cell_options(const SweepInput& in) {
   if (!in.cell_file.empty()) return homog::read_cell_options(in.cell_file);
-  if (in.cell_json == "{}") return {};
-  namespace fs = std::filesystem;
-  const fs::path tmp =
-      fs::temp_directory_path() / ("knit-sweep-cell-" + std::to_string(::getpid()) + ".json");
-  std::ofstream(tmp) << in.cell_json;
-  try {
-    homog::CellOptions co = homog::read_cell_options(tmp.string());
-    fs::remove(tmp);
-    return co;
-  } catch (const InputError& e) {
-    fs::remove(tmp);
-    throw InputError(in.file, "/cell" + e.pointer(), e.message());
-  }
+  return homog::cell_options_from_json(nlohmann::json::parse(in.cell_json), in.file, "/cell");
 }
 
 }  // namespace
@@ -89,14 +67,5 @@ PathRunner cell_runner(const SweepInput& in) {
     return out;
   };
 }
-
-#else
-
-PathRunner cell_runner(const SweepInput& in) {
-  throw InputError(in.file, "/runner",
-                   "the unit-cell runner is not part of this build yet (use \"synthetic\")");
-}
-
-#endif
 
 }  // namespace knit::meso::sweep

@@ -9,9 +9,6 @@
 //     tangent angle of the rational cubic (42 deg at theta1 = 1/2);
 //   - 3.2.3: the hyperbolic paraboloid in mm has its corners at +-15 mm.
 // The material is a test law stored as a database (the cases' database path is replaced).
-#if __has_include("knit/macro/run.hpp") && __has_include(                         \
-                                               "knit/macro/knit_material.hpp") && \
-                                               __has_include("knit/material/database.hpp")
 #include <unistd.h>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -175,4 +172,3 @@ TEST_CASE("paper cases: 3.2.3 - the hyperbolic paraboloid in mm, reduced tension
   CHECK(std::isfinite(f[0]));
   CHECK(f[1] == Approx(f[0]).epsilon(1e-6));  // the same diagonal symmetry as 3.2.1
 }
-#endif

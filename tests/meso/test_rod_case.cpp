@@ -1,5 +1,7 @@
 // The rod driver: every case in cases/rod/ runs and is compared with its reference numbers;
 // bad input gives exit code 2, a JSON-pointer message and no output.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -16,7 +18,9 @@ namespace {
 
 const fs::path kBin = fs::path(KNIT_BIN_DIR) / "knit-meso";
 const fs::path kCases = fs::path(KNIT_SOURCE_DIR) / "cases" / "rod";
-const fs::path kTmp = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "rod";
+// One directory per test process: CTest runs the test cases of this file side by side.
+const fs::path kTmp =
+    fs::path(KNIT_BINARY_DIR) / "test_tmp" / ("rod_" + std::to_string(::getpid()));
 
 int run(const std::string& args, std::string* output = nullptr) {
   fs::create_directories(kTmp);
