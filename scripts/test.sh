@@ -16,7 +16,9 @@ echo "== unit tests under ASan + UBSan =="
 san="$root/build-sanitize"
 gen=()
 command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
-cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKNIT_SANITIZE=ON >/dev/null
+# -O1 with line tables only: what ASan recommends, and about half the compile time of -O2 -g.
+cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
+  -DKNIT_SANITIZE=ON >/dev/null
 cmake --build "$san" --parallel "$jobs"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
