@@ -183,6 +183,27 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
             ", " + std::to_string(x2) + ") (Jacobian determinant " + std::to_string(det) + ")");
     }
 
+  // Blending band: up to kBlendMax, but outside the directions of the outermost paths at any
+  // step (the initial tangent E_2(xi1, 0) included), so data inside the fan are untouched.
+  {
+    const double mid = 0.5 * (phi_.front() + phi_.back());
+    double lo = phi_.front(), hi = phi_.back();
+    for (int j = 0; j <= 8; ++j) {
+      for (double x1 : {0.0, 1.0}) {
+        eval4({x1, j / 8.0}, V);
+        const Eigen::Vector2d e =
+            j == 0 ? Eigen::Vector2d(V.block<2, 1>(0, 2)) : Eigen::Vector2d(V.block<2, 1>(0, 0));
+        double a = std::atan2(e(1), e(0));
+        while (a < mid - kPi) a += 2 * kPi;
+        while (a > mid + kPi) a -= 2 * kPi;
+        lo = std::min(lo, a);
+        hi = std::max(hi, a);
+      }
+    }
+    const double gap = std::min(lo - (mid - 0.5 * kPi), (mid + 0.5 * kPi) - hi);
+    blend_ = std::clamp(0.9 * gap, 1e-3, kBlendMax);
+  }
+
   // C0: least squares over the edge directions, C0 * E_2(xi1, 0) ~ S_2(xi1, 0).
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), B = Eigen::Matrix2d::Zero();
   for (int k = 0; k < m; ++k) {
@@ -417,13 +438,13 @@ ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
   // The extension has two branches (xi2 >= 0 around the fan, xi2 <= 0 opposite to it) whose
   // direction ranges overlap beyond the outermost paths; they give different S there. Around
   // the two switch directions psi = +-pi/2 (psi = angle from the fan's bisector) S is blended
-  // with a C1 weight w(psi) over +-kBlend, so S is continuous in E and
+  // with a C1 weight w(psi) over +-blend_, so S is continuous in E and
   // C = w C+ + (1 - w) C- + (S+ - S-) (dw/dE)^T stays its exact derivative.
   const double mid = 0.5 * (phi_.front() + phi_.back());
   double psi = std::atan2(Et(1), Et(0)) - mid;
   while (psi <= -kPi) psi += 2 * kPi;
   while (psi > kPi) psi -= 2 * kPi;
-  const double sdist = (0.5 * kPi - std::abs(psi)) / kBlend;  // > 0: the fan's side
+  const double sdist = (0.5 * kPi - std::abs(psi)) / blend_;  // > 0: the fan's side
   if (sdist >= 1.0 || sdist <= -1.0) {
     const Branch b = solve_branch(Et, sdist > 0.0 ? 1.0 : -1.0);
     out.S.head<2>() = b.S;
@@ -436,7 +457,7 @@ ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
   const Branch bp = solve_branch(Et, 1.0), bm = solve_branch(Et, -1.0);
   const double x = 0.5 * (sdist + 1.0);  // 0 -> branch -, 1 -> branch +
   const double w = x * x * (3.0 - 2.0 * x);
-  const double dw_dpsi = 6.0 * x * (1.0 - x) * 0.5 * (psi > 0.0 ? -1.0 : 1.0) / kBlend;
+  const double dw_dpsi = 6.0 * x * (1.0 - x) * 0.5 * (psi > 0.0 ? -1.0 : 1.0) / blend_;
   const Eigen::Vector2d dpsi_dE(-Et(1) / rE2, Et(0) / rE2);
   const Eigen::Vector2d jump = bp.S - bm.S;
   out.S.head<2>() = w * bp.S + (1.0 - w) * bm.S;

@@ -104,8 +104,9 @@ class ResponseSurface {
   static constexpr double kTolAbs = 1e-13, kTolRel = 1e-11;
   static constexpr int kMaxIterations = 40;
   static constexpr int kMaxBacktracking = 30;
-  /// Half-width (rad) of the band around the switch between the extension's two branches.
-  static constexpr double kBlend = 0.1745329251994330;  // 10 degrees
+  /// Largest half-width (rad) of the band around the switch between the extension's two
+  /// branches; the band never reaches into the fan of paths (blend_ below).
+  static constexpr double kBlendMax = 0.5235987755982988;  // 30 degrees
 
  private:
   /// Surface values V and derivatives V_1, V_2, V_12 (columns) at xi, extension included.
@@ -130,6 +131,7 @@ class ResponseSurface {
   std::vector<double> slope1_;                   ///< radial dE/dxi2 at xi2 = 1 (guess for xi2 > 1)
   Eigen::Matrix3d C0_ = Eigen::Matrix3d::Zero();
   double E12_max_ = 0.0;
+  double blend_ = kBlendMax;  ///< half-width of the blending band, outside every path
   bool shear_linear_ = false;
 };
 
