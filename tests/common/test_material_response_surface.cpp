@@ -138,3 +138,61 @@ TEST_CASE("response surface: inversion never fails in a large box, tangent consi
   }
   CHECK(worst <= 8);
 }
+
+TEST_CASE("response surface: far extrapolation (|E| up to 1e5) inverts, S finite, C consistent",
+          "[unit]") {
+  // Regression: with a fixed Newton step limit (0.5 in xi2) and a guess that ignored the end
+  // tangent, strains far outside the sweep's fan (which a shell's first Newton iterate can
+  // produce on fine meshes) needed more than kMaxIterations steps: the evaluation failed and
+  // returned S, C of the last iterate, and the shell's load step diverged. The test surface
+  // is built on the sweep's own fan (proportional F, quadratic E along each path).
+  const ResponseSurface rs(make_test_surface(2.0));
+  std::mt19937 gen(11);
+  int worst = 0;
+  for (double R : {0.3, 3.0, 100.0, 1e3, 1e5}) {
+    std::uniform_real_distribution<double> u(-R, R);
+    for (int k = 0; k < 400; ++k) {
+      const Eigen::Vector3d E(u(gen), u(gen), u(gen));
+      const auto ev = rs.evaluate(E);
+      INFO("E = " << E.transpose() << ", xi = " << ev.xi.transpose());
+      REQUIRE((ev.flags & kInversionFailed) == 0);
+      REQUIRE(ev.S.allFinite());
+      REQUIRE(ev.C.allFinite());
+      // E(xi) reproduces the strain.
+      const Eigen::Vector4d P = rs.point(ev.xi);
+      CHECK((P.head<2>() - E.head<2>()).norm() <= 1e-9 * (1.0 + E.head<2>().norm()));
+      worst = std::max(worst, ev.iterations);
+      if (k % 40 == 0) {
+        const Eigen::Matrix3d Cfd = fd_tangent(rs, E, 1e-7 * std::max(1.0, R));
+        CHECK((ev.C - Cfd).norm() <= 1e-4 * Cfd.norm());
+      }
+    }
+  }
+  CHECK(worst <= 20);
+}
+
+TEST_CASE("response surface: S continuous across the switch of extension branches", "[unit]") {
+  // Regression: beyond the outermost paths the xi2 >= 0 and the xi2 <= 0 extensions both reach
+  // the directions at +-90 degrees from the fan's bisector and give different S there (up to a
+  // factor 8 on the swept database); the half-plane rule jumped between them, so S was
+  // discontinuous at arbitrarily small strains and a shell's Newton stalled at the first step.
+  const ResponseSurface rs(make_test_surface(2.0));
+  const double mid = 0.5 * (rs.fan_begin() + rs.fan_end());
+  for (double side : {-1.0, 1.0})
+    for (double r : {1e-4, 0.05, 0.5}) {
+      const double ph = mid + side * 0.5 * M_PI;
+      auto at = [&](double d) {
+        return Eigen::Vector3d(r * std::cos(ph + d), r * std::sin(ph + d), 0.01);
+      };
+      const auto a = rs.evaluate(at(-1e-9)), b = rs.evaluate(at(1e-9));
+      CHECK((a.S - b.S).norm() <= 1e-6 * r);
+      // Tangent inside the blending band and at its edges.
+      for (double d : {-0.17, -0.05, 0.0, 0.08, 0.17}) {
+        const Eigen::Vector3d E = at(d);
+        const auto ev = rs.evaluate(E);
+        REQUIRE((ev.flags & kInversionFailed) == 0);
+        const Eigen::Matrix3d Cfd = fd_tangent(rs, E, 1e-7 * r);
+        CHECK((ev.C - Cfd).norm() <= 1e-4 * Cfd.norm());
+      }
+    }
+}
