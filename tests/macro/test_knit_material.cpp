@@ -38,9 +38,10 @@ MaterialPoint at(double t1, double t2) {
 
 TEST_CASE("knit material: tangent equals finite differences of S (graded, rotated)", "[unit]") {
   const KnitMaterial m = graded(0.4);
-  for (const Eigen::Vector3d E : {Eigen::Vector3d(0.1, 0.05, 0.04), Eigen::Vector3d(0.3, -0.1, 0.2),
-                                  Eigen::Vector3d(0.6, 0.2, 0.1), Eigen::Vector3d(-0.1, -0.05, 0.0),
-                                  Eigen::Vector3d(0.02, 0.4, -0.5)}) {
+  for (const Eigen::Vector3d& E :
+       {Eigen::Vector3d(0.1, 0.05, 0.04), Eigen::Vector3d(0.3, -0.1, 0.2),
+        Eigen::Vector3d(0.6, 0.2, 0.1), Eigen::Vector3d(-0.1, -0.05, 0.0),
+        Eigen::Vector3d(0.02, 0.4, -0.5)}) {
     const auto p = at(0.37, 0.5);
     const auto r = m.evaluate(E, p);
     Eigen::Matrix3d Cfd;
