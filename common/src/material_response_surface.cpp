@@ -141,8 +141,6 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
   table_xi_.resize(m);
   phi_.resize(m);
   radius_.resize(m);
-  radius0_.resize(m);
-  slope1_.resize(m);
   Eigen::Matrix4d V;
   for (int k = 0; k < m; ++k) {
     const double x = static_cast<double>(k) / (m - 1);
@@ -155,8 +153,6 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
     }
     phi_[k] = phi;
     radius_[k] = std::hypot(V(0, 0), V(1, 0));
-    // Radial growth beyond the last step (the extension is linear in xi2 there).
-    slope1_[k] = radius_[k] > 0.0 ? (V(0, 0) * V(0, 2) + V(1, 0) * V(1, 2)) / radius_[k] : 0.0;
     if (k > 0 && !(phi_[k] > phi_[k - 1]))
       throw std::invalid_argument(
           "response surface: the E-surface edge xi2 = 1 does not turn counter-clockwise at xi1 "
@@ -183,33 +179,11 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
             ", " + std::to_string(x2) + ") (Jacobian determinant " + std::to_string(det) + ")");
     }
 
-  // Blending band: up to kBlendMax, but outside the directions of the outermost paths at any
-  // step (the initial tangent E_2(xi1, 0) included), so data inside the fan are untouched.
-  {
-    const double mid = 0.5 * (phi_.front() + phi_.back());
-    double lo = phi_.front(), hi = phi_.back();
-    for (int j = 0; j <= 8; ++j) {
-      for (double x1 : {0.0, 1.0}) {
-        eval4({x1, j / 8.0}, V);
-        const Eigen::Vector2d e =
-            j == 0 ? Eigen::Vector2d(V.block<2, 1>(0, 2)) : Eigen::Vector2d(V.block<2, 1>(0, 0));
-        double a = std::atan2(e(1), e(0));
-        while (a < mid - kPi) a += 2 * kPi;
-        while (a > mid + kPi) a -= 2 * kPi;
-        lo = std::min(lo, a);
-        hi = std::max(hi, a);
-      }
-    }
-    const double gap = std::min(lo - (mid - 0.5 * kPi), (mid + 0.5 * kPi) - hi);
-    blend_ = std::clamp(0.9 * gap, 1e-3, kBlendMax);
-  }
-
   // C0: least squares over the edge directions, C0 * E_2(xi1, 0) ~ S_2(xi1, 0).
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), B = Eigen::Matrix2d::Zero();
   for (int k = 0; k < m; ++k) {
     eval4({table_xi_[k], 0.0}, V);
     const Eigen::Vector2d e = V.block<2, 1>(0, 2), s = V.block<2, 1>(2, 2);
-    radius0_[k] = e.norm();  // xi2 < 0: E = xi2 * E_2(xi1, 0)
     A += e * e.transpose();
     B += s * e.transpose();
   }
@@ -300,63 +274,64 @@ void ResponseSurface::shear(double E12, double& S12, double& dS, std::uint8_t& f
   dS = dc(1) / dc(0);
 }
 
-Eigen::Vector2d ResponseSurface::initial_guess(const Eigen::Vector2d& E, double branch) const {
+Eigen::Vector2d ResponseSurface::initial_guess(const Eigen::Vector2d& E) const {
   const double rE = E.norm();
   const double mid = 0.5 * (phi_.front() + phi_.back());
   double phi = std::atan2(E(1), E(0));
   while (phi < mid - kPi) phi += 2 * kPi;
   while (phi > mid + kPi) phi -= 2 * kPi;
-  // Branch xi2 >= 0: directions around the fan; xi2 <= 0: the opposite ones, mirrored.
-  const double sgn = branch;
-  if (sgn < 0.0) phi += phi > mid ? -kPi : kPi;
+  // Half-plane of directions around the fan -> xi2 >= 0; the opposite one -> xi2 <= 0.
+  double sgn = 1.0;
+  if (std::abs(phi - mid) > 0.5 * kPi) {
+    sgn = -1.0;
+    phi += phi > mid ? -kPi : kPi;
+  }
   const int m = static_cast<int>(phi_.size());
-  double xi1, r, r0, dr, dphi = 0.0;
+  double xi1, r, dphi = 0.0;
   if (phi <= phi_.front()) {
     const double slope = (phi_[1] - phi_[0]) / (table_xi_[1] - table_xi_[0]);
     dphi = std::max(phi - phi_.front(), -1.3);
     xi1 = std::tan(dphi) / slope;
     r = radius_.front();
-    r0 = radius0_.front();
-    dr = slope1_.front();
   } else if (phi >= phi_.back()) {
     const double slope = (phi_[m - 1] - phi_[m - 2]) / (table_xi_[m - 1] - table_xi_[m - 2]);
     dphi = std::min(phi - phi_.back(), 1.3);
     xi1 = 1.0 + std::tan(dphi) / slope;
     r = radius_.back();
-    r0 = radius0_.back();
-    dr = slope1_.back();
   } else {
     const int k =
         static_cast<int>(std::upper_bound(phi_.begin(), phi_.end(), phi) - phi_.begin()) - 1;
     const double w = (phi - phi_[k]) / (phi_[k + 1] - phi_[k]);
     xi1 = table_xi_[k] + w * (table_xi_[k + 1] - table_xi_[k]);
     r = radius_[k] + w * (radius_[k + 1] - radius_[k]);
-    r0 = radius0_[k] + w * (radius0_[k + 1] - radius0_[k]);
-    dr = slope1_[k] + w * (slope1_[k + 1] - slope1_[k]);
   }
-  const double s = rE * std::cos(dphi);
-  // Beyond the last step the paths continue with their end tangent, opposite to the fan with
-  // the initial tangent: scale-aware guesses keep Newton's step count bounded for any |E|.
-  if (sgn < 0.0) return {xi1, r0 > 0.0 ? -s / r0 : -s / r};
-  if (s > r && dr > 0.0) return {xi1, 1.0 + (s - r) / dr};
-  return {xi1, s / r};
+  return {xi1, sgn * rE * std::cos(dphi) / r};
 }
 
-ResponseSurface::Branch ResponseSurface::solve_branch(const Eigen::Vector2d& Et,
-                                                      double branch) const {
-  Branch out;
+ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
+  ResponseEvaluation out;
+  // Shear: S12(E12), E12 = (2E12)/2; C33 = dS12/d(2E12).
+  double S12, dS;
+  shear(0.5 * E(2), S12, dS, out.flags);
+  out.S(2) = S12;
+  out.C(2, 2) = 0.5 * dS;
+
+  const Eigen::Vector2d Et = E.head<2>();
   const double rE = Et.norm();
-  Eigen::Vector2d xi = initial_guess(Et, branch);
+  if (rE == 0.0) {
+    out.C.topLeftCorner<2, 2>() = C0_.topLeftCorner<2, 2>();
+    return out;
+  }
+  Eigen::Vector2d xi = initial_guess(Et);
   Eigen::Matrix4d V;
   Eigen::Matrix2d J;
   const double tol = kTolAbs + kTolRel * rE;
   bool converged = false;
   int it = 0;
-  eval4(xi, V);
-  Eigen::Vector2d r = V.block<2, 1>(0, 0) - Et;
-  double rnorm = r.norm();
   for (; it < kMaxIterations; ++it) {
-    if (rnorm <= tol) {
+    eval4(xi, V);
+    const Eigen::Vector2d r = V.block<2, 1>(0, 0) - Et;
+    if (r.norm() <= tol) {
       converged = true;
       break;
     }
@@ -367,40 +342,19 @@ ResponseSurface::Branch ResponseSurface::solve_branch(const Eigen::Vector2d& Et,
       J.col(0) = V.block<2, 1>(0, 3);
     J.col(1) = V.block<2, 1>(0, 2);
     const Eigen::Vector2d step = J.partialPivLu().solve(-r);  // (xi2 * dxi1, dxi2)
-    if (!step.allFinite()) break;
-    // Step limits relative to the radius parameter: far outside the square (large strains)
-    // xi2 is large, and a fixed limit would need |xi2| / limit iterations to get there.
-    const double lim2 = 0.5 * std::max(1.0, std::abs(xi(1)));
-    // Backtracking on |E(xi) - E|: full Newton steps near the solution, halved steps where
-    // the extension's bilinear corners or the fan's curvature would overshoot.
-    double lambda = 1.0;
-    bool accepted = false;
-    Eigen::Vector2d trial = xi;
-    for (int ls = 0; ls < kMaxBacktracking; ++ls, lambda *= 0.5) {
-      const double d2 = std::clamp(lambda * step(1), -lim2, lim2);
-      const double x2new = xi(1) + d2;
-      // Polar update: the tangential correction xi2*dxi1 over the new radius parameter.
-      const double d1 = x2new != 0.0 ? std::clamp(lambda * step(0) / x2new, -0.5, 0.5) : 0.0;
-      if (!std::isfinite(d1) || !std::isfinite(x2new)) continue;
-      trial = {xi(0) + d1, x2new};
-      eval4(trial, V);
-      const Eigen::Vector2d rt = V.block<2, 1>(0, 0) - Et;
-      const double rtn = rt.norm();
-      if (rtn < rnorm || rtn <= tol) {
-        xi = trial;
-        r = rt;
-        rnorm = rtn;
-        accepted = true;
-        break;
-      }
-    }
-    if (!accepted) {
-      eval4(xi, V);
-      break;
-    }
+    double d2 = std::clamp(step(1), -0.5, 0.5);
+    const double x2new = xi(1) + d2;
+    // Polar update: the tangential correction xi2*dxi1 over the new radius parameter.
+    const double d1 = x2new != 0.0 ? std::clamp(step(0) / x2new, -0.5, 0.5) : 0.0;
+    if (!std::isfinite(d1) || !std::isfinite(x2new)) break;
+    xi(0) += d1;
+    xi(1) = x2new;
   }
   out.iterations = it;
-  if (!converged) out.flags |= kInversionFailed;
+  if (!converged) {
+    out.flags |= kInversionFailed;
+    eval4(xi, V);
+  }
   out.xi = xi;
   if (xi(1) > 1.0 + kInsideTol) out.flags |= kBeyondPaths;
   if (xi(1) < -kInsideTol) out.flags |= kCompression;
@@ -416,56 +370,8 @@ ResponseSurface::Branch ResponseSurface::solve_branch(const Eigen::Vector2d& Et,
   }
   JE.col(1) = V.block<2, 1>(0, 2);
   JS.col(1) = V.block<2, 1>(2, 2);
-  out.S = V.block<2, 1>(2, 0);
-  out.C = JS * JE.inverse();
-  return out;
-}
-
-ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
-  ResponseEvaluation out;
-  // Shear: S12(E12), E12 = (2E12)/2; C33 = dS12/d(2E12).
-  double S12, dS;
-  shear(0.5 * E(2), S12, dS, out.flags);
-  out.S(2) = S12;
-  out.C(2, 2) = 0.5 * dS;
-
-  const Eigen::Vector2d Et = E.head<2>();
-  const double rE2 = Et.squaredNorm();
-  if (rE2 == 0.0) {
-    out.C.topLeftCorner<2, 2>() = C0_.topLeftCorner<2, 2>();
-    return out;
-  }
-  // The extension has two branches (xi2 >= 0 around the fan, xi2 <= 0 opposite to it) whose
-  // direction ranges overlap beyond the outermost paths; they give different S there. Around
-  // the two switch directions psi = +-pi/2 (psi = angle from the fan's bisector) S is blended
-  // with a C1 weight w(psi) over +-blend_, so S is continuous in E and
-  // C = w C+ + (1 - w) C- + (S+ - S-) (dw/dE)^T stays its exact derivative.
-  const double mid = 0.5 * (phi_.front() + phi_.back());
-  double psi = std::atan2(Et(1), Et(0)) - mid;
-  while (psi <= -kPi) psi += 2 * kPi;
-  while (psi > kPi) psi -= 2 * kPi;
-  const double sdist = (0.5 * kPi - std::abs(psi)) / blend_;  // > 0: the fan's side
-  if (sdist >= 1.0 || sdist <= -1.0) {
-    const Branch b = solve_branch(Et, sdist > 0.0 ? 1.0 : -1.0);
-    out.S.head<2>() = b.S;
-    out.C.topLeftCorner<2, 2>() = b.C;
-    out.xi = b.xi;
-    out.flags |= b.flags;
-    out.iterations = b.iterations;
-    return out;
-  }
-  const Branch bp = solve_branch(Et, 1.0), bm = solve_branch(Et, -1.0);
-  const double x = 0.5 * (sdist + 1.0);  // 0 -> branch -, 1 -> branch +
-  const double w = x * x * (3.0 - 2.0 * x);
-  const double dw_dpsi = 6.0 * x * (1.0 - x) * 0.5 * (psi > 0.0 ? -1.0 : 1.0) / blend_;
-  const Eigen::Vector2d dpsi_dE(-Et(1) / rE2, Et(0) / rE2);
-  const Eigen::Vector2d jump = bp.S - bm.S;
-  out.S.head<2>() = w * bp.S + (1.0 - w) * bm.S;
-  out.C.topLeftCorner<2, 2>() =
-      w * bp.C + (1.0 - w) * bm.C + jump * (dw_dpsi * dpsi_dE).transpose();
-  out.xi = w >= 0.5 ? bp.xi : bm.xi;
-  out.flags |= bp.flags | bm.flags;
-  out.iterations = bp.iterations + bm.iterations;
+  out.S.head<2>() = V.block<2, 1>(2, 0);
+  out.C.topLeftCorner<2, 2>() = JS * JE.inverse();
   return out;
 }
 

@@ -103,23 +103,11 @@ class ResponseSurface {
   /// Newton tolerances: |E(xi) - E| <= kTolAbs + kTolRel |E|.
   static constexpr double kTolAbs = 1e-13, kTolRel = 1e-11;
   static constexpr int kMaxIterations = 40;
-  static constexpr int kMaxBacktracking = 30;
-  /// Largest half-width (rad) of the band around the switch between the extension's two
-  /// branches; the band never reaches into the fan of paths (blend_ below).
-  static constexpr double kBlendMax = 0.5235987755982988;  // 30 degrees
 
  private:
   /// Surface values V and derivatives V_1, V_2, V_12 (columns) at xi, extension included.
   void eval4(const Eigen::Vector2d& xi, Eigen::Matrix4d& V) const;
-  /// One branch of the tensile block: xi2 >= 0 (branch = +1) or xi2 <= 0 (branch = -1).
-  struct Branch {
-    Eigen::Vector2d S = Eigen::Vector2d::Zero(), xi = Eigen::Vector2d::Zero();
-    Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
-    std::uint8_t flags = kInside;
-    int iterations = 0;
-  };
-  Branch solve_branch(const Eigen::Vector2d& Et, double branch) const;
-  Eigen::Vector2d initial_guess(const Eigen::Vector2d& E, double branch) const;
+  Eigen::Vector2d initial_guess(const Eigen::Vector2d& E) const;
   void shear(double E12, double& S12, double& dS12_dE12, std::uint8_t& flags) const;
 
   ResponseSurfaceData data_;
@@ -127,11 +115,8 @@ class ResponseSurface {
   /// Interleaved control points (E1, E2, S1, S2), a = i + n1*j.
   std::vector<Eigen::Vector4d> P_;
   std::vector<double> table_xi_, phi_, radius_;  ///< initial-guess table along xi1 at xi2 = 1
-  std::vector<double> radius0_;                  ///< |dE/dxi2| at xi2 = 0 (guess for xi2 < 0)
-  std::vector<double> slope1_;                   ///< radial dE/dxi2 at xi2 = 1 (guess for xi2 > 1)
   Eigen::Matrix3d C0_ = Eigen::Matrix3d::Zero();
   double E12_max_ = 0.0;
-  double blend_ = kBlendMax;  ///< half-width of the blending band, outside every path
   bool shear_linear_ = false;
 };
 
