@@ -12,6 +12,7 @@ MaterialResponse SaintVenantKirchhoff::evaluate(const Eigen::Vector3d& E,
   MaterialResponse r;
   r.S = C_ * E;
   r.C = C_;
+  r.W = 0.5 * E.dot(r.S);  // W = E^T C E / 2 in Voigt form (2E12 pairs with S12)
   return r;
 }
 

@@ -22,14 +22,22 @@
 
 namespace knit::material {
 
-enum class PathKind { kBiaxial = 0, kShear = 1 };
+enum class PathKind { kBiaxial = 0, kShear = 1, kUniaxial = 2, kGradient = 3 };
 
 /// One homogenization load path. Biaxial: end Green-Lagrange strains (E11, E22) at t = 1.
 /// Shear: the end shear angle gamma (rad) at t = 1 (target(0); target(1) unused).
+/// Uniaxial stress: the Green-Lagrange strain along `axis` (target(0)) is prescribed, the
+/// other normal stretch is found at every step so that its stress vanishes.
+/// Gradient: F(t) = I + t H (any in-plane displacement gradient, e.g. shear with stretch).
 struct LoadPath {
   PathKind kind = PathKind::kBiaxial;
   Eigen::Vector2d target = Eigen::Vector2d::Zero();
   int steps = 20;
+  int axis = 0;                                  ///< kUniaxial: 0 = E11 (course), 1 = E22 (wale)
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();  ///< kGradient: end displacement gradient
+  /// "paper": one of the paper's 13 paths (the fan of eq. 17 and the shear curve);
+  /// "coverage": an extra path that only the energy-based law uses.
+  std::string set = "paper";
 };
 
 /// The 13 default paths (12 biaxial + 1 shear), `steps` increments each.

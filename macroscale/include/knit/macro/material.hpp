@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,9 @@ struct MaterialPoint {
 struct MaterialResponse {
   Eigen::Vector3d S = Eigen::Vector3d::Zero();  ///< (S11, S22, S12) in MPa
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();  ///< dS/dE, MPa
+  /// Strain-energy density W(E) per unit reference volume (MPa = N mm/mm^3) with S = dW/dE,
+  /// for a hyperelastic law (hyperelastic() true); NaN otherwise.
+  double W = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Material {
@@ -45,6 +49,10 @@ class Material {
   /// S and C at strain E (Voigt, local Cartesian frame). Must be thread-safe (const):
   /// assembly may run on several threads.
   virtual MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const = 0;
+
+  /// True if S derives from a strain energy (MaterialResponse::W is set, C is symmetric for
+  /// every E): the shell may then use a symmetric factorization and an energy line search.
+  virtual bool hyperelastic() const { return false; }
 
   /// True if the material provides the analytic thickness integration below.
   virtual bool has_analytic_thickness_integration() const { return false; }

@@ -13,6 +13,7 @@ class SaintVenantKirchhoff final : public Material {
   SaintVenantKirchhoff(double youngs_modulus, double poisson_ratio);
   std::string name() const override { return "saint_venant_kirchhoff"; }
   MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override;
+  bool hyperelastic() const override { return true; }
   bool has_analytic_thickness_integration() const override { return true; }
   void thickness_matrices(double thickness, const MaterialPoint& where, Eigen::Matrix3d& A,
                           Eigen::Matrix3d& B, Eigen::Matrix3d& D) const override;
