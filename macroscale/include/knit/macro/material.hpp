@@ -69,6 +69,10 @@ class Material {
     return {};
   }
 
+  /// How many evaluations so far could not produce a valid response (e.g. a response surface
+  /// that could not be inverted). A run with failures must not report plain success.
+  virtual long failed_evaluations() const { return 0; }
+
   /// A human-readable summary for the end of a run (e.g. how often and where a response
   /// surface was extrapolated). Empty by default.
   virtual std::string report() const { return {}; }
