@@ -33,7 +33,7 @@ struct LoadPath {
   PathKind kind = PathKind::kBiaxial;
   Eigen::Vector2d target = Eigen::Vector2d::Zero();
   int steps = 20;
-  int axis = 0;                                  ///< kUniaxial: 0 = E11 (course), 1 = E22 (wale)
+  int axis = 0;                                 ///< kUniaxial: 0 = E11 (course), 1 = E22 (wale)
   Eigen::Matrix2d H = Eigen::Matrix2d::Zero();  ///< kGradient: end displacement gradient
   /// "paper": one of the paper's 13 paths (the fan of eq. 17 and the shear curve);
   /// "coverage": an extra path that only the energy-based law uses.
