@@ -102,8 +102,10 @@ def stop_note(name, curve, target):
 def check_reaches(key, section, name, curve, target):
     ok = curve is not None and reaches(curve, target)
     got = "no converged step" if curve is None or len(curve[0]) < 2 else pct(end_strain(curve), 2)
+    thr = (f"last converged strain >= {pct(target, 1)}" if target > 0 else
+           f"last converged strain <= {pct(target, 1)} (compression)")
     return Check(key, section, f"{name} runs to the paper's strain", pct(target, 1),
-                 f"last converged strain >= {pct(target, 1)} (rel. tol {TOL_REACH:g})", got, ok)
+                 f"{thr} (rel. tol {TOL_REACH:g})", got, ok)
 
 
 def check_monotone(key, section, name, curve):
