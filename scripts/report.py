@@ -1,12 +1,14 @@
 #!/usr/bin/python3
-"""Validation report of the reproduction (issue #8): writes OUT/report.md.
+"""Validation report of the reproduction (issues #8, #12): writes OUT/report.md.
 
 Reads the pipeline's outputs (scripts/pipeline.mk): OUT/database.h5 and database.source/.time,
-OUT/results/NAME/ (knit-macro output) and NAME.status, OUT/figures/*.png. Every statement of the
-paper that can be checked is listed with our number beside it; where the paper gives a number
-(or a yes/no property) the row says pass or fail, with the tolerance used.
+OUT/results/NAME/ (knit-macro output) and NAME.status, OUT/figures/*.png, and the sensitivity
+table when it exists. `Data` loads curves and fields by case name; `checks(data)` turns them into
+the list of verdicts with the pure functions of report_checks.py (each with its threshold and
+our number); `Report.write` renders them. tests/report/test_report.py runs the same path on
+synthetic result directories.
 
-Usage: report.py --out-dir OUT --database OUT/database.h5 [--cells yes]
+Usage: report.py --out-dir OUT --database OUT/database.h5 [--cells yes] [--sensitivity CSV]
 """
 import argparse
 import datetime
