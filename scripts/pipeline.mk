@@ -23,6 +23,9 @@ MACRO := $(BUILD)/bin/knit-macro
 SWEEP_INPUT ?= $(ROOT)/cases/sweep/default.json
 SWEEP_THREADS ?= 2
 DB_SOURCE ?= auto
+# Sensitivity of the observables to the unit-cell parameters (issue #12; CSV columns parameter,
+# value, observable, result: scripts/figures/sensitivity.py). Drawn and reported when it exists.
+SENSITIVITY ?= $(ROOT)/cases/calibration/sensitivity.csv
 CASEDIR := $(ROOT)/cases/paper
 FIGPY := $(ROOT)/scripts/figures
 DB := $(OUT)/database.h5
@@ -168,6 +171,7 @@ $(eval $(call deformed,fig14a_bilinear_E11,s321_bilinear_diagonal,E11,last,Fig. 
 $(eval $(call deformed,fig14b_bilinear_E22,s321_bilinear_diagonal,E22,last,Fig. 14b: diagonal test u1 = u2 = 10 mm (E22)))
 $(eval $(call deformed,fig14c_bilinear_E12,s321_bilinear_diagonal,E12,last,Fig. 14c: diagonal test u1 = u2 = 10 mm (E12)))
 $(eval $(call load,fig14d_load_strain,Fig. 14d: diagonal tensile test,s321_bilinear_diagonal))
+$(eval $(call load,fig14e_mesh_study,Sect. 3.2.1 mesh study (p = 5; h = 1 2 4),s321_bilinear_diagonal mesh321_p5h2 mesh321_p5h4))
 # Sect. 3.2.2 (Fig. 15)
 $(eval $(call fields,fig15ab_curved_fields,s322_curved_horizontal,Fig. 15a/b: stitch value and knitting direction))
 $(eval $(call deformed,fig15c_curved_E11,s322_curved_horizontal,E11,0.3,Fig. 15c: horizontal test at 30 % (E11)))
@@ -179,11 +183,20 @@ $(eval $(call fields,fig16b_hypar_fields,s323_hypar_tension,Fig. 16b: stitch val
 $(eval $(call deformed,fig16c_hypar_tension_E12,s323_hypar_tension,E12,last,Fig. 16c: diagonal tension ~21 % (E12)))
 $(eval $(call deformed,fig16d_hypar_compression_E12,s323_hypar_compression,E12,last,Fig. 16d: diagonal compression ~14 % (E12)))
 
+# Sensitivity (issue #12): only when the calibration study has written its table.
+ifneq ($(wildcard $(SENSITIVITY)),)
+FIGURES += $(FIG)/sensitivity.png
+$(FIG)/sensitivity.png: $(SENSITIVITY) $(FIGPY)/sensitivity.py
+	@$(call draw,$(PY) $(FIGPY)/sensitivity.py $(SENSITIVITY) --out $@,$@)
+endif
+
 figures: $(FIGURES)
 
 # ---- report -----------------------------------------------------------------------------------
-$(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py $(FIGPY)/results.py
-	@$(PY) $(ROOT)/scripts/report.py --out-dir $(OUT) --database $(DB) --cells "$(HAVE_CELL)" > $(LOGS)/report.log 2>&1 \
+$(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py \
+  $(ROOT)/scripts/report_checks.py $(FIGPY)/results.py $(FIGPY)/sensitivity.py $(wildcard $(SENSITIVITY))
+	@$(PY) $(ROOT)/scripts/report.py --out-dir $(OUT) --database $(DB) --cells "$(HAVE_CELL)" \
+	  --sensitivity "$(SENSITIVITY)" > $(LOGS)/report.log 2>&1 \
 	  || { cat $(LOGS)/report.log; exit 1; }
 	@echo "report: $@"
 

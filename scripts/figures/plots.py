@@ -45,7 +45,7 @@ LABELS = {
 def label_of(name):
     if name in LABELS:
         return LABELS[name]
-    if name.startswith("conv"):
+    if name.startswith(("conv", "mesh")):
         tail = name.split("_")[1]  # p5h1
         p, h = tail[1:].split("h")
         return f"p = {p}, h = {h}"

@@ -1,0 +1,442 @@
+#!/usr/bin/python3
+"""Test of the validation report itself (issue #12): synthetic result directories with known
+defects go through scripts/report.py's loading and checks, and each verdict is compared with
+what the defect must cause.
+
+A baseline of synthetic runs (every curve and field built so that each statement holds with a
+margin) must pass every check; each variant injects one known defect (a load dip, an early
+stop, a 3 % / 8 % convergence gap, a cut-back that shifts the rows, a constant zero alpha, a
+non-uniform field, ...) and must fail exactly the checks that read it. Every check key fails in
+at least one variant and passes in the baseline, so no check is vacuous.
+
+Run: /usr/bin/python3 tests/report/test_report.py   (CTest: report_checks)
+"""
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
+import report  # noqa: E402
+import report_checks as rc  # noqa: E402
+
+L = 50.0
+N = 11  # output grid n_u = n_v
+SQ2 = math.sqrt(2.0)
+SQUARE = {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+          "control_points": [[0, 0, 0], [L, 0, 0], [0, L, 0], [L, L, 0]], "thickness": 0.76}
+CURVED = {"degrees": [3, 1], "knots_u": [0, 0, 0, 0, 1, 1, 1, 1], "knots_v": [0, 0, 1, 1],
+          "control_points": [[x * L, y * L, 0.0] for x, y in zip(
+              [-0.5, -1 / 6, 1 / 6, 0.5, -0.5, -1 / 6, 1 / 6, 0.5],
+              [0.0, 0.0, -0.5, -0.5, 0.5, 0.5, 0.0, 0.0])],
+          "weights": [1, 2, 2, 1, 1, 2, 2, 1], "thickness": 0.76}
+
+
+# ---- synthetic runs --------------------------------------------------------------------------
+def grid_X(geometry=SQUARE):
+    _, X = rc.exact_alignment_angle(geometry, N, N)
+    return X
+
+
+def stiffening(k):
+    return lambda e: k * (e + 20.0 * e ** 3)
+
+
+def softening(k):
+    return lambda e: k * (e - e ** 2)
+
+
+def steps_to(target, n=20, cutback_at=None):
+    """Strains of the converged steps: n equal steps to target; a cut-back halves step
+    `cutback_at` (one extra row: the rows after it are shifted)."""
+    e = list(np.linspace(0.0, target, n + 1)[1:])
+    if cutback_at is not None:
+        a = e[cutback_at - 1] if cutback_at > 0 else 0.0
+        e.insert(cutback_at, 0.5 * (a + e[cutback_at]))
+    return np.array(e)
+
+
+class Run:
+    """One synthetic case: its converged strains, a load function of strain, a function of
+    strain giving the fields (dict of (N, N) arrays), the geometry and the exit code."""
+
+    def __init__(self, target, load, fields=None, geometry=SQUARE, cutback_at=None):
+        self.strain = steps_to(target, cutback_at=cutback_at)
+        self.load = load
+        self.fields = fields
+        self.geometry = geometry
+        self.exit_code = 0
+
+    def stop_at(self, eps):
+        """The run stops: only the steps with |strain| <= |eps| converged."""
+        self.strain = self.strain[np.abs(self.strain) <= abs(eps) + 1e-12]
+        self.exit_code = 1
+
+
+def write_run(res_dir, name, run):
+    import h5py
+    d = os.path.join(res_dir, name)
+    os.makedirs(d, exist_ok=True)
+    loads = [run.load(e) for e in run.strain]
+    with open(os.path.join(d, "load_strain.csv"), "w") as f:
+        f.write("step,load_factor,applied_displacement_mm,strain,load_N,iterations\n")
+        for k, (e, p) in enumerate(zip(run.strain, loads), 1):
+            f.write(f"{k},{e / run.strain[-1] if len(run.strain) else 0:.12g},{e * L:.12g},"
+                    f"{e:.15g},{p:.15g},3\n")
+    with open(os.path.join(d, "case.json"), "w") as f:
+        json.dump({"geometry": run.geometry, "output": {"grid": [N, N]}}, f)
+    with open(os.path.join(res_dir, name + ".status"), "w") as f:
+        json.dump({"case": name, "exit_code": run.exit_code, "seconds": 0.01}, f)
+    if run.fields is None:
+        return
+    X = grid_X(run.geometry)
+    with h5py.File(os.path.join(d, "results.h5"), "w") as h:
+        for k, e in enumerate(run.strain, 1):
+            g = h.create_group(f"fields/step_{k:04d}")
+            g.attrs["load_factor"] = e / run.strain[-1]
+            u = np.zeros_like(X)
+            u[..., 1] = e * X[..., 1]
+            g["x"] = (X + u).reshape(-1, 3)
+            g["displacement"] = u.reshape(-1, 3)
+            for key, v in run.fields(e, X).items():
+                g[key] = np.asarray(v, dtype=float).reshape(-1)
+
+
+# ---- the baseline: every statement holds with a margin ----------------------------------------
+def wale_e22(m20, m30, a):
+    """E22 with its maximum m(eps) at the free edges' middle; `a` sets the non-uniformity."""
+    def f(e, X):
+        x, y = X[..., 0], X[..., 1]
+        shape = 1.0 + a * ((x - 25.0) / 25.0) ** 2 * np.exp(-((y - 25.0) / 8.0) ** 2)
+        c = np.interp(e, [0.0, 0.2, 0.3], [0.0, m20, m30]) / (1.0 + a)
+        return {"E22": c * shape, "E11": -0.3 * c * shape, "E12": 0.0 * x}
+    return f
+
+
+def halves_e11(left, right):
+    def f(e, X):
+        x = X[..., 0]
+        return {"E11": np.where(x < 25.0, left, right) * e / 0.3 + 0.0 * x}
+    return f
+
+
+def halves_e22(a_left, a_right):
+    def f(e, X):
+        x, y = X[..., 0], X[..., 1]
+        a = np.where(x < 25.0, a_left, a_right)
+        return {"E22": e * (1.0 + a * np.cos(2 * math.pi * y / L))}
+    return f
+
+
+def graded_e22(gradient, wiggle_bottom, wiggle_top):
+    def f(e, X):
+        x, y = X[..., 0], X[..., 1]
+        s = y / L
+        wig = wiggle_bottom * (1 - s) + wiggle_top * s
+        return {"E22": e * (1.0 + gradient * s) * (1.0 + wig * np.cos(2 * math.pi * x / L))}
+    return f
+
+
+def diagonal_fields(asym11=0.0, asym12=0.0):
+    def f(e, X):
+        x, y = X[..., 0] / L, X[..., 1] / L
+        g = lambda a, b: 0.1 + 0.05 * a + 0.03 * a * b + 0.02 * b ** 2  # noqa: E731
+        return {"E11": e * (g(x, y) + asym11 * x), "E22": e * g(y, x),
+                "E12": e * (0.03 * (x + y) + 0.01 * x * y + asym12 * x)}
+    return f
+
+
+def curved_fields(error):
+    def f(e, X):
+        return {"knitting_angle": EXACT_ALPHA + error(EXACT_ALPHA), "E22": 0.0 * EXACT_ALPHA + e}
+    return f
+
+
+EXACT_ALPHA = rc.exact_alignment_angle(CURVED, N, N)[0]
+
+
+def hypar_fields(e, X):
+    return {"E12": 0.01 * e + 0.0 * X[..., 0], "E22": 0.02 * e + 0.0 * X[..., 0],
+            "kappa11": 0.001 * e + 0.0 * X[..., 0]}
+
+
+def baseline():
+    runs = {}
+    for l, k in (("45", 20.0), ("65", 10.0)):
+        runs[f"s312_uniform_{l}_course"] = Run(0.3, stiffening(k))
+    runs["s312_uniform_45_wale"] = Run(0.3, stiffening(20.0), wale_e22(0.26, 0.38, 0.05))
+    runs["s312_uniform_65_wale"] = Run(0.3, stiffening(10.0), wale_e22(0.25, 0.36, 0.30))
+    runs["s313_discontinuous_course"] = Run(0.3, stiffening(12.0), halves_e11(0.12, 0.30))
+    runs["s313_discontinuous_wale"] = Run(0.3, stiffening(12.0), halves_e22(0.3, 0.1))
+    runs["s314_linear_course"] = Run(0.3, stiffening(12.0))
+    runs["s314_linear_wale"] = Run(0.3, stiffening(12.0), graded_e22(0.5, 0.3, 0.05))
+    runs["s315_diagonal_45deg_vertical"] = Run(0.3, stiffening(12.0))
+    for p in (3, 5, 7):
+        for h in (1, 4):
+            runs[f"conv7c_p{p}h{h}"] = Run(0.3, stiffening(20.0))
+        runs[f"conv9e_p{p}h1"] = Run(0.3, stiffening(12.0))
+    for n in ("s321_bilinear_diagonal", "mesh321_p5h2", "mesh321_p5h4"):
+        runs[n] = Run(SQ2 * 0.2, softening(30.0), diagonal_fields())
+    runs["s322_curved_horizontal"] = Run(0.4, stiffening(8.0),
+                                         curved_fields(lambda a: 0.02 * np.sin(3 * a)), CURVED)
+    runs["s323_hypar_tension"] = Run(SQ2 * 0.15, lambda e: 5 * e, hypar_fields)
+    runs["s323_hypar_compression"] = Run(-SQ2 * 0.10, lambda e: 5 * e, hypar_fields)
+    return runs
+
+
+# ---- variants: one known defect each, and the checks it must fail ------------------------------
+def dip(run, at, frac):
+    """Load drops to `frac` of its value from strain `at` on (17.1 -> 5.7 N at 21 % in #12)."""
+    f = run.load
+    run.load = lambda e: f(e) * (frac if e >= at - 1e-12 else 1.0)
+
+
+def v_dip(r):
+    dip(r["s312_uniform_65_wale"], 0.21, 1 / 3)
+
+
+def v_early_stop_hypar(r):
+    r["s323_hypar_tension"].stop_at(0.004)
+    r["s323_hypar_compression"].stop_at(0.0)
+
+
+def v_gap3(r):  # a known 3 % gap (PASS at 5 %), with a cut-back shifting the rows
+    r["conv7c_p5h1"] = Run(0.3, lambda e: 1.03 * stiffening(20.0)(e), cutback_at=7)
+    r["conv9e_p5h1"] = Run(0.3, lambda e: 0.97 * stiffening(12.0)(e), cutback_at=3)
+
+
+def v_gap8(r):
+    r["conv7c_p5h1"] = Run(0.3, lambda e: 1.08 * stiffening(20.0)(e))
+    r["conv9e_p5h1"] = Run(0.3, lambda e: 0.92 * stiffening(12.0)(e))
+
+
+def v_conv_stop(r):  # the reference stops at 24 %: the comparison cannot be made to 30 %
+    r["conv7c_p7h4"].stop_at(0.24)
+
+
+def v_not_much_stiffer(r):  # end loads 2 % apart (95.3 vs 93.4 N in #12)
+    r["s312_uniform_45_course"].load = stiffening(10.2)
+    r["s312_uniform_45_wale"].load = stiffening(10.2)
+
+
+def v_linear(r):  # nearly linear course-wise curve (ratio 1.2 in #12)
+    r["s312_uniform_45_course"].load = lambda e: 45.0 * (e + 0.3 * e ** 2)
+
+
+def v_concave_middle(r):  # last/first ratio high but not convex (a soft middle third)
+    r["s314_linear_course"].load = lambda e: 12.0 * np.interp(e, [0, 0.1, 0.2, 0.3],
+                                                              [0, 0.1, 0.15, 0.5])
+
+
+def v_e22_low(r):  # max E22 below the kinematic bound and the paper at both strains
+    r["s312_uniform_45_wale"].fields = wale_e22(0.20, 0.30, 0.05)
+
+
+def v_e22_center(r):  # maximum in the middle of the patch
+    r["s312_uniform_65_wale"].fields = wale_e22(0.25, 0.36, -0.2)
+
+
+def v_nonuniform_45(r):  # 4.5 mm less uniform than 6.5 mm along the central section
+    r["s312_uniform_45_wale"].fields = wale_e22(0.26, 0.38, 0.30)
+    r["s312_uniform_65_wale"].fields = wale_e22(0.25, 0.36, 0.05)
+
+
+def v_right_not_higher(r):
+    r["s313_discontinuous_course"].fields = halves_e11(0.12, 0.15)
+
+
+def v_right_nonuniform(r):
+    r["s313_discontinuous_wale"].fields = halves_e22(0.1, 0.3)
+
+
+def v_top_equal(r):  # 0.334 vs 0.329 in #12: larger, but by 1.5 %
+    r["s314_linear_wale"].fields = graded_e22(0.015, 0.3, 0.05)
+
+
+def v_top_nonuniform(r):
+    r["s314_linear_wale"].fields = graded_e22(0.5, 0.05, 0.3)
+
+
+def v_mesh_stiffening(r):  # the finest mesh's curve stiffens
+    r["mesh321_p5h4"].load = stiffening(30.0)
+
+
+def v_mesh_gap(r):  # h = 4 differs from h = 2 by 10 % (still not stiffening)
+    r["mesh321_p5h4"].load = lambda e: 1.1 * softening(30.0)(e)
+
+
+def v_asym(r):
+    r["mesh321_p5h2"].fields = diagonal_fields(asym11=0.01)
+
+
+def v_asym12(r):
+    r["s321_bilinear_diagonal"].fields = diagonal_fields(asym12=0.01)
+
+
+def v_alpha_zero(r):
+    r["s322_curved_horizontal"].fields = curved_fields(lambda a: -a)
+
+
+def v_alpha_off(r):  # 5 degrees off everywhere
+    r["s322_curved_horizontal"].fields = curved_fields(lambda a: math.radians(5) + 0 * a)
+
+
+def v_all_stop(r):  # every run stops at half its strain
+    for run in r.values():
+        run.stop_at(0.5 * run.strain[-1])
+
+
+def v_all_dip(r):  # every curve drops to half at 2/3 of its strain
+    for run in r.values():
+        dip(run, 2 * run.strain[-1] / 3, 0.5)
+
+
+MONO = [f"monotone:{n}" for n in report.TENSILE]
+REACH = [f"reach:{n}" for n in report.PAPER_STRAIN]
+VARIANTS = {
+    # name: (mutation, checks that must fail, exact: no other check may fail)
+    "dip 17.1 -> 5.7 N at 21 %": (v_dip, {"monotone:s312_uniform_65_wale",
+                                          "stiffening:s312_uniform_65_wale"}, True),
+    "hyperbolic paraboloids stop at 0.4 % and 0 %": (
+        v_early_stop_hypar, {"reach:s323_hypar_tension", "reach:s323_hypar_compression"}, True),
+    "3 % convergence gap with cut-backs": (v_gap3, set(), True),
+    "8 % convergence gap": (v_gap8, {"conv7c", "conv9e"}, True),
+    "convergence reference stops at 24 %": (
+        v_conv_stop, {"conv7c", "reach:conv7c_p7h4"}, True),
+    "4.5 mm stiffer by 2 % only": (v_not_much_stiffer, {"stiffer:course", "stiffer:wale"}, True),
+    "nearly linear curve": (v_linear, {"stiffening:s312_uniform_45_course"}, True),
+    "soft middle third": (v_concave_middle, {"stiffening:s314_linear_course"}, True),
+    "max E22 too low": (v_e22_low, {"e22bound:45:0.2", "e22bound:45:0.3", "e22value:45"}, True),
+    "max E22 in the middle": (v_e22_center, {"e22where:65"}, True),
+    "4.5 mm less uniform": (v_nonuniform_45, {"uniform312"}, True),
+    "E11 right not much higher": (v_right_not_higher, {"e11right313"}, True),
+    "E22 right half less uniform": (v_right_nonuniform, {"uniform313"}, True),
+    "top strains 1.5 % larger": (v_top_equal, {"larger314"}, True),
+    "top strains less uniform": (v_top_nonuniform, {"uniform314"}, True),
+    "finest mesh stiffening": (v_mesh_stiffening, {"notstiff321", "mesh321"}, True),
+    "10 % mesh gap": (v_mesh_gap, {"mesh321"}, True),
+    "E11/E22 not mirrored": (v_asym, {"mirror321"}, True),
+    "E12 not symmetric": (v_asym12, {"sym321"}, True),
+    "constant zero alpha": (v_alpha_zero, {"alpha322"}, True),
+    "alpha 5 deg off": (v_alpha_off, {"alpha322"}, True),
+    "every run stops at half": (v_all_stop, set(REACH), False),
+    "every curve drops at 2/3": (v_all_dip, set(MONO), False),
+}
+
+
+def verdicts(runs, tmp):
+    res = os.path.join(tmp, "results")
+    shutil.rmtree(res, ignore_errors=True)
+    os.makedirs(res)
+    for name, run in runs.items():
+        write_run(res, name, run)
+    rep = report.Report(tmp)
+    return rep, {c.key: c for c in rep.checks()}
+
+
+def main():
+    failures = []
+    tmp = tempfile.mkdtemp(prefix="knit_report_test_")
+    try:
+        # -- baseline: every check passes, each with its threshold and number printed ----------
+        rep, base = verdicts(baseline(), tmp)
+        judged = {k for k, c in base.items() if c.ok is not None}
+        for k, c in base.items():
+            if not c.threshold or not c.measured:
+                failures.append(f"baseline: {k} prints no threshold or number")
+            if c.ok is False:
+                failures.append(f"baseline: {k} fails: {c.measured} ({c.threshold})")
+        expected_keys = set(REACH) | set(MONO) | {
+            "e22bound:45:0.2", "e22bound:45:0.3", "e22bound:65:0.2", "e22bound:65:0.3",
+            "e22value:45", "e22value:65", "e22where:45", "e22where:65", "stiffer:course",
+            "stiffer:wale", "uniform312", "conv7c", "e11right313", "uniform313", "conv9e",
+            "larger314", "uniform314", "notstiff321", "mirror321", "sym321", "mesh321",
+            "alpha322"} | {f"stiffening:{n}" for n in report.STIFFENING}
+        if judged != expected_keys:
+            failures.append(f"check keys changed: missing {sorted(expected_keys - judged)}, "
+                            f"new {sorted(judged - expected_keys)} (give them a failing variant)")
+        # the report renders, and its summary counts what the table shows
+        rep.write(os.path.join(tmp, "no-database.h5"), "")
+        text = open(os.path.join(tmp, "report.md")).read()
+        summary = f"**Summary:** {len(judged)} of {len(judged)} checks"
+        if summary not in text:
+            failures.append(f"summary line: '{summary}' not in the report")
+        if "Not yet measured" not in text:
+            failures.append("no sensitivity table: the report must say 'Not yet measured'")
+        # -- variants: the known defect fails exactly the checks that read it ------------------
+        failed_somewhere = set()
+        for name, (mutate, must_fail, exact) in VARIANTS.items():
+            runs = baseline()
+            mutate(runs)
+            rep, got = verdicts(runs, tmp)
+            failed = {k for k, c in got.items() if c.ok is False}
+            failed_somewhere |= failed
+            if not must_fail <= failed:
+                for k in sorted(must_fail - failed):
+                    failures.append(f"{name}: {k} should FAIL, got pass: {got[k].measured}")
+            if exact and failed != must_fail:
+                for k in sorted(failed - must_fail):
+                    failures.append(f"{name}: {k} should pass, got FAIL: {got[k].measured}")
+            if name == "3 % convergence gap with cut-backs":
+                m = got["conv7c"].measured
+                if not m.startswith("3.00 %"):
+                    failures.append(f"{name}: conv7c measured {m}, expected 3.00 %")
+            if name == "every run stops at half":
+                text_ok = all("stopped at" in got[k].measured for k in
+                              ("conv7c", "stiffer:wale", "mesh321"))
+                if not text_ok:
+                    failures.append(f"{name}: an early stop is not named in the verdict")
+        never = judged - failed_somewhere
+        if never:
+            failures.append(f"checks no variant makes FAIL (vacuous?): {sorted(never)}")
+        # -- the sensitivity table: read, drawn, reported -----------------------------------------
+        table = os.path.join(tmp, "sensitivity.csv")
+        with open(table, "w") as f:
+            f.write("# synthetic\nparameter,value,observable,result\n")
+            for g0 in (0.01, 0.02, 0.04):
+                f.write(f"g0,{g0},max_E22_45_wale_30,{0.3 + g0}\n")
+                f.write(f"g0,{g0},F45_over_F65_wale_30,{2 - g0}\n")
+            for gam in (0.2, 0.25, 0.3):
+                f.write(f"gamma,{gam},max_E22_45_wale_30,{0.35 + gam / 10}\n")
+        from sensitivity import draw, read_table
+        rows = read_table(table)
+        if len(rows) != 9 or rows[0] != ("g0", 0.01, "max_E22_45_wale_30", 0.31):
+            failures.append(f"sensitivity table read as {rows[:2]}")
+        draw(rows, os.path.join(tmp, "figures", "sensitivity.png"))
+        rep = report.Report(tmp, table)
+        rep.checks()
+        rep.write(os.path.join(tmp, "no-database.h5"), "")
+        text = open(os.path.join(tmp, "report.md")).read()
+        if "figures/sensitivity.png" not in text or "Not yet measured" in text:
+            failures.append("a sensitivity table exists but the report does not show its figure")
+        with open(table, "w") as f:
+            f.write("parameter,value,result\n")
+        try:
+            read_table(table)
+            failures.append("a table with a wrong header was accepted")
+        except ValueError:
+            pass
+        # -- the pure functions on arrays ---------------------------------------------------------
+        e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
+        if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
+            failures.append("largest_drop")
+        if not rc.reaches((np.array([0, -0.1, -0.1414213562]), np.zeros(3)), -SQ2 * 0.1):
+            failures.append("reaches: compression to -14.1 % not recognised")
+        if abs(rc.stretch_bound(0.3) - 0.345) > 1e-12 or abs(rc.stretch_bound(0.2) - 0.22) > 1e-12:
+            failures.append("kinematic bound")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    for f in failures:
+        print("FAIL:", f)
+    print(f"report test: {len(VARIANTS)} variants, {len(failures)} failure(s)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
