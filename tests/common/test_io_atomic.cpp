@@ -237,7 +237,7 @@ TEST_CASE("check_output_target refuses what a run must not or cannot write", "[u
   }
 }
 
-TEST_CASE("OutputLock: one holder at a time, named in the refusal; stale locks taken over",
+TEST_CASE("OutputLock: one holder at a time, named in the refusal, stale locks taken over",
           "[unit][io][atomic]") {
   const fs::path d = scratch("lock");
   fs::create_directories(d);
