@@ -4,7 +4,8 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/setup.sh"
-"$root/scripts/build.sh" "$root/build"
+# Only the executables the pipeline runs; the test executables are built by scripts/test.sh.
+"$root/scripts/build.sh" "$root/build" knit-meso knit-macro
 out="${KNIT_OUT:-$root/out}"
 mkdir -p "$out"
 if [ -f "$root/scripts/pipeline.mk" ]; then

@@ -2,6 +2,7 @@
 #include "knit/io/atomic.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>  // renameat2 (glibc >= 2.28, _GNU_SOURCE is defined by g++)
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+
+#include "knit/io/provenance.hpp"
 
 namespace fs = std::filesystem;
 
@@ -113,20 +116,74 @@ void write_file_atomically(const fs::path& target, std::string_view content) {
 
 // ---- AtomicDirectory ------------------------------------------------------------------------
 
-AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon)
-    : target_(strip_trailing_slash(std::move(target))), on_abandon_(on_abandon) {
-  if (!target_.has_filename()) fail(target_, "not a directory name");
+namespace {
+
+/// Checks the target and creates its parents; returns it without a trailing '/'.
+fs::path prepare_target(fs::path target, std::string_view option) {
+  target = strip_trailing_slash(std::move(target));
+  check_output_target(target, OutputKind::kDirectory, option);
+  std::error_code ec;
+  fs::create_directories(parent_or_dot(target), ec);
+  if (ec) fail(target, "cannot create its parent directory: " + ec.message());
+  return target;
+}
+
+bool pid_is_dead(long pid) {
+  return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+/// Removes "<target>.partial-<pid>" and "<target>.old-<pid>" left by killed runs: only those
+/// whose pid is dead (or ours: an earlier run with a recycled pid) and which hold the marker.
+void remove_stale_siblings(const fs::path& target) {
+  const std::string name = target.filename().string();
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(parent_or_dot(target), ec);
+       !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    for (const char* tag : {".partial-", ".old-"}) {
+      const std::string prefix = name + tag;
+      if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string digits = f.substr(prefix.size());
+      if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+        continue;
+      const long pid = std::stol(digits);
+      if ((pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path())) {
+        std::error_code rm;
+        fs::remove_all(it->path(), rm);
+      }
+    }
+  }
+}
+
+/// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
+void remove_old_output(const fs::path& old) {
+  std::error_code ec;
+  if (is_knitscale_output(old) || fs::is_empty(old, ec)) fs::remove_all(old, ec);
+}
+
+}  // namespace
+
+AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::string_view option)
+    : target_(prepare_target(std::move(target), option)), lock_(target_), on_abandon_(on_abandon) {
+  // Under the lock: nobody else writes this target now; check again what it holds.
+  check_output_target(target_, OutputKind::kDirectory, option);
+  remove_stale_siblings(target_);
   partial_ = target_;
   partial_ += ".partial-";
   partial_ += std::to_string(::getpid());
   std::error_code ec;
-  fs::remove_all(partial_, ec);
-  fs::create_directories(partial_, ec);
+  if (fs::exists(fs::symlink_status(partial_, ec)))
+    fail(partial_, "exists and is not a knitscale output; rename or remove it");
+  fs::create_directory(partial_, ec);
   if (ec) fail(partial_, "cannot create directory: " + ec.message());
+  std::ofstream marker(partial_ / kOutputMarker, std::ios::binary);
+  marker << "knitscale output\n" << Provenance::current().to_json_string() << "\n";
+  if (!marker) fail(partial_ / kOutputMarker, "cannot write");
 }
 
 AtomicDirectory::AtomicDirectory(AtomicDirectory&& o) noexcept
     : target_(std::move(o.target_)),
+      lock_(std::move(o.lock_)),
       partial_(std::move(o.partial_)),
       on_abandon_(o.on_abandon_),
       committed_(o.committed_),
@@ -165,15 +222,21 @@ void AtomicDirectory::commit() {
     if (::rename(partial_.c_str(), target_.c_str()) != 0)
       fail(target_, "cannot rename " + partial_.string(), errno);
   } else {
-    if (!fs::is_directory(target_, ec)) fail(target_, "exists and is not a directory");
+    if (!fs::is_directory(fs::symlink_status(target_, ec)))
+      fail(target_, "exists and is not a directory");
+    if (!is_knitscale_output(target_) && !fs::is_empty(target_, ec))
+      fail(target_, "is a non-empty directory that is not a knitscale output (no " +
+                        std::string(kOutputMarker) + "): left alone; the new output is in " +
+                        partial_.string());
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
-      fs::remove_all(partial_, ec);  // now holds the old contents
+      remove_old_output(partial_);  // now holds the old contents
     } else {
       // File system without RENAME_EXCHANGE: move the old directory aside first.
       fs::path old = target_;
       old += ".old-";
       old += std::to_string(::getpid());
-      fs::remove_all(old, ec);
+      if (fs::exists(fs::symlink_status(old, ec)))
+        fail(old, "exists and is not ours to remove; rename or remove it");
       if (::rename(target_.c_str(), old.c_str()) != 0)
         fail(target_, "cannot move the previous output aside", errno);
       if (::rename(partial_.c_str(), target_.c_str()) != 0) {
@@ -181,7 +244,7 @@ void AtomicDirectory::commit() {
         ::rename(old.c_str(), target_.c_str());  // put the old output back
         fail(target_, "cannot rename " + partial_.string(), err);
       }
-      fs::remove_all(old, ec);
+      remove_old_output(old);
     }
   }
   committed_ = true;

@@ -1,7 +1,9 @@
-// knit-macro run CASE.json [--output DIR]
+// knit-macro run CASE.json [--output DIR] [--max-output-size SIZE]
 //   Runs a macroscale shell case (docs/case-format.md); writes DIR (default: the case file's
 //   name without extension, in the current directory). Exit codes: 0 completed, 1 a load step
-//   failed (the converged steps are written), 2 bad input (nothing is written).
+//   failed (the converged steps are written), 2 bad input (nothing is written): this includes
+//   an output DIR that cannot be written or is not ours to replace, an output in use by another
+//   run, and an estimated output size above SIZE (default 2G; docs/io.md "Output targets").
 // Example:
 //   knit-macro run cases/verification/scordelis_lo.json --output out/scordelis_lo
 #include <filesystem>
@@ -10,12 +12,13 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/macro/run.hpp"
 
 namespace {
 
 struct Options {
-  std::string case_file, output;
+  std::string case_file, output, max_output_size;
 };
 
 knit::cli::SubcommandRegistrar reg(
@@ -24,12 +27,19 @@ knit::cli::SubcommandRegistrar reg(
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->case_file, "case file (JSON)")->required();
       sub.add_option("--output,-o", o->output, "output directory");
+      sub.add_option("--max-output-size", o->max_output_size,
+                     "refuse a run whose estimated output is larger (default 2G; 0: no cap)");
       return [o]() -> int {
-        const knit::macro::Case c = knit::macro::load_case(o->case_file);
         knit::macro::RunOptions ro;
         ro.output_dir = o->output.empty() ? std::filesystem::path(o->case_file).stem()
                                           : std::filesystem::path(o->output);
+        knit::io::check_output_target(ro.output_dir, knit::io::OutputKind::kDirectory,
+                                      o->output.empty() ? "output directory" : "--output");
+        if (!o->max_output_size.empty())
+          ro.max_output_bytes = knit::io::parse_size(o->max_output_size, "--max-output-size");
+        const knit::macro::Case c = knit::macro::load_case(o->case_file);
         ro.progress = &std::cout;
+        ro.warnings = &std::cerr;
         const auto r = knit::macro::run_case(c, ro);
         if (r.report.status != knit::macro::RunStatus::kCompleted) {
           std::cerr << "knit-macro: " << o->case_file << ": " << r.report.message << " (outputs in "

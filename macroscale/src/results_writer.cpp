@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/io/vtk.hpp"
 
@@ -192,6 +194,43 @@ void ResultsWriter::finish(const RunReport& report) {
   if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
   write_text(dir_.path() / "summary.txt", sum.str());
   dir_.commit();  // DIR.partial-<pid> -> DIR
+}
+
+std::uint64_t estimate_output_bytes(const Case& c) {
+  const auto samples = static_cast<std::uint64_t>(c.output.grid_u) * c.output.grid_v;
+  const auto cells = static_cast<std::uint64_t>(std::max(0, c.output.grid_u - 1)) *
+                     std::max(0, c.output.grid_v - 1);
+  const int every = std::max(1, c.output.every);
+  const auto steps = static_cast<std::uint64_t>((std::max(1, c.solver.steps) + every - 1) / every);
+  const std::uint64_t extra =
+      c.material
+          ? c.material->output_fields(Eigen::Vector2d(0.5, 0.5), Eigen::Vector3d::Zero()).size()
+          : 0;
+  const std::uint64_t fields = 12 + extra;
+  std::uint64_t per_step = 0;
+  // VTU: base64 of float64 (4/3 x 8 bytes) per point value, 41 bytes per quad (connectivity,
+  // offset, type); HDF5: float64 X, x, u and the fields.
+  if (c.output.vtk) per_step += (samples * (6 + fields) * 32 + cells * 41 * 4) / 3;
+  if (c.output.hdf5) per_step += samples * (9 + fields) * 8;
+  return steps * per_step;
+}
+
+void check_output_size(const Case& c, const RunOptions& opt) {
+  const std::uint64_t est = estimate_output_bytes(c);
+  const int every = std::max(1, c.output.every);
+  const std::string what = io::format_bytes(est) + " (" + std::to_string(c.output.grid_u) + " x " +
+                           std::to_string(c.output.grid_v) + " samples x " +
+                           std::to_string((std::max(1, c.solver.steps) + every - 1) / every) +
+                           " output steps)";
+  if (opt.max_output_bytes > 0 && est > opt.max_output_bytes)
+    throw InputError(c.file, "/output/grid",
+                     "the estimated output size " + what + " exceeds the cap of " +
+                         io::format_bytes(opt.max_output_bytes) +
+                         ": use a coarser /output/grid or a larger /output/every, or raise the "
+                         "cap with --max-output-size");
+  if (opt.warnings && opt.max_output_bytes > 0 && est > opt.max_output_bytes / 10)
+    *opt.warnings << "warning: " << c.file << ": the estimated output size is " << what << " (cap "
+                  << io::format_bytes(opt.max_output_bytes) << ", --max-output-size)\n";
 }
 
 }  // namespace knit::macro

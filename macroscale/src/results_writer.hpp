@@ -15,6 +15,10 @@
 
 namespace knit::macro {
 
+/// Refuses (knit::InputError naming /output/grid, with the estimate) a case whose estimated
+/// output exceeds opt.max_output_bytes; warns on opt.warnings above a tenth of it.
+void check_output_size(const Case& c, const RunOptions& opt);
+
 class ResultsWriter {
  public:
   ResultsWriter(const Case& c, const ShellModel& m, std::filesystem::path dir);

@@ -95,6 +95,7 @@ double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge
 }
 
 RunResult run_case(const Case& c, const RunOptions& opt) {
+  if (!opt.output_dir.empty()) check_output_size(c, opt);  // before any work or file
   Problem p = setup_problem(c);
   const ShellModel& m = *p.model;
   std::unique_ptr<ResultsWriter> writer;

@@ -1,6 +1,7 @@
 // knit-meso cell --loop-length L [--out DIR]
-//   Writes the single-jersey unit-cell geometry for a look before simulating (paper Sect. 2.1.2):
-//   DIR/cell.vtp   the four B-spline curves of eq. 5 sampled as polylines with a radius array, plus
+//   Writes (atomically, like every output directory) the single-jersey unit-cell geometry for a
+//   look before simulating (paper Sect. 2.1.2): DIR/cell.vtp   the four B-spline curves of eq. 5
+//   sampled as polylines with a radius array, plus
 //                  the 8 periodic neighbours (cell array "image" > 0);
 //   DIR/cell.json  w, c, h, measured l, minimum clearance between yarns, crossing order.
 // Example: knit-meso cell --loop-length 4.5 --out cell45
@@ -11,6 +12,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 #include "knit/meso/cell/geometry.hpp"
 #include "knit/meso/cell/output.hpp"
 #include "knit/meso/homog/cell_config.hpp"
@@ -40,8 +42,9 @@ int run(const Options& o) {
     go.d = co.section.d;
     go.gamma_over_w = co.geometry.gamma_over_w;
   }
+  knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
   const CellGeometry g = make_cell_geometry(o.loop_length, go);
-  std::filesystem::create_directories(o.out);
+  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
 
   std::vector<Polyline> lines;
   int image = 0;
@@ -58,7 +61,7 @@ int run(const Options& o) {
         lines.push_back(std::move(pl));
       }
     }
-  write_polylines_vtp(o.out + "/cell.vtp", lines, 0.5 * o.d);
+  write_polylines_vtp((dir / "cell.vtp").string(), lines, 0.5 * o.d);
 
   const Clearance cl = minimum_clearance(g.shape, g.dim.c);
   nlohmann::json j;
@@ -84,7 +87,8 @@ int run(const Options& o) {
                   {"dz", x.dz},
                   {"in_front", x.dz > 0 ? "self" : "next course"}});
   j["crossings_with_next_course"] = xs;
-  write_text_atomic(o.out + "/cell.json", j.dump(2) + "\n");
+  write_text_atomic((dir / "cell.json").string(), j.dump(2) + "\n");
+  dir.commit();
   std::cout << "cell l=" << g.dim.loop_length << " mm: w=" << g.dim.w << " c=" << g.dim.c
             << " h=" << g.shape.h << " measured l=" << g.measured_length
             << " min clearance=" << cl.clearance << " mm -> " << o.out << "/cell.{vtp,json}\n";

@@ -9,6 +9,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 
@@ -26,6 +27,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       return [o]() -> int {
         using namespace knit::meso::fit;
+        const std::string target = o->out.empty() ? o->db : o->out;
+        knit::io::check_output_target(target, knit::io::OutputKind::kFile,
+                                      o->out.empty() ? "database" : "--out");
+        const knit::io::OutputLock lock(target);
         auto db = knit::material::read_database(o->db, true);
         const FitOptions fo =
             o->options.empty()
@@ -35,7 +40,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
         std::cout << "knit-meso fit: " << o->db << " (" << fits.size() << " loop lengths)\n";
         knit::meso::fit::print_fit_summaries(std::cout, db, fits);
         db.provenance = knit::material::current_provenance();
-        knit::material::write_database(o->out.empty() ? o->db : o->out, db);
+        knit::material::write_database(target, db);
         for (const auto& f : fits)
           if (!f.ok()) return knit::kExitFailure;
         return knit::kExitOk;

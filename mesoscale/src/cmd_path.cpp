@@ -5,9 +5,9 @@
 //   eqs. 7-9): equilibrates the initial geometry (step 0: residual stress), then N steps.
 //   --biaxial gives the strains of F* = diag(1+eps11, 1+eps22); --shear the shear angle gamma in
 //   DEGREES of F* = [[1, sin g], [0, cos g]].
-//   Writes DIR/path.csv (F*, P*, E, S and solver figures per step), DIR/yarn_NNNN.vtp (deformed
-//   cell yarn and its 8 periodic neighbours, radius array) and DIR/yarn.pvd; prints the time per
-//   step and the Newton iterations.
+//   Writes (atomically: built in DIR.partial-<pid>, DIR replaced at the end) DIR/path.csv (F*, P*,
+//   E, S and solver figures per step), DIR/yarn_NNNN.vtp (deformed cell yarn and its 8 periodic
+//   neighbours, radius array) and DIR/yarn.pvd; prints the time per step and the Newton iterations.
 // Example: knit-meso path --loop-length 4.5 --biaxial 0.3 0 --steps 20 --out path45
 #include <cmath>
 #include <cstdio>
@@ -18,6 +18,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 #include "knit/meso/cell/output.hpp"
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/path.hpp"
@@ -58,6 +59,7 @@ int run(const Options& o) {
   if (bi && o.biaxial.size() != 2) throw knit::InputError("", "--biaxial", "needs EPS11 EPS22");
   if (o.steps < 1) throw knit::InputError("", "--steps", "must be >= 1");
   if (o.elements >= 0 && o.elements < 4) throw knit::InputError("", "--elements", "must be >= 4");
+  knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
   CellOptions co = o.config.empty() ? CellOptions{} : read_cell_options(o.config);
   if (o.elements > 0) co.elements = o.elements;
   if (o.k_N > 0) co.contact.penalty.k_N = o.k_N;
@@ -79,7 +81,7 @@ int run(const Options& o) {
     if (!(std::abs(o.shear) < 80))
       throw knit::InputError("", "--shear", "|gamma| must be < 80 deg");
   }
-  std::filesystem::create_directories(o.out);
+  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
   PeriodicCell cell(o.loop_length, co);
   std::string csv = csv_header();
   std::vector<std::pair<double, std::string>> pvd;
@@ -93,12 +95,13 @@ int run(const Options& o) {
     if (!o.no_vtp) {
       char name[64];
       std::snprintf(name, sizeof name, "yarn_%04d.vtp", k);
-      write_step_vtp(cell, o.out + "/" + name);
+      write_step_vtp(cell, (dir / name).string());
       pvd.emplace_back(double(k), name);
     }
   });
-  knit::meso::cell::write_text_atomic(o.out + "/path.csv", csv);
-  if (!o.no_vtp) knit::meso::cell::write_pvd(o.out + "/yarn.pvd", pvd);
+  knit::meso::cell::write_text_atomic((dir / "path.csv").string(), csv);
+  if (!o.no_vtp) knit::meso::cell::write_pvd((dir / "yarn.pvd").string(), pvd);
+  dir.commit();  // a run that stopped early keeps its converged steps (exit 1)
   const int n = static_cast<int>(res.steps.size()) - 1;
   std::printf(
       "%s: %d steps in %.3f s (%.4f s/step, %.1f Newton iterations/step), "

@@ -9,6 +9,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/rod/rod_case.hpp"
 
 namespace {
@@ -29,12 +30,14 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_flag("-q,--quiet", o->quiet, "no progress lines");
       return [o]() -> int {
         namespace rod = knit::meso::rod;
-        const rod::RodCase c =
-            rod::load_rod_case(o->file);  // InputError -> exit 2, nothing written
         const std::filesystem::path out =
             o->outdir.empty()
                 ? std::filesystem::path(std::filesystem::path(o->file).stem().string() + ".out")
                 : std::filesystem::path(o->outdir);
+        knit::io::check_output_target(out, knit::io::OutputKind::kDirectory,
+                                      o->outdir.empty() ? "output directory" : "--output");
+        const rod::RodCase c =
+            rod::load_rod_case(o->file);  // InputError -> exit 2, nothing written
         const rod::PathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
         std::cout << "rod: " << rep.message << "; lambda = " << rep.lambda_reached << ", "
                   << rep.increments << " increments, " << rep.cutbacks << " cut-backs, "

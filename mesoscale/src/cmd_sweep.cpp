@@ -16,6 +16,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
 namespace {
@@ -89,6 +90,8 @@ int run(const Cli& c) {
     if (c.resume && c.force)
       throw knit::InputError("", "--force", "cannot be combined with --resume");
     if (c.threads < 0) throw knit::InputError("", "--threads", "must be >= 0");
+    // Before any case runs (the lock is taken by run_sweep, on rank 0).
+    knit::io::check_output_target(c.output, knit::io::OutputKind::kFile, "--output");
     SweepOptions o;
     o.output = c.output;
     o.resume = c.resume;

@@ -12,6 +12,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/meso/fit/synthetic.hpp"
@@ -39,6 +40,8 @@ static knit::cli::SubcommandRegistrar reg_synth(
       sub.add_flag("--no-fit", o->no_fit, "store the raw data only");
       return [o]() -> int {
         using namespace knit::meso::fit;
+        knit::io::check_output_target(o->out, knit::io::OutputKind::kFile, "--out");
+        const knit::io::OutputLock lock(o->out);
         SyntheticOptions so;
         so.loop_lengths = o->loop_lengths;
         for (std::size_t k = 0; k < so.loop_lengths.size(); ++k)

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/sweep/checkpoint.hpp"
 #include "knit/meso/sweep/progress.hpp"
 #include "knit/meso/sweep/sweep.hpp"
@@ -136,11 +137,13 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   const std::vector<Job> jobs = make_jobs(in);
 
   // ---- checkpoints (rank 0), the list of pending jobs (broadcast) ---------------------------
+  std::optional<io::OutputLock> lock;  // DB.lock: one sweep per database and checkpoints
   std::unique_ptr<CheckpointStore> store;
   std::map<int, JobResult> finished;
   std::string msg;  // "OK i j k ..." or "ERR <file>\n<message>"
   if (root) {
     try {
+      lock.emplace(opt.output);
       store = std::make_unique<CheckpointStore>(
           opt.output, in.job_definition(), static_cast<int>(jobs.size()), opt.resume, opt.force);
       finished = store->load_finished(jobs);

@@ -9,26 +9,19 @@
 #include <string>
 
 #include "knit/core/build_info.hpp"
+#include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/provenance.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
-struct Scratch {
-  fs::path dir =
-      fs::path(KNIT_BINARY_DIR) / "test_scratch" / ("io_atomic_" + std::to_string(getpid()));
-  Scratch() { fs::create_directories(dir); }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
 fs::path scratch(const std::string& name) {
-  static Scratch s;
-  return s.dir / name;
+  static knit_test::ScratchDir dir("io_atomic");
+  return dir / name;
 }
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -102,6 +95,7 @@ TEST_CASE("AtomicDirectory leaves an existing output intact until commit", "[uni
   const fs::path target = scratch("ad") / "run_out";
   fs::create_directories(target);
   std::ofstream(target / "old.txt") << "old";
+  std::ofstream(target / knit::io::kOutputMarker) << "knitscale output\n";  // an earlier output
 
   {  // abandoned (as when an exception unwinds): old output untouched, partial removed
     knit::io::AtomicDirectory d(target);
@@ -192,4 +186,138 @@ TEST_CASE("Provenance records version, revision, UTC date and command line",
   const auto q = knit::io::read_provenance(f);
   CHECK(q.to_json_string() == j);
   CHECK(f.attribute_string("/g", "git_revision") == p.git_revision);
+}
+
+TEST_CASE("check_output_target refuses what a run must not or cannot write", "[unit][io][atomic]") {
+  using knit::io::OutputKind;
+  const fs::path d = scratch("targets");
+  fs::create_directories(d / "foreign");
+  std::ofstream(d / "foreign" / "keep.txt") << "x";
+  fs::create_directories(d / "ours");
+  std::ofstream(d / "ours" / knit::io::kOutputMarker) << "knitscale output\n";
+  std::ofstream(d / "ours" / "a.csv") << "a";
+  fs::create_directories(d / "empty");
+  std::ofstream(d / "file") << "f";
+  fs::create_symlink(d / "nowhere", d / "dangling");
+  fs::create_symlink(d / "empty", d / "link");
+  auto why = [](const fs::path& t, OutputKind k) -> std::string {
+    try {
+      knit::io::check_output_target(t, k, "--out");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == "--out");
+      CHECK(e.file() == t.string());
+      return e.message();
+    }
+    return "";
+  };
+  const auto dirk = OutputKind::kDirectory, filek = OutputKind::kFile;
+  CHECK_THAT(why(d / "foreign", dirk), Catch::Contains("not a knitscale output"));
+  CHECK_THAT(why(d / "file", dirk), Catch::Contains("not a directory"));
+  CHECK_THAT(why(d / "dangling", dirk), Catch::Contains("dangling symbolic link"));
+  CHECK_THAT(why(d / "dangling", filek), Catch::Contains("dangling symbolic link"));
+  CHECK_THAT(why(d / "link", dirk), Catch::Contains("symbolic link"));
+  CHECK_THAT(why(d / "file" / "sub" / "out", dirk), Catch::Contains("is not a directory"));
+  CHECK_THAT(why(d / "empty", filek), Catch::Contains("is a directory"));
+  for (const fs::path& t :
+       {fs::path("."), fs::path(".."), fs::path("/"), d / "ours" / ".", d / "ours" / ".."})
+    CHECK_THAT(why(t, dirk), Catch::Contains("cannot be replaced"));
+  CHECK_THAT(why(fs::current_path(), dirk), Catch::Contains("current directory"));
+  CHECK_THAT(why(fs::current_path().parent_path(), dirk), Catch::Contains("current directory"));
+  CHECK(why(d / "ours", dirk).empty());
+  CHECK(why(d / "ours/", dirk).empty());
+  CHECK(why(d / "empty", dirk).empty());
+  CHECK(why(d / "new" / "deeper" / "out", dirk).empty());  // parents are created
+  CHECK(why(d / "file", filek).empty());                   // a file output replaces a file
+  CHECK(why(d / "new.h5", filek).empty());
+  if (::geteuid() != 0) {  // root writes everywhere
+    fs::create_directories(d / "ro");
+    fs::permissions(d / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    CHECK_THAT(why(d / "ro" / "out", dirk), Catch::Contains("not writable"));
+    fs::permissions(d / "ro", fs::perms::owner_all);
+  }
+}
+
+TEST_CASE("OutputLock: one holder at a time, named in the refusal, stale locks taken over",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("lock");
+  fs::create_directories(d);
+  const fs::path target = d / "out";
+  CHECK(knit::io::OutputLock::lock_path(fs::path(target.string() + "/")) == d / "out.lock");
+  {
+    knit::io::OutputLock a(target);
+    CHECK(fs::exists(d / "out.lock"));
+    CHECK(slurp(d / "out.lock") == "knitscale lock pid " + std::to_string(::getpid()) + "\n");
+    CHECK_THROWS_WITH(
+        knit::io::OutputLock(target),
+        Catch::Contains("another knitscale process (pid " + std::to_string(::getpid()) + ","));
+    knit::io::OutputLock moved(std::move(a));
+    CHECK_THROWS_AS(knit::io::OutputLock(target), knit::InputError);
+  }
+  CHECK_FALSE(fs::exists(d / "out.lock"));  // removed on release
+  // The lock file of a killed process: not held, taken over.
+  std::ofstream(d / "out.lock") << "knitscale lock pid 999999999\n";
+  { knit::io::OutputLock b(target); }
+  // A file of that name that is not a lock file is neither used nor changed.
+  std::ofstream(d / "out.lock") << "someone's notes";
+  CHECK_THROWS_WITH(knit::io::OutputLock(target), Catch::Contains("not a knitscale lock file"));
+  CHECK(slurp(d / "out.lock") == "someone's notes");
+}
+
+TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our stale partials",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("ours");
+  const fs::path target = d / "out";
+  fs::create_directories(target);
+  std::ofstream(target / "keep.txt") << "precious";
+  CHECK_THROWS_WITH(knit::io::AtomicDirectory(target), Catch::Contains("not a knitscale output"));
+  CHECK(fs::exists(target / "keep.txt"));
+  fs::remove_all(target);
+  {  // new: the marker is in the output, the lock beside it while writing
+    knit::io::AtomicDirectory a(target);
+    CHECK(fs::exists(a.path() / knit::io::kOutputMarker));
+    CHECK(fs::exists(d / "out.lock"));
+    CHECK_THROWS_WITH(knit::io::AtomicDirectory(target), Catch::Contains("pid"));
+    a.commit();
+  }
+  CHECK_THAT(slurp(target / knit::io::kOutputMarker), Catch::StartsWith("knitscale output\n"));
+  CHECK_FALSE(fs::exists(d / "out.lock"));
+  // Stale partial directories: of a dead pid with the marker -> removed; without the marker, or
+  // of a live process, or of another output -> kept.
+  const std::string dead = std::to_string(999999999);
+  auto make = [&](const std::string& name, bool marker) {
+    fs::create_directories(d / name);
+    std::ofstream(d / name / "x") << "x";
+    if (marker) std::ofstream(d / name / knit::io::kOutputMarker) << "knitscale output\n";
+  };
+  make("out.partial-" + dead, true);
+  make("out.old-" + dead, true);
+  make("out.partial-1", true);               // pid 1 lives
+  make("out.partial-99999999x", true);       // not a pid
+  make("out.partial-" + dead + "0", false);  // no marker
+  make("other.partial-" + dead, true);       // another output
+  {
+    knit::io::AtomicDirectory a(target);
+    a.commit();
+  }
+  CHECK_FALSE(fs::exists(d / ("out.partial-" + dead)));
+  CHECK_FALSE(fs::exists(d / ("out.old-" + dead)));
+  CHECK(fs::exists(d / "out.partial-1"));
+  CHECK(fs::exists(d / "out.partial-99999999x"));
+  CHECK(fs::exists(d / ("out.partial-" + dead + "0")));
+  CHECK(fs::exists(d / ("other.partial-" + dead)));
+}
+
+TEST_CASE("Output sizes: parsed from the command line, printed in decimal units",
+          "[unit][io][atomic]") {
+  CHECK(knit::io::parse_size("2G", "--max") == 2'000'000'000u);
+  CHECK(knit::io::parse_size("1.5GB", "--max") == 1'500'000'000u);
+  CHECK(knit::io::parse_size("500M", "--max") == 500'000'000u);
+  CHECK(knit::io::parse_size("10k", "--max") == 10'000u);
+  CHECK(knit::io::parse_size("123", "--max") == 123u);
+  CHECK(knit::io::parse_size("0", "--max") == 0u);
+  for (const char* bad : {"", "G", "-1", "nan", "1Q", "1e30"})
+    CHECK_THROWS_WITH(knit::io::parse_size(bad, "--max"), Catch::Contains("--max"));
+  CHECK(knit::io::format_bytes(7'800'000'000u) == "7.8 GB");
+  CHECK(knit::io::format_bytes(350'000'000u) == "350 MB");
+  CHECK(knit::io::format_bytes(999u) == "999 bytes");
 }

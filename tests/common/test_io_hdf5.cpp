@@ -9,24 +9,15 @@
 #include <string>
 
 #include "knit/io/hdf5.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using knit::io::H5File;
 
 namespace {
-/// Per-process scratch directory under the build tree, removed when the test program exits.
-struct Scratch {
-  fs::path dir =
-      fs::path(KNIT_BINARY_DIR) / "test_scratch" / ("io_hdf5_" + std::to_string(getpid()));
-  Scratch() { fs::create_directories(dir); }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
 fs::path scratch(const std::string& name) {
-  static Scratch s;
-  return s.dir / name;
+  static knit_test::ScratchDir dir("io_hdf5");
+  return dir / name;
 }
 
 std::string message_of(const std::function<void()>& f) {

@@ -12,23 +12,15 @@
 #include <string>
 
 #include "knit/io/vtk.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace knit::io;
 
 namespace {
-struct Scratch {
-  fs::path dir =
-      fs::path(KNIT_BINARY_DIR) / "test_scratch" / ("io_vtk_" + std::to_string(getpid()));
-  Scratch() { fs::create_directories(dir); }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
 fs::path scratch(const std::string& name) {
-  static Scratch s;
-  return s.dir / name;
+  static knit_test::ScratchDir dir("io_vtk");
+  return dir / name;
 }
 
 // ---- a minimal XML reader, enough for well-formed VTK files -------------------------------

@@ -23,6 +23,8 @@
 #include <string>
 #include <string_view>
 
+#include "knit/io/output_target.hpp"
+
 namespace knit::io {
 
 /// One output file written to "<dir>/.<name>.tmp-<pid>-<n>" and renamed over the target on
@@ -59,7 +61,11 @@ class AtomicFile {
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
 
 /// An output directory built as "<DIR>.partial-<pid>" and put in place on commit(). An existing
-/// DIR stays untouched until the new one is complete.
+/// DIR stays untouched until the new one is complete. Only a directory knitscale wrote (it holds
+/// the marker file kOutputMarker, written into every output directory) or an empty one is ever
+/// replaced: a non-empty directory without the marker is refused (check_output_target) and
+/// never deleted. The output is locked (OutputLock on DIR.lock) from construction to
+/// destruction, so two runs never write the same DIR at once.
 class AtomicDirectory {
  public:
   /// What happens to the partial directory when the object dies without commit().
@@ -67,9 +73,13 @@ class AtomicDirectory {
     Remove,  ///< delete it (default)
     Keep     ///< keep it for inspection, with a file INCOMPLETE inside saying so
   };
-  /// Creates the partial directory (and the parents of DIR). A stale partial directory of the
-  /// same name (same pid, earlier run) is removed first.
-  explicit AtomicDirectory(std::filesystem::path target, OnAbandon on_abandon = OnAbandon::Remove);
+  /// Checks the target (check_output_target, InputError naming `option`), creates the parents
+  /// of DIR, takes the lock (InputError naming the holder's pid while another process holds
+  /// it), removes the stale "DIR.partial-<pid>" and "DIR.old-<pid>" directories of dead
+  /// processes (only those holding the marker), then creates the partial directory with the
+  /// marker in it.
+  explicit AtomicDirectory(std::filesystem::path target, OnAbandon on_abandon = OnAbandon::Remove,
+                           std::string_view option = "output directory");
   AtomicDirectory(AtomicDirectory&& o) noexcept;
   AtomicDirectory& operator=(AtomicDirectory&&) = delete;
   AtomicDirectory(const AtomicDirectory&) = delete;
@@ -82,12 +92,15 @@ class AtomicDirectory {
   std::filesystem::path operator/(const std::filesystem::path& name) const { return path() / name; }
   /// fsyncs the files, then replaces DIR by the partial directory: atomically where the file
   /// system supports renameat2(RENAME_EXCHANGE), otherwise by two renames (DIR is moved
-  /// aside to DIR.old-<pid> first, then removed). Throws std::runtime_error on failure.
+  /// aside to DIR.old-<pid> first, then removed). Throws std::runtime_error on failure, and
+  /// when DIR became a non-empty directory without the marker meanwhile (it is left alone).
   void commit();
   bool committed() const { return committed_; }
 
  private:
-  std::filesystem::path target_, partial_;
+  std::filesystem::path target_;
+  OutputLock lock_;  ///< held from construction to destruction (after the checks)
+  std::filesystem::path partial_;
   OnAbandon on_abandon_;
   bool committed_ = false;
   bool active_ = true;

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <iosfwd>
 #include <memory>
@@ -51,10 +52,25 @@ struct StepRow {
 double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge, int component,
                      int rows);
 
+/// Default cap on the estimated size of a run's output directory (estimate_output_bytes):
+/// above it the run is refused before any work; above a tenth of the cap it warns.
+inline constexpr std::uint64_t kDefaultMaxOutputBytes = 2'000'000'000;  // 2 GB
+
 struct RunOptions {
   std::filesystem::path output_dir;  ///< empty: no files are written (tests)
   std::ostream* progress = nullptr;  ///< one line per converged step
+  std::ostream* warnings = nullptr;  ///< e.g. a large estimated output
+  /// Cap on the estimated output size (0: none); knit-macro run --max-output-size.
+  std::uint64_t max_output_bytes = kDefaultMaxOutputBytes;
 };
+
+/// Estimated size in bytes of the output directory of a case (VTU and HDF5 fields; the CSV is
+/// negligible): output steps x grid samples x fields x bytes per value, with
+///   output steps = ceil(solver.steps / output.every) (cut-backs may add a few),
+///   fields       = 3 coordinates + 3 displacements + 12 strains/curvatures/stress resultants
+///                  + the material's extra fields, base64 float64 in VTU (10.7 bytes each),
+///                  and 9 + 12 + extra float64 per sample in HDF5 (held in memory until the end).
+std::uint64_t estimate_output_bytes(const Case& c);
 
 struct RunResult {
   RunReport report;

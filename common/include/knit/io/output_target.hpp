@@ -1,0 +1,72 @@
+// Output targets: what every command checks and holds before it writes (docs/io.md, "Output
+// targets"). Used by AtomicDirectory (atomic.hpp) and by the commands that write one file.
+//
+//   knit::io::check_output_target(out, knit::io::OutputKind::kDirectory, "--output");  // at once
+//   knit::io::AtomicDirectory dir(out);  // locks OUT.lock, cleans stale OUT.partial-<pid>
+//
+//   knit::io::check_output_target(db, knit::io::OutputKind::kFile, "--output");
+//   knit::io::OutputLock lock(db);       // db.h5.lock while the sweep runs
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace knit::io {
+
+/// The file in every output directory knitscale writes ("knitscale output" and the provenance
+/// of the run that wrote it). A non-empty directory without it is never replaced or deleted.
+inline constexpr const char* kOutputMarker = ".knitscale-output";
+
+/// True if `dir` is a directory holding the marker file.
+bool is_knitscale_output(const std::filesystem::path& dir);
+
+enum class OutputKind { kDirectory, kFile };
+
+/// Refuses, before any work, an output target the run could not (or must not) write. Throws
+/// knit::InputError(target, option, why) ("out: --output: is a regular file ...") for
+///  * an empty name, ".", "..", "/" or any path ending in "." or "..";
+///  * a symbolic link (dangling or not: the rename would replace the link, not its target);
+///  * kDirectory: an existing non-directory; the current directory or one of its ancestors; a
+///    non-empty directory that is not a knitscale output (no marker file);
+///  * kFile: an existing directory (or other non-regular file);
+///  * a target whose nearest existing ancestor is not a writable directory (missing parents
+///    are created by the writer, so "a/b/out" needs "a" — or the first existing one — writable).
+void check_output_target(const std::filesystem::path& target, OutputKind kind,
+                         std::string_view option = "--output");
+
+/// An exclusive lock on an output, held for the lifetime of the object: flock(2) on
+/// "<target>.lock" beside the target, which holds "knitscale lock pid <pid>". Another process
+/// (or another OutputLock in this process) asking for the same target is refused with a
+/// knit::InputError naming the holder's pid. A lock file left by a killed process is not held
+/// (the kernel drops flock locks with the process) and is taken over. The file is removed when
+/// the lock is released. A "<target>.lock" that is not a knitscale lock file is never touched.
+/// Missing parent directories of the target are created (as the writer would).
+class OutputLock {
+ public:
+  explicit OutputLock(std::filesystem::path target);
+  OutputLock(OutputLock&& o) noexcept;
+  OutputLock& operator=(OutputLock&&) = delete;
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+  ~OutputLock();
+
+  /// "<target>.lock" (a trailing '/' of the target is ignored).
+  static std::filesystem::path lock_path(const std::filesystem::path& target);
+  const std::filesystem::path& path() const { return file_; }
+
+ private:
+  std::filesystem::path file_;
+  int fd_ = -1;
+};
+
+/// Estimated output size in bytes as "1.2 GB" / "350 MB" / "12 kB" (decimal units).
+std::string format_bytes(std::uint64_t bytes);
+
+/// Parses a size given on the command line: a number with an optional unit k, M, G, T (decimal,
+/// an optional trailing "B"): "500M", "2G", "1.5GB", "100000". Throws knit::InputError(option)
+/// for anything else.
+std::uint64_t parse_size(std::string_view text, std::string_view option);
+
+}  // namespace knit::io

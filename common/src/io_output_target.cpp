@@ -1,0 +1,223 @@
+// Output targets: checks before a run, the output lock (see knit/io/output_target.hpp).
+// POSIX (Linux) only.
+#include "knit/io/output_target.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "knit/core/errors.hpp"
+
+namespace fs = std::filesystem;
+
+namespace knit::io {
+
+namespace {
+
+fs::path without_trailing_slash(fs::path p) {
+  while (!p.has_filename() && p.has_parent_path() && p.parent_path() != p) p = p.parent_path();
+  return p;
+}
+
+/// True if `inner` is `outer` or lies inside it (both made absolute and normal).
+bool contains(const fs::path& outer, const fs::path& inner) {
+  std::error_code ec;
+  const fs::path o = fs::weakly_canonical(outer, ec);
+  if (ec) return false;
+  const fs::path i = fs::weakly_canonical(inner, ec);
+  if (ec) return false;
+  auto oi = o.begin(), ii = i.begin();
+  for (; oi != o.end(); ++oi, ++ii) {
+    if (oi->empty()) continue;  // trailing "" of "a/b/"
+    if (ii == i.end() || *oi != *ii) return false;
+  }
+  return true;
+}
+
+std::string read_small(int fd) {
+  char buf[128] = {};
+  const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+  return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
+}
+
+constexpr const char* kLockTag = "knitscale lock pid ";
+
+}  // namespace
+
+bool is_knitscale_output(const fs::path& dir) {
+  std::error_code ec;
+  return fs::is_directory(fs::symlink_status(dir, ec)) &&
+         fs::is_regular_file(fs::symlink_status(dir / kOutputMarker, ec));
+}
+
+void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option) {
+  const std::string opt(option);
+  const fs::path target = without_trailing_slash(target_in);
+  auto refuse = [&](const std::string& why) { throw InputError(target_in.string(), opt, why); };
+  if (target_in.empty()) throw InputError("", opt, "the output path is empty");
+  const std::string name = target.filename().string();
+  if (name.empty() || name == "." || name == ".." || target == target.root_path())
+    refuse(
+        "names no new file or directory (\".\", \"..\" and \"/\" cannot be replaced); give "
+        "the name of the output to create, e.g. " +
+        std::string(kind == OutputKind::kDirectory ? "out/run1" : "out/database.h5"));
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(target, ec);
+  if (fs::is_symlink(st)) {
+    const bool dangling = !fs::exists(fs::status(target, ec));
+    refuse(dangling
+               ? "is a dangling symbolic link; give a real path"
+               : "is a symbolic link (the output would replace the link, not what it points to); "
+                 "give the real path");
+  }
+  ec.clear();
+  const fs::path parent =
+      target.has_parent_path() ? fs::absolute(target, ec).parent_path() : fs::current_path(ec);
+  if (fs::exists(st)) {
+    if (kind == OutputKind::kDirectory) {
+      if (!fs::is_directory(st))
+        refuse("exists and is not a directory (an output directory is asked for)");
+      if (contains(target, fs::current_path(ec)))
+        refuse("is the current directory or contains it; give a new directory for the outputs");
+      const bool empty = fs::is_empty(target, ec);
+      if (!ec && !empty && !is_knitscale_output(target))
+        refuse(std::string("is a non-empty directory that is not a knitscale output (no ") +
+               kOutputMarker +
+               " file): its files are not ours to replace; give a new or empty directory");
+    } else {
+      if (fs::is_directory(st)) refuse("is a directory; give the name of the file to write");
+      if (!fs::is_regular_file(st)) refuse("exists and is not a regular file");
+    }
+    if (::access(parent.c_str(), W_OK | X_OK) != 0)
+      refuse("cannot be replaced: directory " + parent.string() + " is not writable");
+    return;
+  }
+  // A new target: its nearest existing ancestor must be a writable directory (the writer creates
+  // the missing parents).
+  fs::path p = parent;
+  while (!fs::exists(fs::symlink_status(p, ec)) && p.has_parent_path() && p.parent_path() != p)
+    p = p.parent_path();
+  if (!fs::is_directory(p, ec)) refuse("cannot be created: " + p.string() + " is not a directory");
+  if (::access(p.c_str(), W_OK | X_OK) != 0)
+    refuse("cannot be created: directory " + p.string() + " is not writable");
+}
+
+// ---- OutputLock -----------------------------------------------------------------------------
+
+fs::path OutputLock::lock_path(const fs::path& target) {
+  fs::path l = without_trailing_slash(target);
+  l += ".lock";
+  return l;
+}
+
+OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
+  const std::string out = without_trailing_slash(target).string();
+  std::error_code ec;
+  if (file_.has_parent_path()) fs::create_directories(file_.parent_path(), ec);  // as the writer
+  // A lock file unlinked by its releasing holder between our open() and flock() is not the lock
+  // any more: retry on the new file (checked by comparing inodes).
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    const int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0)
+      throw InputError(
+          out, "",
+          "cannot create the lock file " + file_.string() + " (" + std::strerror(errno) + ")");
+    struct stat a {};
+    const std::string have = read_small(fd);
+    if (::fstat(fd, &a) != 0 || !S_ISREG(a.st_mode) ||
+        (!have.empty() && have.rfind(kLockTag, 0) != 0)) {
+      ::close(fd);
+      throw InputError(out, "",
+                       file_.string() +
+                           " exists and is not a knitscale lock file; rename or remove "
+                           "it, or choose another output");
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      const std::string who = read_small(fd);
+      ::close(fd);
+      if (err != EWOULDBLOCK)
+        throw InputError(out, "",
+                         "cannot lock " + file_.string() + " (" + std::strerror(err) + ")");
+      std::string pid = who.size() > std::strlen(kLockTag) ? who.substr(std::strlen(kLockTag)) : "";
+      while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+      throw InputError(out, "",
+                       "is being written by another knitscale process (pid " +
+                           (pid.empty() ? std::string("unknown") : pid) + ", lock file " +
+                           file_.string() + "); wait for it to finish or choose another output");
+    }
+    struct stat b {};
+    if (::fstat(fd, &a) != 0 || ::stat(file_.c_str(), &b) != 0 || a.st_ino != b.st_ino ||
+        a.st_dev != b.st_dev) {
+      ::close(fd);
+      continue;
+    }
+    const std::string me = kLockTag + std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) < 0) {
+      // Holding the lock is what counts; the pid is for the message of the refused one.
+    }
+    fd_ = fd;
+    return;
+  }
+  throw InputError(out, "", "cannot take the lock " + file_.string() + " (it keeps changing)");
+}
+
+OutputLock::OutputLock(OutputLock&& o) noexcept : file_(std::move(o.file_)), fd_(o.fd_) {
+  o.fd_ = -1;
+}
+
+OutputLock::~OutputLock() {
+  if (fd_ < 0) return;
+  ::unlink(file_.c_str());  // while still held: a waiting process retries on a new file
+  ::close(fd_);
+}
+
+// ---- sizes ----------------------------------------------------------------------------------
+
+std::string format_bytes(std::uint64_t bytes) {
+  static const char* units[] = {"bytes", "kB", "MB", "GB", "TB"};
+  double v = static_cast<double>(bytes);
+  int u = 0;
+  while (v >= 1000.0 && u < 4) v /= 1000.0, ++u;
+  char b[48];
+  if (u == 0)
+    std::snprintf(b, sizeof b, "%llu bytes", static_cast<unsigned long long>(bytes));
+  else
+    std::snprintf(b, sizeof b, v < 10 ? "%.1f %s" : "%.0f %s", v, units[u]);
+  return b;
+}
+
+std::uint64_t parse_size(std::string_view text, std::string_view option) {
+  const std::string s(text);
+  auto bad = [&]() -> std::uint64_t {
+    throw InputError("", std::string(option),
+                     "\"" + s + "\" is not a size (a number with an optional k, M, G or T: 500M)");
+  };
+  if (s.empty()) return bad();
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  std::string unit(end);
+  if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
+  double f = 1;
+  if (unit == "k" || unit == "K")
+    f = 1e3;
+  else if (unit == "M" || unit == "m")
+    f = 1e6;
+  else if (unit == "G" || unit == "g")
+    f = 1e9;
+  else if (unit == "T" || unit == "t")
+    f = 1e12;
+  else if (!unit.empty())
+    return bad();
+  if (end == s.c_str() || !std::isfinite(v) || v < 0 || v * f > 1.8e19) return bad();
+  return static_cast<std::uint64_t>(v * f);
+}
+
+}  // namespace knit::io

@@ -1,0 +1,169 @@
+// knit-macro run and its output directory (issue 14, docs/io.md "Output targets"): it never
+// deletes what it did not write, refuses a target it cannot write before any work (exit 2,
+// naming the option and the path), locks the output against a concurrent run, and refuses a
+// run whose estimated output is larger than the cap.
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "../output_test_util.hpp"
+#include "knit/macro/case.hpp"
+#include "knit/macro/run.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+fs::path scratch(const std::string& tag) {
+  const fs::path d = fs::path(KNIT_BINARY_DIR) / "test_scratch" /
+                     ("run_outputs_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+/// The tensile case with a few steps and a small output grid, written to d/t.json.
+std::string small_case(const fs::path& d, int grid = 5, int steps = 2) {
+  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/tensile_svk.json");
+  json j = json::parse(in);
+  j["solver"]["steps"] = steps;
+  j["output"]["grid"] = {grid, grid};
+  std::ofstream(d / "t.json") << j.dump(2);
+  return (d / "t.json").string();
+}
+
+knit_test::CommandResult macro(const std::string& args) {
+  return knit_test::run_command(std::string(KNIT_BIN_DIR) + "/knit-macro run " + args);
+}
+
+}  // namespace
+
+TEST_CASE("knit-macro run never deletes files it did not write", "[unit][outputs]") {
+  const fs::path d = scratch("loss");
+  const std::string c = small_case(d);
+  fs::create_directories(d / "work");
+  std::ofstream(d / "work" / "keep.txt") << "precious";
+  // The current directory as the output (the reported data loss).
+  auto r = knit_test::run_command("cd " + (d / "work").string() + " && " + KNIT_BIN_DIR +
+                                  "/knit-macro run " + c + " --output \"$(pwd)\"");
+  CHECK(r.rc == 2);
+  CHECK(knit_test::contains(r.output, "--output"));
+  CHECK(fs::exists(d / "work" / "keep.txt"));
+  CHECK(!knit_test::contains(r.output, "step    1"));  // refused before the run
+  // Any non-empty directory without the marker.
+  r = macro(c + " --output " + (d / "work").string());
+  CHECK(r.rc == 2);
+  CHECK(knit_test::contains(r.output, "not a knitscale output"));
+  CHECK(fs::exists(d / "work" / "keep.txt"));
+  // An empty directory and knitscale's own earlier output are replaced.
+  fs::create_directories(d / "empty");
+  REQUIRE(macro(c + " --output " + (d / "empty").string()).rc == 0);
+  CHECK(fs::exists(d / "empty" / "load_strain.csv"));
+  CHECK(fs::exists(d / "empty" / ".knitscale-output"));
+  REQUIRE(macro(c + " --output " + (d / "empty").string()).rc == 0);
+  CHECK(fs::exists(d / "empty" / "load_strain.csv"));
+  for (const auto& e : fs::directory_iterator(d))  // no partial, old or lock files left
+    CHECK((e.path().filename().string().find('.') == std::string::npos ||
+           e.path().extension() == ".json"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("knit-macro run refuses an output it cannot write before the run", "[unit][outputs]") {
+  const fs::path d = scratch("targets");
+  const std::string c = small_case(d);
+  std::ofstream(d / "file") << "a file";
+  fs::create_symlink(d / "missing", d / "dangling");
+  const std::string targets[] = {(d / "file").string(),
+                                 (d / "dangling").string(),
+                                 (d / "file" / "sub").string(),
+                                 "..",
+                                 ".",
+                                 "/"};
+  for (const std::string& t : targets) {
+    INFO("--output " << t);
+    // Run inside d: what a wrong rename would touch stays in the scratch directory.
+    const auto r = knit_test::run_command("cd " + d.string() + " && " + KNIT_BIN_DIR +
+                                          "/knit-macro run " + c + " --output \"" + t + "\"");
+    CHECK(r.rc == 2);
+    CHECK(knit_test::contains(r.output, "--output"));
+    CHECK(!knit_test::contains(r.output, "step    1"));
+  }
+  CHECK(fs::is_regular_file(d / "file"));
+  CHECK(fs::is_symlink(fs::symlink_status(d / "dangling")));
+  if (::geteuid() != 0) {  // root writes everywhere
+    fs::create_directories(d / "ro");
+    fs::permissions(d / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    const auto r = macro(c + " --output " + (d / "ro" / "out").string());
+    CHECK(r.rc == 2);
+    CHECK(knit_test::contains(r.output, "not writable"));
+    fs::permissions(d / "ro", fs::perms::owner_all);
+  }
+  fs::remove_all(d);
+}
+
+TEST_CASE("knit-macro run: an output in use by another run is refused", "[unit][outputs]") {
+  const fs::path d = scratch("lock");
+  const std::string c = small_case(d);
+  const std::string out = (d / "out").string();
+  {
+    knit_test::LockHolder other(d / "out.lock");
+    REQUIRE(other.pid() > 0);
+    const auto r = macro(c + " --output " + out);
+    CHECK(r.rc == 2);
+    CHECK(knit_test::contains(r.output, "pid " + std::to_string(other.pid())));
+    CHECK(!fs::exists(out));
+    other.release();  // killed: its lock file stays behind
+    CHECK(fs::exists(d / "out.lock"));
+    CHECK(macro(c + " --output " + out).rc == 0);  // the stale lock is taken over
+  }
+  CHECK(fs::exists(d / "out" / "load_strain.csv"));
+  CHECK(!fs::exists(d / "out.lock"));  // released at the end of the run
+  fs::remove_all(d);
+}
+
+TEST_CASE("knit-macro run: the estimated output size is capped before the run", "[unit][outputs]") {
+  const fs::path d = scratch("size");
+  const std::string out = (d / "out").string();
+  {  // The reported case: 1001 x 1001 samples (386 s, 7.8 GB) is refused at once.
+    const std::string c = small_case(d, 1001, 10);
+    const auto r = macro(c + " --output " + out);
+    CHECK(r.rc == 2);
+    CHECK(knit_test::contains(r.output, "/output/grid"));
+    CHECK(knit_test::contains(r.output, "estimated output size"));
+    CHECK(knit_test::contains(r.output, "GB"));
+    CHECK(!fs::exists(out));
+  }
+  const std::string c = small_case(d, 5, 2);
+  auto r = macro(c + " --output " + out + " --max-output-size 10k");
+  CHECK(r.rc == 2);
+  CHECK(knit_test::contains(r.output, "--max-output-size"));
+  r = macro(c + " --output " + out + " --max-output-size 150k");  // > a tenth: warns, runs
+  CHECK(r.rc == 0);
+  CHECK(knit_test::contains(r.output, "warning:"));
+  r = macro(c + " --output " + out + " --max-output-size lots");
+  CHECK(r.rc == 2);
+  CHECK(knit_test::contains(r.output, "--max-output-size"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("knit-macro run: the output size estimate matches what is written", "[unit][outputs]") {
+  const fs::path d = scratch("estimate");
+  const std::string file = small_case(d, 41, 3);
+  const knit::macro::Case c = knit::macro::load_case(file);
+  knit::macro::RunOptions ro;
+  ro.output_dir = d / "out";
+  REQUIRE(knit::macro::run_case(c, ro).report.status == knit::macro::RunStatus::kCompleted);
+  std::uintmax_t bytes = 0;
+  for (const auto& e : fs::recursive_directory_iterator(d / "out"))
+    if (e.is_regular_file()) bytes += e.file_size();
+  const double est = static_cast<double>(knit::macro::estimate_output_bytes(c));
+  INFO("estimated " << est << " bytes, written " << bytes);
+  CHECK(est > 0.8 * static_cast<double>(bytes));
+  CHECK(est < 1.2 * static_cast<double>(bytes));
+  fs::remove_all(d);
+}

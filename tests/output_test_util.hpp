@@ -1,0 +1,98 @@
+// Helpers of the output tests (issue 14; docs/io.md "Output targets"): run a command and keep
+// its exit code and output, hold an output lock from another process like a concurrent run.
+#pragma once
+
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace knit_test {
+
+struct CommandResult {
+  int rc = -1;         ///< exit code (-1: killed by a signal)
+  std::string output;  ///< stdout and stderr
+};
+
+/// Runs `command` with /bin/sh (stdout and stderr captured; killed after `timeout_s`).
+inline CommandResult run_command(const std::string& command, int timeout_s = 120) {
+  const std::string log =
+      std::filesystem::temp_directory_path() / ("knit_cmd_" + std::to_string(::getpid()) + ".log");
+  const std::string cmd =
+      "timeout " + std::to_string(timeout_s) + " sh -c '" + command + "' > " + log + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  CommandResult r;
+  r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  std::filesystem::remove(log);
+  return r;
+}
+
+/// A child process holding the lock of an output like a running knitscale command does:
+/// flock(2) on `lock_file`, which holds "knitscale lock pid <pid>". release() kills the child:
+/// the lock file stays, with a dead pid in it (the stale lock of a killed run).
+class LockHolder {
+ public:
+  explicit LockHolder(const std::filesystem::path& lock_file) {
+    int ready[2];
+    if (::pipe(ready) != 0) return;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::close(ready[0]);
+      const int fd = ::open(lock_file.c_str(), O_RDWR | O_CREAT, 0644);
+      if (fd < 0 || ::flock(fd, LOCK_EX) != 0) ::_exit(1);
+      const std::string me = "knitscale lock pid " + std::to_string(::getpid()) + "\n";
+      if (::ftruncate(fd, 0) != 0 || ::write(fd, me.data(), me.size()) < 0) ::_exit(1);
+      if (::write(ready[1], "x", 1) != 1) ::_exit(1);
+      for (;;) ::pause();
+    }
+    ::close(ready[1]);
+    char c = 0;
+    if (::read(ready[0], &c, 1) != 1) pid_ = -1;
+    ::close(ready[0]);
+  }
+  LockHolder(const LockHolder&) = delete;
+  LockHolder& operator=(const LockHolder&) = delete;
+  ~LockHolder() { release(); }
+  int pid() const { return pid_; }
+  void release() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = 0;
+  }
+
+ private:
+  int pid_ = -1;
+};
+
+inline bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+inline std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The pid of a process that has exited (for stale files of killed runs).
+inline int dead_pid() {
+  const int pid = ::fork();
+  if (pid == 0) ::_exit(0);
+  ::waitpid(pid, nullptr, 0);
+  return pid;
+}
+
+}  // namespace knit_test
