@@ -14,13 +14,17 @@
 // LDLT, the inertia of the reduced tangent (negative pivots of D) reported per step, and an
 // energy line search; other materials (the unsymmetric eq. 17 response surface) get LU.
 //
-// Line search, full step first:
-//  * hyperelastic: on the total potential Pi(u) = Psi(u) - lambda f_ext . u (Psi the strain
-//    energy, ShellModel::Evaluation::energy). The full Newton step is taken when Pi does not
-//    increase (Armijo, c1 = 1e-4, or a change within round-off of Pi) or when du is not a
+// Line search, the full Newton step first:
+//  * hyperelastic: each load step is first tried with plain Newton (full steps, halved only
+//    while they degenerate the geometry); only when that attempt fails is the step repeated
+//    with an energy line search on the total potential Pi(u) = Psi(u) - lambda f_ext . u (Psi
+//    the strain energy, ShellModel::Evaluation::energy): the full step is taken when Pi does
+//    not increase (Armijo, c1 = 1e-4, or a change within round-off of Pi) or when du is not a
 //    descent direction (an indefinite tangent past a limit point: Newton then looks for an
 //    unstable equilibrium, which Pi cannot rank); otherwise backtracking with the minimum of
 //    the quadratic through Pi(0), Pi'(0) and Pi(alpha), alpha in [0.1, 0.5] of the last one.
+//    (Searching in every iteration turned the Sze cantilever's 60 iterations into 82: Newton
+//    recovers from overshooting steps that raise Pi, the search only slows it down.)
 //  * otherwise: when the full step increases ||r|| and does not halve g(alpha) = du . r(u +
 //    alpha du), secant iterations on g (Matthies & Strang 1979).
 //
