@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -99,8 +100,9 @@ std::optional<std::string> DofMap::unconstrained_rigid_mode(const Eigen::MatrixX
     else if (root_[d] != d)
       rows.push_back(mode(d) - mode(root_[d]));
   }
-  Eigen::MatrixXd A(rows.size() + 1, 6);
-  A.setZero();
+  // At least 6 rows (zero rows change no singular value): with fewer than five constraint
+  // rows the SVD would have fewer than 6 singular values and s(5) would not exist.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(std::max<Eigen::Index>(rows.size() + 1, 6), 6);
   for (size_t k = 0; k < rows.size(); ++k) A.row(k) = rows[k];
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
   const auto& s = svd.singularValues();

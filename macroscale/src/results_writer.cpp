@@ -37,7 +37,7 @@ void write_text(const fs::path& file, const std::string& text) {
 
 ResultsWriter::ResultsWriter(const Case& c, const ShellModel& m, fs::path dir)
     : case_(c), model_(m), dir_(std::move(dir)), pvd_(dir_.path() / "results.pvd") {
-  fs::create_directories(dir_.path() / "vtk");
+  if (c.output.vtk) fs::create_directories(dir_.path() / "vtk");
   write_text(dir_.path() / "case.json", c.text);
 }
 
@@ -84,13 +84,16 @@ ResultsWriter::Fields ResultsWriter::sample(int step, double lambda,
 }
 
 void ResultsWriter::add_step(int step, double lambda, const Eigen::VectorXd& u) {
+  if (!case_.output.vtk && !case_.output.hdf5) return;
   Fields f = sample(step, lambda, u);
-  char name[64];
-  std::snprintf(name, sizeof name, "step_%04d.vtu", step);
-  write_vtu(dir_.path() / "vtk" / name, f);
-  pvd_.add(lambda, dir_.path() / "vtk" / name);
-  pvd_.write();  // valid after every step
-  steps_.push_back(std::move(f));
+  if (case_.output.vtk) {  // `output.vtk: false`: no VTU files, no PVD
+    char name[64];
+    std::snprintf(name, sizeof name, "step_%04d.vtu", step);
+    write_vtu(dir_.path() / "vtk" / name, f);
+    pvd_.add(lambda, dir_.path() / "vtk" / name);
+    pvd_.write();  // valid after every step
+  }
+  if (case_.output.hdf5) steps_.push_back(std::move(f));
 }
 
 void ResultsWriter::write_vtu(const fs::path& file, const Fields& f) const {
@@ -112,6 +115,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   io::write_provenance(h5, io::Provenance::current(case_.file));
   h5.set_attribute(".", "status", report.status == RunStatus::kCompleted ? "completed" : "stopped");
   h5.set_attribute(".", "message", report.message);
+  h5.set_attribute(".", "stability", stability_summary(report));
   h5.set_attribute(".", "units", "mm, N, MPa");
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
@@ -134,6 +138,9 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.write("steps/iterations", its);
   h5.write("steps/residual", res);
   h5.write("steps/seconds", sec);
+  Eigen::VectorXi neg(n);
+  for (int k = 0; k < n; ++k) neg(k) = rows_[k].negative_pivots;
+  h5.write("steps/negative_pivots", neg);
   for (size_t c = 0; c < case_.output.reactions.size(); ++c) {
     Eigen::VectorXd f(n);
     for (int k = 0; k < n; ++k) f(k) = rows_[k].reactions[c];
@@ -168,7 +175,7 @@ void ResultsWriter::finish(const RunReport& report) {
   for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + "_N");
   for (const OutputPoint& p : case_.output.points)
     header.insert(header.end(), {p.name + "_ux_mm", p.name + "_uy_mm", p.name + "_uz_mm"});
-  header.insert(header.end(), {"iterations", "residual", "seconds"});
+  header.insert(header.end(), {"iterations", "residual", "seconds", "negative_pivots"});
   io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
   csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
                   ", git " + git_revision() + ")");
@@ -179,17 +186,18 @@ void ResultsWriter::finish(const RunReport& report) {
     if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
     for (double f : r.reactions) row.emplace_back(f);
     for (const auto& d : r.points) row.insert(row.end(), {d(0), d(1), d(2)});
-    row.insert(row.end(), {r.iterations, r.residual, r.seconds});
+    row.insert(row.end(), {r.iterations, r.residual, r.seconds, r.negative_pivots});
     csv.add_row(row);
   }
   csv.commit();
-  if (pvd_.size() == 0) pvd_.write();
+  if (case_.output.vtk && pvd_.size() == 0) pvd_.write();
   if (case_.output.hdf5) write_hdf5(dir_.path() / "results.h5", report);
   std::ostringstream sum;
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n"
       << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
   if (!report.message.empty()) sum << "message: " << report.message << "\n";
+  sum << "stability: " << stability_summary(report) << "\n";
   sum << "material: " << case_.material->name() << "\n";
   if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
   write_text(dir_.path() / "summary.txt", sum.str());

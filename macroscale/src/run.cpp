@@ -120,13 +120,18 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     row.iterations = s.iterations;
     row.residual = s.residual;
     row.seconds = s.seconds;
+    row.negative_pivots = s.negative_pivots;
     res.rows.push_back(row);
     res.u = s.u;
     if (opt.progress) {
-      char line[200];
-      std::snprintf(line, sizeof line,
-                    "step %4d  load factor %.6f  iterations %2d  residual %.3e  time %.3f s",
-                    s.step, s.lambda, s.iterations, s.residual, s.seconds);
+      char line[240];
+      int len =
+          std::snprintf(line, sizeof line,
+                        "step %4d  load factor %.6f  iterations %2d  residual %.3e  time %.3f s",
+                        s.step, s.lambda, s.iterations, s.residual, s.seconds);
+      if (s.negative_pivots > 0 && len > 0 && len < int(sizeof line))
+        std::snprintf(line + len, sizeof line - len, "  UNSTABLE: %d negative pivots",
+                      s.negative_pivots);
       *opt.progress << line << std::endl;
     }
     if (writer) {
@@ -139,6 +144,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   });
   const std::string material_report = c.material->report();
   if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
+  if (opt.progress && res.report.first_unstable_step > 0)
+    *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
   if (writer) {
     writer->set_material_report(material_report);
     // A stopped run still writes its last converged state.

@@ -2,7 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/StdVector>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include "knit/spline/quadrature.hpp"
@@ -83,35 +85,59 @@ SectionResponse ShellModel::section(const Eigen::Vector3d& Ec, const Eigen::Vect
   return integrate_section(*material_, opt_.integration, t_, Ec, Kc, where);
 }
 
+int ShellModel::assembly_threads() const {
+  int n = opt_.threads;
+  if (n == 0) {
+    const double work = double(num_quadrature_points()) * (3.0 * nloc_) * (3.0 * nloc_);
+    n = work >= kAutoThreadWork ? static_cast<int>(std::thread::hardware_concurrency()) : 1;
+  }
+  return std::max(1, std::min(n, num_elements()));
+}
+
 void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const {
-  out.fint.setZero(num_dofs());
-  out.ok = true;
+  const int ne = num_elements();
+  out.fe.resize(3 * nloc_, ne);
+  out.element_energy.resize(ne);
   if (tangent) {
     out.Ke.resize(elements_.size());
     for (auto& K : out.Ke) K.resize(3 * nloc_, 3 * nloc_);
   }
-  const int nth = std::max(1, std::min(opt_.threads, num_elements()));
+  const int nth = assembly_threads();
+  bool ok = true;
   if (nth == 1) {
-    out.ok = evaluate_range(0, num_elements(), u, tangent, out, out.fint);
-    return;
+    ok = evaluate_range(0, ne, u, tangent, out);
+  } else {
+    std::vector<char> oks(nth, 1);
+    std::vector<std::thread> pool;
+    for (int k = 1; k < nth; ++k) {
+      const int e0 = ne * k / nth, e1 = ne * (k + 1) / nth;
+      pool.emplace_back([&, k, e0, e1] { oks[k] = evaluate_range(e0, e1, u, tangent, out); });
+    }
+    oks[0] = evaluate_range(0, ne / nth, u, tangent, out);
+    for (auto& th : pool) th.join();
+    for (char o : oks) ok = ok && o;
   }
-  std::vector<Eigen::VectorXd> f(nth, Eigen::VectorXd::Zero(num_dofs()));
-  std::vector<char> ok(nth, 1);
-  std::vector<std::thread> pool;
-  const int ne = num_elements();
-  for (int k = 0; k < nth; ++k) {
-    const int e0 = ne * k / nth, e1 = ne * (k + 1) / nth;
-    pool.emplace_back([&, k, e0, e1] { ok[k] = evaluate_range(e0, e1, u, tangent, out, f[k]); });
-  }
-  for (auto& th : pool) th.join();
-  for (int k = 0; k < nth; ++k) {
-    out.fint += f[k];
-    out.ok = out.ok && ok[k];
+  out.ok = ok;
+  out.fint.setZero(num_dofs());
+  out.energy = material_->hyperelastic() ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+  if (!ok) return;
+  // Sum in element order (independent of the thread split).
+  for (int e = 0; e < ne; ++e) {
+    const Eigen::VectorXi& cp = elements_[e].cp;
+    for (int l = 0; l < nloc_; ++l)
+      out.fint.segment<3>(3 * cp(l)) += out.fe.col(e).segment<3>(3 * l);
+    out.energy += out.element_energy(e);
   }
 }
 
+double ShellModel::energy(const Eigen::VectorXd& u) const {
+  Evaluation ev;
+  evaluate(u, false, ev);
+  return ev.ok ? ev.energy : std::numeric_limits<double>::quiet_NaN();
+}
+
 bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent,
-                                Evaluation& out, Eigen::VectorXd& fint) const {
+                                Evaluation& out) const {
   using Mat3 = Eigen::Matrix3d;
   using Vec3 = Eigen::Vector3d;
   using Mat15 = Eigen::Matrix<double, 15, 15>;
@@ -132,6 +158,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       xloc.row(l) = P.row(a) + u.segment<3>(3 * a).transpose();
     }
     fe.setZero();
+    double energy = 0.0;
     bool symmetric = true;
     for (int q = 0; q < el.num_points; ++q) {
       const int pid = el.first_point + q;
@@ -144,6 +171,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       const Mat3& T = pt.ref.T;
       const SectionResponse sr = section(T * c.eps, T * c.kap, pt.ref.theta, pid);
       const Vec3 N = T.transpose() * sr.n, M = T.transpose() * sr.m;
+      energy += pt.dA * sr.psi;
       // a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i) with P_alpha = (I - a3 a3^T) Q_alpha / j,
       // Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i.
       const Mat3 Q1 = -skew(c.a2), Q2 = skew(c.a1);
@@ -214,7 +242,8 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
         }
       }
     }
-    for (int l = 0; l < nl; ++l) fint.segment<3>(3 * el.cp(l)) += fe.row(l).transpose();
+    for (int l = 0; l < nl; ++l) out.fe.col(e).segment<3>(3 * l) = fe.row(l).transpose();
+    out.element_energy(e) = energy;
     if (!tangent) continue;
     // K(3l+i, 3m+j) = sum_q Phi_q^T H_q(i-th, j-th components) Phi_q: one GEMM per (i, j).
     const int nq = el.num_points;

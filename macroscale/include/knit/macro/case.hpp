@@ -87,7 +87,7 @@ struct Case {
   double thickness = 0.0;
   std::shared_ptr<Material> material;
   ThicknessIntegration integration = ThicknessIntegration::kGauss3;
-  int threads = 1;
+  int threads = 0;  ///< assembly threads; 0: automatic (ShellOptions::threads)
   std::vector<BoundaryCondition> bcs;
   std::vector<Load> loads;
   SolverOptions solver;

@@ -1,21 +1,46 @@
 // Incremental-iterative solution of f_int(u) = lambda f_ext with prescribed displacements
-// ramped by lambda: full Newton-Raphson on the reduced system, an optional line search on
-// the energy-like function g(alpha) = du . r(u + alpha du) (secant, Matthies & Strang 1979),
-// and adaptive cut-back of the load increment when a step does not converge.
+// ramped by lambda: full Newton-Raphson on the reduced system and adaptive cut-back of the
+// load increment when a step does not converge.
 //
 // Convergence of a step: ||r_free|| <= tolerance * max(||lambda f_ext||, ||f_int on the
 // constrained DOFs||) + absolute_tolerance, or a Newton correction ||du|| <= 1e-8 ||u|| while
-// the residual is within 1e3 of that (the round-off floor of very stiff problems). Dense LU
-// (partial pivoting) up to `dense_limit` unknowns, sparse LU above; both accept the unsymmetric
-// tangents of the knit response-surface material. A failure is a status in RunReport, never an
-// exception.
+// the residual is within 1e3 of that (the round-off floor of very stiff problems). A residual
+// or reference force that is not finite fails the step (never "converged").
+//
+// Linear algebra (reduced_tangent.hpp): the scatter map, the sparsity pattern and the symbolic
+// factorization are built once per run; each iteration refactorizes numerically. Dense up to
+// `dense_limit` unknowns, sparse above (the crossover measured by scripts/bench/solver.sh).
+// A hyperelastic material (Material::hyperelastic()) gets the symmetric path: lower triangle,
+// LDLT, the inertia of the reduced tangent (negative pivots of D) reported per step, and an
+// energy line search; other materials (the unsymmetric eq. 17 response surface) get LU.
+//
+// Line search, the full Newton step first:
+//  * hyperelastic: each load step is first tried with plain Newton (full steps, halved only
+//    while they degenerate the geometry); only when that attempt fails is the step repeated
+//    with an energy line search on the total potential Pi(u) = Psi(u) - lambda f_ext . u (Psi
+//    the strain energy, ShellModel::Evaluation::energy): the full step is taken when Pi does
+//    not increase (Armijo, c1 = 1e-4, or a change within round-off of Pi) or when du is not a
+//    descent direction (an indefinite tangent past a limit point: Newton then looks for an
+//    unstable equilibrium, which Pi cannot rank); otherwise backtracking with the minimum of
+//    the quadratic through Pi(0), Pi'(0) and Pi(alpha), alpha in [0.1, 0.5] of the last one.
+//    (Searching in every iteration turned the Sze cantilever's 60 iterations into 82: Newton
+//    recovers from overshooting steps that raise Pi, the search only slows it down.)
+//  * otherwise: when the full step increases ||r|| and does not halve g(alpha) = du . r(u +
+//    alpha du), secant iterations on g (Matthies & Strang 1979).
+//
+// Load stepping stops with a reason (RunReport::reason): the increment cut `max_cutbacks`
+// times within one nominal step, the increment below the floor `min_increment`, or the total
+// work above `max_total_iterations` Newton iterations. A failure is a status in RunReport,
+// never an exception.
 #pragma once
 
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "knit/macro/constraints.hpp"
+#include "knit/macro/reduced_tangent.hpp"
 #include "knit/macro/shell_model.hpp"
 
 namespace knit::macro {
@@ -28,8 +53,20 @@ struct SolverOptions {
       1e-8;                 ///< ||du|| / ||u|| accepted when the residual is at round-off
   int max_iterations = 25;  ///< Newton iterations per step
   int max_cutbacks = 8;     ///< halvings of the increment within one nominal step
+  /// Floor of the load increment (in load factor): a step that would need a smaller one stops
+  /// the run.
+  double min_increment = 1e-9;
+  /// Cap on the total work: Newton iterations over the whole run, failed attempts included.
+  /// 0: 20 x steps x max_iterations.
+  long max_total_iterations = 0;
   bool line_search = true;
-  int dense_limit = 2500;  ///< dense LU up to this many unknowns
+  LinearSolver linear_solver = LinearSolver::kAuto;
+  /// Dense up to this many unknowns with kAuto. Measured crossover (scripts/bench/solver.sh,
+  /// Sze cantilever refinements, 2-core machine): sparse is faster from ~150 unknowns on.
+  int dense_limit = 150;
+  /// false: LU even for a hyperelastic material (to compare the paths; the line search and
+  /// everything else stay the same).
+  bool symmetric = true;
 };
 
 struct StepResult {
@@ -38,22 +75,69 @@ struct StepResult {
   int iterations = 0;     ///< Newton iterations
   double residual = 0.0;  ///< final ||r_free||
   double seconds = 0.0;   ///< wall time of the step
-  Eigen::VectorXd u;      ///< full displacement vector
-  Eigen::VectorXd fint;   ///< internal forces (reactions on constrained DOFs)
+  /// Negative pivots of the LDLT of the reduced tangent at the last iterate factorized in
+  /// this step (the number of unstable modes; > 0 past a limit or bifurcation point), -1 on
+  /// the LU path (unsymmetric material: not available).
+  int negative_pivots = -1;
+  Eigen::VectorXd u;     ///< full displacement vector
+  Eigen::VectorXd fint;  ///< internal forces (reactions on constrained DOFs)
 };
 
 enum class RunStatus { kCompleted, kNotConverged };
 
+/// Why a run stopped (kNone if it completed).
+enum class StopReason { kNone, kCutbacks, kIncrementFloor, kWorkCap };
+
+/// Where the time of a run went (wall seconds), for benchmarks.
+struct SolverStats {
+  long iterations = 0;     ///< Newton iterations (tangent + solve), failed attempts included
+  long evaluations = 0;    ///< residual-only evaluations (line search, convergence checks)
+  double setup = 0.0;      ///< scatter map, pattern and symbolic analysis (once)
+  double assembly = 0.0;   ///< element tangents and forces + scatter into the reduced matrix
+  double solve = 0.0;      ///< numeric factorization and triangular solves
+  double residuals = 0.0;  ///< residual-only evaluations
+  int unknowns = 0;
+  long stored_entries = 0;  ///< of the reduced matrix
+  bool sparse = false, symmetric = false;
+  int threads = 1;  ///< assembly threads
+};
+
 struct RunReport {
   RunStatus status = RunStatus::kCompleted;
+  StopReason reason = StopReason::kNone;
   std::string message;  ///< why the run stopped (empty if completed)
   int converged_steps = 0;
   double last_lambda = 0.0;
+  /// Stability (symmetric path only): the first converged step with a negative pivot, its
+  /// load factor, and the largest count over the run; -1 / 0 if none (or not available).
+  int first_unstable_step = -1;
+  double first_unstable_lambda = 0.0;
+  int max_negative_pivots = -1;
+  SolverStats stats;
 };
 
 using StepCallback = std::function<void(const StepResult&)>;
 
 RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Eigen::VectorXd& fext,
                            const SolverOptions& options, const StepCallback& on_step);
+
+/// Energy line search along a Newton direction du: Pi(alpha) = Pi(u + alpha du) (nullopt if
+/// the state is invalid), Pi0 = Pi(0), g0 = dPi/dalpha(0) = du . r, Pi_scale the round-off
+/// scale of Pi. Tries alpha = 1 first; returns it when Pi decreases by the Armijo condition
+/// (within round-off) or when g0 >= 0 (no descent direction); otherwise backtracks (quadratic
+/// model, alpha in [0.1, 0.5] of the previous one, at most 10 times).
+struct EnergyLineSearch {
+  double alpha = 1.0;
+  double Pi = 0.0;     ///< Pi(alpha)
+  bool valid = false;  ///< Pi(alpha) could be evaluated
+  int evaluations = 0;
+};
+EnergyLineSearch energy_line_search(const std::function<std::optional<double>(double)>& Pi,
+                                    double Pi0, double g0, double Pi_scale);
+
+/// One line on the stability of a run for summaries: "tangent positive definite at every
+/// converged step", "unstable from step N (load factor x): k negative pivots at most", or
+/// "not available (unsymmetric tangent, LU)".
+std::string stability_summary(const RunReport& report);
 
 }  // namespace knit::macro

@@ -1,7 +1,8 @@
 // Running a case (`knit-macro run CASE.json [--output DIR]`): set up the shell, the DOF map
 // and the loads, solve with load stepping, and write one output directory:
 //   load_strain.csv   one row per converged step (load factor, applied displacement and
-//                     strain, reactions, displacements of named points, iterations, residual)
+//                     strain, reactions, displacements of named points, iterations, residual,
+//                     seconds, negative pivots of the tangent: > 0 marks an unstable state)
 //   results.pvd       ParaView collection of vtk/step_NNNN.vtu (deformed mid-surface grid with
 //                     displacement, E11/E22/E12, curvature change, n, m, material fields)
 //   results.h5        the same fields, the case JSON and provenance (when HDF5 is available)
@@ -46,6 +47,7 @@ struct StepRow {
   std::vector<Eigen::Vector3d> points;  ///< displacement of each output point (mm)
   int iterations = 0;
   double residual = 0.0, seconds = 0.0;
+  int negative_pivots = -1;  ///< of the reduced tangent (StepResult), -1 if not available
 };
 
 /// Reaction force: sum of f_int over the control points of the first `rows` rows of an edge.

@@ -40,7 +40,10 @@ namespace knit::macro {
 
 struct ShellOptions {
   ThicknessIntegration integration = ThicknessIntegration::kGauss3;
-  int threads = 1;             ///< assembly threads (elements are split between them)
+  /// Assembly threads (elements are split between them; the result does not depend on the
+  /// number). 0: automatic, all hardware threads when the tangent's element work exceeds
+  /// kAutoThreadWork, one otherwise.
+  int threads = 0;
   int quadrature_points = -1;  ///< per direction and element; -1: p + 1
 };
 
@@ -69,15 +72,31 @@ class ShellModel {
   int num_quadrature_points() const { return static_cast<int>(points_.size()); }
   /// Control points of element e (the (pu+1)(pv+1) functions non-zero on it).
   const Eigen::VectorXi& element_control_points(int e) const { return elements_[e].cp; }
-  void set_threads(int n) { opt_.threads = n < 1 ? 1 : n; }
+  /// n >= 1 threads, 0 automatic (see ShellOptions::threads).
+  void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
+  /// The number of threads evaluate() uses with a tangent.
+  int assembly_threads() const;
+  /// Element work (quadrature points x local DOFs^2) above which the automatic setting uses
+  /// every hardware thread: measured on 2 cores, a tangent evaluation of this size takes
+  /// ~2 ms, 20x the cost of starting the threads.
+  static constexpr double kAutoThreadWork = 2.0e5;
 
   struct Evaluation {
     Eigen::VectorXd fint;             ///< internal force vector (num_dofs)
     std::vector<Eigen::MatrixXd> Ke;  ///< element tangents (3 nloc square, local DOF 3 l + i)
-    bool ok = true;                   ///< false if the current configuration degenerated
+    /// Total strain energy Psi(u) = sum_q dA_q psi_q (N mm; psi the thickness-integrated W,
+    /// section.hpp), dPsi/du = fint; NaN unless the material is hyperelastic().
+    double energy = 0.0;
+    bool ok = true;                  ///< false if the current configuration degenerated
+    Eigen::MatrixXd fe;              ///< workspace: element force vectors (3 nloc x elements)
+    Eigen::VectorXd element_energy;  ///< workspace: element energies
   };
-  /// Internal forces at displacement u (num_dofs), with the element tangents if `tangent`.
+  /// Internal forces and energy at displacement u (num_dofs), with the element tangents if
+  /// `tangent`. Element results are summed in element order, so the result is bitwise the
+  /// same for any number of threads.
   void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const;
+  /// Psi(u) alone (NaN unless hyperelastic, or if the configuration degenerated).
+  double energy(const Eigen::VectorXd& u) const;
 
   /// Output fields at (theta1, theta2) for displacement u.
   ShellSample sample(const Eigen::VectorXd& u, const Eigen::Vector2d& theta) const;
@@ -100,8 +119,8 @@ class ShellModel {
     ReferencePoint ref;
     double dA = 0.0;  ///< quadrature weight x Jacobian
   };
-  bool evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent, Evaluation& out,
-                      Eigen::VectorXd& fint) const;
+  bool evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent,
+                      Evaluation& out) const;
   SectionResponse section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
                           const Eigen::Vector2d& theta, int point_id) const;
 

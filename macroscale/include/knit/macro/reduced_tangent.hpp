@@ -1,0 +1,92 @@
+// The reduced tangent Z^T K Z of the shell (constraints.hpp) and its factorization, for the
+// Newton iterations of newton.hpp.
+//
+// Built once per run: the element-to-free-DOF scatter map (one integer per entry of every
+// element tangent: where it goes in the value array of the reduced matrix, or -1), and on the
+// sparse path the compressed-column pattern and the symbolic analysis (fill-reducing ordering,
+// elimination tree). Every Newton iteration then only scatters the element tangents into the
+// values (one routine for the dense and the sparse storage) and refactorizes numerically.
+//
+// Four factorizations:
+//   unsymmetric (a material that is not hyperelastic, e.g. the eq. 17 response surface):
+//     dense PartialPivLU, sparse SparseLU (COLAMD ordering);
+//   symmetric (a hyperelastic material: C = d2W/dE2, the shell tangent is a Hessian):
+//     only the lower triangle is assembled; dense LDLT (diagonal pivoting), sparse
+//     SimplicialLDLT (AMD ordering). The inertia of the reduced tangent is the number of
+//     negative entries of D (Sylvester's law of inertia: P K P^T = L D L^T is a congruence):
+//     a negative count means the equilibrium is unstable (past a limit or bifurcation point).
+// Singularity is detected from the factorization's pivots (min |pivot| / max |pivot| below
+// kSingularPivotRatio), not from a condition estimate (which cost 11 % of a run).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "knit/macro/constraints.hpp"
+#include "knit/macro/shell_model.hpp"
+
+namespace knit::macro {
+
+enum class LinearSolver {
+  kAuto,    ///< dense up to SolverOptions::dense_limit unknowns, sparse above
+  kDense,   ///< dense LU / LDLT
+  kSparse,  ///< sparse LU / LDLT
+};
+
+struct Factorization {
+  bool ok = false;
+  std::string why;  ///< why the factorization is unusable (singular)
+  /// Number of negative pivots of D (LDLT): the number of negative eigenvalues of the reduced
+  /// tangent. -1 on the LU paths (not available).
+  int negative_pivots = -1;
+  double pivot_ratio = 0.0;  ///< min |pivot| / max |pivot|
+};
+
+class ReducedTangent {
+ public:
+  /// Pivot ratio below which the tangent counts as singular. Round-off leaves a pivot of
+  /// ~1e-16 max|pivot| on an exactly singular matrix; the thinnest shells here (h/L = 1e-2)
+  /// keep ratios above 1e-10.
+  static constexpr double kSingularPivotRatio = 1e-14;
+
+  /// `symmetric`: assemble the lower triangle only and factorize by LDLT (the element
+  /// tangents must be symmetric). `sparse`: sparse storage and factorization.
+  ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse);
+  ~ReducedTangent();
+  ReducedTangent(const ReducedTangent&) = delete;
+  ReducedTangent& operator=(const ReducedTangent&) = delete;
+
+  int size() const { return n_; }
+  bool symmetric() const { return symmetric_; }
+  bool sparse() const { return sparse_; }
+  /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
+  long stored_entries() const;
+
+  /// Scatters the element tangents into the reduced matrix (values reset first).
+  void assemble(const std::vector<Eigen::MatrixXd>& Ke);
+  /// Numeric factorization of the assembled matrix (the symbolic analysis is reused).
+  Factorization factorize();
+  /// Solves with the last successful factorization.
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  /// y = K x with the assembled matrix (both triangles on the symmetric path).
+  Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
+
+ private:
+  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k: the one
+  /// scatter of the dense and sparse paths.
+  void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const;
+
+  int n_ = 0;
+  bool symmetric_ = false, sparse_ = false;
+  int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
+  std::vector<int> map_;  ///< block_ entries per element: value index or -1
+  Eigen::MatrixXd dense_;
+  Eigen::SparseMatrix<double> sparse_matrix_;
+  struct Factors;  ///< the four Eigen factorizations (reduced_tangent.cpp)
+  std::unique_ptr<Factors> f_;
+};
+
+}  // namespace knit::macro

@@ -1,0 +1,219 @@
+#include "knit/macro/reduced_tangent.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace knit::macro {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+/// SparseLU with access to the diagonal of U (stored in the supernodes of L, as in
+/// Eigen::SparseLU::absDeterminant()), for the pivot-based singularity check.
+class PivotedSparseLU : public Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>> {
+ public:
+  /// (min |u_jj|, max |u_jj|).
+  std::pair<double, double> pivot_range() const {
+    double lo = INFINITY, hi = 0.0;
+    for (Eigen::Index j = 0; j < cols(); ++j) {
+      double d = 0.0;
+      for (SCMatrix::InnerIterator it(m_Lstore, j); it; ++it)
+        if (it.index() == j) {
+          d = std::abs(it.value());
+          break;
+        }
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+    return {lo, hi};
+  }
+};
+
+/// Fills in the pivot ratio and the singularity verdict from the pivots d.
+template <typename Vec>
+Factorization from_pivots(const Vec& d, bool count_negative, const char* kind) {
+  Factorization f;
+  const double hi = d.size() ? d.cwiseAbs().maxCoeff() : 0.0;
+  const double lo = d.size() ? d.cwiseAbs().minCoeff() : 0.0;
+  f.pivot_ratio = hi > 0.0 ? lo / hi : 0.0;
+  if (count_negative) f.negative_pivots = static_cast<int>((d.array() < 0.0).count());
+  if (!(f.pivot_ratio > ReducedTangent::kSingularPivotRatio) || !d.allFinite()) {
+    std::ostringstream o;
+    o << "singular tangent stiffness (" << kind << ": smallest / largest pivot " << f.pivot_ratio
+      << ")";
+    f.why = o.str();
+    return f;
+  }
+  f.ok = true;
+  return f;
+}
+
+}  // namespace
+
+struct ReducedTangent::Factors {
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;
+  Eigen::LDLT<Eigen::MatrixXd, Eigen::Lower> dense_ldlt;
+  PivotedSparseLU sparse_lu;
+  Eigen::SimplicialLDLT<SpMat, Eigen::Lower> sparse_ldlt;
+};
+
+ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool symmetric, bool sparse)
+    : n_(dofs.num_free()), symmetric_(symmetric), sparse_(sparse), f_(std::make_unique<Factors>()) {
+  const int ne = m.num_elements();
+  const int nd =
+      m.num_elements() > 0 ? 3 * static_cast<int>(m.element_control_points(0).size()) : 0;
+  block_ = nd * nd;
+  // Free index of each local DOF of each element.
+  std::vector<int> g(static_cast<size_t>(ne) * nd);
+  for (int e = 0; e < ne; ++e) {
+    const Eigen::VectorXi& cp = m.element_control_points(e);
+    for (int r = 0; r < nd; ++r) g[size_t(e) * nd + r] = dofs.free_index(3 * cp(r / 3) + r % 3);
+  }
+  auto wanted = [&](int gr, int gs) { return gr >= 0 && gs >= 0 && (!symmetric_ || gr >= gs); };
+  map_.assign(static_cast<size_t>(ne) * block_, -1);
+  if (!sparse_) {
+    // Column-major n x n: entry (gr, gs) at gr + n gs.
+    if (static_cast<double>(n_) * n_ > 2.0e9)
+      throw std::invalid_argument("dense reduced tangent of " + std::to_string(n_) +
+                                  " unknowns does not fit an int index");
+    dense_.setZero(n_, n_);
+    for (int e = 0; e < ne; ++e)
+      for (int s = 0; s < nd; ++s)
+        for (int r = 0; r < nd; ++r) {
+          const int gr = g[size_t(e) * nd + r], gs = g[size_t(e) * nd + s];
+          if (wanted(gr, gs)) map_[size_t(e) * block_ + r + size_t(nd) * s] = gr + n_ * gs;
+        }
+    return;
+  }
+  // Pattern: per column the sorted rows of every element that couples them.
+  std::vector<std::vector<int>> cols(n_);
+  std::vector<int> ge;
+  for (int e = 0; e < ne; ++e) {
+    ge.assign(g.begin() + size_t(e) * nd, g.begin() + size_t(e + 1) * nd);
+    std::sort(ge.begin(), ge.end());
+    ge.erase(std::unique(ge.begin(), ge.end()), ge.end());
+    for (int gs : ge)
+      for (int gr : ge)
+        if (wanted(gr, gs)) cols[gs].push_back(gr);
+  }
+  long nnz = 0;
+  for (auto& c : cols) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    nnz += static_cast<long>(c.size());
+  }
+  SpMat& K = sparse_matrix_;
+  K.resize(n_, n_);
+  K.resizeNonZeros(nnz);
+  K.outerIndexPtr()[0] = 0;
+  for (int j = 0; j < n_; ++j) {
+    std::copy(cols[j].begin(), cols[j].end(), K.innerIndexPtr() + K.outerIndexPtr()[j]);
+    K.outerIndexPtr()[j + 1] = K.outerIndexPtr()[j] + static_cast<int>(cols[j].size());
+    std::vector<int>().swap(cols[j]);
+  }
+  std::fill(K.valuePtr(), K.valuePtr() + nnz, 0.0);
+  for (int e = 0; e < ne; ++e)
+    for (int s = 0; s < nd; ++s)
+      for (int r = 0; r < nd; ++r) {
+        const int gr = g[size_t(e) * nd + r], gs = g[size_t(e) * nd + s];
+        if (!wanted(gr, gs)) continue;
+        const int* b = K.innerIndexPtr() + K.outerIndexPtr()[gs];
+        const int* end = K.innerIndexPtr() + K.outerIndexPtr()[gs + 1];
+        map_[size_t(e) * block_ + r + size_t(nd) * s] =
+            static_cast<int>(std::lower_bound(b, end, gr) - K.innerIndexPtr());
+      }
+  // Symbolic analysis, once per run.
+  if (symmetric_)
+    f_->sparse_ldlt.analyzePattern(K);
+  else
+    f_->sparse_lu.analyzePattern(K);
+}
+
+ReducedTangent::~ReducedTangent() = default;
+
+long ReducedTangent::stored_entries() const {
+  return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
+}
+
+void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const {
+  const int ne = static_cast<int>(Ke.size());
+  for (int e = 0; e < ne; ++e) {
+    const int* map = map_.data() + static_cast<size_t>(e) * block_;
+    const double* k = Ke[e].data();
+    for (int i = 0; i < block_; ++i)
+      if (map[i] >= 0) values[map[i]] += k[i];
+  }
+}
+
+void ReducedTangent::assemble(const std::vector<Eigen::MatrixXd>& Ke) {
+  if (sparse_) {
+    double* v = sparse_matrix_.valuePtr();
+    std::fill(v, v + sparse_matrix_.nonZeros(), 0.0);
+    scatter(Ke, v);
+  } else {
+    dense_.setZero();
+    scatter(Ke, dense_.data());
+  }
+}
+
+Factorization ReducedTangent::factorize() {
+  if (n_ == 0) {
+    Factorization f;
+    f.ok = true;
+    f.negative_pivots = symmetric_ ? 0 : -1;
+    f.pivot_ratio = 1.0;
+    return f;
+  }
+  if (!sparse_ && !symmetric_) {
+    f_->dense_lu.compute(dense_);
+    return from_pivots(f_->dense_lu.matrixLU().diagonal(), false, "dense LU");
+  }
+  if (!sparse_) {
+    f_->dense_ldlt.compute(dense_);
+    return from_pivots(f_->dense_ldlt.vectorD(), true, "dense LDLT");
+  }
+  if (symmetric_) {
+    f_->sparse_ldlt.factorize(sparse_matrix_);
+    if (f_->sparse_ldlt.info() != Eigen::Success) {
+      Factorization f;
+      f.why = "singular tangent stiffness (sparse LDLT: zero pivot)";
+      return f;
+    }
+    return from_pivots(f_->sparse_ldlt.vectorD(), true, "sparse LDLT");
+  }
+  f_->sparse_lu.factorize(sparse_matrix_);
+  if (f_->sparse_lu.info() != Eigen::Success) {
+    Factorization f;
+    f.why =
+        "singular tangent stiffness (sparse LU failed: " + f_->sparse_lu.lastErrorMessage() + ")";
+    return f;
+  }
+  const auto [lo, hi] = f_->sparse_lu.pivot_range();
+  Eigen::Vector2d d(lo, hi);
+  return from_pivots(d, false, "sparse LU");
+}
+
+Eigen::VectorXd ReducedTangent::solve(const Eigen::VectorXd& b) const {
+  if (n_ == 0) return Eigen::VectorXd(0);
+  if (!sparse_)
+    return symmetric_ ? Eigen::VectorXd(f_->dense_ldlt.solve(b))
+                      : Eigen::VectorXd(f_->dense_lu.solve(b));
+  return symmetric_ ? Eigen::VectorXd(f_->sparse_ldlt.solve(b))
+                    : Eigen::VectorXd(f_->sparse_lu.solve(b));
+}
+
+Eigen::VectorXd ReducedTangent::multiply(const Eigen::VectorXd& x) const {
+  if (sparse_)
+    return symmetric_ ? Eigen::VectorXd(sparse_matrix_.selfadjointView<Eigen::Lower>() * x)
+                      : Eigen::VectorXd(sparse_matrix_ * x);
+  return symmetric_ ? Eigen::VectorXd(dense_.selfadjointView<Eigen::Lower>() * x)
+                    : Eigen::VectorXd(dense_ * x);
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Shell solver timing (issue 14 "And speed"; printed figures, never a timed test):
+#  * dense/sparse crossover: the Sze cantilever (p = 3) at 2..32 x 1 elements with every
+#    linear-solver path (dense/sparse x LU/LDLT), one thread;
+#  * the Sze cantilever at 16x1, 32x1, 64x1 with the defaults (target: 64x1/16x1 <= 4.5);
+#  * the tensile patch at p = 4, 8 x 40 elements (1,584 DOFs, 40 steps; targets <= 5 s on one
+#    core, <= 15 ms per Newton iteration) and 16 x 100 elements (6,240 DOFs; <= 60 ms per
+#    iteration), with the time per Newton iteration split into assembly and solve.
+# Usage: scripts/bench/solver.sh [BUILD_DIR] [CATCH_TEST_NAME_FILTER]
+set -euo pipefail
+BUILD_DIR=${1:-build}
+exe="$BUILD_DIR/bin/test_macro"
+if [[ ! -x "$exe" ]]; then
+  echo "solver bench: $exe not found (build test_macro first)" >&2
+  exit 1
+fi
+"$exe" "${2:-[.bench_solver]}" | grep '^solver'

@@ -1,0 +1,272 @@
+// The Newton solver and its linear algebra (newton.hpp, reduced_tangent.hpp): dense LU, sparse
+// LU, dense LDLT and sparse LDLT give the same load-strain curve; the inertia of the LDLT
+// detects the limit point of a strip in compression; the energy line search decreases the
+// total potential; ShellModel's energy has f_int as its derivative; robustness (non-finite
+// residuals, the floor of the increment and the cap on the work, fewer than five constraints,
+// `output.vtk: false`).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "knit/macro/case.hpp"
+#include "knit/macro/reduced_tangent.hpp"
+#include "knit/macro/run.hpp"
+#include "knit/macro/svk_material.hpp"
+#include "shell_test_util.hpp"
+
+using namespace knit::macro;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json verification_case(const std::string& name) {
+  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
+  return json::parse(in);
+}
+
+/// A St. Venant-Kirchhoff strip 10 x 1 (t = 1, E = 1, nu = 0) on x in [0, 10], supported at
+/// x = 0, loaded at x = 10 by `load` (edge force per length) or by a prescribed displacement.
+json strip(const json& load_or_bc, bool fix_y_everywhere) {
+  json j = json::parse(R"({
+    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]},
+                            {"corner": "u0v0", "fix": ["y"]}],
+    "loads": [],
+    "solver": {"steps": 10},
+    "output": {"points": [{"name": "tip", "at": [1, 0.5]}],
+               "reactions": [{"name": "Fx", "edge": "u0", "component": "x", "rows": 1}]}})");
+  if (fix_y_everywhere) j["boundary_conditions"][0]["fix"] = {"y", "z"};
+  if (load_or_bc.contains("type"))
+    j["loads"].push_back(load_or_bc);
+  else
+    j["boundary_conditions"].push_back(load_or_bc);
+  return j;
+}
+
+RunResult run(const json& j, const std::function<void(Case&)>& edit = {}) {
+  Case c = parse_case(j.dump(), "test.json");
+  if (edit) edit(c);
+  return run_case(c, {});
+}
+
+}  // namespace
+
+TEST_CASE("dense LU, sparse LU, dense LDLT and sparse LDLT give the same load-strain curve",
+          "[unit]") {
+  json j = verification_case("sze_cantilever.json");
+  j["refinement"]["elements"] = {6, 1};
+  j["solver"]["steps"] = 4;
+  struct Path {
+    LinearSolver solver;
+    bool symmetric;
+  };
+  const Path paths[4] = {{LinearSolver::kDense, false},
+                         {LinearSolver::kSparse, false},
+                         {LinearSolver::kDense, true},
+                         {LinearSolver::kSparse, true}};
+  std::vector<RunResult> r;
+  for (const Path& p : paths) {
+    r.push_back(run(j, [&](Case& c) {
+      c.solver.linear_solver = p.solver;
+      c.solver.symmetric = p.symmetric;
+    }));
+    REQUIRE(r.back().report.status == RunStatus::kCompleted);
+    CHECK(r.back().report.stats.sparse == (p.solver == LinearSolver::kSparse));
+    CHECK(r.back().report.stats.symmetric == p.symmetric);
+  }
+  for (int k = 1; k < 4; ++k) {
+    REQUIRE(r[k].rows.size() == r[0].rows.size());
+    for (size_t s = 0; s < r[0].rows.size(); ++s) {
+      const StepRow &a = r[0].rows[s], &b = r[k].rows[s];
+      CHECK(a.lambda == b.lambda);
+      CHECK(a.iterations == b.iterations);
+      CHECK(std::abs(a.reactions[0] - b.reactions[0]) <= 1e-8 * std::abs(a.reactions[0]));
+      CHECK((a.points[0] - b.points[0]).norm() <= 1e-8 * a.points[0].norm());
+    }
+  }
+  // The symmetric paths report the inertia: the cantilever stays stable.
+  CHECK(r[2].rows.back().negative_pivots == 0);
+  CHECK(r[3].rows.back().negative_pivots == 0);
+  CHECK(r[0].rows.back().negative_pivots == -1);
+}
+
+TEST_CASE("LDLT inertia: a strip compressed past its limit point reports negative pivots",
+          "[unit]") {
+  // 1-D SVK bar: P = E A s (s^2 - 1)/2 peaks at the stretch s = 1/sqrt(3) = 0.577. The end is
+  // moved by -5 (s = 0.5) in 10 steps: s = 0.95, ..., 0.6 stable, 0.55 and 0.5 past the limit.
+  const json bc = json::parse(R"({"edge": "u1", "fix": ["y", "z"], "prescribe": {"x": -5.0}})");
+  const bool sparse = GENERATE(false, true);
+  const RunResult r = run(strip(bc, true), [&](Case& c) {
+    c.solver.linear_solver = sparse ? LinearSolver::kSparse : LinearSolver::kDense;
+  });
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);  // a negative eigenvalue is a status
+  REQUIRE(r.rows.size() == 10);
+  for (int k = 0; k < 8; ++k) CHECK(r.rows[k].negative_pivots == 0);
+  for (int k = 8; k < 10; ++k) CHECK(r.rows[k].negative_pivots > 0);
+  // The reaction passed its extremum: the compressive force decreases after s = 0.6.
+  CHECK(std::abs(r.rows[8].reactions[0]) < std::abs(r.rows[7].reactions[0]));
+  const double s = 0.5, P = 1.0 * s * (s * s - 1.0) / 2.0;  // E A = 1
+  CHECK(r.rows[9].reactions[0] == Approx(-P).epsilon(1e-8));
+  CHECK(r.report.first_unstable_step == 9);
+  CHECK(r.report.first_unstable_lambda == Approx(0.9));
+  CHECK(stability_summary(r.report).find("unstable from step 9") != std::string::npos);
+}
+
+TEST_CASE("energy line search: the full step first, backtracking decreases Pi", "[unit]") {
+  // Sze cantilever at the full load from u = 0: the linear Newton step overshoots (tip
+  // deflection ~130 for a length of 10), so Pi(1) > Pi(0) and the search must cut it.
+  const Case c =
+      load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/sze_cantilever.json");
+  const Problem p = setup_problem(c);
+  const ShellModel& m = *p.model;
+  const int n = p.dofs.num_free();
+  ShellModel::Evaluation ev;
+  const Eigen::VectorXd u0 = Eigen::VectorXd::Zero(m.num_dofs());
+  m.evaluate(u0, true, ev);
+  const Eigen::VectorXd r = p.dofs.reduce(ev.fint - p.fext);
+  ReducedTangent K(m, p.dofs, true, true);
+  K.assemble(ev.Ke);
+  REQUIRE(K.factorize().ok);
+  const Eigen::VectorXd du = K.solve(-r);
+  auto Pi = [&](double a) -> std::optional<double> {
+    const Eigen::VectorXd u = p.dofs.expand(a * du, 1.0);
+    return m.energy(u) - p.fext.dot(u);
+  };
+  const double Pi0 = *Pi(0.0), g0 = du.dot(r);
+  REQUIRE(g0 < 0.0);
+  REQUIRE(*Pi(1.0) > Pi0);  // the full step increases Pi here
+  const EnergyLineSearch ls = energy_line_search(Pi, Pi0, g0, std::abs(Pi0) + 1.0);
+  CHECK(ls.valid);
+  CHECK(ls.alpha < 1.0);
+  CHECK(ls.Pi < Pi0);
+  CHECK(ls.Pi == Approx(*Pi(ls.alpha)));
+  // A quadratic whose minimum is at alpha = 1: the full step is accepted with 1 evaluation.
+  const EnergyLineSearch q = energy_line_search(
+      [](double a) { return std::optional<double>((a - 1) * (a - 1)); }, 1.0, -2.0, 1.0);
+  CHECK(q.alpha == 1.0);
+  CHECK(q.evaluations == 1);
+}
+
+TEST_CASE("ShellModel energy: its derivative is f_int (finite differences)", "[unit]") {
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  ShellModel m(test::curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, true), 0.1, mat);
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<double> d(-0.1, 0.1);
+  Eigen::VectorXd u(m.num_dofs());
+  for (int i = 0; i < u.size(); ++i) u(i) = d(gen);
+  ShellModel::Evaluation ev;
+  m.evaluate(u, false, ev);
+  REQUIRE(std::isfinite(ev.energy));
+  CHECK(ev.energy > 0.0);
+  CHECK(m.energy(u) == ev.energy);
+  Eigen::VectorXd g(m.num_dofs());
+  const double h = 1e-6;
+  for (int i = 0; i < u.size(); ++i) {
+    Eigen::VectorXd up = u, um = u;
+    up(i) += h;
+    um(i) -= h;
+    g(i) = (m.energy(up) - m.energy(um)) / (2 * h);
+  }
+  CHECK((g - ev.fint).cwiseAbs().maxCoeff() < 1e-6 * ev.fint.cwiseAbs().maxCoeff());
+  // The analytic thickness integration gives the same energy for SVK.
+  ShellOptions so;
+  so.integration = ThicknessIntegration::kAnalytic;
+  ShellModel ma(test::curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, true), 0.1, mat, so);
+  CHECK(ma.energy(u) == Approx(ev.energy).epsilon(1e-12));
+}
+
+TEST_CASE("a non-finite residual fails the step instead of converging", "[unit]") {
+  // A load of 1e160: ||f_ext|| overflows. Before the fix the first step was accepted as
+  // converged with 0 iterations and zero displacement.
+  const json load =
+      json::parse(R"({"type": "edge", "edge": "u1", "force_per_length": [1e160, 0, 0]})");
+  const RunResult r = run(strip(load, false), [](Case& c) { c.solver.max_cutbacks = 2; });
+  CHECK(r.report.status == RunStatus::kNotConverged);
+  CHECK(r.report.converged_steps == 0);
+  CHECK(r.report.message.find("non-finite residual") != std::string::npos);
+}
+
+TEST_CASE("load stepping: a floor on the increment and a cap on the work, named when hit",
+          "[unit]") {
+  // A material that fails (NaN stress) below E11 = -0.05: the strip under a dead compressive
+  // load reaches that strain at lambda = 0.158 (stretch 0.9487, P = 0.0474), and no smaller
+  // increment gets past it.
+  struct Brittle final : Material {
+    SaintVenantKirchhoff svk{1.0, 0.0};
+    std::string name() const override { return "brittle"; }
+    bool hyperelastic() const override { return true; }
+    MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& w) const override {
+      MaterialResponse r = svk.evaluate(E, w);
+      if (E(0) < -0.05) r.S.setConstant(NAN);
+      return r;
+    }
+  };
+  const json load =
+      json::parse(R"({"type": "edge", "edge": "u1", "force_per_length": [-0.3, 0, 0]})");
+  const json j = strip(load, true);
+  auto brittle = [](Case& c) { c.material = std::make_shared<Brittle>(); };
+  const RunResult floor = run(j, [&](Case& c) {
+    brittle(c);
+    c.solver.max_cutbacks = 40;
+    c.solver.min_increment = 1e-3;
+  });
+  CHECK(floor.report.status == RunStatus::kNotConverged);
+  CHECK(floor.report.reason == StopReason::kIncrementFloor);
+  CHECK(floor.report.message.find("min_increment = 0.001") != std::string::npos);
+  CHECK(floor.report.last_lambda == Approx(0.158).margin(2e-3));
+  const RunResult cap = run(j, [&](Case& c) {
+    brittle(c);
+    c.solver.max_cutbacks = 40;
+    c.solver.max_total_iterations = 30;
+  });
+  CHECK(cap.report.status == RunStatus::kNotConverged);
+  CHECK(cap.report.reason == StopReason::kWorkCap);
+  CHECK(cap.report.message.find("cap on the total work") != std::string::npos);
+  CHECK(cap.report.stats.iterations == 30);
+}
+
+TEST_CASE("DofMap: a rigid mode is found with fewer than five constrained DOFs", "[unit]") {
+  // Before the fix the SVD had fewer than six singular values and s(5) was read out of
+  // bounds (heap-buffer-overflow under ASan).
+  Eigen::MatrixXd X(4, 3);
+  X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0;
+  for (int k = 0; k <= 5; ++k) {
+    Constraints c(12);
+    for (int d = 0; d < k; ++d) c.fix(d);
+    const DofMap dofs(c);
+    CHECK(dofs.unconstrained_rigid_mode(X).has_value());
+  }
+}
+
+TEST_CASE("output.vtk false writes no VTU or PVD files", "[unit]") {
+  const fs::path d = fs::temp_directory_path() / ("knit_solver_vtk_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  json j = verification_case("tensile_svk.json");
+  j["solver"]["steps"] = 2;
+  j["output"]["grid"] = {3, 3};
+  j["output"]["vtk"] = false;
+  const Case c = parse_case(j.dump(), "novtk.json");
+  RunOptions o;
+  o.output_dir = d / "out";
+  const RunResult r = run_case(c, o);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(fs::exists(d / "out" / "load_strain.csv"));
+  CHECK(!fs::exists(d / "out" / "vtk"));
+  CHECK(!fs::exists(d / "out" / "results.pvd"));
+  for (const auto& e : fs::recursive_directory_iterator(d / "out"))
+    CHECK(e.path().extension() != ".vtu");
+  std::ifstream in(d / "out" / "summary.txt");
+  std::stringstream s;
+  s << in.rdbuf();
+  CHECK(s.str().find("stability: the tangent was positive definite") != std::string::npos);
+  fs::remove_all(d);
+}
