@@ -94,23 +94,42 @@ void write_database(const std::filesystem::path& file, const Database& db) {
     H5Group sw = f.create_group("/sweep");
     sw.set_attribute(".", "input_json", db.sweep_input);
     // The load paths of the first loop length (the sweep uses the same set for all).
-    std::vector<int> kind, steps;
-    RowMatrixX target(0, 2);
+    std::vector<int> kind, steps, axis;
+    std::vector<std::string> set;
+    RowMatrixX target(0, 2), H(0, 4);
     if (!db.entries.empty()) {
       const auto& raw = db.entries.front().raw;
-      target.resize(static_cast<Eigen::Index>(raw.size()), 2);
+      const auto n = static_cast<Eigen::Index>(raw.size());
+      target.resize(n, 2);
+      H.resize(n, 4);
       for (std::size_t q = 0; q < raw.size(); ++q) {
-        kind.push_back(static_cast<int>(raw[q].path.kind));
-        steps.push_back(raw[q].path.steps);
-        target.row(static_cast<Eigen::Index>(q)) = raw[q].path.target.transpose();
+        const LoadPath& lp = raw[q].path;
+        kind.push_back(static_cast<int>(lp.kind));
+        steps.push_back(lp.steps);
+        axis.push_back(lp.axis);
+        set.push_back(lp.set);
+        const auto i = static_cast<Eigen::Index>(q);
+        target.row(i) = lp.target.transpose();
+        H.row(i) << lp.H(0, 0), lp.H(0, 1), lp.H(1, 0), lp.H(1, 1);
       }
     }
     sw.write("load_path_kind", kind);
     sw.write("load_path_steps", steps);
     sw.write("load_path_target", target);
-    sw.set_attribute("load_path_kind", "values", "0 = biaxial, 1 = pure shear");
+    sw.write("load_path_axis", axis);
+    sw.write("load_path_H", H);
+    sw.write_strings("load_path_set", set);
+    sw.set_attribute("load_path_kind", "values",
+                     "0 = biaxial, 1 = pure shear, 2 = uniaxial stress, 3 = gradient F = I + t H");
     sw.set_attribute("load_path_target", "columns",
-                     "biaxial: end (E11, E22) Green-Lagrange; shear: (gamma rad, 0)");
+                     "biaxial: end (E11, E22) Green-Lagrange; shear: (gamma rad, 0); uniaxial: "
+                     "(end Green-Lagrange strain along axis, 0); gradient: unused");
+    sw.set_attribute("load_path_axis", "values",
+                     "uniaxial: 0 = E11 (course) prescribed, 1 = E22 (wale); else unused");
+    sw.set_attribute("load_path_H", "columns", "H11, H12, H21, H22 of gradient paths");
+    sw.set_attribute("load_path_set", "values",
+                     "paper (the eq. 17 fan and shear curve), coverage (extra fitted paths), "
+                     "holdout (never fitted: checks of the law)");
     H5Group yarn = f.create_group("/yarn");
     for (const auto& [k, v] : db.yarn) yarn.set_attribute(".", k, v);
     f.write("/loop_lengths", db.loop_lengths());
@@ -138,6 +157,11 @@ void write_database(const std::filesystem::path& file, const Database& db) {
         p.set_attribute(".", "kind", to_string(r.path.kind));
         p.set_attribute(".", "target", std::vector<double>{r.path.target(0), r.path.target(1)});
         p.set_attribute(".", "steps", r.path.steps);
+        p.set_attribute(".", "axis", r.path.axis);
+        p.set_attribute(
+            ".", "H",
+            std::vector<double>{r.path.H(0, 0), r.path.H(0, 1), r.path.H(1, 0), r.path.H(1, 1)});
+        p.set_attribute(".", "set", r.path.set);
         p.write("F", r.F);
         p.write("P", r.P);
         p.write("E", r.E);
@@ -223,8 +247,26 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           where = p;
           require_group(p);
           RawPath r;
-          r.path.kind =
-              f.attribute_string(p, "kind") == "shear" ? PathKind::kShear : PathKind::kBiaxial;
+          try {
+            r.path.kind = path_kind_from_string(f.attribute_string(p, "kind"));
+          } catch (const std::invalid_argument& ex) {
+            throw InputError(fname, p, std::string("attribute kind: ") + ex.what());
+          }
+          // axis, H and set came with issue 11; older files have biaxial/shear paths of the
+          // paper's set only.
+          if (f.has_attribute(p, "axis")) r.path.axis = f.attribute_int(p, "axis");
+          if (f.has_attribute(p, "H")) {
+            const auto h = f.attribute_doubles(p, "H");
+            if (h.size() != 4) throw InputError(fname, p, "attribute H must have 4 values");
+            r.path.H << h[0], h[1], h[2], h[3];
+          }
+          r.path.set = f.has_attribute(p, "set") ? f.attribute_string(p, "set") : "paper";
+          if (!is_valid_path_set(r.path.set))
+            throw InputError(
+                fname, p,
+                "attribute set '" + r.path.set + "' is not one of paper, coverage, holdout");
+          if (r.path.kind == PathKind::kUniaxial && r.path.axis != 0 && r.path.axis != 1)
+            throw InputError(fname, p, "attribute axis must be 0 or 1 for a uniaxial path");
           const auto t = f.attribute_doubles(p, "target");
           if (t.size() != 2) throw InputError(fname, p, "attribute target must have 2 values");
           r.path.target = {t[0], t[1]};

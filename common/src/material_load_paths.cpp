@@ -1,4 +1,5 @@
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -42,16 +43,121 @@ std::vector<LoadPath> default_load_paths(int steps, double e_max, double e_min, 
 
 Eigen::Matrix2d deformation_gradient(const LoadPath& path, double t) {
   Eigen::Matrix2d F = Eigen::Matrix2d::Identity();
-  if (path.kind == PathKind::kBiaxial) {
-    const double l1 = stretch_from_green(path.target(0)), l2 = stretch_from_green(path.target(1));
-    F(0, 0) = 1.0 + t * (l1 - 1.0);
-    F(1, 1) = 1.0 + t * (l2 - 1.0);
-  } else {
-    const double g = t * path.target(0);
-    F(0, 1) = std::sin(g);
-    F(1, 1) = std::cos(g);
+  switch (path.kind) {
+    case PathKind::kBiaxial: {
+      const double l1 = stretch_from_green(path.target(0)), l2 = stretch_from_green(path.target(1));
+      F(0, 0) = 1.0 + t * (l1 - 1.0);
+      F(1, 1) = 1.0 + t * (l2 - 1.0);
+      break;
+    }
+    case PathKind::kShear: {
+      const double g = t * path.target(0);
+      F(0, 1) = std::sin(g);
+      F(1, 1) = std::cos(g);
+      break;
+    }
+    case PathKind::kUniaxial: {
+      if (path.axis != 0 && path.axis != 1)
+        throw std::invalid_argument("load path: uniaxial axis must be 0 (course) or 1 (wale)");
+      const int a = path.axis;
+      F(a, a) = 1.0 + t * (stretch_from_green(path.target(0)) - 1.0);
+      break;
+    }
+    case PathKind::kGradient:
+      F += t * path.H;
+      break;
   }
   return F;
+}
+
+bool StrainBox::contains(double E11, double E22, double E12) const {
+  return E11 >= E11_min && E11 <= E11_max && E22 >= E22_min && E22 <= E22_max &&
+         std::abs(E12) <= E12_max;
+}
+
+double halton(int i, int base) {
+  double f = 1.0, r = 0.0;
+  for (int n = i; n > 0; n /= base) {
+    f /= base;
+    r += f * (n % base);
+  }
+  return r;
+}
+
+Eigen::Matrix2d upper_gradient_for(double E11, double E22, double E12) {
+  const double a = stretch_from_green(E11);
+  const double b = 2.0 * E12 / a;
+  const double d2 = 1.0 + 2.0 * E22 - b * b;
+  if (!(d2 > 0.0))
+    throw std::invalid_argument(
+        "load path: no upper-triangular F for this strain (1 + 2 E22 <= b^2)");
+  Eigen::Matrix2d F;
+  F << a, b, 0.0, std::sqrt(d2);
+  return F;
+}
+
+std::vector<LoadPath> coverage_load_paths(const CoverageOptions& o) {
+  if (o.directions < 0 || o.biaxial_steps < 1 || o.uniaxial_steps < 1 || o.gradient_steps < 1)
+    throw std::invalid_argument("coverage paths: directions >= 0 and steps >= 1 required");
+  const StrainBox& b = o.box;
+  if (!(b.E11_min < 0 && b.E11_max > 0 && b.E22_min < 0 && b.E22_max > 0 && b.E12_max > 0))
+    throw std::invalid_argument("coverage paths: the box must contain E = 0 in its interior");
+  std::vector<LoadPath> paths;
+  for (int axis = 0; axis < 2; ++axis) {
+    LoadPath p;
+    p.kind = PathKind::kUniaxial;
+    p.axis = axis;
+    p.target = {axis == 0 ? b.E11_max : b.E22_max, 0.0};
+    p.steps = o.uniaxial_steps;
+    p.set = "coverage";
+    paths.push_back(p);
+  }
+  constexpr double kPi = 3.14159265358979323846;
+  for (int k = 0; k < o.directions; ++k) {
+    const double th = 2.0 * kPi * k / o.directions;
+    const double c = std::cos(th), s = std::sin(th);
+    // Ray from 0 to the box edge: the largest r with r (c, s) inside.
+    double r = 1e300;
+    if (c > 1e-12) r = std::min(r, b.E11_max / c);
+    if (c < -1e-12) r = std::min(r, b.E11_min / c);
+    if (s > 1e-12) r = std::min(r, b.E22_max / s);
+    if (s < -1e-12) r = std::min(r, b.E22_min / s);
+    LoadPath p;
+    p.kind = PathKind::kBiaxial;
+    p.target = {std::abs(r * c) < 1e-14 ? 0.0 : r * c, std::abs(r * s) < 1e-14 ? 0.0 : r * s};
+    p.steps = o.biaxial_steps;
+    p.set = "coverage";
+    paths.push_back(p);
+  }
+  for (const Eigen::Vector2d& e : o.stretch) {
+    LoadPath p;
+    p.kind = PathKind::kGradient;
+    p.H << e(0), std::sin(o.gamma), 0.0, e(1);
+    p.steps = o.gradient_steps;
+    p.set = "coverage";
+    paths.push_back(p);
+  }
+  return paths;
+}
+
+std::vector<LoadPath> holdout_load_paths(const StrainBox& b, int count, int steps) {
+  if (count < 0 || steps < 1)
+    throw std::invalid_argument("holdout paths: count >= 0 and steps >= 1 required");
+  std::vector<LoadPath> paths;
+  for (int i = 1; static_cast<int>(paths.size()) < count && i < 100000; ++i) {
+    const double E11 = b.E11_min + halton(i, 2) * (b.E11_max - b.E11_min);
+    const double E22 = b.E22_min + halton(i, 3) * (b.E22_max - b.E22_min);
+    const double E12 = (2.0 * halton(i, 5) - 1.0) * b.E12_max;
+    const double a2 = 1.0 + 2.0 * E11, bb = 4.0 * E12 * E12 / a2;
+    if (!(a2 > 0.01) || !(1.0 + 2.0 * E22 - bb > 0.01)) continue;
+    LoadPath p;
+    p.kind = PathKind::kGradient;
+    p.H = upper_gradient_for(E11, E22, E12) - Eigen::Matrix2d::Identity();
+    p.steps = steps;
+    p.set = "holdout";
+    paths.push_back(p);
+  }
+  return paths;
 }
 
 Eigen::Matrix2d green_lagrange(const Eigen::Matrix2d& F) {
@@ -68,7 +174,29 @@ Eigen::Matrix2d first_piola_kirchhoff(const Eigen::Matrix2d& F, const Eigen::Mat
 }
 
 std::string to_string(PathKind k) {
-  return k == PathKind::kShear ? "shear" : "biaxial";
+  switch (k) {
+    case PathKind::kBiaxial:
+      return "biaxial";
+    case PathKind::kShear:
+      return "shear";
+    case PathKind::kUniaxial:
+      return "uniaxial";
+    case PathKind::kGradient:
+      return "gradient";
+  }
+  return "?";
+}
+
+PathKind path_kind_from_string(const std::string& name) {
+  for (PathKind k :
+       {PathKind::kBiaxial, PathKind::kShear, PathKind::kUniaxial, PathKind::kGradient})
+    if (to_string(k) == name) return k;
+  throw std::invalid_argument("unknown load path kind '" + name +
+                              "' (biaxial, shear, uniaxial, gradient)");
+}
+
+bool is_valid_path_set(const std::string& set) {
+  return set == "paper" || set == "coverage" || set == "holdout";
 }
 
 }  // namespace knit::material

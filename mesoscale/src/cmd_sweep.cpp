@@ -10,8 +10,10 @@
 //   knit-meso sweep cases/sweep/default.json --output db.h5
 //   knit-meso sweep cases/sweep/reduced.json --output reduced.h5 --threads 2
 //   mpirun -np 4 knit-meso sweep cases/sweep/default.json --output db.h5
+#include <array>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "knit/core/cli.hpp"
@@ -64,18 +66,34 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
   std::printf("time: cases %.2f s, fit %.2f s, total %.2f s (%d rank%s x %d thread%s)\n",
               rep.seconds_cases, rep.seconds_fit, rep.seconds_total, rep.ranks,
               rep.ranks == 1 ? "" : "s", rep.threads, rep.threads == 1 ? "" : "s");
-  const int failed = rep.failed_cases();
-  if (failed > 0) {
+  // Convergence per path kind and set (issue 11): completed paths / all, converged steps / all.
+  {
+    std::map<std::string, std::array<int, 4>> by;
+    for (const auto& r : rep.results) {
+      auto& c = by[knit::material::to_string(r.raw.path.kind) + " (" + r.raw.path.set + ")"];
+      c[0] += r.status == JobStatus::kConverged ? 1 : 0;
+      c[1] += 1;
+      c[2] += r.converged_steps();
+      c[3] += r.raw.path.steps;
+    }
+    for (const auto& [name, c] : by)
+      std::printf("paths %-22s %3d/%3d completed, steps %5d/%5d converged\n", name.c_str(), c[0],
+                  c[1], c[2], c[3]);
+  }
+  const int failed = rep.failed_cases(), stopped = rep.stopped_cases();
+  if (failed + stopped > 0) {
     std::printf(
-        "%d case%s did not converge (kept in the database with their status, left out "
-        "of the fit where no step converged):\n",
-        failed, failed == 1 ? "" : "s");
+        "%d case%s did not converge (kept in the database with their status; %d of them "
+        "coverage/holdout paths that stopped early, which does not fail the sweep):\n",
+        failed + stopped, failed + stopped == 1 ? "" : "s", stopped);
     for (std::size_t i = 0; i < rep.results.size(); ++i) {
       const auto& r = rep.results[i];
       if (r.status == JobStatus::kConverged) continue;
-      std::printf("  l=%.2f mm case %d: %s, %d/%d steps after %d attempts: %s\n",
-                  jobs[i].loop_length, jobs[i].path, to_string(r.status).c_str(),
-                  r.converged_steps(), jobs[i].load_path.steps, r.attempts, r.message.c_str());
+      std::printf("  l=%.2f mm case %d (%s, %s): %s, %d/%d steps after %d attempts: %s\n",
+                  jobs[i].loop_length, jobs[i].path,
+                  knit::material::to_string(jobs[i].load_path.kind).c_str(),
+                  jobs[i].load_path.set.c_str(), to_string(r.status).c_str(), r.converged_steps(),
+                  jobs[i].load_path.steps, r.attempts, r.message.c_str());
     }
   }
   std::printf("wrote %s\n", output.c_str());

@@ -78,8 +78,32 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
     out.u_anchor_new = pr.u;  // contact released: the anchor follows
     return out;
   }
-  const auto nv = law.eval(out.gap);
-  if (nv.p <= 0) {  // within the allowance g0: no force, no friction, the anchor follows
+  auto nv = law.eval(out.gap);
+  bool tie = false;  // the soft bilateral tie of a reference pair that opened (no friction)
+  if (hist.g_ref < 0) {
+    // Stress-free reference (contact_set.hpp): measured from the reference overlap g_r,
+    //   g <= g_r:     p(g) - p(g_r),  energy Pi(g) - Pi(g_r) - p(g_r) (g_r - g);
+    //   g_r < g < 0:  the tie p = -k_0 (g - g_r) g / g_r (>= -k_0 |g_r| / 4, adhesive), C0 at
+    //                 g_r and 0, slope -k_0 at g_r: opened sections stay weakly coupled, as
+    //                 the plain law's soft branch keeps touching yarns coupled;
+    //                 energy k_0 / g_r (g^3/3 - g_r g^2/2 + g_r^3/6).
+    const double gr = hist.g_ref, g = out.gap;
+    if (g > gr) {
+      const double k0 = law.k_0;
+      if (k0 <= 0) {
+        out.u_anchor_new = pr.u;
+        return out;
+      }
+      tie = true;
+      nv.p = -k0 * (g - gr) * g / gr;
+      nv.dp_dg = -k0 * (2.0 * g - gr) / gr;
+      nv.energy = k0 / gr * (g * g * g / 3.0 - gr * g * g / 2.0 + gr * gr * gr / 6.0);
+    } else {
+      const auto r = law.eval(gr);
+      nv.p -= r.p;
+      nv.energy -= r.energy + r.p * (gr - g);
+    }
+  } else if (nv.p <= 0) {  // within the allowance g0: no force, no friction, the anchor follows
     out.u_anchor_new = pr.u;
     return out;
   }
@@ -96,7 +120,11 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
   const double ftr = -fr.k_T * e;
   const double lim = fr.mu * nv.p;
   const double sgn = e >= 0 ? 1.0 : -1.0;
-  if (std::abs(ftr) <= lim) {
+  if (tie) {  // no friction on the tie: the anchor follows
+    out.f_T = 0;
+    out.u_anchor_new = pr.u;
+    out.energy = nv.energy;
+  } else if (std::abs(ftr) <= lim) {
     out.f_T = ftr;
     out.energy = nv.energy + 0.5 * fr.k_T * e * e;
   } else {
@@ -130,7 +158,9 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
   const MatrixXd dtau = (Matrix3d::Identity() - tau * tau.transpose()) / ell * dxu;
   const Eigen::RowVectorXd dp = nv.dp_dg * drho;
   Eigen::RowVectorXd dfT;
-  if (!out.slip) {
+  if (tie) {
+    dfT = Eigen::RowVectorXd::Zero(nz);
+  } else if (!out.slip) {
     const Eigen::RowVectorXd de = ell * du + (pr.u - hist.u_anchor) * dell;
     dfT = -fr.k_T * de;
   } else {

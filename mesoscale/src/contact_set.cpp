@@ -30,6 +30,7 @@ ContactSet::ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions&
   }
   history_.assign(3 * ns, {});
   pending_.assign(3 * ns, {});
+  reference_.assign(3 * ns, {});
 }
 
 Eigen::MatrixXd ContactSet::positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const {
@@ -108,6 +109,42 @@ double ContactSet::anchor_for(const Found& f) {
   return f.pr.u;
 }
 
+namespace {
+/// Matching tolerance of the stress-free reference pairs in the loop parameter u (choice):
+/// wider than the friction anchors' match_tol, because losing a reference mid-load would switch
+/// the pair to the plain law at once, a jump of p(g_r) (up to ~4 N/mm at 4.5 mm).
+constexpr double kReferenceMatchTol = 0.25;
+}  // namespace
+
+Eigen::Vector2d* ContactSet::reference_for(const Found& f) {
+  Eigen::Vector2d* best = nullptr;
+  double bd = kReferenceMatchTol;
+  for (Eigen::Vector2d& r : reference_[3 * f.point + f.course + 1])
+    if (std::abs(r(0) - f.pr.u) < bd) {
+      bd = std::abs(r(0) - f.pr.u);
+      best = &r;
+    }
+  return best;
+}
+
+int ContactSet::capture_reference(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  reference_.assign(reference_.size(), {});
+  if (opt_.reference != ContactOptions::Reference::kInitialOverlap) return 0;
+  int n = 0;
+  for (const Found& f : search(positions(sys, x)))
+    if (f.pr.distance < opt_.d) {
+      reference_[3 * f.point + f.course + 1].emplace_back(f.pr.u, f.pr.distance - opt_.d);
+      ++n;
+    }
+  return n;
+}
+
+int ContactSet::num_reference_pairs() const {
+  int n = 0;
+  for (const auto& l : reference_) n += static_cast<int>(l.size());
+  return n;
+}
+
 template <class Visit>
 void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool want_jac,
                        Visit&& v) {
@@ -122,6 +159,7 @@ void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool
     // Quick gap test before touching the history: inactive pairs create no anchors.
     if (f.pr.distance >= opt_.d) continue;
     PairHistory h{anchor_for(f)};
+    if (const Eigen::Vector2d* ref = reference_for(f)) h.g_ref = (*ref)(1);
     const PairResult r = evaluate_pair(xs, ch, f.pr, opt_.d, law, opt_.friction, h, want_jac);
     if (r.active) v(f, r);
   }
@@ -218,6 +256,10 @@ void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   });
   history_ = std::move(next);
   pending_.assign(history_.size(), {});
+  // The references follow their pairs (sliding); open pairs keep their last u_r.
+  for (const Found& f : search(positions(sys, x)))
+    if (f.pr.distance < opt_.d)
+      if (Eigen::Vector2d* ref = reference_for(f)) (*ref)(0) = f.pr.u;
   last_dissipation_ = D;
   dissipation_ += D;
 }

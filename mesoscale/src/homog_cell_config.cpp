@@ -93,7 +93,14 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     const json& c = j["contact"];
     R.object(c, "/contact",
              {"penalty", "allowance", "delta", "soft_penalty", "soft_delta", "mu", "stick_penalty",
-              "margin", "self_exclusion"});
+              "margin", "self_exclusion", "reference"});
+    if (c.contains("reference")) {
+      const json& r = c["reference"];
+      if (!r.is_string() || (r != "initial_overlap" && r != "none"))
+        R.fail("/contact/reference", "must be \"initial_overlap\" or \"none\"");
+      o.contact.reference = r == "none" ? contact::ContactOptions::Reference::kNone
+                                        : contact::ContactOptions::Reference::kInitialOverlap;
+    }
     R.num(c, "/contact", "penalty", o.contact.penalty.k_N, 0, inf, true);
     R.num(c, "/contact", "allowance", o.contact.penalty.g0, 0, inf, false);
     R.num(c, "/contact", "delta", o.contact.penalty.delta, 0, inf, true);

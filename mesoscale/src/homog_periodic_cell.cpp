@@ -103,9 +103,18 @@ PeriodicCell::PeriodicCell(double loop_length, const CellOptions& opt) : opt_(op
   }
   x_ = sys_.initial_state();
   set_F(Matrix2d::Identity());
+  // Stress-free reference (contact_set.hpp): the initial overlaps carry no force.
+  contact_->capture_reference(sys_, x_);
 }
 
 PeriodicCell::~PeriodicCell() = default;
+
+void PeriodicCell::restore(const Snapshot& s) {
+  x_ = s.x;
+  F_ = s.F;
+  set_F(F_);
+  contact_->restore(s.contact);
+}
 
 void PeriodicCell::set_F(const Matrix2d& F) {
   const Matrix3d F3 = embed(F);

@@ -8,6 +8,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
+#include "knit/meso/homog/uniaxial.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
 namespace knit::meso::sweep {
@@ -45,10 +46,18 @@ PathRunner cell_runner(const SweepInput& in) {
       return out;
     }
     out.residual << eq.S(0, 0), eq.S(1, 1), 0.5 * (eq.S(0, 1) + eq.S(1, 0));
+    homog::UniaxialState uni;
     for (int k = 0; k < n; ++k) {
       const Eigen::Matrix2d F =
           material::deformation_gradient(path, static_cast<double>(k + 1) / n);
-      const homog::StepResult s = cell.solve(F);
+      homog::StepResult s;
+      if (path.kind == material::PathKind::kUniaxial) {
+        const homog::UniaxialStep u =
+            homog::solve_uniaxial_step(cell, path.axis, F(path.axis, path.axis), uni);
+        s = u.step;
+      } else {
+        s = cell.solve(F);
+      }
       out.iterations += s.iterations;
       if (!s.converged) {
         r.status[static_cast<std::size_t>(k)] = kStepFailed;

@@ -93,7 +93,8 @@ std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
       if (k >= n) return;
       std::vector<material::RawPath> usable;
       for (const auto& r : db.entries[k].raw)
-        if (std::count(r.status.begin(), r.status.end(), 0) > 0) usable.push_back(r);
+        if (r.path.set == "paper" && std::count(r.status.begin(), r.status.end(), 0) > 0)
+          usable.push_back(r);
       out[k] = fit::fit_loop_length(usable, options);
     }
   };
@@ -139,7 +140,7 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
         factor(l, p) = r.step_factor;
         conv(l, p) = r.converged_steps();
         // the fit (fit_sweep_database) uses a case's converged steps, if it has any
-        in_fit(l, p) = in.fit && r.converged_steps() > 0 ? 1 : 0;
+        in_fit(l, p) = in.fit && r.raw.path.set == "paper" && r.converged_steps() > 0 ? 1 : 0;
         seconds(l, p) = r.seconds;
         residual.row(l * np + p) = r.residual.transpose();
         messages.push_back(r.message);

@@ -1,3 +1,4 @@
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -24,6 +25,91 @@ std::string read_text(const std::filesystem::path& file) {
   return ss.str();
 }
 
+/// Appends generated or explicit paths (not in the shared default set: path id -1).
+void append(SweepInput& in, const std::vector<material::LoadPath>& paths) {
+  for (const auto& p : paths) {
+    in.paths.push_back(p);
+    in.path_ids.push_back(-1);
+  }
+}
+
+/// "box": {"E11": [min, max], "E22": [min, max], "E12_max": m} over the defaults of StrainBox.
+material::StrainBox read_box(const nlohmann::json& lp, const std::string& file) {
+  material::StrainBox b;
+  if (!lp.contains("box")) return b;
+  const auto& j = lp.at("box");
+  if (j.contains("E11")) {
+    b.E11_min = j.at("E11").at(0).get<double>();
+    b.E11_max = j.at("E11").at(1).get<double>();
+  }
+  if (j.contains("E22")) {
+    b.E22_min = j.at("E22").at(0).get<double>();
+    b.E22_max = j.at("E22").at(1).get<double>();
+  }
+  b.E12_max = j.value("E12_max", b.E12_max);
+  if (!(b.E11_min < 0 && b.E11_max > 0))
+    throw InputError(file, "/load_paths/box/E11", "must be [min < 0, max > 0]");
+  if (!(b.E22_min < 0 && b.E22_max > 0))
+    throw InputError(file, "/load_paths/box/E22", "must be [min < 0, max > 0]");
+  return b;
+}
+
+/// "coverage": true (the defaults of CoverageOptions) or an object overriding them.
+material::CoverageOptions read_coverage(const nlohmann::json& c, const material::StrainBox& box) {
+  material::CoverageOptions o;
+  o.box = box;
+  if (!c.is_object()) return o;
+  o.directions = c.value("directions", o.directions);
+  o.biaxial_steps = c.value("biaxial_steps", o.biaxial_steps);
+  o.uniaxial_steps = c.value("uniaxial_steps", o.uniaxial_steps);
+  o.gradient_steps = c.value("gradient_steps", o.gradient_steps);
+  if (c.contains("gamma_deg")) o.gamma = c.at("gamma_deg").get<double>() * kPi / 180.0;
+  if (c.contains("stretch")) {
+    o.stretch.clear();
+    for (const auto& e : c.at("stretch"))
+      o.stretch.emplace_back(e.at(0).get<double>(), e.at(1).get<double>());
+  }
+  return o;
+}
+
+/// An explicit list of paths (schemas/sweep.schema.json, the array form).
+std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int steps,
+                                               const std::string& file,
+                                               const std::string& pointer) {
+  std::vector<material::LoadPath> out;
+  for (std::size_t i = 0; i < lp.size(); ++i) {
+    const auto& q = lp[i];
+    material::LoadPath p;
+    p.steps = q.value("steps", steps);
+    p.set = q.value("set", std::string("paper"));
+    p.kind = material::path_kind_from_string(q.at("kind").get<std::string>());
+    switch (p.kind) {
+      case material::PathKind::kBiaxial:
+        p.target = {q.at("E11").get<double>(), q.at("E22").get<double>()};
+        break;
+      case material::PathKind::kShear:
+        p.target = {q.at("gamma_deg").get<double>() * kPi / 180.0, 0.0};
+        break;
+      case material::PathKind::kUniaxial:
+        p.axis = q.at("axis") == "wale" ? 1 : 0;
+        p.target = {q.at("E").get<double>(), 0.0};
+        break;
+      case material::PathKind::kGradient: {
+        const auto& H = q.at("H");
+        p.H << H.at(0).at(0).get<double>(), H.at(0).at(1).get<double>(),
+            H.at(1).at(0).get<double>(), H.at(1).at(1).get<double>();
+        const Eigen::Matrix2d F = Eigen::Matrix2d::Identity() + p.H;
+        if (!(F.determinant() > 0.05))
+          throw InputError(file, io::json_pointer_append(pointer, i) + "/H",
+                           "det(I + H) must be > 0.05 (an admissible deformation)");
+        break;
+      }
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string fingerprint(const std::string& text) {
@@ -44,11 +130,16 @@ std::string SweepInput::job_definition() const {
   for (const auto& q : paths)
     p.push_back({{"kind", material::to_string(q.kind)},
                  {"target", {q.target(0), q.target(1)}},
+                 {"axis", q.axis},
+                 {"H", {q.H(0, 0), q.H(0, 1), q.H(1, 0), q.H(1, 1)}},
+                 {"set", q.set},
                  {"steps", q.steps}});
   j["paths"] = p;
   j["runner"] = runner == RunnerKind::kCell ? "cell" : "synthetic";
   j["cell"] = nlohmann::json::parse(cell_json);
-  j["retry"] = {{"max_retries", retry.max_retries}, {"step_factor", retry.step_factor}};
+  j["retry"] = {{"max_retries", retry.max_retries},
+                {"step_factor", retry.step_factor},
+                {"max_retries_coverage", retry.max_retries_extra}};
   return j.dump();  // keys sorted (std::map): canonical
 }
 
@@ -83,20 +174,19 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
       in.paths = all;
       for (std::size_t i = 0; i < all.size(); ++i) in.path_ids.push_back(static_cast<int>(i));
     }
-  } else {
-    for (const auto& q : lp) {
-      material::LoadPath p;
-      p.steps = q.value("steps", steps);
-      if (q.at("kind") == "biaxial") {
-        p.kind = material::PathKind::kBiaxial;
-        p.target = {q.at("E11").get<double>(), q.at("E22").get<double>()};
-      } else {
-        p.kind = material::PathKind::kShear;
-        p.target = {q.at("gamma_deg").get<double>() * kPi / 180.0, 0.0};
-      }
-      in.paths.push_back(p);
-      in.path_ids.push_back(-1);
+    const material::StrainBox box = read_box(lp, file);
+    if (lp.contains("coverage")) {
+      const auto cov = material::coverage_load_paths(read_coverage(lp.at("coverage"), box));
+      append(in, cov);
     }
+    if (lp.contains("holdout")) {
+      const auto& h = lp.at("holdout");
+      append(in, material::holdout_load_paths(box, h.value("count", 24), h.value("steps", steps)));
+    }
+    if (lp.contains("extra"))
+      append(in, explicit_paths(lp.at("extra"), steps, file, "/load_paths/extra"));
+  } else {
+    append(in, explicit_paths(lp, steps, file, "/load_paths"));
   }
 
   if (j.contains("runner"))
@@ -120,10 +210,12 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     }
     in.cell_json = c.dump();
   }
-  in.subtract_residual = j.value("residual_stress", std::string("subtract")) == "subtract";
+  in.subtract_residual = j.value("residual_stress", std::string("keep")) == "subtract";
   if (j.contains("retry")) {
     in.retry.max_retries = j.at("retry").value("max_retries", in.retry.max_retries);
     in.retry.step_factor = j.at("retry").value("step_factor", in.retry.step_factor);
+    in.retry.max_retries_extra =
+        j.at("retry").value("max_retries_coverage", in.retry.max_retries_extra);
   }
   if (j.contains("fit")) {
     const auto& f = j.at("fit");

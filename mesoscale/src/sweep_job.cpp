@@ -89,7 +89,8 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
   best.raw = subsample(RawPath{}, job.load_path, 1);
   int best_steps = -1;
   int m = 1;
-  for (int a = 0; a <= retry.max_retries; ++a, m *= retry.step_factor) {
+  const int max_retries = retry.retries_for(job.load_path);
+  for (int a = 0; a <= max_retries; ++a, m *= retry.step_factor) {
     material::LoadPath lp = job.load_path;
     lp.steps = job.load_path.steps * m;
     ++best.attempts;
@@ -125,7 +126,8 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
 // ---- serialization --------------------------------------------------------------------------
 
 namespace {
-constexpr const char* kMagic = "knit-sweep-job 2";
+// Version 3 (issue 11): the path's axis, H and set follow its target.
+constexpr const char* kMagic = "knit-sweep-job 3";
 
 void put(std::ostringstream& os, double v) {
   char b[40];
@@ -170,6 +172,9 @@ std::string serialize(const JobResult& r) {
   os << "\nkind " << static_cast<int>(r.raw.path.kind) << "\ntarget";
   put(os, r.raw.path.target(0));
   put(os, r.raw.path.target(1));
+  os << "\naxis " << r.raw.path.axis << "\nH";
+  for (int c = 0; c < 4; ++c) put(os, r.raw.path.H(c / 2, c % 2));
+  os << "\nset " << r.raw.path.set;
   os << "\nsteps " << r.raw.path.steps << "\nrows " << r.raw.status.size() << "\n";
   for (std::size_t k = 0; k < r.raw.status.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
@@ -212,10 +217,19 @@ JobResult deserialize(const std::string& text) {
   expect(is, "residual");
   for (int c = 0; c < 3; ++c) r.residual(c) = get_double(is);
   expect(is, "kind");
-  r.raw.path.kind = get_int(is) == 1 ? material::PathKind::kShear : material::PathKind::kBiaxial;
+  const int kind = get_int(is);
+  if (kind < 0 || kind > 3) throw std::runtime_error("job result: bad path kind");
+  r.raw.path.kind = static_cast<material::PathKind>(kind);
   expect(is, "target");
   r.raw.path.target(0) = get_double(is);
   r.raw.path.target(1) = get_double(is);
+  expect(is, "axis");
+  r.raw.path.axis = get_int(is);
+  expect(is, "H");
+  for (int c = 0; c < 4; ++c) r.raw.path.H(c / 2, c % 2) = get_double(is);
+  expect(is, "set");
+  if (!(is >> r.raw.path.set) || !material::is_valid_path_set(r.raw.path.set))
+    throw std::runtime_error("job result: bad path set");
   expect(is, "steps");
   r.raw.path.steps = get_int(is);
   expect(is, "rows");
@@ -242,7 +256,9 @@ JobResult deserialize(const std::string& text) {
 
 bool matches(const JobResult& r, const Job& job) {
   return r.index == job.index && r.raw.path.kind == job.load_path.kind &&
-         r.raw.path.target == job.load_path.target && r.raw.path.steps == job.load_path.steps &&
+         r.raw.path.target == job.load_path.target && r.raw.path.axis == job.load_path.axis &&
+         r.raw.path.H == job.load_path.H && r.raw.path.set == job.load_path.set &&
+         r.raw.path.steps == job.load_path.steps &&
          static_cast<int>(r.raw.status.size()) == job.load_path.steps;
 }
 

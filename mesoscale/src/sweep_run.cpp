@@ -19,9 +19,20 @@ namespace knit::meso::sweep {
 
 namespace fs = std::filesystem;
 
+bool fails_sweep(const JobResult& r) {
+  if (r.status == JobStatus::kConverged) return false;
+  return r.status == JobStatus::kError || r.raw.path.set == "paper";
+}
+
 int SweepReport::failed_cases() const {
   int n = 0;
-  for (const auto& r : results) n += r.status == JobStatus::kConverged ? 0 : 1;
+  for (const auto& r : results) n += fails_sweep(r) ? 1 : 0;
+  return n;
+}
+
+int SweepReport::stopped_cases() const {
+  int n = 0;
+  for (const auto& r : results) n += r.status != JobStatus::kConverged && !fails_sweep(r) ? 1 : 0;
   return n;
 }
 
@@ -106,12 +117,25 @@ class Pool {
 std::string describe(const Job& j, const JobResult& r) {
   char b[256];
   const auto& p = j.load_path;
-  if (p.kind == material::PathKind::kShear)
-    std::snprintf(b, sizeof b, "l=%.2f mm case %2d shear gamma=%.1f deg", j.loop_length, j.path,
-                  p.target(0) * 180.0 / 3.14159265358979323846);
-  else
-    std::snprintf(b, sizeof b, "l=%.2f mm case %2d biaxial E=(%+.3f,%+.3f)", j.loop_length, j.path,
-                  p.target(0), p.target(1));
+  switch (p.kind) {
+    case material::PathKind::kShear:
+      std::snprintf(b, sizeof b, "l=%.2f mm case %2d shear gamma=%.1f deg", j.loop_length, j.path,
+                    p.target(0) * 180.0 / 3.14159265358979323846);
+      break;
+    case material::PathKind::kBiaxial:
+      std::snprintf(b, sizeof b, "l=%.2f mm case %2d biaxial E=(%+.3f,%+.3f) %s", j.loop_length,
+                    j.path, p.target(0), p.target(1), p.set.c_str());
+      break;
+    case material::PathKind::kUniaxial:
+      std::snprintf(b, sizeof b, "l=%.2f mm case %2d uniaxial %s E=%+.3f %s", j.loop_length, j.path,
+                    p.axis == 0 ? "course" : "wale", p.target(0), p.set.c_str());
+      break;
+    case material::PathKind::kGradient:
+      std::snprintf(b, sizeof b, "l=%.2f mm case %2d gradient H=(%+.3f,%+.3f;%+.3f,%+.3f) %s",
+                    j.loop_length, j.path, p.H(0, 0), p.H(0, 1), p.H(1, 0), p.H(1, 1),
+                    p.set.c_str());
+      break;
+  }
   char c[160];
   std::snprintf(c, sizeof c, ": %s, %d/%d steps, %d attempt%s, %.2f s", to_string(r.status).c_str(),
                 r.converged_steps(), p.steps, r.attempts, r.attempts == 1 ? "" : "s", r.seconds);

@@ -1,9 +1,9 @@
 // The whole chain through the only contract between the two executables (issue #7): the
-// reduced mesoscale sweep (cases/sweep/reduced.json: one loop length, 5 load cases, 6 steps,
-// real unit cell with contact) writes a material database, and knit-macro runs the paper's
-// wale-wise tensile case (Sect. 3.1.2, l = 4.5 mm) on it, reduced to 10 % strain in 4 steps.
-// Checks: both executables succeed, the load is positive and grows with the strain, and the
-// patch's centre moves by half the jaw displacement (symmetry of the uniform patch).
+// reduced mesoscale sweep (cases/sweep/reduced.json: one loop length, 5 paper load cases, 6 steps,
+// plus 4 issue-11 paths, real unit cell with contact) writes a material database, and knit-macro
+// runs the paper's wale-wise tensile case (Sect. 3.1.2, l = 4.5 mm) on it, reduced to 10 % strain
+// in 4 steps. Checks: both executables succeed, the load is positive and grows with the strain, and
+// the patch's centre moves by half the jaw displacement (symmetry of the uniform patch).
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>

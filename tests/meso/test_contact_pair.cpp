@@ -42,6 +42,34 @@ void eval_at(const Fixture& F0, const Vector3d& xs, const MatrixXd& Q, double u0
   m = r.m;
 }
 
+// Central differences of f and m with respect to z = [x_s, Q_first..Q_first+p] at the pair r.
+void finite_differences(const Fixture& F, const Vector3d& xs, const Projection& pr,
+                        const PairResult& r, const PenaltyLaw& law, const FrictionLaw& fr,
+                        const PairHistory& h, MatrixXd& fd_f, MatrixXd& fd_m) {
+  const int p = F.basis.degree();
+  const int nz = 3 + 3 * (p + 1);
+  fd_f.resize(3, nz);
+  fd_m.resize(3, nz);
+  const double eps = 1e-6;
+  for (int j = 0; j < nz; ++j) {
+    Vector3d xp = xs, xm = xs;
+    MatrixXd Qp = F.Q, Qm = F.Q;
+    if (j < 3) {
+      xp(j) += eps;
+      xm(j) -= eps;
+    } else {
+      const int b = (j - 3) / 3, comp = (j - 3) % 3;
+      Qp(r.master_first + b, comp) += eps;
+      Qm(r.master_first + b, comp) -= eps;
+    }
+    Vector3d fp, mp, fm, mm;
+    eval_at(F, xp, Qp, pr.u, law, fr, h, fp, mp);
+    eval_at(F, xm, Qm, pr.u, law, fr, h, fm, mm);
+    fd_f.col(j) = (fp - fm) / (2 * eps);
+    fd_m.col(j) = (mp - mm) / (2 * eps);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
@@ -96,27 +124,8 @@ TEST_CASE("contact tangent matches finite differences (stick and slip)", "[unit]
     CHECK(r.slip == (mode != 0));
     CHECK(r.dissipation >= 0);
     CHECK(std::abs(r.f_T) <= fr.mu * r.p * (1 + 1e-12));
-    const int p = F.basis.degree();
-    const int nz = 3 + 3 * (p + 1);
-    MatrixXd fd_f(3, nz), fd_m(3, nz);
-    const double eps = 1e-6;
-    for (int j = 0; j < nz; ++j) {
-      Vector3d xp = xs, xm = xs;
-      MatrixXd Qp = F.Q, Qm = F.Q;
-      if (j < 3) {
-        xp(j) += eps;
-        xm(j) -= eps;
-      } else {
-        const int b = (j - 3) / 3, comp = (j - 3) % 3;
-        Qp(r.master_first + b, comp) += eps;
-        Qm(r.master_first + b, comp) -= eps;
-      }
-      Vector3d fp, mp, fm, mm;
-      eval_at(F, xp, Qp, pr.u, law, fr, h, fp, mp);
-      eval_at(F, xm, Qm, pr.u, law, fr, h, fm, mm);
-      fd_f.col(j) = (fp - fm) / (2 * eps);
-      fd_m.col(j) = (mp - mm) / (2 * eps);
-    }
+    MatrixXd fd_f, fd_m;
+    finite_differences(F, xs, pr, r, law, fr, h, fd_f, fd_m);
     INFO("mode " << mode << "\nJ_f=\n" << r.df_dz << "\nFD=\n" << fd_f);
     CHECK((r.df_dz - fd_f).norm() <= 1e-6 * (1 + fd_f.norm()));
     CHECK((r.dm_dz - fd_m).norm() <= 1e-6 * (1 + fd_m.norm()));
@@ -174,5 +183,44 @@ TEST_CASE("closest-point parameter derivative and the reaction load match FD", "
     const MatrixXd fd = (Rb[0] - Rb[1]) / (2 * eps);
     const MatrixXd an = r.df_dz.col(j) * r.Nm.row(0) + r.f * r.Nm.row(1) * r.du_dz(j);
     CHECK((fd - an).norm() < 1e-6 * (1 + fd.norm()));
+  }
+}
+
+TEST_CASE("stress-free reference pairs: offset and tie branches, tangent against FD", "[unit]") {
+  Fixture F;
+  PenaltyLaw law{100.0, 0.1, 0.1, 0.5, 0.02};
+  FrictionLaw fr;
+  const Vector3d xs(0.9, 0.1, 0.12);
+  const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
+  REQUIRE(pr.ok);
+  const double g = pr.distance - 0.38;  // ~ -0.23
+  PairHistory h;
+  h.u_anchor = pr.u + 1e-4;
+  // At the reference itself: no force (the unloaded cell), but the pressing side's stiffness.
+  h.g_ref = g;
+  const PairResult r0 = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, true);
+  CHECK(r0.active);
+  CHECK(r0.p == 0.0);
+  CHECK(r0.f.norm() < 1e-14);
+  CHECK(r0.df_dz.norm() > 0);
+  // Pressed beyond the reference: p(g) - p(g_r) > 0, less than the plain law.
+  h.g_ref = g + 0.02;
+  const PairResult r1 = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, true);
+  CHECK(r1.p == Approx(law.eval(g).p - law.eval(g + 0.02).p));
+  // Opened from the reference: the soft tie pulls (p < 0, at most k_0 |g_r| / 4), no friction.
+  h.g_ref = g - 0.02;
+  const PairResult r2 = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, true);
+  CHECK(r2.active);
+  CHECK(r2.p < 0);
+  CHECK(r2.p >= -0.25 * law.k_0 * std::abs(h.g_ref));
+  CHECK(r2.f_T == 0.0);
+  for (const double gr : {g + 0.02, g - 0.02}) {
+    h.g_ref = gr;
+    const PairResult r = evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, true);
+    MatrixXd fd_f, fd_m;
+    finite_differences(F, xs, pr, r, law, fr, h, fd_f, fd_m);
+    INFO("g_ref " << gr << "\nJ_f=\n" << r.df_dz << "\nFD=\n" << fd_f);
+    CHECK((r.df_dz - fd_f).norm() <= 1e-6 * (1 + fd_f.norm()));
+    CHECK((r.dm_dz - fd_m).norm() <= 1e-6 * (1 + fd_m.norm()));
   }
 }

@@ -35,14 +35,22 @@ TEST_CASE("reduced sweep on the unit cell: cell -> fit -> database the macroscal
   CHECK(e.cell.wale_width == Approx(1.26).margin(1e-9));
   CHECK(e.cell.course_height == Approx(0.88).margin(1e-9));
   CHECK(e.cell.thickness == Approx(0.76).margin(1e-12));
-  REQUIRE(e.raw.size() == 5);
+  // 5 paper paths (6 steps) + one path of each new kind (issue 11: uniaxial, coverage biaxial,
+  // gradient, held-out gradient; 4 steps)
+  REQUIRE(e.raw.size() == 9);
   double srange = 0;
   for (const RawPath& r : e.raw) {
-    REQUIRE(r.steps() == 6);
-    for (int k = 0; k < 6; ++k) {
+    const int n = r.path.set == "paper" ? 6 : 4;
+    REQUIRE(r.steps() == n);
+    for (int k = 0; k < n; ++k) {
       CHECK(r.status[static_cast<std::size_t>(k)] == 0);
       // F* as prescribed by the shared load-path definition; E from F exactly (eq. 9)
-      const Eigen::Matrix2d F = deformation_gradient(r.path, (k + 1) / 6.0);
+      const Eigen::Matrix2d F = deformation_gradient(r.path, (k + 1.0) / n);
+      if (r.path.kind == PathKind::kUniaxial) {  // lateral stretch found: S11 = 0 (1e-4 MPa)
+        CHECK(std::abs(r.F(k, 3) - F(1, 1)) < 1e-12);
+        CHECK(std::abs(r.S(k, 0)) <= 1e-4);
+        continue;
+      }
       CHECK(std::abs(r.F(k, 0) - F(0, 0)) + std::abs(r.F(k, 1) - F(0, 1)) +
                 std::abs(r.F(k, 3) - F(1, 1)) <
             1e-12);

@@ -56,21 +56,50 @@ SweepOptions quiet(const std::filesystem::path& out) {
 TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
   const auto d = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/default.json");
   CHECK(d.loop_lengths == std::vector<double>{4.5, 5.0, 5.5, 6.0, 6.5});
-  REQUIRE(d.paths.size() == 13);
-  CHECK(make_jobs(d).size() == 65);
-  for (const auto& p : d.paths) CHECK(p.steps == 20);
+  // The paper's 13 paths, then 2 uniaxial + 16 biaxial + 7 gradient coverage paths and 24
+  // held-out paths (issue 11).
+  REQUIRE(d.paths.size() == 13 + 25 + 24);
+  CHECK(make_jobs(d).size() == 5 * 62);
+  CHECK_FALSE(d.subtract_residual);
   // the shared definition (knit/material/load_paths.hpp) is used, not a copy
   const auto shared = knit::material::default_load_paths(20);
   for (std::size_t i = 0; i < 13; ++i) {
     CHECK(d.paths[i].kind == shared[i].kind);
+    CHECK(d.paths[i].steps == 20);
+    CHECK(d.paths[i].set == "paper");
     CHECK((d.paths[i].target - shared[i].target).norm() < 1e-15);
   }
+  int uni = 0, bi = 0, grad = 0, hold = 0;
+  for (std::size_t i = 13; i < d.paths.size(); ++i) {
+    const auto& p = d.paths[i];
+    CHECK(d.path_ids[i] == -1);
+    if (p.set == "holdout") {
+      ++hold;
+    } else {
+      CHECK(p.set == "coverage");
+      uni += p.kind == knit::material::PathKind::kUniaxial ? 1 : 0;
+      bi += p.kind == knit::material::PathKind::kBiaxial ? 1 : 0;
+      grad += p.kind == knit::material::PathKind::kGradient ? 1 : 0;
+    }
+  }
+  CHECK(uni == 2);
+  CHECK(bi == 16);
+  CHECK(grad == 7);
+  CHECK(hold == 24);
   CHECK(d.runner == RunnerKind::kCell);
   CHECK(d.fit_options.n_ctrl1 == 11);
   const auto r = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/reduced.json");
   CHECK(r.loop_lengths.size() == 1);
-  CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12});
-  CHECK(r.paths.back().kind == knit::material::PathKind::kShear);
+  CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12, -1, -1, -1, -1});
+  CHECK(r.paths[4].kind == knit::material::PathKind::kShear);
+  // one path of each new kind (issue 11)
+  CHECK(r.paths[5].kind == knit::material::PathKind::kUniaxial);
+  CHECK(r.paths[5].axis == 1);
+  CHECK(r.paths[5].target(0) == 0.2);
+  CHECK(r.paths[6].set == "coverage");
+  CHECK(r.paths[7].kind == knit::material::PathKind::kGradient);
+  CHECK(r.paths[7].H(0, 1) == 0.3);
+  CHECK(r.paths[8].set == "holdout");
 }
 
 TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
@@ -159,6 +188,25 @@ TEST_CASE("sweep job: exact serialization round trip", "[unit]") {
   CHECK((q.raw.F.array() == r.raw.F.array()).all());
   CHECK(q.cell.course_height == r.cell.course_height);
   CHECK(q.message == "multi line");
+  // issue 11: the kind, axis, H and set of every path kind survive bit-exactly
+  for (const auto kind :
+       {knit::material::PathKind::kUniaxial, knit::material::PathKind::kGradient}) {
+    JobResult u = r;
+    u.raw.path.kind = kind;
+    u.raw.path.axis = 1;
+    u.raw.path.H << 0.1, 1.0 / 3.0, -std::nextafter(1e-300, 1.0), -0.05;
+    u.raw.path.set = "holdout";
+    const JobResult v = deserialize(serialize(u));
+    CHECK(v.raw.path.kind == kind);
+    CHECK(v.raw.path.axis == 1);
+    CHECK((v.raw.path.H.array() == u.raw.path.H.array()).all());
+    CHECK(v.raw.path.set == "holdout");
+    Job j = jobs[3];
+    j.load_path = u.raw.path;
+    CHECK(matches(v, j));
+    j.load_path.set = "coverage";
+    CHECK_FALSE(matches(v, j));
+  }
   CHECK(matches(q, jobs[3]));
   CHECK_FALSE(matches(q, jobs[4]));
   CHECK_THROWS(deserialize(serialize(r).substr(0, 200)));
@@ -323,7 +371,8 @@ TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consiste
   };
   const std::string text = R"({"loop_lengths": [5.0], "steps": 5, "runner": "synthetic",
       "load_paths": {"preset": "default", "select": [0, 12]}, "fit": false)";
-  const auto sub = parse_sweep_input(text + "}", "sub.json");
+  const auto sub = parse_sweep_input(text + R"(, "residual_stress": "subtract"})", "sub.json");
+  CHECK_FALSE(parse_sweep_input(text + "}", "default.json").subtract_residual);
   const auto keep = parse_sweep_input(text + R"(, "residual_stress": "keep"})", "keep.json");
   CHECK(sub.subtract_residual);
   CHECK_FALSE(keep.subtract_residual);

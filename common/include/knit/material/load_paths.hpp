@@ -36,15 +36,64 @@ struct LoadPath {
   int axis = 0;                                 ///< kUniaxial: 0 = E11 (course), 1 = E22 (wale)
   Eigen::Matrix2d H = Eigen::Matrix2d::Zero();  ///< kGradient: end displacement gradient
   /// "paper": one of the paper's 13 paths (the fan of eq. 17 and the shear curve);
-  /// "coverage": an extra path that only the energy-based law uses.
+  /// "coverage": an extra path that only the energy-based law uses;
+  /// "holdout": a check of the law, never fitted.
   std::string set = "paper";
 };
+
+/// The strain box the database covers (material frame, Green-Lagrange, tensor E12); the
+/// evidence for its default is in docs/unit-cell.md ("Strain box"): the paper's cases visit
+/// E11 in [-0.32, 0.40], E22 in [-0.15, 0.50], |E12| <= 0.39.
+struct StrainBox {
+  double E11_min = -0.35, E11_max = 0.45;
+  double E22_min = -0.30, E22_max = 0.55;
+  double E12_max = 0.40;  ///< |E12| <= E12_max
+  bool contains(double E11, double E22, double E12) const;
+};
+
+/// The coverage paths (set "coverage") that the energy-based law needs beyond the paper's fan
+/// (issue 11), all inside `box`:
+///   * 2 uniaxial-stress paths (axis 0 = course, 1 = wale) to the box's tensile edge;
+///   * `directions` proportional biaxial paths whose end strains (E11, E22) lie on the box edge
+///     in the directions theta_k = 2 pi k / directions (k = 0.., the full circle incl. biaxial
+///     compression and the anticlastic quadrants);
+///   * gradient paths F = I + t H, H = [[e1, sin g], [0, e2]] for the (e1, e2) of `stretch`
+///     (shear combined with stretch; (e1, e2) = uniaxial-like states too), g = `gamma`.
+struct CoverageOptions {
+  StrainBox box;
+  int directions = 16;  ///< biaxial directions on the full circle (22.5 deg)
+  int biaxial_steps = 10, uniaxial_steps = 10, gradient_steps = 10;
+  double gamma = 0.6981317007977318;  ///< 40 deg, end shear angle of the gradient paths
+  /// (e1, e2) of the gradient paths (displacement gradients F11 - 1, F22 - 1).
+  std::vector<Eigen::Vector2d> stretch = {{0.0, 0.0},   {0.2, 0.0},  {0.0, 0.25}, {0.25, -0.12},
+                                          {-0.12, 0.3}, {0.15, 0.2}, {-0.1, -0.1}};
+};
+std::vector<LoadPath> coverage_load_paths(const CoverageOptions& opt);
+
+/// `count` held-out paths (set "holdout"): gradient paths F = I + t H from 0 to the strain
+/// states E_k of the Halton sequence (bases 2, 3, 5; points 1..count) mapped onto `box`
+/// (E12 over [-E12_max, E12_max]); H upper triangular, so F(1) = [[a, b], [0, d]] with
+/// a = sqrt(1 + 2 E11), b = 2 E12 / a, d = sqrt(1 + 2 E22 - b^2) gives E(F(1)) = E_k exactly.
+/// States with 1 + 2 E22 - b^2 <= 0.01 are skipped (the next Halton point is taken).
+std::vector<LoadPath> holdout_load_paths(const StrainBox& box, int count, int steps);
+
+/// The end deformation gradient of an upper-triangular F with E(F) = E (see above); throws
+/// std::invalid_argument where none exists.
+Eigen::Matrix2d upper_gradient_for(double E11, double E22, double E12);
+
+/// Point i (i >= 1) of the Halton sequence in base b (radical inverse), in [0, 1).
+double halton(int i, int base);
 
 /// The 13 default paths (12 biaxial + 1 shear), `steps` increments each.
 std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = 0.40, double e_min = -0.15,
                                          double gamma_max = 0.6981317007977318 /*40 deg*/);
 
 /// Macroscopic deformation gradient F* (2x2) of path `path` at step fraction t in [0, 1].
+///   biaxial:  diag(1 + t (l1 - 1), 1 + t (l2 - 1)), l_i = sqrt(1 + 2 E_ii(target))
+///   shear:    [[1, sin(t gamma)], [0, cos(t gamma)]]
+///   uniaxial: the prescribed stretch 1 + t (l - 1) along `axis`, the other one 1 -- the start
+///             value of the unknown lateral stretch that the runner finds (S_lateral = 0)
+///   gradient: I + t H
 Eigen::Matrix2d deformation_gradient(const LoadPath& path, double t);
 
 /// Green-Lagrange strain E = (F^T F - I)/2 (paper eq. 9) as a 2x2 tensor.
@@ -57,7 +106,11 @@ Eigen::Matrix2d second_piola_kirchhoff(const Eigen::Matrix2d& F, const Eigen::Ma
 /// First Piola-Kirchhoff stress from S: P = F S.
 Eigen::Matrix2d first_piola_kirchhoff(const Eigen::Matrix2d& F, const Eigen::Matrix2d& S);
 
-/// Name of a path kind in files ("biaxial" / "shear").
+/// Name of a path kind in files ("biaxial", "shear", "uniaxial", "gradient").
 std::string to_string(PathKind k);
+/// Inverse of to_string(PathKind); throws std::invalid_argument for an unknown name.
+PathKind path_kind_from_string(const std::string& name);
+/// The set names ("paper", "coverage", "holdout"); true if `set` is one of them.
+bool is_valid_path_set(const std::string& set);
 
 }  // namespace knit::material

@@ -22,6 +22,20 @@
 // them made the net force on the course, which must vanish, as large as the yarn force). The
 // same for the friction moment. The end points' balance rows carry the periodicity: loads on them
 // are dropped (the seam is the head top, free of contact).
+// Stress-free reference (issue 11; choice, ContactOptions::reference): the closed-form loops
+// start with overlaps of up to 0.16 mm, so with the plain law the unloaded cell carries contact
+// forces and a residual stress. With Reference::kInitialOverlap, capture_reference() records
+// at the reference state every overlapping pair (slave point, course, master parameter u_r, gap
+// g_r < 0); its line load is then p(g) - p(g_r) while g <= g_r and 0 when it opens (g > g_r):
+// the reference overlap is the stress-free flattening of the yarn sections, so the unloaded
+// cell is in equilibrium with zero force in every pair and zero stress. The stiffness of a
+// pressed pair is the plain law's dp/dg at the same geometric gap. A found pair takes the
+// reference of its (slave point, course) with the nearest u_r within `match_tol`; u_r follows
+// the pair at every commit (sliding). A pair that opens keeps its reference (its last u_r), so
+// re-closing is elastic and history-free: force 0 until g returns below g_r. Pairs found only
+// later (no reference within match_tol) use the plain law p(g) (p = 0 at g >= 0: no jump).
+// Reference::kNone: the plain law everywhere (the old behaviour; the cell then equilibrates
+// with a residual stress, see homog/periodic_cell.hpp).
 // History: per (slave point, course) the list of sticking anchors of the last converged state;
 // a pair found in an iteration takes the nearest anchor within `match_tol` in u, else it starts
 // sticking where it is found (kept for the rest of the increment). commit() accepts the
@@ -38,6 +52,8 @@
 namespace knit::meso::contact {
 
 struct ContactOptions {
+  enum class Reference { kNone, kInitialOverlap };
+  Reference reference = Reference::kInitialOverlap;  ///< see "Stress-free reference" above
   PenaltyLaw penalty;
   FrictionLaw friction;
   double d = 0.38;              ///< yarn diameter [mm]
@@ -77,8 +93,27 @@ class ContactSet : public rod::ExternalContribution {
   std::vector<ActivePair> active_pairs(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   /// Stored contact energy (penalty + elastic stick) [N mm], each contact counted once.
   double energy(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Records the overlapping pairs of the state x as the stress-free reference (see above).
+  /// Returns their number.
+  int capture_reference(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  int num_reference_pairs() const;
   /// Accepts the state x as converged: histories and dissipation are updated.
   void commit(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// Everything commit() changes (friction anchors, references, dissipation): trial solves
+  /// (the uniaxial path's lateral iteration) save and restore it.
+  struct State {
+    std::vector<std::vector<double>> history;
+    std::vector<std::vector<Eigen::Vector2d>> reference;
+    double dissipation = 0, last_dissipation = 0;
+  };
+  State save() const { return {history_, reference_, dissipation_, last_dissipation_}; }
+  void restore(const State& s) {
+    history_ = s.history;
+    reference_ = s.reference;
+    dissipation_ = s.dissipation;
+    last_dissipation_ = s.last_dissipation;
+    reset_increment();
+  }
   /// Drops the pending (in-increment) pairs, e.g. after a failed increment.
   void reset_increment() { pending_.assign(pending_.size(), {}); }
 
@@ -95,6 +130,8 @@ class ContactSet : public rod::ExternalContribution {
   std::vector<Found> search(const Eigen::MatrixXd& Q) const;
   Chain chain(const Eigen::MatrixXd& Q, int course) const;
   double anchor_for(const Found& f);
+  /// The reference (u_r, g_r) matched by f, or nullptr.
+  Eigen::Vector2d* reference_for(const Found& f);
   Eigen::MatrixXd positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const;
   template <class Visit>
   void visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool want_jac, Visit&& v);
@@ -111,6 +148,8 @@ class ContactSet : public rod::ExternalContribution {
   double scale_ = 1.0;
   // history_[slave*3 + course+1]: anchors of the last converged state; pending_: new in step
   std::vector<std::vector<double>> history_, pending_;
+  // reference_[slave*3 + course+1]: (u_r, g_r) of the stress-free reference pairs
+  std::vector<std::vector<Eigen::Vector2d>> reference_;
   double dissipation_ = 0, last_dissipation_ = 0;
 };
 

@@ -54,9 +54,14 @@ struct Projection {
 Projection project(const Chain& c, const Eigen::Vector3d& x_s, int k, double lo, double hi,
                    double u0);
 
-/// Friction history of one contact pair.
+/// History of one contact pair.
 struct PairHistory {
   double u_anchor = 0;  ///< master parameter at which the slave sticks
+  /// Reference gap g_r < 0 of a pair that overlaps in the stress-free reference cell
+  /// (contact_set.hpp, "Stress-free reference"); 0 = none. With g_r < 0 the normal line load is
+  /// p(g) - p(g_r) for g <= g_r and 0 for g > g_r (the pair is active at g = g_r itself, with
+  /// zero force and the stiffness dp/dg(g_r) of the pressing side).
+  double g_ref = 0;
 };
 
 struct PairResult {

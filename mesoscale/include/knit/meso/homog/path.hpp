@@ -2,7 +2,8 @@
 //   biaxial:    F*(lambda) = diag(1 + lambda eps11, 1 + lambda eps22)
 //   pure shear: F*(lambda) = [[1, sin(lambda gamma)], [0, cos(lambda gamma)]]
 //               (E11 = E22 = 0, E12 = sin(lambda gamma)/2 exactly at every step)
-// lambda = k / steps, k = 0..steps; step 0 is the equilibrated initial state (residual stress).
+// lambda = k / steps, k = 0..steps; step 0 is the equilibrated initial state (zero stress with
+// the stress-free reference, the residual stress with contact.reference = none).
 #pragma once
 
 #include <Eigen/Core>

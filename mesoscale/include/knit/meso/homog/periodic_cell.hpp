@@ -24,9 +24,14 @@
 // n2 = 1/2 [sum_{j, course +1} W_j f_j - sum_{j, course -1} W_j f_j], W_j tributary lengths);
 // P* = [n1/A1, n2/A2] (2x2 in-plane), A1 = c t, A2 = w t, t = 2 d; E = (F^T F - I)/2, S = F^-1 P.
 //
-// Initial equilibrium (choice): at F* = I the penalty is ramped from 0 to k_N in
-// `equilibration_steps` increments (friction active), so the initial overlaps push the yarns apart
-// gradually; the P* that remains is the residual stress reported at step 0.
+// Reference state (issue 11, choice; CellOptions::contact.reference, docs/unit-cell.md
+// "Stress-free reference"): by default the contact pairs that overlap in the closed-form loop
+// are measured from their initial overlap (contact/contact_set.hpp), so the unloaded cell is in
+// equilibrium with zero contact force, zero yarn force and zero homogenized stress by
+// construction; equilibrate() then returns the initial state at once. With
+// contact.reference = kNone (the old behaviour) the penalty is ramped from 0 to k_N in
+// `equilibration_steps` increments at F* = I (friction active), the initial overlaps push the
+// yarns apart gradually, and the P* that remains is the residual stress reported at step 0.
 #pragma once
 
 #include <Eigen/Core>
@@ -109,6 +114,16 @@ class PeriodicCell {
   StepResult homogenize(const Eigen::Matrix2d& F);
   /// Full residual and Jacobian at the current state (for checks).
   void residual_and_jacobian(Eigen::VectorXd& R, Eigen::SparseMatrix<double>& J);
+  /// The converged state (yarn, F*, contact histories): restore() returns to it, e.g. after a
+  /// trial solve of the uniaxial path's lateral iteration (homog/uniaxial.hpp).
+  struct Snapshot {
+    Eigen::VectorXd x;
+    Eigen::Matrix2d F;
+    contact::ContactSet::State contact;
+  };
+  Snapshot snapshot() const { return {x_, F_, contact_->save()}; }
+  void restore(const Snapshot& s);
+  const Eigen::Matrix2d& F() const { return F_; }
   /// Strain energy of the yarn [N mm] (Gauss quadrature of the compliance form).
   double strain_energy() const;
 

@@ -28,6 +28,12 @@ enum class RunnerKind {
 struct RetryPolicy {
   int max_retries = 2;
   int step_factor = 2;
+  /// Retries of coverage and held-out paths (issue 11): many of them end where the cell jams
+  /// or buckles, where smaller steps do not help, and each retry reruns the whole path.
+  int max_retries_extra = 0;
+  int retries_for(const material::LoadPath& p) const {
+    return p.set == "paper" ? max_retries : max_retries_extra;
+  }
 };
 
 struct SweepInput {
@@ -43,9 +49,10 @@ struct SweepInput {
   std::string cell_json = "{}";
   std::string cell_file;  ///< the cell parameter file, if "cell" named one (messages)
   RetryPolicy retry;
-  /// Subtract the residual stress of the cell at F* = I from every step (choice, see
+  /// Subtract the residual stress of the cell at F* = I from every step (see
   /// schemas/sweep.schema.json "residual_stress"); applied when the database is assembled.
-  bool subtract_residual = true;
+  /// Default false: the default cell is stress-free (docs/unit-cell.md).
+  bool subtract_residual = false;
   bool fit = true;
   fit::FitOptions fit_options;
 

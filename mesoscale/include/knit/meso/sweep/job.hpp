@@ -78,7 +78,7 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
 std::string serialize(const JobResult& r);
 /// Parses serialize()'s output; throws std::runtime_error on anything malformed.
 JobResult deserialize(const std::string& text);
-/// True if r was computed for this job (loop length, path kind, target, steps).
+/// True if r was computed for this job (index, path kind, target, axis, H, set, steps).
 bool matches(const JobResult& r, const Job& job);
 
 }  // namespace knit::meso::sweep

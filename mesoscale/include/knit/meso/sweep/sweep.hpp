@@ -42,10 +42,17 @@ struct SweepReport {
   double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
   int threads = 1, ranks = 1;
   bool wrote_database = false;  ///< false on ranks other than 0
+  /// Cases that fail the sweep: a paper path that did not converge to its end, or a runner
+  /// error on any path. Coverage and held-out paths may stop early where the cell jams or
+  /// buckles (issue 11): they are kept with their step status, counted by stopped_cases().
   int failed_cases() const;
+  int stopped_cases() const;
   bool fits_ok() const;
   bool ok() const { return failed_cases() == 0 && fits_ok(); }
 };
+
+/// True if this result makes the sweep fail (see SweepReport::failed_cases).
+bool fails_sweep(const JobResult& r);
 
 /// Runs the sweep; rank 0 writes the database. `mpi` may be nullptr (serial).
 SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
@@ -55,8 +62,9 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
 /// parameters; yarn; the input), not fitted yet.
 material::Database assemble_database(const SweepInput& in, const std::vector<JobResult>& results);
 
-/// Fits every loop length from its usable cases (those with at least one converged step; the
-/// fitter skips non-converged steps); stores the surfaces in db. Fits run in parallel.
+/// Fits every loop length from its usable cases (paper-set paths with at least one converged
+/// step; the fitter skips non-converged steps; coverage and held-out paths never enter the
+/// eq. 17 fit); stores the surfaces in db. Fits run in parallel.
 std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
                                                 const fit::FitOptions& options, int threads);
 

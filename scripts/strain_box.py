@@ -1,0 +1,83 @@
+#!/usr/bin/python3
+"""Material-frame strains that the macroscale cases visit, against the database's strain box.
+
+Reads fields/step_NNNN/{E_course, E_wale, E_course_wale} (mid-surface Green-Lagrange strains in
+the material frame, tensor shear E12; written by knit-macro for `knit` materials, see
+docs/case-format.md) of every results.h5 under a results directory (the pipeline writes
+out/results/<case>/results.h5, scripts/pipeline.mk), and prints per case and overall the
+visited box (min/max of E11 = E_course, E22 = E_wale, |E12|), the 1/99 % quantiles and the
+fraction of samples inside the database box (docs/unit-cell.md, "Strain box").
+
+    /usr/bin/python3 scripts/strain_box.py out/results
+    /usr/bin/python3 scripts/strain_box.py out/results --box -0.35 0.45 -0.30 0.55 0.40
+"""
+import argparse
+import glob
+import os
+import sys
+
+import h5py
+import numpy as np
+
+# The default box of knit/material/load_paths.hpp (StrainBox): E11, E22 ranges and |E12| bound.
+DEFAULT_BOX = (-0.35, 0.45, -0.30, 0.55, 0.40)
+
+
+def read_case(path):
+    """All (E11, E22, E12) samples of every output step of one results.h5, shape (n, 3)."""
+    rows = []
+    with h5py.File(path, "r") as f:
+        if "fields" not in f:
+            return np.zeros((0, 3))
+        for name in sorted(f["fields"]):
+            g = f["fields"][name]
+            if not all(k in g for k in ("E_course", "E_wale", "E_course_wale")):
+                continue
+            rows.append(np.column_stack([np.asarray(g["E_course"]), np.asarray(g["E_wale"]),
+                                         np.asarray(g["E_course_wale"])]))
+    return np.vstack(rows) if rows else np.zeros((0, 3))
+
+
+def inside(E, box):
+    e11lo, e11hi, e22lo, e22hi, e12 = box
+    return ((E[:, 0] >= e11lo) & (E[:, 0] <= e11hi) & (E[:, 1] >= e22lo) & (E[:, 1] <= e22hi) &
+            (np.abs(E[:, 2]) <= e12))
+
+
+def line(name, E, box):
+    q = np.quantile(E, [0.01, 0.99], axis=0)
+    return ("%-34s %7d  E11 [%+.3f, %+.3f] (1-99%%: %+.3f, %+.3f)  E22 [%+.3f, %+.3f] "
+            "(%+.3f, %+.3f)  |E12| <= %.3f (99%%: %.3f)  inside %.2f %%" %
+            (name, len(E), E[:, 0].min(), E[:, 0].max(), q[0, 0], q[1, 0], E[:, 1].min(),
+             E[:, 1].max(), q[0, 1], q[1, 1], np.abs(E[:, 2]).max(),
+             np.quantile(np.abs(E[:, 2]), 0.99), 100.0 * inside(E, box).mean()))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("results", help="directory searched recursively for results.h5")
+    ap.add_argument("--box", nargs=5, type=float, default=DEFAULT_BOX,
+                    metavar=("E11_MIN", "E11_MAX", "E22_MIN", "E22_MAX", "E12_MAX"))
+    a = ap.parse_args()
+    files = sorted(glob.glob(os.path.join(a.results, "**", "results.h5"), recursive=True))
+    if not files:
+        print("no results.h5 under %s" % a.results, file=sys.stderr)
+        return 2
+    print("database box: E11 [%+.2f, %+.2f], E22 [%+.2f, %+.2f], |E12| <= %.2f" % tuple(a.box))
+    allE = []
+    for p in files:
+        E = read_case(p)
+        if len(E) == 0:
+            print("%-34s no material-frame strain fields (not a knit material?)" %
+                  os.path.basename(os.path.dirname(p)))
+            continue
+        allE.append(E)
+        print(line(os.path.basename(os.path.dirname(p)), E, a.box))
+    if not allE:
+        return 1
+    print(line("ALL", np.vstack(allE), a.box))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,177 @@
+// Load paths of issue 11 (knit/material/load_paths.hpp): the uniaxial and gradient kinds, the
+// coverage and held-out sets, their names, and their HDF5 storage (every new field read back
+// exactly; raw paths of older files, without the new attributes, read as set "paper").
+#include <catch2/catch.hpp>
+#include <filesystem>
+
+#include "knit/io/hdf5.hpp"
+#include "knit/material/database.hpp"
+#include "knit/material/load_paths.hpp"
+
+using namespace knit::material;
+namespace fs = std::filesystem;
+
+TEST_CASE("load paths: gradient F(t) = I + t H and uniaxial prescribed stretch", "[unit]") {
+  LoadPath g;
+  g.kind = PathKind::kGradient;
+  g.H << 0.2, 0.5, 0.0, -0.1;
+  for (double t : {0.0, 0.3, 1.0}) {
+    const Eigen::Matrix2d F = deformation_gradient(g, t);
+    CHECK((F - (Eigen::Matrix2d::Identity() + t * g.H)).norm() == 0.0);
+    const Eigen::Matrix2d E = green_lagrange(F);
+    CHECK(E(0, 1) == Approx(0.5 * F(0, 0) * F(0, 1)));  // E12 = F11 F12 / 2 for F21 = 0
+  }
+  LoadPath u;
+  u.kind = PathKind::kUniaxial;
+  u.target = {0.3, 0.0};
+  for (int axis : {0, 1}) {
+    u.axis = axis;
+    const Eigen::Matrix2d F = deformation_gradient(u, 1.0);
+    CHECK(green_lagrange(F)(axis, axis) == Approx(0.3).epsilon(1e-14));
+    CHECK(F(1 - axis, 1 - axis) == 1.0);  // the lateral start value; the runner finds it
+    CHECK(F(0, 1) == 0.0);
+  }
+  u.axis = 2;
+  CHECK_THROWS(deformation_gradient(u, 1.0));
+}
+
+TEST_CASE("load paths: names of the kinds and sets", "[unit]") {
+  for (PathKind k :
+       {PathKind::kBiaxial, PathKind::kShear, PathKind::kUniaxial, PathKind::kGradient})
+    CHECK(path_kind_from_string(to_string(k)) == k);
+  CHECK(to_string(PathKind::kUniaxial) == "uniaxial");
+  CHECK(to_string(PathKind::kGradient) == "gradient");
+  CHECK_THROWS(path_kind_from_string("triaxial"));
+  CHECK(is_valid_path_set("paper"));
+  CHECK(is_valid_path_set("coverage"));
+  CHECK(is_valid_path_set("holdout"));
+  CHECK_FALSE(is_valid_path_set("Paper"));
+}
+
+TEST_CASE("load paths: coverage fills the circle to the box edge, held-out points inside",
+          "[unit]") {
+  CoverageOptions o;
+  const auto cov = coverage_load_paths(o);
+  REQUIRE(cov.size() == 2 + 16 + 7);
+  int quadrant[4] = {0, 0, 0, 0};
+  for (const auto& p : cov) {
+    CHECK(p.set == "coverage");
+    if (p.kind == PathKind::kBiaxial) {
+      const double E11 = p.target(0), E22 = p.target(1);
+      CHECK(o.box.contains(E11, E22, 0.0));
+      // on the box edge
+      const bool edge =
+          std::abs(E11 - o.box.E11_min) < 1e-12 || std::abs(E11 - o.box.E11_max) < 1e-12 ||
+          std::abs(E22 - o.box.E22_min) < 1e-12 || std::abs(E22 - o.box.E22_max) < 1e-12;
+      CHECK(edge);
+      if (E11 > 1e-9 && E22 > 1e-9) ++quadrant[0];
+      if (E11 < -1e-9 && E22 > 1e-9) ++quadrant[1];
+      if (E11 < -1e-9 && E22 < -1e-9) ++quadrant[2];  // biaxial compression
+      if (E11 > 1e-9 && E22 < -1e-9) ++quadrant[3];
+    }
+  }
+  for (int q = 0; q < 4; ++q) CHECK(quadrant[q] == 3);  // + 4 on the axes = 16
+  CHECK(cov[0].kind == PathKind::kUniaxial);
+  CHECK(cov[1].axis == 1);
+  const auto hold = holdout_load_paths(o.box, 24, 6);
+  REQUIRE(hold.size() == 24);
+  for (const auto& p : hold) {
+    CHECK(p.set == "holdout");
+    CHECK(p.kind == PathKind::kGradient);
+    const Eigen::Matrix2d E = green_lagrange(deformation_gradient(p, 1.0));
+    CHECK(o.box.contains(E(0, 0), E(1, 1), E(0, 1)));
+  }
+  // Halton points of the first coordinate: 1/2, 1/4, 3/4, ...; the end strain is exact.
+  CHECK(halton(3, 2) == 0.75);
+  const Eigen::Matrix2d F = upper_gradient_for(0.1, -0.2, 0.3);
+  const Eigen::Matrix2d E = green_lagrange(F);
+  CHECK(E(0, 0) == Approx(0.1));
+  CHECK(E(1, 1) == Approx(-0.2));
+  CHECK(E(0, 1) == Approx(0.3));
+}
+
+namespace {
+fs::path tmp(const std::string& name) {
+  const fs::path d = fs::path(KNIT_BINARY_DIR) / "test_tmp";
+  fs::create_directories(d);
+  return d / name;
+}
+RawPath raw(const LoadPath& p) {
+  RawPath r;
+  r.path = p;
+  r.F = RowMatrixX::Random(2, 4);
+  r.P = RowMatrixX::Random(2, 4);
+  r.E = RowMatrixX::Random(2, 3);
+  r.S = RowMatrixX::Random(2, 3);
+  r.status = {0, 1};
+  return r;
+}
+}  // namespace
+
+TEST_CASE("database: the new path fields round trip; old raw paths read as set paper", "[unit]") {
+  Database db;
+  db.provenance = current_provenance();
+  db.generator = "test";
+  db.sweep_input = "{}";
+  LoopLengthEntry e;
+  e.loop_length = 4.5;
+  e.cell = {1.26, 0.88, 0.76};
+  LoadPath b;  // paper biaxial
+  b.target = {0.3, 0.1};
+  LoadPath u;
+  u.kind = PathKind::kUniaxial;
+  u.axis = 1;
+  u.target = {0.45, 0.0};
+  u.set = "coverage";
+  LoadPath g;
+  g.kind = PathKind::kGradient;
+  g.H << 0.1, 1.0 / 3.0, 0.0, -0.05;
+  g.set = "holdout";
+  for (const auto& p : {b, u, g}) e.raw.push_back(raw(p));
+  db.entries.push_back(e);
+  const auto file = tmp("load_paths_roundtrip.h5");
+  write_database(file, db);
+  const Database back = read_database(file);
+  REQUIRE(back.entries.at(0).raw.size() == 3);
+  for (std::size_t q = 0; q < 3; ++q) {
+    const LoadPath &a = db.entries[0].raw[q].path, &c = back.entries[0].raw[q].path;
+    CHECK(c.kind == a.kind);
+    CHECK(c.axis == a.axis);
+    CHECK((c.H.array() == a.H.array()).all());
+    CHECK((c.target.array() == a.target.array()).all());
+    CHECK(c.set == a.set);
+    CHECK(c.steps == a.steps);
+  }
+  {  // /sweep: one row per path
+    const auto f = knit::io::H5File::open_read(file);
+    CHECK(f.read_ints("/sweep/load_path_kind") == std::vector<int>{0, 2, 3});
+    CHECK(f.read_ints("/sweep/load_path_axis") == std::vector<int>{0, 1, 0});
+    CHECK(f.read_strings("/sweep/load_path_set") ==
+          std::vector<std::string>{"paper", "coverage", "holdout"});
+    CHECK(f.read_matrix("/sweep/load_path_H")(2, 1) == 1.0 / 3.0);
+  }
+  // An older file: the path group as the format-1 writer made it (no axis, H, set).
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    const std::string p = "/loop_0/raw/path_01";
+    f.remove(p);
+    auto g0 = f.create_group(p);
+    g0.set_attribute(".", "kind", "shear");
+    g0.set_attribute(".", "target", std::vector<double>{0.5, 0.0});
+    g0.set_attribute(".", "steps", 20);
+    const RawPath r = raw(b);
+    g0.write("F", r.F);
+    g0.write("P", r.P);
+    g0.write("E", r.E);
+    g0.write("S", r.S);
+    g0.write("status", r.status);
+    f.close();
+  }
+  const Database old = read_database(file);
+  const LoadPath& o = old.entries[0].raw[1].path;
+  CHECK(o.kind == PathKind::kShear);
+  CHECK(o.set == "paper");
+  CHECK(o.axis == 0);
+  CHECK(o.H.isZero());
+  CHECK(old.entries[0].raw[2].path.set == "holdout");
+}
