@@ -52,6 +52,19 @@ int run_exe(const std::string& args, const fs::path& log) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/// A St. Venant-Kirchhoff strip 10 x 1 mm (E = 1 MPa, nu = 0, t = 1 mm), held at u0 and loaded
+/// at u1 by the edge force q (N/mm) along x; no solver or output settings.
+json strip_case(double q) {
+  json j = json::parse(R"({
+    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}]})");
+  j["loads"] = json::array({{{"type", "edge"}, {"edge", "u1"}, {"force_per_length", {q, 0, 0}}}});
+  return j;
+}
+
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
   std::stringstream s;
@@ -191,15 +204,9 @@ TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged 
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with
   // q = -0.3 the load factor is limited to 0.6415: steps 1-6 converge, the 7th cannot.
   const fs::path d = temp_dir("stop");
-  const json j = json::parse(R"({
-    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
-                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
-    "refinement": {"degree": 2, "elements": [2, 1]},
-    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
-    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}],
-    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [-0.3, 0, 0]}],
-    "solver": {"steps": 10, "max_cutbacks": 1, "max_iterations": 8},
-    "output": {"points": [{"name": "tip", "at": [1, 0.5]}]}})");
+  json j = strip_case(-0.3);
+  j["solver"] = {{"steps", 10}, {"max_cutbacks", 1}, {"max_iterations", 8}};
+  j["output"] = json::parse(R"({"points": [{"name": "tip", "at": [1, 0.5]}]})");
   std::ofstream(d / "stop.json") << j.dump(2);
   const int rc =
       run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
@@ -378,14 +385,8 @@ class FailingMaterial : public Material {
 
 TEST_CASE("a run with failed material evaluations does not report plain success", "[unit]") {
   const fs::path d = temp_dir("failing");
-  const json j = json::parse(R"({
-    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
-                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
-    "refinement": {"degree": 2, "elements": [2, 1]},
-    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
-    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}],
-    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [0.01, 0, 0]}],
-    "solver": {"steps": 2}})");
+  json j = strip_case(0.01);
+  j["solver"] = {{"steps", 2}};
   Case c = parse_case(j.dump(), "failing.json");
   c.material = std::make_shared<FailingMaterial>();
   RunOptions ro;
