@@ -1,8 +1,13 @@
 #include "knit/core/cli.hpp"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 #include "knit/core/build_info.hpp"
@@ -20,6 +25,57 @@ std::vector<Entry>& registry() {
   return r;
 }
 }  // namespace
+
+std::string describe_range(double lo, double hi, Ends ends) {
+  const bool lo_open = ends == Ends::kOpenLow || ends == Ends::kOpen;
+  const bool hi_open = ends == Ends::kOpenHigh || ends == Ends::kOpen;
+  std::ostringstream os;
+  os.precision(12);
+  if (std::isinf(lo) && std::isinf(hi))
+    os << "a finite number";
+  else if (std::isinf(hi))
+    os << (lo_open ? "> " : ">= ") << lo;
+  else if (std::isinf(lo))
+    os << (hi_open ? "< " : "<= ") << hi;
+  else
+    os << "in " << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+  return os.str();
+}
+
+CLI::Validator number(double lo, double hi, Ends ends) {
+  const std::string range = describe_range(lo, hi, ends);
+  const bool lo_open = ends == Ends::kOpenLow || ends == Ends::kOpen;
+  const bool hi_open = ends == Ends::kOpenHigh || ends == Ends::kOpen;
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        errno = 0;
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end == text.c_str() || *end != '\0')
+          return "must be a number " + range + ", got \"" + text + "\"";
+        if (!std::isfinite(v) || errno == ERANGE)
+          return "must be a finite number " + range + ", got " + text;
+        if ((lo_open ? !(v > lo) : !(v >= lo)) || (hi_open ? !(v < hi) : !(v <= hi)))
+          return "must be " + range + ", got " + text;
+        return {};
+      },
+      "NUMBER " + range);
+}
+
+CLI::Validator integer(long long lo, long long hi) {
+  const std::string range = describe_range(double(lo), double(hi), Ends::kClosed);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        errno = 0;
+        char* end = nullptr;
+        const long long v = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || end == text.c_str() || *end != '\0' || errno == ERANGE)
+          return "must be an integer " + range + ", got \"" + text + "\"";
+        if (v < lo || v > hi) return "must be an integer " + range + ", got " + text;
+        return {};
+      },
+      "INTEGER " + range);
+}
 
 SubcommandRegistrar::SubcommandRegistrar(std::string name, std::string description, Setup setup) {
   registry().push_back({std::move(name), std::move(description), std::move(setup)});

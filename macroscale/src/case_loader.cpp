@@ -9,6 +9,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/macro/case.hpp"
+#include "knit/macro/geometry_check.hpp"
 #include "knit/macro/material_factory.hpp"
 #include "knit/macro/refinement.hpp"
 #include "knit/spline/basis.hpp"
@@ -422,6 +423,10 @@ Case parse_case(const std::string& text, const std::string& file) {
     c.description = r.string(root.at("description"), "/description");
   if (root.contains("units")) r.string(root.at("units"), "/units");
   read_geometry(r, root, c);
+  // A zero or flipped Jacobian anywhere (corners and edges included) is bad input, refused
+  // before any work (knit/macro/geometry_check.hpp).
+  if (const auto bad = find_geometry_defect(c.surface))
+    r.fail("/geometry/control_points", bad->message);
   CaseContext ctx;
   ctx.file = file;
   ctx.pointer = "/material";

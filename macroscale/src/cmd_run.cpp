@@ -1,9 +1,11 @@
 // knit-macro run CASE.json [--output DIR] [--max-output-size SIZE]
 //   Runs a macroscale shell case (docs/case-format.md); writes DIR (default: the case file's
 //   name without extension, in the current directory). Exit codes: 0 completed, 1 a load step
-//   failed (the converged steps are written), 2 bad input (nothing is written): this includes
-//   an output DIR that cannot be written or is not ours to replace, an output in use by another
-//   run, and an estimated output size above SIZE (default 2G; docs/io.md "Output targets").
+//   failed or the material failed to evaluate somewhere ("completed with N failed material
+//   evaluations; results are not trustworthy"; the outputs are written), 2 bad input (nothing
+//   is written): this includes an output DIR that cannot be written or is not ours to replace,
+//   an output in use by another run, and an estimated output size above SIZE (default 2G;
+//   docs/io.md "Output targets").
 // Example:
 //   knit-macro run cases/verification/scordelis_lo.json --output out/scordelis_lo
 #include <filesystem>
@@ -41,9 +43,15 @@ knit::cli::SubcommandRegistrar reg(
         ro.progress = &std::cout;
         ro.warnings = &std::cerr;
         const auto r = knit::macro::run_case(c, ro);
-        if (r.report.status != knit::macro::RunStatus::kCompleted) {
-          std::cerr << "knit-macro: " << o->case_file << ": " << r.report.message << " (outputs in "
-                    << ro.output_dir.string() << ")\n";
+        if (!r.succeeded()) {
+          std::cerr << "knit-macro: " << o->case_file << ": ";
+          if (r.report.status != knit::macro::RunStatus::kCompleted)
+            std::cerr << r.report.message << "; ";
+          if (r.failed_material_evaluations > 0)
+            std::cerr << knit::macro::material_failure_message(r.report,
+                                                               r.failed_material_evaluations)
+                      << "; ";
+          std::cerr << "outputs in " << ro.output_dir.string() << "\n";
           return knit::kExitFailure;
         }
         std::cout << "wrote " << ro.output_dir.string() << "\n";

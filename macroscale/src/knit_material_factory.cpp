@@ -23,6 +23,7 @@
 #include "knit/macro/knit_material.hpp"
 #include "knit/macro/material_factory.hpp"
 #include "knit/material/database.hpp"
+#include "knit/material/response_surface.hpp"
 
 namespace knit::macro {
 
@@ -159,6 +160,16 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
     family = std::make_shared<const material::LoopLengthFamily>(data.family());
   } catch (const std::exception& e) {
     throw InputError(ctx.file, p + "/database", db.string() + ": " + e.what());
+  }
+  // Every stored law must be usable (e.g. an E-surface folded by a damaged file): refused
+  // here, naming the database and the HDF5 group, before any work.
+  for (std::size_t k = 0; k < data.entries.size(); ++k) {
+    try {
+      const material::ResponseSurface check(*data.entries[k].surface);
+    } catch (const std::exception& e) {
+      throw InputError(ctx.file, p + "/database",
+                       db.string() + ": /loop_" + std::to_string(k) + "/fit: " + e.what());
+    }
   }
   const auto l = read_field(m.at("stitch_value"), p + "/stitch_value", ctx, false);
   const auto a = m.contains("knitting_angle")

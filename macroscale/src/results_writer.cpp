@@ -181,6 +181,7 @@ void ResultsWriter::finish(const RunReport& report) {
                   ", git " + git_revision() + ")");
   if (report.status != RunStatus::kCompleted)
     csv.add_comment("run stopped early: " + report.message);
+  if (!material_failure_.empty()) csv.add_comment(material_failure_);
   for (const StepRow& r : rows_) {
     std::vector<io::CsvCell> row = {r.step, r.lambda};
     if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
@@ -193,8 +194,9 @@ void ResultsWriter::finish(const RunReport& report) {
   if (case_.output.vtk && pvd_.size() == 0) pvd_.write();
   if (case_.output.hdf5) write_hdf5(dir_.path() / "results.h5", report);
   std::ostringstream sum;
-  sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n"
-      << "converged steps: " << report.converged_steps
+  sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n";
+  if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
+  sum << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
   if (!report.message.empty()) sum << "message: " << report.message << "\n";
   sum << "stability: " << stability_summary(report) << "\n";

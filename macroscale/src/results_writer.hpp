@@ -30,6 +30,9 @@ class ResultsWriter {
   void finish(const RunReport& report);
   /// The material's end-of-run summary (Material::report()), written to summary.txt and HDF5.
   void set_material_report(std::string r) { material_report_ = std::move(r); }
+  /// The run's verdict on the material (run.hpp, material_failure_message()); empty if the
+  /// material never failed. Written to summary.txt and load_strain.csv.
+  void set_material_failure(std::string m) { material_failure_ = std::move(m); }
 
  private:
   struct Fields {
@@ -50,6 +53,7 @@ class ResultsWriter {
   std::vector<StepRow> rows_;
   std::vector<Fields> steps_;  ///< kept for the HDF5 file
   std::string material_report_;
+  std::string material_failure_;
 };
 
 }  // namespace knit::macro

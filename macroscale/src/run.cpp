@@ -94,6 +94,13 @@ double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge
   return f;
 }
 
+std::string material_failure_message(const RunReport& report, long n) {
+  if (n <= 0) return {};
+  return std::string(report.status == RunStatus::kCompleted ? "completed" : "stopped") + " with " +
+         std::to_string(n) + " failed material evaluation" + (n == 1 ? "" : "s") +
+         "; results are not trustworthy";
+}
+
 RunResult run_case(const Case& c, const RunOptions& opt) {
   if (!opt.output_dir.empty()) check_output_size(c, opt);  // before any work or file
   Problem p = setup_problem(c);
@@ -142,12 +149,16 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
         last_written = s.u;
     }
   });
+  res.failed_material_evaluations = c.material->failed_evaluations();
+  const std::string failure = material_failure_message(res.report, res.failed_material_evaluations);
+  if (opt.progress && !failure.empty()) *opt.progress << failure << std::endl;
   const std::string material_report = c.material->report();
   if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
   if (opt.progress && res.report.first_unstable_step > 0)
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
   if (writer) {
     writer->set_material_report(material_report);
+    writer->set_material_failure(failure);
     // A stopped run still writes its last converged state.
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)

@@ -1,12 +1,18 @@
-// knit-meso cell --loop-length L [--out DIR]
+// knit-meso cell --loop-length L [--out DIR] [--diameter D] [--gamma-over-w G] [--config CELL.json]
 //   Writes (atomically, like every output directory) the single-jersey unit-cell geometry for a
 //   look before simulating (paper Sect. 2.1.2): DIR/cell.vtp   the four B-spline curves of eq. 5
 //   sampled as polylines with a radius array, plus
 //                  the 8 periodic neighbours (cell array "image" > 0);
 //   DIR/cell.json  w, c, h, measured l, minimum clearance between yarns, crossing order.
+//   --config reads the yarn diameter and the loop shape from a cell parameter file
+//   (schemas/cell.schema.json, the same object as a sweep's inline "cell"); --diameter and
+//   --gamma-over-w given on the command line override it.
+//   Every option is range-checked before any work (exit 2, the message names the option).
 // Example: knit-meso cell --loop-length 4.5 --out cell45
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -26,22 +32,32 @@ struct Options {
   double gamma_over_w = 0.25 / 1.26;
   int samples = 60;
   std::string config;
+  bool d_given = false, gamma_given = false;  ///< flags override --config
 };
+
+// The ranges of the options (docs/unit-cell.md): the loop length as in the sweep schema, the
+// yarn diameter and the loop bulge as in the cell schema.
+constexpr double kMaxLoopLength = 50.0;  // mm
 
 int run(const Options& o) {
   using namespace knit::meso::cell;
-  if (!(o.loop_length > 0))
+  // The parser's validators already refused non-finite and out-of-range values; these
+  // re-checks keep run() safe on its own.
+  if (!(o.loop_length > 0 && o.loop_length <= kMaxLoopLength))
     throw knit::InputError("", "--loop-length",
-                           "must be positive, got " + std::to_string(o.loop_length));
-  if (!(o.d > 0)) throw knit::InputError("", "--diameter", "must be positive");
+                           "must be in (0, 50] mm, got " + std::to_string(o.loop_length));
   GeometryOptions go;
-  go.d = o.d;
-  go.gamma_over_w = o.gamma_over_w;
   if (!o.config.empty()) {  // yarn diameter and loop shape from the cell parameters
     const auto co = knit::meso::homog::read_cell_options(o.config);
     go.d = co.section.d;
     go.gamma_over_w = co.geometry.gamma_over_w;
   }
+  if (o.d_given || o.config.empty()) go.d = o.d;
+  if (o.gamma_given || o.config.empty()) go.gamma_over_w = o.gamma_over_w;
+  if (!(go.d > 0 && std::isfinite(go.d)))
+    throw knit::InputError("", "--diameter", "must be a finite number > 0");
+  if (!(go.gamma_over_w >= 0 && go.gamma_over_w <= 1))
+    throw knit::InputError("", "--gamma-over-w", "must be in [0, 1]");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
   const CellGeometry g = make_cell_geometry(o.loop_length, go);
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
@@ -61,7 +77,7 @@ int run(const Options& o) {
         lines.push_back(std::move(pl));
       }
     }
-  write_polylines_vtp((dir / "cell.vtp").string(), lines, 0.5 * o.d);
+  write_polylines_vtp((dir / "cell.vtp").string(), lines, 0.5 * go.d);
 
   const Clearance cl = minimum_clearance(g.shape, g.dim.c);
   nlohmann::json j;
@@ -98,11 +114,24 @@ int run(const Options& o) {
 knit::cli::SubcommandRegistrar reg(
     "cell", "Write the single-jersey unit-cell geometry (VTP + JSON)", [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
-      sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")->required();
+      using knit::cli::Ends;
+      const double inf = std::numeric_limits<double>::infinity();
+      sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")
+          ->required()
+          ->check(knit::cli::number(0, kMaxLoopLength, Ends::kOpenLow));
       sub.add_option("-o,--output,--out", o->out, "output directory");
-      sub.add_option("--diameter", o->d, "yarn diameter d (mm)");
-      sub.add_option("--gamma-over-w", o->gamma_over_w, "loop bulge gamma / w");
-      return [o]() { return run(*o); };
+      auto* d = sub.add_option("--diameter", o->d, "yarn diameter d (mm)")
+                    ->check(knit::cli::number(0, inf, Ends::kOpenLow));
+      auto* g = sub.add_option("--gamma-over-w", o->gamma_over_w, "loop bulge gamma / w")
+                    ->check(knit::cli::number(0, 1));
+      sub.add_option("--config", o->config,
+                     "JSON cell parameters (schemas/cell.schema.json): yarn d and loop shape; "
+                     "flags override it");
+      return [o, d, g]() {
+        o->d_given = d->count() > 0;
+        o->gamma_given = g->count() > 0;
+        return run(*o);
+      };
     });
 
 }  // namespace

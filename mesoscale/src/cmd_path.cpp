@@ -5,6 +5,8 @@
 //   eqs. 7-9): equilibrates the initial geometry (step 0: residual stress), then N steps.
 //   --biaxial gives the strains of F* = diag(1+eps11, 1+eps22); --shear the shear angle gamma in
 //   DEGREES of F* = [[1, sin g], [0, cos g]].
+//   Every option is checked for finiteness and range before any work (exit 2, the message names
+//   the option and the allowed range); a value is never silently replaced by its default.
 //   Writes (atomically: built in DIR.partial-<pid>, DIR replaced at the end) DIR/path.csv (F*, P*,
 //   E, S and solver figures per step), DIR/yarn_NNNN.vtp (deformed cell yarn and its 8 periodic
 //   neighbours, radius array) and DIR/yarn.pvd; prints the time per step and the Newton iterations.
@@ -13,7 +15,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "knit/core/cli.hpp"
@@ -31,8 +35,12 @@ struct Options {
   double shear = std::nan("");
   int steps = 20;
   std::string out = "path";
-  int elements = -1;
-  double k_N = -1, g0 = -1, delta = -1, mu = -1, k_T = -1;
+  // Overrides of the cell parameters: applied only when given, never replaced by defaults.
+  std::optional<int> elements;
+  std::optional<double> k_N, g0, delta, mu, k_T;
+  // Parser targets of the overrides (copied into the optionals when the flag was given).
+  int elements_arg = 0;
+  double k_N_arg = 0, g0_arg = 0, delta_arg = 0, mu_arg = 0, k_T_arg = 0;
   bool no_vtp = false;
   std::string config;
 };
@@ -58,15 +66,19 @@ int run(const Options& o) {
   if (bi == sh) throw knit::InputError("", "", "give exactly one of --biaxial or --shear");
   if (bi && o.biaxial.size() != 2) throw knit::InputError("", "--biaxial", "needs EPS11 EPS22");
   if (o.steps < 1) throw knit::InputError("", "--steps", "must be >= 1");
-  if (o.elements >= 0 && o.elements < 4) throw knit::InputError("", "--elements", "must be >= 4");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
   CellOptions co = o.config.empty() ? CellOptions{} : read_cell_options(o.config);
-  if (o.elements > 0) co.elements = o.elements;
-  if (o.k_N > 0) co.contact.penalty.k_N = o.k_N;
-  if (o.g0 >= 0) co.contact.penalty.g0 = o.g0;
-  if (o.delta > 0) co.contact.penalty.delta = o.delta;
-  if (o.mu >= 0) co.contact.friction.mu = o.mu;
-  if (o.k_T > 0) co.contact.friction.k_T = o.k_T;
+  if (o.elements) co.elements = *o.elements;
+  if (o.k_N) co.contact.penalty.k_N = *o.k_N;
+  if (o.g0) co.contact.penalty.g0 = *o.g0;
+  if (o.delta) co.contact.penalty.delta = *o.delta;
+  if (o.mu) co.contact.friction.mu = *o.mu;
+  if (o.k_T) co.contact.friction.k_T = *o.k_T;
+  // The same checks as the cell parameter file (CellOptions::validate names the field): a flag
+  // the parser let through is still refused here, never replaced by a default.
+  if (const auto bad = co.validate())
+    throw knit::InputError(o.config.empty() ? "" : o.config, bad->pointer,
+                           bad->message + " (command-line flags override the file)");
   PathSpec p;
   p.steps = o.steps;
   if (bi) {
@@ -114,23 +126,48 @@ int run(const Options& o) {
 knit::cli::SubcommandRegistrar reg(
     "path", "Run one macroscopic deformation path on the unit cell (CSV + VTP)", [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
-      sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")->required();
-      auto* b =
-          sub.add_option("--biaxial", o->biaxial, "EPS11 EPS22 of F* = diag(1+eps)")->expected(2);
-      auto* s = sub.add_option("--shear", o->shear, "pure-shear angle gamma (degrees)");
+      using knit::cli::Ends;
+      using knit::cli::number;
+      const double inf = std::numeric_limits<double>::infinity();
+      // Ranges: the cell schema's (schemas/cell.schema.json) for the cell parameters; strains
+      // of a path in (-1, 10], shear angles in (-80, 80) degrees.
+      sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")
+          ->required()
+          ->check(number(0, 50, Ends::kOpenLow));
+      auto* b = sub.add_option("--biaxial", o->biaxial, "EPS11 EPS22 of F* = diag(1+eps)")
+                    ->expected(2)
+                    ->check(number(-1, 10, Ends::kOpenLow));
+      auto* s = sub.add_option("--shear", o->shear, "pure-shear angle gamma (degrees)")
+                    ->check(number(-80, 80, Ends::kOpen));
       b->excludes(s);
-      sub.add_option("--steps", o->steps, "load steps (default 20)");
+      sub.add_option("--steps", o->steps, "load steps (default 20)")
+          ->check(knit::cli::integer(1, 100000));
       sub.add_option("-o,--output,--out", o->out, "output directory");
-      sub.add_option("--elements", o->elements, "analysis-curve elements (default 32)");
-      sub.add_option("--penalty", o->k_N, "normal penalty stiffness k_N (MPa)");
-      sub.add_option("--allowance", o->g0, "penetration allowance g0 (mm)");
-      sub.add_option("--delta", o->delta, "quadratic onset width delta (mm)");
-      sub.add_option("--mu", o->mu, "Coulomb friction coefficient (default 0.15)");
-      sub.add_option("--stick", o->k_T, "stick penalty k_T (MPa)");
+      auto* ne =
+          sub.add_option("--elements", o->elements_arg, "analysis-curve elements (default 32)")
+              ->check(knit::cli::integer(4, 100000));
+      auto* kn = sub.add_option("--penalty", o->k_N_arg, "normal penalty stiffness k_N (MPa)")
+                     ->check(number(0, inf, Ends::kOpenLow));
+      auto* g0 = sub.add_option("--allowance", o->g0_arg, "penetration allowance g0 (mm)")
+                     ->check(number(0, inf));
+      auto* dl = sub.add_option("--delta", o->delta_arg, "quadratic onset width delta (mm)")
+                     ->check(number(0, inf, Ends::kOpenLow));
+      auto* mu = sub.add_option("--mu", o->mu_arg, "Coulomb friction coefficient (default 0.15)")
+                     ->check(number(0, inf));
+      auto* kt = sub.add_option("--stick", o->k_T_arg, "stick penalty k_T (MPa)")
+                     ->check(number(0, inf, Ends::kOpenLow));
       sub.add_flag("--no-vtp", o->no_vtp, "skip the per-step VTP files");
       sub.add_option("--config", o->config,
                      "JSON cell parameters (schemas/cell.schema.json); flags override it");
-      return [o]() { return run(*o); };
+      return [o, ne, kn, g0, dl, mu, kt]() {
+        if (ne->count()) o->elements = o->elements_arg;
+        if (kn->count()) o->k_N = o->k_N_arg;
+        if (g0->count()) o->g0 = o->g0_arg;
+        if (dl->count()) o->delta = o->delta_arg;
+        if (mu->count()) o->mu = o->mu_arg;
+        if (kt->count()) o->k_T = o->k_T_arg;
+        return run(*o);
+      };
     });
 
 }  // namespace

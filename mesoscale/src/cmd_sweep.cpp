@@ -146,7 +146,8 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_option("--output,-o", c->output, "material database to write (default database.h5)");
       sub.add_flag("--resume", c->resume, "continue an interrupted sweep from OUTPUT.parts");
       sub.add_flag("--force", c->force, "discard checkpoints of an unfinished earlier sweep");
-      sub.add_option("--threads", c->threads, "worker threads per rank (default: all cores)");
+      sub.add_option("--threads", c->threads, "worker threads per rank (default: all cores)")
+          ->check(knit::cli::integer(0, 4096));
       sub.add_flag("--keep-parts", c->keep_parts, "keep OUTPUT.parts after writing the database");
       sub.add_flag("--no-progress", c->no_progress, "no progress output");
       sub.add_flag("--plain", c->plain, "plain progress lines even on a terminal");

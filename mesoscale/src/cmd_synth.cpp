@@ -34,8 +34,10 @@ static knit::cli::SubcommandRegistrar reg_synth(
       auto o = std::make_shared<SynthCli>();
       sub.add_option("-o,--output,--out", o->out, "output database (.h5)")->required();
       sub.add_option("--loop-lengths", o->loop_lengths, "loop lengths in mm (increasing)")
-          ->delimiter(',');
-      sub.add_option("--steps", o->steps, "load steps per path")->check(CLI::Range(4, 1000));
+          ->delimiter(',')
+          ->check(knit::cli::number(0, 50, knit::cli::Ends::kOpenLow));
+      sub.add_option("--steps", o->steps, "load steps per path")
+          ->check(knit::cli::integer(4, 1000));
       sub.add_option("--fit-options", o->fit_options, "fit options (JSON file)");
       sub.add_flag("--no-fit", o->no_fit, "store the raw data only");
       return [o]() -> int {

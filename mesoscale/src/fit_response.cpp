@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -207,6 +208,56 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
   return o;
 }
 
+std::string check_fan(const FitOptions& o, const FanShape& fan) {
+  if (const std::string why = o.validate(); !why.empty()) return "invalid options: " + why;
+  const int m = static_cast<int>(fan.phi.size());
+  if (m < o.degree1 + 1)
+    return std::to_string(m) + " biaxial paths cannot determine a degree-" +
+           std::to_string(o.degree1) +
+           " surface across the paths (need >= " + std::to_string(o.degree1 + 1) + ")";
+  if (!fan.shear) return "no pure-shear path: the S12(E12) curve cannot be fitted";
+  // Directions not known in advance (NaN: a path whose end strain only the run tells) take
+  // no part in the direction checks.
+  std::vector<double> phi;
+  for (double p : fan.phi)
+    if (!std::isnan(p)) phi.push_back(p);
+  std::sort(phi.begin(), phi.end());
+  for (std::size_t i = 1; i < phi.size(); ++i)
+    if (phi[i] - phi[i - 1] < 1e-6)
+      return "two biaxial paths point in the same strain direction (" +
+             std::to_string(phi[i] * 180 / M_PI) + " deg)";
+  if (!phi.empty() && phi.back() - phi.front() >= M_PI)
+    return "the biaxial paths span 180 degrees or more; the fan cannot be inverted";
+  if (fan.min_steps < o.degree2 + 1)
+    return "paths with " + std::to_string(fan.min_steps) + " steps cannot determine a degree-" +
+           std::to_string(o.degree2) + " surface along the paths";
+  if (o.smoothing == 0.0 && (o.n_ctrl1 > m || o.n_ctrl2 > fan.min_steps + 1))
+    return "without smoothing, " + std::to_string(o.n_ctrl1) + " x " + std::to_string(o.n_ctrl2) +
+           " control points need at least as many paths (" + std::to_string(m) +
+           ") and steps + 1 (" + std::to_string(fan.min_steps + 1) + ")";
+  return {};
+}
+
+std::string check_feasible(const FitOptions& options, const std::vector<material::LoadPath>& paths,
+                           int steps) {
+  FanShape fan;
+  fan.min_steps = 1 << 30;
+  for (const auto& p : paths) {
+    if (p.kind == material::PathKind::kShear) {
+      fan.shear = true;
+      continue;
+    }
+    // The end strain of a biaxial path is its target (E11, E22); the run reaches it when
+    // every step converges, so its direction is that of the fitted data.
+    fan.phi.push_back(p.kind == material::PathKind::kBiaxial
+                          ? std::atan2(p.target(1), p.target(0))
+                          : std::numeric_limits<double>::quiet_NaN());
+    fan.min_steps = std::min(fan.min_steps, steps > 0 ? steps : p.steps);
+  }
+  if (fan.phi.empty()) fan.min_steps = 0;
+  return check_fan(options, fan);
+}
+
 FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o) {
   FitSummary out;
   auto refuse = [&](const std::string& why) {
@@ -247,27 +298,16 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     fan.push_back({&r, std::atan2(r.E(last, 1), r.E(last, 0)), last});
   }
   const int m = static_cast<int>(fan.size());
-  if (m < o.degree1 + 1)
-    return refuse(std::to_string(m) + " biaxial paths cannot determine a degree-" +
-                  std::to_string(o.degree1) +
-                  " surface across the paths (need >= " + std::to_string(o.degree1 + 1) + ")");
-  if (!shear) return refuse("no pure-shear path: the S12(E12) curve cannot be fitted");
-  std::sort(fan.begin(), fan.end(), [](const Path& a, const Path& b) { return a.phi < b.phi; });
-  for (int i = 1; i < m; ++i)
-    if (fan[i].phi - fan[i - 1].phi < 1e-6)
-      return refuse("two biaxial paths point in the same strain direction (" +
-                    std::to_string(fan[i].phi * 180 / M_PI) + " deg)");
-  if (fan.back().phi - fan.front().phi >= M_PI)
-    return refuse("the biaxial paths span 180 degrees or more; the fan cannot be inverted");
   int min_steps = 1 << 30;
   for (const auto& f : fan) min_steps = std::min(min_steps, f.p->steps());
-  if (min_steps < o.degree2 + 1)
-    return refuse("paths with " + std::to_string(min_steps) + " steps cannot determine a degree-" +
-                  std::to_string(o.degree2) + " surface along the paths");
-  if (o.smoothing == 0.0 && (o.n_ctrl1 > m || o.n_ctrl2 > min_steps + 1))
-    return refuse("without smoothing, " + std::to_string(o.n_ctrl1) + " x " +
-                  std::to_string(o.n_ctrl2) + " control points need at least as many paths (" +
-                  std::to_string(m) + ") and steps + 1 (" + std::to_string(min_steps + 1) + ")");
+  {
+    FanShape shape;  // the refusals shared with check_feasible()
+    for (const auto& f : fan) shape.phi.push_back(f.phi);
+    shape.min_steps = m > 0 ? min_steps : 0;
+    shape.shear = shear != nullptr;
+    if (const std::string why = check_fan(o, shape); !why.empty()) return refuse(why);
+  }
+  std::sort(fan.begin(), fan.end(), [](const Path& a, const Path& b) { return a.phi < b.phi; });
 
   std::vector<DataPoint> data;
   double sE = 0.0, sS = 0.0;

@@ -1,6 +1,8 @@
 // JSON reader of the unit-cell parameters: see knit/meso/homog/cell_config.hpp.
 #include "knit/meso/homog/cell_config.hpp"
 
+#include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -54,6 +56,65 @@ struct Reader {
 };
 
 }  // namespace
+
+namespace {
+
+// One range check of CellOptions::validate(): finite and within [lo, hi] (lo excluded if
+// lo_open). Ranges as in schemas/cell.schema.json.
+struct RangeCheck {
+  const char* pointer;
+  double value, lo, hi;
+  bool lo_open, hi_open;
+};
+
+std::optional<CellOptionError> check_ranges(std::initializer_list<RangeCheck> checks) {
+  for (const RangeCheck& c : checks) {
+    const double v = c.value;
+    const bool ok = std::isfinite(v) && (c.lo_open ? v > c.lo : v >= c.lo) &&
+                    (c.hi_open ? v < c.hi : v <= c.hi);
+    if (ok) continue;
+    std::ostringstream m;
+    m << "must be a finite number ";
+    if (std::isinf(c.hi))
+      m << (c.lo_open ? "> " : ">= ") << c.lo;
+    else
+      m << "in " << (c.lo_open ? "(" : "[") << c.lo << ", " << c.hi << (c.hi_open ? ")" : "]");
+    m << ", got " << v;
+    return CellOptionError{c.pointer, m.str()};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<CellOptionError> CellOptions::validate() const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const auto& p = contact.penalty;
+  const auto& f = contact.friction;
+  return check_ranges({
+      {"/yarn/E", section.E, 0, inf, true, false},
+      {"/yarn/nu", section.nu, -1, 0.5, true, true},
+      {"/yarn/d", section.d, 0, inf, true, false},
+      {"/loop/gamma_over_w", geometry.gamma_over_w, 0, 1, false, false},
+      {"/analysis/elements", double(elements), 4, inf, false, false},
+      {"/analysis/degree", double(degree), 2, inf, false, false},
+      {"/analysis/slave_points_per_element", double(contact.slave_points_per_element), 1, inf,
+       false, false},
+      {"/contact/penalty", p.k_N, 0, inf, true, false},
+      {"/contact/allowance", p.g0, 0, inf, false, false},
+      {"/contact/delta", p.delta, 0, inf, true, false},
+      {"/contact/soft_penalty", p.k_0, 0, inf, false, false},
+      {"/contact/soft_delta", p.delta_0, 0, inf, true, false},
+      {"/contact/mu", f.mu, 0, inf, false, false},
+      {"/contact/stick_penalty", f.k_T, 0, inf, true, false},
+      {"/contact/margin", contact.margin, 0, inf, false, false},
+      {"/contact/self_exclusion", contact.self_exclusion, 0, 1, true, false},
+      {"/solver/tolerance", newton.tol, 0, 1, true, false},
+      {"/solver/max_iterations", double(newton.max_iterations), 1, inf, false, false},
+      {"/solver/equilibration_steps", double(equilibration_steps), 1, inf, false, false},
+      {"/solver/max_cutbacks", double(max_cutbacks), 0, inf, false, false},
+  });
+}
 
 CellOptions read_cell_options(const std::string& file, CellOptions o) {
   // Schema first (schemas/cell.schema.json, embedded): types, ranges, unknown keys with
@@ -119,6 +180,7 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1);
     R.integer(s, "/solver", "max_cutbacks", o.max_cutbacks, 0);
   }
+  if (const auto bad = o.validate()) R.fail(bad->pointer, bad->message);
   return o;
 }
 

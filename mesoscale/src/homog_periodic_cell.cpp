@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "knit/meso/rod/quaternion.hpp"
 #include "knit/spline/quadrature.hpp"
@@ -76,6 +77,8 @@ class PeriodicCell::PeriodicRows : public rod::ExternalContribution {
 };
 
 PeriodicCell::PeriodicCell(double loop_length, const CellOptions& opt) : opt_(opt) {
+  if (const auto bad = opt.validate())
+    throw std::invalid_argument("cell parameter " + bad->pointer + ": " + bad->message);
   dim_ = cell::cell_dimensions(loop_length);
   opt_.geometry.d = opt_.section.d;
   opt_.contact.d = opt_.section.d;

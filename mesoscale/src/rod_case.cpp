@@ -238,7 +238,9 @@ RodCase load_rod_case(const std::filesystem::path& path) {
   }
   if (j.contains("steps")) {
     const json& js = j["steps"];
-    R.object(js, "/steps", {"count", "max_cutbacks", "tolerance", "max_iterations", "predictor"});
+    R.object(js, "/steps",
+             {"count", "max_cutbacks", "tolerance", "max_iterations", "predictor", "min_increment",
+              "max_total_iterations"});
     if (js.contains("count")) c.path.steps = R.integer(js["count"], "/steps/count", 1);
     if (js.contains("max_cutbacks"))
       c.path.max_cutbacks = R.integer(js["max_cutbacks"], "/steps/max_cutbacks", 0);
@@ -246,6 +248,12 @@ RodCase load_rod_case(const std::filesystem::path& path) {
       c.path.newton.tol = R.positive(js["tolerance"], "/steps/tolerance");
     if (js.contains("max_iterations"))
       c.path.newton.max_iterations = R.integer(js["max_iterations"], "/steps/max_iterations", 1);
+    if (js.contains("min_increment"))
+      c.path.min_increment =
+          R.number(js["min_increment"], "/steps/min_increment", 0.0, 1.0, true, false);
+    if (js.contains("max_total_iterations"))
+      c.path.max_total_iterations =
+          R.integer(js["max_total_iterations"], "/steps/max_total_iterations", 0);
     if (js.contains("predictor")) {
       if (!js["predictor"].is_boolean()) R.fail("/steps/predictor", "must be a boolean");
       c.path.predictor = js["predictor"].get<bool>();

@@ -103,24 +103,66 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
   }
 }
 
+std::string to_string(PathStop s) {
+  switch (s) {
+    case PathStop::kCompleted:
+      return "completed";
+    case PathStop::kStartState:
+      return "start state did not converge";
+    case PathStop::kCutbacks:
+      return "cut-back limit";
+    case PathStop::kStepFloor:
+      return "step floor";
+    case PathStop::kWorkCap:
+      return "work cap";
+    case PathStop::kBadOptions:
+      return "bad options";
+  }
+  return "?";
+}
+
+long PathOptions::work_cap() const {
+  if (max_total_iterations > 0) return max_total_iterations;
+  return kWorkFactor * std::max(1, steps) * std::max(1, newton.max_iterations);
+}
+
+std::string PathOptions::validate() const {
+  if (steps < 1) return "steps must be >= 1";
+  if (!std::isfinite(lambda_start) || !std::isfinite(lambda_end) || lambda_start == lambda_end)
+    return "lambda_start and lambda_end must be finite and differ";
+  if (max_cutbacks < 0) return "max_cutbacks must be >= 0";
+  if (!(min_increment > 0 && min_increment <= 1))
+    return "min_increment must be in (0, 1] (a fraction of the nominal increment)";
+  if (max_total_iterations < 0) return "max_total_iterations must be >= 0 (0 = automatic)";
+  if (!(newton.tol > 0) || !std::isfinite(newton.tol)) return "tolerance must be > 0";
+  if (newton.max_iterations < 1) return "max_iterations must be >= 1";
+  return {};
+}
+
 PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOptions& opt,
                       const StepCallback& on_step,
                       const std::vector<ExternalContribution*>& extra) {
   PathReport rep;
   double lam = opt.lambda_start;
   rep.lambda_reached = lam;
+  auto stop = [&](PathStop why, const std::string& message) {
+    rep.stop = why;
+    rep.message = to_string(why) + ": " + message;
+    return rep;
+  };
+  if (const std::string why = opt.validate(); !why.empty()) return stop(PathStop::kBadOptions, why);
+  const long cap = opt.work_cap();
   // Make sure the start state satisfies the equations (e.g. the quaternion gauge).
   {
     const NewtonReport r0 = solve_newton(sys, x, lam, extra, opt.newton);
     rep.total_iterations += r0.iterations;
-    if (!r0.converged) {
-      rep.message =
-          "start state at lambda = " + std::to_string(lam) + " did not converge: " + r0.message;
-      return rep;
-    }
+    if (!r0.converged)
+      return stop(PathStop::kStartState,
+                  "lambda = " + std::to_string(lam) + " did not converge: " + r0.message);
   }
-  const int steps = std::max(1, opt.steps);
+  const int steps = opt.steps;
   const double nominal = (opt.lambda_end - opt.lambda_start) / steps;
+  const double inc_floor = opt.min_increment * std::abs(nominal);
   double inc = nominal;
   int halvings = 0;
   Eigen::VectorXd x_prev = x, x_last = x;
@@ -137,6 +179,11 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
       // Secant predictor from the last converged increment (saves about one iteration).
       if (opt.predictor && have_last && std::abs(last_inc) > 0.0)
         x += ((next - lam) / last_inc) * (x - x_last);
+      if (rep.total_iterations >= cap)
+        return stop(PathStop::kWorkCap,
+                    std::to_string(rep.total_iterations) + " Newton iterations spent (cap " +
+                        std::to_string(cap) + ", steps.max_total_iterations) at lambda = " +
+                        std::to_string(lam) + " of " + std::to_string(opt.lambda_end));
       const NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
       rep.total_iterations += r.iterations;
       if (r.converged) {
@@ -153,17 +200,24 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
       } else {
         x = x_prev;
         ++rep.cutbacks;
-        if (++halvings > opt.max_cutbacks) {
-          rep.message = "increment to lambda = " + std::to_string(next) + " failed after " +
-                        std::to_string(opt.max_cutbacks) + " cut-backs: " + r.message;
-          return rep;
-        }
+        if (++halvings > opt.max_cutbacks)
+          return stop(PathStop::kCutbacks, "increment to lambda = " + std::to_string(next) +
+                                               " failed after " + std::to_string(opt.max_cutbacks) +
+                                               " cut-backs: " + r.message);
         inc = 0.5 * (next - lam);
+        if (std::abs(inc) < inc_floor)
+          return stop(PathStop::kStepFloor,
+                      "the increment from lambda = " + std::to_string(lam) + " would fall to " +
+                          std::to_string(std::abs(inc)) + ", below the floor " +
+                          std::to_string(inc_floor) +
+                          " (steps.min_increment = " + std::to_string(opt.min_increment) +
+                          " of the nominal increment); last failure: " + r.message);
       }
     }
     if (on_step) on_step(s, lam, x);
   }
   rep.completed = true;
+  rep.stop = PathStop::kCompleted;
   rep.message = "completed";
   return rep;
 }

@@ -20,6 +20,11 @@ std::string job_file(int index) {
   return b;
 }
 
+// Every record ends with a digest line over the record text before it (64-bit FNV-1a,
+// fingerprint() of input.hpp): a record edited by hand or damaged on disk is refused on
+// --resume, naming the file and the record.
+constexpr const char* kDigestTag = "digest fnv1a64 ";
+
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream ss;
@@ -68,23 +73,55 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
   io::write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");
 }
 
+namespace {
+
+std::string seal_record(const std::string& record) {
+  return record + kDigestTag + fingerprint(record) + "\n";
+}
+
+std::string open_record(const std::string& text, const std::string& file, const std::string& what) {
+  auto refuse = [&](const std::string& why) -> std::string {
+    throw InputError(file, "",
+                     what + ": " + why +
+                         "; the checkpoint was edited or damaged -- delete this file to "
+                         "recompute the case, or discard all checkpoints with --force");
+  };
+  if (text.empty() || text.back() != '\n') refuse("no digest line at the end");
+  const std::size_t start = text.rfind('\n', text.size() - 2);
+  const std::size_t line = start == std::string::npos ? 0 : start + 1;
+  const std::string last = text.substr(line, text.size() - 1 - line);
+  if (last.rfind(kDigestTag, 0) != 0) refuse("no digest line at the end");
+  const std::string record = text.substr(0, line);
+  const std::string have = last.substr(std::string(kDigestTag).size());
+  const std::string want = fingerprint(record);
+  if (have != want) refuse("digest mismatch (stored " + have + ", record hashes to " + want + ")");
+  return record;
+}
+
+}  // namespace
+
 std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& jobs) const {
   std::map<int, JobResult> out;
   for (const Job& j : jobs) {
     const fs::path p = dir_ / job_file(j.index);
     if (!fs::exists(p)) continue;
+    const std::string what = "checkpoint record of job " + std::to_string(j.index) +
+                             " (l = " + std::to_string(j.loop_length) + " mm, load case " +
+                             std::to_string(j.path) + ")";
+    const std::string record = open_record(slurp(p), p.string(), what);
+    JobResult r;
     try {
-      JobResult r = deserialize(slurp(p));
-      if (matches(r, j)) out.emplace(j.index, std::move(r));
-    } catch (const std::exception&) {
-      // unreadable: recomputed
+      r = deserialize(record);
+    } catch (const std::exception& e) {
+      throw InputError(p.string(), "", what + ": " + e.what());
     }
+    if (matches(r, j)) out.emplace(j.index, std::move(r));  // else: foreign, recomputed
   }
   return out;
 }
 
 void CheckpointStore::store(const JobResult& r) const {
-  io::write_file_atomically(dir_ / job_file(r.index), serialize(r));
+  io::write_file_atomically(dir_ / job_file(r.index), seal_record(serialize(r)));
 }
 
 void CheckpointStore::remove() const {

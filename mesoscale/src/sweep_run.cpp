@@ -152,6 +152,14 @@ int default_threads(const MpiSession* mpi) {
 
 SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
                       const MpiSession* mpi) {
+  // Early check, before any case runs: a fit that cannot succeed with these paths and options
+  // (the fit's own refusals, fit::check_feasible) is bad input, not hours of wasted cases.
+  if (in.fit)
+    if (const std::string why = fit::check_feasible(in.fit_options, in.paths); !why.empty())
+      throw InputError(in.file, "/load_paths",
+                       "the response-surface fit cannot succeed: " + why +
+                           "; nothing was run (add load paths or steps, change \"fit\", or set "
+                           "\"fit\": false to run the cases without a fit)");
   const auto t0 = std::chrono::steady_clock::now();
   const int rank = mpi ? mpi->rank() : 0, size = mpi ? mpi->size() : 1;
   const bool root = rank == 0;

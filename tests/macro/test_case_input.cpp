@@ -7,10 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "../common/test_material_util.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/run.hpp"
+#include "knit/macro/svk_material.hpp"
+#include "knit/material/database.hpp"
 
 using namespace knit::macro;
 namespace fs = std::filesystem;
@@ -47,6 +50,19 @@ int run_exe(const std::string& args, const fs::path& log) {
       std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " + log.string() + " 2>&1";
   const int st = std::system(cmd.c_str());
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/// A St. Venant-Kirchhoff strip 10 x 1 mm (E = 1 MPa, nu = 0, t = 1 mm), held at u0 and loaded
+/// at u1 by the edge force q (N/mm) along x; no solver or output settings.
+json strip_case(double q) {
+  json j = json::parse(R"({
+    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}]})");
+  j["loads"] = json::array({{{"type", "edge"}, {"edge", "u1"}, {"force_per_length", {q, 0, 0}}}});
+  return j;
 }
 
 std::string slurp(const fs::path& p) {
@@ -188,15 +204,9 @@ TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged 
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with
   // q = -0.3 the load factor is limited to 0.6415: steps 1-6 converge, the 7th cannot.
   const fs::path d = temp_dir("stop");
-  const json j = json::parse(R"({
-    "geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
-                 "control_points": [[0, 0, 0], [10, 0, 0], [0, 1, 0], [10, 1, 0]], "thickness": 1.0},
-    "refinement": {"degree": 2, "elements": [2, 1]},
-    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0, "poisson_ratio": 0.0},
-    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x"]}, {"corner": "u0v0", "fix": ["y"]}],
-    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [-0.3, 0, 0]}],
-    "solver": {"steps": 10, "max_cutbacks": 1, "max_iterations": 8},
-    "output": {"points": [{"name": "tip", "at": [1, 0.5]}]}})");
+  json j = strip_case(-0.3);
+  j["solver"] = {{"steps", 10}, {"max_cutbacks", 1}, {"max_iterations", 8}};
+  j["output"] = json::parse(R"({"points": [{"name": "tip", "at": [1, 0.5]}]})");
   std::ofstream(d / "stop.json") << j.dump(2);
   const int rc =
       run_exe((d / "stop.json").string() + " --output " + (d / "out").string(), d / "log.txt");
@@ -324,5 +334,103 @@ TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provena
   CHECK(json::parse(h5.read_strings("case_json").at(0)) == j);
   CHECK(h5.read_doubles("fields/step_0004/E22").size() == 35u);
   CHECK(h5.read_doubles("steps/reactions/jaw_force").size() == 4u);
+  fs::remove_all(d);
+}
+
+TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry", "[unit]") {
+  // Issue 14: the corner u1v1 pulled in so that A1 || A2 there: |A1 x A2| = 0 only at that
+  // corner, positive at every quadrature point -- the loader used to accept it and the run
+  // stopped after step 1.
+  json j = read_json("tensile_svk.json");
+  j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 50, 0}, {25, 25, 0}};
+  std::string e;
+  try {
+    parse_case(j.dump(), "dart.json");  // the loader alone, before any work
+  } catch (const knit::InputError& err) {
+    e = err.what();
+  }
+  CHECK(e.rfind("dart.json: /geometry/control_points: degenerate geometry:", 0) == 0);
+  CHECK(e.find("(theta1, theta2) = (1, 1), a corner of the patch") != std::string::npos);
+}
+
+TEST_CASE("a folded (flipped) reference surface is refused at load", "[unit]") {
+  json j = read_json("tensile_svk.json");
+  j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 50, 0}, {-10, -10, 0}};
+  std::string e;
+  try {
+    parse_case(j.dump(), "fold.json");
+  } catch (const knit::InputError& err) {
+    e = err.what();
+  }
+  CHECK(e.rfind("fold.json: /geometry/control_points: ", 0) == 0);
+  CHECK((e.find("degenerate geometry") != std::string::npos ||
+         e.find("folded geometry") != std::string::npos));
+}
+
+namespace {
+// A linear material that claims failed evaluations (stands in for a knit law whose
+// response-surface inversions failed).
+class FailingMaterial : public Material {
+ public:
+  std::string name() const override { return "failing"; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override {
+    return svk_.evaluate(E, where);
+  }
+  long failed_evaluations() const override { return 22000; }
+
+ private:
+  SaintVenantKirchhoff svk_{1.0, 0.0};
+};
+}  // namespace
+
+TEST_CASE("a run with failed material evaluations does not report plain success", "[unit]") {
+  const fs::path d = temp_dir("failing");
+  json j = strip_case(0.01);
+  j["solver"] = {{"steps", 2}};
+  Case c = parse_case(j.dump(), "failing.json");
+  c.material = std::make_shared<FailingMaterial>();
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  const RunResult r = run_case(c, ro);
+  CHECK(r.report.status == RunStatus::kCompleted);  // every step converged...
+  CHECK(r.failed_material_evaluations == 22000);
+  CHECK_FALSE(r.succeeded());  // ...but the run is not a plain success (knit-macro: exit 1)
+  const std::string msg = material_failure_message(r.report, r.failed_material_evaluations);
+  CHECK(msg == "completed with 22000 failed material evaluations; results are not trustworthy");
+  REQUIRE(fs::exists(d / "out" / "summary.txt"));  // outputs kept
+  CHECK(slurp(d / "out" / "summary.txt").find(msg) != std::string::npos);
+  CHECK(slurp(d / "out" / "load_strain.csv").find(msg) != std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST_CASE("a folded database surface is refused at load, naming the database and HDF5 group",
+          "[unit]") {
+  // Issue 14: the error of a folded E-surface named neither the file nor the dataset.
+  using namespace knit::material;
+  const fs::path d = temp_dir("folded");
+  Database db;
+  db.provenance = current_provenance();
+  db.generator = "test";
+  for (double l : {4.5, 5.5}) {
+    LoopLengthEntry e;
+    e.loop_length = l;
+    e.surface = testing::make_test_surface();
+    db.entries.push_back(e);
+  }
+  auto& E = db.entries[1].surface->E_ctrl;  // swap two paths on the edge xi2 = 1: folded
+  const int n = 11;
+  E.row(2 + n * (n - 1)).swap(E.row(3 + n * (n - 1)));
+  write_database(d / "db.h5", db);
+  json j = read_json("tensile_svk.json");
+  j["material"] = {{"type", "knit"}, {"database", (d / "db.h5").string()}, {"stitch_value", 5.0}};
+  std::string e;
+  try {
+    parse_case(j.dump(), "knit.json");
+  } catch (const knit::InputError& err) {
+    e = err.what();
+  }
+  INFO(e);
+  CHECK(e.rfind("knit.json: /material/database: " + (d / "db.h5").string() + ": /loop_1/fit: ",
+                0) == 0);
   fs::remove_all(d);
 }

@@ -153,3 +153,15 @@ TEST_CASE("knit material: alpha aligned with a vector at the Greville points", "
   for (double u : {0.0, 0.3, 1.0})
     for (double v : {0.0, 0.7}) CHECK(alpha.eval(u, v)(0) == Approx(-beta).margin(1e-12));
 }
+
+TEST_CASE("knit material: failed inversions are its failed evaluations", "[unit]") {
+  // Material::failed_evaluations() is what knit-macro run checks before reporting success.
+  KnitMaterial m = graded(0.0);
+  CHECK(m.failed_evaluations() == 0);
+  for (double s : {1.0, 10.0, 40.0, 400.0})
+    for (const Eigen::Vector3d& E :
+         {Eigen::Vector3d(s, -s, 0.0), Eigen::Vector3d(-s, s, s), Eigen::Vector3d(s, s, -s)})
+      m.evaluate(E, at(0.3, 0.6));
+  CHECK(m.failed_evaluations() > 0);  // far outside the data, some inversions fail
+  CHECK(m.failed_evaluations() == m.stats().count[4]);
+}

@@ -1,6 +1,9 @@
 // JSON input of the cell parameters: values land in CellOptions, bad fields name their pointer.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <fstream>
+#include <limits>
+#include <stdexcept>
 
 #include "knit/core/errors.hpp"
 #include "knit/meso/homog/cell_config.hpp"
@@ -43,4 +46,34 @@ TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
   CHECK(pointer_of(R"({"yarn": {"nu": 0.7}})") == "/yarn/nu");
   CHECK(pointer_of(R"({"bogus": 1})") == "");
   CHECK(pointer_of(R"({not json)") == "");
+}
+
+TEST_CASE("cell options: validate() names the field of a value out of range or not finite",
+          "[unit]") {
+  using knit::meso::homog::CellOptions;
+  CHECK_FALSE(CellOptions{}.validate().has_value());
+  auto pointer_of = [](const CellOptions& o) {
+    const auto bad = o.validate();
+    return bad ? bad->pointer : std::string();
+  };
+  CellOptions o;
+  o.contact.penalty.k_N = -5;
+  CHECK(pointer_of(o) == "/contact/penalty");
+  CHECK(o.validate()->message.find("got -5") != std::string::npos);
+  o = {};
+  o.contact.friction.mu = -1;
+  CHECK(pointer_of(o) == "/contact/mu");
+  o = {};
+  o.geometry.gamma_over_w = std::nan("");
+  CHECK(pointer_of(o) == "/loop/gamma_over_w");
+  o = {};
+  o.section.d = std::numeric_limits<double>::infinity();
+  CHECK(pointer_of(o) == "/yarn/d");
+  o = {};
+  o.elements = 2;
+  CHECK(pointer_of(o) == "/analysis/elements");
+  // the cell refuses such options too (no silent default)
+  o = {};
+  o.contact.penalty.delta = 0;
+  CHECK_THROWS_AS(knit::meso::homog::PeriodicCell(4.5, o), std::invalid_argument);
 }

@@ -155,3 +155,27 @@ TEST_CASE("rod case: arc_unbend.json straightens a NURBS quarter circle exactly"
   CHECK(rows.back()[4] == Approx(std::numbers::pi * R / 2 - R).epsilon(1e-5));
   CHECK(std::abs(rows.back()[5]) < 1e-8);
 }
+
+TEST_CASE("rod case: a reversed end moment stops at the work cap, outputs of converged steps kept",
+          "[unit]") {
+  // Issue 14: rollup.json with its end moment reversed and ten times larger sub-stepped
+  // forever. The load stepping now stops at its floor or work cap (exit 1) and says which.
+  std::ifstream in(kCases / "rollup.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const std::string m = "-2.4674011002723395e-3";
+  const auto at = text.find(m);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, m.size(), "2.4674011002723395e-2");
+  const fs::path f = kTmp / "reversed.json", out = kTmp / "reversed_out";
+  fs::remove_all(out);
+  write(f, text);
+  std::string msg;
+  const int rc = run("rod " + f.string() + " -q -o " + out.string(), &msg);
+  INFO(msg);
+  CHECK(rc == 1);
+  CHECK((msg.find("work cap: ") != std::string::npos ||
+         msg.find("step floor: ") != std::string::npos));
+  CHECK(fs::exists(out / "load_displacement.csv"));  // step 0 and any converged steps
+}

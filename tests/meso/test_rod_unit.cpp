@@ -193,6 +193,54 @@ TEST_CASE("rod: load stepping cuts back a too large increment; failure is a stat
   }
 }
 
+TEST_CASE("rod: load stepping stops at the step floor and at the work cap, and says which",
+          "[unit]") {
+  // Issue 14: a path that only converges with ever smaller increments used to sub-step
+  // forever (the successive-halving limit resets after every success).
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0);
+  RodSystem sys;
+  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
+  s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);
+  sys.add_rod(s);
+  PathOptions def;
+  CHECK(def.work_cap() == PathOptions::kWorkFactor * def.steps * def.newton.max_iterations);
+  {  // one Newton iteration never converges: halvings until the floor
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.max_cutbacks = 1000;
+    po.min_increment = 1e-2;
+    po.newton.max_iterations = 1;
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK_FALSE(rep.completed);
+    CHECK(rep.stop == PathStop::kStepFloor);
+    CHECK(rep.message.rfind("step floor: ", 0) == 0);
+    CHECK(rep.cutbacks == 7);  // 1/2^7 < 1e-2 <= 1/2^6
+    CHECK((x - sys.initial_state()).norm() < 1e-12);
+  }
+  {  // the work cap: total Newton iterations over the path
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 1;
+    po.max_cutbacks = 1000;
+    po.min_increment = 1e-12;
+    po.max_total_iterations = 5;
+    po.newton.max_iterations = 3;  // the full increment fails: cut-backs, until the cap
+    const PathReport rep = solve_path(sys, x, po);
+    CHECK_FALSE(rep.completed);
+    CHECK(rep.stop == PathStop::kWorkCap);
+    CHECK(rep.message.rfind("work cap: ", 0) == 0);
+    CHECK(rep.total_iterations <= po.max_total_iterations + po.newton.max_iterations);
+  }
+  {  // options are checked
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.min_increment = std::nan("");
+    CHECK(solve_path(sys, x, po).stop == PathStop::kBadOptions);
+  }
+}
+
 TEST_CASE("section: yarn defaults reproduce the values of design/notes.md", "[unit]") {
   const Section s;  // d = 0.38 mm, E = 800 MPa, nu = 0.3
   CHECK(s.A() == Approx(0.1134).epsilon(1e-3));

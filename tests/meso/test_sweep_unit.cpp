@@ -4,6 +4,8 @@
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -389,4 +391,105 @@ TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consiste
     CHECK((rs.P - rp.P).cwiseAbs().maxCoeff() < 1e-14);  // P = F (S - S0)
     CHECK((rk.S.rowwise() - S0.transpose() - rp.S).cwiseAbs().maxCoeff() < 1e-14);
   }
+}
+
+TEST_CASE("sweep: a hand-edited checkpoint is refused on --resume, naming file and record",
+          "[unit]") {
+  // Issue 14: an edited job file used to be accepted. Every record carries a digest now.
+  const auto dir = knit_test::scratch("sweep_unit_digest");
+  const auto in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  const auto out = dir / "db.h5";
+  {
+    CheckpointStore store(out, in.job_definition(), static_cast<int>(jobs.size()), false, false);
+    for (int i : {0, 3})
+      store.store(run_job(jobs[static_cast<std::size_t>(i)], in.retry, synthetic_runner()));
+  }
+  const auto file = CheckpointStore::parts_dir(out) / "job_00003.txt";
+  {  // intact: both records load
+    CheckpointStore store(out, in.job_definition(), static_cast<int>(jobs.size()), true, false);
+    CHECK(store.load_finished(jobs).size() == 2);
+  }
+  std::string text;
+  {
+    std::ifstream f(file);
+    std::stringstream s;
+    s << f.rdbuf();
+    text = s.str();
+  }
+  // change one stress value of the last data row (the kind of edit a user makes by hand)
+  const auto row = text.rfind("\n0 ");
+  REQUIRE(row != std::string::npos);
+  const auto pos = text.find("0x1.", row + 3);
+  REQUIRE(pos != std::string::npos);
+  text[pos + 4] = text[pos + 4] == '8' ? '9' : '8';
+  knit_test::write_text(file, text);
+  std::atomic<int> calls{0};
+  const PathRunner counting = [&](double l, const LoadPath& p) {
+    ++calls;
+    return synthetic_runner()(l, p);
+  };
+  auto ro = quiet(out);
+  ro.resume = true;
+  std::string msg;
+  try {
+    run_sweep(in, ro, counting);
+  } catch (const knit::InputError& e) {
+    msg = e.what();
+  }
+  CHECK(msg.find(file.string()) == 0);
+  CHECK(msg.find("checkpoint record of job 3") != std::string::npos);
+  CHECK(msg.find("digest mismatch") != std::string::npos);
+  CHECK(calls == 0);  // refused before any work
+  // a record without its digest line (older or truncated) is refused too
+  knit_test::write_text(file, text.substr(0, text.rfind("digest ")));
+  CheckpointStore store(out, in.job_definition(), static_cast<int>(jobs.size()), true, false);
+  CHECK_THROWS_AS(store.load_finished(jobs), knit::InputError);
+}
+
+TEST_CASE("sweep: an infeasible fit is refused from the input, before any case runs", "[unit]") {
+  // Issue 14: 3 steps for a cubic surface, only shear paths, too few paths -- each used to run
+  // every case before the fit said so.
+  namespace fit = knit::meso::fit;
+  const fit::FitOptions cubic;
+  CHECK(fit::check_feasible(cubic, knit::material::default_load_paths(20)).empty());
+  CHECK(fit::check_feasible(cubic, knit::material::default_load_paths(20), 3).find("3 steps") !=
+        std::string::npos);
+  const auto all = knit::material::default_load_paths(6);
+  CHECK(fit::check_feasible(cubic, {all[12]}).find("biaxial paths") != std::string::npos);
+  CHECK(fit::check_feasible(cubic, {all[0], all[4], all[8], all[11]}).find("no pure-shear path") !=
+        std::string::npos);
+  // the fit refuses with the same words on the data (one function decides both)
+  std::atomic<int> calls{0};
+  const PathRunner counting = [&](double l, const LoadPath& p) {
+    ++calls;
+    return synthetic_runner()(l, p);
+  };
+  const auto dir = knit_test::scratch("sweep_unit_feasible");
+  for (const std::string& text :
+       {knit_test::synthetic_sweep_json(3),
+        std::string(R"({"loop_lengths": [4.5], "steps": 6, "runner": "synthetic",
+                        "load_paths": {"preset": "default", "select": [12]}})"),
+        std::string(R"({"loop_lengths": [4.5], "steps": 6, "runner": "synthetic",
+                        "load_paths": {"preset": "default", "select": [0, 6, 12]}})")}) {
+    const SweepInput in = parse_sweep_input(text, "infeasible.json");
+    std::string msg, ptr;
+    try {
+      run_sweep(in, quiet(dir / "db.h5"), counting);
+    } catch (const knit::InputError& e) {
+      msg = e.what();
+      ptr = e.pointer();
+    }
+    CHECK(msg.rfind("infeasible.json: /load_paths: the response-surface fit cannot succeed", 0) ==
+          0);
+    CHECK(calls == 0);
+  }
+  CHECK_FALSE(std::filesystem::exists(CheckpointStore::parts_dir(dir / "db.h5")));
+  // "fit": false runs the cases without a fit: no refusal
+  const SweepInput nofit = parse_sweep_input(
+      R"({"loop_lengths": [4.5], "steps": 3, "runner": "synthetic", "fit": false,
+          "load_paths": {"preset": "default", "select": [12]}})",
+      "nofit.json");
+  CHECK_NOTHROW(run_sweep(nofit, quiet(dir / "nofit.h5"), counting));
+  CHECK(calls == 1);
 }

@@ -12,6 +12,11 @@
 //
 // run_main() parses the command line, runs the chosen subcommand and turns errors into exit
 // codes: InputError and CLI usage errors -> 2, other exceptions -> 1.
+//
+// Every numeric option carries a range validator (number() / integer() below) so that a
+// non-finite or out-of-range value is refused at parse time, before any work, with a message
+// naming the option and the allowed range (CLI11's own CLI::Range lets NaN through):
+//   sub.add_option("--mu", o->mu, "...")->check(knit::cli::number(0, 10));
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -26,6 +31,19 @@ using Setup = std::function<Runner(CLI::App&)>;
 struct SubcommandRegistrar {
   SubcommandRegistrar(std::string name, std::string description, Setup setup);
 };
+
+/// Which ends of a range are open (excluded).
+enum class Ends { kClosed, kOpenLow, kOpenHigh, kOpen };
+
+/// A validator for a floating-point option: the value must parse completely as a finite
+/// number within [lo, hi] (ends excluded as `ends` says). Use +-infinity for no bound.
+CLI::Validator number(double lo, double hi, Ends ends = Ends::kClosed);
+
+/// A validator for an integer option: an integer within [lo, hi].
+CLI::Validator integer(long long lo, long long hi);
+
+/// The text "[lo, hi]" / "(lo, hi]" / "> lo" ... of a range, for messages and help.
+std::string describe_range(double lo, double hi, Ends ends);
 
 /// Builds the app from the registered subcommands, parses, runs; returns the exit code.
 int run_main(int argc, char** argv, const std::string& program, const std::string& description);

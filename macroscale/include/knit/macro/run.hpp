@@ -9,7 +9,10 @@
 //   case.json         the case as read
 // The directory is built as DIR.partial-<pid> and renamed to DIR at the end, so it is never
 // half-written; a run that stops early still writes every converged step (status in the
-// summary) and the caller returns exit code 1.
+// summary) and the caller returns exit code 1. So does a run in which the material failed to
+// evaluate somewhere (Material::failed_evaluations() > 0, e.g. response-surface inversions that
+// did not converge): its results are not trustworthy, even if every step converged; the
+// message says so on stderr and in summary.txt, and the outputs are kept.
 #pragma once
 
 #include <Eigen/Core>
@@ -76,10 +79,20 @@ std::uint64_t estimate_output_bytes(const Case& c);
 
 struct RunResult {
   RunReport report;
+  /// Material::failed_evaluations() at the end of the run; > 0 means not trustworthy.
+  long failed_material_evaluations = 0;
+  /// Plain success: every step converged and the material never failed.
+  bool succeeded() const {
+    return report.status == RunStatus::kCompleted && failed_material_evaluations == 0;
+  }
   std::vector<StepRow> rows;
   Eigen::VectorXd u;  ///< displacement of the last converged step
 };
 
 RunResult run_case(const Case& c, const RunOptions& options);
+
+/// "completed with N failed material evaluations; results are not trustworthy" (or
+/// "stopped ..." for a run that did not complete); empty if n == 0.
+std::string material_failure_message(const RunReport& report, long n);
 
 }  // namespace knit::macro

@@ -64,6 +64,27 @@ struct FitSummary {
   bool ok() const { return status == FitStatus::kOk; }
 };
 
+/// What the structural refusals of the fit look at: the strain direction atan2(E22, E11) of
+/// the end of every biaxial path (NaN if not known before the run), the fewest steps of a
+/// biaxial path, and whether a pure-shear path exists.
+struct FanShape {
+  std::vector<double> phi;
+  int min_steps = 0;
+  bool shear = false;
+};
+
+/// The fit's refusals that depend only on the options and the shape of the fan (too few
+/// paths or steps for the degrees, no shear path, two paths in one direction, a fan of 180
+/// degrees or more, too few data without smoothing): empty if none applies, else the reason.
+/// fit_loop_length() refuses with exactly these reasons.
+std::string check_fan(const FitOptions& options, const FanShape& fan);
+
+/// check_fan() for load paths that have not run yet (a sweep's input): can a fit of their
+/// data succeed at all? steps > 0 overrides every path's own step count. Empty if feasible,
+/// else the reason -- a sweep checks this before running any case.
+std::string check_feasible(const FitOptions& options, const std::vector<material::LoadPath>& paths,
+                           int steps = 0);
+
 /// Fits one loop length's raw data.
 FitSummary fit_loop_length(const std::vector<material::RawPath>& raw, const FitOptions& options);
 

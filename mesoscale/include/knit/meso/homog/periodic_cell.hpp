@@ -36,6 +36,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,13 @@
 #include "knit/meso/rod/solver.hpp"
 
 namespace knit::meso::homog {
+
+/// A cell parameter outside its range: the JSON pointer of the field in the cell parameter
+/// file (schemas/cell.schema.json, e.g. "/contact/penalty") and what is wrong.
+struct CellOptionError {
+  std::string pointer;
+  std::string message;
+};
 
 struct CellOptions {
   int elements = 32;  ///< analysis curve elements (convergence study: docs/unit-cell.md)
@@ -61,6 +69,12 @@ struct CellOptions {
   }();
   int equilibration_steps = 4;
   int max_cutbacks = 6;
+
+  /// Checks every field for finiteness and against the range of schemas/cell.schema.json
+  /// (implemented beside the JSON reader, homog_cell_config.cpp); the first bad field, or
+  /// nothing. The reader, the command line and PeriodicCell use it, so no value is ever
+  /// silently replaced by a default.
+  std::optional<CellOptionError> validate() const;
 };
 
 /// Green-Lagrange strain (eq. 9).

@@ -49,8 +49,34 @@ struct PathOptions {
   double lambda_end = 1.0;
   int max_cutbacks = 10;  ///< successive halvings of an increment before giving up
   bool predictor = true;  ///< secant extrapolation from the previous increment
+  /// Floor of the load increment, relative to the nominal one (lambda_end - lambda_start) /
+  /// steps: a failed increment that would have to be cut below it stops the path. Unlike
+  /// max_cutbacks (successive halvings, reset by every success), the floor holds over the
+  /// whole path, so a path cannot creep on with ever smaller increments (choice: 1e-4).
+  double min_increment = 1e-4;
+  /// Cap on the total work: Newton iterations over the whole path, all increments and
+  /// cut-backs included. 0 = automatic, kWorkFactor x steps x newton.max_iterations (room
+  /// for every nominal step to be cut back several times).
+  long max_total_iterations = 0;
+  static constexpr long kWorkFactor = 10;
   NewtonOptions newton;
+
+  /// The cap in effect (max_total_iterations or its automatic value).
+  long work_cap() const;
+  /// Empty if the options are usable, else the reason (naming the option).
+  std::string validate() const;
 };
+
+/// How a load path ended.
+enum class PathStop {
+  kCompleted,   ///< lambda_end reached
+  kStartState,  ///< the start state did not converge
+  kCutbacks,    ///< max_cutbacks successive halvings of one increment failed
+  kStepFloor,   ///< the increment would fall below min_increment x nominal
+  kWorkCap,     ///< max_total_iterations Newton iterations spent
+  kBadOptions   ///< PathOptions::validate() refused the options
+};
+std::string to_string(PathStop s);
 
 struct StepRecord {
   double lambda = 0.0;
@@ -59,9 +85,10 @@ struct StepRecord {
 };
 
 struct PathReport {
-  bool completed = false;       ///< lambda_end reached
-  double lambda_reached = 0.0;  ///< last converged load factor
-  int increments = 0;           ///< converged increments (including cut-back sub-increments)
+  bool completed = false;                ///< lambda_end reached
+  PathStop stop = PathStop::kCompleted;  ///< why the path ended (see message)
+  double lambda_reached = 0.0;           ///< last converged load factor
+  int increments = 0;  ///< converged increments (including cut-back sub-increments)
   int cutbacks = 0;
   int total_iterations = 0;
   std::vector<StepRecord> steps;  ///< one per converged increment
@@ -73,7 +100,9 @@ using StepCallback = std::function<void(int step, double lambda, const Eigen::Ve
 
 /// Load stepping: x must hold a converged state at lambda_start (e.g. initial_state() at 0).
 /// A failed increment is halved (x restored) up to max_cutbacks times in a row; after a success
-/// the increment grows back towards the nominal one.
+/// the increment grows back towards the nominal one. The path also stops (report.stop says
+/// which) when an increment would fall below the floor min_increment, or when the total
+/// Newton iterations reach work_cap(); x then holds the last converged state.
 PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOptions& opt,
                       const StepCallback& on_step = {},
                       const std::vector<ExternalContribution*>& extra = {});

@@ -2,8 +2,12 @@
 // one small file DB.h5.parts/job_NNNNN.txt (serialize() of job.hpp: hex floats, bit-exact), next
 // to a manifest that holds the fingerprint of the job definition. A sweep killed at any moment
 // leaves only complete job files (temporary file + rename), so `--resume` recomputes nothing
-// that finished and loses nothing. The database itself is assembled from the job files and
-// written atomically at the end; the parts directory is then removed.
+// that finished and loses nothing. Every job file ends with a digest line (64-bit FNV-1a of the
+// record text above it); on --resume a record whose digest does not match (edited by hand,
+// damaged on disk) or that does not parse is refused with knit::InputError naming the file and
+// the record (exit 2): delete that file to recompute the case, or use --force. The database itself
+// is assembled from the job files and written atomically at the end; the parts directory is then
+// removed.
 #pragma once
 
 #include <filesystem>
@@ -29,8 +33,9 @@ class CheckpointStore {
                   int job_count, bool resume, bool force);
 
   const std::filesystem::path& dir() const { return dir_; }
-  /// Finished results found on opening, validated against the jobs (unreadable or foreign
-  /// files are ignored and recomputed).
+  /// Finished results found on opening, validated against the jobs: a record with a missing
+  /// or wrong digest, or one that does not parse, throws knit::InputError (file + record);
+  /// a valid record of another job definition is ignored and recomputed.
   std::map<int, JobResult> load_finished(const std::vector<Job>& jobs) const;
   /// Persists one result atomically.
   void store(const JobResult& r) const;

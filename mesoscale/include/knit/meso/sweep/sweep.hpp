@@ -54,7 +54,9 @@ struct SweepReport {
 /// True if this result makes the sweep fail (see SweepReport::failed_cases).
 bool fails_sweep(const JobResult& r);
 
-/// Runs the sweep; rank 0 writes the database. `mpi` may be nullptr (serial).
+/// Runs the sweep; rank 0 writes the database. `mpi` may be nullptr (serial). Throws
+/// knit::InputError before running any case if the fit cannot succeed with the input's paths
+/// and fit options (fit::check_feasible), or if a checkpoint fails its digest on resume.
 SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
                       const MpiSession* mpi = nullptr);
 

@@ -1,0 +1,32 @@
+// Load-time check of the reference surface of a shell patch: the surface Jacobian
+// J = |A1 x A2| (A_a = dX/dtheta_a, paper eq. 10) must not vanish and the normal
+// A3 = A1 x A2 / J must not flip anywhere in the patch -- at the quadrature points, where the
+// shell integrates, and on the element boundaries (corners and edges), where outputs are
+// sampled and the boundary conditions act. A degenerate corner (two coincident control points)
+// has J = 0 only there, so checking the quadrature points alone lets it pass.
+//
+// Sample set (choice): per knot span in each direction the span ends and the p + 1 Gauss
+// points (the shell's quadrature); the tensor grid of these abscissae. J <= 1e-10 scale^2
+// (the tolerance of reference_point(), scale = diagonal of the control net's bounding box)
+// is degenerate; a normal that turns by more than 90 degrees between neighbouring samples
+// (A3 . A3' <= 0) is a fold.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "knit/spline/surface.hpp"
+
+namespace knit::macro {
+
+struct GeometryDefect {
+  Eigen::Vector2d theta = Eigen::Vector2d::Zero();  ///< parametric location
+  double jacobian = 0.0;                            ///< |A1 x A2| there
+  std::string message;  ///< one line: what and where ("... at the corner (0, 1)")
+};
+
+/// The first defect of the reference surface, or nothing.
+std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& surface);
+
+}  // namespace knit::macro

@@ -1,0 +1,88 @@
+// Load-time check of the reference surface (see knit/macro/geometry_check.hpp).
+#include "knit/macro/geometry_check.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "knit/spline/quadrature.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+/// Span ends and the p + 1 Gauss points of every non-empty knot span, increasing.
+std::vector<double> sample_abscissae(const std::vector<double>& U, int p) {
+  const spline::QuadratureRule g = spline::gauss_legendre(p + 1);
+  std::vector<double> s;
+  for (std::size_t i = 0; i + 1 < U.size(); ++i) {
+    const double a = U[i], b = U[i + 1];
+    if (!(b > a)) continue;
+    if (s.empty() || s.back() < a) s.push_back(a);
+    for (double x : g.points) s.push_back(0.5 * (a + b) + 0.5 * (b - a) * x);
+    s.push_back(b);
+  }
+  return s;
+}
+
+std::string where(const Eigen::Vector2d& t, const std::vector<double>& su,
+                  const std::vector<double>& sv) {
+  const bool u_end = t(0) == su.front() || t(0) == su.back();
+  const bool v_end = t(1) == sv.front() || t(1) == sv.back();
+  std::ostringstream os;
+  os << "(theta1, theta2) = (" << t(0) << ", " << t(1) << ")"
+     << (u_end && v_end   ? ", a corner of the patch"
+         : u_end || v_end ? ", on an edge of the patch"
+                          : "");
+  return os.str();
+}
+
+}  // namespace
+
+std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& s) {
+  const Eigen::MatrixXd& P = s.control_points();
+  double scale = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+  if (!(scale > 0)) scale = 1.0;
+  const std::vector<double> su = sample_abscissae(s.basis_u().knots(), s.basis_u().degree());
+  const std::vector<double> sv = sample_abscissae(s.basis_v().knots(), s.basis_v().degree());
+  const std::size_t nu = su.size();
+  spline::SurfaceBasis sb;
+  std::vector<Eigen::Vector3d> prev_row(nu);  // normals of the previous v row
+  Eigen::Vector3d left = Eigen::Vector3d::Zero();
+  for (std::size_t j = 0; j < sv.size(); ++j) {
+    for (std::size_t i = 0; i < nu; ++i) {
+      const Eigen::Vector2d t(su[i], sv[j]);
+      s.basis(t(0), t(1), 1, sb);
+      Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = Eigen::Vector3d::Zero();
+      for (Eigen::Index l = 0; l < sb.index.size(); ++l) {
+        A1 += sb.R(1, l) * P.row(sb.index(l)).transpose();
+        A2 += sb.R(2, l) * P.row(sb.index(l)).transpose();
+      }
+      const Eigen::Vector3d a3 = A1.cross(A2);
+      const double J = a3.norm();
+      if (!(J > 1e-10 * scale * scale) || !(A1.norm() > 1e-12 * scale) ||
+          !(A2.norm() > 1e-12 * scale)) {
+        std::ostringstream os;
+        os << "degenerate geometry: the surface Jacobian |A1 x A2| = " << J << " vanishes at "
+           << where(t, su, sv) << " (coincident or collinear control points?)";
+        return GeometryDefect{t, J, os.str()};
+      }
+      const Eigen::Vector3d n = a3 / J;
+      const bool fold_u = i > 0 && !(n.dot(left) > 0.0);
+      const bool fold_v = j > 0 && !(n.dot(prev_row[i]) > 0.0);
+      if (fold_u || fold_v) {
+        std::ostringstream os;
+        os << "folded geometry: the surface normal flips (turns by more than 90 degrees from "
+              "the neighbouring sample in theta"
+           << (fold_u ? 1 : 2) << ") at " << where(t, su, sv) << " (control points out of order?)";
+        return GeometryDefect{t, J, os.str()};
+      }
+      left = n;
+      prev_row[i] = n;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace knit::macro
