@@ -367,7 +367,10 @@ TEST_CASE("output names are checked at load: characters, length, '.', uniqueness
         "bad.json: /output/points/0/name: a name has at most 64 characters, got 30000");
   json j = base;
   j["output"]["points"].push_back(j["output"]["points"][0]);
-  CHECK_THAT(load_error_of(j.dump()), Catch::Contains("/output/points/1/name: the name"));
+  CHECK_THAT(
+      load_error_of(j.dump()),
+      Catch::EndsWith("/name: the name \"" +
+                      base["output"]["points"][0]["name"].get<std::string>() + "\" is used twice"));
 }
 
 TEST_CASE("a number outside the double range in a case names file and pointer, exit 2", "[unit]") {
