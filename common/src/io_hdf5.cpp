@@ -4,12 +4,18 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <system_error>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 
 namespace knit::io {
 
@@ -17,6 +23,31 @@ static_assert(std::is_same_v<hid_t, std::int64_t>,
               "hid_t is expected to be int64_t (HDF5 >= 1.10)");
 
 namespace {
+
+// ---- library shutdown ------------------------------------------------------------------------
+// After a failed H5Fclose (disk full during the final flush) the file stays half-closed inside
+// HDF5, and the library's own exit handler (H5_term_library) crashed on it with SIGSEGV
+// (issue 14). So the library is told not to install its handler; ours shuts it down at exit
+// unless a file failed to close, in which case the process leaves it to the OS (the data of
+// that file is lost anyway; every other file was closed by its owner).
+std::atomic<bool> g_file_close_failed{false};
+
+void shutdown_hdf5() {
+  if (!g_file_close_failed.load()) H5close();
+}
+
+[[maybe_unused]] const bool g_shutdown_installed = [] {
+  H5dont_atexit();
+  std::atexit(shutdown_hdf5);
+  return true;
+}();
+
+/// H5Fclose that remembers a failure (see shutdown_hdf5).
+herr_t close_file(hid_t id) {
+  const herr_t r = H5Fclose(id);
+  if (r < 0) g_file_close_failed.store(true);
+  return r;
+}
 
 /// HDF5 prints its error stack to stderr by default; we report through exceptions instead.
 void silence_hdf5() {
@@ -92,11 +123,113 @@ const char* class_name(H5T_class_t c) {
   }
 }
 
+/// What a failing operation reports: `io` for I/O and library failures (std::runtime_error),
+/// `input` for a file whose content is wrong (knit::InputError naming file and object path).
+struct Fail {
+  std::function<void(const std::string&)> io, input;
+  void operator()(const std::string& what) const { io(what); }
+};
+
+// ---- integrity: declared sizes, Fletcher32, digests --------------------------------------
+
+/// Attribute holding the FNV-1a 64 digest of datasets that cannot carry the Fletcher32 filter
+/// (scalars, strings).
+constexpr const char* kDigestAttribute = "knit_fnv1a64";
+
+std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+std::uint64_t strings_digest(const std::vector<std::string>& v) {
+  std::uint64_t h = fnv1a(nullptr, 0);
+  for (const auto& s : v) {
+    const std::uint64_t len = s.size();
+    h = fnv1a(&len, sizeof len, h);
+    h = fnv1a(s.data(), s.size(), h);
+  }
+  return h;
+}
+
+void write_digest(hid_t obj, std::uint64_t digest, const Fail& fail) {
+  H5Handle space(H5Screate(H5S_SCALAR));
+  H5Handle a(
+      H5Acreate2(obj, kDigestAttribute, H5T_STD_U64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT));
+  if (!a.valid() || H5Awrite(a.get(), H5T_NATIVE_UINT64, &digest) < 0)
+    fail("cannot write the checksum attribute");
+}
+
+std::optional<std::uint64_t> read_digest(hid_t obj) {
+  if (H5Aexists(obj, kDigestAttribute) <= 0) return std::nullopt;
+  H5Handle a(H5Aopen(obj, kDigestAttribute, H5P_DEFAULT));
+  std::uint64_t d = 0;
+  if (!a.valid() || H5Aread(a.get(), H5T_NATIVE_UINT64, &d) < 0) return std::nullopt;
+  return d;
+}
+
+bool has_filter(hid_t ds, H5Z_filter_t filter) {
+  H5Handle dcpl(H5Dget_create_plist(ds));
+  unsigned flags = 0;
+  std::size_t nelem = 0;
+  return dcpl.valid() && H5Pget_filter_by_id2(dcpl.get(), filter, &flags, &nelem, nullptr, 0,
+                                              nullptr, nullptr) >= 0;
+}
+
+int num_filters(hid_t ds) {
+  H5Handle dcpl(H5Dget_create_plist(ds));
+  return dcpl.valid() ? H5Pget_nfilters(dcpl.get()) : 0;
+}
+
+std::string bytes_text(long double b) {
+  char buf[48];
+  if (b >= 1e9L)
+    std::snprintf(buf, sizeof buf, "%.1Lf GB", b / 1e9L);
+  else if (b >= 1e6L)
+    std::snprintf(buf, sizeof buf, "%.1Lf MB", b / 1e6L);
+  else
+    std::snprintf(buf, sizeof buf, "%.0Lf bytes", b);
+  return buf;
+}
+
+/// Refuses a dataset or attribute whose declared extent cannot be right, before anything is
+/// allocated (issue 14: a 2^27 x 2 dataset declared in a 445 KB file allocated 4.2 GB before
+/// the read failed). Limits: kMaxH5DatasetBytes in memory; the stored bytes may not exceed
+/// the file size (unfiltered data) or 1100 times it (compressed data; deflate's largest ratio
+/// is about 1032).
+void check_declared_size(hid_t obj, const std::vector<std::size_t>& dims, std::size_t file_elem,
+                         std::size_t mem_elem, bool filtered, const Fail& fail) {
+  long double n = 1;
+  std::string shape;
+  for (std::size_t d : dims) {
+    n *= static_cast<long double>(d);
+    shape += (shape.empty() ? "" : " x ") + std::to_string(d);
+  }
+  if (shape.empty()) shape = "1";
+  const long double in_memory = n * static_cast<long double>(std::max(file_elem, mem_elem));
+  if (in_memory > static_cast<long double>(kMaxH5DatasetBytes))
+    fail.input("declares " + shape + " elements (" + bytes_text(in_memory) + "), more than the " +
+               bytes_text(static_cast<long double>(kMaxH5DatasetBytes)) + " accepted per dataset");
+  H5Handle file(H5Iget_file_id(obj));
+  hsize_t file_size = 0;
+  if (!file.valid() || H5Fget_filesize(file.get(), &file_size) < 0) return;
+  const long double stored = n * static_cast<long double>(file_elem);
+  const long double allowed = static_cast<long double>(file_size) * (filtered ? 1100.0L : 1.0L);
+  if (stored > allowed)
+    fail.input("declares " + shape + " elements (" + bytes_text(stored) +
+               ") but the file has only " + std::to_string(file_size) +
+               " bytes (corrupt or truncated file)");
+}
+
 /// Reads a string-typed object (dataset or attribute) into strings, variable or fixed length.
 template <class ReadFn>
-std::vector<std::string> read_string_data(hid_t ftype, hid_t space, std::size_t n, ReadFn read,
-                                          const std::function<void(const std::string&)>& fail) {
+std::vector<std::string> read_string_data(hid_t obj, hid_t ftype, hid_t space,
+                                          const std::vector<std::size_t>& dims, ReadFn read,
+                                          const Fail& fail) {
   std::vector<std::string> out;
+  check_declared_size(obj, dims, H5Tget_size(ftype), sizeof(char*), false, fail);
+  std::size_t n = 1;
+  for (std::size_t d : dims) n *= d;
   if (n == 0) return out;
   if (H5Tis_variable_str(ftype) > 0) {
     H5Handle mtype = utf8_vlen_string_type();
@@ -137,7 +270,7 @@ void H5Handle::reset() noexcept {
   if (id_ < 0) return;
   switch (H5Iget_type(id_)) {
     case H5I_FILE:
-      H5Fclose(id_);
+      close_file(id_);
       break;
     case H5I_GROUP:
       H5Gclose(id_);
@@ -179,6 +312,18 @@ std::string H5Group::h5name(const std::string& rel) {
 void H5Group::fail(const std::string& rel, const std::string& what) const {
   throw std::runtime_error(file_ + ": " + full(rel) + ": " + what);
 }
+
+void H5Group::fail_input(const std::string& rel, const std::string& what) const {
+  throw InputError(file_, full(rel), what);
+}
+
+/// Builds the Fail of a group's member function (the free helpers below report through it).
+struct H5GroupAccess {
+  static Fail fail(const H5Group& g, const std::string& rel) {
+    return Fail{[&g, rel](const std::string& w) { g.fail(rel, w); },
+                [&g, rel](const std::string& w) { g.fail_input(rel, w); }};
+  }
+};
 
 // ---- structure ------------------------------------------------------------------------------
 
@@ -263,11 +408,9 @@ hid_t native_type() {
 }  // namespace
 
 template <class T>
-static void write_numeric(H5Group& self, hid_t loc, const std::string& name,
-                          std::span<const T> data, const std::vector<std::size_t>& shape,
-                          const H5WriteOptions& opts,
-                          const std::function<void(const std::string&)>& fail) {
-  (void)self;
+static void write_numeric(hid_t loc, const std::string& name, std::span<const T> data,
+                          const std::vector<std::size_t>& shape, const H5WriteOptions& opts,
+                          const Fail& fail) {
   if (product(shape) != data.size()) fail("shape does not match the data size");
   const std::vector<hsize_t> dims(shape.begin(), shape.end());
   H5Handle space(shape.empty()
@@ -275,16 +418,25 @@ static void write_numeric(H5Group& self, hid_t loc, const std::string& name,
                      : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
   if (!space.valid()) fail("cannot create dataspace");
   H5Handle dcpl(H5Pcreate(H5P_DATASET_CREATE));
-  if (opts.gzip_level > 0 && !data.empty() && !shape.empty() &&
-      H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
+  // Integrity (issue 14: one flipped sign bit in /loop_0/fit/S_ctrl ran to completion with
+  // 18.6 N instead of 41.4 N): every non-empty array is chunked and carries HDF5's Fletcher32
+  // checksum, which H5Dread verifies; scalars get a digest attribute instead (chunking needs
+  // an array). Fletcher32 comes last, so it covers the compressed bytes.
+  const bool array = !data.empty() && !shape.empty();
+  const bool deflate = array && opts.gzip_level > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0;
+  const bool fletcher32 = array && opts.checksum;
+  if (deflate || fletcher32) {
     // One chunk per dataset, capped to ~1M elements along the first axis.
     std::vector<hsize_t> chunk = dims;
     std::size_t rest = 1;
     for (std::size_t i = 1; i < chunk.size(); ++i) rest *= chunk[i];
     chunk[0] = std::max<hsize_t>(
         1, std::min<hsize_t>(chunk[0], (1u << 20) / std::max<std::size_t>(rest, 1)));
-    H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data());
-    H5Pset_deflate(dcpl.get(), static_cast<unsigned>(std::min(opts.gzip_level, 9)));
+    if (H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()) < 0)
+      fail("cannot set the chunk layout");
+    if (deflate) H5Pset_deflate(dcpl.get(), static_cast<unsigned>(std::min(opts.gzip_level, 9)));
+    if (fletcher32 && H5Pset_fletcher32(dcpl.get()) < 0)
+      fail("cannot set the Fletcher32 checksum filter");
   }
   if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(loc, name.c_str(), H5P_DEFAULT);
   H5Handle lcpl = intermediate_lcpl();
@@ -294,20 +446,21 @@ static void write_numeric(H5Group& self, hid_t loc, const std::string& name,
   if (data.empty()) return;
   if (H5Dwrite(ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     fail("cannot write dataset");
+  if (opts.checksum && !fletcher32)
+    write_digest(ds.get(), fnv1a(data.data(), data.size_bytes()), fail);
 }
 
 void H5Group::write_dataset(const std::string& path, std::span<const double> data,
                             const std::vector<std::size_t>& shape, const H5WriteOptions& opts) {
   silence_hdf5();
-  write_numeric<double>(*this, id_.get(), h5name(path), data, shape, opts,
-                        [&](const std::string& w) { fail(path, w); });
+  write_numeric<double>(id_.get(), h5name(path), data, shape, opts,
+                        H5GroupAccess::fail(*this, path));
 }
 
 void H5Group::write_dataset(const std::string& path, std::span<const int> data,
                             const std::vector<std::size_t>& shape, const H5WriteOptions& opts) {
   silence_hdf5();
-  write_numeric<int>(*this, id_.get(), h5name(path), data, shape, opts,
-                     [&](const std::string& w) { fail(path, w); });
+  write_numeric<int>(id_.get(), h5name(path), data, shape, opts, H5GroupAccess::fail(*this, path));
 }
 
 void H5Group::write_strings(const std::string& path, const std::vector<std::string>& v) {
@@ -328,6 +481,8 @@ void H5Group::write_strings(const std::string& path, const std::vector<std::stri
   for (const auto& s : v) ptrs.push_back(s.c_str());
   if (H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) < 0)
     fail(path, "cannot write dataset");
+  // Fletcher32 on a string dataset would cover only the references to the heap: a digest.
+  write_digest(ds.get(), strings_digest(v), H5GroupAccess::fail(*this, path));
 }
 
 namespace {
@@ -338,8 +493,7 @@ struct OpenDataset {
 };
 }  // namespace
 
-static OpenDataset open_dataset(hid_t loc, const std::string& name,
-                                const std::function<void(const std::string&)>& fail) {
+static OpenDataset open_dataset(hid_t loc, const std::string& name, const Fail& fail) {
   OpenDataset d;
   d.ds = H5Handle(H5Dopen2(loc, name.c_str(), H5P_DEFAULT));
   if (!d.ds.valid()) fail("cannot open dataset");
@@ -353,14 +507,13 @@ static OpenDataset open_dataset(hid_t loc, const std::string& name,
 std::vector<std::size_t> H5Group::shape(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
-  auto d = open_dataset(id_.get(), h5name(path), [&](const std::string& w) { fail(path, w); });
+  auto d = open_dataset(id_.get(), h5name(path), H5GroupAccess::fail(*this, path));
   return d.dims;
 }
 
 template <class T>
 static std::vector<T> read_numeric(hid_t loc, const std::string& name, std::size_t want_rank,
-                                   std::vector<std::size_t>& dims_out,
-                                   const std::function<void(const std::string&)>& fail) {
+                                   std::vector<std::size_t>& dims_out, const Fail& fail) {
   auto d = open_dataset(loc, name, fail);
   if (d.cls != H5T_INTEGER && d.cls != H5T_FLOAT)
     fail(std::string("expected a numeric dataset, found ") + class_name(d.cls));
@@ -371,11 +524,30 @@ static std::vector<T> read_numeric(hid_t loc, const std::string& name, std::size
   if (want_rank != kAnyRank && !(rank == want_rank || (want_rank == 1 && rank == 0)))
     fail("expected a " + std::to_string(want_rank) + "-D dataset, found rank " +
          std::to_string(rank));
+  const bool fletcher32 = has_filter(d.ds.get(), H5Z_FILTER_FLETCHER32);
+  check_declared_size(d.ds.get(), d.dims, H5Tget_size(d.type.get()), sizeof(T),
+                      num_filters(d.ds.get()) > 0, fail);
   dims_out = d.dims;
   std::vector<T> out(product(d.dims));
-  if (!out.empty() &&
-      H5Dread(d.ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+  if (out.empty()) return out;
+  if (H5Dread(d.ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0) {
+    if (fletcher32) {  // was it the checksum? read again without verifying it to find out
+      H5Handle dxpl(H5Pcreate(H5P_DATASET_XFER));
+      H5Pset_edc_check(dxpl.get(), H5Z_DISABLE_EDC);
+      if (H5Dread(d.ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, dxpl.get(), out.data()) >= 0)
+        fail.input("checksum mismatch (Fletcher32): the stored data is corrupt");
+    }
     fail("cannot read dataset");
+  }
+  if (const auto digest = read_digest(d.ds.get())) {
+    // Scalars: the digest is of the values as written (native type of the file's type).
+    H5Handle mtype(H5Tget_native_type(d.type.get(), H5T_DIR_ASCEND));
+    std::vector<unsigned char> raw(out.size() * H5Tget_size(mtype.get()));
+    if (H5Dread(d.ds.get(), mtype.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0 ||
+        fnv1a(raw.data(), raw.size()) != *digest)
+      fail.input("checksum mismatch (" + std::string(kDigestAttribute) +
+                 "): the stored data is corrupt");
+  }
   return out;
 }
 
@@ -383,16 +555,14 @@ std::vector<double> H5Group::read_doubles(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  return read_numeric<double>(id_.get(), h5name(path), 1, dims,
-                              [&](const std::string& w) { fail(path, w); });
+  return read_numeric<double>(id_.get(), h5name(path), 1, dims, H5GroupAccess::fail(*this, path));
 }
 
 std::vector<int> H5Group::read_ints(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  return read_numeric<int>(id_.get(), h5name(path), 1, dims,
-                           [&](const std::string& w) { fail(path, w); });
+  return read_numeric<int>(id_.get(), h5name(path), 1, dims, H5GroupAccess::fail(*this, path));
 }
 
 H5Array H5Group::read_array(const std::string& path) const {
@@ -400,7 +570,7 @@ H5Array H5Group::read_array(const std::string& path) const {
   if (!is_dataset(path)) fail(path, "dataset missing");
   H5Array a;
   a.data = read_numeric<double>(id_.get(), h5name(path), static_cast<std::size_t>(-1), a.shape,
-                                [&](const std::string& w) { fail(path, w); });
+                                H5GroupAccess::fail(*this, path));
   return a;
 }
 
@@ -408,8 +578,7 @@ RowMatrixXd H5Group::read_matrix(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  auto v = read_numeric<double>(id_.get(), h5name(path), 2, dims,
-                                [&](const std::string& w) { fail(path, w); });
+  auto v = read_numeric<double>(id_.get(), h5name(path), 2, dims, H5GroupAccess::fail(*this, path));
   RowMatrixXd m(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
   std::copy(v.begin(), v.end(), m.data());
   return m;
@@ -419,8 +588,7 @@ RowMatrixXi H5Group::read_int_matrix(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  auto v = read_numeric<int>(id_.get(), h5name(path), 2, dims,
-                             [&](const std::string& w) { fail(path, w); });
+  auto v = read_numeric<int>(id_.get(), h5name(path), 2, dims, H5GroupAccess::fail(*this, path));
   RowMatrixXi m(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
   std::copy(v.begin(), v.end(), m.data());
   return m;
@@ -429,18 +597,22 @@ RowMatrixXi H5Group::read_int_matrix(const std::string& path) const {
 std::vector<std::string> H5Group::read_strings(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
-  auto f = [&](const std::string& w) { fail(path, w); };
+  auto f = H5GroupAccess::fail(*this, path);
   auto d = open_dataset(id_.get(), h5name(path), f);
   if (d.cls != H5T_STRING)
     fail(path, std::string("expected a string dataset, found ") + class_name(d.cls));
   if (d.dims.size() > 1) fail(path, "expected a 1-D string dataset");
   hid_t ds = d.ds.get();
-  return read_string_data(
-      d.type.get(), d.space.get(), product(d.dims),
+  auto v = read_string_data(
+      ds, d.type.get(), d.space.get(), d.dims,
       [ds](hid_t mtype, void* buf) {
         return H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
       },
       f);
+  if (const auto digest = read_digest(ds); digest && *digest != strings_digest(v))
+    f.input("checksum mismatch (" + std::string(kDigestAttribute) +
+            "): the stored strings are corrupt");
+  return v;
 }
 
 // ---- attributes -----------------------------------------------------------------------------
@@ -470,8 +642,7 @@ void H5Group::set_attribute(const std::string& obj_path, const std::string& name
 
 template <class T>
 static void set_numeric_attribute(hid_t loc, const std::string& obj, const std::string& name,
-                                  const T* data, std::size_t n, bool scalar,
-                                  const std::function<void(const std::string&)>& fail) {
+                                  const T* data, std::size_t n, bool scalar, const Fail& fail) {
   drop_attribute(loc, obj, name);
   const hsize_t dim = n;
   H5Handle space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &dim, nullptr));
@@ -486,14 +657,14 @@ void H5Group::set_attribute(const std::string& obj_path, const std::string& name
   silence_hdf5();
   if (!exists(obj_path)) fail(obj_path, "object missing (attribute " + name + ")");
   set_numeric_attribute<double>(id_.get(), h5name(obj_path), name, &value, 1, true,
-                                [&](const std::string& w) { fail(obj_path, w); });
+                                H5GroupAccess::fail(*this, obj_path));
 }
 
 void H5Group::set_attribute(const std::string& obj_path, const std::string& name, int value) {
   silence_hdf5();
   if (!exists(obj_path)) fail(obj_path, "object missing (attribute " + name + ")");
   set_numeric_attribute<int>(id_.get(), h5name(obj_path), name, &value, 1, true,
-                             [&](const std::string& w) { fail(obj_path, w); });
+                             H5GroupAccess::fail(*this, obj_path));
 }
 
 void H5Group::set_attribute(const std::string& obj_path, const std::string& name,
@@ -501,7 +672,7 @@ void H5Group::set_attribute(const std::string& obj_path, const std::string& name
   silence_hdf5();
   if (!exists(obj_path)) fail(obj_path, "object missing (attribute " + name + ")");
   set_numeric_attribute<double>(id_.get(), h5name(obj_path), name, value.data(), value.size(),
-                                false, [&](const std::string& w) { fail(obj_path, w); });
+                                false, H5GroupAccess::fail(*this, obj_path));
 }
 
 bool H5Group::has_attribute(const std::string& obj_path, const std::string& name) const {
@@ -536,7 +707,7 @@ struct OpenAttribute {
 
 static OpenAttribute open_attribute(const H5Group& g, hid_t loc, const std::string& obj_path,
                                     const std::string& obj, const std::string& name,
-                                    const std::function<void(const std::string&)>& fail) {
+                                    const Fail& fail) {
   if (!g.has_attribute(obj_path, name)) fail("attribute " + name + " missing");
   OpenAttribute o;
   o.a = H5Handle(H5Aopen_by_name(loc, obj.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT));
@@ -550,7 +721,7 @@ static OpenAttribute open_attribute(const H5Group& g, hid_t loc, const std::stri
 
 std::string H5Group::attribute_string(const std::string& obj_path, const std::string& name) const {
   silence_hdf5();
-  auto f = [&](const std::string& w) { fail(obj_path, w); };
+  auto f = H5GroupAccess::fail(*this, obj_path);
   auto o = open_attribute(*this, id_.get(), obj_path, h5name(obj_path), name, f);
   if (o.cls != H5T_STRING)
     f("attribute " + name + ": expected a string, found " + class_name(o.cls));
@@ -558,7 +729,7 @@ std::string H5Group::attribute_string(const std::string& obj_path, const std::st
   if (n != 1) f("attribute " + name + ": expected one string, found " + std::to_string(n));
   hid_t a = o.a.get();
   auto v = read_string_data(
-      o.type.get(), o.space.get(), 1,
+      a, o.type.get(), o.space.get(), o.dims,
       [a](hid_t mtype, void* buf) { return H5Aread(a, mtype, buf); }, f);
   return v.front();
 }
@@ -566,10 +737,11 @@ std::string H5Group::attribute_string(const std::string& obj_path, const std::st
 std::vector<double> H5Group::attribute_doubles(const std::string& obj_path,
                                                const std::string& name) const {
   silence_hdf5();
-  auto f = [&](const std::string& w) { fail(obj_path, w); };
+  auto f = H5GroupAccess::fail(*this, obj_path);
   auto o = open_attribute(*this, id_.get(), obj_path, h5name(obj_path), name, f);
   if (o.cls != H5T_INTEGER && o.cls != H5T_FLOAT)
     f("attribute " + name + ": expected a number, found " + class_name(o.cls));
+  check_declared_size(o.a.get(), o.dims, H5Tget_size(o.type.get()), sizeof(double), false, f);
   std::vector<double> v(product(o.dims));
   if (!v.empty() && H5Aread(o.a.get(), H5T_NATIVE_DOUBLE, v.data()) < 0)
     f("cannot read attribute " + name);
@@ -586,7 +758,7 @@ double H5Group::attribute_double(const std::string& obj_path, const std::string&
 
 int H5Group::attribute_int(const std::string& obj_path, const std::string& name) const {
   silence_hdf5();
-  auto f = [&](const std::string& w) { fail(obj_path, w); };
+  auto f = H5GroupAccess::fail(*this, obj_path);
   auto o = open_attribute(*this, id_.get(), obj_path, h5name(obj_path), name, f);
   if (o.cls != H5T_INTEGER)
     f("attribute " + name + ": expected an integer, found " + class_name(o.cls));
@@ -595,6 +767,163 @@ int H5Group::attribute_int(const std::string& obj_path, const std::string& name)
   if (H5Aread(o.a.get(), H5T_NATIVE_INT, &v) < 0) f("cannot read attribute " + name);
   return v;
 }
+
+// ---- structure checksum (a trailer after HDF5's end of file) --------------------------------
+// Layout, little-endian u64 words: n, (addr, size) x n raw-data extents, end (bytes covered),
+// digest, trailer size in bytes, then the 8-byte magic "KNITSUM1". HDF5 ignores bytes past its
+// end of allocation, so h5py and the HDF5 tools read these files as usual.
+
+namespace {
+
+constexpr char kTrailerMagic[8] = {'K', 'N', 'I', 'T', 'S', 'U', 'M', '1'};
+
+struct Extent {
+  std::uint64_t addr, size;
+};
+
+/// Raw-data extents (contiguous data and chunks) of every dataset in an open file.
+std::vector<Extent> raw_data_extents(hid_t file) {
+  struct Visit {
+    std::vector<Extent> out;
+    bool ok = true;
+  } v;
+  auto cb = [](hid_t group, const char* name, const H5L_info_t* info, void* data) -> herr_t {
+    auto& v = *static_cast<Visit*>(data);
+    if (info->type != H5L_TYPE_HARD || object_type(group, name) != H5O_TYPE_DATASET) return 0;
+    H5Handle ds(H5Dopen2(group, name, H5P_DEFAULT));
+    H5Handle dcpl(ds.valid() ? H5Dget_create_plist(ds.get()) : -1);
+    H5Handle space(ds.valid() ? H5Dget_space(ds.get()) : -1);
+    if (!ds.valid() || !dcpl.valid() || !space.valid()) {
+      v.ok = false;
+      return -1;
+    }
+    const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+    if (layout == H5D_CONTIGUOUS) {
+      const haddr_t a = H5Dget_offset(ds.get());
+      const hsize_t n = H5Dget_storage_size(ds.get());
+      if (a != HADDR_UNDEF && n > 0) v.out.push_back({a, n});
+    } else if (layout == H5D_CHUNKED) {
+      hsize_t chunks = 0;
+      if (H5Dget_num_chunks(ds.get(), space.get(), &chunks) < 0) chunks = 0;
+      for (hsize_t i = 0; i < chunks; ++i) {
+        unsigned mask = 0;
+        haddr_t addr = HADDR_UNDEF;
+        hsize_t size = 0;
+        if (H5Dget_chunk_info(ds.get(), space.get(), i, nullptr, &mask, &addr, &size) >= 0 &&
+            addr != HADDR_UNDEF && size > 0)
+          v.out.push_back({addr, size});
+      }
+    }
+    return 0;
+  };
+  if (H5Lvisit(file, H5_INDEX_NAME, H5_ITER_NATIVE, cb, &v) < 0 || !v.ok)
+    throw std::runtime_error("cannot list the datasets");
+  std::sort(v.out.begin(), v.out.end(),
+            [](const Extent& a, const Extent& b) { return a.addr < b.addr; });
+  return v.out;
+}
+
+/// Digest of bytes [0, end) of `in` without the extents, chained with the extents and end.
+std::uint64_t structure_digest(std::FILE* in, std::uint64_t end, const std::vector<Extent>& ex) {
+  std::uint64_t h = fnv1a(nullptr, 0);
+  std::vector<char> buf(1 << 16);
+  std::uint64_t pos = 0;
+  std::size_t next = 0;
+  if (std::fseek(in, 0, SEEK_SET) != 0) throw std::runtime_error("cannot read the file");
+  while (pos < end) {
+    while (next < ex.size() && ex[next].addr + ex[next].size <= pos) ++next;
+    std::uint64_t stop = end;  // read up to the next extent (or skip the one we are in)
+    if (next < ex.size()) {
+      if (ex[next].addr <= pos) {
+        pos = std::min(end, ex[next].addr + ex[next].size);
+        if (std::fseek(in, static_cast<long>(pos), SEEK_SET) != 0)
+          throw std::runtime_error("cannot read the file");
+        continue;
+      }
+      stop = std::min(end, ex[next].addr);
+    }
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(stop - pos, buf.size()));
+    if (std::fread(buf.data(), 1, n, in) != n) throw std::runtime_error("cannot read the file");
+    h = fnv1a(buf.data(), n, h);
+    pos += n;
+  }
+  for (const Extent& e : ex) {
+    h = fnv1a(&e.addr, 8, h);
+    h = fnv1a(&e.size, 8, h);
+  }
+  return fnv1a(&end, 8, h);
+}
+
+struct CFile {
+  std::FILE* f;
+  ~CFile() {
+    if (f) std::fclose(f);
+  }
+};
+
+/// Appends the trailer to a closed HDF5 file written here.
+void stamp_structure(const std::string& name) {
+  std::vector<Extent> ex;
+  {
+    H5Handle f(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+    if (!f.valid()) throw std::runtime_error(name + ": cannot reopen the HDF5 file to checksum it");
+    ex = raw_data_extents(f.get());
+  }
+  CFile c{std::fopen(name.c_str(), "r+b")};
+  if (!c.f) throw std::runtime_error(name + ": cannot reopen the HDF5 file to checksum it");
+  if (std::fseek(c.f, 0, SEEK_END) != 0) throw std::runtime_error(name + ": cannot seek");
+  const auto end = static_cast<std::uint64_t>(std::ftell(c.f));
+  std::vector<std::uint64_t> words{ex.size()};
+  for (const Extent& e : ex) {
+    words.push_back(e.addr);
+    words.push_back(e.size);
+  }
+  words.push_back(end);
+  words.push_back(structure_digest(c.f, end, ex));
+  words.push_back((words.size() + 1) * 8 + sizeof kTrailerMagic);
+  if (std::fseek(c.f, 0, SEEK_END) != 0 ||
+      std::fwrite(words.data(), 8, words.size(), c.f) != words.size() ||
+      std::fwrite(kTrailerMagic, 1, sizeof kTrailerMagic, c.f) != sizeof kTrailerMagic ||
+      std::fflush(c.f) != 0)
+    throw std::runtime_error(name + ": cannot write the checksum trailer (disk full?)");
+}
+
+/// Verifies the trailer of a file, if it has one (files written before it existed do not).
+void verify_structure(const std::string& name, std::uint64_t file_size) {
+  const std::uint64_t tail = 3 * 8 + sizeof kTrailerMagic;
+  if (file_size < tail) return;
+  CFile c{std::fopen(name.c_str(), "rb")};
+  if (!c.f) throw InputError(name, "", "cannot read file");
+  char magic[8];
+  std::uint64_t last[3];
+  if (std::fseek(c.f, static_cast<long>(file_size - tail), SEEK_SET) != 0 ||
+      std::fread(last, 8, 3, c.f) != 3 || std::fread(magic, 1, 8, c.f) != 8 ||
+      std::memcmp(magic, kTrailerMagic, 8) != 0)
+    return;  // no trailer: an older file, read unverified
+  const auto bad = [&](const std::string& why) {
+    throw InputError(name, "",
+                     "the file's structure checksum does not match (" + why +
+                         "): it was changed or damaged after it was written");
+  };
+  const std::uint64_t size = last[2], end = last[0], digest = last[1];
+  if (size < tail || size > file_size || (size - tail) % 16 != 8 || end != file_size - size)
+    bad("trailer damaged");
+  std::vector<std::uint64_t> words((size - sizeof kTrailerMagic) / 8);
+  if (std::fseek(c.f, static_cast<long>(end), SEEK_SET) != 0 ||
+      std::fread(words.data(), 8, words.size(), c.f) != words.size())
+    bad("trailer unreadable");
+  const std::uint64_t n = words[0];
+  if (n * 2 + 4 != words.size()) bad("trailer damaged");
+  std::vector<Extent> ex(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < ex.size(); ++i) {
+    ex[i] = {words[1 + 2 * i], words[2 + 2 * i]};
+    if (ex[i].addr > end || ex[i].size > end - ex[i].addr || (i > 0 && ex[i].addr < ex[i - 1].addr))
+      bad("trailer damaged");
+  }
+  if (structure_digest(c.f, end, ex) != digest) bad("FNV-1a 64");
+}
+
+}  // namespace
 
 // ---- H5File ---------------------------------------------------------------------------------
 
@@ -606,20 +935,25 @@ bool is_hdf5_file(const std::filesystem::path& file) {
 }
 
 H5File::H5File(const std::filesystem::path& file, Mode mode)
-    : H5Group(H5Handle(), file.string(), "/") {
+    : H5Group(H5Handle(), file.string(), "/"), mode_(mode) {
   silence_hdf5();
   const std::string name = file.string();
   // File access: keep HDF5's file locking, but do not fail on file systems without locks (NFS).
   H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
   H5Pset_file_locking(fapl.get(), 1, 1);
+  // Closing the file closes every object still open in it (groups a caller holds), so the
+  // file is complete on disk when close() returns and its structure checksum is final.
+  H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG);
   if (mode == Mode::Truncate) {
     file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
     if (!file_id_.valid())
       throw std::runtime_error(name +
                                ": cannot create HDF5 file (directory missing or not writable?)");
   } else {
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) throw std::runtime_error(name + ": file not found");
+    // Regular files only (a FIFO or a device is refused before HDF5 touches it); the
+    // structure checksum before HDF5 parses anything.
+    const std::uint64_t size = check_input_file(file, kMaxHdf5InputBytes);
+    verify_structure(name, size);
     if (!is_hdf5_file(file)) throw std::runtime_error(name + ": not an HDF5 file (or truncated)");
     const unsigned flags = mode == Mode::ReadOnly ? H5F_ACC_RDONLY : H5F_ACC_RDWR;
     file_id_ = H5Handle(H5Fopen(name.c_str(), flags, fapl.get()));
@@ -630,16 +964,31 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
   if (!id_.valid()) throw std::runtime_error(name + ": cannot open the root group (corrupt file?)");
 }
 
+H5File::~H5File() {
+  // The root group before the file: a file closed under an open group stays half-open in
+  // the library, and HDF5's exit handler crashed on it after a failed flush (disk full).
+  if (!file_id_.valid()) return;
+  try {
+    close();
+  } catch (const std::exception&) {
+    // A destructor reports nothing: close() explicitly to see errors (AtomicH5File does).
+  }
+}
+
 void H5File::flush() {
   if (file_id_.valid() && H5Fflush(file_id_.get(), H5F_SCOPE_GLOBAL) < 0)
-    throw std::runtime_error(file_ + ": cannot flush HDF5 file");
+    throw std::runtime_error(file_ + ": cannot flush HDF5 file (disk full?)");
 }
 
 void H5File::close() {
   if (!file_id_.valid()) return;
-  flush();
+  // Every handle is released whether or not the flush succeeds (then the error is reported).
+  const bool flushed = H5Fflush(file_id_.get(), H5F_SCOPE_GLOBAL) >= 0;
   id_.reset();
-  file_id_.reset();
+  const bool closed = close_file(file_id_.release()) >= 0;
+  if (!flushed || !closed)
+    throw std::runtime_error(file_ + ": cannot write the HDF5 file to disk (disk full?)");
+  if (mode_ != Mode::ReadOnly) stamp_structure(file_);
 }
 
 // ---- AtomicH5File -------------------------------------------------------------------------

@@ -2,13 +2,14 @@
 #include "knit/io/json_input.hpp"
 
 #include <algorithm>
-#include <fstream>
+#include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 
 namespace knit::io {
 
@@ -25,18 +26,28 @@ struct LineScanner {
   std::string_view t;
   std::size_t i = 0;
   int line = 1;
-  bool record = true;  // fill `lines` (otherwise only look for duplicate keys)
+  std::size_t line_start = 0;  // offset of the current line's first character
+  bool record = true;          // fill `lines` (otherwise only look for duplicate keys)
   std::map<std::string, int> lines;
   struct Duplicate {
     std::string pointer;
     int first_line, second_line;
   };
   std::vector<Duplicate> duplicates;
+  struct BadNumber {
+    std::string pointer, token;
+    int line;
+    std::size_t column;
+  };
+  std::vector<BadNumber> bad_numbers;  // numbers that do not fit a double (1e400)
 
   bool at_ws() const { return t[i] == ' ' || t[i] == '\t' || t[i] == '\n' || t[i] == '\r'; }
   void ws() {
     while (i < t.size() && at_ws()) {
-      if (t[i] == '\n') ++line;
+      if (t[i] == '\n') {
+        ++line;
+        line_start = i + 1;
+      }
       ++i;
     }
   }
@@ -143,7 +154,12 @@ struct LineScanner {
     } else if (t[i] == '"') {
       string();
     } else {  // number, true, false, null
+      const std::size_t start = i;
       while (i < t.size() && t[i] != ',' && t[i] != '}' && t[i] != ']' && !at_ws()) ++i;
+      const std::string token(t.substr(start, i - start));
+      if (!token.empty() && (token[0] == '-' || (token[0] >= '0' && token[0] <= '9')) &&
+          !std::isfinite(std::strtod(token.c_str(), nullptr)))
+        bad_numbers.push_back({ptr, token, line, start - line_start + 1});
     }
   }
 };
@@ -156,57 +172,102 @@ std::map<std::string, int> json_pointer_lines(std::string_view text) {
   return std::move(s.lines);
 }
 
-nlohmann::json parse_json(std::string_view text, const std::string& source) {
-  try {
-    nlohmann::json j = nlohmann::json::parse(text.begin(), text.end());
-    // nlohmann keeps the last of duplicate keys silently; a case file with a key twice is
-    // almost certainly a mistake.
-    LineScanner scan;
-    scan.t = text;
-    scan.record = false;
-    scan.value("");
-    if (!scan.duplicates.empty()) {
-      const auto& d = scan.duplicates.front();
-      throw knit::InputError(source, d.pointer,
-                             "duplicate key (lines " + std::to_string(d.first_line) + " and " +
-                                 std::to_string(d.second_line) + ")");
+namespace {
+/// Line and column (1-based) of byte offset `at`.
+std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t at) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i < std::min(at, text.size()); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
     }
-    return j;
+  }
+  return {line, col};
+}
+
+[[noreturn]] void fail_at(std::string_view text, const std::string& source, std::size_t at,
+                          const std::string& what) {
+  const auto [line, col] = line_column(text, at);
+  throw knit::InputError(source, "",
+                         "invalid JSON at line " + std::to_string(line) + ", column " +
+                             std::to_string(col) + ": " + what);
+}
+
+/// Refuses nesting deeper than kMaxJsonDepth before anything recursive (the line scanner, the
+/// schema validator, the loaders) sees the text: 40,000 levels overflowed the stack (issue 14).
+void check_depth(std::string_view text, const std::string& source) {
+  std::size_t depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        fail_at(text, source, i,
+                "nested deeper than " + std::to_string(kMaxJsonDepth) + " arrays/objects");
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
+}  // namespace
+
+nlohmann::json parse_json(std::string_view text, const std::string& source) {
+  check_depth(text, source);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text.begin(), text.end());
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte is the 1-based offset of the character where parsing failed.
-    const std::size_t at = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i < at; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
     // Keep nlohmann's explanation, without its "[json.exception...] parse error at ...:" prefix.
     std::string what = e.what();
     if (auto p = what.find("parse error"); p != std::string::npos) {
       what = what.substr(p);
       if (auto q = what.find(": "); q != std::string::npos) what = what.substr(q + 2);
     }
-    throw knit::InputError(source, "",
-                           "invalid JSON at line " + std::to_string(line) + ", column " +
-                               std::to_string(col) + ": " + what);
+    fail_at(text, source, e.byte > 0 ? e.byte - 1 : 0, what);
+  } catch (const nlohmann::json::exception& e) {
+    // A number that does not fit a double (1e400; nlohmann's out_of_range 406 names neither
+    // the file nor the place): find it with the scanner, which knows the pointer.
+    LineScanner scan;
+    scan.t = text;
+    scan.record = false;
+    scan.value("");
+    if (!scan.bad_numbers.empty()) {
+      const auto& b = scan.bad_numbers.front();
+      throw knit::InputError(source, b.pointer,
+                             "the number " + b.token + " is outside the range of a double (line " +
+                                 std::to_string(b.line) + ", column " + std::to_string(b.column) +
+                                 ")");
+    }
+    throw knit::InputError(source, "", std::string("invalid JSON: ") + e.what());
   }
+  // nlohmann keeps the last of duplicate keys silently; a case file with a key twice is
+  // almost certainly a mistake.
+  LineScanner scan;
+  scan.t = text;
+  scan.record = false;
+  scan.value("");
+  if (!scan.duplicates.empty()) {
+    const auto& d = scan.duplicates.front();
+    throw knit::InputError(source, d.pointer,
+                           "duplicate key (lines " + std::to_string(d.first_line) + " and " +
+                               std::to_string(d.second_line) + ")");
+  }
+  return j;
 }
 
 namespace {
 std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    const bool exists = std::filesystem::exists(file, ec);
-    throw knit::InputError(file.string(), "", exists ? "cannot read file" : "file not found");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return read_input_file(file, kMaxJsonInputBytes);
 }
 }  // namespace
 

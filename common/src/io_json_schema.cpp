@@ -5,12 +5,12 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <stdexcept>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/pattern.hpp"
 
 namespace knit::io {
 
@@ -159,7 +159,8 @@ struct JsonSchema::Impl {
   json root;
   std::string name;
   mutable std::mutex regex_mutex;
-  mutable std::map<std::string, std::regex> regexes;
+  // Not std::regex: it recurses per subject character (a long string overflows the stack).
+  mutable std::map<std::string, Pattern> regexes;
 
   // Internal error record: `expected_type` is set for pure type mismatches (used to merge the
   // alternatives of oneOf/anyOf into one message).
@@ -174,11 +175,10 @@ struct JsonSchema::Impl {
                            what);
   }
 
-  const std::regex& regex(const std::string& pattern) const {
+  const Pattern& regex(const std::string& pattern) const {
     std::lock_guard<std::mutex> lock(regex_mutex);
     auto it = regexes.find(pattern);
-    if (it == regexes.end())
-      it = regexes.emplace(pattern, std::regex(pattern, std::regex::ECMAScript)).first;
+    if (it == regexes.end()) it = regexes.emplace(pattern, Pattern(pattern)).first;
     return it->second;
   }
 
@@ -254,7 +254,7 @@ struct JsonSchema::Impl {
   void regex_checked(const std::string& pattern, const std::string& where) const {
     try {
       regex(pattern);
-    } catch (const std::regex_error& e) {
+    } catch (const std::invalid_argument& e) {
       schema_fail(where, "invalid regular expression \"" + pattern + "\": " + e.what());
     }
   }
@@ -347,7 +347,7 @@ struct JsonSchema::Impl {
           "must have at most " + short_dump(*it) + " characters, got " + describe_value(v));
     if (auto it = s.find("pattern"); it != s.end()) {
       const std::string& pat = it->get_ref<const std::string&>();
-      if (!std::regex_search(str, regex(pat)))
+      if (!regex(pat).search(str))
         add(out, ptr, "must match the pattern " + short_dump(*it) + ", got " + describe_value(v));
     }
   }
@@ -414,7 +414,7 @@ struct JsonSchema::Impl {
       }
       if (patterns) {
         for (auto p = patterns->begin(); p != patterns->end(); ++p)
-          if (std::regex_search(key, regex(p.key()))) {
+          if (regex(p.key()).search(key)) {
             matched = true;
             run(p.value(), it.value(), child, depth + 1, out);
           }

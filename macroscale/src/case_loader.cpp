@@ -1,13 +1,13 @@
 // Case JSON -> Case (case.hpp). Every check names the file and the JSON pointer; unknown keys
 // are errors at every level (the same rules as schemas/case.schema.json).
 #include <algorithm>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/names.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/material_factory.hpp"
@@ -188,6 +188,16 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
     const int ev = r.integer(el[1], "/refinement/elements/1", 1, 256);
     c.surface = refine_patch(c.input_surface, p, eu, ev);
   }
+  // Refuse what cannot fit in memory now, not with std::bad_alloc at the start of the run.
+  const MemoryEstimate mem = estimate_shell_memory(c.surface);
+  const std::uint64_t limit = memory_limit_bytes();
+  if (mem.total() > limit)
+    r.fail(root.contains("refinement") ? "/refinement" : "/geometry",
+           std::to_string(c.surface.size_u()) + " x " + std::to_string(c.surface.size_v()) +
+               " control points of degree (" + std::to_string(c.surface.basis_u().degree()) + ", " +
+               std::to_string(c.surface.basis_v().degree()) + ") need about " + mem.describe() +
+               ", more than the " + format_bytes(limit) +
+               " available (KNIT_MAX_MEMORY_MB overrides); use fewer elements or a lower degree");
 }
 
 void read_bcs(const Reader& r, const json& root, Case& c) {
@@ -340,10 +350,11 @@ void read_output(const Reader& r, const json& root, Case& c) {
   if (o.contains("vtk")) out.vtk = r.boolean(o.at("vtk"), "/output/vtk");
   if (o.contains("hdf5")) out.hdf5 = r.boolean(o.at("hdf5"), "/output/hdf5");
   std::set<std::string> names;
+  // Names become HDF5 datasets and CSV columns: checked here, before any work (a point
+  // named "." used to fail only when the results were written).
   auto unique_name = [&](const json& j, const std::string& ptr) {
     const std::string n = r.string(j, ptr);
-    if (n.empty() || n.find_first_of(",\"\n/") != std::string::npos)
-      r.fail(ptr, "names must be non-empty without commas, quotes, slashes or newlines");
+    if (const auto problem = io::output_name_problem(n)) r.fail(ptr, *problem);
     if (!names.insert(n).second) r.fail(ptr, "the name \"" + n + "\" is used twice");
     return n;
   };
@@ -446,11 +457,8 @@ Case parse_case(const std::string& text, const std::string& file) {
 }
 
 Case load_case(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open the case file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return parse_case(s.str(), path);
+  // Regular files only, at most io::kMaxJsonInputBytes (a FIFO blocked, /dev/zero never ended).
+  return parse_case(io::read_input_file(path), path);
 }
 
 }  // namespace knit::macro

@@ -24,6 +24,7 @@
 #include "knit/macro/material_factory.hpp"
 #include "knit/material/database.hpp"
 #include "knit/material/response_surface.hpp"
+#include "knit/spline/basis.hpp"
 
 namespace knit::macro {
 
@@ -64,6 +65,12 @@ Basis2 read_basis(const nlohmann::json& j, const std::string& p, const CaseConte
   const auto d = number_array(j.at("degrees"), p + "/degrees", ctx);
   if (d.size() != 2 || d[0] < 0 || d[1] < 0 || d[0] != std::floor(d[0]) || d[1] != std::floor(d[1]))
     throw InputError(ctx.file, p + "/degrees", "must be two non-negative integers");
+  // Range before the conversion to int (1e10 overflowed it: undefined behaviour).
+  for (int k = 0; k < 2; ++k)
+    if (d[k] > spline::kMaxDegree)
+      throw InputError(ctx.file, p + "/degrees/" + std::to_string(k),
+                       "must be at most " + std::to_string(spline::kMaxDegree) + ", got " +
+                           nlohmann::json(d[k]).dump());
   b.pu = static_cast<int>(d[0]);
   b.pv = static_cast<int>(d[1]);
   b.U = number_array(j.at("knots_u"), p + "/knots_u", ctx);

@@ -2,6 +2,11 @@
 // (knit/spline/refine.hpp: degree elevation A5.9, then knot insertion A5.4).
 #include "knit/macro/refinement.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +20,59 @@ spline::SplineSurface refine_patch(const spline::SplineSurface& s, int p, int eu
                                 " is below the patch's degree");
   if (eu < 1 || ev < 1) throw std::invalid_argument("the number of elements must be at least 1");
   return spline::refine(s, p, eu, ev);
+}
+
+namespace {
+/// Number of non-empty knot spans.
+std::uint64_t num_spans(const std::vector<double>& U) {
+  std::uint64_t n = 0;
+  for (std::size_t i = 1; i < U.size(); ++i) n += U[i] > U[i - 1];
+  return n;
+}
+
+}  // namespace
+
+std::string format_bytes(std::uint64_t b) {
+  char buf[32];
+  const double gb = static_cast<double>(b) / 1e9;
+  if (gb >= 1.0)
+    std::snprintf(buf, sizeof buf, gb >= 10 ? "%.0f GB" : "%.1f GB", gb);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f MB", static_cast<double>(b) / 1e6);
+  return buf;
+}
+
+std::string MemoryEstimate::describe() const {
+  return format_bytes(total()) + " (quadrature data " + format_bytes(quadrature) +
+         ", element tangents " + format_bytes(element_tangents) + ", global system " +
+         format_bytes(global_system) + ")";
+}
+
+MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
+  // Doubles throughout: the counts reach 1e11 for the largest schema-legal refinement.
+  const double pu = s.basis_u().degree(), pv = s.basis_v().degree();
+  const double nloc = (pu + 1) * (pv + 1), q = nloc;
+  const double E = static_cast<double>(num_spans(s.basis_u().knots())) *
+                   static_cast<double>(num_spans(s.basis_v().knots()));
+  const double N = 3.0 * s.size_u() * s.size_v();
+  MemoryEstimate m;
+  m.quadrature = static_cast<std::uint64_t>(E * q * (11.0 * nloc * 8.0 + 256.0));
+  m.element_tangents = static_cast<std::uint64_t>(E * 9.0 * nloc * nloc * 8.0);
+  const double nnz = N * 3.0 * (2 * pu + 1) * (2 * pv + 1);
+  m.global_system =
+      static_cast<std::uint64_t>(N <= 2500 ? 2.0 * N * N * 8.0 : 3.0 * 16.0 * std::min(nnz, N * N));
+  return m;
+}
+
+std::uint64_t memory_limit_bytes() {
+  if (const char* env = std::getenv("KNIT_MAX_MEMORY_MB")) {
+    char* end = nullptr;
+    const unsigned long long mb = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && mb > 0) return static_cast<std::uint64_t>(mb) << 20;
+  }
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return ~std::uint64_t{0};
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page);
 }
 
 }  // namespace knit::macro

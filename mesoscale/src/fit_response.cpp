@@ -161,6 +161,11 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
     if (!j.contains(k)) return;
     if (!j[k].is_number_integer())
       throw InputError(file, std::string("/") + k, "must be an integer");
+    // Range before narrowing: get<int>() of 4294967297 gave 1 (issue 14).
+    if (j[k].is_number_unsigned()
+            ? j[k].get<unsigned long long>() > 2147483647ull
+            : (j[k].get<long long>() < -2147483648ll || j[k].get<long long>() > 2147483647ll))
+      throw InputError(file, std::string("/") + k, "must fit a 32-bit integer, got " + j[k].dump());
     v = j[k].get<int>();
   };
   auto get_double = [&](const char* k, double& v) {

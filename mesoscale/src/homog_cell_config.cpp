@@ -49,9 +49,13 @@ struct Reader {
     const json& x = j[key];
     const std::string p = ptr + "/" + key;
     if (!x.is_number_integer()) fail(p, "must be an integer");
-    const int i = x.get<int>();
+    // Range before narrowing: get<int>() of 4294967297 gave 1 (issue 14).
+    const long long i = x.is_number_unsigned() && x.get<unsigned long long>() > 1ull << 62
+                            ? 1ll << 62
+                            : x.get<long long>();
     if (i < lo) fail(p, "must be >= " + std::to_string(lo) + ", got " + std::to_string(i));
-    v = i;
+    if (i > std::numeric_limits<int>::max()) fail(p, "must be at most 2147483647, got " + x.dump());
+    v = static_cast<int>(i);
   }
 };
 

@@ -25,13 +25,14 @@ class ScratchDir {
   ScratchDir& operator=(const ScratchDir&) = delete;
   ~ScratchDir() {
     std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
+    if (::getpid() == owner_) std::filesystem::remove_all(dir_, ec);  // not in a forked child
   }
   const std::filesystem::path& path() const { return dir_; }
   std::filesystem::path operator/(const std::string& name) const { return dir_ / name; }
 
  private:
   std::filesystem::path dir_;
+  pid_t owner_ = ::getpid();
 };
 
 }  // namespace knit_test

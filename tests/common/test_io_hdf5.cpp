@@ -1,15 +1,23 @@
 // HDF5 adapter: round trips, shapes as h5py sees them, attribute kinds, and error messages
 // that name the file and the object path.
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
 #include <catch2/catch.hpp>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <regex>
 #include <string>
 
+#include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "scratch_dir.hpp"
+#include "knit/material/database.hpp"
+#include "test_material_util.hpp"
 
 namespace fs = std::filesystem;
 using knit::io::H5File;
@@ -195,4 +203,228 @@ TEST_CASE("only the HDF5 adapter includes hdf5.h", "[unit][io][layering]") {
   }
   for (const auto& h : hits) UNSCOPED_INFO(h);
   CHECK(hits.empty());
+}
+
+// ---- hardening (issue 14) ----------------------------------------------------------------------
+
+namespace {
+std::string bytes_of(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// Flips the sign bit of `value` where its 8 bytes occur exactly once in the file (the data
+/// of one dataset; found by its bit pattern, so the test needs no HDF5 API). False if the
+/// pattern is absent or not unique.
+bool flip_sign_bit_of(const fs::path& f, double value) {
+  std::string b = bytes_of(f);
+  const std::string pat(reinterpret_cast<const char*>(&value), sizeof value);
+  const auto at = b.find(pat);
+  if (at == std::string::npos || b.find(pat, at + 1) != std::string::npos) return false;
+  b[at + 7] = static_cast<char>(b[at + 7] ^ 0x80);  // little-endian: the sign is in byte 7
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << b;
+  return true;
+}
+
+/// Replaces every 8-byte little-endian `from` (the dimension and maximum dimension of a
+/// dataspace) by `to`.
+bool patch_u64(const fs::path& f, std::uint64_t from, std::uint64_t to) {
+  std::string b = bytes_of(f);
+  const std::string pat(reinterpret_cast<const char*>(&from), 8);
+  auto at = b.find(pat);
+  if (at == std::string::npos) return false;
+  for (; at != std::string::npos; at = b.find(pat, at + 8)) std::memcpy(b.data() + at, &to, 8);
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << b;
+  return true;
+}
+
+/// Removes the structure-checksum trailer (the file then looks like one written before it).
+void strip_trailer(const fs::path& f) {
+  const std::string b = bytes_of(f);
+  REQUIRE(b.size() > 16);
+  REQUIRE(b.substr(b.size() - 8) == "KNITSUM1");
+  std::uint64_t size = 0;
+  std::memcpy(&size, b.data() + b.size() - 16, 8);
+  fs::resize_file(f, b.size() - size);
+}
+
+std::string input_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const knit::InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("not an InputError: ") + e.what();
+  }
+  return "<no exception>";
+}
+}  // namespace
+
+TEST_CASE("HDF5 checksums: a flipped bit in any dataset is an InputError naming it",
+          "[unit][io][hdf5]") {
+  const fs::path file = scratch("checksum.h5");
+  knit::io::RowMatrixXd M(3, 2);
+  M << 1.25, -2.5, 3.75, 41.4375, 5.5, 6.0625;
+  {
+    H5File f = H5File::create(file);
+    f.write("/loop_0/fit/S_ctrl", M);
+    f.write_dataset("/scalar", std::vector<double>{17.3125}, {});
+    f.write_strings("/names", {"alpha", "beta"});
+    f.write("/gz", std::vector<double>{7.0, 8.0, 9.0}, {.gzip_level = 4});
+  }
+  {
+    H5File f = H5File::open_read(file);
+    CHECK(f.read_matrix("/loop_0/fit/S_ctrl") == M);
+    CHECK(f.read_doubles("/scalar") == std::vector<double>{17.3125});
+    CHECK(f.read_strings("/names") == std::vector<std::string>{"alpha", "beta"});
+    CHECK(f.read_doubles("/gz") == std::vector<double>{7.0, 8.0, 9.0});
+  }
+  const fs::path bad = scratch("checksum_bad.h5");
+  fs::copy_file(file, bad, fs::copy_options::overwrite_existing);
+  REQUIRE(flip_sign_bit_of(bad, 41.4375));
+  CHECK(input_error_of([&] { H5File::open_read(bad).read_matrix("/loop_0/fit/S_ctrl"); }) ==
+        bad.string() +
+            ": /loop_0/fit/S_ctrl: checksum mismatch (Fletcher32): the stored data is corrupt");
+  fs::copy_file(file, bad, fs::copy_options::overwrite_existing);
+  REQUIRE(flip_sign_bit_of(bad, 17.3125));
+  CHECK(input_error_of([&] { H5File::open_read(bad).read_doubles("/scalar"); }) ==
+        bad.string() + ": /scalar: checksum mismatch (knit_fnv1a64): the stored data is corrupt");
+  // A string lives in HDF5's global heap, which the structure checksum covers: flip one
+  // bit of "alpha" (unique in the file) and the file is refused when opened.
+  auto flip_alpha = [&] {
+    std::string b = bytes_of(bad);
+    const auto at = b.find("alpha");
+    REQUIRE(at != std::string::npos);
+    b[at] = 'b';
+    std::ofstream(bad, std::ios::binary | std::ios::trunc) << b;
+  };
+  fs::copy_file(file, bad, fs::copy_options::overwrite_existing);
+  flip_alpha();
+  CHECK(input_error_of([&] { H5File::open_read(bad); }) ==
+        bad.string() +
+            ": the file's structure checksum does not match (FNV-1a 64): it was changed or "
+            "damaged after it was written");
+  // Without the trailer (an older file), the dataset's own digest still finds it.
+  fs::copy_file(file, bad, fs::copy_options::overwrite_existing);
+  strip_trailer(bad);
+  flip_alpha();
+  CHECK_THAT(input_error_of([&] { H5File::open_read(bad).read_strings("/names"); }),
+             Catch::StartsWith(bad.string() + ": /names: checksum mismatch"));
+  // Any metadata byte: the name of a group.
+  fs::copy_file(file, bad, fs::copy_options::overwrite_existing);
+  {
+    std::string b = bytes_of(bad);
+    const auto at = b.find("loop_0");
+    REQUIRE(at != std::string::npos);
+    b[at] = 'L';
+    std::ofstream(bad, std::ios::binary | std::ios::trunc) << b;
+  }
+  CHECK_THAT(input_error_of([&] { H5File::open_read(bad); }),
+             Catch::Contains("structure checksum does not match"));
+}
+
+TEST_CASE("HDF5 files written without checksums still load", "[unit][io][hdf5]") {
+  const fs::path file = scratch("old.h5");
+  {
+    H5File f = H5File::create(file);
+    f.write("/v", std::vector<double>{1.0, 2.0}, {.checksum = false});
+    f.write_dataset("/s", std::vector<double>{3.0}, {}, {.checksum = false});
+  }
+  strip_trailer(file);
+  H5File f = H5File::open_read(file);
+  CHECK(f.read_doubles("/v") == std::vector<double>{1.0, 2.0});
+  CHECK(f.read_doubles("/s") == std::vector<double>{3.0});
+}
+
+TEST_CASE("HDF5: a declared extent larger than the file or the cap is refused before allocating",
+          "[unit][io][hdf5]") {
+  // A 2^27 x 2 dataset declared in a small file allocated 4.2 GB before the read failed.
+  const fs::path file = scratch("extent.h5");
+  for (const auto& [rows, expect] :
+       {std::pair<std::uint64_t, std::string>{1ull << 27,
+                                              "declares 134217728 x 2 elements (2.1 GB), more "
+                                              "than the 1.1 GB accepted per dataset"},
+        {100000, "declares 100000 x 2 elements (1.6 MB) but the file has only "}}) {
+    {
+      H5File f = H5File::create(file);
+      f.write("/m", knit::io::RowMatrixXd::Constant(777, 2, 0.5), {.checksum = false});
+    }
+    strip_trailer(file);                  // as a file from elsewhere: no structure checksum
+    REQUIRE(patch_u64(file, 777, rows));  // the dataspace's first dimension
+    CHECK_THAT(input_error_of([&] { H5File::open_read(file).read_matrix("/m"); }),
+               Catch::StartsWith(file.string() + ": /m: " + expect));
+  }
+}
+
+TEST_CASE("HDF5: only regular files are opened", "[unit][io][hdf5]") {
+  CHECK(input_error_of([] { H5File::open_read("/dev/zero"); }) ==
+        "/dev/zero: not a regular file (a character device); inputs must be regular files");
+  CHECK_THAT(input_error_of([] { H5File::open_read(KNIT_BINARY_DIR); }),
+             Catch::Contains("not a regular file (a directory)"));
+}
+
+TEST_CASE("HDF5: disk full while flushing gives a clean error and a clean exit",
+          "[unit][io][hdf5]") {
+  // The disk is made full with RLIMIT_FSIZE in a child process (writes past the limit fail
+  // with EFBIG; SIGXFSZ ignored). Before the fix the child printed "cannot flush HDF5 file"
+  // and then died of SIGSEGV in HDF5's exit handler (an open root group of a failed file).
+  // Also tested by hand on a 200 KB tmpfs (docs/io.md).
+  const fs::path file = scratch("full.h5");
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit r{100000, 100000};
+    setrlimit(RLIMIT_FSIZE, &r);
+    int code = 0;
+    try {
+      knit::io::AtomicH5File f(file);
+      for (int k = 0; k < 100; ++k) {
+        f->write("/g" + std::to_string(k) + "/b", std::vector<double>(100, 1.0));
+        f->set_attribute("/g" + std::to_string(k), "x", std::string(1000, 'x'));
+      }
+      f.commit();
+    } catch (const std::runtime_error& e) {
+      code = std::string(e.what()).find("disk full") != std::string::npos ? 3 : 4;
+    }
+    std::exit(code);  // runs the exit handlers, HDF5's included
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  CHECK(WIFEXITED(status));
+  CHECK((WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status)) == 3);
+  CHECK_FALSE(fs::exists(file));
+}
+
+TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",
+          "[unit][io][hdf5]") {
+  // Issue 14: this ran to completion with 18.6 N instead of 41.4 N.
+  using namespace knit::material;
+  Database db;
+  db.provenance = current_provenance();
+  db.generator = "test";
+  db.sweep_input = "{}";
+  db.yarn = {{"diameter", 0.38}};
+  LoopLengthEntry e;
+  e.loop_length = 5.0;
+  e.cell = {1.26, 0.88, 0.76};
+  e.surface = testing::make_test_surface(1.0);
+  e.diagnostics.options_json = "{}";
+  db.entries.push_back(e);
+  const fs::path file = scratch("db_flip.h5");
+  write_database(file, db);
+  REQUIRE_NOTHROW(read_database(file));
+  const knit::io::RowMatrixXd S = H5File::open_read(file).read_matrix("/loop_0/fit/S_ctrl");
+  bool flipped = false;
+  for (Eigen::Index i = 0; i < S.size() && !flipped; ++i)
+    if (S.data()[i] != 0.0) flipped = flip_sign_bit_of(file, S.data()[i]);
+  REQUIRE(flipped);
+  try {
+    read_database(file);
+    FAIL("no exception");
+  } catch (const knit::InputError& err) {
+    CHECK(err.file() == file.string());
+    CHECK(err.pointer() == "/loop_0/fit/S_ctrl");
+    CHECK_THAT(err.message(), Catch::StartsWith("checksum mismatch (Fletcher32)"));
+  }
 }

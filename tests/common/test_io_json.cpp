@@ -1,15 +1,20 @@
 // JSON input: parse errors with line/column, the schema validator keyword by keyword (on
 // tests/data/io_test.schema.json), JSON pointer escaping, and the embedded schemas.
+#include <sys/stat.h>
 #include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/pattern.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -314,4 +319,92 @@ TEST_CASE("paths inside input files are relative to the file", "[unit][io][json]
         fs::path("/cases/db/m.h5"));
   CHECK(knit::io::resolve_input_path("/cases/a.json", "/abs/m.h5") == fs::path("/abs/m.h5"));
   CHECK(knit::io::resolve_input_path("a.json", "m.h5") == fs::path("m.h5"));
+}
+
+// ---- hardening (issue 14) ----------------------------------------------------------------------
+
+TEST_CASE("JSON nested 40,000 levels deep is an input error, not a stack overflow",
+          "[unit][io][json]") {
+  const std::string deep = "{\"a\": " + std::string(40000, '[') + std::string(40000, ']') + "}";
+  try {
+    knit::io::parse_json(deep, "deep.json");
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == "deep.json");
+    CHECK_THAT(e.message(), Catch::StartsWith("invalid JSON at line 1, column ") &&
+                                Catch::Contains("nested deeper than 256"));
+  }
+  // Deep but allowed, and brackets inside strings do not count.
+  const std::size_t ok = knit::io::kMaxJsonDepth - 1;
+  CHECK_NOTHROW(knit::io::parse_json("{\"s\": \"" + std::string(1000, '[') + "\", \"a\": " +
+                                         std::string(ok, '[') + std::string(ok, ']') + "}",
+                                     "t"));
+}
+
+TEST_CASE("a number outside the double range names file, pointer, line and column",
+          "[unit][io][json]") {
+  const fs::path f = scratch("huge.json", "{\"a\": [1,\n   1e400]}");
+  try {
+    knit::io::read_json_file(f);
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == f.string());
+    CHECK(e.pointer() == "/a/1");
+    CHECK(e.message() == "the number 1e400 is outside the range of a double (line 2, column 4)");
+  }
+  CHECK_THROWS_WITH(knit::io::parse_json(R"({"k~/": -2e999})", "x.json"),
+                    "x.json: /k~0~1: the number -2e999 is outside the range of a double (line 1, "
+                    "column 9)");
+  CHECK(knit::io::parse_json("[1e-400]", "t")[0] == 0.0);  // underflow to 0 is fine
+}
+
+TEST_CASE("only regular files of bounded size are read", "[unit][io][json]") {
+  // /dev/zero reads without end; a FIFO blocks forever when opened.
+  CHECK_THROWS_WITH(knit::io::read_json_file("/dev/zero"),
+                    "/dev/zero: not a regular file (a character device); inputs must be regular "
+                    "files");
+  const fs::path fifo = scratch("fifo_dir_marker", "").parent_path() / "case.fifo";
+  fs::remove(fifo);
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(knit::io::read_json_file(fifo), Catch::Contains("(a FIFO)"));
+  CHECK_THROWS_WITH(knit::io::read_json_file(fifo.parent_path()), Catch::Contains("directory"));
+  // A sparse file just above the cap: refused from its size, nothing read.
+  const fs::path big = scratch("big.json", "{}");
+  fs::resize_file(big, knit::io::kMaxJsonInputBytes + 1);
+  CHECK_THROWS_WITH(knit::io::read_json_file(big), Catch::Contains("more than the 64 MiB"));
+}
+
+TEST_CASE("schema patterns run in linear time without recursion", "[unit][io][json][schema]") {
+  // A 30,000-character name overflowed std::regex's recursive executor.
+  const knit::io::JsonSchema s(json::parse(R"({"type": "string", "pattern": "^[^,\"/\\n]+$"})"),
+                               "t");
+  CHECK(s.errors(json(std::string(30000, 'a'))).empty());
+  CHECK(s.errors(json(std::string(30000, 'a') + ",")).size() == 1);
+  // Same answers as std::regex (ECMAScript search) on short ASCII subjects (std::regex works
+  // on bytes, JSON Schema and Pattern on code points).
+  const std::vector<std::string> patterns = {
+      "^[^,\"/\\n]+$", "^[a-z][a-z0-9_]*$", "ab|cd",       "^(ab)+$", "^a{2,3}$",
+      "x?y*z+",        "^\\d{3}-\\w+$",     "^(?:a|b)*c$", "^$",      "[.]",
+      "^.{2}$",        "^(a*)*$",           "^[^a-c]$",    "\\s",     "^a{2,}$",
+      "^[-a]+$"};
+  const std::vector<std::string> subjects = {
+      "",    "a",   "ab",  "abc", "aab", "abab", "cd", "x",   "yyz", "1",   "123-x", "ababc",
+      "a,b", "a/b", "A_1", "a.b", "aaa", "aaaa", "d",  "a b", "-a-", "a_1", "q\n"};
+  for (const auto& p : patterns) {
+    const knit::io::Pattern mine(p);
+    const std::regex ref(p, std::regex::ECMAScript);
+    for (const auto& t : subjects) {
+      INFO("pattern " << p << ", subject \"" << t << "\"");
+      CHECK(mine.search(t) == std::regex_search(t, ref));
+    }
+  }
+  CHECK(knit::io::Pattern("^.$").search("\xc3\xa9"));  // one code point
+  CHECK(knit::io::Pattern("^[^a-c]$").search("\xc3\xa9"));
+  CHECK_FALSE(knit::io::Pattern("^.{2}$").search("\xc3\xa9"));
+  CHECK_THROWS_AS(knit::io::Pattern("(a)\\1"), std::invalid_argument);
+  CHECK_THROWS_AS(knit::io::Pattern("(?=a)"), std::invalid_argument);
+  CHECK_THROWS_AS(knit::io::Pattern("a{2000}"), std::invalid_argument);
+  CHECK_THROWS_AS(knit::io::Pattern("[a"), std::invalid_argument);
+  CHECK_THROWS_AS(knit::io::JsonSchema(json::parse(R"x({"pattern": "(?<n>a)"})x"), "t"),
+                  std::logic_error);
 }

@@ -1,5 +1,7 @@
 // Case files: bad input gives one error line with the file and the JSON pointer (exit code 2,
 // no output directory); the verification cases run and match their references.
+#include <sys/stat.h>
+
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
+#include "knit/macro/refinement.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
 #include "knit/material/database.hpp"
@@ -433,4 +436,113 @@ TEST_CASE("a folded database surface is refused at load, naming the database and
   CHECK(e.rfind("knit.json: /material/database: " + (d / "db.h5").string() + ": /loop_1/fit: ",
                 0) == 0);
   fs::remove_all(d);
+}
+
+// ---- hardening (issue 14) ----------------------------------------------------------------------
+
+namespace {
+/// parse_case only (no solve); the InputError text or "".
+std::string load_error_of(const std::string& text) {
+  try {
+    parse_case(text, "bad.json");
+  } catch (const knit::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST_CASE("output names are checked at load: characters, length, '.', uniqueness", "[unit]") {
+  const json base = read_json("tensile_svk.json");
+  REQUIRE(base["output"].contains("points"));
+  auto with_name = [&](const std::string& n) {
+    json j = base;
+    j["output"]["points"][0]["name"] = n;
+    return load_error_of(j.dump());
+  };
+  CHECK(with_name("mid-1.x_2").empty());
+  // "." ran the whole case and then failed writing HDF5.
+  CHECK_THAT(with_name("."), Catch::StartsWith("bad.json: /output/points/0/name: a name starts "
+                                               "with a letter, a digit or '_'"));
+  CHECK_THAT(with_name(".."), Catch::StartsWith("bad.json: /output/points/0/name: a name starts"));
+  CHECK_THAT(with_name("a/b"), Catch::Contains("may contain only letters, digits and _ . + -"));
+  CHECK_THAT(with_name("a b"), Catch::Contains("may contain only"));
+  CHECK_THAT(with_name(""), Catch::Contains("must not be empty"));
+  // 30,000 characters overflowed std::regex's stack.
+  CHECK(with_name(std::string(30000, 'a')) ==
+        "bad.json: /output/points/0/name: a name has at most 64 characters, got 30000");
+  json j = base;
+  j["output"]["points"].push_back(j["output"]["points"][0]);
+  CHECK_THAT(
+      load_error_of(j.dump()),
+      Catch::EndsWith("/name: the name \"" +
+                      base["output"]["points"][0]["name"].get<std::string>() + "\" is used twice"));
+}
+
+TEST_CASE("a number outside the double range in a case names file and pointer, exit 2", "[unit]") {
+  std::string text = read_json("tensile_svk.json").dump();
+  text.replace(text.find("\"thickness\":0.76"), 16, "\"thickness\":1e400");
+  CHECK(load_error_of(text) ==
+        "bad.json: /geometry/thickness: the number 1e400 is outside the range of a double (line "
+        "1, column " +
+            std::to_string(text.find("1e400") + 1) + ")");
+  const fs::path dir = temp_dir("huge_number");
+  std::ofstream(dir / "case.json") << text;
+  CHECK(run_exe((dir / "case.json").string() + " --output " + (dir / "out").string(),
+                dir / "log.txt") == 2);
+  CHECK_THAT(slurp(dir / "log.txt"), Catch::Contains("/geometry/thickness: the number 1e400"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a case path that is a FIFO or a device is refused at once", "[unit]") {
+  // A FIFO blocked forever; /dev/zero read without end.
+  CHECK_THROWS_WITH(load_case("/dev/zero"), Catch::Contains("not a regular file"));
+  const fs::path dir = temp_dir("fifo");
+  REQUIRE(mkfifo((dir / "case.json").c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(load_case((dir / "case.json").string()), Catch::Contains("(a FIFO)"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a refinement that cannot fit in memory is refused at load with the estimate", "[unit]") {
+  json j = read_json("tensile_svk.json");
+  j["refinement"] = {{"degree", 15}, {"elements", {256, 256}}};  // schema-legal
+  const std::string e = load_error_of(j.dump());
+  CHECK_THAT(e, Catch::StartsWith("bad.json: /refinement: 271 x 271 control points of degree "
+                                  "(15, 15) need about ") &&
+                    Catch::Contains("quadrature data") && Catch::Contains("KNIT_MAX_MEMORY_MB"));
+  // The estimate itself: 1 element of degree 5 is small; 16 x 16 of degree 15 is not.
+  const Case small = parse_case(read_json("tensile_svk.json").dump(), "t.json");
+  CHECK(estimate_shell_memory(small.surface).total() < (64ull << 20));
+  j["refinement"] = {{"degree", 15}, {"elements", {16, 16}}};
+  const Case mid = parse_case(j.dump(), "t.json");
+  const MemoryEstimate m = estimate_shell_memory(mid.surface);
+  // 256 elements x 256 points x (11 x 256 x 8 + 256) bytes of quadrature data.
+  CHECK(m.quadrature == 256ull * 256 * (11 * 256 * 8 + 256));
+  CHECK(m.element_tangents == 256ull * 768 * 768 * 8);
+}
+
+TEST_CASE("a knit field degree of 1e10 is an input error before any int conversion", "[unit]") {
+  // static_cast<int>(1e10) is undefined behaviour (seen under UBSan).
+  const fs::path dir = temp_dir("knit_degree");
+  knit::material::Database db;
+  db.provenance = knit::material::current_provenance();
+  db.generator = "test";
+  for (double l : {4.5, 6.5}) {
+    knit::material::LoopLengthEntry e;
+    e.loop_length = l;
+    e.surface = knit::material::testing::make_test_surface(1.0);
+    db.entries.push_back(e);
+  }
+  knit::material::write_database(dir / "db.h5", db);
+  json j = read_json("tensile_svk.json");
+  j["material"] = {{"type", "knit"},
+                   {"database", (dir / "db.h5").string()},
+                   {"stitch_value",
+                    {{"degrees", {1e10, 0}},
+                     {"knots_u", {0, 0, 1, 1}},
+                     {"knots_v", {0, 1}},
+                     {"values", {5, 5}}}}};
+  CHECK(load_error_of(j.dump()) ==
+        "bad.json: /material/stitch_value/degrees/0: must be at most 15, got 10000000000.0");
+  fs::remove_all(dir);
 }

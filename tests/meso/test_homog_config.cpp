@@ -43,6 +43,8 @@ TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
   CHECK(pointer_of(R"({"contact": {"penalty": -5}})") == "/contact/penalty");
   CHECK(pointer_of(R"({"contact": {"friction": 0.1}})") == "/contact");  // unknown key
   CHECK(pointer_of(R"({"analysis": {"elements": 2}})") == "/analysis/elements");
+  // 4294967300 narrowed to 4 and was accepted (issue 14): ranges are checked before narrowing.
+  CHECK(pointer_of(R"({"analysis": {"elements": 4294967300}})") == "/analysis/elements");
   CHECK(pointer_of(R"({"yarn": {"nu": 0.7}})") == "/yarn/nu");
   CHECK(pointer_of(R"({"bogus": 1})") == "");
   CHECK(pointer_of(R"({not json)") == "");

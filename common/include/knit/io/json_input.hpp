@@ -42,10 +42,17 @@ namespace knit::io {
 
 // ---- reading ---------------------------------------------------------------------------------
 
-/// Parses a JSON file. Throws knit::InputError(file, "", "cannot read file") or
+/// Deepest nesting of arrays/objects accepted in a JSON input (ours need < 10). Deeper text
+/// is refused before it is parsed, so nothing recursive ever sees it.
+inline constexpr std::size_t kMaxJsonDepth = 256;
+
+/// Parses a JSON file: a regular file of at most kMaxJsonInputBytes (knit/io/input_file.hpp).
+/// Throws knit::InputError(file, "", "file not found" / "not a regular file (a FIFO)...") or
 /// (file, "", "invalid JSON at line L, column C: <what>").
 nlohmann::json read_json_file(const std::filesystem::path& file);
-/// Parses JSON text; `source` names it in errors.
+/// Parses JSON text; `source` names it in errors. Besides syntax errors (line, column), these
+/// are InputErrors too: nesting deeper than kMaxJsonDepth (line, column), a number outside the
+/// range of a double such as 1e400 (its JSON pointer, line and column), a duplicate key.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
 
 /// A path written inside an input file: absolute as is, relative ones are taken relative to the

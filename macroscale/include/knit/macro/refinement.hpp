@@ -3,6 +3,9 @@
 // are kept; the same rule as knit::spline::refine). The geometry is unchanged (exactly).
 #pragma once
 
+#include <cstdint>
+#include <string>
+
 #include "knit/spline/surface.hpp"
 
 namespace knit::macro {
@@ -10,5 +13,28 @@ namespace knit::macro {
 /// Throws std::invalid_argument if p is below a degree of the patch or elements < 1.
 spline::SplineSurface refine_patch(const spline::SplineSurface& s, int p, int elements_u,
                                    int elements_v);
+
+/// Memory a shell run on this patch needs, estimated before anything is allocated (issue 14:
+/// a schema-legal p = 15, 256 x 256 ended in std::bad_alloc). With nloc = (pu+1)(pv+1) local
+/// functions, Q = (pu+1)(pv+1) Gauss points per element (the ShellModel default), E elements
+/// and N = 3 n_cp unknowns, in bytes:
+///   quadrature data   E Q (11 nloc 8 + 256)      basis derivatives R_ and Phi, point data
+///   element tangents  E (3 nloc)^2 8             all stored for one assembly
+///   global system     dense (N <= 2500): 2 N^2 8; sparse: 3 x 16 nnz, nnz = N 3 (2pu+1)(2pv+1)
+/// It is a lower bound of the peak (solver work vectors, outputs and the material are left
+/// out), meant to refuse what cannot run, not to predict what can.
+struct MemoryEstimate {
+  std::uint64_t quadrature = 0, element_tangents = 0, global_system = 0;
+  std::uint64_t total() const { return quadrature + element_tangents + global_system; }
+  /// e.g. "207 GB (quadrature data 186 GB, element tangents 19 GB, global system 2.1 GB)"
+  std::string describe() const;
+};
+/// "207 GB", "12 MB" (decimal units).
+std::string format_bytes(std::uint64_t bytes);
+MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s);
+
+/// The memory a run may use: KNIT_MAX_MEMORY_MB from the environment if set (a positive
+/// integer), else the machine's physical memory.
+std::uint64_t memory_limit_bytes();
 
 }  // namespace knit::macro

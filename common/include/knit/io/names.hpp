@@ -1,0 +1,22 @@
+// Names chosen by the user that become file, HDF5 or CSV names (output points, reactions):
+// checked when the input is loaded, before any work, with plain character tests (no
+// std::regex, whose recursive matcher overflowed the stack on a 30,000-character name).
+//
+// A valid name has 1..kMaxOutputNameLength characters from [A-Za-z0-9_.+-], starts with a
+// letter, digit or '_' (so never "." or ".." and never a hidden file), and is unique in its
+// input (the loader checks uniqueness).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace knit::io {
+
+inline constexpr std::size_t kMaxOutputNameLength = 64;
+
+/// Why `name` is not a valid output name, or nullopt if it is.
+std::optional<std::string> output_name_problem(std::string_view name);
+
+}  // namespace knit::io
