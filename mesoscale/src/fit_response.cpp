@@ -119,6 +119,11 @@ std::string loss_name(Loss l) {
 
 }  // namespace
 
+bool in_paper_fit(const RawPath& r) {
+  return r.path.set == "paper" &&
+         (r.path.kind == material::PathKind::kBiaxial || r.path.kind == material::PathKind::kShear);
+}
+
 std::string FitOptions::validate() const {
   if (degree1 < 1 || degree2 < 1 || shear_degree < 1) return "degrees must be >= 1";
   if (degree1 > 9 || degree2 > 9 || shear_degree > 9) return "degrees must be <= 9";
@@ -227,6 +232,9 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   int skipped = 0;
   for (std::size_t q = 0; q < raw.size(); ++q) {
     const RawPath& r = raw[q];
+    // Eq. 17 is the paper's law: only its fan of biaxial paths and its shear path enter
+    // (coverage and holdout paths of the sweep are for the energy law and its checks).
+    if (!in_paper_fit(r)) continue;
     const int n = r.steps();
     if (r.E.rows() != n || r.S.rows() != n || r.E.cols() != 3 || r.S.cols() != 3)
       return refuse("path " + std::to_string(q) + ": E and S need one row of 3 per step");
@@ -469,7 +477,7 @@ material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
     ++count(c);
   };
   for (const RawPath& r : raw)
-    for (int k = 0; k < r.steps(); ++k) {
+    for (int k = 0; k < r.steps() && in_paper_fit(r); ++k) {
       if (r.status[k] != 0) continue;
       ++dg.points_used;
       srange = std::max(srange, r.S.row(k).cwiseAbs().maxCoeff());
@@ -485,7 +493,7 @@ material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
   // E-surface errors at the grid parameters (path index, step fraction), as in the fit.
   std::vector<std::pair<double, const RawPath*>> fan;
   for (const RawPath& r : raw)
-    if (r.path.kind == material::PathKind::kBiaxial) {
+    if (r.path.kind == material::PathKind::kBiaxial && in_paper_fit(r)) {
       int last = -1;
       for (int k = 0; k < r.steps(); ++k)
         if (r.status[k] == 0) last = k;

@@ -64,7 +64,11 @@ struct FitSummary {
   bool ok() const { return status == FitStatus::kOk; }
 };
 
-/// Fits one loop length's raw data.
+/// Whether a raw path enters the eq. (17) fit: the paper's set ("paper") of biaxial paths
+/// (the fan) and the shear path. Coverage and holdout paths are ignored by this fit.
+bool in_paper_fit(const material::RawPath& r);
+
+/// Fits one loop length's raw data (the paths for which in_paper_fit() holds; others ignored).
 FitSummary fit_loop_length(const std::vector<material::RawPath>& raw, const FitOptions& options);
 
 /// Fits every loop length of db in place; returns one summary per entry (stops at nothing:
