@@ -80,7 +80,7 @@ ResponseSurfaceData LoopLengthFamily::at(double l) const {
 }
 
 std::shared_ptr<const ResponseSurface> LoopLengthFamily::surface(double l) const {
-  return std::make_shared<const ResponseSurface>(at(l));
+  return std::make_shared<const ResponseSurface>(at(l), extension_);
 }
 
 }  // namespace knit::material

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -117,8 +118,22 @@ void validate(const ResponseSurfaceData& d) {
           "invertible)");
 }
 
-ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(data)) {
+void ExtensionOptions::validate() const {
+  if (!(blend_begin_deg >= 0.0) || !(blend_end_deg > blend_begin_deg) || !(blend_end_deg <= 90.0))
+    throw std::invalid_argument(
+        "response surface extension: need 0 <= blend_begin_deg < blend_end_deg <= 90");
+  if (!(compression_scale > 0.0) || !(compression_scale <= 1.0))
+    throw std::invalid_argument(
+        "response surface extension: compression_scale must be in (0, 1] (never stiffer than "
+        "the fan's initial stiffness)");
+  if (!(compression_floor > 0.0) || !(compression_floor <= 1.0))
+    throw std::invalid_argument("response surface extension: compression_floor must be in (0, 1]");
+}
+
+ResponseSurface::ResponseSurface(ResponseSurfaceData data, ExtensionOptions extension)
+    : data_(std::move(data)) {
   validate(data_);
+  extension.validate();
   b1_ = spline::BSplineBasis(data_.degree1, data_.knots1);
   b2_ = spline::BSplineBasis(data_.degree2, data_.knots2);
   bs_ = spline::BSplineBasis(data_.shear_degree, data_.shear_knots);
@@ -141,6 +156,7 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
   table_xi_.resize(m);
   phi_.resize(m);
   radius_.resize(m);
+  slope1_.resize(m);
   Eigen::Matrix4d V;
   for (int k = 0; k < m; ++k) {
     const double x = static_cast<double>(k) / (m - 1);
@@ -153,6 +169,8 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
     }
     phi_[k] = phi;
     radius_[k] = std::hypot(V(0, 0), V(1, 0));
+    // Radial growth beyond the last step (the extension is linear in xi2 there).
+    slope1_[k] = radius_[k] > 0.0 ? (V(0, 0) * V(0, 2) + V(1, 0) * V(1, 2)) / radius_[k] : 0.0;
     if (k > 0 && !(phi_[k] > phi_[k - 1]))
       throw std::invalid_argument(
           "response surface: the E-surface edge xi2 = 1 does not turn counter-clockwise at xi1 "
@@ -193,6 +211,53 @@ ResponseSurface::ResponseSurface(ResponseSurfaceData data) : data_(std::move(dat
   std::uint8_t f = 0;
   shear(0.0, S12, dS, f);
   C0_(2, 2) = 0.5 * dS;
+
+  // The fan's angular range: every path (the guess table) at every step, with the initial
+  // tangent (xi2 = 0) and the end tangent (the direction of the continuation beyond xi2 = 1).
+  {
+    const double mid = 0.5 * (phi_.front() + phi_.back());
+    auto unwrap = [&](double a) {
+      while (a < mid - kPi) a += 2 * kPi;
+      while (a > mid + kPi) a -= 2 * kPi;
+      return a;
+    };
+    lo_ = phi_.front();
+    hi_ = phi_.back();
+    const int steps = 4 * (data_.n2() - 1);
+    for (int k = 0; k < m; ++k)
+      for (int j = 0; j <= steps + 1; ++j) {
+        eval4({table_xi_[k], std::min(1.0, static_cast<double>(j) / steps)}, V);
+        const Eigen::Vector2d e = j == 0 || j > steps ? Eigen::Vector2d(V.block<2, 1>(0, 2))
+                                                      : Eigen::Vector2d(V.block<2, 1>(0, 0));
+        const double a = unwrap(std::atan2(e(1), e(0)));
+        lo_ = std::min(lo_, a);
+        hi_ = std::max(hi_, a);
+      }
+    if (hi_ - lo_ >= kPi)
+      throw std::invalid_argument(
+          "response surface: the paths (with their initial and end tangents) span 180 degrees "
+          "or more");
+    // The two bands (beyond hi and below lo) must not overlap on the far side.
+    const double half_gap = kPi - 0.5 * (hi_ - lo_);
+    const double deg = kPi / 180.0;
+    const double shrink = std::min(1.0, half_gap / (extension.blend_end_deg * deg));
+    beta0_ = shrink * extension.blend_begin_deg * deg;
+    beta1_ = shrink * extension.blend_end_deg * deg;
+  }
+  // K_c: the symmetric part of C0's tensile block, eigenvalues floored, scaled (SPD).
+  {
+    const Eigen::Matrix2d C2 = C0_.topLeftCorner<2, 2>();
+    const Eigen::Matrix2d Cs = 0.5 * (C2 + C2.transpose());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(Cs);
+    const double lmax = es.eigenvalues().maxCoeff();
+    if (!(lmax > 0.0))
+      throw std::invalid_argument(
+          "response surface: the fan's initial stiffness has no positive eigenvalue (no "
+          "compression stiffness can be derived)");
+    const Eigen::Vector2d lam =
+        extension.compression_scale * es.eigenvalues().cwiseMax(extension.compression_floor * lmax);
+    Kc_ = es.eigenvectors() * lam.asDiagonal() * es.eigenvectors().transpose();
+  }
 }
 
 void ResponseSurface::eval4(const Eigen::Vector2d& xi, Eigen::Matrix4d& V) const {
@@ -274,64 +339,54 @@ void ResponseSurface::shear(double E12, double& S12, double& dS, std::uint8_t& f
   dS = dc(1) / dc(0);
 }
 
-Eigen::Vector2d ResponseSurface::initial_guess(const Eigen::Vector2d& E) const {
-  const double rE = E.norm();
-  const double mid = 0.5 * (phi_.front() + phi_.back());
-  double phi = std::atan2(E(1), E(0));
-  while (phi < mid - kPi) phi += 2 * kPi;
-  while (phi > mid + kPi) phi -= 2 * kPi;
-  // Half-plane of directions around the fan -> xi2 >= 0; the opposite one -> xi2 <= 0.
-  double sgn = 1.0;
-  if (std::abs(phi - mid) > 0.5 * kPi) {
-    sgn = -1.0;
-    phi += phi > mid ? -kPi : kPi;
-  }
+Eigen::Vector2d ResponseSurface::initial_guess(double rE, double phi) const {
+  // phi is unwrapped around the fan's range, so it lies within beta1 < pi - half-range of it.
   const int m = static_cast<int>(phi_.size());
-  double xi1, r, dphi = 0.0;
+  double xi1, r, dr, dphi = 0.0;
   if (phi <= phi_.front()) {
     const double slope = (phi_[1] - phi_[0]) / (table_xi_[1] - table_xi_[0]);
     dphi = std::max(phi - phi_.front(), -1.3);
     xi1 = std::tan(dphi) / slope;
     r = radius_.front();
+    dr = slope1_.front();
   } else if (phi >= phi_.back()) {
     const double slope = (phi_[m - 1] - phi_[m - 2]) / (table_xi_[m - 1] - table_xi_[m - 2]);
     dphi = std::min(phi - phi_.back(), 1.3);
     xi1 = 1.0 + std::tan(dphi) / slope;
     r = radius_.back();
+    dr = slope1_.back();
   } else {
-    const int k =
-        static_cast<int>(std::upper_bound(phi_.begin(), phi_.end(), phi) - phi_.begin()) - 1;
+    // phi is finite and inside (phi_.front(), phi_.back()): upper_bound stays in the table.
+    const int k = std::clamp(
+        static_cast<int>(std::upper_bound(phi_.begin(), phi_.end(), phi) - phi_.begin()) - 1, 0,
+        m - 2);
     const double w = (phi - phi_[k]) / (phi_[k + 1] - phi_[k]);
     xi1 = table_xi_[k] + w * (table_xi_[k + 1] - table_xi_[k]);
     r = radius_[k] + w * (radius_[k + 1] - radius_[k]);
+    dr = slope1_[k] + w * (slope1_[k + 1] - slope1_[k]);
   }
-  return {xi1, sgn * rE * std::cos(dphi) / r};
+  const double s = rE * std::cos(dphi);
+  // Beyond the last step the paths continue with their end tangent: a scale-aware guess keeps
+  // Newton's step count bounded for any |E|.
+  if (s > r && dr > 0.0) return {xi1, 1.0 + (s - r) / dr};
+  return {xi1, s / r};
 }
 
-ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
-  ResponseEvaluation out;
-  // Shear: S12(E12), E12 = (2E12)/2; C33 = dS12/d(2E12).
-  double S12, dS;
-  shear(0.5 * E(2), S12, dS, out.flags);
-  out.S(2) = S12;
-  out.C(2, 2) = 0.5 * dS;
-
-  const Eigen::Vector2d Et = E.head<2>();
+ResponseSurface::FanSolution ResponseSurface::solve_fan(const Eigen::Vector2d& Et,
+                                                        double psi) const {
+  FanSolution out;
   const double rE = Et.norm();
-  if (rE == 0.0) {
-    out.C.topLeftCorner<2, 2>() = C0_.topLeftCorner<2, 2>();
-    return out;
-  }
-  Eigen::Vector2d xi = initial_guess(Et);
+  Eigen::Vector2d xi = initial_guess(rE, psi);
   Eigen::Matrix4d V;
   Eigen::Matrix2d J;
   const double tol = kTolAbs + kTolRel * rE;
   bool converged = false;
   int it = 0;
+  eval4(xi, V);
+  Eigen::Vector2d r = V.block<2, 1>(0, 0) - Et;
+  double rnorm = r.norm();
   for (; it < kMaxIterations; ++it) {
-    eval4(xi, V);
-    const Eigen::Vector2d r = V.block<2, 1>(0, 0) - Et;
-    if (r.norm() <= tol) {
+    if (rnorm <= tol) {
       converged = true;
       break;
     }
@@ -342,22 +397,38 @@ ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
       J.col(0) = V.block<2, 1>(0, 3);
     J.col(1) = V.block<2, 1>(0, 2);
     const Eigen::Vector2d step = J.partialPivLu().solve(-r);  // (xi2 * dxi1, dxi2)
-    double d2 = std::clamp(step(1), -0.5, 0.5);
-    const double x2new = xi(1) + d2;
-    // Polar update: the tangential correction xi2*dxi1 over the new radius parameter.
-    const double d1 = x2new != 0.0 ? std::clamp(step(0) / x2new, -0.5, 0.5) : 0.0;
-    if (!std::isfinite(d1) || !std::isfinite(x2new)) break;
-    xi(0) += d1;
-    xi(1) = x2new;
+    if (!step.allFinite()) break;
+    // The xi2 step limit is relative (far outside the square xi2 is large: a fixed limit would
+    // need |xi2| / limit iterations), and every step is backtracked until |E(xi) - E| drops.
+    // xi2 stays positive (the fan chart); at most it shrinks tenfold per step.
+    const double lim2 = 0.5 * std::max(1.0, xi(1));
+    double lambda = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls < kMaxBacktracking && !accepted; ++ls, lambda *= 0.5) {
+      const double x2new = std::max(xi(1) + std::clamp(lambda * step(1), -lim2, lim2), 0.1 * xi(1));
+      // Polar update: the tangential correction xi2*dxi1 over the new radius parameter.
+      const double d1 = x2new > 0.0 ? std::clamp(lambda * step(0) / x2new, -0.5, 0.5) : 0.0;
+      const Eigen::Vector2d trial(xi(0) + d1, x2new);
+      if (!trial.allFinite()) continue;
+      eval4(trial, V);
+      const Eigen::Vector2d rt = V.block<2, 1>(0, 0) - Et;
+      const double rtn = rt.norm();
+      if (rtn < rnorm || rtn <= tol) {
+        xi = trial;
+        r = rt;
+        rnorm = rtn;
+        accepted = true;
+      }
+    }
+    if (!accepted) {
+      eval4(xi, V);
+      break;
+    }
   }
   out.iterations = it;
-  if (!converged) {
-    out.flags |= kInversionFailed;
-    eval4(xi, V);
-  }
+  if (!converged) out.flags |= kInversionFailed;
   out.xi = xi;
   if (xi(1) > 1.0 + kInsideTol) out.flags |= kBeyondPaths;
-  if (xi(1) < -kInsideTol) out.flags |= kCompression;
   if (xi(0) < -kInsideTol || xi(0) > 1.0 + kInsideTol) out.flags |= kOutsideFan;
 
   Eigen::Matrix2d JE, JS;
@@ -370,8 +441,72 @@ ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
   }
   JE.col(1) = V.block<2, 1>(0, 2);
   JS.col(1) = V.block<2, 1>(2, 2);
-  out.S.head<2>() = V.block<2, 1>(2, 0);
-  out.C.topLeftCorner<2, 2>() = JS * JE.inverse();
+  out.S = V.block<2, 1>(2, 0);
+  out.C = JS * JE.inverse();
+  return out;
+}
+
+ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
+  ResponseEvaluation out;
+  // A non-finite strain never reaches the lookups: flagged, with non-finite S and C.
+  if (!E.allFinite() || !std::isfinite(E.head<2>().norm())) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.S.setConstant(nan);
+    out.C.setConstant(nan);
+    out.xi.setConstant(nan);
+    out.flags = kInversionFailed | kNonFiniteStrain;
+    return out;
+  }
+  // Shear: S12(E12), E12 = (2E12)/2; C33 = dS12/d(2E12).
+  double S12, dS;
+  shear(0.5 * E(2), S12, dS, out.flags);
+  out.S(2) = S12;
+  out.C(2, 2) = 0.5 * dS;
+
+  const Eigen::Vector2d Et = E.head<2>();
+  const double rE2 = Et.squaredNorm();
+  if (rE2 == 0.0) {
+    out.C.topLeftCorner<2, 2>() = C0_.topLeftCorner<2, 2>();
+    return out;
+  }
+  // The angle psi of (E11, E22) unwrapped around the fan's range, its distance beta beyond the
+  // range, and the C1 blending weight w(beta) of the compression law.
+  const double centre = 0.5 * (lo_ + hi_), half = 0.5 * (hi_ - lo_);
+  double psi = std::atan2(Et(1), Et(0));
+  while (psi <= centre - kPi) psi += 2 * kPi;
+  while (psi > centre + kPi) psi -= 2 * kPi;
+  const double beta = std::abs(psi - centre) - half;
+  double w = 0.0, dw_dbeta = 0.0;
+  if (beta >= beta1_) {
+    w = 1.0;
+  } else if (beta > beta0_) {
+    const double x = (beta - beta0_) / (beta1_ - beta0_);
+    w = x * x * (3.0 - 2.0 * x);
+    dw_dbeta = 6.0 * x * (1.0 - x) / (beta1_ - beta0_);
+  }
+  out.blend = w;
+  if (w == 1.0) {
+    out.S.head<2>() = Kc_ * Et;
+    out.C.topLeftCorner<2, 2>() = Kc_;
+    out.flags |= kCompression;
+    return out;
+  }
+  const FanSolution f = solve_fan(Et, psi);
+  out.xi = f.xi;
+  out.flags |= f.flags;
+  out.iterations = f.iterations;
+  if (w == 0.0) {
+    out.S.head<2>() = f.S;
+    out.C.topLeftCorner<2, 2>() = f.C;
+    return out;
+  }
+  // dw/dE = dw/dbeta * sign(psi - centre) * dpsi/dE, dpsi/dE = (-E22, E11) / |E|^2.
+  const Eigen::Vector2d Sc = Kc_ * Et;
+  const Eigen::Vector2d dw_dE =
+      dw_dbeta * (psi > centre ? 1.0 : -1.0) * Eigen::Vector2d(-Et(1), Et(0)) / rE2;
+  out.S.head<2>() = (1.0 - w) * f.S + w * Sc;
+  out.C.topLeftCorner<2, 2>() = (1.0 - w) * f.C + w * Kc_ + (Sc - f.S) * dw_dE.transpose();
+  out.flags |= kCompression;
   return out;
 }
 

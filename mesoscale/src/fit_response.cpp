@@ -120,6 +120,11 @@ std::string loss_name(Loss l) {
 
 }  // namespace
 
+bool in_paper_fit(const RawPath& r) {
+  return r.path.set == "paper" &&
+         (r.path.kind == material::PathKind::kBiaxial || r.path.kind == material::PathKind::kShear);
+}
+
 std::string FitOptions::validate() const {
   if (degree1 < 1 || degree2 < 1 || shear_degree < 1) return "degrees must be >= 1";
   if (degree1 > 9 || degree2 > 9 || shear_degree > 9) return "degrees must be <= 9";
@@ -248,15 +253,17 @@ std::string check_feasible(const FitOptions& options, const std::vector<material
   FanShape fan;
   fan.min_steps = 1 << 30;
   for (const auto& p : paths) {
+    // Only what in_paper_fit() lets into the fit: the paper set's biaxial fan and shear path
+    // (coverage and holdout paths, e.g. the full circle of directions, never enter eq. 17).
+    if (p.set != "paper") continue;
     if (p.kind == material::PathKind::kShear) {
       fan.shear = true;
       continue;
     }
+    if (p.kind != material::PathKind::kBiaxial) continue;
     // The end strain of a biaxial path is its target (E11, E22); the run reaches it when
     // every step converges, so its direction is that of the fitted data.
-    fan.phi.push_back(p.kind == material::PathKind::kBiaxial
-                          ? std::atan2(p.target(1), p.target(0))
-                          : std::numeric_limits<double>::quiet_NaN());
+    fan.phi.push_back(std::atan2(p.target(1), p.target(0)));
     fan.min_steps = std::min(fan.min_steps, steps > 0 ? steps : p.steps);
   }
   if (fan.phi.empty()) fan.min_steps = 0;
@@ -283,6 +290,9 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   int skipped = 0;
   for (std::size_t q = 0; q < raw.size(); ++q) {
     const RawPath& r = raw[q];
+    // Eq. 17 is the paper's law: only its fan of biaxial paths and its shear path enter
+    // (coverage and holdout paths of the sweep are for the energy law and its checks).
+    if (!in_paper_fit(r)) continue;
     const int n = r.steps();
     if (r.E.rows() != n || r.S.rows() != n || r.E.cols() != 3 || r.S.cols() != 3)
       return refuse("path " + std::to_string(q) + ": E and S need one row of 3 per step");
@@ -514,7 +524,7 @@ material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
     ++count(c);
   };
   for (const RawPath& r : raw)
-    for (int k = 0; k < r.steps(); ++k) {
+    for (int k = 0; k < r.steps() && in_paper_fit(r); ++k) {
       if (r.status[k] != 0) continue;
       ++dg.points_used;
       srange = std::max(srange, r.S.row(k).cwiseAbs().maxCoeff());
@@ -530,7 +540,7 @@ material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
   // E-surface errors at the grid parameters (path index, step fraction), as in the fit.
   std::vector<std::pair<double, const RawPath*>> fan;
   for (const RawPath& r : raw)
-    if (r.path.kind == material::PathKind::kBiaxial) {
+    if (r.path.kind == material::PathKind::kBiaxial && in_paper_fit(r)) {
       int last = -1;
       for (int k = 0; k < r.steps(); ++k)
         if (r.status[k] == 0) last = k;

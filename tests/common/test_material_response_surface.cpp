@@ -8,20 +8,8 @@
 #include "test_material_util.hpp"
 
 using namespace knit::material;
+using knit::material::testing::fd_tangent;
 using knit::material::testing::make_test_surface;
-
-namespace {
-Eigen::Matrix3d fd_tangent(const ResponseSurface& rs, const Eigen::Vector3d& E, double h = 1e-7) {
-  Eigen::Matrix3d C;
-  for (int c = 0; c < 3; ++c) {
-    Eigen::Vector3d Ep = E, Em = E;
-    Ep(c) += h;
-    Em(c) -= h;
-    C.col(c) = (rs.evaluate(Ep).S - rs.evaluate(Em).S) / (2 * h);
-  }
-  return C;
-}
-}  // namespace
 
 TEST_CASE("response surface: inversion reproduces the E-surface", "[unit]") {
   const ResponseSurface rs(make_test_surface());

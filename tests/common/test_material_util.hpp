@@ -55,4 +55,17 @@ inline ResponseSurfaceData make_test_surface(double k = 1.0, int n = 11, int p =
   return d;
 }
 
+/// Central finite differences of S with respect to (E11, E22, 2E12), step h.
+inline Eigen::Matrix3d fd_tangent(const ResponseSurface& rs, const Eigen::Vector3d& E,
+                                  double h = 1e-7) {
+  Eigen::Matrix3d C;
+  for (int c = 0; c < 3; ++c) {
+    Eigen::Vector3d Ep = E, Em = E;
+    Ep(c) += h;
+    Em(c) -= h;
+    C.col(c) = (rs.evaluate(Ep).S - rs.evaluate(Em).S) / (2 * h);
+  }
+  return C;
+}
+
 }  // namespace knit::material::testing

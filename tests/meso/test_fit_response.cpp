@@ -106,3 +106,45 @@ TEST_CASE("fit: data that cannot determine the surface are refused with the reas
                       Catch::Contains("/smoth: unknown fit option"));
   }
 }
+
+TEST_CASE("fit: eq. 17 uses the paper's paths only (coverage and holdout paths are ignored)",
+          "[unit]") {
+  SyntheticOptions so;
+  const auto paper = synthetic_paths(so, 5.0);
+  auto extended = paper;
+  // Coverage paths of every kind, with data the paper fit must not see: a biaxial path in
+  // biaxial compression (outside the fan, opposite stresses), a uniaxial and a gradient path,
+  // a second shear path, a holdout path inside the fan, and a path that never converged.
+  auto add = [&](RawPath r, PathKind kind, const std::string& set, double scale) {
+    r.path.kind = kind;
+    r.path.set = set;
+    r.E *= scale;
+    r.S *= -3.0;
+    extended.push_back(std::move(r));
+  };
+  add(paper[0], PathKind::kBiaxial, "coverage", -1.0);
+  add(paper[3], PathKind::kUniaxial, "coverage", 0.8);
+  add(paper[5], PathKind::kGradient, "coverage", 1.1);
+  add(paper.back(), PathKind::kShear, "coverage", 0.5);
+  add(paper[6], PathKind::kBiaxial, "holdout", 0.7);
+  RawPath failed = paper[2];
+  failed.path.set = "coverage";
+  std::fill(failed.status.begin(), failed.status.end(), 1);
+  extended.push_back(failed);
+  // Coverage paths first, so that a fit taking them would also change the ordering.
+  std::rotate(extended.begin(), extended.begin() + static_cast<long>(paper.size()), extended.end());
+
+  const FitSummary a = fit_loop_length(paper, FitOptions{});
+  const FitSummary b = fit_loop_length(extended, FitOptions{});
+  REQUIRE(a.ok());
+  INFO(b.reason);
+  REQUIRE(b.ok());
+  CHECK(a.surface.E_ctrl == b.surface.E_ctrl);
+  CHECK(a.surface.S_ctrl == b.surface.S_ctrl);
+  CHECK(a.surface.E12_ctrl == b.surface.E12_ctrl);
+  CHECK(a.surface.S12_ctrl == b.surface.S12_ctrl);
+  CHECK(a.diagnostics.points_used == b.diagnostics.points_used);
+  CHECK(a.diagnostics.max_relative == b.diagnostics.max_relative);
+  CHECK_FALSE(in_paper_fit(extended.front()));
+  CHECK(in_paper_fit(paper.front()));
+}

@@ -34,14 +34,22 @@ class LoopLengthFamily {
   Eigen::VectorXd weights(double l) const;
   /// The interpolated control data at l (eq. 25).
   ResponseSurfaceData at(double l) const;
-  /// An evaluator at l.
+  /// An evaluator at l, with the family's extension options.
   std::shared_ptr<const ResponseSurface> surface(double l) const;
+
+  /// The extension beyond the fan used by surface() (validated; throws std::invalid_argument).
+  void set_extension(const ExtensionOptions& e) {
+    e.validate();
+    extension_ = e;
+  }
+  const ExtensionOptions& extension() const { return extension_; }
 
  private:
   std::vector<double> l_;
   std::vector<ResponseSurfaceData> laws_;
   spline::BSplineBasis basis_;
   Eigen::MatrixXd Ainv_;
+  ExtensionOptions extension_;
 };
 
 }  // namespace knit::material

@@ -85,7 +85,12 @@ std::string check_fan(const FitOptions& options, const FanShape& fan);
 std::string check_feasible(const FitOptions& options, const std::vector<material::LoadPath>& paths,
                            int steps = 0);
 
-/// Fits one loop length's raw data.
+
+/// Whether a raw path enters the eq. (17) fit: the paper's set ("paper") of biaxial paths
+/// (the fan) and the shear path. Coverage and holdout paths are ignored by this fit.
+bool in_paper_fit(const material::RawPath& r);
+
+/// Fits one loop length's raw data (the paths for which in_paper_fit() holds; others ignored).
 FitSummary fit_loop_length(const std::vector<material::RawPath>& raw, const FitOptions& options);
 
 /// Fits every loop length of db in place; returns one summary per entry (stops at nothing:
