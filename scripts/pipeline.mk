@@ -144,6 +144,11 @@ FIGURES += $(FIG)/fig06_response_surfaces.png
 $(FIG)/fig06_response_surfaces.png: $(DB) $(FIGPY)/surfaces.py
 	@$(call draw,$(PY) $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5 --out $@,$@)
 
+# Beside Fig. 6: the energy-based law (W, S11, S22 at 6.5 mm with the data; issue 11).
+FIGURES += $(FIG)/fig06e_energy_law.png
+$(FIG)/fig06e_energy_law.png: $(DB) $(FIGPY)/energy_law.py $(FIGPY)/surfaces.py
+	@$(call draw,$(PY) $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5 --out $@,$@)
+
 # Sect. 3.1.2 (Fig. 7)
 $(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22)))
 $(eval $(call deformed,fig07b_uniform65_wale_E22,s312_uniform_65_wale,E22,0.3,Fig. 7b: l = 6.5 mm wale-wise at 30 % (E22)))

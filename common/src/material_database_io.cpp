@@ -9,6 +9,7 @@
 #include "knit/io/hdf5.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/material/database.hpp"
+#include "material_energy_law_io.hpp"
 
 namespace knit::material {
 
@@ -25,6 +26,9 @@ std::string path_group(std::size_t q) {
   os << "path_" << (q < 10 ? "0" : "") << q;
   return os.str();
 }
+
+/// The oldest format version this build still reads (version 1: no /energy_law).
+constexpr int kOldestReadableVersion = 1;
 
 void write_surface(H5Group& g, const ResponseSurfaceData& d) {
   g.set_attribute(".", "degree_1", d.degree1);
@@ -81,7 +85,7 @@ void write_database(const std::filesystem::path& file, const Database& db) {
   {
     H5File f = H5File::create(out.temp_path());
     f.set_attribute(".", "format", kDatabaseFormatName);
-    f.set_attribute(".", "format_version", db.format_version);
+    f.set_attribute(".", "format_version", kDatabaseFormatVersion);  // always the current format
     f.set_attribute(".", "software_version", db.provenance.software_version);
     f.set_attribute(".", "git_revision", db.provenance.git_revision);
     f.set_attribute(".", "created", db.provenance.created);
@@ -186,6 +190,7 @@ void write_database(const std::filesystem::path& file, const Database& db) {
         d.set_attribute(".", "options_json", e.diagnostics.options_json);
       }
     }
+    if (db.energy_law) detail::write_energy_law(f, *db.energy_law, db.energy_diagnostics);
     f.close();
   }
   out.commit();
@@ -205,10 +210,11 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                        std::string("not a material database (attribute format != \"") +
                            kDatabaseFormatName + "\")");
     db.format_version = f.attribute_int(".", "format_version");
-    if (db.format_version != kDatabaseFormatVersion)
+    if (db.format_version < kOldestReadableVersion || db.format_version > kDatabaseFormatVersion)
       throw InputError(fname, "/",
                        "format_version " + std::to_string(db.format_version) +
-                           " is not supported (this build reads version " +
+                           " is not supported (this build reads versions " +
+                           std::to_string(kOldestReadableVersion) + " to " +
                            std::to_string(kDatabaseFormatVersion) + ")");
     auto require_group = [&](const std::string& p) {
       if (!f.is_group(p)) throw InputError(fname, p, "group missing");
@@ -315,12 +321,39 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       }
       db.entries.push_back(std::move(e));
     }
+    // Version 2: the energy-based law, when it was fitted (version 1 never has it).
+    if (db.format_version >= 2 && f.exists(detail::kEnergyLawGroup)) {
+      where = detail::kEnergyLawGroup;
+      db.energy_law.emplace();
+      detail::read_energy_law(f, fname, *db.energy_law, db.energy_diagnostics);
+      if (!db.entries.empty() && (db.energy_law->l_min > db.entries.front().loop_length ||
+                                  db.energy_law->l_max < db.entries.back().loop_length))
+        throw InputError(fname, detail::kEnergyLawGroup,
+                         "the law's loop-length range does not cover /loop_lengths");
+    }
+    // Written by an older build: the file stays version 1 in memory until it is rewritten.
     return db;
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
     throw InputError(fname, where == "/" ? "" : where, strip_file(e.what(), fname));
   }
+}
+
+const EnergyLawData& require_energy_law(const Database& db, const std::string& file) {
+  if (db.energy_law) return *db.energy_law;
+  const std::string fix = "run `knit-meso fit " + (file.empty() ? std::string("DB") : file) +
+                          " --law energy` to add it (no re-simulation needed)";
+  if (db.format_version < 2)
+    throw InputError(file, detail::kEnergyLawGroup,
+                     "a format-version-" + std::to_string(db.format_version) +
+                         " database has no energy-based law; " + fix);
+  throw InputError(file, detail::kEnergyLawGroup,
+                   "group missing: the database was fitted without the energy-based law; " + fix);
+}
+
+std::string raw_path_location(std::size_t k, std::size_t q) {
+  return loop_group(k) + "/raw/" + path_group(q);
 }
 
 }  // namespace knit::material

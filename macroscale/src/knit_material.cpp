@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -77,19 +78,27 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
 KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
                            spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
                            Source source)
+    : KnitMaterial(std::move(family), nullptr, std::move(stitch_value), std::move(knitting_angle),
+                   std::move(source)) {}
+
+KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
+                           std::shared_ptr<const material::EnergyLaw> energy,
+                           spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
+                           Source source)
     : family_(std::move(family)),
+      energy_(std::move(energy)),
       l_field_(std::move(stitch_value)),
       a_field_(std::move(knitting_angle)),
       source_(std::move(source)) {
-  if (!family_) throw std::invalid_argument("knit material: no database");
+  if (!family_ && !energy_) throw std::invalid_argument("knit material: no database");
   if (l_field_.dim() != 1 || a_field_.dim() != 1)
     throw std::invalid_argument("knit material: the fields must be scalar");
+  reset_stats();
   const Eigen::MatrixXd& L = l_field_.control_points();
   for (int a = 0; a < L.rows(); ++a)
-    if (!family_->contains(L(a, 0))) {
+    if (!(L(a, 0) >= l_min() && L(a, 0) <= l_max())) {
       std::ostringstream os;
-      os << L(a, 0) << " mm is outside the database's " << family_->min() << "-" << family_->max()
-         << " mm";
+      os << L(a, 0) << " mm is outside the database's " << l_min() << "-" << l_max() << " mm";
       if (!source_.database.empty()) os << " (" << source_.database << ")";
       throw InputError(source_.file, source_.stitch_pointer + "/values/" + std::to_string(a),
                        os.str());
@@ -120,7 +129,10 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   for (const auto& t : theta) {
     const double l = stitch_value(t);
     const double a = knitting_angle(t);
-    bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a)});
+    if (energy_)
+      bound_.push_back({nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), energy_at(l).get()});
+    else
+      bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a)});
   }
 }
 
@@ -168,7 +180,12 @@ MaterialResponse KnitMaterial::evaluate(const Eigen::Vector3d& E,
                                         const MaterialPoint& where) const {
   if (where.point_id >= 0 && where.point_id < static_cast<int>(bound_.size())) {
     const Bound& b = bound_[where.point_id];
+    if (b.ea) return evaluate_energy(E, *b.ea, b.TE, where.theta);
     return evaluate_at(E, *b.rs, b.alpha, b.TE, b.TSinv, where.theta);
+  }
+  if (energy_) {
+    const auto ea = energy_at(stitch_value(where.theta));
+    return evaluate_energy(E, *ea, mech::T_E(knitting_angle(where.theta)), where.theta);
   }
   const auto rs = surface_at(stitch_value(where.theta));
   const double a = knitting_angle(where.theta);
@@ -198,11 +215,18 @@ KnitMaterial::Stats KnitMaterial::stats() const {
 void KnitMaterial::reset_stats() {
   evaluations_ = 0;
   for (auto& c : counts_) c = 0;
+  outside_box_ = 0;
+  failed_ = 0;
+  for (int k = 0; k < 3; ++k) {
+    visited_[k] = std::numeric_limits<double>::infinity();
+    visited_[k + 3] = -std::numeric_limits<double>::infinity();
+  }
   std::lock_guard<std::mutex> lock(where_mutex_);
   where_.clear();
 }
 
 std::string KnitMaterial::report() const {
+  if (energy_) return energy_report();
   const Stats s = stats();
   static const char* names[5] = {"beyond the last load step", "outside the fan of load paths",
                                  "biaxial compression (linear initial law)",

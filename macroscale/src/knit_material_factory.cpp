@@ -5,7 +5,8 @@
 //     "database": "db.h5",                        // relative to the case file's directory
 //     "stitch_value": 5.5 | {field},              // l(theta1, theta2), mm
 //     "knitting_angle": 0.0 | {field} | {"align_with": [vx, vy, vz], "degrees": [pu, pv],
-//                                         "knots_u": [...], "knots_v": [...]}
+//                                         "knots_u": [...], "knots_v": [...]},
+//     "law": "energy" | "paper"    // default: "energy" when the database has it, else "paper"
 //   }
 //   {field} = {"degrees": [pu, pv], "knots_u": [...], "knots_v": [...], "values": [...],
 //              "unit": "rad" | "deg" (knitting angle only)}
@@ -146,7 +147,8 @@ spline::SplineSurface read_field(const nlohmann::json& j, const std::string& p,
 
 std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const CaseContext& ctx) {
   const std::string& p = ctx.pointer;
-  check_keys(m, p, ctx, {"type", "database", "stitch_value", "knitting_angle", "description"});
+  check_keys(m, p, ctx,
+             {"type", "database", "stitch_value", "knitting_angle", "law", "description"});
   for (const char* k : {"database", "stitch_value"})
     if (!m.contains(k))
       throw InputError(ctx.file, p, std::string("missing required key \"") + k + "\"");
@@ -162,9 +164,25 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   } catch (const InputError& e) {
     throw InputError(ctx.file, p + "/database", e.what());
   }
+  // The law: "energy" (issue 11) by default when the database has it, else "paper" (eq. 17).
+  std::string law = data.energy_law ? "energy" : "paper";
+  if (m.contains("law")) {
+    law = m.at("law").is_string() ? m.at("law").get<std::string>() : "";
+    if (law != "energy" && law != "paper")
+      throw InputError(ctx.file, p + "/law", "must be \"energy\" or \"paper\"");
+  }
+  std::shared_ptr<const material::EnergyLaw> energy;
+  if (law == "energy") {
+    try {
+      energy = std::make_shared<const material::EnergyLaw>(
+          material::require_energy_law(data, db.string()));
+    } catch (const InputError& e) {
+      throw InputError(ctx.file, p + "/law", e.what());
+    }
+  }
   std::shared_ptr<const material::LoopLengthFamily> family;
   try {
-    family = std::make_shared<const material::LoopLengthFamily>(data.family());
+    if (law == "paper") family = std::make_shared<const material::LoopLengthFamily>(data.family());
   } catch (const std::exception& e) {
     throw InputError(ctx.file, p + "/database", db.string() + ": " + e.what());
   }
@@ -190,14 +208,16 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   if (m.at("stitch_value").is_number()) {
     // A constant: name the value itself rather than a control value.
     const double v = m.at("stitch_value").get<double>();
-    if (!family->contains(v)) {
+    const double lo = energy ? energy->data().l_min : family->min();
+    const double hi = energy ? energy->data().l_max : family->max();
+    if (!(v >= lo && v <= hi)) {
       std::ostringstream os;
-      os << v << " mm is outside the database's " << family->min() << "-" << family->max()
-         << " mm (" << db.string() << ")";
+      os << v << " mm is outside the database's " << lo << "-" << hi << " mm (" << db.string()
+         << ")";
       throw InputError(ctx.file, p + "/stitch_value", os.str());
     }
   }
-  return std::make_unique<KnitMaterial>(family, l, a, src);
+  return std::make_unique<KnitMaterial>(family, energy, l, a, src);
 }
 
 }  // namespace knit::macro

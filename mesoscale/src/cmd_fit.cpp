@@ -1,29 +1,37 @@
-// knit-meso fit DB.h5: refits the response surfaces of an existing material database from its
-// raw data with new options, without re-simulating (paper eq. 17; options in
-// knit/meso/fit/response_fit.hpp).
+// knit-meso fit DB.h5: refits the laws of an existing material database from its raw data with
+// new options, without re-simulating: the paper's response surfaces (eq. 17; options in
+// knit/meso/fit/response_fit.hpp) and/or the energy-based law (issue 11; options in
+// knit/meso/fit/energy_fit.hpp). A version-1 database is rewritten as version 2.
 //
-//   knit-meso fit db.h5
-//   knit-meso fit db.h5 --options fit.json --out refit.h5
+//   knit-meso fit db.h5                       # both laws
+//   knit-meso fit db.h5 --law energy --energy-options energy.json -o refit.h5
+//   knit-meso fit db.h5 --law paper --options fit.json
 #include <iostream>
 #include <memory>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 
 static knit::cli::SubcommandRegistrar reg_fit(
     "fit",
-    "Refit the response surfaces of an existing material database from its raw data (no "
-    "re-simulation)",
+    "Refit the laws of an existing material database from its raw data (no re-simulation): "
+    "the paper's response surfaces and/or the energy-based law",
     [](CLI::App& sub) {
       struct FitCli {
-        std::string db, out, options;
+        std::string db, out, options, energy_options, law = "both";
       };
       auto o = std::make_shared<FitCli>();
       sub.add_option("database", o->db, "material database (.h5)")->required();
-      sub.add_option("--options", o->options, "fit options (JSON file; defaults otherwise)");
+      sub.add_option("--law", o->law, "which law to fit: energy, paper or both (default)")
+          ->check(CLI::IsMember({"energy", "paper", "both"}));
+      sub.add_option("--options", o->options,
+                     "paper-law fit options (JSON file; defaults otherwise)");
+      sub.add_option("--energy-options", o->energy_options,
+                     "energy-law fit options (JSON file; defaults otherwise)");
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       return [o]() -> int {
         using namespace knit::meso::fit;
@@ -32,17 +40,32 @@ static knit::cli::SubcommandRegistrar reg_fit(
                                       o->out.empty() ? "database" : "--out");
         const knit::io::OutputLock lock(target);
         auto db = knit::material::read_database(o->db, true);
-        const FitOptions fo =
-            o->options.empty()
-                ? FitOptions{}
-                : FitOptions::from_json(knit::meso::fit::read_text_file(o->options), o->options);
-        const auto fits = fit_database(db, fo);
-        std::cout << "knit-meso fit: " << o->db << " (" << fits.size() << " loop lengths)\n";
-        knit::meso::fit::print_fit_summaries(std::cout, db, fits);
+        const bool paper = o->law != "energy", energy = o->law != "paper";
+        int rc = knit::kExitOk;
+        std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()
+                  << " loop lengths, law " << o->law << ")\n";
+        if (paper) {
+          const FitOptions fo = o->options.empty()
+                                    ? FitOptions{}
+                                    : FitOptions::from_json(read_text_file(o->options), o->options);
+          const auto fits = fit_paper_law(db, fo);
+          print_fit_summaries(std::cout, db, fits);
+          for (const auto& f : fits)
+            if (!f.ok()) rc = knit::kExitFailure;
+        }
+        if (energy) {
+          const EnergyFitOptions eo =
+              o->energy_options.empty() ? EnergyFitOptions{}
+                                        : EnergyFitOptions::from_json(
+                                              read_text_file(o->energy_options), o->energy_options);
+          const auto s = fit_energy_database(db, eo);
+          std::cout << energy_fit_report(s);
+          if (s.status == FitStatus::kRefused)
+            throw knit::InputError(o->db, "", "energy law refused: " + s.reason);
+          if (!s.ok()) rc = knit::kExitFailure;
+        }
         db.provenance = knit::material::current_provenance();
         knit::material::write_database(target, db);
-        for (const auto& f : fits)
-          if (!f.ok()) return knit::kExitFailure;
-        return knit::kExitOk;
+        return rc;
       };
     });

@@ -63,6 +63,8 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
     else
       std::printf("fit l=%.2f mm: NOT FITTED: %s\n", in.loop_lengths[k], f.reason.c_str());
   }
+  if (rep.energy_fit)
+    std::printf("%s", knit::meso::fit::energy_fit_report(*rep.energy_fit).c_str());
   std::printf("time: cases %.2f s, fit %.2f s, total %.2f s (%d rank%s x %d thread%s)\n",
               rep.seconds_cases, rep.seconds_fit, rep.seconds_total, rep.ranks,
               rep.ranks == 1 ? "" : "s", rep.threads, rep.threads == 1 ? "" : "s");

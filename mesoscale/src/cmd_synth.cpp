@@ -1,10 +1,14 @@
 // knit-meso synth: a synthetic material database, the STAND-IN for the mesoscale sweep until
 // real homogenized data exist. It evaluates a known orthotropic, stiffening law (not a knit;
-// see knit/meso/fit/synthetic.hpp) on the default 13 load paths, stores the raw data like the
-// sweep would, fits the response surfaces (unless --no-fit) and writes the database.
+// see knit/meso/fit/synthetic.hpp) on the default 13 load paths plus coverage and held-out
+// paths (synthetic_coverage_paths: the full circle of biaxial directions, shear with stretch,
+// 24 quasi-random held-out states), stores the raw data like the sweep would, fits the paper's
+// response surfaces (from the "paper" set) and the energy-based law (unless --no-fit) and
+// writes the database.
 //
 //   knit-meso synth --out synthetic.h5
 //   knit-meso synth --out db.h5 --loop-lengths 4.5,5.5,6.5 --steps 20 --fit-options fit.json
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -13,16 +17,17 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 
 namespace {
 struct SynthCli {
-  std::string out, fit_options;
+  std::string out, fit_options, energy_options;
   std::vector<double> loop_lengths = {4.5, 5.0, 5.5, 6.0, 6.5};
   int steps = 20;
-  bool no_fit = false;
+  bool no_fit = false, no_coverage = false;
 };
 }  // namespace
 
@@ -39,7 +44,10 @@ static knit::cli::SubcommandRegistrar reg_synth(
       sub.add_option("--steps", o->steps, "load steps per path")
           ->check(knit::cli::integer(4, 1000));
       sub.add_option("--fit-options", o->fit_options, "fit options (JSON file)");
+      sub.add_option("--energy-options", o->energy_options, "energy-law fit options (JSON file)");
       sub.add_flag("--no-fit", o->no_fit, "store the raw data only");
+      sub.add_flag("--no-coverage", o->no_coverage,
+                   "only the 13 paper paths (no coverage or held-out paths)");
       return [o]() -> int {
         using namespace knit::meso::fit;
         knit::io::check_output_target(o->out, knit::io::OutputKind::kFile, "--out");
@@ -51,6 +59,9 @@ static knit::cli::SubcommandRegistrar reg_synth(
               (k > 0 && !(so.loop_lengths[k] > so.loop_lengths[k - 1])))
             throw knit::InputError("", "--loop-lengths", "must be positive and increasing");
         so.paths = knit::material::default_load_paths(o->steps);
+        if (!o->no_coverage)
+          for (const auto& p : synthetic_coverage_paths(std::max(4, o->steps / 2)))
+            so.paths.push_back(p);
         auto db = synthetic_database(so);
         int rc = knit::kExitOk;
         if (!o->no_fit) {
@@ -59,11 +70,18 @@ static knit::cli::SubcommandRegistrar reg_synth(
                   ? FitOptions{}
                   : FitOptions::from_json(knit::meso::fit::read_text_file(o->fit_options),
                                           o->fit_options);
-          const auto fits = fit_database(db, fo);
+          const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
           for (const auto& f : fits)
             if (!f.ok()) rc = knit::kExitFailure;
+          const EnergyFitOptions eo =
+              o->energy_options.empty() ? EnergyFitOptions{}
+                                        : EnergyFitOptions::from_json(
+                                              read_text_file(o->energy_options), o->energy_options);
+          const auto es = fit_energy_database(db, eo);
+          std::cout << energy_fit_report(es);
+          if (!es.ok()) rc = knit::kExitFailure;
         }
         knit::material::write_database(o->out, db);
         std::cout << "wrote " << o->out << " (synthetic stand-in, generator = \"synth\")\n";

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -20,6 +21,20 @@ void print_fit_summaries(std::ostream& os, const material::Database& db,
        << 100 * d.max_relative << " % of the stress range); rms S1 " << d.rms(2) << ", S2 "
        << d.rms(3) << ", S12 " << d.rms(4) << " MPa\n";
   }
+}
+
+std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& options) {
+  material::Database paper = db;
+  for (auto& e : paper.entries)
+    e.raw.erase(std::remove_if(e.raw.begin(), e.raw.end(),
+                               [](const material::RawPath& r) { return r.path.set != "paper"; }),
+                e.raw.end());
+  const auto fits = fit_database(paper, options);
+  for (std::size_t k = 0; k < db.entries.size(); ++k) {
+    db.entries[k].surface = paper.entries[k].surface;
+    db.entries[k].diagnostics = paper.entries[k].diagnostics;
+  }
+  return fits;
 }
 
 std::string read_text_file(const std::string& file) {

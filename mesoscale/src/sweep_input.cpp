@@ -229,6 +229,13 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
       }
     }
   }
+  if (j.contains("energy_fit")) {
+    const auto& f = j.at("energy_fit");
+    if (f.is_boolean())
+      in.energy_fit = f.get<bool>();
+    else
+      in.energy_fit_options = fit::EnergyFitOptions::from_json(f.dump(), file, "/energy_fit");
+  }
   return in;
 }
 

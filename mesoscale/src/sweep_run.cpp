@@ -37,7 +37,8 @@ int SweepReport::stopped_cases() const {
 }
 
 bool SweepReport::fits_ok() const {
-  return std::all_of(fits.begin(), fits.end(), [](const auto& f) { return f.ok(); });
+  return std::all_of(fits.begin(), fits.end(), [](const auto& f) { return f.ok(); }) &&
+         (!energy_fit || energy_fit->ok());
 }
 
 namespace {
@@ -295,6 +296,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   material::Database db = assemble_database(in, rep.results);
   const auto tf = std::chrono::steady_clock::now();
   if (in.fit) rep.fits = fit_sweep_database(db, in.fit_options, rep.threads);
+  if (in.fit && in.energy_fit) rep.energy_fit = fit::fit_energy_database(db, in.energy_fit_options);
   rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
   rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_sweep_database(opt.output, db, in, rep.results, rep);

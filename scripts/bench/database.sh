@@ -7,6 +7,8 @@ build="${1:-$root/build}"
 bin="$build/bin"
 "$bin/test_common" "bench: response-surface evaluations per second" 2>/dev/null |
   grep "^material evaluation" || echo "material evaluation: n/a (test_common missing)"
+"$bin/test_common" "bench: energy-law evaluations per second" 2>/dev/null |
+  grep "^energy-law evaluation" || echo "energy-law evaluation: n/a (test_common missing)"
 "$bin/test_common" "bench: loading the material database" 2>/dev/null |
   grep "^database load" || echo "database load: n/a (needs knit/io)"
 if [[ -x "$bin/test_macro" ]]; then

@@ -106,15 +106,15 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("not an HDF5 file"));
   }
   SECTION("another format version") {
-    const auto bad = tmp("v2.h5");
+    const auto bad = tmp("v3.h5");
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
     {
       auto f = knit::io::H5File::open_rw(bad);
-      f.set_attribute(".", "format_version", 2);
+      f.set_attribute(".", "format_version", 3);
     }
     CHECK_THROWS_WITH(
         read_database(bad),
-        Catch::Contains("format_version 2 is not supported (this build reads version 1)"));
+        Catch::Contains("format_version 3 is not supported (this build reads versions 1 to 2)"));
   }
   SECTION("missing group") {
     const auto bad = tmp("nogroup.h5");

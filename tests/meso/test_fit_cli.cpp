@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "knit/io/hdf5.hpp"
 #include "knit/material/database.hpp"
 
 namespace fs = std::filesystem;
@@ -22,14 +23,14 @@ TEST_CASE("knit-meso synth --no-fit, then fit, refits from the raw data", "[unit
   const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
   fs::create_directories(dir);
   const fs::path db = dir / "cli_synth.h5";
-  REQUIRE(run("synth --no-fit --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  REQUIRE(run("synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
   auto raw = knit::material::read_database(db);
   REQUIRE(raw.entries.size() == 2);
   CHECK(!raw.entries[0].surface);
   CHECK(raw.entries[1].raw.size() == 13);
   const fs::path opts = dir / "cli_opts.json";
   std::ofstream(opts) << R"({"control_points_1": 9, "smoothing": 1e-6})";
-  REQUIRE(run("fit " + db.string() + " --options " + opts.string()) == 0);
+  REQUIRE(run("fit " + db.string() + " --law paper --options " + opts.string()) == 0);
   const auto fitted = knit::material::read_database(db);
   REQUIRE(fitted.entries[0].surface);
   CHECK(fitted.entries[0].surface->n1() == 9);
@@ -39,4 +40,32 @@ TEST_CASE("knit-meso synth --no-fit, then fit, refits from the raw data", "[unit
   std::ofstream(opts) << R"({"loss": "l1"})";
   CHECK(run("fit " + db.string() + " --options " + opts.string()) == 2);
   CHECK(run("fit " + (dir / "missing.h5").string()) == 2);
+}
+
+TEST_CASE("knit-meso synth writes the energy law; fit --law energy adds it to a v1 file",
+          "[unit]") {
+  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
+  fs::create_directories(dir);
+  const fs::path db = dir / "cli_synth_energy.h5";
+  REQUIRE(run("synth --steps 8 --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  const auto a = knit::material::read_database(db, false);
+  REQUIRE(a.energy_law);
+  CHECK(a.energy_diagnostics.holdout_points == 2 * 24);
+  CHECK(a.energy_diagnostics.holdout_within_5_percent == 2 * 24);
+  REQUIRE(a.entries[0].surface);  // the paper's law beside it, from the "paper" paths
+  {                               // What a version-1 build wrote (no /energy_law).
+    auto f = knit::io::H5File::open_rw(db);
+    f.remove("/energy_law");
+    f.set_attribute(".", "format_version", 1);
+  }
+  CHECK_FALSE(knit::material::read_database(db, false).energy_law);
+  REQUIRE(run("fit " + db.string() + " --law energy") == 0);
+  const auto b = knit::material::read_database(db, false);
+  CHECK(b.format_version == 2);
+  REQUIRE(b.energy_law);
+  CHECK(b.entries[0].surface);  // untouched
+  std::ofstream(dir / "cli_energy_opts.json") << R"({"s_spans": -1})";
+  CHECK(run("fit " + db.string() + " --law energy --energy-options " +
+            (dir / "cli_energy_opts.json").string()) == 2);
+  CHECK(run("fit " + db.string() + " --law neither") != 0);
 }

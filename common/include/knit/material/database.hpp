@@ -19,13 +19,15 @@
 #include <string>
 #include <vector>
 
+#include "knit/material/energy_law.hpp"
 #include "knit/material/load_paths.hpp"
 #include "knit/material/loop_length_family.hpp"
 #include "knit/material/response_surface.hpp"
 
 namespace knit::material {
 
-inline constexpr int kDatabaseFormatVersion = 1;
+/// Version 2 adds the energy-based law (/energy_law); version 1 files still load (without it).
+inline constexpr int kDatabaseFormatVersion = 2;
 inline constexpr const char* kDatabaseFormatName = "knitscale-material-database";
 
 using RowMatrixX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -77,6 +79,27 @@ struct StrainDomain {
   double E11_min = 0, E11_max = 0, E22_min = 0, E22_max = 0, E12_max = 0;
 };
 
+/// Errors of the energy-based law (issue 11): per loop length on the fit data, and on the
+/// held-out paths (set "holdout", never fitted). Components S11, S22, S12 (MPa). The stress
+/// range of a loop length is the largest (max - min) of a stress component over its fit data;
+/// relative errors divide by it (held-out states by the range of their loop length).
+struct EnergyFitDiagnostics {
+  struct PerLoop {
+    double loop_length = 0.0;
+    int points = 0;
+    Eigen::Vector3d rms = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
+    double stress_range = 0.0, max_relative = 0.0, rms_relative = 0.0;
+  };
+  std::vector<PerLoop> per_loop;
+  int holdout_points = 0;
+  int holdout_within_5_percent = 0;  ///< held-out states whose largest error is <= 5 % of the range
+  Eigen::Vector3d holdout_rms = Eigen::Vector3d::Zero(), holdout_max = Eigen::Vector3d::Zero();
+  double holdout_max_relative = 0.0;
+  int points_used = 0, points_skipped = 0;
+  double min_eigenvalue = 0.0;  ///< smallest eigenvalue of C over the fit data (>= floor)
+  std::string options_json;
+};
+
 struct Provenance {
   std::string software_version, git_revision, created;  ///< created: ISO 8601 UTC
 };
@@ -88,6 +111,10 @@ struct Database {
   std::string sweep_input;               ///< the sweep's input (JSON text)
   std::map<std::string, double> yarn;    ///< e.g. diameter, youngs_modulus, poisson_ratio
   std::vector<LoopLengthEntry> entries;  ///< increasing loop length
+  /// The energy-based law (format version 2, /energy_law); absent in version-1 files and
+  /// until `knit-meso fit --law energy|both` has run.
+  std::optional<EnergyLawData> energy_law;
+  EnergyFitDiagnostics energy_diagnostics;
 
   std::vector<double> loop_lengths() const;
   StrainDomain domain() const;
@@ -95,6 +122,13 @@ struct Database {
   /// not fitted.
   LoopLengthFamily family() const;
 };
+
+/// The energy law of db, read from `file`; throws knit::InputError(file, "/energy_law", ...)
+/// saying how to add it when db has none (a version-1 file, or a database fitted without it).
+const EnergyLawData& require_energy_law(const Database& db, const std::string& file);
+
+/// HDF5 path of raw path q of loop length k ("/loop_k/raw/path_qq"), for messages.
+std::string raw_path_location(std::size_t k, std::size_t q);
 
 /// Provenance of this build, now.
 Provenance current_provenance();

@@ -20,6 +20,15 @@
 //
 // Extrapolation of the response surface (see knit/material/response_surface.hpp) is counted
 // per kind and the first locations are kept; report() summarizes them at the end of a run.
+//
+// Two laws (case key /material/law): "paper" is the eq. (16-18) response surface above;
+// "energy" (the default when the database has it, issue 11) is the convex strain energy of
+// knit/material/energy_law.hpp. With "energy" the material is hyperelastic: W is invariant
+// under the rotation, W(E) = W_hat(T_E E), so S = T_E^T S_hat = T^-1 S_hat and
+// C = T_E^T C_hat T_E = T^-1 C_hat T^-T (symmetric); evaluations outside the database's data
+// strain box are counted as extrapolated, failed ones (a non-finite strain) as failed, and the
+// visited material-frame strain box (min/max of E_hat over all evaluations) is recorded --
+// the evidence for choosing the sweep's box. Both go to report().
 #pragma once
 
 #include <Eigen/Core>
@@ -33,6 +42,7 @@
 
 #include "knit/macro/material.hpp"
 #include "knit/macro/material_factory.hpp"
+#include "knit/material/energy_law.hpp"
 #include "knit/material/loop_length_family.hpp"
 #include "knit/spline/surface.hpp"
 
@@ -76,7 +86,17 @@ class KnitMaterial : public Material {
                spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
                Source source = {});
 
+  /// The energy-based law ("energy"); `family` (the paper's law) may then be null.
+  KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
+               std::shared_ptr<const material::EnergyLaw> energy,
+               spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
+               Source source = {});
+
   std::string name() const override { return "knit"; }
+  /// "energy" or "paper".
+  std::string law() const { return energy_ ? "energy" : "paper"; }
+  bool hyperelastic() const override { return energy_ != nullptr; }
+  long failed_evaluations() const override;
   void bind_points(const std::vector<Eigen::Vector2d>& theta) override;
   MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override;
   std::vector<std::pair<std::string, double>> output_fields(
@@ -100,6 +120,13 @@ class KnitMaterial : public Material {
     std::vector<Where> first;  ///< up to kMaxLocations locations
   };
   Stats stats() const;
+  /// Energy law: evaluations, outside the data strain box, failed; visited material-frame
+  /// strain box (e = (E11, E22, 2E12); +-inf before the first evaluation).
+  struct EnergyStats {
+    long evaluations = 0, outside_box = 0, failed = 0;
+    Eigen::Vector3d visited_min, visited_max;
+  };
+  EnergyStats energy_stats() const;
   void reset_stats();
   static constexpr int kMaxLocations = 10;
 
@@ -108,6 +135,7 @@ class KnitMaterial : public Material {
     const material::ResponseSurface* rs;
     double l, alpha;
     Eigen::Matrix3d TE, TSinv;  ///< T_E(alpha) = T^-T and T_S(-alpha) = T^-1, precomputed
+    const material::EnergyLawAt* ea = nullptr;  ///< law "energy"
   };
   std::shared_ptr<const material::ResponseSurface> surface_at(double l) const;
   void record(const Eigen::Vector2d& theta, const Eigen::Vector3d& E_material, int flags) const;
@@ -115,7 +143,19 @@ class KnitMaterial : public Material {
                                double alpha, const Eigen::Matrix3d& TE,
                                const Eigen::Matrix3d& TSinv, const Eigen::Vector2d& theta) const;
 
+  std::shared_ptr<const material::EnergyLawAt> energy_at(double l) const;
+  MaterialResponse evaluate_energy(const Eigen::Vector3d& E, const material::EnergyLawAt& law,
+                                   const Eigen::Matrix3d& TE, const Eigen::Vector2d& theta) const;
+  std::string energy_report() const;
+  double l_min() const;
+  double l_max() const;
+
   std::shared_ptr<const material::LoopLengthFamily> family_;
+  std::shared_ptr<const material::EnergyLaw> energy_;
+  mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_cache_;
+  mutable std::atomic<long> outside_box_{0}, failed_{0};
+  /// Visited box: min of (E11, E22, 2E12) in [0..2], max in [3..5].
+  mutable std::array<std::atomic<double>, 6> visited_;
   spline::SplineSurface l_field_, a_field_;
   Source source_;
   std::vector<Bound> bound_;

@@ -13,6 +13,10 @@ namespace knit::meso::fit {
 void print_fit_summaries(std::ostream& os, const material::Database& db,
                          const std::vector<FitSummary>& fits);
 
+/// Fits the paper's law (eq. 17) of every loop length from the raw paths of the "paper" set
+/// only (the coverage and held-out paths are the energy law's), and stores it in db.
+std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& options);
+
 /// The whole file as text; throws knit::InputError if it cannot be opened.
 std::string read_text_file(const std::string& file);
 

@@ -25,11 +25,25 @@ struct SyntheticLaw {
   Eigen::Vector3d stress(const Eigen::Vector3d& E, double l) const;
 };
 
+/// Coverage paths for the energy-based law (set "coverage"): the full circle of biaxial
+/// directions (every 15 degrees, radius e_max in (E11, E22), compression included) and
+/// shear-with-stretch gradient paths F = I + t H; plus `holdout` single-state gradient paths
+/// (set "holdout") at quasi-random (Halton 2, 3, 5) strain states inside the box. The law is
+/// known, so these are exact data for the fit test.
+std::vector<material::LoadPath> synthetic_coverage_paths(int steps = 10, double e_max = 0.4,
+                                                         int holdout = 24);
+
 struct SyntheticOptions {
   std::vector<double> loop_lengths = {4.5, 5.0, 5.5, 6.0, 6.5};
   std::vector<material::LoadPath> paths = material::default_load_paths();
   SyntheticLaw law;
 };
+
+/// F of a path at step fraction t, for every kind (uniaxial: the prescribed Green-Lagrange
+/// strain along the axis grows linearly in t and the lateral strain makes the synthetic law's
+/// lateral stress vanish).
+Eigen::Matrix2d synthetic_deformation_gradient(const material::LoadPath& path, double t,
+                                               const SyntheticLaw& law, double l);
 
 /// Raw data of one loop length (all steps converged).
 std::vector<material::RawPath> synthetic_paths(const SyntheticOptions& o, double l);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "knit/material/load_paths.hpp"
+#include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 
 namespace knit::meso::sweep {
@@ -55,6 +56,10 @@ struct SweepInput {
   bool subtract_residual = false;
   bool fit = true;
   fit::FitOptions fit_options;
+  /// The energy-based law (issue 11), fitted after the paper's law when `fit` is on; the
+  /// input key "energy_fit": false | {options of knit/meso/fit/energy_fit.hpp}.
+  bool energy_fit = true;
+  fit::EnergyFitOptions energy_fit_options;
 
   /// Canonical JSON of everything that determines the job results (loop lengths, paths,
   /// runner, cell, retry) -- not the fit options: a resumed sweep may refit differently.

@@ -12,10 +12,12 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "knit/material/database.hpp"
+#include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/meso/sweep/input.hpp"
 #include "knit/meso/sweep/job.hpp"
@@ -39,6 +41,8 @@ struct SweepReport {
   int computed = 0;  ///< jobs run in this session (rank 0: by all ranks; others: by this rank)
   int resumed = 0;   ///< jobs taken from the checkpoints
   std::vector<fit::FitSummary> fits;  ///< one per loop length (empty if no fit)
+  /// The energy-based law's fit (absent without a fit or with "energy_fit": false).
+  std::optional<fit::EnergyFitSummary> energy_fit;
   double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
   int threads = 1, ranks = 1;
   bool wrote_database = false;  ///< false on ranks other than 0

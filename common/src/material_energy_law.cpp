@@ -1,0 +1,219 @@
+// The energy-based response surface (see knit/material/energy_law.hpp).
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "knit/material/energy_law.hpp"
+#include "knit/spline/knot_vector.hpp"
+
+namespace knit::material {
+
+int RidgeDirections::functions() const {
+  return function_of.empty() ? 0 : *std::max_element(function_of.begin(), function_of.end()) + 1;
+}
+
+RidgeDirections mirror_closed(const std::vector<Eigen::Vector3d>& base) {
+  std::vector<Eigen::Vector3d> dirs;
+  std::vector<int> fn;
+  auto add = [&](const Eigen::Vector3d& d, int g) {
+    // Parallel directions of different functions duplicate each other. The mirror of pure
+    // shear (0, 0, 1) is its opposite: f(2E12) + f(-2E12) with one f, the even shear term.
+    for (std::size_t k = 0; k < dirs.size(); ++k)
+      if (fn[k] != g && std::abs(std::abs(dirs[k].dot(d)) - 1.0) < 1e-12)
+        throw std::invalid_argument("ridge directions: two directions are parallel");
+    dirs.push_back(d);
+    fn.push_back(g);
+  };
+  int g = 0;
+  for (const auto& b : base) {
+    const double n = b.norm();
+    if (!(n > 0.0) || !std::isfinite(n))
+      throw std::invalid_argument("ridge directions: zero or non-finite direction");
+    const Eigen::Vector3d d = b / n;
+    add(d, g);
+    if (d(2) != 0.0) add(Eigen::Vector3d(d(0), d(1), -d(2)), g);
+    ++g;
+  }
+  RidgeDirections r;
+  r.d.resize(static_cast<Eigen::Index>(dirs.size()), 3);
+  for (std::size_t k = 0; k < dirs.size(); ++k)
+    r.d.row(static_cast<Eigen::Index>(k)) = dirs[k].transpose();
+  r.function_of = std::move(fn);
+  return r;
+}
+
+RidgeDirections default_ridge_directions() {
+  std::vector<Eigen::Vector3d> b;
+  const double pi = 3.14159265358979323846;
+  // Fibre-like: the normal strain along theta, E_nn = c^2 E11 + s^2 E22 + c s (2 E12). The
+  // mirror of theta is 180 - theta, so theta in [0, 90] spans the set with its mirrors.
+  for (int deg = 0; deg <= 90; deg += 15) {
+    const double c = std::cos(deg * pi / 180), s = std::sin(deg * pi / 180);
+    b.emplace_back(c * c, s * s, std::abs(c * s) < 1e-15 ? 0.0 : c * s);
+  }
+  // Area-like (membrane dilatation, distortion, stretch with lateral contraction).
+  b.emplace_back(1, 1, 0);
+  b.emplace_back(1, -1, 0);
+  b.emplace_back(1, -0.5, 0);
+  b.emplace_back(-0.5, 1, 0);
+  // Shear coupled with stretch, and pure shear.
+  b.emplace_back(1, 0, 1);
+  b.emplace_back(0, 1, 1);
+  b.emplace_back(1, -1, 1);  // (1, 1, 1) is the fibre at 45 deg
+  b.emplace_back(0, 0, 1);
+  return mirror_closed(b);
+}
+
+void validate(const EnergyLawData& d) {
+  auto fail = [](const std::string& m) { throw std::invalid_argument("energy law: " + m); };
+  const Eigen::Index K = d.directions.d.rows();
+  if (K < 1) fail("no directions");
+  if (static_cast<Eigen::Index>(d.directions.function_of.size()) != K)
+    fail("function_of must have one entry per direction");
+  const int G = d.functions();
+  for (int g : d.directions.function_of)
+    if (g < 0) fail("function_of has a negative index");
+  for (Eigen::Index k = 0; k < K; ++k) {
+    const double n = d.directions.d.row(k).norm();
+    if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-9)
+      fail("direction " + std::to_string(k) + " is not a unit vector");
+  }
+  if (d.s_degree < 0 || d.s_degree > 5) fail("s_degree must be in 0..5");
+  if (d.s_spans < 1 || d.s_spans > 1000) fail("s_spans must be in 1..1000");
+  if (d.s_range.rows() != G) fail("s_range needs one row per function");
+  for (int g = 0; g < G; ++g) {
+    const std::string why = d.grid(g).validate();
+    if (!why.empty()) fail("function " + std::to_string(g) + ": " + why);
+  }
+  if (!(std::isfinite(d.l_min) && std::isfinite(d.l_max) && d.l_min > 0 && d.l_max >= d.l_min))
+    fail("loop-length range must be finite, positive and increasing");
+  try {
+    spline::validate_knots(d.l_knots, d.l_degree);
+  } catch (const std::exception& e) {
+    fail(std::string("l_knots: ") + e.what());
+  }
+  if (d.l_knots.front() > d.l_min || d.l_knots.back() < d.l_max)
+    fail("l_knots must cover [l_min, l_max]");
+  if (d.coefficients.rows() != G || d.coefficients.cols() != d.n_s() * d.n_l())
+    fail("coefficients must be functions x (n_s * n_l) = " + std::to_string(G) + " x " +
+         std::to_string(d.n_s() * d.n_l()));
+  if (!d.coefficients.allFinite()) fail("coefficients must be finite");
+  if ((d.coefficients.array() < 0.0).any())
+    fail("coefficients must be >= 0 (f'' >= 0 keeps W convex)");
+  if (!(std::isfinite(d.floor) && d.floor >= 0.0)) fail("floor must be finite and >= 0");
+  if (!d.box_min.allFinite() || !d.box_max.allFinite() ||
+      (d.box_min.array() > d.box_max.array()).any())
+    fail("data strain box must be finite with min <= max");
+}
+
+EnergyLaw::EnergyLaw(EnergyLawData d) : d_(std::move(d)) {
+  validate(d_);
+  lb_ = spline::BSplineBasis(d_.l_degree, d_.l_knots);
+}
+
+Eigen::VectorXd EnergyLaw::l_basis(double l, int derivative) const {
+  return lb_.eval_all(std::clamp(l, lb_.lo(), lb_.hi()), derivative);
+}
+
+Eigen::VectorXd EnergyLaw::ridge_coefficients(int g, double l, int derivative) const {
+  const Eigen::VectorXd M = l_basis(l, derivative);
+  const int ns = d_.n_s();
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(ns);
+  for (int j = 0; j < d_.n_l(); ++j)
+    a += M(j) * d_.coefficients.row(g).segment(j * ns, ns).transpose();
+  return a;
+}
+
+EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative)
+    : l_(l), floor_(d.floor), P_(d.s_degree + 2), box_min_(d.box_min), box_max_(d.box_max) {
+  const EnergyLaw law(d);
+  const int G = d.functions();
+  std::vector<std::size_t> offset(static_cast<std::size_t>(G));
+  for (int g = 0; g < G; ++g) {
+    offset[static_cast<std::size_t>(g)] = poly_.size();
+    const Eigen::VectorXd a = law.ridge_coefficients(g, l);
+    ridge_polynomials(d.grid(g), a.data(), poly_);
+    if (with_l_derivative) {
+      const Eigen::VectorXd da = law.ridge_coefficients(g, l, 1);
+      ridge_polynomials(d.grid(g), da.data(), dpoly_);
+    }
+  }
+  for (Eigen::Index k = 0; k < d.directions.d.rows(); ++k) {
+    const int g = d.directions.function_of[static_cast<std::size_t>(k)];
+    const RidgeGrid grid = d.grid(g);
+    dirs_.push_back({d.directions.d(k, 0), d.directions.d(k, 1), d.directions.d(k, 2), grid.a,
+                     1.0 / grid.h(), grid.spans, offset[static_cast<std::size_t>(g)]});
+  }
+}
+
+template <int P>
+void EnergyLawAt::accumulate(const Eigen::Vector3d& e, EnergyResponse& r) const {
+  double W = 0, S0 = 0, S1 = 0, S2 = 0, C00 = 0, C01 = 0, C02 = 0, C11 = 0, C12 = 0, C22 = 0;
+  const double* q = poly_.data();
+  for (const Dir& k : dirs_) {
+    const double s = k.d0 * e(0) + k.d1 * e(1) + k.d2 * e(2);
+    double f, df, ddf;
+    ridge_eval<P>(q + k.offset, k.a, k.inv_h, k.spans, s, f, df, ddf);
+    W += f;
+    S0 += df * k.d0;
+    S1 += df * k.d1;
+    S2 += df * k.d2;
+    const double c0 = ddf * k.d0, c1 = ddf * k.d1;
+    C00 += c0 * k.d0;
+    C01 += c0 * k.d1;
+    C02 += c0 * k.d2;
+    C11 += c1 * k.d1;
+    C12 += c1 * k.d2;
+    C22 += ddf * k.d2 * k.d2;
+  }
+  r.W += W;
+  r.S += Eigen::Vector3d(S0, S1, S2);
+  r.C(0, 0) += C00;
+  r.C(1, 1) += C11;
+  r.C(2, 2) += C22;
+  r.C(0, 1) = r.C(1, 0) = C01;
+  r.C(0, 2) = r.C(2, 0) = C02;
+  r.C(1, 2) = r.C(2, 1) = C12;
+}
+
+EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
+  EnergyResponse r;
+  r.W = 0.5 * floor_ * e.squaredNorm();
+  r.S = floor_ * e;
+  r.C = floor_ * Eigen::Matrix3d::Identity();
+  switch (P_) {
+    case 2:
+      accumulate<2>(e, r);
+      break;
+    case 3:
+      accumulate<3>(e, r);
+      break;
+    case 4:
+      accumulate<4>(e, r);
+      break;
+    case 5:
+      accumulate<5>(e, r);
+      break;
+    case 6:
+      accumulate<6>(e, r);
+      break;
+    default:
+      accumulate<7>(e, r);
+      break;
+  }
+  return r;
+}
+
+Eigen::Vector3d EnergyLawAt::dS_dl(const Eigen::Vector3d& e) const {
+  if (dpoly_.empty()) throw std::logic_error("EnergyLawAt: built without the l-derivative");
+  Eigen::Vector3d dS = Eigen::Vector3d::Zero();
+  for (const Dir& k : dirs_) {
+    // Not a hot path: the generic evaluator (same polynomials, any degree).
+    const RidgeGrid grid{k.a, k.a + k.spans / k.inv_h, k.spans, P_ - 2};
+    const double s = k.d0 * e(0) + k.d1 * e(1) + k.d2 * e(2);
+    dS += ridge_eval_any(grid, dpoly_.data() + k.offset, s)(1) * Eigen::Vector3d(k.d0, k.d1, k.d2);
+  }
+  return dS;
+}
+
+}  // namespace knit::material

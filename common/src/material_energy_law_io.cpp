@@ -1,0 +1,164 @@
+// HDF5 reading and writing of the energy-based law (layout: schemas/database.layout.json,
+// docs/database.md "The energy-based law").
+#include <stdexcept>
+
+#include "knit/core/errors.hpp"
+#include "material_energy_law_io.hpp"
+
+namespace knit::material::detail {
+
+namespace {
+
+std::vector<double> to_vec(const Eigen::VectorXd& v) {
+  return {v.data(), v.data() + v.size()};
+}
+
+}  // namespace
+
+void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyFitDiagnostics& dg) {
+  io::H5Group g = root.create_group(kEnergyLawGroup);
+  g.set_attribute(".", "law",
+                  "W(e; l) = sum_k f_g(k)(d_k . e; l) + floor/2 |e|^2, S = dW/de, C = d2W/de2; "
+                  "f_g'' = sum_ij coefficients[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l) >= 0, "
+                  "f_g(0) = f_g'(0) = 0");
+  g.set_attribute(".", "strain", "e = (E11, E22, 2 E12) (Voigt, Green-Lagrange, material frame)");
+  g.set_attribute(".", "units", "W MPa (N mm/mm^3), S and C MPa, l mm");
+  g.set_attribute(".", "s_degree", law.s_degree);
+  g.set_attribute(".", "s_spans", law.s_spans);
+  g.set_attribute(".", "l_degree", law.l_degree);
+  g.set_attribute(".", "l_min", law.l_min);
+  g.set_attribute(".", "l_max", law.l_max);
+  g.set_attribute(".", "floor", law.floor);
+  g.write("directions", RowMatrixX(law.directions.d));
+  g.set_attribute("directions", "columns", "d_k (unit) in e = (E11, E22, 2 E12)");
+  g.write("function_of", law.directions.function_of);
+  g.set_attribute("function_of", "values", "index g of the ridge function of direction k");
+  g.write("s_range", RowMatrixX(law.s_range));
+  g.set_attribute("s_range", "columns",
+                  "a_g, b_g: uniform clamped knots of f_g'' on [a_g, b_g] (s_spans spans)");
+  g.write("l_knots", law.l_knots);
+  g.set_attribute("l_knots", "units", "mm (clamped knot vector of degree l_degree)");
+  g.write("coefficients", RowMatrixX(law.coefficients));
+  g.set_attribute("coefficients", "index",
+                  "row g, column i + n_s j (n_s = s_spans + s_degree); MPa, >= 0");
+  g.write("box_min", law.box_min);
+  g.write("box_max", law.box_max);
+  g.set_attribute("box_min", "units", "e = (E11, E22, 2 E12): the data strain box");
+  g.set_attribute("box_max", "units", "e = (E11, E22, 2 E12): the data strain box");
+
+  io::H5Group d = g.create_group("diagnostics");
+  const auto n = static_cast<Eigen::Index>(dg.per_loop.size());
+  Eigen::VectorXd l(n), range(n), maxrel(n), rmsrel(n);
+  std::vector<int> points;
+  RowMatrixX rms(n, 3), mx(n, 3);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto& p = dg.per_loop[static_cast<std::size_t>(k)];
+    l(k) = p.loop_length;
+    range(k) = p.stress_range;
+    maxrel(k) = p.max_relative;
+    rmsrel(k) = p.rms_relative;
+    points.push_back(p.points);
+    rms.row(k) = p.rms.transpose();
+    mx.row(k) = p.max.transpose();
+  }
+  d.write("loop_length", to_vec(l));
+  d.write("points", points);
+  d.write("rms", rms);
+  d.write("max", mx);
+  d.write("stress_range", to_vec(range));
+  d.write("max_relative", to_vec(maxrel));
+  d.write("rms_relative", to_vec(rmsrel));
+  d.set_attribute("rms", "columns", "S11, S22, S12 (MPa); rows: loop_length");
+  d.set_attribute("max", "columns", "S11, S22, S12 (MPa); rows: loop_length");
+  d.set_attribute("stress_range", "definition",
+                  "largest (max - min) of a stress component over the fit data of the loop length");
+  d.write("holdout_rms", dg.holdout_rms);
+  d.write("holdout_max", dg.holdout_max);
+  d.set_attribute(".", "holdout_points", dg.holdout_points);
+  d.set_attribute(".", "holdout_within_5_percent", dg.holdout_within_5_percent);
+  d.set_attribute(".", "holdout_max_relative", dg.holdout_max_relative);
+  d.set_attribute(".", "points_used", dg.points_used);
+  d.set_attribute(".", "points_skipped", dg.points_skipped);
+  d.set_attribute(".", "min_eigenvalue", dg.min_eigenvalue);
+  d.set_attribute(".", "options_json", dg.options_json);
+}
+
+void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLawData& law,
+                     EnergyFitDiagnostics& dg) {
+  const std::string g = kEnergyLawGroup;
+  std::string where = g;
+  try {
+    for (const char* n :
+         {"directions", "function_of", "s_range", "l_knots", "coefficients", "box_min", "box_max"})
+      if (!root.is_dataset(g + "/" + n)) throw InputError(file, g + "/" + n, "dataset missing");
+    law.s_degree = root.attribute_int(g, "s_degree");
+    law.s_spans = root.attribute_int(g, "s_spans");
+    law.l_degree = root.attribute_int(g, "l_degree");
+    law.l_min = root.attribute_double(g, "l_min");
+    law.l_max = root.attribute_double(g, "l_max");
+    law.floor = root.attribute_double(g, "floor");
+    law.directions.d = root.read_matrix(g + "/directions");
+    if (law.directions.d.cols() != 3)
+      throw InputError(file, g + "/directions", "must have 3 columns");
+    law.directions.function_of = root.read_ints(g + "/function_of");
+    const RowMatrixX sr = root.read_matrix(g + "/s_range");
+    if (sr.cols() != 2) throw InputError(file, g + "/s_range", "must have 2 columns");
+    law.s_range = sr;
+    law.l_knots = root.read_doubles(g + "/l_knots");
+    law.coefficients = root.read_matrix(g + "/coefficients");
+    const auto bmin = root.read_doubles(g + "/box_min"), bmax = root.read_doubles(g + "/box_max");
+    if (bmin.size() != 3 || bmax.size() != 3)
+      throw InputError(file, g + "/box_min", "box_min and box_max need 3 values");
+    law.box_min = Eigen::Vector3d(bmin[0], bmin[1], bmin[2]);
+    law.box_max = Eigen::Vector3d(bmax[0], bmax[1], bmax[2]);
+    validate(law);
+
+    const std::string d = g + "/diagnostics";
+    where = d;
+    if (!root.is_group(d)) throw InputError(file, d, "group missing");
+    const auto l = root.read_doubles(d + "/loop_length");
+    const auto pts = root.read_ints(d + "/points");
+    const RowMatrixX rms = root.read_matrix(d + "/rms"), mx = root.read_matrix(d + "/max");
+    const auto range = root.read_doubles(d + "/stress_range");
+    const auto maxrel = root.read_doubles(d + "/max_relative");
+    const auto rmsrel = root.read_doubles(d + "/rms_relative");
+    const auto n = l.size();
+    if (pts.size() != n || range.size() != n || maxrel.size() != n || rmsrel.size() != n ||
+        static_cast<std::size_t>(rms.rows()) != n || static_cast<std::size_t>(mx.rows()) != n ||
+        (n > 0 && (rms.cols() != 3 || mx.cols() != 3)))
+      throw InputError(file, d, "per-loop-length datasets differ in length");
+    dg.per_loop.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      EnergyFitDiagnostics::PerLoop p;
+      p.loop_length = l[k];
+      p.points = pts[k];
+      p.rms = rms.row(static_cast<Eigen::Index>(k)).transpose();
+      p.max = mx.row(static_cast<Eigen::Index>(k)).transpose();
+      p.stress_range = range[k];
+      p.max_relative = maxrel[k];
+      p.rms_relative = rmsrel[k];
+      dg.per_loop.push_back(p);
+    }
+    const auto hr = root.read_doubles(d + "/holdout_rms"),
+               hm = root.read_doubles(d + "/holdout_max");
+    if (hr.size() != 3 || hm.size() != 3)
+      throw InputError(file, d, "holdout_rms and holdout_max need 3 values");
+    dg.holdout_rms = Eigen::Vector3d(hr[0], hr[1], hr[2]);
+    dg.holdout_max = Eigen::Vector3d(hm[0], hm[1], hm[2]);
+    dg.holdout_points = root.attribute_int(d, "holdout_points");
+    dg.holdout_within_5_percent = root.attribute_int(d, "holdout_within_5_percent");
+    dg.holdout_max_relative = root.attribute_double(d, "holdout_max_relative");
+    dg.points_used = root.attribute_int(d, "points_used");
+    dg.points_skipped = root.attribute_int(d, "points_skipped");
+    dg.min_eigenvalue = root.attribute_double(d, "min_eigenvalue");
+    dg.options_json = root.attribute_string(d, "options_json");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    std::string m = e.what();
+    if (m.rfind(file + ": ", 0) == 0) m = m.substr(file.size() + 2);
+    throw InputError(file, where, m);
+  }
+}
+
+}  // namespace knit::material::detail

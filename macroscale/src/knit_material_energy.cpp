@@ -1,0 +1,116 @@
+// The knit material with the energy-based law (case key /material/law = "energy"); see
+// knit/macro/knit_material.hpp and knit/material/energy_law.hpp.
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "knit/macro/knit_material.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+void atomic_min(std::atomic<double>& a, double v) {
+  double cur = a.load(std::memory_order_relaxed);
+  while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+}
+void atomic_max(std::atomic<double>& a, double v) {
+  double cur = a.load(std::memory_order_relaxed);
+  while (v > cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+}
+
+}  // namespace
+
+double KnitMaterial::l_min() const {
+  return energy_ ? energy_->data().l_min : family_->min();
+}
+double KnitMaterial::l_max() const {
+  return energy_ ? energy_->data().l_max : family_->max();
+}
+
+long KnitMaterial::failed_evaluations() const {
+  return energy_ ? failed_.load() : counts_[4].load();
+}
+
+std::shared_ptr<const material::EnergyLawAt> KnitMaterial::energy_at(double l) const {
+  // The field is a convex combination of in-range control values; clamp round-off.
+  l = std::clamp(l, l_min(), l_max());
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  auto it = energy_cache_.find(l);
+  if (it != energy_cache_.end()) return it->second;
+  auto at = std::make_shared<const material::EnergyLawAt>(energy_->at(l));
+  energy_cache_.emplace(l, at);
+  return at;
+}
+
+MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,
+                                               const material::EnergyLawAt& law,
+                                               const Eigen::Matrix3d& TE,
+                                               const Eigen::Vector2d& theta) const {
+  MaterialResponse out;
+  evaluations_.fetch_add(1, std::memory_order_relaxed);
+  // W(E) = W_hat(T_E E): S = T_E^T S_hat, C = T_E^T C_hat T_E (T_E^T = T^-1, eq. 22).
+  const Eigen::Vector3d Ehat = TE * E;
+  if (!Ehat.allFinite()) {
+    failed_.fetch_add(1, std::memory_order_relaxed);
+    out.W = 0.0;
+    record(theta, Ehat, 16);
+    return out;  // zero response: the run reports the failure (failed_evaluations())
+  }
+  for (int k = 0; k < 3; ++k) {
+    atomic_min(visited_[k], Ehat(k));
+    atomic_max(visited_[k + 3], Ehat(k));
+  }
+  if (!law.inside_box(Ehat)) {
+    outside_box_.fetch_add(1, std::memory_order_relaxed);
+    record(theta, Ehat, 1);
+  }
+  const material::EnergyResponse r = law.evaluate(Ehat);
+  out.W = r.W;
+  out.S.noalias() = TE.transpose() * r.S;
+  const Eigen::Matrix3d C = TE.transpose() * r.C * TE;
+  out.C = 0.5 * (C + C.transpose());  // symmetric to the last bit
+  return out;
+}
+
+KnitMaterial::EnergyStats KnitMaterial::energy_stats() const {
+  EnergyStats s;
+  s.evaluations = evaluations_.load();
+  s.outside_box = outside_box_.load();
+  s.failed = failed_.load();
+  for (int k = 0; k < 3; ++k) {
+    s.visited_min(k) = visited_[k].load();
+    s.visited_max(k) = visited_[k + 3].load();
+  }
+  return s;
+}
+
+std::string KnitMaterial::energy_report() const {
+  const EnergyStats s = energy_stats();
+  const auto& box = energy_->data();
+  std::ostringstream os;
+  os << std::setprecision(4);
+  os << "knit material (energy law): " << s.evaluations << " evaluations";
+  if (s.evaluations == 0) return os.str();
+  os << "; " << s.outside_box << " extrapolated ("
+     << 100.0 * static_cast<double>(s.outside_box) / static_cast<double>(s.evaluations)
+     << " %, outside the data strain box E11 [" << box.box_min(0) << ", " << box.box_max(0)
+     << "], E22 [" << box.box_min(1) << ", " << box.box_max(1) << "], 2E12 [" << box.box_min(2)
+     << ", " << box.box_max(2) << "])";
+  if (s.failed) os << "; " << s.failed << " failed (non-finite strain)";
+  os << "\n  visited material-frame strain box: E11 [" << s.visited_min(0) << ", "
+     << s.visited_max(0) << "], E22 [" << s.visited_min(1) << ", " << s.visited_max(1)
+     << "], 2E12 [" << s.visited_min(2) << ", " << s.visited_max(2) << "]";
+  const Stats st = stats();
+  if (!st.first.empty()) {
+    os << "\n  first locations outside the box (theta1, theta2; E_course, E_wale, 2E_cw):";
+    for (const auto& w : st.first)
+      os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();
+  }
+  return os.str();
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,85 @@
+// Fit of the energy-based law (knit/material/energy_law.hpp) to the cell's stresses, with
+// Ceres (issue 11, item 3).
+//
+// Data: E and S of every converged step (status 0) of every raw path whose set is not
+// "holdout", at every loop length; e = (E11, E22, 2 E12). Paths with set "holdout" only give
+// the held-out errors.
+//
+// The law is linear in its coefficients x = (c_gij) (f_g'' coefficients, s index i, l index
+// j): S(e; l) = A(e, l) x + floor e. Objective (dimensionless):
+//   (1/N) sum_data w_p |(A_p x + floor e_p - S_p) / sS|^2
+//     + lambda sum |second differences of c along s and along l / sK|^2,     x >= 0,
+// N = number of stress residuals, sS = largest |S| of the data, sK = sS / sE (sE = largest
+// |e|), w_p = 1 without a loss, IRLS weights of the Huber or Cauchy loss otherwise. Because
+// the data term is quadratic, it is condensed to its square-root information form
+// (R x - z, R^T R = normal matrix, a tiny ridge keeps it definite) and handed to Ceres as one
+// dense residual block with lower bounds 0 on every parameter. The nonnegativity makes every
+// fitted W convex at every l of the range (C >= floor I): a fit that cannot be made convex
+// cannot happen by construction.
+//
+// Choices (documented in docs/database.md, all configurable):
+//  * s-range of each function: the range of d_k . e over the data (both mirror directions),
+//    widened by s_margin times its width on each side (and always containing 0);
+//  * l: cubic with min(4, loop lengths) control points (degree capped at control points - 1);
+//  * floor: `floor` MPa if >= 0, else floor_relative * sS / sE (a fraction of the data's
+//    secant stiffness; default 1 %).
+//
+// Refusals (status kRefused, with the reason and the HDF5 path): no loop length, a loop length
+// without usable data (fewer than 4 converged non-holdout steps), non-finite data in a
+// converged step, invalid options.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "knit/material/database.hpp"
+#include "knit/meso/fit/response_fit.hpp"
+
+namespace knit::meso::fit {
+
+struct EnergyFitOptions {
+  /// Ridge directions before mirror closure; empty = material::default_ridge_directions().
+  std::vector<Eigen::Vector3d> directions;
+  int s_degree = 3, s_spans = 8;
+  int l_degree = 3, l_control_points = 4;
+  double s_margin = 0.1;
+  double floor = -1.0;  ///< MPa; < 0: floor_relative * secant stiffness of the data
+  double floor_relative = 0.01;
+  double smoothing = 1e-7;
+  Loss loss = Loss::kNone;
+  double loss_scale = 0.05;  ///< in units of sS
+  int loss_rounds = 4;       ///< IRLS rounds with a loss
+  int max_iterations = 200;
+
+  std::string validate() const;
+  std::string to_json() const;
+  /// Parses the options (same keys as to_json()); errors name `file` and the JSON pointer
+  /// below `pointer`.
+  static EnergyFitOptions from_json(const std::string& text, const std::string& file = "<options>",
+                                    const std::string& pointer = "");
+};
+
+struct EnergyFitSummary {
+  FitStatus status = FitStatus::kOk;
+  std::string reason;
+  material::EnergyLawData law;
+  material::EnergyFitDiagnostics diagnostics;
+  int ceres_iterations = 0;
+  bool ok() const { return status == FitStatus::kOk; }
+};
+
+/// Fits the law to every loop length of db (raw data needed). db is not changed.
+EnergyFitSummary fit_energy_law(const material::Database& db, const EnergyFitOptions& options);
+
+/// Fits and stores the law (db.energy_law) when the fit succeeds; returns the summary.
+EnergyFitSummary fit_energy_database(material::Database& db, const EnergyFitOptions& options);
+
+/// Errors of a law against db's raw data: per loop length on the fit data, and on the
+/// held-out paths.
+material::EnergyFitDiagnostics diagnose_energy_law(const material::EnergyLawData& law,
+                                                   const material::Database& db);
+
+/// Text summary (per l: RMS, max, relative; held-out) for the command line.
+std::string energy_fit_report(const EnergyFitSummary& s);
+
+}  // namespace knit::meso::fit

@@ -1,0 +1,471 @@
+// Fit of the energy-based law with Ceres (see knit/meso/fit/energy_fit.hpp). Ceres is included
+// in the fit files only (design/style.md habit 6).
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/meso/fit/energy_fit.hpp"
+#include "knit/spline/knot_vector.hpp"
+
+namespace knit::meso::fit {
+
+using material::Database;
+using material::EnergyFitDiagnostics;
+using material::EnergyLawData;
+
+namespace {
+
+/// r = R x - z: the square-root information form of a quadratic objective (one dense block).
+class SqrtInformationCost : public ceres::CostFunction {
+ public:
+  SqrtInformationCost(Eigen::MatrixXd R, Eigen::VectorXd z) : R_(std::move(R)), z_(std::move(z)) {
+    set_num_residuals(static_cast<int>(z_.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(R_.cols()));
+  }
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    const Eigen::Map<const Eigen::VectorXd> xv(x[0], R_.cols());
+    Eigen::Map<Eigen::VectorXd>(r, R_.rows()) = R_ * xv - z_;
+    if (J && J[0])
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          J[0], R_.rows(), R_.cols()) = R_;
+    return true;
+  }
+
+ private:
+  Eigen::MatrixXd R_;
+  Eigen::VectorXd z_;
+};
+
+struct Point {
+  Eigen::Vector3d e, S;  // Voigt strain, stress
+  double l;
+  std::size_t loop;  // entry index
+};
+
+std::string loss_name(Loss l) {
+  return l == Loss::kHuber ? "huber" : (l == Loss::kCauchy ? "cauchy" : "none");
+}
+
+bool is_holdout(const material::RawPath& r) {
+  return r.path.set == "holdout";
+}
+
+/// Data of db: fit points and held-out points; the reason (with its HDF5 path) if unusable.
+std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Point>& held,
+                    int& skipped) {
+  skipped = 0;
+  for (std::size_t k = 0; k < db.entries.size(); ++k) {
+    const auto& entry = db.entries[k];
+    int used = 0;
+    for (std::size_t q = 0; q < entry.raw.size(); ++q) {
+      const auto& r = entry.raw[q];
+      for (int s = 0; s < r.steps(); ++s) {
+        if (r.status[static_cast<std::size_t>(s)] != 0) {
+          ++skipped;
+          continue;
+        }
+        Point p{
+            {r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)}, r.S.row(s).transpose(), entry.loop_length, k};
+        if (!p.e.allFinite() || !p.S.allFinite())
+          return material::raw_path_location(k, q) + ": step " + std::to_string(s + 1) +
+                 " is marked converged but its E or S is not finite";
+        (is_holdout(r) ? held : fit).push_back(p);
+        if (!is_holdout(r)) ++used;
+      }
+    }
+    if (used < 4)
+      return "/loop_" + std::to_string(k) + "/raw: only " + std::to_string(used) +
+             " converged steps outside the held-out set (at least 4 needed)";
+  }
+  return {};
+}
+
+/// The normal equations of the data term, accumulated in chunks (no full design matrix).
+struct Design {
+  const EnergyLawData& law;
+  std::vector<material::RidgeBasis> bases;
+  spline::BSplineBasis lb;
+  int ns, nl, P;
+  explicit Design(const EnergyLawData& d)
+      : law(d), lb(d.l_degree, d.l_knots), ns(d.n_s()), nl(d.n_l()), P(d.functions() * ns * nl) {
+    for (int g = 0; g < d.functions(); ++g) bases.emplace_back(d.grid(g));
+  }
+  /// Rows (3) of the stress of point p: S = A x + floor e.
+  void rows(const Point& p, Eigen::MatrixXd& A) const {
+    A.setZero();
+    const Eigen::VectorXd M = lb.eval_all(std::clamp(p.l, lb.lo(), lb.hi()));
+    for (Eigen::Index k = 0; k < law.directions.d.rows(); ++k) {
+      const Eigen::Vector3d d = law.directions.d.row(k).transpose();
+      const int g = law.directions.function_of[static_cast<std::size_t>(k)];
+      Eigen::Matrix<double, 3, Eigen::Dynamic> F(3, ns);
+      bases[static_cast<std::size_t>(g)].eval(d.dot(p.e), F);
+      for (int j = 0; j < nl; ++j) {
+        if (M(j) == 0.0) continue;
+        const int col = (g * nl + j) * ns;  // x index g * ns * nl + i + ns * j
+        for (int c = 0; c < 3; ++c) A.row(c).segment(col, ns) += (d(c) * M(j)) * F.row(1);
+      }
+    }
+  }
+};
+
+}  // namespace
+
+std::string EnergyFitOptions::validate() const {
+  if (s_degree < 0 || s_degree > 5) return "s_degree must be in 0..5";
+  if (s_spans < 1 || s_spans > 200) return "s_spans must be in 1..200";
+  if (l_degree < 0 || l_degree > 5) return "l_degree must be in 0..5";
+  if (l_control_points < 1 || l_control_points > 50) return "l_control_points must be in 1..50";
+  if (!(s_margin >= 0.0 && s_margin <= 10.0)) return "s_margin must be in [0, 10]";
+  if (!std::isfinite(floor)) return "floor must be finite";
+  if (!(floor_relative >= 0.0 && floor_relative < 1.0)) return "floor_relative must be in [0, 1)";
+  if (!(smoothing >= 0.0 && std::isfinite(smoothing))) return "smoothing must be >= 0";
+  if (!(loss_scale > 0.0)) return "loss_scale must be positive";
+  if (loss_rounds < 1 || loss_rounds > 50) return "loss_rounds must be in 1..50";
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  for (const auto& d : directions)
+    if (!d.allFinite() || d.norm() == 0.0) return "directions must be finite and non-zero";
+  return {};
+}
+
+std::string EnergyFitOptions::to_json() const {
+  nlohmann::json j = {{"s_degree", s_degree},
+                      {"s_spans", s_spans},
+                      {"l_degree", l_degree},
+                      {"l_control_points", l_control_points},
+                      {"s_margin", s_margin},
+                      {"floor", floor},
+                      {"floor_relative", floor_relative},
+                      {"smoothing", smoothing},
+                      {"loss", loss_name(loss)},
+                      {"loss_scale", loss_scale},
+                      {"loss_rounds", loss_rounds},
+                      {"max_iterations", max_iterations}};
+  if (!directions.empty()) {
+    nlohmann::json d = nlohmann::json::array();
+    for (const auto& v : directions) d.push_back({v(0), v(1), v(2)});
+    j["directions"] = d;
+  }
+  return j.dump();
+}
+
+EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std::string& file,
+                                             const std::string& pointer) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(file, pointer, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw InputError(file, pointer, "energy-fit options must be a JSON object");
+  EnergyFitOptions o;
+  static const char* known[] = {"s_degree",  "s_spans",    "l_degree",       "l_control_points",
+                                "s_margin",  "floor",      "floor_relative", "smoothing",
+                                "loss",      "loss_scale", "loss_rounds",    "max_iterations",
+                                "directions"};
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (std::find_if(std::begin(known), std::end(known),
+                     [&](const char* k) { return it.key() == k; }) == std::end(known))
+      throw InputError(file, pointer + "/" + it.key(), "unknown energy-fit option");
+  auto get_int = [&](const char* k, int& v) {
+    if (!j.contains(k)) return;
+    if (!j[k].is_number_integer()) throw InputError(file, pointer + "/" + k, "must be an integer");
+    v = j[k].get<int>();
+  };
+  auto get_double = [&](const char* k, double& v) {
+    if (!j.contains(k)) return;
+    if (!j[k].is_number()) throw InputError(file, pointer + "/" + k, "must be a number");
+    v = j[k].get<double>();
+  };
+  get_int("s_degree", o.s_degree);
+  get_int("s_spans", o.s_spans);
+  get_int("l_degree", o.l_degree);
+  get_int("l_control_points", o.l_control_points);
+  get_double("s_margin", o.s_margin);
+  get_double("floor", o.floor);
+  get_double("floor_relative", o.floor_relative);
+  get_double("smoothing", o.smoothing);
+  get_double("loss_scale", o.loss_scale);
+  get_int("loss_rounds", o.loss_rounds);
+  get_int("max_iterations", o.max_iterations);
+  if (j.contains("loss")) {
+    const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
+    if (l == "none")
+      o.loss = Loss::kNone;
+    else if (l == "huber")
+      o.loss = Loss::kHuber;
+    else if (l == "cauchy")
+      o.loss = Loss::kCauchy;
+    else
+      throw InputError(file, pointer + "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
+  }
+  if (j.contains("directions")) {
+    const auto& d = j["directions"];
+    if (!d.is_array() || d.empty())
+      throw InputError(file, pointer + "/directions", "must be a non-empty array of [a, b, c]");
+    for (std::size_t k = 0; k < d.size(); ++k) {
+      if (!d[k].is_array() || d[k].size() != 3 || !d[k][0].is_number() || !d[k][1].is_number() ||
+          !d[k][2].is_number())
+        throw InputError(file, pointer + "/directions/" + std::to_string(k),
+                         "must be [a, b, c] (a direction in (E11, E22, 2 E12))");
+      o.directions.emplace_back(d[k][0].get<double>(), d[k][1].get<double>(),
+                                d[k][2].get<double>());
+    }
+  }
+  if (const std::string why = o.validate(); !why.empty()) throw InputError(file, pointer, why);
+  return o;
+}
+
+EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
+  EnergyFitSummary out;
+  auto refuse = [&](const std::string& why) {
+    out.status = FitStatus::kRefused;
+    out.reason = why;
+    return out;
+  };
+  if (const std::string why = o.validate(); !why.empty()) return refuse("invalid options: " + why);
+  if (db.entries.empty()) return refuse("/loop_lengths: no loop length to fit");
+  std::vector<Point> pts, held;
+  int skipped = 0;
+  if (const std::string why = collect(db, pts, held, skipped); !why.empty()) return refuse(why);
+
+  // ---- layout: directions, scales, s-ranges, l-basis, floor, box -------------------------
+  EnergyLawData& law = out.law;
+  try {
+    law.directions = o.directions.empty() ? material::default_ridge_directions()
+                                          : material::mirror_closed(o.directions);
+  } catch (const std::exception& e) {
+    return refuse(std::string("invalid options: ") + e.what());
+  }
+  const int G = law.functions();
+  double sS = 0.0, sE = 0.0;
+  law.box_min = law.box_max = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) {
+    sS = std::max(sS, p.S.cwiseAbs().maxCoeff());
+    sE = std::max(sE, p.e.norm());
+    law.box_min = law.box_min.cwiseMin(p.e);
+    law.box_max = law.box_max.cwiseMax(p.e);
+  }
+  // W is even in E12: the data at +2E12 speak for -2E12 too.
+  const double g_max = std::max(std::abs(law.box_min(2)), std::abs(law.box_max(2)));
+  law.box_min(2) = -g_max;
+  law.box_max(2) = g_max;
+  if (!(sS > 0.0) || !(sE > 0.0))
+    return refuse("/loop_0/raw: every usable step has zero strain or zero stress");
+  const double sK = sS / sE;
+  law.s_degree = o.s_degree;
+  law.s_spans = o.s_spans;
+  law.s_range.resize(G, 2);
+  for (int g = 0; g < G; ++g) {
+    double lo = 0.0, hi = 0.0;
+    for (Eigen::Index k = 0; k < law.directions.d.rows(); ++k) {
+      if (law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
+      const Eigen::Vector3d d = law.directions.d.row(k).transpose();
+      for (const auto& p : pts) {
+        lo = std::min(lo, d.dot(p.e));
+        hi = std::max(hi, d.dot(p.e));
+      }
+    }
+    const double w = std::max(hi - lo, 1e-3 * sE), m = o.s_margin * w;
+    law.s_range.row(g) << std::min(lo - m, -0.01 * w), std::max(hi + m, 0.01 * w);
+  }
+  std::vector<double> ls;
+  for (const auto& e : db.entries) ls.push_back(e.loop_length);
+  law.l_min = ls.front();
+  law.l_max = ls.back();
+  const int nl = std::min<int>(o.l_control_points, static_cast<int>(ls.size()));
+  law.l_degree = std::min(o.l_degree, nl - 1);
+  law.l_knots = law.l_max > law.l_min
+                    ? spline::uniform_knots(law.l_degree, nl - law.l_degree, law.l_min, law.l_max)
+                    : std::vector<double>{law.l_min - 0.5, law.l_min + 0.5};
+  law.floor = o.floor >= 0.0 ? o.floor : o.floor_relative * sK;
+
+  // ---- normal equations ------------------------------------------------------------------
+  const Design design(law);
+  const int P = design.P, ns = design.ns;
+  const double N = 3.0 * static_cast<double>(pts.size());
+  std::vector<double> w(pts.size(), 1.0);
+  Eigen::MatrixXd A(3, P);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(P);
+  // Smoothness: second differences along s (each g, j) and along l (each g, i), / sK.
+  Eigen::MatrixXd DtD = Eigen::MatrixXd::Zero(P, P);
+  auto add_diff = [&](int a, int b, int c) {
+    const int idx[3] = {a, b, c};
+    const double coef[3] = {1.0, -2.0, 1.0};
+    for (int r = 0; r < 3; ++r)
+      for (int s = 0; s < 3; ++s) DtD(idx[r], idx[s]) += coef[r] * coef[s];
+  };
+  for (int g = 0; g < G; ++g)
+    for (int j = 0; j < nl; ++j)
+      for (int i = 0; i < ns; ++i) {
+        const int base = (g * nl + j) * ns;
+        if (i + 2 < ns) add_diff(base + i, base + i + 1, base + i + 2);
+        if (j + 2 < nl) add_diff(base + i, base + ns + i, base + 2 * ns + i);
+      }
+  ceres::Solver::Summary summary;
+  for (int round = 0; round < (o.loss == Loss::kNone ? 1 : o.loss_rounds); ++round) {
+    Eigen::MatrixXd M = (o.smoothing * N / (sK * sK)) * DtD;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(P);
+    for (std::size_t p = 0; p < pts.size(); ++p) {
+      design.rows(pts[p], A);
+      const Eigen::Vector3d b = pts[p].S - law.floor * pts[p].e;
+      M.selfadjointView<Eigen::Upper>().rankUpdate(A.transpose(), w[p] / (sS * sS));
+      rhs.noalias() += (w[p] / (sS * sS)) * (A.transpose() * b);
+    }
+    M.triangularView<Eigen::StrictlyLower>() = M.transpose();
+    // A tiny ridge keeps M definite where no datum and no penalty reaches a coefficient.
+    const double ridge = 1e-12 * std::max(M.diagonal().maxCoeff(), 1e-300) + 1e-14 / (sK * sK);
+    M.diagonal().array() += ridge;
+    const Eigen::LLT<Eigen::MatrixXd> llt(M);
+    if (llt.info() != Eigen::Success) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = "the normal matrix is not positive definite (non-finite data?)";
+      return out;
+    }
+    Eigen::MatrixXd R = llt.matrixU();
+    Eigen::VectorXd z = llt.matrixL().solve(rhs);
+    // Scale the unknowns to O(1): x = sK * y.
+    R *= sK;
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    Eigen::VectorXd y = x / sK;
+    problem.AddResidualBlock(new SqrtInformationCost(std::move(R), std::move(z)), nullptr,
+                             y.data());
+    for (int i = 0; i < P; ++i) problem.SetParameterLowerBound(y.data(), i, 0.0);
+    ceres::Solver::Options so;
+    so.max_num_iterations = o.max_iterations;
+    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    so.function_tolerance = 1e-13;
+    so.gradient_tolerance = 1e-14;
+    so.parameter_tolerance = 1e-12;
+    so.logging_type = ceres::SILENT;
+    so.num_threads = 1;
+    ceres::Solve(so, &problem, &summary);
+    out.ceres_iterations += static_cast<int>(summary.iterations.size());
+    if (!summary.IsSolutionUsable()) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = "Ceres: " + summary.message;
+      return out;
+    }
+    x = (sK * y).cwiseMax(0.0);
+    if (o.loss == Loss::kNone) break;
+    // IRLS weights of the loss on the scaled residual norm of each point.
+    for (std::size_t p = 0; p < pts.size(); ++p) {
+      design.rows(pts[p], A);
+      const double r = (A * x + law.floor * pts[p].e - pts[p].S).norm() / sS;
+      const double d = o.loss_scale;
+      w[p] = o.loss == Loss::kHuber ? (r <= d ? 1.0 : d / r) : 1.0 / (1.0 + (r / d) * (r / d));
+    }
+  }
+  law.coefficients.resize(G, ns * nl);
+  for (int g = 0; g < G; ++g) law.coefficients.row(g) = x.segment(g * ns * nl, ns * nl).transpose();
+  try {
+    material::validate(law);
+  } catch (const std::exception& e) {
+    out.status = FitStatus::kSolverFailed;
+    out.reason = e.what();
+    return out;
+  }
+  out.diagnostics = diagnose_energy_law(law, db);
+  out.diagnostics.points_skipped = skipped;
+  out.diagnostics.options_json = o.to_json();
+  return out;
+}
+
+EnergyFitSummary fit_energy_database(Database& db, const EnergyFitOptions& options) {
+  EnergyFitSummary s = fit_energy_law(db, options);
+  if (s.ok()) {
+    db.energy_law = s.law;
+    db.energy_diagnostics = s.diagnostics;
+  }
+  return s;
+}
+
+EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Database& db) {
+  EnergyFitDiagnostics dg;
+  const material::EnergyLaw family(law);
+  std::vector<Point> pts, held;
+  int skipped = 0;
+  collect(db, pts, held, skipped);  // diagnostics of whatever is usable
+  dg.points_skipped = skipped;
+  dg.min_eigenvalue = std::numeric_limits<double>::infinity();
+  std::vector<double> range(db.entries.size(), 0.0);
+  for (std::size_t k = 0; k < db.entries.size(); ++k) {
+    const material::EnergyLawAt at = family.at(db.entries[k].loop_length);
+    EnergyFitDiagnostics::PerLoop pl;
+    pl.loop_length = db.entries[k].loop_length;
+    Eigen::Vector3d smin = Eigen::Vector3d::Constant(1e300), smax = -smin,
+                    sq = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) {
+      if (p.loop != k) continue;
+      const material::EnergyResponse r = at.evaluate(p.e);
+      const Eigen::Vector3d err = (r.S - p.S).cwiseAbs();
+      pl.max = pl.max.cwiseMax(err);
+      sq += err.cwiseProduct(err);
+      smin = smin.cwiseMin(p.S);
+      smax = smax.cwiseMax(p.S);
+      dg.min_eigenvalue = std::min(
+          dg.min_eigenvalue, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
+      ++pl.points;
+    }
+    if (pl.points > 0) {
+      pl.rms = (sq / pl.points).cwiseSqrt();
+      pl.stress_range = (smax - smin).maxCoeff();
+      if (pl.stress_range > 0) {
+        pl.max_relative = pl.max.maxCoeff() / pl.stress_range;
+        pl.rms_relative = pl.rms.maxCoeff() / pl.stress_range;
+      }
+    }
+    range[k] = pl.stress_range;
+    dg.points_used += pl.points;
+    dg.per_loop.push_back(pl);
+  }
+  Eigen::Vector3d sq = Eigen::Vector3d::Zero();
+  for (const auto& p : held) {
+    const Eigen::Vector3d err =
+        (family.at(db.entries[p.loop].loop_length).evaluate(p.e).S - p.S).cwiseAbs();
+    dg.holdout_max = dg.holdout_max.cwiseMax(err);
+    sq += err.cwiseProduct(err);
+    const double rel = range[p.loop] > 0 ? err.maxCoeff() / range[p.loop] : 0.0;
+    dg.holdout_max_relative = std::max(dg.holdout_max_relative, rel);
+    if (rel <= 0.05) ++dg.holdout_within_5_percent;
+    ++dg.holdout_points;
+  }
+  if (dg.holdout_points > 0) dg.holdout_rms = (sq / dg.holdout_points).cwiseSqrt();
+  if (!std::isfinite(dg.min_eigenvalue)) dg.min_eigenvalue = law.floor;
+  return dg;
+}
+
+std::string energy_fit_report(const EnergyFitSummary& s) {
+  std::ostringstream os;
+  if (!s.ok()) {
+    os << "  energy law: " << (s.status == FitStatus::kRefused ? "REFUSED: " : "FAILED: ")
+       << s.reason << "\n";
+    return os.str();
+  }
+  const auto& d = s.diagnostics;
+  os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
+     << " functions, floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue
+     << " MPa, " << s.ceres_iterations << " Ceres iterations):\n";
+  for (const auto& p : d.per_loop)
+    os << "    l = " << p.loop_length << " mm: " << p.points << " states, rms (S11, S22, S12) "
+       << p.rms(0) << ", " << p.rms(1) << ", " << p.rms(2) << " MPa, max " << p.max(0) << ", "
+       << p.max(1) << ", " << p.max(2) << " MPa; max " << 100 * p.max_relative << " %, rms "
+       << 100 * p.rms_relative << " % of the stress range " << p.stress_range << " MPa\n";
+  if (d.holdout_points > 0)
+    os << "    held out: " << d.holdout_within_5_percent << " of " << d.holdout_points
+       << " states within 5 % of the stress range (largest error " << 100 * d.holdout_max_relative
+       << " %; rms S11, S22, S12 " << d.holdout_rms(0) << ", " << d.holdout_rms(1) << ", "
+       << d.holdout_rms(2) << " MPa)\n";
+  else
+    os << "    held out: none (no path with set \"holdout\")\n";
+  return os.str();
+}
+
+}  // namespace knit::meso::fit

@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+"""Beside Fig. 6: the energy-based law of one loop length (issue 11; docs/database.md "The
+energy-based law") -- W(E11, E22), S11 and S22 over the (E11, E22) plane at E12 = 0, with the
+homogenized data points of that loop length (converged steps with |E12| small, held-out
+states as crosses), from /energy_law of the material database.
+
+The law is re-evaluated here from the stored coefficients (schemas/database.layout.json):
+f_g'' = sum_ij c[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l); f' and f are integrated
+numerically from 0 on a fine grid (a plot, not the C++ evaluator).
+
+Usage: energy_law.py --database DB.h5 --loop-length 6.5 --out fig06e_energy_law.png
+"""
+import argparse
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import h5py  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from surfaces import basis, pick_loop  # noqa: E402
+
+
+def uniform_clamped(p, n, a, b):
+    return np.concatenate([[a] * p, np.linspace(a, b, n + 1), [b] * p])
+
+
+class Law:
+    def __init__(self, g, l):
+        self.D = np.array(g["directions"])
+        self.fn = np.array(g["function_of"])
+        self.sr = np.array(g["s_range"])
+        self.C = np.array(g["coefficients"])
+        self.p = int(g.attrs["s_degree"])
+        self.n = int(g.attrs["s_spans"])
+        self.floor = float(g.attrs["floor"])
+        q = int(g.attrs["l_degree"])
+        lk = np.array(g["l_knots"])
+        M = basis(q, lk, l)[0]
+        ns = self.n + self.p
+        self.a = np.stack([sum(M[j] * self.C[gi, j * ns:(j + 1) * ns] for j in range(len(M)))
+                           for gi in range(self.C.shape[0])])
+        # f, f' tabulated from 0 by cumulative trapezoids on a fine grid per function.
+        self.tab = []
+        for gi in range(self.C.shape[0]):
+            a, b = self.sr[gi]
+            w = b - a
+            s = np.linspace(a - 2 * w, b + 2 * w, 6001)
+            U = uniform_clamped(self.p, self.n, a, b)
+            g2 = basis(self.p, U, np.clip(s, a, b)) @ self.a[gi]
+            d1 = np.concatenate([[0], np.cumsum(0.5 * (g2[1:] + g2[:-1]) * np.diff(s))])
+            d1 -= np.interp(0.0, s, d1)
+            f = np.concatenate([[0], np.cumsum(0.5 * (d1[1:] + d1[:-1]) * np.diff(s))])
+            f -= np.interp(0.0, s, f)
+            self.tab.append((s, f, d1))
+
+    def eval(self, e):
+        """W and S at strains e (..., 3) = (E11, E22, 2E12)."""
+        W = 0.5 * self.floor * np.sum(e * e, axis=-1)
+        S = self.floor * e.copy()
+        for k, d in enumerate(self.D):
+            s, f, d1 = self.tab[self.fn[k]]
+            x = e @ d
+            W = W + np.interp(x, s, f)
+            S = S + np.interp(x, s, d1)[..., None] * d
+        return W, S
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--database", required=True)
+    ap.add_argument("--loop-length", type=float, default=6.5)
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    with h5py.File(a.database, "r") as f:
+        if "energy_law" not in f:
+            sys.exit(f"{a.database}: /energy_law: group missing (run `knit-meso fit "
+                     f"{a.database} --law energy`)")
+        k, l = pick_loop(f, a.loop_length)
+        law = Law(f["energy_law"], l)
+        box_min, box_max = np.array(f["energy_law/box_min"]), np.array(f["energy_law/box_max"])
+        pts, held = [], []
+        raw = f[f"loop_{k}/raw"]
+        for name in sorted(raw):
+            p = raw[name]
+            st = np.array(p["status"])
+            E, S = np.array(p["E"]), np.array(p["S"])
+            sel = (st == 0) & (np.abs(E[:, 2]) < 0.02)
+            target = held if p.attrs.get("set", "paper") == "holdout" else pts
+            for i in np.nonzero(sel)[0]:
+                target.append((E[i, 0], E[i, 1], S[i, 0], S[i, 1]))
+    pts, held = np.array(pts).reshape(-1, 4), np.array(held).reshape(-1, 4)
+    e11 = np.linspace(min(box_min[0], -0.2) * 1.2, box_max[0] * 1.2, 121)
+    e22 = np.linspace(min(box_min[1], -0.2) * 1.2, box_max[1] * 1.2, 121)
+    X, Y = np.meshgrid(e11, e22)
+    e = np.stack([X, Y, np.zeros_like(X)], axis=-1)
+    W, S = law.eval(e)
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+    panels = [(W, "W (MPa)", None), (S[..., 0], "S11 (MPa)", 2), (S[..., 1], "S22 (MPa)", 3)]
+    for axk, (Z, title, col) in zip(ax, panels):
+        lim = np.percentile(np.abs(Z), 99)
+        cs = axk.contourf(X, Y, Z, levels=30, cmap="viridis" if col is None else "RdBu_r",
+                          vmin=None if col is None else -lim, vmax=None if col is None else lim)
+        fig.colorbar(cs, ax=axk)
+        axk.add_patch(plt.Rectangle((box_min[0], box_min[1]), box_max[0] - box_min[0],
+                                    box_max[1] - box_min[1], fill=False, ls="--", ec="k", lw=0.8))
+        if col is None:
+            axk.plot(pts[:, 0], pts[:, 1], "k.", ms=2, label="data (|E12| < 0.02)")
+        else:
+            axk.scatter(pts[:, 0], pts[:, 1], c=pts[:, col], cmap="RdBu_r", vmin=-lim, vmax=lim,
+                        edgecolors="k", linewidths=0.4, s=14, label="data, same colour scale")
+        if len(held):
+            axk.plot(held[:, 0], held[:, 1], "kx", ms=5, label="held out")
+        axk.set_xlabel("E11 (course)")
+        axk.set_ylabel("E22 (wale)")
+        axk.set_title(f"{title}, l = {l:g} mm, E12 = 0")
+        axk.legend(loc="lower right", fontsize=7)
+    fig.suptitle("Energy-based law (convex ridge-spline W; dashed: data strain box)")
+    fig.savefig(a.out, dpi=130)
+    print(f"wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()

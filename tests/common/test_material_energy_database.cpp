@@ -1,0 +1,160 @@
+// The energy-based law in the material database (format version 2): round trip, a version-1
+// file still loads and refuses the energy law with file + HDF5 path + what to do, bad
+// /energy_law content is refused with its HDF5 path.
+#include <catch2/catch.hpp>
+#include <filesystem>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/material/database.hpp"
+#include "test_energy_util.hpp"
+
+using namespace knit::material;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path tmp(const std::string& name) {
+  const fs::path d = fs::path(KNIT_BINARY_DIR) / "test_tmp";
+  fs::create_directories(d);
+  return d / name;
+}
+Database db_with_law() {
+  Database db;
+  db.provenance = current_provenance();
+  db.generator = "test";
+  db.sweep_input = "{}";
+  for (double l : {4.5, 6.5}) {
+    LoopLengthEntry e;
+    e.loop_length = l;
+    e.cell = {1.26, 0.88, 0.76};
+    db.entries.push_back(e);
+  }
+  db.energy_law = testing::make_test_energy_law();
+  auto& dg = db.energy_diagnostics;
+  for (double l : {4.5, 6.5}) {
+    EnergyFitDiagnostics::PerLoop p;
+    p.loop_length = l;
+    p.points = 17;
+    p.rms << 0.1, 0.2, 0.3;
+    p.max << 0.4, 0.5, 0.6;
+    p.stress_range = 2.0;
+    p.max_relative = 0.3;
+    p.rms_relative = 0.15;
+    dg.per_loop.push_back(p);
+  }
+  dg.holdout_points = 21;
+  dg.holdout_within_5_percent = 20;
+  dg.holdout_rms << 0.01, 0.02, 0.03;
+  dg.holdout_max << 0.04, 0.05, 0.06;
+  dg.holdout_max_relative = 0.07;
+  dg.points_used = 34;
+  dg.points_skipped = 2;
+  dg.min_eigenvalue = 0.02;
+  dg.options_json = "{\"smoothing\": 1}";
+  return db;
+}
+}  // namespace
+
+TEST_CASE("database v2: the energy law round trip", "[unit]") {
+  const auto file = tmp("energy_roundtrip.h5");
+  const Database db = db_with_law();
+  write_database(file, db);
+  const Database back = read_database(file, false);
+  CHECK(back.format_version == 2);
+  REQUIRE(back.energy_law);
+  const EnergyLawData &a = *db.energy_law, &b = *back.energy_law;
+  CHECK(b.directions.d == a.directions.d);
+  CHECK(b.directions.function_of == a.directions.function_of);
+  CHECK(b.s_range == a.s_range);
+  CHECK(b.coefficients == a.coefficients);
+  CHECK(b.l_knots == a.l_knots);
+  CHECK(b.s_degree == a.s_degree);
+  CHECK(b.s_spans == a.s_spans);
+  CHECK(b.l_degree == a.l_degree);
+  CHECK(b.floor == a.floor);
+  CHECK(b.box_min == a.box_min);
+  CHECK(b.box_max == a.box_max);
+  CHECK(b.l_min == a.l_min);
+  CHECK(b.l_max == a.l_max);
+  const auto &da = db.energy_diagnostics, &dbk = back.energy_diagnostics;
+  REQUIRE(dbk.per_loop.size() == 2);
+  CHECK(dbk.per_loop[1].max == da.per_loop[1].max);
+  CHECK(dbk.per_loop[0].rms == da.per_loop[0].rms);
+  CHECK(dbk.per_loop[1].stress_range == 2.0);
+  CHECK(dbk.holdout_points == 21);
+  CHECK(dbk.holdout_within_5_percent == 20);
+  CHECK(dbk.holdout_max == da.holdout_max);
+  CHECK(dbk.min_eigenvalue == 0.02);
+  CHECK(dbk.options_json == da.options_json);
+  // The same law: same response.
+  const auto ea = EnergyLaw(a).at(5.1).evaluate({0.1, -0.05, 0.2});
+  const auto eb = EnergyLaw(b).at(5.1).evaluate({0.1, -0.05, 0.2});
+  CHECK(ea.S == eb.S);
+  CHECK(ea.W == eb.W);
+  CHECK(&require_energy_law(back, file.string()) == &*back.energy_law);
+}
+
+TEST_CASE("database v1: loads, and asking it for the energy law names file and path", "[unit]") {
+  const auto file = tmp("energy_v1.h5");
+  Database db = db_with_law();
+  write_database(file, db);
+  {  // What a version-1 build wrote: no /energy_law (an extra group there would be ignored).
+    auto f = knit::io::H5File::open_rw(file);
+    f.set_attribute(".", "format_version", 1);
+  }
+  const Database back = read_database(file);
+  CHECK(back.format_version == 1);
+  CHECK_FALSE(back.energy_law);
+  REQUIRE(back.entries.size() == 2);
+  try {
+    require_energy_law(back, file.string());
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == file.string());
+    CHECK(e.pointer() == "/energy_law");
+    CHECK_THAT(e.message(), Catch::Contains("format-version-1"));
+    CHECK_THAT(e.message(), Catch::Contains("knit-meso fit " + file.string() + " --law energy"));
+  }
+  // A version-2 file fitted without the energy law says so too.
+  db.energy_law.reset();
+  write_database(file, db);
+  const Database v2 = read_database(file);
+  CHECK_THROWS_WITH(
+      require_energy_law(v2, file.string()),
+      Catch::Contains("/energy_law: group missing") && Catch::Contains("--law energy"));
+}
+
+TEST_CASE("database v2: bad /energy_law content is refused with its HDF5 path", "[unit]") {
+  const auto good = tmp("energy_good.h5");
+  write_database(good, db_with_law());
+  const auto bad = tmp("energy_bad.h5");
+  SECTION("negative coefficient (a non-convex law)") {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      RowMatrixX c = f.read_matrix("/energy_law/coefficients");
+      c(3, 4) = -0.5;
+      f.write("/energy_law/coefficients", c);
+    }
+    CHECK_THROWS_WITH(read_database(bad), Catch::Contains("energy_bad.h5: /energy_law: ") &&
+                                              Catch::Contains("coefficients must be >= 0"));
+  }
+  SECTION("missing dataset") {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      f.remove("/energy_law/s_range");
+    }
+    CHECK_THROWS_WITH(read_database(bad),
+                      Catch::Contains("energy_bad.h5: /energy_law/s_range: dataset missing"));
+  }
+  SECTION("range that does not cover the loop lengths") {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      f.set_attribute("/energy_law", "l_max", 6.0);
+    }
+    CHECK_THROWS_WITH(read_database(bad), Catch::Contains("/energy_law: ") &&
+                                              Catch::Contains("does not cover /loop_lengths"));
+  }
+}

@@ -1,0 +1,217 @@
+// The energy-based law (knit/material/energy_law.hpp, ridge_spline.hpp): exact antiderivatives,
+// and the law checks of issue 11 on a polar grid of strains at every loop length of the
+// range and midway between: S continuous (Lipschitz), C = FD of S, S = FD of W, C symmetric,
+// eig(C) >= floor, W(0) = 0, S(0) = 0, W even in E12, dS/dl = FD in l.
+#include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+
+#include "knit/material/energy_law.hpp"
+#include "test_energy_util.hpp"
+
+using namespace knit::material;
+
+TEST_CASE("ridge spline: per-span polynomials equal the integrals of the B-spline", "[unit]") {
+  const int degree = GENERATE(0, 1, 2, 3, 4);
+  RidgeGrid grid{-0.35, 0.6, 7, degree};
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> coef(static_cast<std::size_t>(grid.size()));
+  for (double& c : coef) c = u(gen);
+  std::vector<double> q;
+  ridge_polynomials(grid, coef.data(), q);
+  REQUIRE(q.size() == static_cast<std::size_t>((grid.spans + 2) * (degree + 3)));
+  // f(0) = f'(0) = 0 and agreement with quadrature everywhere, extensions included.
+  const Eigen::Vector3d at0 = ridge_eval_any(grid, q.data(), 0.0);
+  CHECK(std::abs(at0(0)) < 1e-15);
+  CHECK(std::abs(at0(1)) < 1e-15);
+  for (double s = -1.2; s <= 1.5; s += 0.0137) {
+    const Eigen::Vector3d f = ridge_eval_any(grid, q.data(), s);
+    const Eigen::Vector3d r = ridge_eval_reference(grid, coef.data(), s);
+    INFO("degree " << degree << ", s = " << s << ": " << f.transpose() << " vs " << r.transpose());
+    CHECK((f - r).norm() <= 1e-12 * (1.0 + r.norm()));
+  }
+  // The unit-basis map is the same linear map.
+  RidgeBasis basis(grid);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> B(3, grid.size());
+  basis.eval(0.37, B);
+  const Eigen::Map<const Eigen::VectorXd> c(coef.data(), grid.size());
+  CHECK((B * c - ridge_eval_any(grid, q.data(), 0.37)).norm() < 1e-13);
+}
+
+TEST_CASE("ridge spline: the grid refuses bad layouts", "[unit]") {
+  CHECK_FALSE(RidgeGrid{0.1, 0.5, 4, 3}.validate().empty());  // 0 not inside
+  CHECK_FALSE(RidgeGrid{-0.1, 0.5, 0, 3}.validate().empty());
+  CHECK_FALSE(RidgeGrid{-0.1, 0.5, 4, 6}.validate().empty());
+  CHECK_FALSE(RidgeGrid{-0.1, NAN, 4, 3}.validate().empty());
+  CHECK(RidgeGrid{-0.1, 0.5, 4, 3}.validate().empty());
+  CHECK_THROWS_AS(RidgeBasis(RidgeGrid{0.1, 0.5, 4, 3}), std::invalid_argument);
+}
+
+TEST_CASE("energy law: default directions are unit, mirror-closed and tied", "[unit]") {
+  const RidgeDirections r = default_ridge_directions();
+  CHECK(r.d.rows() == 24);
+  CHECK(r.functions() == 15);
+  for (Eigen::Index k = 0; k < r.d.rows(); ++k) {
+    CHECK(std::abs(r.d.row(k).norm() - 1.0) < 1e-14);
+    if (r.d(k, 2) == 0.0) continue;
+    bool found = false;
+    for (Eigen::Index m = 0; m < r.d.rows(); ++m)
+      if (m != k &&
+          (r.d.row(m) - Eigen::RowVector3d(r.d(k, 0), r.d(k, 1), -r.d(k, 2))).norm() < 1e-15 &&
+          r.function_of[static_cast<std::size_t>(m)] == r.function_of[static_cast<std::size_t>(k)])
+        found = true;
+    CHECK(found);
+  }
+  CHECK_THROWS_AS(mirror_closed({{1, 0, 0}, {2, 0, 0}}), std::invalid_argument);
+  CHECK_THROWS_AS(mirror_closed({{0, 0, 0}}), std::invalid_argument);
+}
+
+namespace {
+
+/// The polar grid of the acceptance checks: radii 0.005-0.6, 1 degree steps, in three planes
+/// of e = (E11, E22, 2E12): the E11-E22 plane and two planes with shear.
+std::vector<Eigen::Vector3d> polar_plane_basis(int plane) {
+  switch (plane) {
+    case 0:
+      return {{1, 0, 0}, {0, 1, 0}};
+    case 1:
+      return {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 1).normalized()};
+    default:
+      return {Eigen::Vector3d(1, 1, 0).normalized(), Eigen::Vector3d(1, -1, 1).normalized()};
+  }
+}
+const std::vector<double> kRadii = {0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+
+}  // namespace
+
+TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[unit]") {
+  const EnergyLawData data = testing::make_test_energy_law();
+  const EnergyLaw law(data);
+  // The test law's ridge coefficients reach about 2 MPa on 24 directions: |C| <~ 50 MPa. FD
+  // steps: central differences with h = 1e-6 have truncation h^2 |S'''| and round-off
+  // eps |S| / h; both below 1e-6 here.
+  const double h = 1e-6, tol_fd = 2e-6;
+  for (double l : {4.5, 4.75, 5.0, 5.25, 5.5, 5.75, 6.0, 6.25, 6.5}) {
+    const EnergyLawAt at = law.at(l);
+    const EnergyResponse r0 = at.evaluate(Eigen::Vector3d::Zero());
+    // W(0) = 0 and S(0) = 0 up to the round-off of the span polynomials (|C| ~ 10-50 MPa).
+    CHECK(std::abs(r0.W) < 1e-16);
+    CHECK(r0.S.norm() < 1e-14);
+    long count = 0;
+    double worst_lipschitz = 0.0, worst_fd_C = 0.0, worst_fd_S = 0.0, min_eig = 1e300;
+    for (int plane = 0; plane < 3; ++plane) {
+      const auto B = polar_plane_basis(plane);
+      for (double rad : kRadii)
+        for (int deg = 0; deg < 360; ++deg) {
+          const double phi = deg * M_PI / 180, phi1 = (deg + 1) * M_PI / 180;
+          const Eigen::Vector3d e = rad * (std::cos(phi) * B[0] + std::sin(phi) * B[1]);
+          const Eigen::Vector3d e1 = rad * (std::cos(phi1) * B[0] + std::sin(phi1) * B[1]);
+          const EnergyResponse r = at.evaluate(e);
+          // Symmetric to round-off: exactly, by construction.
+          REQUIRE(r.C == r.C.transpose());
+          // eig(C) >= floor.
+          const double lmin = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0);
+          min_eig = std::min(min_eig, lmin);
+          // C = central FD of S; S = central FD of W.
+          Eigen::Matrix3d Cfd;
+          Eigen::Vector3d Sfd;
+          for (int j = 0; j < 3; ++j) {
+            Eigen::Vector3d d = Eigen::Vector3d::Zero();
+            d(j) = h;
+            const EnergyResponse p = at.evaluate(e + d), m = at.evaluate(e - d);
+            Cfd.col(j) = (p.S - m.S) / (2 * h);
+            Sfd(j) = (p.W - m.W) / (2 * h);
+          }
+          worst_fd_C = std::max(worst_fd_C, (Cfd - r.C).norm() / (1.0 + r.C.norm()));
+          worst_fd_S = std::max(worst_fd_S, (Sfd - r.S).norm() / (1.0 + r.S.norm()));
+          // Continuity: |S(e1) - S(e)| <= L |e1 - e| with L = 1.5 max |C|_2 over the ends and
+          // the midpoint of the 1-degree step (mean-value theorem, 50 % margin for the
+          // variation of C between the three samples). A jump of S breaks it.
+          const Eigen::Vector3d mid = 0.5 * (e + e1);
+          double L = 0.0;
+          for (const auto& x : {e, e1, mid}) {
+            const Eigen::Matrix3d C = at.evaluate(x).C;
+            L = std::max(L, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(C)
+                                .eigenvalues()
+                                .cwiseAbs()
+                                .maxCoeff());
+          }
+          const double ratio = (at.evaluate(e1).S - r.S).norm() / (1.5 * L * (e1 - e).norm());
+          worst_lipschitz = std::max(worst_lipschitz, ratio);
+          ++count;
+        }
+    }
+    INFO("l = " << l << ", " << count << " strains: FD(C) " << worst_fd_C << ", FD(S) "
+                << worst_fd_S << ", Lipschitz ratio " << worst_lipschitz << ", min eig "
+                << min_eig);
+    CHECK(worst_fd_C < tol_fd);
+    CHECK(worst_fd_S < tol_fd);
+    CHECK(worst_lipschitz <= 1.0);
+    CHECK(min_eig >= data.floor * (1 - 1e-12));
+  }
+}
+
+TEST_CASE("energy law: where every ridge is slack, C is the floor", "[unit]") {
+  EnergyLawData d = testing::make_test_energy_law(7, 0.03);
+  d.coefficients.setZero();
+  const EnergyLawAt at = EnergyLaw(d).at(5.0);
+  const EnergyResponse r = at.evaluate({-0.2, 0.1, 0.3});
+  CHECK((r.C - 0.03 * Eigen::Matrix3d::Identity()).norm() < 1e-15);
+  CHECK((r.S - 0.03 * Eigen::Vector3d(-0.2, 0.1, 0.3)).norm() < 1e-15);
+  CHECK(r.W == Approx(0.015 * 0.14).epsilon(1e-14));
+}
+
+TEST_CASE("energy law: W is even in E12 (orthotropy in the course/wale frame)", "[unit]") {
+  const EnergyLaw law(testing::make_test_energy_law());
+  const EnergyLawAt at = law.at(5.3);
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen)), m(e(0), e(1), -e(2));
+    const EnergyResponse a = at.evaluate(e), b = at.evaluate(m);
+    REQUIRE(std::abs(a.W - b.W) <= 1e-14 * (1 + std::abs(a.W)));
+    REQUIRE(std::abs(a.S(0) - b.S(0)) <= 1e-13 * (1 + a.S.norm()));
+    REQUIRE(std::abs(a.S(2) + b.S(2)) <= 1e-13 * (1 + a.S.norm()));
+  }
+}
+
+TEST_CASE("energy law: dS/dl equals the finite difference in l", "[unit]") {
+  const EnergyLaw law(testing::make_test_energy_law());
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  const double h = 1e-6;
+  for (double l : {4.6, 5.0, 5.5, 6.2}) {
+    const EnergyLawAt at = law.at(l, true), p = law.at(l + h), m = law.at(l - h);
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+      const Eigen::Vector3d fd = (p.evaluate(e).S - m.evaluate(e).S) / (2 * h);
+      const Eigen::Vector3d dS = at.dS_dl(e);
+      REQUIRE((fd - dS).norm() <= 1e-6 * (1 + dS.norm()));
+    }
+  }
+  CHECK_THROWS_AS(law.at(5.0).dS_dl(Eigen::Vector3d::Zero()), std::logic_error);
+}
+
+TEST_CASE("energy law: validation refuses bad data", "[unit]") {
+  const EnergyLawData good = testing::make_test_energy_law();
+  CHECK_NOTHROW(validate(good));
+  auto bad = [&](auto&& change) {
+    EnergyLawData d = good;
+    change(d);
+    return d;
+  };
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.coefficients(0, 3) = -1e-9; })),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.coefficients(2, 0) = NAN; })),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.s_range(1, 0) = 0.1; })), std::invalid_argument);
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.floor = -1; })), std::invalid_argument);
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.l_min = 4.0; })), std::invalid_argument);
+  CHECK_THROWS_AS(
+      validate(bad([](auto& d) { d.coefficients.conservativeResize(14, Eigen::NoChange); })),
+      std::invalid_argument);
+  CHECK_THROWS_AS(validate(bad([](auto& d) { d.directions.d(0, 0) = 2.0; })),
+                  std::invalid_argument);
+}

@@ -1,0 +1,167 @@
+// The knit material with the energy-based law (/material/law = "energy"): hyperelastic, W
+// invariant under the rotation (W(E) = W_hat(T_E E)), S = FD of W, C = FD of S and symmetric,
+// extrapolation outside the data box and the visited box in report(), failed evaluations;
+// the case key and its refusals.
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "../common/test_energy_util.hpp"
+#include "../common/test_material_util.hpp"
+#include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
+#include "knit/macro/case.hpp"
+#include "knit/macro/knit_material.hpp"
+#include "knit/material/database.hpp"
+#include "knit/mechanics/voigt.hpp"
+
+using namespace knit::macro;
+using namespace knit::material;
+namespace fs = std::filesystem;
+
+namespace {
+KnitMaterial energy_material(double alpha) {
+  ScalarFieldSpec l;
+  l.degree_u = 1;
+  l.knots_u = {0, 0, 1, 1};
+  l.values = {4.5, 6.5};
+  auto law = std::make_shared<const EnergyLaw>(testing::make_test_energy_law());
+  return KnitMaterial(nullptr, law, make_scalar_field(l),
+                      make_scalar_field(ScalarFieldSpec::constant(alpha)));
+}
+MaterialPoint at(double t1, double t2) {
+  MaterialPoint p;
+  p.theta = {t1, t2};
+  return p;
+}
+}  // namespace
+
+TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded, rotated)",
+          "[unit]") {
+  for (double alpha : {0.0, 0.4, -1.1}) {
+    const KnitMaterial m = energy_material(alpha);
+    CHECK(m.hyperelastic());
+    CHECK(m.law() == "energy");
+    const auto p = at(0.37, 0.5);
+    for (const Eigen::Vector3d& E :
+         {Eigen::Vector3d(0.1, 0.05, 0.04), Eigen::Vector3d(0.3, -0.1, 0.2),
+          Eigen::Vector3d(-0.1, -0.05, 0.0), Eigen::Vector3d(0.02, 0.4, -0.5)}) {
+      const auto r = m.evaluate(E, p);
+      REQUIRE(std::isfinite(r.W));
+      REQUIRE(r.C == r.C.transpose());
+      Eigen::Matrix3d Cfd;
+      Eigen::Vector3d Sfd;
+      const double h = 1e-6;
+      for (int c = 0; c < 3; ++c) {
+        Eigen::Vector3d Ep = E, Em = E;
+        Ep(c) += h;
+        Em(c) -= h;
+        const auto rp = m.evaluate(Ep, p), rm = m.evaluate(Em, p);
+        Cfd.col(c) = (rp.S - rm.S) / (2 * h);
+        Sfd(c) = (rp.W - rm.W) / (2 * h);
+      }
+      INFO("alpha " << alpha << ", E = " << E.transpose());
+      CHECK((r.C - Cfd).norm() <= 1e-6 * (1 + Cfd.norm()));
+      CHECK((r.S - Sfd).norm() <= 1e-6 * (1 + Sfd.norm()));
+    }
+  }
+}
+
+TEST_CASE("knit material, energy law: W is invariant under the rotation", "[unit]") {
+  // The same physical strain state seen in the shell frame rotated by alpha: the shell strain
+  // is E = T_E(alpha)^-1 E_hat; W and the material-frame stress must not change.
+  const KnitMaterial m0 = energy_material(0.0);
+  const auto p = at(0.61, 0.2);
+  for (double alpha : {0.3, 1.2, -2.0}) {
+    const KnitMaterial ma = energy_material(alpha);
+    for (const Eigen::Vector3d& Ehat :
+         {Eigen::Vector3d(0.2, -0.05, 0.1), Eigen::Vector3d(-0.1, 0.3, -0.3)}) {
+      const Eigen::Vector3d E = knit::mech::T_E(alpha).inverse() * Ehat;
+      const auto r = ma.evaluate(E, p), r0 = m0.evaluate(Ehat, p);
+      CHECK(r.W == Approx(r0.W).epsilon(1e-12));
+      // S = T^-1 S_hat  <=>  S_hat = T_E^-T S
+      const Eigen::Vector3d Shat = knit::mech::T_E(alpha).transpose().inverse() * r.S;
+      CHECK((Shat - r0.S).norm() <= 1e-12 * (1 + r0.S.norm()));
+    }
+  }
+}
+
+TEST_CASE("knit material, energy law: report counts extrapolation and the visited box", "[unit]") {
+  KnitMaterial m = energy_material(0.0);
+  std::vector<Eigen::Vector2d> pts = {{0.2, 0.5}, {0.8, 0.5}};
+  m.bind_points(pts);
+  MaterialPoint p;
+  p.point_id = 0;
+  p.theta = pts[0];
+  m.evaluate({0.1, 0.2, 0.0}, p);
+  m.evaluate({-0.2, 0.1, 0.3}, p);
+  p.point_id = 1;
+  p.theta = pts[1];
+  m.evaluate({0.6, 0.0, 0.0}, p);  // E11 = 0.6 > box 0.45: extrapolated
+  const auto s = m.energy_stats();
+  CHECK(s.evaluations == 3);
+  CHECK(s.outside_box == 1);
+  CHECK(s.visited_min(0) == -0.2);
+  CHECK(s.visited_max(0) == 0.6);
+  CHECK(s.visited_max(2) == 0.3);
+  const std::string rep = m.report();
+  CHECK_THAT(rep, Catch::Contains("1 extrapolated") &&
+                      Catch::Contains("visited material-frame strain box: E11 [-0.2, 0.6]"));
+  CHECK(m.failed_evaluations() == 0);
+  const auto bad = m.evaluate({NAN, 0.0, 0.0}, p);
+  CHECK(m.failed_evaluations() == 1);
+  CHECK(bad.S.allFinite());
+  m.reset_stats();
+  CHECK(m.energy_stats().evaluations == 0);
+}
+
+namespace {
+std::string square_case(const std::string& material) {
+  std::ostringstream cs;
+  cs << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+    "control_points": [[0, 0, 0], [50, 0, 0], [0, 50, 0], [50, 50, 0]], "thickness": 0.76},
+    "material": )"
+     << material << R"(, "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
+  return cs.str();
+}
+std::string db_file(const std::string& name, bool energy, int version) {
+  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
+  fs::create_directories(dir);
+  const fs::path f = dir / name;
+  Database db;
+  db.provenance = current_provenance();
+  for (double l : {4.5, 6.5}) {
+    LoopLengthEntry e;
+    e.loop_length = l;
+    e.surface = testing::make_test_surface(std::pow(4.5 / l, 2));
+    db.entries.push_back(e);
+  }
+  if (energy) db.energy_law = testing::make_test_energy_law();
+  write_database(f, db);
+  if (version != kDatabaseFormatVersion) {
+    auto h = knit::io::H5File::open_rw(f);
+    h.set_attribute(".", "format_version", version);
+  }
+  return f.string();
+}
+}  // namespace
+
+TEST_CASE("knit material: the case key /material/law", "[unit]") {
+  const std::string with = db_file("law_energy.h5", true, 2), v1 = db_file("law_v1.h5", false, 1);
+  auto material = [](const std::string& db, const std::string& law) {
+    return R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": 5.0)" +
+           (law.empty() ? "" : R"(, "law": ")" + law + "\"") + "}";
+  };
+  auto law_of = [](const Case& c) { return dynamic_cast<const KnitMaterial&>(*c.material).law(); };
+  CHECK(law_of(parse_case(square_case(material(with, "")), "c.json")) == "energy");
+  CHECK(law_of(parse_case(square_case(material(with, "paper")), "c.json")) == "paper");
+  CHECK(law_of(parse_case(square_case(material(v1, "")), "c.json")) == "paper");
+  CHECK_THROWS_WITH(parse_case(square_case(material(v1, "energy")), "c.json"),
+                    Catch::Contains("c.json: /material/law: ") && Catch::Contains(v1) &&
+                        Catch::Contains("/energy_law") &&
+                        Catch::Contains("knit-meso fit " + v1 + " --law energy"));
+  CHECK_THROWS_WITH(parse_case(square_case(material(with, "neo")), "c.json"),
+                    Catch::Contains("c.json: /material/law"));
+}
