@@ -7,10 +7,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "../common/test_material_util.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/knitmap.hpp"
 #include "knit/material/database.hpp"
+#include "knit_test_database.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;
@@ -20,33 +20,16 @@ namespace {
 
 const fs::path kDir = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "knitmap";
 
-// The synthetic stand-in's cell parameters (mesoscale/src/fit_synthetic.cpp).
 double w_of(double l) {
-  return 1.26 + (l - 4.5) * (1.41 - 1.26) / 2.0;
+  return knit::testing::synth_wale_width(l);
 }
 double c_of(double l) {
-  return l * l / (18.27 * w_of(l));
+  return knit::testing::synth_course_height(l);
 }
 
 std::string database(bool with_cells = true) {
-  fs::create_directories(kDir);
-  const fs::path f = kDir / (with_cells ? "db.h5" : "db_nocells.h5");
-  Database db;
-  db.provenance = current_provenance();
-  db.generator = "test";
-  for (double l : {4.5, 5.5, 6.5}) {
-    LoopLengthEntry e;
-    e.loop_length = l;
-    if (with_cells) {
-      e.cell.wale_width = w_of(l);
-      e.cell.course_height = c_of(l);
-      e.cell.thickness = 0.76;
-    }
-    e.surface = testing::make_test_surface(std::pow(4.5 / l, 2));
-    db.entries.push_back(e);
-  }
-  write_database(f, db);
-  return f.string();
+  return knit::testing::write_knit_test_database(
+      with_cells ? "knitmap_db.h5" : "knitmap_db_nocells.h5", {4.5, 5.5, 6.5}, with_cells);
 }
 
 /// A W x H rectangle rotated by beta in the plane z = z0 (z1 for the last control point).
