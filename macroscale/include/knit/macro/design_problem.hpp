@@ -1,0 +1,51 @@
+// The design file of `knit-macro design` (schemas/design.schema.json, docs/design.md): a knit
+// case, design variables (control values of the l and/or alpha field with bounds; several
+// control values in one variable are tied), objectives and a smoothness penalty. Plain
+// structs; the JSON stays in design_problem.cpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "knit/macro/case.hpp"
+#include "knit/macro/design_gradient.hpp"
+
+namespace knit::macro {
+
+struct DesignVariableSpec {
+  std::string name;
+  DesignVariable::Field field = DesignVariable::Field::kStitchValue;
+  std::vector<int> indices;  ///< control values moved together (a symmetry tie)
+  double lower = 0.0, upper = 0.0;
+  double initial = 0.0;  ///< the case's value at these indices
+};
+
+struct DesignObjective {
+  enum class Kind { kReaction, kDisplacement, kStrainVariance, kTargetStrain };
+  Kind kind = Kind::kReaction;
+  std::string name;
+  double weight = 1.0;
+  std::vector<double> at_strain, target;
+  int reaction = -1;  ///< index into the case's output.reactions
+  int point = -1;     ///< index into the case's output.points
+  int component = 0;  ///< x, y, z (displacement) or E11, E22, E12 (strain terms)
+  Eigen::Vector2d u_range = {0, 1}, v_range = {0, 1};
+};
+
+struct DesignProblem {
+  std::string file;       ///< the design file
+  std::string case_file;  ///< resolved
+  Case c;
+  std::vector<DesignVariableSpec> variables;
+  std::vector<DesignObjective> objectives;
+  double smoothness = 0.0;
+  /// The control values each variable sets, as DesignVariable entries (for case_with_design).
+  std::vector<DesignVariable> expanded() const;
+};
+
+/// Reads and checks a design file. Every problem throws knit::InputError naming the design
+/// file (or the case file, for errors inside the case) and the JSON pointer.
+DesignProblem load_design(const std::string& path);
+
+}  // namespace knit::macro
