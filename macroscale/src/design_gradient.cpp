@@ -9,6 +9,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/macro/knit_material.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/shell_model.hpp"
 
@@ -37,12 +38,13 @@ nlohmann::json& value_of(nlohmann::json& root, const DesignVariable& v, const st
   return vals[static_cast<std::size_t>(v.index)];
 }
 
-/// dS/dp_j by a central difference of the material at fixed strain: (S(p + h) - S(p - h)) / 2h.
-class MaterialDerivative : public Material {
+/// dS/dp_j for a stitch-value control value: a central difference of the material at fixed
+/// strain, (S(p + h e_j) - S(p - h e_j)) / 2h (INTERIM, until the energy law's dS/dl).
+class StitchValueDerivative : public Material {
  public:
-  MaterialDerivative(std::shared_ptr<Material> plus, std::shared_ptr<Material> minus, double h)
+  StitchValueDerivative(std::shared_ptr<Material> plus, std::shared_ptr<Material> minus, double h)
       : plus_(std::move(plus)), minus_(std::move(minus)), h_(h) {}
-  std::string name() const override { return "dS/dp"; }
+  std::string name() const override { return "dS/dl"; }
   void bind_points(const std::vector<Eigen::Vector2d>& theta) override {
     plus_->bind_points(theta);
     minus_->bind_points(theta);
@@ -56,6 +58,37 @@ class MaterialDerivative : public Material {
  private:
   std::shared_ptr<Material> plus_, minus_;
   double h_;
+};
+
+/// dS/dp_j for a knitting-angle control value, analytic through T(alpha) (eqs. 20-22):
+/// S = T^-1 Shat(T_E E); rotations compose, T_E(alpha + d) = T_E(d) T_E(alpha), so
+///   dS/dalpha = -G_S S + C G_E E,
+/// G_E = dT_E/dalpha at 0 = [[0, 0, 1], [0, 0, -1], [-2, 2, 0]] (strains E11, E22, 2E12),
+/// G_S = dT_S/dalpha at 0 = [[0, 0, 2], [0, 0, -2], [-1, 1, 0]] (stresses S11, S22, S12);
+/// times dalpha/dp_j = N_j(theta), the field's basis function (alpha is linear in its control
+/// values: N_j = alpha(p + e_j) - alpha(p), exact, with the field's unit).
+class KnittingAngleDerivative : public Material {
+ public:
+  KnittingAngleDerivative(std::shared_ptr<Material> at_p, std::shared_ptr<Material> unit_step)
+      : p_(std::move(at_p)), step_(std::move(unit_step)) {
+    GE_ << 0, 0, 1, 0, 0, -1, -2, 2, 0;
+    GS_ << 0, 0, 2, 0, 0, -2, -1, 1, 0;
+  }
+  std::string name() const override { return "dS/dalpha"; }
+  void bind_points(const std::vector<Eigen::Vector2d>& theta) override { p_->bind_points(theta); }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override {
+    const auto& kp = dynamic_cast<const KnitMaterial&>(*p_);
+    const auto& ks = dynamic_cast<const KnitMaterial&>(*step_);
+    const double Nj = ks.knitting_angle(where.theta) - kp.knitting_angle(where.theta);
+    const MaterialResponse m = p_->evaluate(E, where);
+    MaterialResponse r;
+    r.S = Nj * (-GS_ * m.S + m.C * (GE_ * E));
+    return r;
+  }
+
+ private:
+  std::shared_ptr<Material> p_, step_;
+  Eigen::Matrix3d GE_, GS_;
 };
 
 using Sparse = Eigen::SparseMatrix<double>;
@@ -164,13 +197,22 @@ ReactionGradient reaction_gradient(const std::string& text, const std::string& f
   so.threads = c.threads;
   out.dJ.resize(static_cast<Eigen::Index>(vars.size()));
   for (std::size_t j = 0; j < vars.size(); ++j) {
-    const double h = opt.material_step * std::max(1.0, std::abs(p[j]));
-    std::vector<double> pp = p, pm = p;
-    pp[j] += h;
-    pm[j] -= h;
-    auto dmat =
-        std::make_shared<MaterialDerivative>(case_with_design(text, file, vars, pp).material,
-                                             case_with_design(text, file, vars, pm).material, h);
+    std::shared_ptr<Material> dmat;
+    if (vars[j].field == DesignVariable::Field::kStitchValue) {
+      const double h = opt.material_step * std::max(1.0, std::abs(p[j]));
+      std::vector<double> pp = p, pm = p;
+      pp[j] += h;
+      pm[j] -= h;
+      dmat = std::make_shared<StitchValueDerivative>(
+          case_with_design(text, file, vars, pp).material,
+          case_with_design(text, file, vars, pm).material, h);
+    } else {
+      std::vector<double> pp = p;
+      pp[j] += 1.0;
+      dmat = std::make_shared<KnittingAngleDerivative>(
+          case_with_design(text, file, vars, p).material,
+          case_with_design(text, file, vars, pp).material);
+    }
     const ShellModel dm(c.surface, c.thickness, dmat, so);
     ShellModel::Evaluation dev;
     dm.evaluate(run.u, false, dev);

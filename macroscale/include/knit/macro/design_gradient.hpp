@@ -10,9 +10,10 @@
 //
 // one extra linear solve with the tangent K = df_int/du at the converged state. The explicit
 // derivative df_int/dp_j at fixed u is f_int evaluated with the stress field dS/dp_j in place
-// of S (f_int is linear in S at fixed kinematics, eqs. 10-15); dS/dp_j comes from the knit
-// material at p +- h e_j at fixed strain (central difference of the material, INTERIM: until
-// the energy law's dS/dl and an analytic dT(alpha)/dalpha are wired in, for both l and alpha).
+// of S (f_int is linear in S at fixed kinematics, eqs. 10-15). For an angle control value
+// dS/dalpha = -G_S S + C G_E E (analytic through T(alpha), eqs. 20-22) times the field's basis
+// function; for a stitch-value control value dS/dl is a central difference of the knit
+// material at fixed strain (INTERIM, until the energy law's dS/dl lands).
 #pragma once
 
 #include <Eigen/Core>
@@ -50,7 +51,7 @@ struct ReactionGradient {
 };
 
 struct GradientOptions {
-  /// Relative step of the material's central difference in a design variable.
+  /// Relative step of the material's central difference in a stitch-value variable.
   double material_step = 1e-5;
 };
 
