@@ -126,6 +126,17 @@ Sparse expansion(const DofMap& d) {
   return Z;
 }
 
+/// The case with its prescribed displacements and dead loads scaled by lambda: its state at
+/// load factor 1 is the original case's state at lambda (the law has no history).
+Case scaled(Case c, double lambda) {
+  for (auto& bc : c.bcs)
+    for (auto& v : bc.prescribe)
+      if (v) *v *= lambda;
+  for (auto& l : c.loads) l.value *= lambda;
+  if (c.output.applied) c.output.applied->value *= lambda;
+  return c;
+}
+
 }  // namespace
 
 Case case_with_design(const std::string& text, const std::string& file,
@@ -149,9 +160,10 @@ std::vector<double> design_values(const std::string& text, const std::string& fi
 
 ReactionGradient reaction_gradient(const std::string& text, const std::string& file,
                                    const std::vector<DesignVariable>& vars, int reaction,
-                                   const GradientOptions& opt) {
+                                   double lambda, const GradientOptions& opt) {
   const std::vector<double> p = design_values(text, file, vars);
-  const Case c = case_with_design(text, file, vars, p);
+  if (!(lambda > 0.0)) throw InputError(file, "", "the load factor of a gradient must be positive");
+  const Case c = scaled(case_with_design(text, file, vars, p), lambda);
   if (reaction < 0 || reaction >= static_cast<int>(c.output.reactions.size()))
     throw InputError(file, "/output/reactions",
                      "no reaction " + std::to_string(reaction) + " among the case's outputs");

@@ -43,25 +43,32 @@ TEST_CASE("design gradient: adjoint reaction gradient equals finite differences 
   using F = DesignVariable::Field;
   const std::vector<DesignVariable> vars = {
       {F::kStitchValue, 0}, {F::kStitchValue, 1}, {F::kKnittingAngle, 0}, {F::kKnittingAngle, 1}};
-  const ReactionGradient g = reaction_gradient(text, "tiny.json", vars, 0);
-  REQUIRE(g.status == RunStatus::kCompleted);
   const std::vector<double> p = design_values(text, "tiny.json", vars);
-  auto J = [&](const std::vector<double>& q) {
-    const RunResult r = run_case(case_with_design(text, "tiny.json", vars, q), {});
-    REQUIRE(r.report.status == RunStatus::kCompleted);
-    return r.rows.back().reactions[0];
-  };
-  CHECK(J(p) == Approx(g.J).epsilon(1e-12));
-  for (std::size_t j = 0; j < vars.size(); ++j) {
-    const double h = 1e-3;
-    std::vector<double> pp = p, pm = p;
-    pp[j] += h;
-    pm[j] -= h;
-    const double fd = (J(pp) - J(pm)) / (2 * h);
-    INFO("variable " << j << ": adjoint " << g.dJ(j) << ", finite difference " << fd
-                     << ", relative difference " << std::abs(g.dJ(j) - fd) / std::abs(fd));
-    CHECK(g.dJ(j) == Approx(fd).epsilon(1e-5));
-    CHECK(std::abs(fd) > 1e-6);  // the check means something
+  for (double lambda : {1.0, 0.5}) {
+    INFO("load factor " << lambda);
+    const ReactionGradient g = reaction_gradient(text, "tiny.json", vars, 0, lambda);
+    REQUIRE(g.status == RunStatus::kCompleted);
+    // J(q): the reaction at lambda from the run's load stepping (2 steps: lambda = 0.5, 1).
+    auto J = [&](const std::vector<double>& q) {
+      const RunResult r = run_case(case_with_design(text, "tiny.json", vars, q), {});
+      REQUIRE(r.report.status == RunStatus::kCompleted);
+      for (const auto& row : r.rows)
+        if (std::abs(row.lambda - lambda) < 1e-12) return row.reactions[0];
+      FAIL("no step at the load factor");
+      return 0.0;
+    };
+    CHECK(J(p) == Approx(g.J).epsilon(1e-10));
+    for (std::size_t j = 0; j < vars.size(); ++j) {
+      const double h = 1e-3;
+      std::vector<double> pp = p, pm = p;
+      pp[j] += h;
+      pm[j] -= h;
+      const double fd = (J(pp) - J(pm)) / (2 * h);
+      INFO("variable " << j << ": adjoint " << g.dJ(j) << ", finite difference " << fd
+                       << ", relative difference " << std::abs(g.dJ(j) - fd) / std::abs(fd));
+      CHECK(g.dJ(j) == Approx(fd).epsilon(1e-5));
+      CHECK(std::abs(fd) > 1e-6);  // the check means something
+    }
   }
 }
 

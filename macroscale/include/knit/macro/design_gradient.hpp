@@ -55,11 +55,12 @@ struct GradientOptions {
   double material_step = 1e-5;
 };
 
-/// J = output.reactions[reaction] of the case at the end of its load path and its adjoint
+/// J = output.reactions[reaction] of the case at load factor `lambda` (prescribed displacements
+/// and dead loads scaled by lambda; the state depends on lambda alone) and its adjoint
 /// gradient. The reaction must be an edge reaction. Throws knit::InputError for bad variables;
 /// a solve that does not complete gives its status.
 ReactionGradient reaction_gradient(const std::string& case_text, const std::string& file,
                                    const std::vector<DesignVariable>& vars, int reaction,
-                                   const GradientOptions& options = {});
+                                   double lambda = 1.0, const GradientOptions& options = {});
 
 }  // namespace knit::macro
