@@ -132,3 +132,30 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
              R"(, "optimizer": "lbfgs"})",
          "/optimizer");
 }
+
+TEST_CASE("design objective: reaction terms and their gradient equal finite differences",
+          "[case]") {
+  write_case();
+  write(kDir / "reaction.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5},
+                          {"field": "knitting_angle", "indices": [0], "lower": -45, "upper": 45}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [0.5, 1.0], "weight": 2}]})");
+  const DesignProblem d = load_design((kDir / "reaction.json").string());
+  const std::vector<double> x = {5.2, 10.0};
+  const DesignEvaluation e = evaluate_design(d, x);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.terms.size() == 1);
+  CHECK(e.J == Approx(e.terms[0].second));
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    const double h = 1e-3;
+    std::vector<double> xp = x, xm = x;
+    xp[j] += h;
+    xm[j] -= h;
+    const double fd = (evaluate_design(d, xp).J - evaluate_design(d, xm).J) / (2 * h);
+    INFO("variable " << j << ": adjoint " << e.gradient(j) << ", finite difference " << fd);
+    CHECK(e.gradient(j) == Approx(fd).epsilon(1e-5));
+    CHECK(std::abs(fd) > 1e-8);
+  }
+}

@@ -49,3 +49,21 @@ struct DesignProblem {
 DesignProblem load_design(const std::string& path);
 
 }  // namespace knit::macro
+
+namespace knit::macro {
+
+/// The weighted least-squares objective of a design at variable values x (one per
+/// DesignProblem::variables entry) and its adjoint gradient (design_objective.cpp):
+///   J = sum_terms weight sum_k (R(eps_k) - target_k)^2,  lambda_k = eps_k L / Delta_1.
+/// This round evaluates reaction terms only; other terms (and a smoothness weight > 0) make
+/// the status kNotConverged with a message saying so.
+struct DesignEvaluation {
+  RunStatus status = RunStatus::kCompleted;
+  std::string message;
+  double J = 0.0;
+  std::vector<std::pair<std::string, double>> terms;  ///< per objective (name, value)
+  Eigen::VectorXd gradient;                           ///< dJ/dx
+};
+DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x);
+
+}  // namespace knit::macro
