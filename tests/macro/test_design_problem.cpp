@@ -159,3 +159,33 @@ TEST_CASE("design objective: reaction terms and their gradient equal finite diff
     CHECK(std::abs(fd) > 1e-8);
   }
 }
+
+TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value", "[case]") {
+  write_case();
+  // The target: the load of the case at l = 5.0 (both control values) at 10 % and 20 %.
+  write(kDir / "twin_probe.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [0, 0]}]})");
+  const DesignProblem probe = load_design((kDir / "twin_probe.json").string());
+  const double a = std::sqrt(evaluate_design(probe, {5.0}).J);  // |(R1, R2)| at l = 5
+  REQUIRE(a > 0.0);
+  // R(eps) at l = 5.0 from the case at each strain separately.
+  auto R = [&](double eps) {
+    DesignProblem p = probe;
+    p.objectives[0].at_strain = {eps};
+    p.objectives[0].target = {0.0};
+    return std::sqrt(evaluate_design(p, {5.0}).J);
+  };
+  DesignProblem twin = probe;
+  twin.objectives[0].target = {R(0.1), R(0.2)};
+  twin.variables[0].initial = 6.0;
+  const DesignResult r = optimize_design(twin);
+  REQUIRE(r.status == RunStatus::kCompleted);
+  INFO("recovered l = " << r.x[0] << " after " << r.history.size() - 1 << " iterations");
+  CHECK(std::abs(r.x[0] - 5.0) < 0.01 * (6.5 - 4.5));
+  CHECK(r.x[0] >= 4.5);
+  CHECK(r.x[0] <= 6.5);
+  CHECK(r.history.back().J < r.history.front().J);
+}

@@ -67,3 +67,30 @@ struct DesignEvaluation {
 DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x);
 
 }  // namespace knit::macro
+
+namespace knit::macro {
+
+/// A bounded projected-gradient descent with backtracking (Armijo) on evaluate_design()
+/// (design_optimize.cpp). INTERIM stand-in for the Ceres optimizer of issue 13: the first
+/// step moves the variable with the largest gradient by 10 % of its bound interval; accepted
+/// steps double the next trial, rejected ones halve it. Stops when a step changes no variable
+/// by more than `x_tolerance` times its interval, or after `max_iterations`.
+struct OptimizeOptions {
+  int max_iterations = 30;
+  double x_tolerance = 1e-6;
+};
+struct DesignIteration {
+  int iteration = 0;
+  double J = 0.0, gradient_norm = 0.0, seconds = 0.0;
+  std::vector<double> x;
+};
+struct DesignResult {
+  RunStatus status = RunStatus::kCompleted;
+  std::string message;
+  std::vector<double> x;  ///< the best design found (inside the bounds)
+  double J = 0.0;
+  std::vector<DesignIteration> history;
+};
+DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options = {});
+
+}  // namespace knit::macro
