@@ -211,13 +211,24 @@ ReactionGradient reaction_gradient(const std::string& text, const std::string& f
   for (std::size_t j = 0; j < vars.size(); ++j) {
     std::shared_ptr<Material> dmat;
     if (vars[j].field == DesignVariable::Field::kStitchValue) {
+      // Central difference; one-sided at the end of the database's loop lengths (a step
+      // beyond it is refused by the material factory).
       const double h = opt.material_step * std::max(1.0, std::abs(p[j]));
-      std::vector<double> pp = p, pm = p;
-      pp[j] += h;
-      pm[j] -= h;
-      dmat = std::make_shared<StitchValueDerivative>(
-          case_with_design(text, file, vars, pp).material,
-          case_with_design(text, file, vars, pm).material, h);
+      auto material_at = [&](double step, double& used) {
+        std::vector<double> q = p;
+        q[j] += step;
+        try {
+          used = std::abs(step);
+          return case_with_design(text, file, vars, q).material;
+        } catch (const InputError&) {
+          used = 0.0;
+          return c.material;
+        }
+      };
+      double hp = 0.0, hm = 0.0;
+      auto plus = material_at(h, hp);
+      auto minus = material_at(-h, hm);
+      dmat = std::make_shared<StitchValueDerivative>(plus, minus, 0.5 * (hp + hm));
     } else {
       std::vector<double> pp = p;
       pp[j] += 1.0;

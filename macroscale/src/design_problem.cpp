@@ -243,3 +243,20 @@ DesignProblem load_design(const std::string& path) {
 }
 
 }  // namespace knit::macro
+
+namespace knit::macro {
+
+std::string design_case_text(const DesignProblem& d, const std::vector<double>& x) {
+  std::vector<double> values;
+  for (std::size_t k = 0; k < d.variables.size(); ++k)
+    for (std::size_t i = 0; i < d.variables[k].indices.size(); ++i) values.push_back(x.at(k));
+  json root =
+      io::parse_json(case_with_design(d.c.text, d.case_file, d.expanded(), values).text, d.file);
+  auto& db = root.at("material").at("database");
+  db = std::filesystem::absolute(io::resolve_input_path(d.case_file, db.get<std::string>()))
+           .lexically_normal()
+           .string();
+  return root.dump(2) + "\n";
+}
+
+}  // namespace knit::macro

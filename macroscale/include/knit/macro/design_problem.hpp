@@ -94,3 +94,11 @@ struct DesignResult {
 DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options = {});
 
 }  // namespace knit::macro
+
+namespace knit::macro {
+
+/// The case text with the variables at x and the database path made absolute, so that the
+/// file runs as is with `knit-macro run` from any directory.
+std::string design_case_text(const DesignProblem& d, const std::vector<double>& x);
+
+}  // namespace knit::macro
