@@ -195,7 +195,24 @@ $(FIG)/sensitivity.png: $(SENSITIVITY) $(FIGPY)/sensitivity.py
 	@$(call draw,$(PY) $(FIGPY)/sensitivity.py $(SENSITIVITY) --out $@,$@)
 endif
 
-figures: $(FIGURES)
+
+# ---- knitting maps (issue 13, docs/design.md) ----------------------------------------------------
+# `knit-macro knitmap` on the planar paper cases, then the PNG by scripts/figures/knitmap.py.
+KNITMAPS := s312_uniform_45_course s313_discontinuous_course s314_linear_course \
+  s315_diagonal_45deg_vertical s322_curved_horizontal
+KNITMAP_FIGURES := $(KNITMAPS:%=$(FIG)/knitmap_%.png)
+# Named as targets so that make does not delete them as intermediates.
+KNITMAP_SUMMARIES := $(KNITMAPS:%=$(OUT)/knitmap/%/summary.txt)
+$(OUT)/knitmap/%/summary.txt: $(OUT)/cases/%.json $(DB) $(MACRO)
+	@mkdir -p $(OUT)/knitmap $(LOGS)
+	@"$(MACRO)" knitmap $< --output $(OUT)/knitmap/$* > $(LOGS)/knitmap_$*.log 2>&1 \
+	  || { echo "knitmap: $* failed, see $(LOGS)/knitmap_$*.log"; exit 1; }
+$(FIG)/knitmap_%.png: $(OUT)/knitmap/%/summary.txt $(FIGPY)/knitmap.py
+	@$(call draw,$(PY) $(FIGPY)/knitmap.py $(OUT)/knitmap/$* --title "knitting map: $*" --out $@,$@)
+.PHONY: knitmaps
+knitmaps: $(KNITMAP_SUMMARIES) $(KNITMAP_FIGURES)
+
+figures: $(FIGURES) knitmaps
 
 # ---- report -----------------------------------------------------------------------------------
 $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py \
@@ -209,6 +226,6 @@ report: $(OUT)/report.md
 
 clean:
 	rm -rf $(OUT)/database.h5 $(OUT)/database.source $(OUT)/database.time $(OUT)/cases \
-	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/report.md
+	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/knitmap $(OUT)/report.md
 
 FORCE:

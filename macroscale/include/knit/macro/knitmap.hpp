@@ -1,0 +1,107 @@
+// The knitting map (issue 13, docs/design.md "The knitting map"): from the stitch-value field
+// l(theta) and the knitting-angle field alpha(theta) of a planar knit case to the table a
+// flat-knitting machine with per-stitch yarn delivery needs: course by course and needle by
+// needle, the loop length of each stitch.
+//
+// Layout (all in the patch's plane z = const, mm):
+//  * the course direction d1 is the global in-plane direction of the courses, phi = angle(e1)
+//    + alpha (alpha about the surface normal, paper eqs. 19-20; e1 = a1/|a1|); a flat machine
+//    knits straight courses, so phi must be constant over the patch within a tolerance
+//    (otherwise the map is refused with the reason); d2 = z x d1 is the wale direction;
+//  * courses are stacked along d2 from the patch's lowest point; course k is the chord of the
+//    patch along d1 at its centre line; its stitches are laid side by side from the chord's
+//    start, each as wide as the wale width w(l) at its centre, while the centre lies inside the
+//    chord (a uniform chord of length W holds round(W/w) stitches);
+//  * the course height is the mean course height c(l) of the course's stitches (a course is
+//    one row on the machine); where c(l) varies along a course the mismatch is reported
+//    (short rows that would absorb it are not generated);
+//  * the needle of a stitch: each course is centred about its chord's midpoint, measured in the
+//    course's mean stitch width from the midpoint of the patch's extent along d1; the machine
+//    needs `needles` needles (the widest course in needles); courses with fewer stitches leave
+//    their outer needles out of work (fully fashioned narrowing).
+// w(l) and c(l) interpolate the database's cell parameters (per loop length /loop_k attributes
+// wale_width, course_height) piecewise linearly in l.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "knit/macro/case.hpp"
+
+namespace knit::material {
+struct Database;
+}
+
+namespace knit::macro {
+
+/// w(l) and c(l) from the database's cell parameters, piecewise linear in l (mm).
+class CellTable {
+ public:
+  CellTable() = default;
+  /// Throws knit::InputError(db_file, "/loop_k", ...) if a cell parameter is not positive.
+  CellTable(const material::Database& db, const std::string& db_file);
+  double wale_width(double l) const { return interpolate(w_, l); }
+  double course_height(double l) const { return interpolate(c_, l); }
+  const std::vector<double>& loop_lengths() const { return l_; }
+
+ private:
+  double interpolate(const std::vector<double>& y, double l) const;
+  std::vector<double> l_, w_, c_;
+};
+
+struct KnitMapOptions {
+  /// Largest allowed deviation of the course direction from its mean over the patch (deg).
+  double angle_tolerance_deg = 2.0;
+  /// Samples per patch edge for the boundary polygon (chords of the courses).
+  int boundary_samples = 400;
+};
+
+struct KnitStitch {
+  int course = 0, needle = 0;                          ///< 1-based
+  double l = 0.0;                                      ///< loop length (mm)
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< stitch centre (x, y), mm
+};
+
+struct KnitCourse {
+  int index = 0;                       ///< 1-based
+  int first_needle = 0, stitches = 0;  ///< needles first_needle .. first_needle + stitches - 1
+  double height = 0.0;                 ///< mean c(l) of its stitches (mm)
+  double t = 0.0;                      ///< centre line along d2 from the patch's lowest point
+  double height_mismatch = 0.0;        ///< max |c(l_i) - height| / height over its stitches
+};
+
+struct KnitMap {
+  std::vector<KnitStitch> stitches;  ///< course by course, needle by needle
+  std::vector<KnitCourse> courses;
+  int needles = 0;
+  double yarn_length = 0.0;           ///< sum of l (mm)
+  double course_direction_deg = 0.0;  ///< phi: angle of d1 from the x axis
+  double angle_spread_deg = 0.0;      ///< max deviation of the course direction from phi
+  double max_height_mismatch = 0.0;   ///< max over the courses
+  double l_min = 0.0, l_max = 0.0;
+  std::vector<std::string> warnings;
+};
+
+/// Lays out the map of a loaded case. Throws knit::InputError naming c.file and the JSON
+/// pointer if the material is not "knit", the patch is not planar (z = const), or the course
+/// direction varies beyond the tolerance.
+KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions& options = {});
+
+/// Reads the case (load_case) and its database's cell parameters. Throws knit::InputError.
+struct KnitMapInput {
+  Case c;
+  CellTable cells;
+  std::string database;  ///< resolved path
+};
+KnitMapInput load_knitmap_input(const std::string& case_file);
+
+/// The totals as "key: value" lines (summary.txt and stdout).
+std::string knitmap_summary(const KnitMap& map);
+
+/// Writes DIR/knitmap.csv (course, needle, l_mm, x_mm, y_mm), DIR/courses.csv and
+/// DIR/summary.txt atomically (the directory appears complete or not at all).
+void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir);
+
+}  // namespace knit::macro

@@ -1,0 +1,51 @@
+// knit-macro knitmap CASE.json [--output DIR] [--angle-tolerance DEG]
+//   The knitting map of a planar knit case (docs/design.md "The knitting map"): course by
+//   course and needle by needle, the loop length of each stitch. Writes DIR (default: the
+//   case file's name without extension + "_knitmap") with knitmap.csv, courses.csv and
+//   summary.txt, and prints the totals. The PNG map is drawn from DIR by
+//   scripts/figures/knitmap.py (the pipeline calls it; this command never needs python).
+//   Exit codes: 0 written, 2 bad input (nothing is written).
+// Example:
+//   knit-macro knitmap cases/design/knitmap_graded.json --output out/knitmap_graded
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "knit/core/cli.hpp"
+#include "knit/core/errors.hpp"
+#include "knit/macro/knitmap.hpp"
+
+namespace {
+
+struct Options {
+  std::string case_file, output;
+  double angle_tolerance = knit::macro::KnitMapOptions{}.angle_tolerance_deg;
+};
+
+knit::cli::SubcommandRegistrar reg(
+    "knitmap", "Knitting map of a planar knit case: loop length per course and needle (CSV)",
+    [](CLI::App& sub) {
+      auto o = std::make_shared<Options>();
+      sub.add_option("case", o->case_file, "case file (JSON, knit material, planar patch)")
+          ->required();
+      sub.add_option("--output,-o", o->output, "output directory");
+      sub.add_option("--angle-tolerance", o->angle_tolerance,
+                     "largest deviation of the course direction from its mean (deg)")
+          ->check(CLI::PositiveNumber);
+      return [o]() -> int {
+        const auto in = knit::macro::load_knitmap_input(o->case_file);
+        knit::macro::KnitMapOptions opt;
+        opt.angle_tolerance_deg = o->angle_tolerance;
+        const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
+        const std::filesystem::path dir =
+            o->output.empty()
+                ? std::filesystem::path(std::filesystem::path(o->case_file).stem().string() +
+                                        "_knitmap")
+                : std::filesystem::path(o->output);
+        knit::macro::write_knitmap(map, in, dir);
+        std::cout << knit::macro::knitmap_summary(map) << "wrote " << dir.string() << "\n";
+        return knit::kExitOk;
+      };
+    });
+
+}  // namespace

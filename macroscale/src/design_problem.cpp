@@ -1,0 +1,262 @@
+// Design file -> DesignProblem (knit/macro/design_problem.hpp). The specific checks come first
+// (they name what is wrong in design terms); the schema is the last word, as in the case
+// loader.
+#include "knit/macro/design_problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
+#include "knit/material/database.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+using nlohmann::json;
+
+const char* kKinds[] = {"reaction", "displacement", "strain_variance", "target_strain"};
+
+std::string fmt(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+double number(const json& j, const std::string& file, const std::string& p) {
+  if (!j.is_number()) throw InputError(file, p, "must be a number");
+  return j.get<double>();
+}
+
+std::vector<double> numbers(const json& j, const std::string& file, const std::string& p) {
+  if (!j.is_array()) throw InputError(file, p, "must be an array of numbers");
+  std::vector<double> v;
+  for (std::size_t k = 0; k < j.size(); ++k)
+    v.push_back(number(j[k], file, p + "/" + std::to_string(k)));
+  return v;
+}
+
+void read_variable(const json& j, const std::string& p, const json& case_root, const Case& c,
+                   const std::string& file, DesignVariableSpec& v) {
+  if (!j.is_object()) throw InputError(file, p, "must be an object");
+  for (const char* k : {"field", "indices", "lower", "upper"})
+    if (!j.contains(k))
+      throw InputError(file, p, std::string("missing required key \"") + k + "\"");
+  const std::string field = j.at("field").is_string() ? j.at("field").get<std::string>() : "";
+  if (field != "stitch_value" && field != "knitting_angle")
+    throw InputError(file, p + "/field", "must be \"stitch_value\" or \"knitting_angle\"");
+  v.field = field == "stitch_value" ? DesignVariable::Field::kStitchValue
+                                    : DesignVariable::Field::kKnittingAngle;
+  if (j.contains("name") && j.at("name").is_string()) v.name = j.at("name").get<std::string>();
+  const json& f =
+      case_root.at("material").contains(field) ? case_root.at("material").at(field) : json();
+  if (!f.is_object() || !f.contains("values") || !f.at("values").is_array())
+    throw InputError(file, p + "/field",
+                     "the case's /material/" + field +
+                         " has no control values (a constant or aligned field cannot be designed; "
+                         "write it as a spline field)");
+  const json& vals = f.at("values");
+  const json& idx = j.at("indices");
+  if (!idx.is_array() || idx.empty())
+    throw InputError(file, p + "/indices", "must be a non-empty array of control-value indices");
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const std::string ip = p + "/indices/" + std::to_string(k);
+    if (!idx[k].is_number_integer() || idx[k].get<long>() < 0 ||
+        idx[k].get<long>() >= static_cast<long>(vals.size()))
+      throw InputError(file, ip,
+                       "must be the index of one of the " + std::to_string(vals.size()) +
+                           " control values of the case's /material/" + field);
+    v.indices.push_back(idx[k].get<int>());
+  }
+  v.lower = number(j.at("lower"), file, p + "/lower");
+  v.upper = number(j.at("upper"), file, p + "/upper");
+  if (!(v.lower < v.upper)) throw InputError(file, p + "/upper", "must exceed lower");
+  if (v.field == DesignVariable::Field::kStitchValue) {
+    std::filesystem::path db =
+        io::resolve_input_path(c.file, case_root.at("material").at("database").get<std::string>());
+    const auto ls = material::read_database(db, false).loop_lengths();
+    for (const char* b : {"lower", "upper"}) {
+      const double x = std::string(b) == "lower" ? v.lower : v.upper;
+      if (x < ls.front() || x > ls.back())
+        throw InputError(file, p + "/" + b,
+                         fmt(x) + " mm is outside the database's " + fmt(ls.front()) + "-" +
+                             fmt(ls.back()) + " mm (" + db.string() + ")");
+    }
+  } else {
+    const bool deg = f.contains("unit") && f.at("unit") == "deg";
+    const double lim = deg ? 180.0 : std::numbers::pi;
+    if (v.lower < -lim || v.upper > lim)
+      throw InputError(file, p + (v.lower < -lim ? "/lower" : "/upper"),
+                       "knitting-angle bounds must lie in [-" + fmt(lim) + ", " + fmt(lim) + "] (" +
+                           (deg ? "deg" : "rad") + ", the field's unit)");
+  }
+  v.initial = number(vals[static_cast<std::size_t>(v.indices[0])], file, "/material/" + field);
+  for (int i : v.indices)
+    if (vals[static_cast<std::size_t>(i)] != vals[static_cast<std::size_t>(v.indices[0])])
+      throw InputError(file, p + "/indices",
+                       "tied control values must start equal in the case (" + fmt(v.initial) +
+                           " and " + vals[static_cast<std::size_t>(i)].dump() + ")");
+  if (v.initial < v.lower || v.initial > v.upper)
+    throw InputError(file, p, "the case's value " + fmt(v.initial) + " is outside the bounds");
+}
+
+int find_name(const std::vector<std::string>& names, const json& j, const std::string& file,
+              const std::string& p, const std::string& what) {
+  const std::string n = j.is_string() ? j.get<std::string>() : "";
+  const auto it = std::find(names.begin(), names.end(), n);
+  if (it == names.end()) {
+    std::string list;
+    for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
+    throw InputError(file, p,
+                     "\"" + n + "\" is not among the case's " + what + " (" +
+                         (list.empty() ? "none" : list) + ")");
+  }
+  return static_cast<int>(it - names.begin());
+}
+
+void read_objective(const json& j, const std::string& p, const Case& c, const std::string& file,
+                    DesignObjective& o) {
+  if (!j.is_object() || !j.contains("type") || !j.at("type").is_string())
+    throw InputError(file, p, "an objective needs a \"type\"");
+  const std::string type = j.at("type").get<std::string>();
+  const auto k = std::find(std::begin(kKinds), std::end(kKinds), type);
+  if (k == std::end(kKinds))
+    throw InputError(file, p + "/type",
+                     "unknown objective \"" + type +
+                         "\" (allowed: reaction, displacement, strain_variance, target_strain)");
+  o.kind = static_cast<DesignObjective::Kind>(k - std::begin(kKinds));
+  o.name = j.contains("name") && j.at("name").is_string() ? j.at("name").get<std::string>() : type;
+  if (j.contains("weight")) o.weight = number(j.at("weight"), file, p + "/weight");
+  if (!j.contains("at_strain")) throw InputError(file, p, "missing required key \"at_strain\"");
+  if (!c.output.applied)
+    throw InputError(file, p + "/at_strain",
+                     "the case names no applied displacement (output.applied_displacement)");
+  o.at_strain = numbers(j.at("at_strain"), file, p + "/at_strain");
+  if (o.at_strain.empty()) throw InputError(file, p + "/at_strain", "needs at least one strain");
+  const bool targets = o.kind != DesignObjective::Kind::kStrainVariance;
+  if (targets) {
+    if (!j.contains("target")) throw InputError(file, p, "missing required key \"target\"");
+    o.target = numbers(j.at("target"), file, p + "/target");
+    if (o.target.size() != o.at_strain.size())
+      throw InputError(file, p + "/target", "needs one target per applied strain");
+  }
+  if (o.kind == DesignObjective::Kind::kReaction) {
+    std::vector<std::string> names;
+    for (const auto& r : c.output.reactions) names.push_back(r.name);
+    if (!j.contains("reaction")) throw InputError(file, p, "missing required key \"reaction\"");
+    o.reaction = find_name(names, j.at("reaction"), file, p + "/reaction", "output.reactions");
+    return;
+  }
+  if (!j.contains("component")) throw InputError(file, p, "missing required key \"component\"");
+  const std::string comp =
+      j.at("component").is_string() ? j.at("component").get<std::string>() : "";
+  const std::vector<std::string> allowed = o.kind == DesignObjective::Kind::kDisplacement
+                                               ? std::vector<std::string>{"x", "y", "z"}
+                                               : std::vector<std::string>{"E11", "E22", "E12"};
+  const auto ci = std::find(allowed.begin(), allowed.end(), comp);
+  if (ci == allowed.end())
+    throw InputError(file, p + "/component",
+                     "must be one of " + allowed[0] + ", " + allowed[1] + ", " + allowed[2]);
+  o.component = static_cast<int>(ci - allowed.begin());
+  if (o.kind == DesignObjective::Kind::kDisplacement) {
+    std::vector<std::string> names;
+    for (const auto& q : c.output.points) names.push_back(q.name);
+    if (!j.contains("point")) throw InputError(file, p, "missing required key \"point\"");
+    o.point = find_name(names, j.at("point"), file, p + "/point", "output.points");
+    return;
+  }
+  if (!j.contains("region")) throw InputError(file, p, "missing required key \"region\"");
+  for (const char* d : {"u", "v"}) {
+    const std::string rp = p + "/region/" + d;
+    if (!j.at("region").contains(d))
+      throw InputError(file, p + "/region", std::string("missing \"") + d + "\"");
+    const auto r = numbers(j.at("region").at(d), file, rp);
+    if (r.size() != 2 || !(r[0] < r[1]) || r[0] < 0 || r[1] > 1)
+      throw InputError(file, rp, "must be [lo, hi] with 0 <= lo < hi <= 1");
+    (d[0] == 'u' ? o.u_range : o.v_range) = Eigen::Vector2d(r[0], r[1]);
+  }
+}
+
+}  // namespace
+
+std::vector<DesignVariable> DesignProblem::expanded() const {
+  std::vector<DesignVariable> out;
+  for (const auto& v : variables)
+    for (int i : v.indices) out.push_back({v.field, i});
+  return out;
+}
+
+DesignProblem load_design(const std::string& path) {
+  DesignProblem d;
+  d.file = path;
+  const json root = io::read_json_file(path);
+  if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
+  for (auto it = root.begin(); it != root.end(); ++it)
+    if (std::string k = it.key(); k != "$schema" && k != "description" && k != "case" &&
+                                  k != "variables" && k != "objectives" && k != "smoothness")
+      throw InputError(path, io::json_pointer_append("", k),
+                       "unknown key (allowed: $schema, description, case, variables, objectives, "
+                       "smoothness)");
+  if (!root.contains("case") || !root.at("case").is_string())
+    throw InputError(path, "/case", "needs the case file (a string, relative to this file)");
+  d.case_file = io::resolve_input_path(path, root.at("case").get<std::string>()).string();
+  d.c = load_case(d.case_file);
+  const json case_root = io::parse_json(d.c.text, d.case_file);
+  if (d.c.material->name() != "knit")
+    throw InputError(path, "/case",
+                     "the design needs a knit case (" + d.case_file + " has the material \"" +
+                         d.c.material->name() + "\")");
+  if (!root.contains("variables") || !root.at("variables").is_array() ||
+      root.at("variables").empty())
+    throw InputError(path, "/variables", "needs at least one design variable");
+  if (!root.contains("objectives") || !root.at("objectives").is_array() ||
+      root.at("objectives").empty())
+    throw InputError(path, "/objectives", "needs at least one objective");
+  std::vector<std::pair<int, int>> used;
+  for (std::size_t k = 0; k < root.at("variables").size(); ++k) {
+    const std::string p = "/variables/" + std::to_string(k);
+    DesignVariableSpec v;
+    read_variable(root.at("variables")[k], p, case_root, d.c, path, v);
+    for (int i : v.indices) {
+      const std::pair<int, int> key(static_cast<int>(v.field), i);
+      if (std::find(used.begin(), used.end(), key) != used.end())
+        throw InputError(
+            path, p + "/indices",
+            "control value " + std::to_string(i) + " is already set by another variable");
+      used.push_back(key);
+    }
+    d.variables.push_back(v);
+  }
+  for (std::size_t k = 0; k < root.at("objectives").size(); ++k) {
+    DesignObjective o;
+    read_objective(root.at("objectives")[k], "/objectives/" + std::to_string(k), d.c, path, o);
+    d.objectives.push_back(o);
+  }
+  if (root.contains("smoothness") && root.at("smoothness").contains("weight"))
+    d.smoothness = number(root.at("smoothness").at("weight"), path, "/smoothness/weight");
+  io::JsonSchema::embedded("design").validate(root, path);
+  return d;
+}
+
+}  // namespace knit::macro
+
+namespace knit::macro {
+
+std::string design_case_text(const DesignProblem& d, const std::vector<double>& x) {
+  std::vector<double> values;
+  for (std::size_t k = 0; k < d.variables.size(); ++k)
+    for (std::size_t i = 0; i < d.variables[k].indices.size(); ++i) values.push_back(x.at(k));
+  json root =
+      io::parse_json(case_with_design(d.c.text, d.case_file, d.expanded(), values).text, d.file);
+  auto& db = root.at("material").at("database");
+  db = std::filesystem::absolute(io::resolve_input_path(d.case_file, db.get<std::string>()))
+           .lexically_normal()
+           .string();
+  return root.dump(2) + "\n";
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,348 @@
+// The knitting map's layout (knit/macro/knitmap.hpp; rules in docs/design.md).
+#include "knit/macro/knitmap.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/macro/knit_material.hpp"
+#include "knit/material/database.hpp"
+
+namespace knit::macro {
+
+CellTable::CellTable(const material::Database& db, const std::string& db_file) {
+  for (std::size_t k = 0; k < db.entries.size(); ++k) {
+    const auto& e = db.entries[k];
+    const std::string g = "/loop_" + std::to_string(k);
+    if (!(std::isfinite(e.cell.wale_width) && e.cell.wale_width > 0))
+      throw InputError(db_file, g + "/wale_width",
+                       "the knitting map needs a positive wale width (cell parameter) at l = " +
+                           std::to_string(e.loop_length) + " mm");
+    if (!(std::isfinite(e.cell.course_height) && e.cell.course_height > 0))
+      throw InputError(db_file, g + "/course_height",
+                       "the knitting map needs a positive course height (cell parameter) at l = " +
+                           std::to_string(e.loop_length) + " mm");
+    l_.push_back(e.loop_length);
+    w_.push_back(e.cell.wale_width);
+    c_.push_back(e.cell.course_height);
+  }
+  if (l_.empty()) throw InputError(db_file, "/loop_lengths", "the database has no loop length");
+}
+
+double CellTable::interpolate(const std::vector<double>& y, double l) const {
+  if (l_.size() == 1 || l <= l_.front()) return y.front();
+  if (l >= l_.back()) return y.back();
+  const auto it = std::upper_bound(l_.begin(), l_.end(), l);
+  const std::size_t k = static_cast<std::size_t>(it - l_.begin());
+  const double s = (l - l_[k - 1]) / (l_[k] - l_[k - 1]);
+  return (1 - s) * y[k - 1] + s * y[k];
+}
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// The planar patch seen in the course frame: (s, t) = (p . d1, p . d2) for p = (x, y).
+class PlanarPatch {
+ public:
+  PlanarPatch(const spline::SplineSurface& g, const KnitMaterial& m) : g_(g), m_(m) {}
+
+  Eigen::Vector2d xy(const Eigen::Vector2d& th) const {
+    const Eigen::VectorXd p = g_.eval(th.x(), th.y());
+    return {p(0), p(1)};
+  }
+  /// Course direction angle phi = angle(e1) + alpha (alpha about the normal).
+  double course_angle(const Eigen::Vector2d& th) const {
+    const Eigen::MatrixXd d = g_.derivatives(th.x(), th.y(), 1);
+    const double cross = d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0);
+    const double sign = cross >= 0 ? 1.0 : -1.0;
+    return std::atan2(d(1, 1), d(1, 0)) + sign * m_.knitting_angle(th);
+  }
+  /// The parametric point of the plane point p (Newton, clamped to the domain, warm-started
+  /// from the previous call). Points just outside the patch give the nearest boundary point.
+  Eigen::Vector2d invert(const Eigen::Vector2d& p) {
+    const auto& bu = g_.basis_u();
+    const auto& bv = g_.basis_v();
+    Eigen::Vector2d th =
+        guess_valid_ ? guess_
+                     : Eigen::Vector2d(0.5 * (bu.lo() + bu.hi()), 0.5 * (bv.lo() + bv.hi()));
+    for (int it = 0; it < 50; ++it) {
+      const Eigen::MatrixXd d = g_.derivatives(th.x(), th.y(), 1);
+      const Eigen::Vector2d r(d(0, 0) - p.x(), d(0, 1) - p.y());
+      Eigen::Matrix2d J;
+      J << d(1, 0), d(2, 0), d(1, 1), d(2, 1);
+      const Eigen::Vector2d step = J.partialPivLu().solve(r);
+      th -= step;
+      th.x() = std::clamp(th.x(), bu.lo(), bu.hi());
+      th.y() = std::clamp(th.y(), bv.lo(), bv.hi());
+      if (step.norm() < 1e-13 * (1 + th.norm())) break;
+    }
+    guess_ = th;
+    guess_valid_ = true;
+    return th;
+  }
+  double stitch_value(const Eigen::Vector2d& th) const { return m_.stitch_value(th); }
+
+ private:
+  const spline::SplineSurface& g_;
+  const KnitMaterial& m_;
+  Eigen::Vector2d guess_ = Eigen::Vector2d::Zero();
+  bool guess_valid_ = false;
+};
+
+void check_planar(const Case& c) {
+  const Eigen::MatrixXd& P = c.input_surface.control_points();
+  const double size = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+  for (Eigen::Index a = 0; a < P.rows(); ++a)
+    if (std::abs(P(a, 2) - P(0, 2)) > 1e-9 * (1 + size)) {
+      std::ostringstream os;
+      os << "the knitting map needs a planar patch in a plane z = const (z = " << P(a, 2)
+         << " here, " << P(0, 2)
+         << " at control point 0); curved shells are not flattened (docs/design.md)";
+      throw InputError(c.file, "/geometry/control_points/" + std::to_string(a), os.str());
+    }
+}
+
+/// The boundary polygon of the patch in (s, t).
+std::vector<Eigen::Vector2d> boundary(const PlanarPatch& patch, const spline::SplineSurface& g,
+                                      const Eigen::Matrix2d& R, int n) {
+  const auto& bu = g.basis_u();
+  const auto& bv = g.basis_v();
+  std::vector<Eigen::Vector2d> poly;
+  auto edge = [&](Eigen::Vector2d a, Eigen::Vector2d b) {
+    for (int i = 0; i < n; ++i) poly.push_back(R * patch.xy(a + (b - a) * (double(i) / n)));
+  };
+  edge({bu.lo(), bv.lo()}, {bu.hi(), bv.lo()});
+  edge({bu.hi(), bv.lo()}, {bu.hi(), bv.hi()});
+  edge({bu.hi(), bv.hi()}, {bu.lo(), bv.hi()});
+  edge({bu.lo(), bv.hi()}, {bu.lo(), bv.lo()});
+  return poly;
+}
+
+/// The crossings (s values) of the line t = tc with the closed polygon, sorted.
+std::vector<double> crossings(const std::vector<Eigen::Vector2d>& poly, double tc) {
+  std::vector<double> s;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector2d& a = poly[i];
+    const Eigen::Vector2d& b = poly[(i + 1) % poly.size()];
+    if ((a.y() - tc) * (b.y() - tc) > 0 || a.y() == b.y()) continue;
+    if (b.y() == tc) continue;  // counted once, as the start of the next segment
+    s.push_back(a.x() + (b.x() - a.x()) * (tc - a.y()) / (b.y() - a.y()));
+  }
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+struct Laid {
+  std::vector<double> s, l;
+};
+
+}  // namespace
+
+KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions& opt) {
+  const auto* mat = dynamic_cast<const KnitMaterial*>(c.material.get());
+  if (!mat)
+    throw InputError(c.file, "/material/type",
+                     "the knitting map needs the knit material (type \"knit\"), not \"" +
+                         c.material->name() + "\"");
+  check_planar(c);
+  PlanarPatch patch(c.surface, *mat);
+  KnitMap map;
+
+  // The course direction: its mean over the patch (as a line, modulo pi) and its spread.
+  const auto& bu = c.surface.basis_u();
+  const auto& bv = c.surface.basis_v();
+  const int ns = 21;
+  std::vector<double> phis;
+  double C = 0, S = 0;
+  for (int j = 0; j < ns; ++j)
+    for (int i = 0; i < ns; ++i) {
+      const Eigen::Vector2d th(bu.lo() + (bu.hi() - bu.lo()) * i / (ns - 1.0),
+                               bv.lo() + (bv.hi() - bv.lo()) * j / (ns - 1.0));
+      const double phi = patch.course_angle(th);
+      phis.push_back(phi);
+      C += std::cos(2 * phi);
+      S += std::sin(2 * phi);
+    }
+  const double phi0 = 0.5 * std::atan2(S, C);
+  double spread = 0;
+  for (double phi : phis) {
+    const double d = std::remainder(phi - phi0, kPi);
+    spread = std::max(spread, std::abs(d));
+  }
+  map.course_direction_deg = phi0 * 180 / kPi;
+  map.angle_spread_deg = spread * 180 / kPi;
+  if (map.angle_spread_deg > opt.angle_tolerance_deg) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "the course direction varies by up to " << map.angle_spread_deg << " deg from its mean "
+       << map.course_direction_deg
+       << " deg over the patch; a flat-knitting machine knits straight courses, so the map "
+          "needs a course direction constant within "
+       << opt.angle_tolerance_deg << " deg (--angle-tolerance)";
+    throw InputError(c.file, "/material/knitting_angle", os.str());
+  }
+
+  const Eigen::Vector2d d1(std::cos(phi0), std::sin(phi0)), d2(-std::sin(phi0), std::cos(phi0));
+  Eigen::Matrix2d R;  // (x, y) -> (s, t)
+  R.row(0) = d1.transpose();
+  R.row(1) = d2.transpose();
+  const auto poly = boundary(patch, c.surface, R, std::max(4, opt.boundary_samples));
+  double s_min = 1e300, s_max = -1e300, t_min = 1e300, t_max = -1e300;
+  for (const auto& q : poly) {
+    s_min = std::min(s_min, q.x());
+    s_max = std::max(s_max, q.x());
+    t_min = std::min(t_min, q.y());
+    t_max = std::max(t_max, q.y());
+  }
+  const double s_mid = 0.5 * (s_min + s_max);
+
+  auto l_at = [&](double s, double t) {
+    return patch.stitch_value(patch.invert(R.transpose() * Eigen::Vector2d(s, t)));
+  };
+  // Stitches of the chord [s0, s1] at t: side by side, each w(l) wide at its centre.
+  auto lay = [&](double s0, double s1, double t) {
+    Laid out;
+    double s = s0, w = cells.wale_width(l_at(std::min(s0 + 1e-9, s1), t));
+    for (;;) {
+      for (int it = 0; it < 30 && s + 0.5 * w < s1; ++it) {
+        const double wn = cells.wale_width(l_at(s + 0.5 * w, t));
+        if (std::abs(wn - w) <= 1e-13 * w) break;
+        w = wn;
+      }
+      if (!(s + 0.5 * w < s1)) break;
+      out.s.push_back(s + 0.5 * w);
+      out.l.push_back(l_at(s + 0.5 * w, t));
+      s += w;
+    }
+    // Centre the stitches on the chord (their total width differs from it by less than one
+    // stitch); each keeps the l it was laid with.
+    const double shift = 0.5 * (s1 - s);
+    for (double& x : out.s) x += shift;
+    return out;
+  };
+
+  struct Row {
+    KnitCourse course;
+    Laid laid;
+    double r = 0;
+  };
+  std::vector<Row> rows;
+  double t = t_min;
+  double height = cells.course_height(l_at(s_mid, t_min + 1e-9 * (t_max - t_min)));
+  bool nonconvex_warned = false;
+  for (;;) {
+    Row row;
+    bool done = false;
+    for (int it = 0; it < 30; ++it) {
+      const double tc = t + 0.5 * height;
+      if (!(tc < t_max)) {
+        done = true;
+        break;
+      }
+      const auto cr = crossings(poly, tc);
+      if (cr.size() < 2) {
+        done = true;
+        break;
+      }
+      if (cr.size() > 2 && !nonconvex_warned) {
+        map.warnings.push_back("a course line crosses the patch boundary " +
+                               std::to_string(cr.size()) +
+                               " times (a non-convex patch): each course spans its whole chord");
+        nonconvex_warned = true;
+      }
+      row.laid = lay(cr.front(), cr.back(), tc);
+      row.course.t = tc - t_min;
+      if (row.laid.l.empty()) {
+        done = true;
+        break;
+      }
+      double sum = 0;
+      for (double l : row.laid.l) sum += cells.course_height(l);
+      const double hn = sum / double(row.laid.l.size());
+      const bool converged = std::abs(hn - height) <= 1e-13 * height;
+      height = hn;
+      if (converged) break;
+    }
+    if (done) break;
+    row.course.height = height;
+    row.course.stitches = static_cast<int>(row.laid.l.size());
+    double wsum = 0;
+    for (std::size_t i = 0; i < row.laid.l.size(); ++i) {
+      wsum += cells.wale_width(row.laid.l[i]);
+      row.course.height_mismatch =
+          std::max(row.course.height_mismatch,
+                   std::abs(cells.course_height(row.laid.l[i]) - height) / height);
+    }
+    const double wmean = wsum / row.course.stitches;
+    const double smid_k = 0.5 * (row.laid.s.front() + row.laid.s.back());
+    row.r = (smid_k - s_mid) / wmean - 0.5 * (row.course.stitches - 1);
+    rows.push_back(std::move(row));
+    t += height;
+    if (rows.size() > 1000000)
+      throw InputError(c.file, "/material/stitch_value", "more than 10^6 courses");
+  }
+  if (rows.empty())
+    throw InputError(c.file, "/geometry", "the patch holds no course (smaller than one stitch)");
+
+  // Round half up with a tolerance: a centred course of an even stitch count has r exactly at
+  // a half integer, where round-off must not shift some courses by one needle.
+  auto first_of = [](double r) { return static_cast<long>(std::floor(r + 0.5 + 1e-6)); };
+  long first_min = std::numeric_limits<long>::max();
+  for (const auto& row : rows) first_min = std::min(first_min, first_of(row.r));
+  map.l_min = 1e300;
+  map.l_max = -1e300;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    auto& row = rows[k];
+    row.course.index = static_cast<int>(k) + 1;
+    row.course.first_needle = static_cast<int>(first_of(row.r) - first_min) + 1;
+    map.needles = std::max(map.needles, row.course.first_needle + row.course.stitches - 1);
+    map.max_height_mismatch = std::max(map.max_height_mismatch, row.course.height_mismatch);
+    for (std::size_t i = 0; i < row.laid.l.size(); ++i) {
+      KnitStitch st;
+      st.course = row.course.index;
+      st.needle = row.course.first_needle + static_cast<int>(i);
+      st.l = row.laid.l[i];
+      st.position = R.transpose() * Eigen::Vector2d(row.laid.s[i], t_min + row.course.t);
+      if (!std::isfinite(st.l) || !st.position.allFinite())
+        throw InputError(
+            c.file, "/material/stitch_value",
+            "a non-finite stitch value or position in course " + std::to_string(st.course));
+      map.yarn_length += st.l;
+      map.l_min = std::min(map.l_min, st.l);
+      map.l_max = std::max(map.l_max, st.l);
+      map.stitches.push_back(st);
+    }
+    map.courses.push_back(row.course);
+  }
+  if (map.max_height_mismatch > 0.05) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "the course height c(l) varies by up to " << 100 * map.max_height_mismatch
+       << " % along a course; the map knits each course at its mean height (no short rows)";
+    map.warnings.push_back(os.str());
+  }
+  return map;
+}
+
+std::string knitmap_summary(const KnitMap& map) {
+  std::ostringstream os;
+  os.precision(10);
+  os << "stitches: " << map.stitches.size() << "\n"
+     << "yarn_length_mm: " << map.yarn_length << "\n"
+     << "needles: " << map.needles << "\n"
+     << "courses: " << map.courses.size() << "\n"
+     << "loop_length_min_mm: " << map.l_min << "\n"
+     << "loop_length_max_mm: " << map.l_max << "\n"
+     << "course_direction_deg: " << map.course_direction_deg << "\n"
+     << "course_direction_spread_deg: " << map.angle_spread_deg << "\n"
+     << "max_course_height_mismatch: " << map.max_height_mismatch << "\n";
+  for (const auto& w : map.warnings) os << "warning: " << w << "\n";
+  return os.str();
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,63 @@
+// Input and output of the knitting map (knit/macro/knitmap.hpp): the case is read by
+// load_case (its knit material by knit_material_factory.cpp); here only the database's cell
+// parameters are read again, for w(l) and c(l). Outputs go to an atomic directory.
+#include <nlohmann/json.hpp>
+
+#include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
+#include "knit/io/csv.hpp"
+#include "knit/io/json_input.hpp"
+#include "knit/io/provenance.hpp"
+#include "knit/macro/knitmap.hpp"
+#include "knit/material/database.hpp"
+
+namespace knit::macro {
+
+KnitMapInput load_knitmap_input(const std::string& case_file) {
+  KnitMapInput in;
+  in.c = load_case(case_file);  // validates everything, the knit fields and the database too
+  const nlohmann::json root = io::parse_json(in.c.text, case_file);
+  const nlohmann::json& m = root.at("material");
+  const std::string type = m.value("type", std::string());
+  if (type != "knit")
+    throw InputError(
+        case_file, "/material/type",
+        "the knitting map needs the knit material (type \"knit\"), not \"" + type + "\"");
+  in.database = io::resolve_input_path(case_file, m.at("database").get<std::string>()).string();
+  material::Database db;
+  try {
+    db = material::read_database(in.database, false);
+  } catch (const InputError& e) {
+    throw InputError(case_file, "/material/database", e.what());
+  }
+  in.cells = CellTable(db, in.database);
+  return in;
+}
+
+void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir) {
+  io::AtomicDirectory out(dir);
+  const std::string prov = "provenance: " + io::Provenance::current(in.c.file).to_json_string();
+  {
+    io::CsvWriter csv(out / "knitmap.csv", {"course", "needle", "l_mm", "x_mm", "y_mm"});
+    csv.add_comment(prov);
+    csv.add_comment("database: " + in.database);
+    for (const auto& s : map.stitches)
+      csv.add_row({s.course, s.needle, s.l, s.position.x(), s.position.y()});
+    csv.commit();
+  }
+  {
+    io::CsvWriter csv(out / "courses.csv", {"course", "first_needle", "last_needle", "stitches",
+                                            "height_mm", "t_mm", "height_mismatch"});
+    csv.add_comment(prov);
+    for (const auto& k : map.courses)
+      csv.add_row({k.index, k.first_needle, k.first_needle + k.stitches - 1, k.stitches, k.height,
+                   k.t, k.height_mismatch});
+    csv.commit();
+  }
+  io::write_file_atomically(out / "summary.txt", "# " + prov + "\ncase: " + in.c.file +
+                                                     "\ndatabase: " + in.database + "\n" +
+                                                     knitmap_summary(map));
+  out.commit();
+}
+
+}  // namespace knit::macro

@@ -1,0 +1,83 @@
+// The adjoint gradient of a reaction with respect to control values of the l and alpha fields
+// equals central finite differences of the whole solve (issue 13 acceptance, relative 1e-5).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "knit/core/errors.hpp"
+#include "knit/macro/design_gradient.hpp"
+#include "knit/macro/run.hpp"
+#include "knit_test_database.hpp"
+
+using namespace knit::macro;
+
+namespace {
+
+std::string gradient_database() {
+  return knit::testing::write_knit_test_database("design_gradient_db.h5", {4.5, 5.5, 6.5});
+}
+
+/// A 20 x 10 mm patch (p = 2, one element), u0 held, u1 pulled by 2 mm along x (10 %) with
+/// the lateral motion free; l and alpha linear across u.
+std::string tiny_case(const std::string& db) {
+  return R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+      "control_points": [[0, 0, 0], [20, 0, 0], [0, 10, 0], [20, 10, 0]], "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [1, 1]},
+    "material": {"type": "knit", "database": ")" +
+         db + R"(",
+      "stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
+                       "values": [5.0, 6.0]},
+      "knitting_angle": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
+                         "values": [0.2, 0.5]}},
+    "boundary_conditions": [{"all": true, "fix": ["z"]},
+      {"edge": "u0", "fix": ["x", "y"]}, {"edge": "u1", "prescribe": {"x": 2.0}}],
+    "solver": {"steps": 2, "tolerance": 1e-13, "max_iterations": 40},
+    "output": {"vtk": false, "hdf5": false,
+               "reactions": [{"name": "fx", "edge": "u1", "component": "x"}]}})";
+}
+
+}  // namespace
+
+TEST_CASE("design gradient: adjoint reaction gradient equals finite differences of the solve",
+          "[case]") {
+  const std::string text = tiny_case(gradient_database());
+  using F = DesignVariable::Field;
+  const std::vector<DesignVariable> vars = {
+      {F::kStitchValue, 0}, {F::kStitchValue, 1}, {F::kKnittingAngle, 0}, {F::kKnittingAngle, 1}};
+  const std::vector<double> p = design_values(text, "tiny.json", vars);
+  for (double lambda : {1.0, 0.5}) {
+    INFO("load factor " << lambda);
+    const ReactionGradient g = reaction_gradient(text, "tiny.json", vars, 0, lambda);
+    REQUIRE(g.status == RunStatus::kCompleted);
+    // J(q): the reaction at lambda from the run's load stepping (2 steps: lambda = 0.5, 1).
+    auto J = [&](const std::vector<double>& q) {
+      const RunResult r = run_case(case_with_design(text, "tiny.json", vars, q), {});
+      REQUIRE(r.report.status == RunStatus::kCompleted);
+      for (const auto& row : r.rows)
+        if (std::abs(row.lambda - lambda) < 1e-12) return row.reactions[0];
+      FAIL("no step at the load factor");
+      return 0.0;
+    };
+    CHECK(J(p) == Approx(g.J).epsilon(1e-10));
+    for (std::size_t j = 0; j < vars.size(); ++j) {
+      const double h = 1e-3;
+      std::vector<double> pp = p, pm = p;
+      pp[j] += h;
+      pm[j] -= h;
+      const double fd = (J(pp) - J(pm)) / (2 * h);
+      INFO("variable " << j << ": adjoint " << g.dJ(j) << ", finite difference " << fd
+                       << ", relative difference " << std::abs(g.dJ(j) - fd) / std::abs(fd));
+      CHECK(g.dJ(j) == Approx(fd).epsilon(1e-5));
+      CHECK(std::abs(fd) > 1e-6);  // the check means something
+    }
+  }
+}
+
+TEST_CASE("design gradient: a variable outside the field names the field", "[unit]") {
+  const std::string text = tiny_case(gradient_database());
+  try {
+    (void)design_values(text, "tiny.json", {{DesignVariable::Field::kStitchValue, 2}});
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/material/stitch_value/values");
+  }
+}

@@ -1,0 +1,191 @@
+// The design file (schemas/design.schema.json): a valid file loads; an unknown objective, a
+// variable outside the field, bounds outside the database's range and an empty objective list
+// are JSON-pointer errors, and `knit-macro design` exits with 2 for them.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/macro/design_problem.hpp"
+#include "knit_test_database.hpp"
+
+using namespace knit::macro;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kDir = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "design_problem";
+
+void write(const fs::path& f, const std::string& text) {
+  fs::create_directories(f.parent_path());
+  std::ofstream(f) << text;
+}
+
+/// A wale-wise tensile case with a designable l field (two control values across u).
+void write_case() {
+  const std::string db =
+      knit::testing::write_knit_test_database("design_problem_db.h5", {4.5, 5.5, 6.5});
+  write(kDir / "case.json", R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1],
+      "knots_v": [0, 0, 1, 1],
+      "control_points": [[0, 0, 0], [20, 0, 0], [0, 20, 0], [20, 20, 0]], "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [1, 1]},
+    "material": {"type": "knit", "database": ")" +
+                                db + R"(",
+      "stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
+                       "values": [5.0, 5.0]},
+      "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1],
+                         "values": [0], "unit": "deg"}},
+    "boundary_conditions": [{"all": true, "fix": ["z"]},
+      {"edge": "v0", "fix": ["x", "y"]}, {"edge": "v1", "prescribe": {"y": 4.0}}],
+    "output": {"vtk": false, "hdf5": false, "points": [{"name": "mid", "at": [0.5, 0.5]}],
+               "reactions": [{"name": "fy", "edge": "v1", "component": "y"}],
+               "applied_displacement": {"edge": "v1", "component": "y", "gauge_length": 20}}})");
+}
+
+std::string design(const std::string& variables, const std::string& objectives) {
+  return R"({"case": "case.json", "variables": )" + variables + R"(, "objectives": )" + objectives +
+         R"(, "smoothness": {"weight": 0.01}})";
+}
+
+const std::string kVars =
+    R"([{"name": "l", "field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5},
+        {"field": "knitting_angle", "indices": [0], "lower": -45, "upper": 45}])";
+const std::string kObjs =
+    R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2], "target": [1.0, 2.5]},
+        {"type": "strain_variance", "component": "E22", "region": {"u": [0, 1], "v": [0.4, 0.6]},
+         "at_strain": [0.2]},
+        {"type": "displacement", "point": "mid", "component": "y", "at_strain": [0.2],
+         "target": [2.0]}])";
+
+int run_design(const fs::path& file) {
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " + file.string() +
+                          " --check > " + (kDir / "cmd.log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("design file: a valid file loads", "[unit]") {
+  write_case();
+  write(kDir / "ok.json", design(kVars, kObjs));
+  const DesignProblem d = load_design((kDir / "ok.json").string());
+  REQUIRE(d.variables.size() == 2);
+  CHECK(d.variables[0].indices == std::vector<int>{0, 1});
+  CHECK(d.variables[0].initial == 5.0);
+  CHECK(d.expanded().size() == 3);
+  REQUIRE(d.objectives.size() == 3);
+  CHECK(d.objectives[0].kind == DesignObjective::Kind::kReaction);
+  CHECK(d.objectives[0].reaction == 0);
+  CHECK(d.objectives[1].component == 1);
+  CHECK(d.objectives[2].point == 0);
+  CHECK(d.smoothness == 0.01);
+  CHECK(run_design(kDir / "ok.json") == 0);
+}
+
+TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]") {
+  write_case();
+  auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr) {
+    INFO(name);
+    const fs::path f = kDir / name;
+    write(f, text);
+    try {
+      (void)load_design(f.string());
+      FAIL("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.file() == f.string());
+      CHECK(e.pointer() == ptr);
+    }
+    CHECK(run_design(f) == 2);
+  };
+  expect("unknown_objective.json",
+         design(kVars, R"([{"type": "stiffness", "at_strain": [0.1], "target": [1]}])"),
+         "/objectives/0/type");
+  expect(
+      "outside_field.json",
+      design(R"([{"field": "stitch_value", "indices": [2], "lower": 4.5, "upper": 6.5}])", kObjs),
+      "/variables/0/indices/0");
+  expect(
+      "bounds.json",
+      design(R"([{"field": "stitch_value", "indices": [0], "lower": 4.0, "upper": 6.5}])", kObjs),
+      "/variables/0/lower");
+  expect(
+      "angle_bounds.json",
+      design(R"([{"field": "knitting_angle", "indices": [0], "lower": -10, "upper": 200}])", kObjs),
+      "/variables/0/upper");
+  expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
+  expect("unknown_reaction.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fx", "at_strain": [0.1],
+                            "target": [1]}])"),
+         "/objectives/0/reaction");
+  expect("targets.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [1]}])"),
+         "/objectives/0/target");
+  expect("tied_twice.json",
+         design(R"([{"field": "stitch_value", "indices": [0], "lower": 4.5, "upper": 6.5},
+                    {"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}])",
+                kObjs),
+         "/variables/1/indices");
+  expect("unknown_key.json",
+         R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
+             R"(, "optimizer": "lbfgs"})",
+         "/optimizer");
+}
+
+TEST_CASE("design objective: reaction terms and their gradient equal finite differences",
+          "[case]") {
+  write_case();
+  write(kDir / "reaction.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5},
+                          {"field": "knitting_angle", "indices": [0], "lower": -45, "upper": 45}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [0.5, 1.0], "weight": 2}]})");
+  const DesignProblem d = load_design((kDir / "reaction.json").string());
+  const std::vector<double> x = {5.2, 10.0};
+  const DesignEvaluation e = evaluate_design(d, x);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.terms.size() == 1);
+  CHECK(e.J == Approx(e.terms[0].second));
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    const double h = 1e-3;
+    std::vector<double> xp = x, xm = x;
+    xp[j] += h;
+    xm[j] -= h;
+    const double fd = (evaluate_design(d, xp).J - evaluate_design(d, xm).J) / (2 * h);
+    INFO("variable " << j << ": adjoint " << e.gradient(j) << ", finite difference " << fd);
+    CHECK(e.gradient(j) == Approx(fd).epsilon(1e-5));
+    CHECK(std::abs(fd) > 1e-8);
+  }
+}
+
+TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value", "[case]") {
+  write_case();
+  // The target: the load of the case at l = 5.0 (both control values) at 10 % and 20 %.
+  write(kDir / "twin_probe.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [0, 0]}]})");
+  const DesignProblem probe = load_design((kDir / "twin_probe.json").string());
+  const double a = std::sqrt(evaluate_design(probe, {5.0}).J);  // |(R1, R2)| at l = 5
+  REQUIRE(a > 0.0);
+  // R(eps) at l = 5.0 from the case at each strain separately.
+  auto R = [&](double eps) {
+    DesignProblem p = probe;
+    p.objectives[0].at_strain = {eps};
+    p.objectives[0].target = {0.0};
+    return std::sqrt(evaluate_design(p, {5.0}).J);
+  };
+  DesignProblem twin = probe;
+  twin.objectives[0].target = {R(0.1), R(0.2)};
+  twin.variables[0].initial = 6.0;
+  const DesignResult r = optimize_design(twin);
+  REQUIRE(r.status == RunStatus::kCompleted);
+  INFO("recovered l = " << r.x[0] << " after " << r.history.size() - 1 << " iterations");
+  CHECK(std::abs(r.x[0] - 5.0) < 0.01 * (6.5 - 4.5));
+  CHECK(r.x[0] >= 4.5);
+  CHECK(r.x[0] <= 6.5);
+  CHECK(r.history.back().J < r.history.front().J);
+}

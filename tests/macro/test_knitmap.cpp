@@ -1,0 +1,283 @@
+// The knitting map (issue 13): a uniform patch needs round(W/w) needles and round(H/c)
+// courses; a discontinuous 4.5|6.5 patch gives two blocks; the yarn length is the sum of the
+// loop lengths; bad input names the file and the JSON pointer, exits 2 and writes nothing.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "knit/core/errors.hpp"
+#include "knit/macro/knitmap.hpp"
+#include "knit/material/database.hpp"
+#include "knit_test_database.hpp"
+
+using namespace knit::macro;
+using namespace knit::material;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kDir = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "knitmap";
+
+double w_of(double l) {
+  return knit::testing::synth_wale_width(l);
+}
+double c_of(double l) {
+  return knit::testing::synth_course_height(l);
+}
+
+std::string database(bool with_cells = true) {
+  return knit::testing::write_knit_test_database(
+      with_cells ? "knitmap_db.h5" : "knitmap_db_nocells.h5", {4.5, 5.5, 6.5}, with_cells);
+}
+
+/// A W x H rectangle rotated by beta in the plane z = z0 (z1 for the last control point).
+std::string case_text(const std::string& material, double W, double H, double beta = 0.0,
+                      double z1 = 0.0) {
+  const double c = std::cos(beta), s = std::sin(beta);
+  std::ostringstream os;
+  os.precision(17);
+  auto pt = [&](double x, double y, double z) {
+    os << "[" << c * x - s * y << ", " << s * x + c * y << ", " << z << "]";
+  };
+  os << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                          "control_points": [)";
+  pt(0, 0, 0);
+  os << ", ";
+  pt(W, 0, 0);
+  os << ", ";
+  pt(0, H, 0);
+  os << ", ";
+  pt(W, H, z1);
+  os << R"(], "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [1, 1]},
+    "material": )"
+     << material << R"(,
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "u0", "fix": ["x", "y"]}],
+    "output": {"vtk": false, "hdf5": false}})";
+  return os.str();
+}
+
+std::string knit_material(const std::string& db, const std::string& l,
+                          const std::string& alpha = "0.0") {
+  return R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": )" + l +
+         R"(, "knitting_angle": )" + alpha + "}";
+}
+
+std::string write_case(const std::string& name, const std::string& text) {
+  fs::create_directories(kDir);
+  const fs::path f = kDir / name;
+  std::ofstream(f) << text;
+  return f.string();
+}
+
+KnitMap map_of(const std::string& name, const std::string& text) {
+  const auto in = load_knitmap_input(write_case(name, text));
+  return make_knitmap(in.c, in.cells);
+}
+
+int run_knitmap(const std::string& args) {
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro knitmap " + args + " > " +
+                          (kDir / "cmd.log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+double sum_l(const KnitMap& m) {
+  double s = 0;
+  for (const auto& st : m.stitches) s += st.l;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("knitmap: cell table interpolates w and c linearly in l", "[unit]") {
+  Database db;
+  db.entries.resize(2);
+  db.entries[0].loop_length = 4.5;
+  db.entries[0].cell = {1.0, 2.0, 0.5};
+  db.entries[1].loop_length = 6.5;
+  db.entries[1].cell = {2.0, 4.0, 0.5};
+  const CellTable t(db, "db.h5");
+  CHECK(t.wale_width(5.0) == Approx(1.25));
+  CHECK(t.course_height(6.0) == Approx(3.5));
+  CHECK(t.wale_width(6.5) == Approx(2.0));
+  db.entries[1].cell.course_height = 0.0;
+  try {
+    CellTable bad(db, "db.h5");
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == "db.h5");
+    CHECK(e.pointer() == "/loop_1/course_height");
+  }
+}
+
+TEST_CASE("knitmap: a uniform patch needs round(W/w) needles and round(H/c) courses", "[case]") {
+  const std::string db = database();
+  const double W = 40.0, H = 30.0, l = 5.5;  // a database loop length: w, c exact
+  for (double beta : {0.0, 0.6}) {
+    INFO("patch rotated by " << beta);
+    const KnitMap m = map_of("uniform.json", case_text(knit_material(db, "5.5"), W, H, beta));
+    const int n = static_cast<int>(std::lround(W / w_of(l)));
+    const int k = static_cast<int>(std::lround(H / c_of(l)));
+    CHECK(m.needles == n);
+    CHECK(m.courses.size() == std::size_t(k));
+    CHECK(m.stitches.size() == std::size_t(n * k));
+    CHECK(m.course_direction_deg == Approx(beta * 180 / M_PI).margin(1e-9));
+    for (const auto& cr : m.courses) {
+      CHECK(cr.first_needle == 1);
+      CHECK(cr.stitches == n);
+      CHECK(cr.height == Approx(c_of(l)));
+    }
+    // The first stitch: the course's stitches are centred on the chord, the first course sits
+    // on the patch's lowest edge.
+    const Eigen::Vector2d d1(std::cos(beta), std::sin(beta)), d2(-std::sin(beta), std::cos(beta));
+    const Eigen::Vector2d p0 = 0.5 * (W - (n - 1) * w_of(l)) * d1 + 0.5 * c_of(l) * d2;
+    CHECK((m.stitches.front().position - p0).norm() < 1e-8);
+    CHECK(m.yarn_length == Approx(n * k * l));
+    CHECK(m.warnings.empty());
+  }
+  // Along the wale direction instead (alpha = 90 deg): W and H swap roles.
+  const KnitMap m =
+      map_of("uniform90.json", case_text(knit_material(db, "5.5", "1.5707963267948966"), W, H));
+  CHECK(m.needles == std::lround(H / w_of(l)));
+  CHECK(m.courses.size() == std::size_t(std::lround(W / c_of(l))));
+}
+
+TEST_CASE("knitmap: a discontinuous 4.5|6.5 patch gives two blocks", "[case]") {
+  const std::string db = database();
+  const double W = 40.0, H = 30.0;
+  SECTION("across the courses (wale-wise grading): two blocks of courses") {
+    const KnitMap m = map_of(
+        "blocks_v.json",
+        case_text(
+            knit_material(db, R"({"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 0.5, 1],
+                               "values": [4.5, 6.5]})"),
+            W, H));
+    const long k1 = std::lround(0.5 * H / c_of(4.5));
+    const long k2 = std::lround((H - k1 * c_of(4.5)) / c_of(6.5));
+    REQUIRE(m.courses.size() == std::size_t(k1 + k2));
+    const long n1 = std::lround(W / w_of(4.5)), n2 = std::lround(W / w_of(6.5));
+    for (const auto& cr : m.courses) CHECK(cr.stitches == (cr.index <= k1 ? n1 : n2));
+    for (const auto& s : m.stitches) CHECK(s.l == (s.course <= k1 ? 4.5 : 6.5));
+    CHECK(m.needles == n1);
+    // The narrower block (fewer, wider stitches) is centred: its outer needles are out of work.
+    const auto& top = m.courses.back();
+    CHECK(std::abs((top.first_needle - 1) - (n1 - (top.first_needle + n2 - 1))) <= 1);
+    CHECK(m.yarn_length == Approx(sum_l(m)));
+    CHECK(m.yarn_length == Approx(k1 * n1 * 4.5 + k2 * n2 * 6.5));
+  }
+  SECTION("along the courses: two blocks of needles in every course") {
+    const KnitMap m = map_of(
+        "blocks_u.json",
+        case_text(
+            knit_material(db, R"({"degrees": [0, 0], "knots_u": [0, 0.5, 1], "knots_v": [0, 1],
+                               "values": [4.5, 6.5]})"),
+            W, H));
+    const long n1 = std::lround(0.5 * W / w_of(4.5));
+    const long n2 = std::lround((W - n1 * w_of(4.5)) / w_of(6.5));
+    CHECK(m.needles == n1 + n2);
+    for (const auto& s : m.stitches) CHECK(s.l == (s.needle <= n1 ? 4.5 : 6.5));
+    for (const auto& cr : m.courses) {
+      CHECK(cr.stitches == n1 + n2);
+      CHECK(cr.height == Approx((n1 * c_of(4.5) + n2 * c_of(6.5)) / double(n1 + n2)));
+    }
+    // c(6.5)/c(4.5) differs by far more than 5 %: the mismatch is reported.
+    CHECK(m.max_height_mismatch > 0.05);
+    CHECK(m.warnings.size() == 1);
+    CHECK(m.yarn_length == Approx(sum_l(m)));
+  }
+}
+
+TEST_CASE("knitmap: a linear grading and the command's outputs", "[case]") {
+  const std::string db = database();
+  const std::string file = write_case(
+      "graded.json", case_text(knit_material(db, R"({"degrees": [1, 0], "knots_u": [0, 0, 1, 1],
+                                        "knots_v": [0, 1], "values": [4.5, 6.5]})"),
+                               30.0, 10.0));
+  const fs::path out = kDir / "graded_out";
+  fs::remove_all(out);
+  REQUIRE(run_knitmap(file + " --output " + out.string()) == 0);
+  for (const char* f : {"knitmap.csv", "courses.csv", "summary.txt"}) CHECK(fs::exists(out / f));
+  // Yarn length in the summary = sum of the CSV's l column.
+  std::ifstream csv(out / "knitmap.csv");
+  std::string line;
+  double sum = 0;
+  long rows = 0;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == 'c') continue;
+    std::istringstream is(line);
+    std::string a, b, l;
+    std::getline(is, a, ',');
+    std::getline(is, b, ',');
+    std::getline(is, l, ',');
+    sum += std::stod(l);
+    ++rows;
+  }
+  std::ifstream sm(out / "summary.txt");
+  double yarn = -1;
+  long stitches = -1;
+  while (std::getline(sm, line)) {
+    if (line.rfind("yarn_length_mm: ", 0) == 0) yarn = std::stod(line.substr(16));
+    if (line.rfind("stitches: ", 0) == 0) stitches = std::stol(line.substr(10));
+  }
+  CHECK(stitches == rows);
+  CHECK(yarn == Approx(sum).epsilon(1e-8));
+  // Wider stitches along the grading: fewer stitches than a uniform 4.5 mm course.
+  const auto in = load_knitmap_input(file);
+  const KnitMap m = make_knitmap(in.c, in.cells);
+  CHECK(m.courses.front().stitches < std::lround(30.0 / w_of(4.5)));
+  CHECK(m.courses.front().stitches > std::lround(30.0 / w_of(6.5)));
+  for (std::size_t i = 1; i < m.stitches.size(); ++i)
+    if (m.stitches[i].course == m.stitches[i - 1].course)
+      CHECK(m.stitches[i].l > m.stitches[i - 1].l);
+}
+
+TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothing", "[case]") {
+  const std::string db = database();
+  auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr,
+                    const std::string& args = "") {
+    INFO(name);
+    const std::string file = write_case(name, text);
+    try {
+      const auto in = load_knitmap_input(file);
+      (void)make_knitmap(in.c, in.cells);
+      FAIL("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == ptr);
+      CHECK(std::string(e.what()).find(ptr) != std::string::npos);
+    }
+    const fs::path out = kDir / (name + "_out");
+    fs::remove_all(out);
+    CHECK(run_knitmap(file + " --output " + out.string() + args) == 2);
+    CHECK(!fs::exists(out));
+  };
+  expect("svk.json",
+         case_text(R"({"type": "saint_venant_kirchhoff", "youngs_modulus": 1.0,
+                       "poisson_ratio": 0.3})",
+                   10, 10),
+         "/material/type");
+  expect("curved.json", case_text(knit_material(db, "5.0"), 10, 10, 0.0, 2.0),
+         "/geometry/control_points/3");
+  expect("nodb.json", case_text(knit_material((kDir / "missing.h5").string(), "5.0"), 10, 10),
+         "/material/database");
+  // A course direction turning over the patch (alpha linear from 0 to 30 deg).
+  expect("turning.json",
+         case_text(knit_material(db, "5.0", R"({"degrees": [1, 0], "knots_u": [0, 0, 1, 1],
+                                      "knots_v": [0, 1], "values": [0, 30], "unit": "deg"})"),
+                   10, 10),
+         "/material/knitting_angle");
+  // A database without cell parameters: the HDF5 path of the missing value.
+  const std::string nocells = database(false);
+  const std::string file =
+      write_case("nocells.json", case_text(knit_material(nocells, "5.0"), 10, 10));
+  try {
+    (void)load_knitmap_input(file);
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/loop_0/wale_width");
+  }
+  CHECK(run_knitmap(file + " --output " + (kDir / "nocells_out").string()) == 2);
+  CHECK(!fs::exists(kDir / "nocells_out"));
+}
