@@ -102,8 +102,6 @@ class KnitMaterial : public Material {
   std::vector<std::pair<std::string, double>> output_fields(
       const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const override;
   std::string report() const override;
-  /// Response-surface inversions that did not converge (kInversionFailed).
-  long failed_evaluations() const override { return counts_[4].load(); }
 
   double stitch_value(const Eigen::Vector2d& theta) const;
   double knitting_angle(const Eigen::Vector2d& theta) const;
