@@ -15,8 +15,8 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
-#include "scratch_dir.hpp"
 #include "knit/material/database.hpp"
+#include "scratch_dir.hpp"
 #include "test_material_util.hpp"
 
 namespace fs = std::filesystem;

@@ -85,7 +85,6 @@ std::string check_fan(const FitOptions& options, const FanShape& fan);
 std::string check_feasible(const FitOptions& options, const std::vector<material::LoadPath>& paths,
                            int steps = 0);
 
-
 /// Whether a raw path enters the eq. (17) fit: the paper's set ("paper") of biaxial paths
 /// (the fan) and the shear path. Coverage and holdout paths are ignored by this fit.
 bool in_paper_fit(const material::RawPath& r);
