@@ -1,23 +1,28 @@
 // knit-macro design DESIGN.json [--check] [--output DIR]
 //   Inverse design of the l and alpha fields (issue 13, docs/design.md): reads and checks the
 //   design file (schemas/design.schema.json) and prints the problem; with --check that is all.
-//   Otherwise optimizes (projected gradient with the adjoint gradient; reaction terms only this
-//   round) and writes DIR (default: the design file's name without extension) atomically:
-//   history.csv (iteration, J, gradient norm, seconds, the variables) and case.json (the best
-//   design, runs as is with `knit-macro run`).
-//   Exit codes: 0 converged, 1 the optimization stopped early (the best design is written),
-//   2 bad input (nothing is written).
+//   Otherwise optimizes (the design file's `optimizer`: bounded Levenberg-Marquardt in Ceres by
+//   default) and writes DIR (default: the design file's name without extension) atomically:
+//   history.csv (iteration, J, gradient norm, seconds, the variables), summary.txt (status,
+//   objective terms before and after, evaluations, time), case.json (the best design; runs as
+//   is with `knit-macro run`) and run/ (that run's usual outputs).
+//   A status line "status: converged | infeasible target | iteration limit | failed".
+//   Exit codes: 0 converged or infeasible target (the best design inside the bounds is
+//   written; the status line says which), 1 iteration limit or a failed solve (the best design
+//   so far is written; nothing if the first solve fails), 2 bad input (nothing is written).
 // Example:
-//   knit-macro design cases/design/uniform_load.json --check
+//   knit-macro design cases/design/uniform_load.json --output out/design/uniform_load
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/macro/design_problem.hpp"
+#include "knit/macro/run.hpp"
 
 namespace {
 
@@ -52,8 +57,10 @@ knit::cli::SubcommandRegistrar reg(
         std::cout << "smoothness weight: " << d.smoothness << "\n";
         if (o->check) return knit::kExitOk;
         const auto r = knit::macro::optimize_design(d);
-        if (r.history.empty()) {
+        using knit::macro::DesignStatus;
+        if (r.status == DesignStatus::kFailed && r.evaluations <= 1) {
           std::cerr << "knit-macro design: " << o->file << ": " << r.message << "\n";
+          std::cout << "status: failed\n";
           return knit::kExitFailure;
         }
         const std::filesystem::path dir = o->output.empty() ? std::filesystem::path(o->file).stem()
@@ -70,13 +77,50 @@ knit::cli::SubcommandRegistrar reg(
           csv.add_row(row);
         }
         csv.commit();
-        knit::io::write_file_atomically(out / "case.json", knit::macro::design_case_text(d, r.x));
+        const std::string case_text = knit::macro::design_case_text(d, r.x);
+        knit::io::write_file_atomically(out / "case.json", case_text);
+        // The final run's usual outputs.
+        const auto best = knit::macro::parse_case(case_text, (out / "case.json").string());
+        knit::macro::RunOptions ro;
+        ro.output_dir = out / "run";
+        const auto run = knit::macro::run_case(best, ro);
+        std::ostringstream sum;
+        sum << "status: " << to_string(r.status) << "\n";
+        if (!r.message.empty()) sum << "message: " << r.message << "\n";
+        sum << "optimizer: "
+            << (d.optimizer.method == knit::macro::DesignOptimizerSpec::Method::kCeres
+                    ? "ceres"
+                    : "projected_gradient")
+            << "\niterations: " << (r.history.empty() ? 0 : r.history.back().iteration)
+            << "\nevaluations: " << r.evaluations
+            << "\nseconds: " << (r.history.empty() ? 0.0 : r.history.back().seconds)
+            << "\nJ_initial: " << r.J0 << "\nJ_final: " << r.J
+            << "\nforward_seconds: " << r.forward_seconds
+            << "\ngradient_seconds: " << r.gradient_seconds << "\ngradients: " << r.gradients;
+        // One gradient (forward run + sensitivities) in units of one forward run.
+        if (r.forward_seconds > 0.0)
+          sum << "\ngradient_cost_in_forward_solves: "
+              << (r.forward_seconds + r.gradient_seconds) / r.forward_seconds;
+        sum << "\n";
+        for (std::size_t k = 0; k < r.terms0.size(); ++k)
+          sum << "term " << r.terms0[k].first << ": " << r.terms0[k].second << " -> "
+              << (k < r.terms.size() ? r.terms[k].second : r.terms0[k].second) << "\n";
+        for (std::size_t k = 0; k < d.variables.size(); ++k)
+          sum << "variable " << header[4 + k] << ": " << d.variables[k].initial << " -> " << r.x[k]
+              << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "]\n";
+        sum << "final run: "
+            << (run.succeeded() ? "completed"
+                                : knit::macro::material_failure_message(
+                                      run.report, run.failed_material_evaluations))
+            << "\n";
+        knit::io::write_file_atomically(out / "summary.txt", sum.str());
         out.commit();
         for (const auto& h : r.history)
           std::cout << "iteration " << h.iteration << ": J = " << h.J << "\n";
-        std::cout << "wrote " << dir.string() << "\n";
-        if (r.status != knit::macro::RunStatus::kCompleted || !r.message.empty()) {
-          std::cerr << "knit-macro design: " << r.message << "\n";
+        std::cout << sum.str() << "wrote " << dir.string() << "\n";
+        if (r.status == DesignStatus::kIterationLimit || r.status == DesignStatus::kFailed) {
+          std::cerr << "knit-macro design: " << o->file << ": " << to_string(r.status)
+                    << (r.message.empty() ? "" : ": " + r.message) << "\n";
           return knit::kExitFailure;
         }
         return knit::kExitOk;

@@ -1,52 +1,188 @@
-// The design objective and its adjoint gradient (knit/macro/design_problem.hpp).
+// The design objective as residuals with their Jacobian (knit/macro/design_problem.hpp).
+#include <algorithm>
 #include <cmath>
 
 #include "knit/macro/design_problem.hpp"
+#include "knit/macro/design_sensitivity.hpp"
 
 namespace knit::macro {
 
-DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x) {
-  DesignEvaluation out;
-  out.gradient = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d.variables.size()));
-  if (d.smoothness > 0.0) {
-    out.status = RunStatus::kNotConverged;
-    out.message = "the smoothness penalty is not implemented yet";
-    return out;
+namespace {
+
+/// Accumulates residuals and their Jacobian rows (over the variables).
+struct Residuals {
+  std::vector<double> r;
+  std::vector<Eigen::RowVectorXd> rows;
+  void add(double value, Eigen::RowVectorXd row) {
+    r.push_back(value);
+    rows.push_back(std::move(row));
   }
-  // The case text at x (every control value of a variable set to its value).
+};
+
+/// Chains d/d(control values) to d/d(variables): a variable moves all its control values.
+Eigen::RowVectorXd to_variables(const DesignProblem& d, const Eigen::RowVectorXd& dcv) {
+  Eigen::RowVectorXd out = Eigen::RowVectorXd::Zero(static_cast<Eigen::Index>(d.variables.size()));
+  if (dcv.size() == 0) return out;
+  Eigen::Index c = 0;
+  for (std::size_t v = 0; v < d.variables.size(); ++v)
+    for (std::size_t i = 0; i < d.variables[v].indices.size(); ++i, ++c)
+      out(static_cast<Eigen::Index>(v)) += dcv(c);
+  return out;
+}
+
+/// Sample points of a strain term: a uniform grid over its region.
+std::vector<Eigen::Vector2d> samples(const DesignObjective& o) {
+  std::vector<Eigen::Vector2d> t;
+  auto at = [](const Eigen::Vector2d& r, int n, int i) {
+    return n == 1 ? 0.5 * (r(0) + r(1)) : r(0) + (r(1) - r(0)) * i / (n - 1);
+  };
+  for (int j = 0; j < o.samples_v; ++j)
+    for (int i = 0; i < o.samples_u; ++i)
+      t.emplace_back(at(o.u_range, o.samples_u, i), at(o.v_range, o.samples_v, j));
+  return t;
+}
+
+/// Second differences of the designed fields' control values along u and v.
+void smoothness(const DesignProblem& d, const std::vector<double>& x, Residuals& res) {
+  const double s = std::sqrt(d.smoothness);
+  const auto nv = static_cast<Eigen::Index>(d.variables.size());
+  for (const DesignFieldGrid& g : d.fields) {
+    std::vector<double> v = g.values;
+    std::vector<int> owner(v.size(), -1);  // the variable of each control value
+    for (std::size_t k = 0; k < d.variables.size(); ++k)
+      if (d.variables[k].field == g.field)
+        for (int i : d.variables[k].indices) {
+          v[static_cast<std::size_t>(i)] = x[k];
+          owner[static_cast<std::size_t>(i)] = static_cast<int>(k);
+        }
+    auto term = [&](int a, int b, int c) {
+      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv);
+      const int idx[3] = {a, b, c};
+      const double w[3] = {1.0, -2.0, 1.0};
+      double r = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        r += w[k] * v[static_cast<std::size_t>(idx[k])];
+        if (owner[static_cast<std::size_t>(idx[k])] >= 0)
+          row(owner[static_cast<std::size_t>(idx[k])]) += s * w[k];
+      }
+      if (row.cwiseAbs().maxCoeff() > 0.0) res.add(s * r, row);
+    };
+    for (int j = 0; j < g.nv; ++j)
+      for (int i = 1; i + 1 < g.nu; ++i) term(j * g.nu + i - 1, j * g.nu + i, j * g.nu + i + 1);
+    for (int i = 0; i < g.nu; ++i)
+      for (int j = 1; j + 1 < g.nv; ++j) term((j - 1) * g.nu + i, j * g.nu + i, (j + 1) * g.nu + i);
+  }
+}
+
+}  // namespace
+
+DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x,
+                                 bool with_gradient) {
+  DesignEvaluation out;
   const auto vars = d.expanded();
   std::vector<double> values;
   for (std::size_t k = 0; k < d.variables.size(); ++k)
     for (std::size_t i = 0; i < d.variables[k].indices.size(); ++i) values.push_back(x.at(k));
   const std::string text = case_with_design(d.c.text, d.case_file, vars, values).text;
+  // The load factors of every objective: lambda = eps L / Delta_1.
   const double delta1 = d.c.output.applied ? d.c.output.applied->value : 0.0;
+  auto lambda_of = [&](double eps) { return eps * d.c.output.applied->gauge_length / delta1; };
+  std::vector<double> levels;
+  for (const auto& o : d.objectives)
+    for (double e : o.at_strain)
+      if (std::find(levels.begin(), levels.end(), lambda_of(e)) == levels.end())
+        levels.push_back(lambda_of(e));
+  const DesignSolve s(text, d.case_file, vars, levels, with_gradient);
+  out.forward_seconds = s.forward_seconds();
+  out.gradient_seconds = s.sensitivity_seconds();
+  if (s.status() != RunStatus::kCompleted) {
+    out.status = s.status();
+    out.message = s.message();
+    return out;
+  }
+  Residuals res;
   for (const auto& o : d.objectives) {
-    if (o.kind != DesignObjective::Kind::kReaction) {
-      out.status = RunStatus::kNotConverged;
-      out.message = "objective \"" + o.name + "\": only reaction terms are evaluated so far";
-      return out;
+    const std::size_t first = res.r.size();
+    const double w = std::sqrt(o.weight);
+    if (o.kind == DesignObjective::Kind::kReactionLinearity) {
+      const ReactionOutput& ro = d.c.output.reactions[static_cast<std::size_t>(o.reaction)];
+      const double eK = o.at_strain.back();
+      const Sensitive end = s.reaction(s.level(lambda_of(eK)), ro);
+      for (std::size_t k = 0; k + 1 < o.at_strain.size(); ++k) {
+        const Sensitive q = s.reaction(s.level(lambda_of(o.at_strain[k])), ro);
+        const double t = o.at_strain[k] / eK;
+        res.add(w * (q.value - t * end.value), w * to_variables(d, q.d - t * end.d));
+      }
+    }
+    for (std::size_t k = 0; k < o.at_strain.size(); ++k) {
+      if (o.kind == DesignObjective::Kind::kReactionLinearity) break;
+      const int L = s.level(lambda_of(o.at_strain[k]));
+      switch (o.kind) {
+        case DesignObjective::Kind::kReaction: {
+          const Sensitive q =
+              s.reaction(L, d.c.output.reactions[static_cast<std::size_t>(o.reaction)]);
+          res.add(w * (q.value - o.target[k]), w * to_variables(d, q.d));
+          break;
+        }
+        case DesignObjective::Kind::kDisplacement: {
+          const Sensitive q = s.displacement(
+              L, d.c.output.points[static_cast<std::size_t>(o.point)].at, o.component);
+          res.add(w * (q.value - o.target[k]), w * to_variables(d, q.d));
+          break;
+        }
+        case DesignObjective::Kind::kStrainVariance:
+        case DesignObjective::Kind::kTargetStrain: {
+          const auto pts = samples(o);
+          const double n = static_cast<double>(pts.size()), wn = std::sqrt(o.weight / n);
+          std::vector<double> E;
+          std::vector<Eigen::RowVectorXd> dE;
+          for (const auto& t : pts) {
+            const Sensitive q = s.strain(L, t, o.component);
+            E.push_back(q.value);
+            dE.push_back(to_variables(d, q.d));
+          }
+          double ref = o.kind == DesignObjective::Kind::kTargetStrain ? o.target[k] : 0.0;
+          Eigen::RowVectorXd dref = Eigen::RowVectorXd::Zero(dE[0].size());
+          if (o.kind == DesignObjective::Kind::kStrainVariance) {
+            for (std::size_t i = 0; i < E.size(); ++i) {
+              ref += E[i] / n;
+              dref += dE[i] / n;
+            }
+          }
+          for (std::size_t i = 0; i < E.size(); ++i)
+            res.add(wn * (E[i] - ref), wn * (dE[i] - dref));
+          break;
+        }
+        case DesignObjective::Kind::kReactionLinearity:
+          break;
+      }
     }
     double term = 0.0;
-    for (std::size_t k = 0; k < o.at_strain.size(); ++k) {
-      const double lambda = o.at_strain[k] * d.c.output.applied->gauge_length / delta1;
-      const ReactionGradient g = reaction_gradient(text, d.case_file, vars, o.reaction, lambda);
-      if (g.status != RunStatus::kCompleted) {
-        out.status = g.status;
-        out.message = "objective \"" + o.name + "\" at strain " + std::to_string(o.at_strain[k]) +
-                      ": " + g.message;
-        return out;
-      }
-      const double r = g.J - o.target[k];
-      term += o.weight * r * r;
-      // Chain rule to the variables: a variable moves all its control values.
-      Eigen::Index c = 0;
-      for (std::size_t v = 0; v < d.variables.size(); ++v)
-        for (std::size_t i = 0; i < d.variables[v].indices.size(); ++i, ++c)
-          out.gradient(static_cast<Eigen::Index>(v)) += 2.0 * o.weight * r * g.dJ(c);
-    }
+    for (std::size_t i = first; i < res.r.size(); ++i) term += res.r[i] * res.r[i];
     out.terms.emplace_back(o.name, term);
-    out.J += term;
   }
+  if (d.smoothness > 0.0) {
+    const std::size_t first = res.r.size();
+    smoothness(d, x, res);
+    double term = 0.0;
+    for (std::size_t i = first; i < res.r.size(); ++i) term += res.r[i] * res.r[i];
+    out.terms.emplace_back("smoothness", term);
+  }
+  const auto m = static_cast<Eigen::Index>(res.r.size());
+  const auto n = static_cast<Eigen::Index>(d.variables.size());
+  out.residuals = Eigen::Map<const Eigen::VectorXd>(res.r.data(), m);
+  out.J = out.residuals.squaredNorm();
+  if (with_gradient) {
+    out.jacobian.resize(m, n);
+    for (Eigen::Index i = 0; i < m; ++i)
+      out.jacobian.row(i) = res.rows[static_cast<std::size_t>(i)];
+    out.gradient = 2.0 * out.jacobian.transpose() * out.residuals;
+  }
+  for (double r : res.r)
+    if (!std::isfinite(r)) {
+      out.status = RunStatus::kNotConverged;
+      out.message = "a residual is not finite";
+    }
   return out;
 }
 

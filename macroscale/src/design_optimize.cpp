@@ -1,4 +1,5 @@
-// Projected-gradient descent on the design objective (knit/macro/design_problem.hpp).
+// The interim projected-gradient descent on the design objective, the optimizer dispatch and
+// the result's status (knit/macro/design_problem.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -7,17 +8,65 @@
 
 namespace knit::macro {
 
-DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& opt) {
+std::string to_string(DesignStatus s) {
+  switch (s) {
+    case DesignStatus::kConverged:
+      return "converged";
+    case DesignStatus::kIterationLimit:
+      return "iteration limit";
+    case DesignStatus::kInfeasible:
+      return "infeasible target";
+    case DesignStatus::kFailed:
+      break;
+  }
+  return "failed";
+}
+
+void classify_result(const DesignProblem& d, const OptimizeOptions& opt, bool converged,
+                     DesignResult& r) {
+  if (r.status == DesignStatus::kFailed) return;
+  if (!converged) {
+    r.status = DesignStatus::kIterationLimit;
+    return;
+  }
+  bool on_bound = false;
+  for (std::size_t i = 0; i < d.variables.size(); ++i) {
+    const auto& v = d.variables[i];
+    const double tol = 1e-6 * (v.upper - v.lower);
+    on_bound = on_bound || r.x[i] <= v.lower + tol || r.x[i] >= v.upper - tol;
+  }
+  r.status =
+      on_bound && r.J > opt.feasible * r.J0 ? DesignStatus::kInfeasible : DesignStatus::kConverged;
+}
+
+DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options) {
+  OptimizeOptions o = options;
+  o.max_iterations = d.optimizer.max_iterations;
+  return d.optimizer.method == DesignOptimizerSpec::Method::kCeres
+             ? optimize_design_ceres(d, o)
+             : optimize_design_projected(d, o);
+}
+
+DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = d.variables.size();
   DesignResult res;
   for (const auto& v : d.variables) res.x.push_back(v.initial);
+  auto count = [&res](const DesignEvaluation& e) {
+    ++res.evaluations;
+    ++res.gradients;
+    res.forward_seconds += e.forward_seconds;
+    res.gradient_seconds += e.gradient_seconds;
+  };
   DesignEvaluation cur = evaluate_design(d, res.x);
+  count(cur);
   if (cur.status != RunStatus::kCompleted) {
-    res.status = cur.status;
+    res.status = DesignStatus::kFailed;
     res.message = cur.message;
     return res;
   }
+  res.J0 = cur.J;
+  res.terms0 = cur.terms;
   auto record = [&](int it) {
     DesignIteration h;
     h.iteration = it;
@@ -30,12 +79,16 @@ DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& opt)
   record(0);
   // Step in "interval units": x_i -= s * range_i^2 * g_i / max_j |range_j g_j|.
   double s = 0.1;
+  bool converged = false;
   for (int it = 1; it <= opt.max_iterations; ++it) {
     double gmax = 0.0;
     for (std::size_t i = 0; i < n; ++i)
       gmax = std::max(gmax, std::abs((d.variables[i].upper - d.variables[i].lower) *
                                      cur.gradient(static_cast<Eigen::Index>(i))));
-    if (gmax == 0.0) break;
+    if (gmax == 0.0) {
+      converged = true;
+      break;
+    }
     bool accepted = false, moved = false;
     for (int trial = 0; trial < 30 && !accepted; ++trial) {
       std::vector<double> xt = res.x;
@@ -47,9 +100,13 @@ DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& opt)
         dir_dot += g * (xt[i] - res.x[i]);
         largest = std::max(largest, std::abs(xt[i] - res.x[i]) / r);
       }
-      if (largest <= opt.x_tolerance) break;
+      if (largest <= opt.x_tolerance) {
+        converged = true;
+        break;
+      }
       moved = true;
       const DesignEvaluation e = evaluate_design(d, xt);
+      count(e);
       if (e.status == RunStatus::kCompleted && e.J <= cur.J + 1e-4 * dir_dot) {
         res.x = xt;
         cur = e;
@@ -62,10 +119,13 @@ DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& opt)
     record(it);
     if (!accepted) {
       if (moved) res.message = "no descent step found (the best design is kept)";
+      converged = converged || moved;
       break;
     }
   }
   res.J = cur.J;
+  res.terms = cur.terms;
+  classify_result(d, opt, converged, res);
   return res;
 }
 

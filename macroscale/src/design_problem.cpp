@@ -19,7 +19,8 @@ namespace {
 
 using nlohmann::json;
 
-const char* kKinds[] = {"reaction", "displacement", "strain_variance", "target_strain"};
+const char* kKinds[] = {"reaction", "displacement", "strain_variance", "target_strain",
+                        "reaction_linearity"};
 
 std::string fmt(double x) {
   std::ostringstream os;
@@ -127,7 +128,8 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
   if (k == std::end(kKinds))
     throw InputError(file, p + "/type",
                      "unknown objective \"" + type +
-                         "\" (allowed: reaction, displacement, strain_variance, target_strain)");
+                         "\" (allowed: reaction, displacement, strain_variance, target_strain, "
+                         "reaction_linearity)");
   o.kind = static_cast<DesignObjective::Kind>(k - std::begin(kKinds));
   o.name = j.contains("name") && j.at("name").is_string() ? j.at("name").get<std::string>() : type;
   if (j.contains("weight")) o.weight = number(j.at("weight"), file, p + "/weight");
@@ -137,14 +139,26 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
                      "the case names no applied displacement (output.applied_displacement)");
   o.at_strain = numbers(j.at("at_strain"), file, p + "/at_strain");
   if (o.at_strain.empty()) throw InputError(file, p + "/at_strain", "needs at least one strain");
-  const bool targets = o.kind != DesignObjective::Kind::kStrainVariance;
+  const bool targets = o.kind != DesignObjective::Kind::kStrainVariance &&
+                       o.kind != DesignObjective::Kind::kReactionLinearity;
+  if (o.kind == DesignObjective::Kind::kReactionLinearity) {
+    if (o.at_strain.size() < 2)
+      throw InputError(file, p + "/at_strain", "a linearity term needs at least two strains");
+    for (std::size_t k = 0; k + 1 < o.at_strain.size(); ++k)
+      if (!(o.at_strain[k] < o.at_strain.back()))
+        throw InputError(file, p + "/at_strain/" + std::to_string(k),
+                         "must be below the last strain (the line's end point)");
+    if (!(o.at_strain.back() > 0.0))
+      throw InputError(file, p + "/at_strain", "the last strain must be positive");
+  }
   if (targets) {
     if (!j.contains("target")) throw InputError(file, p, "missing required key \"target\"");
     o.target = numbers(j.at("target"), file, p + "/target");
     if (o.target.size() != o.at_strain.size())
       throw InputError(file, p + "/target", "needs one target per applied strain");
   }
-  if (o.kind == DesignObjective::Kind::kReaction) {
+  if (o.kind == DesignObjective::Kind::kReaction ||
+      o.kind == DesignObjective::Kind::kReactionLinearity) {
     std::vector<std::string> names;
     for (const auto& r : c.output.reactions) names.push_back(r.name);
     if (!j.contains("reaction")) throw InputError(file, p, "missing required key \"reaction\"");
@@ -175,9 +189,51 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     if (!j.at("region").contains(d))
       throw InputError(file, p + "/region", std::string("missing \"") + d + "\"");
     const auto r = numbers(j.at("region").at(d), file, rp);
-    if (r.size() != 2 || !(r[0] < r[1]) || r[0] < 0 || r[1] > 1)
-      throw InputError(file, rp, "must be [lo, hi] with 0 <= lo < hi <= 1");
+    if (r.size() != 2 || !(r[0] <= r[1]) || r[0] < 0 || r[1] > 1)
+      throw InputError(file, rp, "must be [lo, hi] with 0 <= lo <= hi <= 1 (lo = hi: a section)");
     (d[0] == 'u' ? o.u_range : o.v_range) = Eigen::Vector2d(r[0], r[1]);
+  }
+  o.samples_u = o.u_range(0) == o.u_range(1) ? 1 : 11;
+  o.samples_v = o.v_range(0) == o.v_range(1) ? 1 : 11;
+  if (j.contains("samples")) {
+    const auto n = numbers(j.at("samples"), file, p + "/samples");
+    if (n.size() != 2 || n[0] < 1 || n[1] < 1 || n[0] != std::floor(n[0]) ||
+        n[1] != std::floor(n[1]) || n[0] > 1000 || n[1] > 1000)
+      throw InputError(file, p + "/samples", "must be two integers in 1..1000 (u, v)");
+    o.samples_u = o.u_range(0) == o.u_range(1) ? 1 : static_cast<int>(n[0]);
+    o.samples_v = o.v_range(0) == o.v_range(1) ? 1 : static_cast<int>(n[1]);
+  }
+}
+
+/// The control grid of a field of the case (u fastest): nu = knots_u - degree_u - 1.
+DesignFieldGrid field_grid(const json& case_root, DesignVariable::Field field) {
+  DesignFieldGrid g;
+  g.field = field;
+  const json& f =
+      case_root.at("material")
+          .at(field == DesignVariable::Field::kStitchValue ? "stitch_value" : "knitting_angle");
+  g.nu = static_cast<int>(f.at("knots_u").size()) - f.at("degrees")[0].get<int>() - 1;
+  g.nv = static_cast<int>(f.at("knots_v").size()) - f.at("degrees")[1].get<int>() - 1;
+  for (const auto& v : f.at("values")) g.values.push_back(v.get<double>());
+  return g;
+}
+
+void read_optimizer(const json& j, const std::string& file, DesignOptimizerSpec& o) {
+  if (!j.is_object()) throw InputError(file, "/optimizer", "must be an object");
+  if (j.contains("method")) {
+    const std::string m = j.at("method").is_string() ? j.at("method").get<std::string>() : "";
+    if (m == "ceres")
+      o.method = DesignOptimizerSpec::Method::kCeres;
+    else if (m == "projected_gradient")
+      o.method = DesignOptimizerSpec::Method::kProjectedGradient;
+    else
+      throw InputError(file, "/optimizer/method", "must be \"ceres\" or \"projected_gradient\"");
+  }
+  if (j.contains("max_iterations")) {
+    const double n = number(j.at("max_iterations"), file, "/optimizer/max_iterations");
+    if (n < 1 || n > 10000 || n != std::floor(n))
+      throw InputError(file, "/optimizer/max_iterations", "must be an integer in 1..10000");
+    o.max_iterations = static_cast<int>(n);
   }
 }
 
@@ -197,10 +253,11 @@ DesignProblem load_design(const std::string& path) {
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
   for (auto it = root.begin(); it != root.end(); ++it)
     if (std::string k = it.key(); k != "$schema" && k != "description" && k != "case" &&
-                                  k != "variables" && k != "objectives" && k != "smoothness")
+                                  k != "variables" && k != "objectives" && k != "smoothness" &&
+                                  k != "optimizer")
       throw InputError(path, io::json_pointer_append("", k),
                        "unknown key (allowed: $schema, description, case, variables, objectives, "
-                       "smoothness)");
+                       "smoothness, optimizer)");
   if (!root.contains("case") || !root.at("case").is_string())
     throw InputError(path, "/case", "needs the case file (a string, relative to this file)");
   d.case_file = io::resolve_input_path(path, root.at("case").get<std::string>()).string();
@@ -238,6 +295,11 @@ DesignProblem load_design(const std::string& path) {
   }
   if (root.contains("smoothness") && root.at("smoothness").contains("weight"))
     d.smoothness = number(root.at("smoothness").at("weight"), path, "/smoothness/weight");
+  if (root.contains("optimizer")) read_optimizer(root.at("optimizer"), path, d.optimizer);
+  for (auto f : {DesignVariable::Field::kStitchValue, DesignVariable::Field::kKnittingAngle})
+    if (std::any_of(d.variables.begin(), d.variables.end(),
+                    [f](const DesignVariableSpec& v) { return v.field == f; }))
+      d.fields.push_back(field_grid(case_root, f));
   io::JsonSchema::embedded("design").validate(root, path);
   return d;
 }

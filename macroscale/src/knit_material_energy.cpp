@@ -4,8 +4,10 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "knit/macro/knit_material.hpp"
+#include "knit/mechanics/voigt.hpp"
 
 namespace knit::macro {
 
@@ -44,6 +46,37 @@ std::shared_ptr<const material::EnergyLawAt> KnitMaterial::energy_at(double l) c
   auto at = std::make_shared<const material::EnergyLawAt>(energy_->at(l));
   energy_cache_.emplace(l, at);
   return at;
+}
+
+Eigen::Vector3d KnitMaterial::dS_dl(const Eigen::Vector3d& E, const MaterialPoint& where,
+                                    double step) const {
+  const bool bound = where.point_id >= 0 && where.point_id < static_cast<int>(bound_.size());
+  const double l = std::clamp(
+      bound ? bound_[static_cast<std::size_t>(where.point_id)].l : stitch_value(where.theta),
+      l_min(), l_max());
+  const double alpha =
+      bound ? bound_[static_cast<std::size_t>(where.point_id)].alpha : knitting_angle(where.theta);
+  const Eigen::Matrix3d TE = mech::T_E(alpha);
+  if (!energy_) {
+    const double h = step * std::max(1.0, std::abs(l));
+    const double lp = std::min(l + h, l_max()), lm = std::max(l - h, l_min());
+    const Eigen::Matrix3d TSinv = mech::T_S_inv(alpha);
+    const Eigen::Vector3d Sp = evaluate_at(E, *surface_at(lp), alpha, TE, TSinv, where.theta).S;
+    const Eigen::Vector3d Sm = evaluate_at(E, *surface_at(lm), alpha, TE, TSinv, where.theta).S;
+    return (Sp - Sm) / (lp - lm);
+  }
+  std::shared_ptr<const material::EnergyLawAt> law;
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex_);
+    auto it = energy_dl_cache_.find(l);
+    if (it == energy_dl_cache_.end())
+      it = energy_dl_cache_
+               .emplace(l, std::make_shared<const material::EnergyLawAt>(energy_->at(l, true)))
+               .first;
+    law = it->second;
+  }
+  // S = T_E^T S_hat(T_E E, l): at fixed E and alpha, dS/dl = T_E^T dS_hat/dl.
+  return TE.transpose() * law->dS_dl(TE * E);
 }
 
 MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,

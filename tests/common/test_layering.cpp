@@ -44,3 +44,13 @@ TEST_CASE("mesoscale and macroscale do not include each other", "[unit][layering
   CHECK(macro_hits.empty());
   CHECK(common_hits.empty());
 }
+
+TEST_CASE("macroscale includes Ceres in its design adapter only", "[unit][layering]") {
+  // docs/design.md "The optimizer": the bounded least-squares solver of `knit-macro design`
+  // is Ceres, seen by macroscale/src/design_ceres.cpp alone (as the fit files in mesoscale).
+  const fs::path root = KNIT_SOURCE_DIR;
+  const auto hits = offending_includes(root / "macroscale", std::regex(R"(<ceres/)"));
+  for (const auto& h : hits) UNSCOPED_INFO(h);
+  REQUIRE(hits.size() == 1);
+  CHECK(hits[0].find("macroscale/src/design_ceres.cpp:") != std::string::npos);
+}

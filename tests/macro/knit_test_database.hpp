@@ -1,7 +1,8 @@
 // A fitted test database for the knit-material tests (the test law of test_material_util.hpp
 // scaled by (4.5/l)^2 at each loop length), written to the build's test_tmp directory; with
 // the synthetic stand-in's cell parameters (mesoscale/src/fit_synthetic.cpp) unless
-// with_cells is false.
+// with_cells is false; with_energy adds the energy-based law of test_energy_util.hpp
+// (4.5-6.5 mm), which the knit material then uses by default.
 #pragma once
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/test_energy_util.hpp"
 #include "../common/test_material_util.hpp"
 #include "knit/material/database.hpp"
 
@@ -24,7 +26,7 @@ inline double synth_course_height(double l) {
 
 inline std::string write_knit_test_database(const std::string& name,
                                             const std::vector<double>& loop_lengths,
-                                            bool with_cells = true) {
+                                            bool with_cells = true, bool with_energy = false) {
   const std::filesystem::path dir = std::filesystem::path(KNIT_BINARY_DIR) / "test_tmp";
   std::filesystem::create_directories(dir);
   const std::filesystem::path f = dir / name;
@@ -38,6 +40,7 @@ inline std::string write_knit_test_database(const std::string& name,
     e.surface = material::testing::make_test_surface(std::pow(4.5 / l, 2));
     db.entries.push_back(e);
   }
+  if (with_energy) db.energy_law = material::testing::make_test_energy_law();
   material::write_database(f, db);
   return f.string();
 }

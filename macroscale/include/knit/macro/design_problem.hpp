@@ -22,7 +22,7 @@ struct DesignVariableSpec {
 };
 
 struct DesignObjective {
-  enum class Kind { kReaction, kDisplacement, kStrainVariance, kTargetStrain };
+  enum class Kind { kReaction, kDisplacement, kStrainVariance, kTargetStrain, kReactionLinearity };
   Kind kind = Kind::kReaction;
   std::string name;
   double weight = 1.0;
@@ -31,6 +31,23 @@ struct DesignObjective {
   int point = -1;     ///< index into the case's output.points
   int component = 0;  ///< x, y, z (displacement) or E11, E22, E12 (strain terms)
   Eigen::Vector2d u_range = {0, 1}, v_range = {0, 1};
+  /// Strain terms: sample points per direction (a uniform grid over the region; a direction
+  /// whose range is a single value -- a section -- has one).
+  int samples_u = 11, samples_v = 11;
+};
+
+/// The control grid of a designed field (for the smoothness penalty): nu x nv values, u fastest.
+struct DesignFieldGrid {
+  DesignVariable::Field field = DesignVariable::Field::kStitchValue;
+  int nu = 1, nv = 1;
+  std::vector<double> values;  ///< the case's values (those of no variable stay fixed)
+};
+
+/// `optimizer` of the design file.
+struct DesignOptimizerSpec {
+  enum class Method { kCeres, kProjectedGradient };
+  Method method = Method::kCeres;
+  int max_iterations = 30;
 };
 
 struct DesignProblem {
@@ -40,6 +57,8 @@ struct DesignProblem {
   std::vector<DesignVariableSpec> variables;
   std::vector<DesignObjective> objectives;
   double smoothness = 0.0;
+  std::vector<DesignFieldGrid> fields;  ///< every field that has a variable
+  DesignOptimizerSpec optimizer;
   /// The control values each variable sets, as DesignVariable entries (for case_with_design).
   std::vector<DesignVariable> expanded() const;
 };
@@ -53,45 +72,80 @@ DesignProblem load_design(const std::string& path);
 namespace knit::macro {
 
 /// The weighted least-squares objective of a design at variable values x (one per
-/// DesignProblem::variables entry) and its adjoint gradient (design_objective.cpp):
-///   J = sum_terms weight sum_k (R(eps_k) - target_k)^2,  lambda_k = eps_k L / Delta_1.
-/// This round evaluates reaction terms only; other terms (and a smoothness weight > 0) make
-/// the status kNotConverged with a message saying so.
+/// DesignProblem::variables entry), as residuals r (J = sum r^2) with their Jacobian dr/dx
+/// from the state sensitivities (design_objective.cpp, knit/macro/design_sensitivity.hpp):
+///   reaction, displacement: r_k = sqrt(w) (q(eps_k) - target_k), lambda_k = eps_k L / Delta_1
+///   strain_variance:        r_i = sqrt(w / n) (E_i - mean E) over the n samples of the region
+///                           (sum r^2 = w x the variance)
+///   target_strain:          r_i = sqrt(w / n) (E_i - target_k)
+///   reaction_linearity:     r_k = sqrt(w) (R(eps_k) - eps_k / eps_K R(eps_K)), k < K: the
+///                           load-strain curve's distance from the straight line through the
+///                           origin and its last point eps_K (the largest strain)
+///   smoothness:             r = sqrt(w_s) (v_{i-1} - 2 v_i + v_{i+1}), second differences of
+///                           each designed field's control values along u and along v
+/// One forward run over all levels, one factorization per level.
 struct DesignEvaluation {
   RunStatus status = RunStatus::kCompleted;
   std::string message;
   double J = 0.0;
-  std::vector<std::pair<std::string, double>> terms;  ///< per objective (name, value)
-  Eigen::VectorXd gradient;                           ///< dJ/dx
+  std::vector<std::pair<std::string, double>> terms;  ///< per objective (name, sum r^2)
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian;  ///< dr/dx (residuals x variables); empty without gradient
+  Eigen::VectorXd gradient;  ///< dJ/dx = 2 jacobian^T r
+  double forward_seconds = 0.0, gradient_seconds = 0.0;
 };
-DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x);
+DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x,
+                                 bool with_gradient = true);
 
 }  // namespace knit::macro
 
 namespace knit::macro {
 
-/// A bounded projected-gradient descent with backtracking (Armijo) on evaluate_design()
-/// (design_optimize.cpp). INTERIM stand-in for the Ceres optimizer of issue 13: the first
-/// step moves the variable with the largest gradient by 10 % of its bound interval; accepted
-/// steps double the next trial, rejected ones halve it. Stops when a step changes no variable
-/// by more than `x_tolerance` times its interval, or after `max_iterations`.
+/// The optimizers of `knit-macro design` (design file key `optimizer`):
+///  * "ceres" (default; design_ceres.cpp, the only macroscale file that sees Ceres): bounded
+///    Levenberg-Marquardt (ceres::Problem, one parameter block with per-coordinate bounds)
+///    on the residuals and their Jacobian of evaluate_design();
+///  * "projected_gradient" (design_optimize.cpp; the interim optimizer, kept to compare): a
+///    bounded projected-gradient descent with Armijo backtracking on J; the first step moves
+///    the variable with the largest gradient by 10 % of its bound interval; accepted steps
+///    double the next trial, rejected ones halve it.
+/// Both stop when a step changes no variable by more than `x_tolerance` times its interval,
+/// or after `max_iterations`. The result's status: kConverged, kIterationLimit,
+/// kInfeasible (converged with J above `feasible` x J0 and a variable on a bound: the target
+/// is out of reach inside the bounds; the best design is kept) or kFailed (a solve failed).
 struct OptimizeOptions {
   int max_iterations = 30;
   double x_tolerance = 1e-6;
+  /// J / J0 below which a converged design counts as meeting its targets.
+  double feasible = 1e-6;
 };
+enum class DesignStatus { kConverged, kIterationLimit, kInfeasible, kFailed };
+/// "converged", "iteration limit", "infeasible target", "failed".
+std::string to_string(DesignStatus s);
 struct DesignIteration {
   int iteration = 0;
   double J = 0.0, gradient_norm = 0.0, seconds = 0.0;
   std::vector<double> x;
 };
 struct DesignResult {
-  RunStatus status = RunStatus::kCompleted;
+  DesignStatus status = DesignStatus::kConverged;
   std::string message;
   std::vector<double> x;  ///< the best design found (inside the bounds)
-  double J = 0.0;
+  double J = 0.0, J0 = 0.0;
+  std::vector<std::pair<std::string, double>> terms0, terms;  ///< at the start and the best
   std::vector<DesignIteration> history;
+  int evaluations = 0;  ///< objective evaluations (each one forward run)
+  /// Wall seconds over all evaluations: forward solves, and the sensitivities (gradients).
+  double forward_seconds = 0.0, gradient_seconds = 0.0;
+  int gradients = 0;  ///< evaluations with a gradient
 };
+/// Runs the optimizer the design file names (options.max_iterations from the file).
 DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options = {});
+DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOptions& options);
+DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions& options);
+/// Sets the status from the termination (converged or not) and the bounds (shared by both).
+void classify_result(const DesignProblem& d, const OptimizeOptions& options, bool converged,
+                     DesignResult& r);
 
 }  // namespace knit::macro
 

@@ -105,6 +105,16 @@ class KnitMaterial : public Material {
 
   double stitch_value(const Eigen::Vector2d& theta) const;
   double knitting_angle(const Eigen::Vector2d& theta) const;
+  /// The stitch-value and knitting-angle fields (alpha in rad).
+  const spline::SplineSurface& stitch_value_field() const { return l_field_; }
+  const spline::SplineSurface& knitting_angle_field() const { return a_field_; }
+  /// dS/dl at the local strain E and the point, at fixed E and alpha (the design adjoint,
+  /// issue 13). Energy law: analytic, T_E^T dS_hat/dl (T_E E) (eqs. 21-22 with the law's
+  /// l-derivative). Paper law (eq. 25's interpolation has no analytic l-derivative here): a
+  /// central difference of the response surfaces at l +- h, h = step * l (one-sided at the
+  /// ends of the database's range). l is clamped to the range like evaluate().
+  Eigen::Vector3d dS_dl(const Eigen::Vector3d& E, const MaterialPoint& where,
+                        double step = 1e-5) const;
 
   /// Extrapolation statistics (kinds as in material::ExtrapolationFlag).
   struct Stats {
@@ -151,6 +161,8 @@ class KnitMaterial : public Material {
   std::shared_ptr<const material::LoopLengthFamily> family_;
   std::shared_ptr<const material::EnergyLaw> energy_;
   mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_cache_;
+  /// Laws built with their l-derivative (dS_dl() only; the runs do not pay for it).
+  mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_dl_cache_;
   mutable std::atomic<long> outside_box_{0}, failed_{0};
   /// Visited box: min of (E11, E22, 2E12) in [0..2], max in [3..5].
   mutable std::array<std::atomic<double>, 6> visited_;

@@ -1,0 +1,159 @@
+// The Ceres adapter of `knit-macro design` (knit/macro/design_problem.hpp): the ONLY file of
+// macroscale that includes Ceres (tests/common/test_layering.cpp checks it). Ceres sees one
+// parameter block x (the design variables) with per-coordinate bounds and one cost function
+// whose residuals are the weighted objective terms of evaluate_design() and whose Jacobian
+// comes from the state sensitivities (one forward run over all load levels and one
+// factorization per level per evaluation).
+//
+// CHOICE (docs/design.md "The optimizer"): bounded Levenberg-Marquardt on the residuals
+// (ceres::Problem, TRUST_REGION / LEVENBERG_MARQUARDT, DENSE_QR) rather than a
+// GradientProblem (L-BFGS on J, which has no bounds in Ceres) with a change of variables
+// p = lo + (hi - lo)(1 + sin z)/2: the objectives are least squares of few residuals in few
+// variables, where Gauss-Newton steps converge in a handful of iterations, the bounds are
+// handled by Ceres' projection instead of a map whose derivative vanishes on the bounds
+// (where an infeasible target's optimum lies), and the Jacobian costs no more than the
+// gradient because the direct sensitivities du/dp are computed anyway.
+#include <ceres/ceres.h>
+
+#include <chrono>
+#include <limits>
+
+#include "knit/macro/design_problem.hpp"
+
+namespace knit::macro {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Shared between the cost function and the iteration callback: the last evaluation (Ceres
+/// asks for the Jacobian at an accepted point it evaluated before: the cached evaluation
+/// answers without a second run) and the best design seen.
+struct Tracker {
+  const DesignProblem* d = nullptr;
+  DesignResult* res = nullptr;
+  std::vector<double> last_x;
+  DesignEvaluation last;
+  bool have_last = false;
+  const DesignEvaluation& evaluate(const std::vector<double>& x) {
+    if (have_last && x == last_x) return last;
+    last = evaluate_design(*d, x, true);
+    last_x = x;
+    have_last = true;
+    ++res->evaluations;
+    ++res->gradients;
+    res->forward_seconds += last.forward_seconds;
+    res->gradient_seconds += last.gradient_seconds;
+    if (last.status == RunStatus::kCompleted && last.J < res->J) {
+      res->J = last.J;
+      res->x = x;
+      res->terms = last.terms;
+    }
+    return last;
+  }
+};
+
+class DesignCost : public ceres::CostFunction {
+ public:
+  DesignCost(Tracker& t, int residuals, int variables) : t_(t), n_(variables) {
+    set_num_residuals(residuals);
+    mutable_parameter_block_sizes()->push_back(variables);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const std::vector<double> x(parameters[0], parameters[0] + n_);
+    const DesignEvaluation& e = t_.evaluate(x);
+    if (e.status != RunStatus::kCompleted || e.residuals.size() != num_residuals()) return false;
+    for (int i = 0; i < num_residuals(); ++i) residuals[i] = e.residuals(i);
+    if (jacobians && jacobians[0])
+      for (int i = 0; i < num_residuals(); ++i)
+        for (int k = 0; k < n_; ++k) jacobians[0][i * n_ + k] = e.jacobian(i, k);
+    return true;
+  }
+
+ private:
+  Tracker& t_;
+  int n_;
+};
+
+class History : public ceres::IterationCallback {
+ public:
+  History(DesignResult& r, const std::vector<double>& x, Clock::time_point t0)
+      : r_(r), x_(x), t0_(t0) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    // A rejected step leaves x where it was (its cost is the trial's): not a history point.
+    if (s.iteration > 0 && !s.step_is_successful) return ceres::SOLVER_CONTINUE;
+    DesignIteration h;
+    h.iteration = s.iteration;
+    h.J = 2.0 * s.cost;  // Ceres' cost is (1/2) sum r^2
+    h.gradient_norm = 2.0 * s.gradient_norm;
+    h.seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
+    h.x = x_;
+    r_.history.push_back(h);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  DesignResult& r_;
+  const std::vector<double>& x_;
+  Clock::time_point t0_;
+};
+
+}  // namespace
+
+DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions& opt) {
+  const auto t0 = Clock::now();
+  DesignResult res;
+  std::vector<double> x;
+  for (const auto& v : d.variables) x.push_back(v.initial);
+  res.x = x;
+  res.J = std::numeric_limits<double>::infinity();
+  Tracker t;
+  t.d = &d;
+  t.res = &res;
+  const DesignEvaluation& e0 = t.evaluate(x);
+  if (e0.status != RunStatus::kCompleted) {
+    res.status = DesignStatus::kFailed;
+    res.message = e0.message;
+    res.history.clear();
+    return res;
+  }
+  res.J0 = e0.J;
+  res.terms0 = e0.terms;
+  const int n = static_cast<int>(x.size());
+  ceres::Problem problem;
+  problem.AddResidualBlock(new DesignCost(t, static_cast<int>(e0.residuals.size()), n), nullptr,
+                           x.data());
+  for (int i = 0; i < n; ++i) {
+    problem.SetParameterLowerBound(x.data(), i, d.variables[static_cast<std::size_t>(i)].lower);
+    problem.SetParameterUpperBound(x.data(), i, d.variables[static_cast<std::size_t>(i)].upper);
+  }
+  ceres::Solver::Options o;
+  o.minimizer_type = ceres::TRUST_REGION;
+  o.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.max_num_iterations = opt.max_iterations;
+  o.parameter_tolerance = opt.x_tolerance;
+  o.function_tolerance = 1e-6;  // relative change of J: the last digits do not matter
+  o.gradient_tolerance = 1e-12;
+  o.logging_type = ceres::SILENT;
+  o.minimizer_progress_to_stdout = false;
+  o.num_threads = 1;
+  o.update_state_every_iteration = true;
+  History history(res, x, t0);
+  o.callbacks.push_back(&history);
+  ceres::Solver::Summary summary;
+  ceres::Solve(o, &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE ||
+      summary.termination_type == ceres::USER_FAILURE) {
+    res.message = summary.message;
+    if (res.evaluations <= 1) res.status = DesignStatus::kFailed;
+  }
+  // A converged J = 0 (an exact target) ends by the function tolerance as well.
+  classify_result(d, opt, summary.termination_type == ceres::CONVERGENCE, res);
+  if (res.message.empty() && summary.termination_type != ceres::CONVERGENCE)
+    res.message = summary.message;
+  return res;
+}
+
+}  // namespace knit::macro
