@@ -37,7 +37,13 @@ struct Tracker {
   bool have_last = false;
   const DesignEvaluation& evaluate(const std::vector<double>& x) {
     if (have_last && x == last_x) return last;
-    last = evaluate_design(*d, x, true);
+    try {
+      last = evaluate_design(*d, x, true);
+    } catch (const std::exception& e) {  // never through Ceres: a failed evaluation
+      last = DesignEvaluation();
+      last.status = RunStatus::kNotConverged;
+      last.message = e.what();
+    }
     last_x = x;
     have_last = true;
     ++res->evaluations;

@@ -35,11 +35,17 @@ nlohmann::json& value_of(nlohmann::json& root, const DesignVariable& v, const st
 
 }  // namespace
 
-Case case_with_design(const std::string& text, const std::string& file,
-                      const std::vector<DesignVariable>& vars, const std::vector<double>& values) {
+std::string case_text_with_design(const std::string& text, const std::string& file,
+                                  const std::vector<DesignVariable>& vars,
+                                  const std::vector<double>& values) {
   nlohmann::json root = io::parse_json(text, file);
   for (std::size_t k = 0; k < vars.size(); ++k) value_of(root, vars[k], file) = values.at(k);
-  return parse_case(root.dump(1), file);
+  return root.dump(1);
+}
+
+Case case_with_design(const std::string& text, const std::string& file,
+                      const std::vector<DesignVariable>& vars, const std::vector<double>& values) {
+  return parse_case(case_text_with_design(text, file, vars, values), file);
 }
 
 std::vector<double> design_values(const std::string& text, const std::string& file,

@@ -83,7 +83,7 @@ DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<doubl
   std::vector<double> values;
   for (std::size_t k = 0; k < d.variables.size(); ++k)
     for (std::size_t i = 0; i < d.variables[k].indices.size(); ++i) values.push_back(x.at(k));
-  const std::string text = case_with_design(d.c.text, d.case_file, vars, values).text;
+  const std::string text = case_text_with_design(d.c.text, d.case_file, vars, values);
   // The load factors of every objective: lambda = eps L / Delta_1.
   const double delta1 = d.c.output.applied ? d.c.output.applied->value : 0.0;
   auto lambda_of = [&](double eps) { return eps * d.c.output.applied->gauge_length / delta1; };

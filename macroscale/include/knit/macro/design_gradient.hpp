@@ -26,6 +26,10 @@ struct DesignVariable {
 /// spline field of the case.
 Case case_with_design(const std::string& case_text, const std::string& file,
                       const std::vector<DesignVariable>& vars, const std::vector<double>& values);
+/// The same text without parsing the case (the design loop parses it once, in DesignSolve).
+std::string case_text_with_design(const std::string& case_text, const std::string& file,
+                                  const std::vector<DesignVariable>& vars,
+                                  const std::vector<double>& values);
 /// The current values of the design variables in the case text.
 std::vector<double> design_values(const std::string& case_text, const std::string& file,
                                   const std::vector<DesignVariable>& vars);
