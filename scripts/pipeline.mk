@@ -212,7 +212,37 @@ $(FIG)/knitmap_%.png: $(OUT)/knitmap/%/summary.txt $(FIGPY)/knitmap.py
 .PHONY: knitmaps
 knitmaps: $(KNITMAP_SUMMARIES) $(KNITMAP_FIGURES)
 
-figures: $(FIGURES) knitmaps
+# ---- inverse design (issue 13, docs/design.md) -------------------------------------------------
+# `knit-macro design` on the examples of cases/design (their case files resolved to the
+# pipeline's database), then the objective history and designed fields by
+# scripts/figures/design.py. Outputs: $(OUT)/design/NAME/ (history.csv, summary.txt, case.json,
+# run/), $(OUT)/design/NAME.status (exit code and wall time), figures/design_NAME.png.
+DESIGNS := uniform_load graded_wale diagonal_linear
+DESIGN_CASES := uniform_wale graded_wale_case diagonal_case
+DESIGN_INPUTS := $(addprefix $(OUT)/design/inputs/,$(addsuffix .json,$(DESIGNS) $(DESIGN_CASES)))
+DESIGN_STATUS := $(DESIGNS:%=$(OUT)/design/%.status)
+DESIGN_FIGURES := $(DESIGNS:%=$(FIG)/design_%.png)
+$(OUT)/design/inputs/%.json: $(ROOT)/cases/design/%.json $(FIGPY)/resolve_case.py
+	@mkdir -p $(OUT)/design/inputs
+	@$(PY) $(FIGPY)/resolve_case.py $< $(DB) $@
+# Exit 1 (iteration limit, failed solve) does not stop the pipeline: the report shows it.
+$(OUT)/design/%.status: $(DESIGN_INPUTS) $(DB) $(MACRO)
+	@mkdir -p $(LOGS)
+	@echo "design: $*"
+	@start=$$(date +%s.%N); rc=0; \
+	"$(MACRO)" design $(OUT)/design/inputs/$*.json --output $(OUT)/design/$* > $(LOGS)/design_$*.log 2>&1 || rc=$$?; \
+	end=$$(date +%s.%N); \
+	echo "{\"design\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+	if [ $$rc -ne 0 ]; then echo "design: $* exited with $$rc (see $(LOGS)/design_$*.log)"; fi
+$(FIG)/design_%.png: $(OUT)/design/%.status $(FIGPY)/design.py
+	@$(call draw,$(PY) $(FIGPY)/design.py $(OUT)/design/$* --title "design: $*" --out $@,$@)
+.PHONY: designs
+designs: $(DESIGN_STATUS) $(DESIGN_FIGURES)
+# The resolved inputs are kept (not intermediates): a second run does nothing.
+.SECONDARY: $(DESIGN_INPUTS)
+$(OUT)/report.md: $(DESIGN_STATUS) $(DESIGN_FIGURES)
+
+figures: $(FIGURES) knitmaps designs
 
 # ---- report -----------------------------------------------------------------------------------
 $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py \
@@ -226,6 +256,7 @@ report: $(OUT)/report.md
 
 clean:
 	rm -rf $(OUT)/database.h5 $(OUT)/database.source $(OUT)/database.time $(OUT)/cases \
-	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/knitmap $(OUT)/report.md
+	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/knitmap $(OUT)/design \
+	  $(OUT)/report.md
 
 FORCE:

@@ -422,13 +422,14 @@ class Report:
             L.append(f"- `{n}`: {summ} (log: logs/{n}.log)")
         if failed:
             L.append("")
+        L.extend(design_section(self.out))
         L.append("## Figures\n")
         figs = sorted(glob.glob(os.path.join(self.out, "figures", "*.png")))
         if cells != "yes":
             L.append("Fig. 5 (unit cells) is missing: this build has no `knit-meso cell`.\n")
         for p in figs:
             base = os.path.basename(p)
-            if base == SENSITIVITY_FIGURE:
+            if base == SENSITIVITY_FIGURE or base.startswith("design_"):
                 continue  # shown in its own section
             L.append(f"### {base[:-4]}\n\n![{base}](figures/{base})\n")
         with open(os.path.join(self.out, "report.md.tmp"), "w") as f:
@@ -461,6 +462,46 @@ class Report:
         else:
             L.append("(the figure was not drawn: see logs/figures/sensitivity.log)\n")
         return L
+
+
+def design_section(out):
+    """Inverse design (issue 13, docs/design.md): each example's status, objective before and
+    after and its figure, from $(OUT)/design/NAME.status and NAME/summary.txt."""
+    L = ["## Inverse design (knit-macro design)\n"]
+    names = sorted(os.path.basename(p)[:-7] for p in glob.glob(os.path.join(out, "design", "*.status")))
+    if not names:
+        L.append("No design example was run (`make -f scripts/pipeline.mk designs`).\n")
+        return L
+    L.append("The examples of cases/design (docs/design.md): `knit-macro design` with the "
+             "pipeline's database; J is the weighted least-squares objective.\n")
+    L.append("| example | status | J before | J after | iterations | evaluations | wall [s] |")
+    L.append("|---|---|---|---|---|---|---|")
+    figs = []
+    for n in names:
+        try:
+            with open(os.path.join(out, "design", n + ".status")) as f:
+                st = json.load(f)
+        except (OSError, ValueError):
+            st = {}
+        summ = {}
+        try:
+            with open(os.path.join(out, "design", n, "summary.txt")) as f:
+                for line in f:
+                    k, _, v = line.partition(":")
+                    summ.setdefault(k.strip(), v.strip())
+        except OSError:
+            pass
+        status = summ.get("status", f"no output (exit {st.get('exit_code', '?')})")
+        L.append(f"| {n} | {md(status)} | {md(summ.get('J_initial', '-'))} | "
+                 f"{md(summ.get('J_final', '-'))} | {summ.get('iterations', '-')} | "
+                 f"{summ.get('evaluations', '-')} | {fmt(st.get('seconds', float('nan')), 1)} |")
+        fig = f"design_{n}.png"
+        if os.path.exists(os.path.join(out, "figures", fig)):
+            figs.append(fig)
+    L.append("")
+    for fig in figs:
+        L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
+    return L
 
 
 def md(text):

@@ -1,0 +1,96 @@
+#!/usr/bin/python3
+"""The objective history and the designed fields of a `knit-macro design` directory (PNG).
+
+  design.py DIR [--out F.png] [--title T]
+
+Left: J per iteration (history.csv, log scale). Middle and right: the designed case's
+stitch-value field l and knitting-angle field alpha (case.json) over the parameter domain,
+with the control values along u at mid-height below when a field varies. Writes
+DIR/design.png unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
+designs); the C++ command never needs python.
+"""
+import argparse
+import json
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from scipy.interpolate import BSpline  # noqa: E402
+
+
+def read_history(path):
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    return np.atleast_1d(np.genfromtxt(lines, delimiter=",", names=True))
+
+
+def field_grid(spec, n=81):
+    """Values of a scalar spline field {degrees, knots_u, knots_v, values (u fastest)}."""
+    if not isinstance(spec, dict) or "values" not in spec:
+        return None
+    pu, pv = spec["degrees"]
+    U, V = np.array(spec["knots_u"], float), np.array(spec["knots_v"], float)
+    nu, nv = len(U) - pu - 1, len(V) - pv - 1
+    C = np.array(spec["values"], float).reshape(nv, nu)
+    scale = np.pi / 180.0 if spec.get("unit") == "deg" else 1.0
+    u = np.linspace(U[0], U[-1], n)
+    v = np.linspace(V[0], V[-1], n)
+
+    def basis(knots, p, count, x):
+        B = np.zeros((len(x), count))
+        for i in range(count):
+            c = np.zeros(count)
+            c[i] = 1.0
+            B[:, i] = BSpline(knots, c, p, extrapolate=False)(np.clip(x, knots[0], knots[-1] - 1e-12))
+        return np.nan_to_num(B)
+
+    Bu, Bv = basis(U, pu, nu, u), basis(V, pv, nv, v)
+    return u, v, Bv @ C @ Bu.T, C, scale
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dir")
+    ap.add_argument("--out")
+    ap.add_argument("--title", default="")
+    a = ap.parse_args()
+    h = read_history(os.path.join(a.dir, "history.csv"))
+    with open(os.path.join(a.dir, "case.json")) as f:
+        case = json.load(f)
+    fields = [(k, case["material"].get(k)) for k in ("stitch_value", "knitting_angle")]
+    fields = [(k, field_grid(s)) for k, s in fields if field_grid(s) is not None]
+    fig, axes = plt.subplots(1, 1 + len(fields), figsize=(4.2 * (1 + len(fields)), 3.8), squeeze=False)
+    ax = axes[0][0]
+    J = np.maximum(np.atleast_1d(h["J"]), 1e-300)
+    ax.semilogy(np.atleast_1d(h["iteration"]), J, "o-")
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("objective J")
+    ax.set_title("objective history")
+    ax.grid(True, which="both", alpha=0.3)
+    for i, (name, (u, v, F, C, scale)) in enumerate(fields):
+        ax = axes[0][i + 1]
+        unit = "mm" if name == "stitch_value" else "rad"
+        im = ax.imshow(F, origin="lower", extent=(u[0], u[-1], v[0], v[-1]), aspect="equal", cmap="viridis")
+        fig.colorbar(im, ax=ax, label=("l" if name == "stitch_value" else "alpha") + f" ({unit})")
+        ax.set_xlabel("theta1 (u)")
+        ax.set_ylabel("theta2 (v)")
+        ax.set_title(f"designed {name}")
+        if C.shape[1] > 1:  # the profile along u at mid-height, on the same axes' scale
+            prof = F[F.shape[0] // 2]
+            lo, hi = prof.min(), prof.max()
+            span = hi - lo if hi - lo > 1e-6 * max(1.0, abs(hi)) else np.inf  # constant: flat
+            ax.plot(u, 0.05 + 0.3 * (prof - lo) / span, "w-", lw=1.5)
+            ax.text(0.02, 0.37, f"profile at v = 0.5: {lo:.3g}..{hi:.3g}", color="w", fontsize=7)
+    if a.title:
+        fig.suptitle(a.title)
+    fig.tight_layout()
+    out = a.out or os.path.join(a.dir, "design.png")
+    fig.savefig(out, dpi=110)
+    print(out)
+
+
+if __name__ == "__main__":
+    main()
