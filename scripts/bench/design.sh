@@ -2,14 +2,20 @@
 # Inverse-design speed (issue 13, docs/design.md): example (b) (cases/design/graded_wale.json:
 # 8 variables, p = 5, h = 1) optimized on one core. Targets: converged in <= 20 s; one
 # gradient (forward run + sensitivities) <= 1.5 forward solves. Prints the figures.
-#   scripts/bench/design.sh BUILD_DIR [DATABASE.h5]   (default database: out/database.h5)
+#   scripts/bench/design.sh BUILD_DIR [DATABASE.h5]   (default: out/database.h5, else the synthetic
+#   stand-in written by knit-meso synth)
 set -euo pipefail
 build="${1:?usage: design.sh BUILD_DIR [DATABASE.h5]}"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-db="$(realpath "${2:-$root/out/database.h5}")"
-[[ -f "$db" ]] || { echo "design.sh: no database $db (run the pipeline or pass one)"; exit 2; }
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
+db="${2:-$root/out/database.h5}"
+if [[ ! -f "$db" ]]; then  # no pipeline database: the synthetic stand-in (other figures)
+  db="$out/synth.h5"
+  "$build/bin/knit-meso" synth --out "$db" > /dev/null
+  echo "design: no out/database.h5, using the SYNTHETIC stand-in (knit-meso synth)"
+fi
+db="$(realpath "$db")"
 for f in graded_wale graded_wale_case; do
   /usr/bin/python3 "$root/scripts/figures/resolve_case.py" "$root/cases/design/$f.json" "$db" "$out/$f.json"
 done
