@@ -234,8 +234,9 @@ $(OUT)/design/%.status: $(DESIGN_INPUTS) $(DB) $(MACRO)
 	end=$$(date +%s.%N); \
 	echo "{\"design\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
 	if [ $$rc -ne 0 ]; then echo "design: $* exited with $$rc (see $(LOGS)/design_$*.log)"; fi
+DESIGN_FIG_ARGS_graded_wale := --section E22
 $(FIG)/design_%.png: $(OUT)/design/%.status $(FIGPY)/design.py
-	@$(call draw,$(PY) $(FIGPY)/design.py $(OUT)/design/$* --title "design: $*" --out $@,$@)
+	@$(call draw,$(PY) $(FIGPY)/design.py $(OUT)/design/$* $(DESIGN_FIG_ARGS_$*) --title "design: $*" --out $@,$@)
 .PHONY: designs
 designs: $(DESIGN_STATUS) $(DESIGN_FIGURES)
 # The resolved inputs are kept (not intermediates): a second run does nothing.

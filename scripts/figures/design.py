@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """The objective history and the designed fields of a `knit-macro design` directory (PNG).
 
-  design.py DIR [--out F.png] [--title T]
+  design.py DIR [--out F.png] [--title T] [--section E22]
 
-Left: J per iteration (history.csv, log scale). Middle and right: the designed case's
-stitch-value field l and knitting-angle field alpha (case.json) over the parameter domain,
-with the control values along u at mid-height below when a field varies. Writes
+Panels: J per iteration (history.csv, log scale); the designed case's stitch-value field l and
+knitting-angle field alpha (case.json) over the parameter domain, with the profile at
+mid-height when a field varies; the final run's load-strain curve (run/load_strain.csv, the
+first reaction) with the straight line through its last point; with --section, that strain
+component of the final run along the central section v = 0.5 (run/results.h5, last step). Writes
 DIR/design.png unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
 designs); the C++ command never needs python.
 """
@@ -18,6 +20,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+try:
+    import h5py  # noqa: E402
+except ImportError:  # the section panel is then left out
+    h5py = None
 from scipy.interpolate import BSpline  # noqa: E402
 
 
@@ -56,13 +63,31 @@ def main():
     ap.add_argument("dir")
     ap.add_argument("--out")
     ap.add_argument("--title", default="")
+    ap.add_argument("--section", default="", help="strain field along v = 0.5 of the final run (E11, E22, E12)")
     a = ap.parse_args()
     h = read_history(os.path.join(a.dir, "history.csv"))
     with open(os.path.join(a.dir, "case.json")) as f:
         case = json.load(f)
     fields = [(k, case["material"].get(k)) for k in ("stitch_value", "knitting_angle")]
     fields = [(k, field_grid(s)) for k, s in fields if field_grid(s) is not None]
-    fig, axes = plt.subplots(1, 1 + len(fields), figsize=(4.2 * (1 + len(fields)), 3.8), squeeze=False)
+    run = os.path.join(a.dir, "run")
+    curve = None
+    if os.path.exists(os.path.join(run, "load_strain.csv")):
+        ls = read_history(os.path.join(run, "load_strain.csv"))
+        loads = [n for n in ls.dtype.names if n.endswith("_N")]
+        if loads:
+            curve = (np.atleast_1d(ls["strain"]), np.atleast_1d(ls[loads[0]]), loads[0])
+    section = None
+    h5 = os.path.join(run, "results.h5")
+    if a.section and h5py is not None and os.path.exists(h5):
+        with h5py.File(h5, "r") as f:
+            last = sorted(f["fields"].keys())[-1]
+            g = f["fields"][last]
+            nu, nv = int(g.attrs["grid_u"]), int(g.attrs["grid_v"])
+            E = np.array(g[a.section]).reshape(nv, nu)  # u fastest
+            section = (np.linspace(0, 1, nu), E[nv // 2])
+    npan = 1 + len(fields) + (curve is not None) + (section is not None)
+    fig, axes = plt.subplots(1, npan, figsize=(4.2 * npan, 3.8), squeeze=False)
     ax = axes[0][0]
     J = np.maximum(np.atleast_1d(h["J"]), 1e-300)
     ax.semilogy(np.atleast_1d(h["iteration"]), J, "o-")
@@ -81,9 +106,31 @@ def main():
         if C.shape[1] > 1:  # the profile along u at mid-height, on the same axes' scale
             prof = F[F.shape[0] // 2]
             lo, hi = prof.min(), prof.max()
-            span = hi - lo if hi - lo > 1e-6 * max(1.0, abs(hi)) else np.inf  # constant: flat
-            ax.plot(u, 0.05 + 0.3 * (prof - lo) / span, "w-", lw=1.5)
+            flo, fhi = F.min(), F.max()  # scaled like the colours (a constant profile is flat)
+            span = fhi - flo if fhi - flo > 1e-9 * max(1.0, abs(fhi)) else np.inf
+            ax.plot(u, 0.05 + 0.3 * (prof - flo) / span, "w-", lw=1.5)
             ax.text(0.02, 0.37, f"profile at v = 0.5: {lo:.3g}..{hi:.3g}", color="w", fontsize=7)
+    k = 1 + len(fields)
+    if curve is not None:
+        ax = axes[0][k]
+        e, F, name = curve
+        ax.plot(100 * e, F, "o-", ms=3, label="designed")
+        if len(e) and e[-1] != 0:
+            ax.plot([0, 100 * e[-1]], [0, F[-1]], "k--", lw=1, label="line through the last point")
+        ax.set_xlabel("applied strain (%)")
+        ax.set_ylabel(name.replace("_N", "") + " (N)")
+        ax.set_title("final run: load-strain")
+        ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+        k += 1
+    if section is not None:
+        ax = axes[0][k]
+        u, E = section
+        ax.plot(u, E, "-")
+        ax.set_xlabel("theta1 (u) at v = 0.5")
+        ax.set_ylabel(a.section)
+        ax.set_title(f"final run: {a.section} along the section (std {np.std(E):.2g})")
+        ax.grid(True, alpha=0.3)
     if a.title:
         fig.suptitle(a.title)
     fig.tight_layout()
