@@ -37,7 +37,7 @@ std::vector<double> design_values(const std::string& case_text, const std::strin
 struct ReactionGradient {
   RunStatus status = RunStatus::kCompleted;
   std::string message;
-  double J = 0.0;      ///< the reaction (N) at lambda = 1
+  double J = 0.0;      ///< the reaction (N) at the load factor
   Eigen::VectorXd dJ;  ///< dJ/dp (N per unit of the control value)
 };
 
