@@ -45,7 +45,8 @@ class SqrtInformationCost : public ceres::CostFunction {
 struct Point {
   Eigen::Vector3d e, S;  // Voigt strain, stress
   double l;
-  std::size_t loop;  // entry index
+  std::size_t loop;   // entry index
+  double set_weight;  // weight_uniaxial / weight_paper / 1 (see EnergyFitOptions)
 };
 
 std::string loss_name(Loss l) {
@@ -58,7 +59,7 @@ bool is_holdout(const material::RawPath& r) {
 
 /// Data of db: fit points and held-out points; the reason (with its HDF5 path) if unusable.
 std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Point>& held,
-                    int& skipped) {
+                    int& skipped, const EnergyFitOptions& o = EnergyFitOptions()) {
   skipped = 0;
   for (std::size_t k = 0; k < db.entries.size(); ++k) {
     const auto& entry = db.entries[k];
@@ -70,8 +71,14 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
           ++skipped;
           continue;
         }
-        Point p{
-            {r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)}, r.S.row(s).transpose(), entry.loop_length, k};
+        const double sw = r.path.kind == material::PathKind::kUniaxial
+                              ? o.weight_uniaxial
+                              : (r.path.set == "paper" ? o.weight_paper : 1.0);
+        Point p{{r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)},
+                r.S.row(s).transpose(),
+                entry.loop_length,
+                k,
+                sw};
         if (!p.e.allFinite() || !p.S.allFinite())
           return material::raw_path_location(k, q) + ": step " + std::to_string(s + 1) +
                  " is marked converged but its E or S is not finite";
@@ -128,6 +135,11 @@ std::string EnergyFitOptions::validate() const {
   if (!(loss_scale > 0.0)) return "loss_scale must be positive";
   if (loss_rounds < 1 || loss_rounds > 50) return "loss_rounds must be in 1..50";
   if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!(weight_relative >= 0.0 && weight_relative <= 100.0))
+    return "weight_relative must be in [0, 100] (0: absolute errors)";
+  if (!(weight_uniaxial > 0.0 && weight_uniaxial <= 1e3))
+    return "weight_uniaxial must be in (0, 1000]";
+  if (!(weight_paper > 0.0 && weight_paper <= 1e3)) return "weight_paper must be in (0, 1000]";
   for (const auto& d : directions)
     if (!d.allFinite() || d.norm() == 0.0) return "directions must be finite and non-zero";
   return {};
@@ -145,7 +157,10 @@ std::string EnergyFitOptions::to_json() const {
                       {"loss", loss_name(loss)},
                       {"loss_scale", loss_scale},
                       {"loss_rounds", loss_rounds},
-                      {"max_iterations", max_iterations}};
+                      {"max_iterations", max_iterations},
+                      {"weight_relative", weight_relative},
+                      {"weight_uniaxial", weight_uniaxial},
+                      {"weight_paper", weight_paper}};
   if (!directions.empty()) {
     nlohmann::json d = nlohmann::json::array();
     for (const auto& v : directions) d.push_back({v(0), v(1), v(2)});
@@ -164,10 +179,11 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   }
   if (!j.is_object()) throw InputError(file, pointer, "energy-fit options must be a JSON object");
   EnergyFitOptions o;
-  static const char* known[] = {"s_degree",  "s_spans",    "l_degree",       "l_control_points",
-                                "s_margin",  "floor",      "floor_relative", "smoothing",
-                                "loss",      "loss_scale", "loss_rounds",    "max_iterations",
-                                "directions"};
+  static const char* known[] = {
+      "s_degree",   "s_spans",         "l_degree",        "l_control_points",
+      "s_margin",   "floor",           "floor_relative",  "smoothing",
+      "loss",       "loss_scale",      "loss_rounds",     "max_iterations",
+      "directions", "weight_relative", "weight_uniaxial", "weight_paper"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
@@ -193,6 +209,9 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("loss_scale", o.loss_scale);
   get_int("loss_rounds", o.loss_rounds);
   get_int("max_iterations", o.max_iterations);
+  get_double("weight_relative", o.weight_relative);
+  get_double("weight_uniaxial", o.weight_uniaxial);
+  get_double("weight_paper", o.weight_paper);
   if (j.contains("loss")) {
     const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
     if (l == "none")
@@ -232,7 +251,7 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   if (db.entries.empty()) return refuse("/loop_lengths: no loop length to fit");
   std::vector<Point> pts, held;
   int skipped = 0;
-  if (const std::string why = collect(db, pts, held, skipped); !why.empty()) return refuse(why);
+  if (const std::string why = collect(db, pts, held, skipped, o); !why.empty()) return refuse(why);
 
   // ---- layout: directions, scales, s-ranges, l-basis, floor, box -------------------------
   EnergyLawData& law = out.law;
@@ -288,8 +307,21 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);
   const int P = design.P, ns = design.ns;
-  const double N = 3.0 * static_cast<double>(pts.size());
-  std::vector<double> w(pts.size(), 1.0);
+  // Data weights (squared-residual weights): the set weight, and with weight_relative > 0 a
+  // relative error measure, (1 + c) / (|S_p| / sS + c), so that the slack states (|S| of a few
+  // 0.01 MPa, where the macroscale patches spend their first strains) are not drowned by the
+  // jammed corners of the box (|S| ~ 10-30 MPa).
+  std::vector<double> base(pts.size(), 1.0);
+  for (std::size_t p = 0; p < pts.size(); ++p) {
+    double f = pts[p].set_weight;
+    if (o.weight_relative > 0.0)
+      f *= (1.0 + o.weight_relative) / (pts[p].S.norm() / sS + o.weight_relative);
+    base[p] = f * f;
+  }
+  std::vector<double> w = base;
+  double wsum = 0.0;
+  for (double b : base) wsum += b;
+  const double N = 3.0 * wsum;  // the smoothing is relative to the total data weight
   Eigen::MatrixXd A(3, P);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(P);
   // Smoothness: second differences along s (each g, j) and along l (each g, i), / sK.
@@ -360,7 +392,8 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
       design.rows(pts[p], A);
       const double r = (A * x + law.floor * pts[p].e - pts[p].S).norm() / sS;
       const double d = o.loss_scale;
-      w[p] = o.loss == Loss::kHuber ? (r <= d ? 1.0 : d / r) : 1.0 / (1.0 + (r / d) * (r / d));
+      w[p] = base[p] *
+             (o.loss == Loss::kHuber ? (r <= d ? 1.0 : d / r) : 1.0 / (1.0 + (r / d) * (r / d)));
     }
   }
   law.coefficients.resize(G, ns * nl);
@@ -385,6 +418,22 @@ EnergyFitSummary fit_energy_database(Database& db, const EnergyFitOptions& optio
     db.energy_diagnostics = s.diagnostics;
   }
   return s;
+}
+
+double uniaxial_axial_stress(const material::EnergyLawAt& at, int axis, double e_axial,
+                             double lateral) {
+  const int lat = 1 - axis;
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();
+  e(axis) = e_axial;
+  e(lat) = lateral;
+  for (int it = 0; it < 100; ++it) {
+    const material::EnergyResponse r = at.evaluate(e);
+    if (std::abs(r.S(lat)) <= 1e-10 * (1.0 + std::abs(r.S(axis)))) return r.S(axis);
+    const double step = -r.S(lat) / r.C(lat, lat);
+    e(lat) += std::clamp(step, -0.05, 0.05);
+    if (!std::isfinite(e(lat))) break;
+  }
+  return std::nan("");
 }
 
 EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Database& db) {
@@ -420,6 +469,23 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       if (pl.stress_range > 0) {
         pl.max_relative = pl.max.maxCoeff() / pl.stress_range;
         pl.rms_relative = pl.rms.maxCoeff() / pl.stress_range;
+      }
+    }
+    for (const auto& r : db.entries[k].raw) {
+      if (r.path.kind != material::PathKind::kUniaxial || r.steps() == 0) continue;
+      const int ax = r.path.axis;
+      double smax = 0.0;
+      for (int s = 0; s < r.steps(); ++s)
+        if (r.status[static_cast<std::size_t>(s)] == 0) smax = std::max(smax, std::abs(r.S(s, ax)));
+      for (int s = 0; s < r.steps(); ++s) {
+        if (r.status[static_cast<std::size_t>(s)] != 0 || !(smax > 0.0)) continue;
+        const double law_s = uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax));
+        const double ratio = law_s / r.S(s, ax);
+        if (std::abs(r.S(s, ax)) >= 0.1 * smax)
+          pl.uniaxial_max_relative = std::isfinite(ratio)
+                                         ? std::max(pl.uniaxial_max_relative, std::abs(ratio - 1.0))
+                                         : std::numeric_limits<double>::infinity();
+        if (s == r.steps() - 1) pl.uniaxial_end_ratio(ax) = ratio;
       }
     }
     range[k] = pl.stress_range;
@@ -458,6 +524,14 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
        << p.rms(0) << ", " << p.rms(1) << ", " << p.rms(2) << " MPa, max " << p.max(0) << ", "
        << p.max(1) << ", " << p.max(2) << " MPa; max " << 100 * p.max_relative << " %, rms "
        << 100 * p.rms_relative << " % of the stress range " << p.stress_range << " MPa\n";
+  for (const auto& p : d.per_loop)
+    if (p.uniaxial_end_ratio.array().isFinite().any())
+      os << "    l = " << p.loop_length
+         << " mm, uniaxial stress (lateral stress of the law zero): law / cell axial stress at the "
+            "end, course "
+         << p.uniaxial_end_ratio(0) << ", wale " << p.uniaxial_end_ratio(1)
+         << "; largest |law / cell - 1| where the cell's stress is >= 10 % of its path's largest: "
+         << 100 * p.uniaxial_max_relative << " %\n";
   if (d.holdout_points > 0)
     os << "    held out: " << d.holdout_within_5_percent << " of " << d.holdout_points
        << " states within 5 % of the stress range (largest error " << 100 * d.holdout_max_relative

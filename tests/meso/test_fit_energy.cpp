@@ -7,11 +7,13 @@
 #include <cstdio>
 
 #include "knit/core/errors.hpp"
+#include "knit/material/energy_law.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 
 using namespace knit::meso::fit;
 using knit::material::Database;
+namespace material = knit::material;
 
 namespace {
 
@@ -81,6 +83,49 @@ TEST_CASE("energy fit: a robust loss and custom directions also fit", "[unit]") 
   for (const auto& p : s.diagnostics.per_loop) CHECK(p.max_relative < 0.03);
 }
 
+TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven like the cell",
+          "[unit]") {
+  Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  const EnergyFitSummary s = fit_energy_law(db, {});
+  REQUIRE(s.ok());
+  const material::EnergyLawAt at = material::EnergyLaw(s.law).at(6.5);
+  // A wale-wise uniaxial path made of the law's own uniaxial response: the ratio must be 1;
+  // the same path with the cell's stress scaled by 1.5 must give 1 / 1.5.
+  for (const double scale : {1.0, 1.5}) {
+    material::RawPath r;
+    r.path.kind = material::PathKind::kUniaxial;
+    r.path.axis = 1;
+    r.path.set = "coverage";
+    const int n = 5;
+    r.E = material::RowMatrixX::Zero(n, 3);
+    r.S = material::RowMatrixX::Zero(n, 3);
+    r.F = r.P = material::RowMatrixX::Zero(n, 4);
+    r.status.assign(n, 0);
+    double lateral = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double e2 = 0.05 * (k + 1);
+      const double s2 = uniaxial_axial_stress(at, 1, e2, lateral);
+      REQUIRE(std::isfinite(s2));
+      // recover the lateral strain the solve found: its lateral stress vanishes there
+      double lo = -0.6, hi = 0.6;
+      for (int it = 0; it < 200; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (at.evaluate({mid, e2, 0.0}).S(0) > 0.0 ? hi : lo) = mid;
+      }
+      lateral = 0.5 * (lo + hi);
+      CHECK(at.evaluate({lateral, e2, 0.0}).S(1) == Approx(s2).epsilon(1e-8));
+      r.E.row(k) << lateral, e2, 0.0;
+      r.S.row(k) << 0.0, scale * s2, 0.0;
+    }
+    db.entries[1].raw.push_back(r);
+    const auto dg = diagnose_energy_law(s.law, db);
+    db.entries[1].raw.pop_back();
+    CHECK(dg.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
+    CHECK(dg.per_loop[1].uniaxial_max_relative == Approx(1.0 - 1.0 / scale).margin(1e-6));
+    CHECK(std::isnan(dg.per_loop[1].uniaxial_end_ratio(0)));
+  }
+}
+
 TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
   SECTION("non-finite data in a converged step") {
     Database db = synthetic_coverage_db({4.5, 6.5}, 4);
@@ -107,6 +152,10 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("f.json: /energy_fit: s_spans"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"floor_relative": "x"})", "f.json"),
                       Catch::Contains("f.json: /floor_relative: must be a number"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"weight_relative": -1})", "f.json"),
+                      Catch::Contains("weight_relative must be in [0, 100]"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"weight_uniaxial": 0})", "f.json"),
+                      Catch::Contains("weight_uniaxial"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"smooth": 1})", "f.json"),
                       Catch::Contains("/smooth: unknown energy-fit option"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"directions": [[1, 0]]})", "f.json"),

@@ -12,6 +12,8 @@
 // the HDF5 path of what is wrong (another format version, a truncated file, a missing group).
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 #include <filesystem>
 #include <map>
@@ -89,6 +91,13 @@ struct EnergyFitDiagnostics {
     int points = 0;
     Eigen::Vector3d rms = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
     double stress_range = 0.0, max_relative = 0.0, rms_relative = 0.0;
+    /// The law driven like the cell's uniaxial-stress paths (axial strain prescribed, lateral
+    /// strain solved so that the law's lateral stress vanishes): law / cell axial stress at
+    /// the last step, course (0) and wale (1); NaN without such a path. Printed, not stored.
+    Eigen::Vector2d uniaxial_end_ratio = Eigen::Vector2d::Constant(std::nan(""));
+    /// Largest |law / cell - 1| of that axial stress over the steps whose cell stress is at
+    /// least 10 % of the path's largest. Printed, not stored.
+    double uniaxial_max_relative = 0.0;
   };
   std::vector<PerLoop> per_loop;
   int holdout_points = 0;

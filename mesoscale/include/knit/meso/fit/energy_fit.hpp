@@ -20,7 +20,8 @@
 // Choices (documented in docs/database.md, all configurable):
 //  * s-range of each function: the range of d_k . e over the data (both mirror directions),
 //    widened by s_margin times its width on each side (and always containing 0);
-//  * l: cubic with min(4, loop lengths) control points (degree capped at control points - 1);
+//  * l: quadratic with min(5, loop lengths) control points (degree capped at control points - 1;
+//    5 = one per default loop length, so each simulated l has its own freedom, C1 in l);
 //  * floor: `floor` MPa if >= 0, else floor_relative * sS / sE (a fraction of the data's
 //    secant stiffness; default 1 %).
 //
@@ -40,16 +41,27 @@ namespace knit::meso::fit {
 struct EnergyFitOptions {
   /// Ridge directions before mirror closure; empty = material::default_ridge_directions().
   std::vector<Eigen::Vector3d> directions;
-  int s_degree = 3, s_spans = 8;
-  int l_degree = 3, l_control_points = 4;
+  int s_degree = 3, s_spans = 12;
+  int l_degree = 2, l_control_points = 5;
   double s_margin = 0.1;
   double floor = -1.0;  ///< MPa; < 0: floor_relative * secant stiffness of the data
   double floor_relative = 0.01;
-  double smoothing = 1e-7;
+  double smoothing = 1e-9;
   Loss loss = Loss::kNone;
   double loss_scale = 0.05;  ///< in units of sS
   int loss_rounds = 4;       ///< IRLS rounds with a loss
   int max_iterations = 200;
+  /// Data weights (choice, docs/database.md "Weights"): each state's squared stress residual
+  /// is weighted by (set weight * (1 + c) / (|S| / sS + c))^2 with c = weight_relative (0: plain
+  /// absolute errors), set weight = weight_uniaxial on uniaxial-stress paths, weight_paper on
+  /// the paper's 13 paths, 1 elsewhere. The cell's data are not exactly hyperelastic (friction;
+  /// the slack wale and stiff course of the uniaxial paths violate the reciprocity
+  /// nu12 / E1 = nu21 / E2 of any W several-fold), so the fit must choose: it favours the
+  /// uniaxial and paper states, where the macroscale patches live, and relative accuracy in
+  /// the slack regime over the jammed corners of the box.
+  double weight_relative = 0.1;
+  double weight_uniaxial = 30.0;
+  double weight_paper = 3.0;
 
   std::string validate() const;
   std::string to_json() const;
@@ -73,6 +85,13 @@ EnergyFitSummary fit_energy_law(const material::Database& db, const EnergyFitOpt
 
 /// Fits and stores the law (db.energy_law) when the fit succeeds; returns the summary.
 EnergyFitSummary fit_energy_database(material::Database& db, const EnergyFitOptions& options);
+
+/// The law's axial stress under uniaxial stress (the cell's uniaxial paths, set "coverage"):
+/// e(axis) = e_axial, 2E12 = 0, the lateral strain solved by Newton from `lateral` so that the
+/// law's lateral stress vanishes (C(lat, lat) >= floor > 0 and S(lat) increases with e(lat): a
+/// unique root). NaN if Newton does not converge.
+double uniaxial_axial_stress(const material::EnergyLawAt& at, int axis, double e_axial,
+                             double lateral);
 
 /// Errors of a law against db's raw data: per loop length on the fit data, and on the
 /// held-out paths.
