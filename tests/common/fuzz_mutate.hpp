@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -141,5 +142,16 @@ class Mutator {
     return out;
   }
 };
+
+/// Number of mutants per fuzz test: KNIT_FUZZ_INPUTS if set (1..10^7), else `fallback`. The
+/// sanitizer build sets 500 (tests/CMakeLists.txt) — the Release suite runs the full 2,000;
+/// longer runs on demand: KNIT_FUZZ_INPUTS=100000 build/bin/test_common "fuzz*".
+inline int fuzz_inputs(int fallback = 2000) {
+  const char* v = std::getenv("KNIT_FUZZ_INPUTS");
+  if (v == nullptr) return fallback;
+  char* end = nullptr;
+  const long n = std::strtol(v, &end, 10);
+  return (end != v && *end == '\0' && n >= 1 && n <= 10000000) ? static_cast<int>(n) : fallback;
+}
 
 }  // namespace knit::testing

@@ -52,7 +52,7 @@ TEST_CASE("fuzz: mutated database files load or throw InputError", "[unit][fuzz]
   }
   REQUIRE_NOTHROW(read_database(seed_file));
 
-  constexpr int kInputs = 2000;
+  const int kInputs = knit::testing::fuzz_inputs();
   knit::testing::Mutator mut(1130);
   int loaded = 0, refused = 0;
   std::vector<std::string> failures;

@@ -64,7 +64,7 @@ TEST_CASE("fuzz: mutated case files load or throw InputError", "[unit][fuzz]") {
   REQUIRE(seeds.size() >= 5);
   for (const Seed& s : seeds) CHECK_NOTHROW(knit::macro::parse_case(s.text, s.label));
 
-  constexpr int kInputs = 2000;
+  const int kInputs = knit::testing::fuzz_inputs();
   knit::testing::Mutator mut(20261130);
   int loaded = 0, refused = 0;
   std::vector<std::string> failures;
