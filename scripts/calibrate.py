@@ -49,7 +49,7 @@ E_GRID = [0.05 + 0.025 * k for k in range(15)]  # 0.05 ... 0.40: the "over the r
 
 # The cell defaults (schemas/cell.schema.json) and the plausible ranges (docs/unit-cell.md,
 # "Calibration", where each range has its source).
-DEFAULTS = {"g0": 0.14, "k_N": 1000.0, "mu": 0.15, "gamma_over_w": 0.25 / 1.26, "d": 0.38}
+DEFAULTS = {"g0": 0.14, "k_N": 1000.0, "mu": 0.15, "gamma_over_w": 0.225, "d": 0.38}
 RANGES = {
     "g0": [0.06, 0.10, 0.14, 0.18, 0.22],
     "gamma_over_w": [0.10, 0.15, 0.175, 0.198413, 0.225, 0.25, 0.275, 0.30],
