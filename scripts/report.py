@@ -462,6 +462,17 @@ class Report:
         obs = sorted({r[2] for r in rows})
         L.append(f"Table `{path}`: {len(rows)} results, parameters {', '.join(params)}; "
                  f"observables {', '.join(obs)}.\n")
+        head = sorted(o for o in obs if o.startswith("min_ratio"))
+        if head:
+            L.append("Headline (the paper's \"4.5 mm much stiffer than 6.5 mm\", cell level: "
+                     "the smallest S(4.5)/S(6.5) over the strain range; scripts/calibrate.py):\n")
+            L.append("| parameter | value | " + " | ".join(head) + " |")
+            L.append("|---|---|" + "---|" * len(head))
+            res = {(r[0], r[1], r[2]): r[3] for r in rows}
+            for p, v in sorted({(r[0], r[1]) for r in rows}):
+                cells = [fmt(res[(p, v, o)]) if (p, v, o) in res else "–" for o in head]
+                L.append(f"| {md(p)} | {v:g} | " + " | ".join(cells) + " |")
+            L.append("")
         fig = os.path.join(self.out, "figures", SENSITIVITY_FIGURE)
         if os.path.exists(fig):
             L.append(f"![{SENSITIVITY_FIGURE}](figures/{SENSITIVITY_FIGURE})\n")

@@ -206,9 +206,9 @@ void read_bcs(const Reader& r, const json& root, Case& c) {
   for (size_t k = 0; k < bcs.size(); ++k) {
     const std::string ptr = "/boundary_conditions/" + std::to_string(k);
     const json& j = bcs[k];
-    r.keys(
-        j, ptr,
-        {"edge", "corner", "point", "all", "fix", "prescribe", "clamp", "symmetry", "description"});
+    r.keys(j, ptr,
+           {"edge", "corner", "point", "all", "fix", "prescribe", "clamp", "symmetry", "radius",
+            "description"});
     BoundaryCondition bc;
     bc.pointer = ptr;
     const int targets = int(j.contains("edge")) + int(j.contains("corner")) +
@@ -236,6 +236,12 @@ void read_bcs(const Reader& r, const json& root, Case& c) {
       if (!r.boolean(j.at("all"), ptr + "/all"))
         r.fail(ptr + "/all", "must be true (every control point)");
       bc.target = BoundaryCondition::Target::kAll;
+    }
+    if (j.contains("radius")) {
+      if (bc.target != BoundaryCondition::Target::kCorner)
+        r.fail(ptr + "/radius", "a radius spreads a corner condition: it needs \"corner\"");
+      bc.radius = r.number(j.at("radius"), ptr + "/radius");
+      if (bc.radius < 0) r.fail(ptr + "/radius", "must be >= 0 (mm), got " + j.at("radius").dump());
     }
     if (j.contains("fix")) {
       const json& f = r.array(j.at("fix"), ptr + "/fix");
@@ -371,7 +377,8 @@ void read_output(const Reader& r, const json& root, Case& c) {
     const json& rs = r.array(o.at("reactions"), "/output/reactions");
     for (size_t k = 0; k < rs.size(); ++k) {
       const std::string ptr = "/output/reactions/" + std::to_string(k);
-      r.keys(rs[k], ptr, {"name", "edge", "corner", "component", "rows"}, {"name", "component"});
+      r.keys(rs[k], ptr, {"name", "edge", "corner", "component", "rows", "radius"},
+             {"name", "component"});
       if (rs[k].contains("edge") == rs[k].contains("corner"))
         r.fail(ptr, "needs either \"edge\" or \"corner\"");
       ReactionOutput ro;
@@ -382,6 +389,12 @@ void read_output(const Reader& r, const json& root, Case& c) {
       else
         ro.corner = r.corner(rs[k].at("corner"), ptr + "/corner");
       if (!ro.at_edge && rs[k].contains("rows")) r.fail(ptr + "/rows", "rows apply to edges only");
+      if (rs[k].contains("radius")) {
+        if (ro.at_edge) r.fail(ptr + "/radius", "a radius applies to corners only");
+        ro.radius = r.number(rs[k].at("radius"), ptr + "/radius");
+        if (ro.radius < 0)
+          r.fail(ptr + "/radius", "must be >= 0 (mm), got " + rs[k].at("radius").dump());
+      }
       ro.component = r.component(rs[k].at("component"), ptr + "/component");
       if (rs[k].contains("rows")) ro.rows = r.integer(rs[k].at("rows"), ptr + "/rows", 1, 2);
       out.reactions.push_back(ro);

@@ -56,6 +56,21 @@ int corner_control_point(int nu, int nv, const Eigen::Vector2d& c) {
   return i + nu * j;
 }
 
+std::vector<int> corner_region(const spline::SplineSurface& s, const Eigen::Vector2d& corner,
+                               double radius) {
+  const int nu = s.size_u(), nv = s.size_v();
+  const int a0 = corner_control_point(nu, nv, corner);
+  const Eigen::VectorXd x0 = s.eval(corner(0) > 0.5 ? 1.0 : 0.0, corner(1) > 0.5 ? 1.0 : 0.0);
+  const std::vector<double> gu = s.basis_u().greville(), gv = s.basis_v().greville();
+  std::vector<int> out;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const int a = i + nu * j;
+      if (a == a0 || (s.eval(gu[i], gv[j]) - x0).norm() <= radius) out.push_back(a);
+    }
+  return out;
+}
+
 int parse_component(const std::string& s) {
   if (s == "x" || s == "1") return 0;
   if (s == "y" || s == "2") return 1;

@@ -31,7 +31,7 @@ Problem setup_problem(const Case& c) {
           row1 = edge_row(nu, nv, bc.edge, 1);
           break;
         case BoundaryCondition::Target::kCorner:
-          row0 = {corner_control_point(nu, nv, bc.corner)};
+          row0 = corner_region(c.surface, bc.corner, bc.radius);
           break;
         case BoundaryCondition::Target::kAll:
           for (int a = 0; a < m.num_control_points(); ++a) row0.push_back(a);
@@ -108,6 +108,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   std::unique_ptr<ResultsWriter> writer;
   if (!opt.output_dir.empty()) writer = std::make_unique<ResultsWriter>(c, m, opt.output_dir);
   RunResult res;
+  std::vector<std::vector<int>> corner_sets;  // the control points of each corner reaction
+  for (const ReactionOutput& r : c.output.reactions)
+    corner_sets.push_back(r.at_edge ? std::vector<int>{}
+                                    : corner_region(c.surface, r.corner, r.radius));
   int outputs = 0;
   Eigen::VectorXd last_written;
   res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
@@ -118,10 +122,14 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
       row.applied = s.lambda * c.output.applied->value;
       row.strain = row.applied / c.output.applied->gauge_length;
     }
-    for (const ReactionOutput& r : c.output.reactions) {
-      const int a = corner_control_point(c.surface.size_u(), c.surface.size_v(), r.corner);
-      row.reactions.push_back(r.at_edge ? edge_reaction(m, s.fint, r.edge, r.component, r.rows)
-                                        : s.fint(3 * a + r.component));
+    for (size_t k = 0; k < c.output.reactions.size(); ++k) {
+      const ReactionOutput& r = c.output.reactions[k];
+      double f = 0.0;
+      if (r.at_edge)
+        f = edge_reaction(m, s.fint, r.edge, r.component, r.rows);
+      else
+        for (int a : corner_sets[k]) f += s.fint(3 * a + r.component);
+      row.reactions.push_back(f);
     }
     for (const OutputPoint& op : c.output.points) row.points.push_back(m.displacement(s.u, op.at));
     row.iterations = s.iterations;

@@ -29,7 +29,7 @@ struct Options {
   double loop_length = 0;
   std::string out = "cell";
   double d = 0.38;
-  double gamma_over_w = 0.25 / 1.26;
+  double gamma_over_w = knit::meso::cell::GeometryOptions{}.gamma_over_w;
   int samples = 60;
   std::string config;
   bool d_given = false, gamma_given = false;  ///< flags override --config

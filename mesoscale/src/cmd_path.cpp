@@ -1,10 +1,13 @@
-// knit-meso path --loop-length L (--biaxial EPS11 EPS22 | --shear GAMMA_DEG) [--steps N]
+// knit-meso path --loop-length L (--biaxial EPS11 EPS22 | --shear GAMMA_DEG |
+//                --uniaxial AXIS E) [--steps N]
 //                [--out DIR] [--elements NE] [--penalty K_N] [--allowance G0] [--delta D]
 //                [--mu MU] [--stick K_T] [--no-vtp] [--config CELL.json]
 //   Runs one macroscopic deformation path on the single-jersey unit cell (paper Sect. 2.1.2,
 //   eqs. 7-9): equilibrates the initial geometry (step 0: residual stress), then N steps.
 //   --biaxial gives the strains of F* = diag(1+eps11, 1+eps22); --shear the shear angle gamma in
-//   DEGREES of F* = [[1, sin g], [0, cos g]].
+//   DEGREES of F* = [[1, sin g], [0, cos g]]; --uniaxial the axis (0 = course, 1 = wale) and the
+//   end Green-Lagrange strain E along it under uniaxial stress (the other normal stress zero,
+//   homog/uniaxial.hpp: the sweep's uniaxial kind, F_aa = 1 + t (sqrt(1 + 2E) - 1)).
 //   Every option is checked for finiteness and range before any work (exit 2, the message names
 //   the option and the allowed range); a value is never silently replaced by its default.
 //   Writes (atomically: built in DIR.partial-<pid>, DIR replaced at the end) DIR/path.csv (F*, P*,
@@ -32,6 +35,7 @@ namespace {
 struct Options {
   double loop_length = 0;
   std::vector<double> biaxial;
+  std::vector<double> uniaxial;  ///< AXIS E
   double shear = std::nan("");
   int steps = 20;
   std::string out = "path";
@@ -62,8 +66,9 @@ void write_step_vtp(knit::meso::homog::PeriodicCell& cell, const std::string& fi
 int run(const Options& o) {
   using namespace knit::meso::homog;
   if (!(o.loop_length > 0)) throw knit::InputError("", "--loop-length", "must be positive");
-  const bool bi = !o.biaxial.empty(), sh = !std::isnan(o.shear);
-  if (bi == sh) throw knit::InputError("", "", "give exactly one of --biaxial or --shear");
+  const bool bi = !o.biaxial.empty(), sh = !std::isnan(o.shear), un = !o.uniaxial.empty();
+  if (int(bi) + int(sh) + int(un) != 1)
+    throw knit::InputError("", "", "give exactly one of --biaxial, --shear or --uniaxial");
   if (bi && o.biaxial.size() != 2) throw knit::InputError("", "--biaxial", "needs EPS11 EPS22");
   if (o.steps < 1) throw knit::InputError("", "--steps", "must be >= 1");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
@@ -87,6 +92,15 @@ int run(const Options& o) {
     p.eps22 = o.biaxial[1];
     if (!(1 + p.eps11 > 0 && 1 + p.eps22 > 0))
       throw knit::InputError("", "--biaxial", "strains must be > -1");
+  } else if (un) {
+    if (o.uniaxial.size() != 2) throw knit::InputError("", "--uniaxial", "needs AXIS E");
+    p.kind = PathSpec::Kind::kUniaxial;
+    if (!(o.uniaxial[0] == 0 || o.uniaxial[0] == 1))
+      throw knit::InputError("", "--uniaxial", "AXIS must be 0 (course) or 1 (wale)");
+    p.axis = static_cast<int>(o.uniaxial[0]);
+    if (!(o.uniaxial[1] > -0.5 && o.uniaxial[1] <= 10))
+      throw knit::InputError("", "--uniaxial", "E must be in (-0.5, 10]");
+    p.stretch = std::sqrt(1 + 2 * o.uniaxial[1]);
   } else {
     p.kind = PathSpec::Kind::kShear;
     p.gamma = o.shear * M_PI / 180.0;
@@ -139,7 +153,14 @@ knit::cli::SubcommandRegistrar reg(
                     ->check(number(-1, 10, Ends::kOpenLow));
       auto* s = sub.add_option("--shear", o->shear, "pure-shear angle gamma (degrees)")
                     ->check(number(-80, 80, Ends::kOpen));
+      auto* u = sub.add_option("--uniaxial", o->uniaxial,
+                               "AXIS E: uniaxial stress along AXIS (0 course, 1 wale) to the "
+                               "Green-Lagrange strain E")
+                    ->expected(2)
+                    ->check(number(-0.5, 10, Ends::kOpenLow));
       b->excludes(s);
+      u->excludes(b);
+      u->excludes(s);
       sub.add_option("--steps", o->steps, "load steps (default 20)")
           ->check(knit::cli::integer(1, 100000));
       sub.add_option("-o,--output,--out", o->out, "output directory");

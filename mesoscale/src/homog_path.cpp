@@ -1,6 +1,8 @@
 // Deformation paths of the unit cell: see knit/meso/homog/path.hpp.
 #include "knit/meso/homog/path.hpp"
 
+#include "knit/meso/homog/uniaxial.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +13,9 @@ Eigen::Matrix2d path_F(const PathSpec& p, double lam) {
   Eigen::Matrix2d F;
   if (p.kind == PathSpec::Kind::kBiaxial) {
     F << 1 + lam * p.eps11, 0, 0, 1 + lam * p.eps22;
+  } else if (p.kind == PathSpec::Kind::kUniaxial) {
+    F.setIdentity();
+    F(p.axis, p.axis) = 1 + lam * (p.stretch - 1);
   } else {
     const double g = lam * p.gamma;
     F << 1, std::sin(g), 0, std::cos(g);
@@ -30,8 +35,13 @@ PathResult run_path(PeriodicCell& cell, const PathSpec& path,
   }
   if (on_step) on_step(0, r0);
   const auto t0 = std::chrono::steady_clock::now();
+  UniaxialState uni;
   for (int k = 1; k <= path.steps; ++k) {
-    const StepResult r = cell.solve(path_F(path, double(k) / path.steps));
+    const Eigen::Matrix2d F = path_F(path, double(k) / path.steps);
+    const StepResult r =
+        path.kind == PathSpec::Kind::kUniaxial
+            ? solve_uniaxial_step(cell, path.axis, F(path.axis, path.axis), uni).step
+            : cell.solve(F);
     out.iterations += r.iterations;
     if (!r.converged) {
       out.message = "step " + std::to_string(k) + " did not converge: " + r.message;

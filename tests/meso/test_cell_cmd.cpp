@@ -32,6 +32,13 @@ std::vector<std::vector<std::string>> read_csv(const std::string& path) {
   }
   return rows;
 }
+/// Index of the column `name` in a CSV header.
+std::size_t column(const std::vector<std::string>& header, const std::string& name) {
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return i;
+  FAIL("no column " << name);
+  return 0;
+}
 }  // namespace
 
 TEST_CASE("knit-meso cell writes the geometry and its summary", "[unit]") {
@@ -55,13 +62,7 @@ TEST_CASE("knit-meso path: shear CSV rows and VTP files", "[unit]") {
   REQUIRE(run("path --loop-length 4.5 --shear 20 --steps 3 --elements 16 --out " + out) == 0);
   const auto rows = read_csv(out + "/path.csv");
   REQUIRE(rows.size() == 5);  // header + steps 0..3
-  const auto& h = rows[0];
-  auto col = [&](const std::string& name) {
-    for (std::size_t i = 0; i < h.size(); ++i)
-      if (h[i] == name) return i;
-    FAIL("no column " << name);
-    return std::size_t(0);
-  };
+  auto col = [&](const std::string& name) { return column(rows[0], name); };
   for (int k = 0; k <= 3; ++k) {
     const auto& r = rows[k + 1];
     const double g = 20.0 * M_PI / 180.0 * k / 3.0;
@@ -72,6 +73,28 @@ TEST_CASE("knit-meso path: shear CSV rows and VTP files", "[unit]") {
   CHECK(fs::exists(out + "/yarn_0003.vtp"));
   CHECK(fs::exists(out + "/yarn.pvd"));
   CHECK(run("path --loop-length 4.5 --out " + out) == 2);  // neither --biaxial nor --shear
+}
+
+TEST_CASE("knit-meso path --uniaxial: the lateral stress vanishes at every step", "[unit]") {
+  // Issue 12 (calibration): the sweep's uniaxial kind on the command line. Wale-wise to the
+  // Green-Lagrange strain 0.1 in 3 steps: E22 = 0.1 at the end, E11 < 0 (contraction),
+  // |S11| <= 1e-4 MPa (UniaxialOptions::tol), S22 > 0.
+  const std::string out = std::string(KNIT_BINARY_DIR) + "/test_cell_cmd_uniaxial";
+  fs::remove_all(out);
+  REQUIRE(run("path --loop-length 4.5 --uniaxial 1 0.1 --steps 3 --elements 16 --no-vtp --out " +
+              out) == 0);
+  const auto rows = read_csv(out + "/path.csv");
+  REQUIRE(rows.size() == 5);
+  auto col = [&](const std::string& name) { return column(rows[0], name); };
+  for (int k = 1; k <= 3; ++k) {
+    const auto& r = rows[k + 1];
+    INFO("step " << k);
+    CHECK(std::abs(std::stod(r[col("S11")])) <= 1e-4);
+    CHECK(std::stod(r[col("E11")]) < 0);
+    CHECK(std::stod(r[col("S22")]) > 0);
+    CHECK(std::abs(std::stod(r[col("E12")])) < 1e-12);
+  }
+  CHECK(std::stod(rows[4][col("E22")]) == Approx(0.1).margin(1e-12));
 }
 
 namespace {
@@ -111,6 +134,9 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"path --loop-length 4.5 --shear 5 --mu nan", "--mu", ">= 0"},
       {"path --loop-length 4.5 --shear nan", "--shear", "in (-80, 80)"},
       {"path --loop-length 4.5 --biaxial nan 0", "--biaxial", "in (-1, 10]"},
+      {"path --loop-length 4.5 --uniaxial 1 nan", "--uniaxial", "in (-0.5, 10]"},
+      {"path --loop-length 4.5 --uniaxial 2 0.1", "--uniaxial", "AXIS must be 0 (course) or 1"},
+      {"path --loop-length 4.5 --uniaxial 1 0.1 --shear 5", "--uniaxial", "excludes"},
       {"path --loop-length 4.5 --shear 5 --steps 0", "--steps", "[1, 100000]"},
       {"path --loop-length 4.5 --shear 5 --elements 2", "--elements", "[4, 100000]"},
       {"path --loop-length 4.5 --shear 5 --allowance -0.1", "--allowance", ">= 0"},

@@ -43,6 +43,7 @@ TEST_CASE("stress-free reference cell: no stress unloaded; the old reference kee
   }
   homog::CellOptions old = fast_options();
   old.contact.reference = contact::ContactOptions::Reference::kNone;
+  old.geometry.gamma_over_w = 0.25 / 1.26;  // the loop of the old database (before issue 12)
   homog::PeriodicCell cell(4.5, old);
   CHECK(cell.contacts().num_reference_pairs() == 0);
   const homog::StepResult r0 = cell.equilibrate();

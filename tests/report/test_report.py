@@ -402,11 +402,12 @@ def main():
             for g0 in (0.01, 0.02, 0.04):
                 f.write(f"g0,{g0},max_E22_45_wale_30,{0.3 + g0}\n")
                 f.write(f"g0,{g0},F45_over_F65_wale_30,{2 - g0}\n")
+                f.write(f"g0,{g0},min_ratio_wale,{0.9 + g0}\n")
             for gam in (0.2, 0.25, 0.3):
                 f.write(f"gamma,{gam},max_E22_45_wale_30,{0.35 + gam / 10}\n")
         from sensitivity import draw, read_table
         rows = read_table(table)
-        if len(rows) != 9 or rows[0] != ("g0", 0.01, "max_E22_45_wale_30", 0.31):
+        if len(rows) != 12 or rows[0] != ("g0", 0.01, "max_E22_45_wale_30", 0.31):
             failures.append(f"sensitivity table read as {rows[:2]}")
         draw(rows, os.path.join(tmp, "figures", "sensitivity.png"))
         rep = report.Report(tmp, table)
@@ -415,6 +416,8 @@ def main():
         text = open(os.path.join(tmp, "report.md")).read()
         if "figures/sensitivity.png" not in text or "Not yet measured" in text:
             failures.append("a sensitivity table exists but the report does not show its figure")
+        if "| g0 | 0.04 | 0.940 |" not in text:
+            failures.append("the sensitivity section lacks the headline table (min_ratio_*)")
         with open(table, "w") as f:
             f.write("parameter,value,result\n")
         try:

@@ -29,8 +29,11 @@ struct BoundaryCondition {
   Eigen::Vector2d corner = Eigen::Vector2d::Zero();
   std::array<bool, 3> fix = {false, false, false};
   std::array<std::optional<double>, 3> prescribe;  ///< displacement at load factor 1 (mm)
-  bool clamp = false;   ///< tie the second row to the edge row (zero rotation about the edge)
-  int symmetry = -1;    ///< plane normal component: fix it on the edge row, tie the others
+  bool clamp = false;  ///< tie the second row to the edge row (zero rotation about the edge)
+  int symmetry = -1;   ///< plane normal component: fix it on the edge row, tie the others
+  /// Corner targets: act on every control point of corner_region(radius) (mm; 0 = the corner
+  /// control point alone). A prescribed displacement then moves the region as a rigid pad.
+  double radius = 0.0;
   std::string pointer;  ///< JSON pointer of the entry (for messages)
 };
 
@@ -56,6 +59,7 @@ struct ReactionOutput {
   Eigen::Vector2d corner = Eigen::Vector2d::Zero();
   int component = 0;
   int rows = 1;
+  double radius = 0.0;  ///< corners: sum over corner_region(radius) (the pad of a corner BC)
 };
 
 /// The applied displacement Delta (the prescribed value of a component on an edge or corner,

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "knit/spline/surface.hpp"
+
 namespace knit::macro {
 
 enum class Edge { kU0, kU1, kV0, kV1 };
@@ -23,6 +25,13 @@ std::optional<Eigen::Vector2d> parse_corner(const std::string& s);
 std::vector<int> edge_row(int nu, int nv, Edge e, int row);
 /// Control-point index of a corner (theta values 0 or 1).
 int corner_control_point(int nu, int nv, const Eigen::Vector2d& corner);
+/// A corner region (issue 12, the 3.2.1 mesh study: a corner load spread over a few mm instead
+/// of one control point, whose support shrinks with h): the control points whose Greville point
+/// -- the reference surface at the Greville abscissae (g_i, g_j), where the control point acts
+/// most -- lies within `radius` (mm, straight distance) of the surface corner. Always contains
+/// the corner control point (radius 0: that point alone). Ascending indices.
+std::vector<int> corner_region(const spline::SplineSurface& s, const Eigen::Vector2d& corner,
+                               double radius);
 
 /// Component name "x"/"y"/"z" (or "1"/"2"/"3") -> 0..2, or -1.
 int parse_component(const std::string& s);

@@ -2,6 +2,9 @@
 //   biaxial:    F*(lambda) = diag(1 + lambda eps11, 1 + lambda eps22)
 //   pure shear: F*(lambda) = [[1, sin(lambda gamma)], [0, cos(lambda gamma)]]
 //               (E11 = E22 = 0, E12 = sin(lambda gamma)/2 exactly at every step)
+//   uniaxial:   F*_aa(lambda) = 1 + lambda (stretch - 1) along `axis` (0 = course, 1 = wale),
+//               the lateral stretch found so that S_bb = 0 (homog/uniaxial.hpp; the sweep's
+//               uniaxial kind, knit/material/load_paths.hpp)
 // lambda = k / steps, k = 0..steps; step 0 is the equilibrated initial state (zero stress with
 // the stress-free reference, the residual stress with contact.reference = none).
 #pragma once
@@ -16,13 +19,17 @@
 namespace knit::meso::homog {
 
 struct PathSpec {
-  enum class Kind { kBiaxial, kShear };
+  enum class Kind { kBiaxial, kShear, kUniaxial };
   Kind kind = Kind::kBiaxial;
   double eps11 = 0, eps22 = 0;  ///< biaxial strains in F*
   double gamma = 0;             ///< shear angle [rad]
+  int axis = 0;                 ///< uniaxial: 0 = course (F11 prescribed), 1 = wale (F22)
+  double stretch = 1;           ///< uniaxial: end stretch F*_aa along `axis`
   int steps = 20;
 };
 
+/// The prescribed F* at `lambda`; for a uniaxial path only the prescribed stretch is meaningful
+/// (the lateral entry is 1: the solve finds it).
 Eigen::Matrix2d path_F(const PathSpec& path, double lambda);
 
 struct PathResult {
