@@ -252,7 +252,7 @@ void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   double D = 0;
   visit(sys, x, false, [&](const Found& f, const PairResult& r) {
     next[3 * f.point + f.course + 1].push_back(r.u_anchor_new);
-    D += weight_[f.point] * r.dissipation;
+    D += 0.5 * weight_[f.point] * r.dissipation;  // two passes, half each (as forces, energy)
   });
   history_ = std::move(next);
   pending_.assign(history_.size(), {});
