@@ -8,6 +8,7 @@ Units: mm, N, MPa. All validation patches are 50 x 50 mm, t = 2d = 0.76 mm (pape
 The database path is relative to this directory and points at the default pipeline output
 (out/database.h5); the pipeline (scripts/pipeline.mk) rewrites it to the database it built.
 """
+import copy
 import json
 import math
 import os
@@ -150,10 +151,15 @@ cases["s315_diagonal_45deg_vertical"] = case(
     "Paper Sect. 3.1.5, Fig. 12: 4.5 mm in the bottom-left half, 6.5 mm in the top-right half, "
     "constant knitting angle alpha = pi/4 (course direction at 45 deg to theta1), vertical "
     f"tensile test. {TENSILE} CHOICE (the paper is silent): p = 5 x 5 with h = 2 x 2 elements (the "
-    f"diagonal interface runs through the element corners). With the sweep database h = 3 and 4 "
-    f"stop within the first steps (the strain localizes in the 2.5 mm transition band and the "
-    f"response-surface inversion fails there), h = 2 completes. {PLANAR}",
+    f"diagonal interface runs through the element corners). With the eq. 17 law of the old sweep "
+    f"database h = 3 and 4 stopped within the first steps (the response-surface inversion failed "
+    f"in the 2.5 mm transition band); with the energy law h = 4 completes too (mesh315_p5h4). "
+    f"{PLANAR}",
     SQUARE, knit(DIAG_FIELD, PI / 4), bcs, out, elements=(2, 2))
+cases["mesh315_p5h4"] = case(
+    "Paper Sect. 3.1.5 (s315_diagonal_45deg_vertical) refined to p = 5, h = 4 x 4: issue 11 asks "
+    f"that it completes with the energy law. {TENSILE} {PLANAR}",
+    SQUARE, knit(DIAG_FIELD, PI / 4), bcs, out, elements=(4, 4))
 
 # --- 3.2.1 bilinear l and alpha, diagonal test ------------------------------------------------
 BIL_L = field([1, 1], [0, 0, 1, 1], [0, 0, 1, 1], [4.5, 6.5, 6.5, 4.5],
@@ -234,9 +240,9 @@ cases["s322_curved_horizontal"] = case(
     "stitch value cubic in theta1, knitting direction aligned with x1. Left edge (u0) fixed, "
     "right edge (u1) displaced horizontally by 20 mm (40 % of L = 50 mm) with its vertical "
     "displacement held; the load is the edge reaction in x. CHOICE (the paper is silent): "
-    "refinement p = 5 x 5, h = 1 x 1 as in the validation cases (with the sweep database, "
-    "h = 2 and 4 stop early: the response-surface inversion fails at the extreme strains of the "
-    "fixed corners); edges not clamped. 20 steps, so step 15 is 30 %. "
+    "refinement p = 5 x 5, h = 1 x 1 as in the validation cases (with the eq. 17 law of the old "
+    "sweep database h = 2 and 4 stopped early; with the energy law h = 4 completes too, "
+    "mesh322_p5h4); edges not clamped. 20 steps, so step 15 is 30 %. "
     f"{PLANAR}",
     CURVED, knit(CUBIC_L, ALIGN),
     [{"all": True, "fix": ["z"]},
@@ -246,6 +252,14 @@ cases["s322_curved_horizontal"] = case(
      "reactions": [{"name": "load", "edge": "u1", "component": "x"}],
      "applied_displacement": {"edge": "u1", "component": "x", "gauge_length": L}},
     elements=(1, 1))
+
+mesh322 = copy.deepcopy(cases["s322_curved_horizontal"])
+mesh322["description"] = ("Paper Sect. 3.2.2 (s322_curved_horizontal) refined to p = 5, h = 4 x 4: "
+                          "issue 11 asks that it completes with the energy law. Same fields, "
+                          "supports and displacement; output every 5 steps. " + PLANAR)
+mesh322["refinement"]["elements"] = [4, 4]
+mesh322["output"]["every"] = 5
+cases["mesh322_p5h4"] = mesh322
 
 # --- 3.2.3 hyperbolic paraboloid ---------------------------------------------------------------
 # The paper prints x3 = 0.24 (x1 - 2.5)(x2 - 2.5) in cm (corners at +-1.5 cm); in mm:
