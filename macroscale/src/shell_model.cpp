@@ -169,8 +169,15 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       const Point& pt = points_[pid];
       const auto R = R_.block(0, static_cast<Eigen::Index>(pid) * nl, 6, nl);
       // dx = R xloc as a sum of outer products (contiguous columns of R, no GEMM call).
-      SurfaceDerivs dx = SurfaceDerivs::Zero();
-      for (int l = 0; l < nl; ++l) dx.noalias() += R.col(l) * xloc.row(l);
+      Eigen::Matrix<double, 6, 1> d0 = Eigen::Matrix<double, 6, 1>::Zero(), d1 = d0, d2 = d0;
+      for (int l = 0; l < nl; ++l) {
+        const Eigen::Matrix<double, 6, 1> r = R.col(l);
+        d0 += r * xloc(l, 0);
+        d1 += r * xloc(l, 1);
+        d2 += r * xloc(l, 2);
+      }
+      SurfaceDerivs dx;
+      dx << d0, d1, d2;
       const CurrentPoint c = current_point(dx, pt.ref);
       if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite())
         return false;
@@ -256,12 +263,20 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
     // GEMM Phi^T [ (H Phi)_ij^T ... ] (nloc x 5 nq times 5 nq x pairs nloc).
     const int nq = el.num_points;
     const Eigen::MatrixXd& PhiT = el.PhiT;
+    // Symmetric: the off-diagonal pairs (0,1), (0,2), (1,2) first, then the diagonal ones,
+    // whose blocks are symmetric: only their lower triangles are computed.
     int pairs = 0;
     int pi[9], pj[9];
     for (int i = 0; i < 3; ++i)
-      for (int j = symmetric ? i : 0; j < 3; ++j) {
+      for (int j = symmetric ? i + 1 : 0; j < 3; ++j) {
         pi[pairs] = i;
         pj[pairs++] = j;
+      }
+    const int full = pairs;  // pairs computed as full blocks
+    if (symmetric)
+      for (int i = 0; i < 3; ++i) {
+        pi[pairs] = i;
+        pj[pairs++] = i;
       }
     const Eigen::Index ldw = W.rows();
     for (int q = 0; q < nq; ++q) {
@@ -278,15 +293,24 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
             w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
         }
     }
-    Kall.leftCols(pairs * nl).noalias() =
-        PhiT.leftCols(5 * nq) * W.topLeftCorner(pairs * nl, 5 * nq).transpose();
+    const auto Phi5 = PhiT.leftCols(5 * nq);
+    Kall.leftCols(full * nl).noalias() = Phi5 * W.topLeftCorner(full * nl, 5 * nq).transpose();
+    for (int p = full; p < pairs; ++p)
+      Kall.middleCols(p * nl, nl).triangularView<Eigen::Lower>() =
+          Phi5 * W.block(p * nl, 0, nl, 5 * nq).transpose();
     Eigen::MatrixXd& Ke = out.Ke[e];
     for (int p = 0; p < pairs; ++p) {
       const int i = pi[p], j = pj[p];
       const auto Kij = Kall.middleCols(p * nl, nl);
+      if (p >= full) {  // symmetric diagonal block from its lower triangle
+        for (int m = 0; m < nl; ++m)
+          for (int l = m; l < nl; ++l)
+            Ke(3 * l + i, 3 * m + i) = Ke(3 * m + i, 3 * l + i) = Kij(l, m);
+        continue;
+      }
       for (int m = 0; m < nl; ++m)
         for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) = Kij(l, m);
-      if (symmetric && j != i)
+      if (symmetric)
         for (int m = 0; m < nl; ++m)
           for (int l = 0; l < nl; ++l) Ke(3 * m + j, 3 * l + i) = Kij(l, m);
     }

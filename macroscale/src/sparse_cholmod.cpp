@@ -3,6 +3,7 @@
 
 #ifdef KNIT_HAVE_CHOLMOD
 #include <cholmod.h>
+#include <dlfcn.h>
 #endif
 
 #include <algorithm>
@@ -13,6 +14,19 @@ namespace knit::macro {
 #ifdef KNIT_HAVE_CHOLMOD
 
 namespace {
+
+/// Debian's CHOLMOD runs a few short loops of the supernodal factorization in OpenMP parallel
+/// regions with a built-in thread count (num_threads(4)); on a busy 2-core machine waking
+/// those threads cost more than the loops (a 1,440-unknown run: 5.2 s CPU with them limited
+/// to one thread, 5.7-6.0 s without). The BLAS calls, where the work is, are serial anyway. A
+/// max-active-levels of 0 makes every parallel region of the calling thread run on that
+/// thread alone. Looked up at run time: present only when CHOLMOD brought libgomp along.
+void serial_openmp_regions() {
+  using SetLevels = void (*)(int);
+  static const auto set_levels =
+      reinterpret_cast<SetLevels>(::dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  if (set_levels) set_levels(0);
+}
 
 /// A view of Eigen's compressed lower triangle as a CHOLMOD matrix (no copy; stype -1: only
 /// the lower triangle is referenced).
@@ -82,6 +96,7 @@ bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>& lower) {
 SupernodalCholesky::Status SupernodalCholesky::factorize(
     const Eigen::SparseMatrix<double>& lower) {
   if (!impl_->L) return Status::kFailed;
+  serial_openmp_regions();
   cholmod_sparse A = view(lower);
   cholmod_factorize(&A, impl_->L, &impl_->c);
   if (impl_->c.status == CHOLMOD_NOT_POSDEF) return Status::kNotPositiveDefinite;
