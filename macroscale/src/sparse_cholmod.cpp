@@ -71,7 +71,9 @@ struct SupernodalCholesky::Impl {
   }
 };
 
-bool SupernodalCholesky::available() { return true; }
+bool SupernodalCholesky::available() {
+  return true;
+}
 
 std::vector<int> SupernodalCholesky::fill_reducing_ordering(
     const Eigen::SparseMatrix<double>& lower) {
@@ -93,8 +95,7 @@ bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>& lower) {
   return impl_->L != nullptr && impl_->c.status == CHOLMOD_OK;
 }
 
-SupernodalCholesky::Status SupernodalCholesky::factorize(
-    const Eigen::SparseMatrix<double>& lower) {
+SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
   if (!impl_->L) return Status::kFailed;
   serial_openmp_regions();
   cholmod_sparse A = view(lower);
@@ -149,17 +150,23 @@ Eigen::VectorXd SupernodalCholesky::solve(const Eigen::VectorXd& b) const {
 #else  // without CHOLMOD: never used (available() is false)
 
 struct SupernodalCholesky::Impl {};
-bool SupernodalCholesky::available() { return false; }
+bool SupernodalCholesky::available() {
+  return false;
+}
 SupernodalCholesky::SupernodalCholesky() = default;
 SupernodalCholesky::~SupernodalCholesky() = default;
 std::vector<int> SupernodalCholesky::fill_reducing_ordering(const Eigen::SparseMatrix<double>&) {
   return {};
 }
-bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>&) { return false; }
+bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>&) {
+  return false;
+}
 SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>&) {
   return Status::kFailed;
 }
-Eigen::VectorXd SupernodalCholesky::pivots() const { return {}; }
+Eigen::VectorXd SupernodalCholesky::pivots() const {
+  return {};
+}
 Eigen::VectorXd SupernodalCholesky::solve(const Eigen::VectorXd& b) const {
   return Eigen::VectorXd::Constant(b.size(), std::numeric_limits<double>::quiet_NaN());
 }
