@@ -9,6 +9,7 @@ PACKAGES=(
   libceres-dev           # response-surface fitting (2.1)
   nlohmann-json3-dev     # JSON input (3.11)
   libhdf5-dev            # material database and results (1.10)
+  libsuitesparse-dev     # CHOLMOD: supernodal Cholesky of the shell tangent (5.12)
   catch2                 # tests (2.13)
   libcli11-dev           # command lines (2.1)
   libopenmpi-dev openmpi-bin   # distributed database sweep

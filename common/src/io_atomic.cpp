@@ -47,6 +47,47 @@ fs::path parent_or_dot(const fs::path& p) {
   return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
 
+bool pid_is_dead(long pid) {
+  return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+/// The pid in a name "<prefix><pid>" (with_counter: "<prefix><pid>-<n>"), or -1 if the name
+/// has another form (digits only, at most 9 of them).
+long pid_in_name(const std::string& f, const std::string& prefix, bool with_counter) {
+  if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) return -1;
+  std::string digits = f.substr(prefix.size());
+  if (with_counter) {
+    const size_t dash = digits.find('-');
+    if (dash == std::string::npos) return -1;
+    const std::string n = digits.substr(dash + 1);
+    if (n.empty() || n.size() > 9 || n.find_first_not_of("0123456789") != std::string::npos)
+      return -1;
+    digits.resize(dash);
+  }
+  if (digits.empty() || digits.size() > 9 ||
+      digits.find_first_not_of("0123456789") != std::string::npos)
+    return -1;
+  return std::stol(digits);
+}
+
+/// Removes the temporaries ".<name>.tmp-<pid>-<n>" of `target` left by killed runs: regular
+/// files only, and only when their pid is dead (ours may be writing another one right now).
+void remove_stale_temporaries(const fs::path& target) {
+  std::string prefix(".");
+  prefix += target.filename().string();
+  prefix += ".tmp-";
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(parent_or_dot(target), ec);
+       !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const long pid = pid_in_name(it->path().filename().string(), prefix, true);
+    std::error_code st;
+    if (pid > 0 && pid_is_dead(pid) && fs::is_regular_file(fs::symlink_status(it->path(), st))) {
+      std::error_code rm;
+      fs::remove(it->path(), rm);
+    }
+  }
+}
+
 }  // namespace
 
 // ---- AtomicFile -----------------------------------------------------------------------------
@@ -64,6 +105,7 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   name += '-';
   name += std::to_string(g_counter++);
   temp_ = dir / name;
+  remove_stale_temporaries(target_);
 }
 
 AtomicFile::AtomicFile(AtomicFile&& o) noexcept
@@ -128,10 +170,6 @@ fs::path prepare_target(fs::path target, std::string_view option) {
   return target;
 }
 
-bool pid_is_dead(long pid) {
-  return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
-}
-
 /// Removes "<target>.partial-<pid>" and "<target>.old-<pid>" left by killed runs: only those
 /// whose pid is dead (or ours: an earlier run with a recycled pid) and which hold the marker.
 void remove_stale_siblings(const fs::path& target) {
@@ -141,12 +179,8 @@ void remove_stale_siblings(const fs::path& target) {
        !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const std::string f = it->path().filename().string();
     for (const char* tag : {".partial-", ".old-"}) {
-      const std::string prefix = name + tag;
-      if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string digits = f.substr(prefix.size());
-      if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
-        continue;
-      const long pid = std::stol(digits);
+      const long pid = pid_in_name(f, name + tag, false);
+      if (pid < 0) continue;
       if ((pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path())) {
         std::error_code rm;
         fs::remove_all(it->path(), rm);

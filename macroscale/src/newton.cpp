@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <optional>
 #include <sstream>
 
@@ -14,6 +15,11 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// CPU seconds of the process (all threads): the cost of a phase on a loaded machine.
+double cpu_now() {
+  return double(std::clock()) / CLOCKS_PER_SEC;
 }
 
 /// The residual at one iterate.
@@ -86,12 +92,13 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   const bool sparse = opt.linear_solver == LinearSolver::kSparse ||
                       (opt.linear_solver == LinearSolver::kAuto && n > opt.dense_limit);
   const auto t_setup = Clock::now();
-  ReducedTangent K(model, dofs, hyper && opt.symmetric, sparse);
+  ReducedTangent K(model, dofs, hyper && opt.symmetric, sparse, opt.supernodal);
   stats.setup = since(t_setup);
   stats.unknowns = n;
   stats.stored_entries = K.stored_entries();
   stats.sparse = sparse;
   stats.symmetric = K.symmetric();
+  stats.supernodal = K.supernodal();
   stats.threads = model.assembly_threads();
 
   const int nsteps = std::max(1, opt.steps);
@@ -172,6 +179,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       }
       ++stats.iterations;
       auto t0 = Clock::now();
+      double c0 = cpu_now();
       model.evaluate(dofs.expand(uf, lam), true, ev);
       if (!ev.ok) {
         o.why = why_not(Eval::kDegenerate, cur);
@@ -179,11 +187,14 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       }
       K.assemble(ev.Ke);
       stats.assembly += since(t0);
+      stats.assembly_cpu += cpu_now() - c0;
       t0 = Clock::now();
+      c0 = cpu_now();
       const Factorization f = K.factorize();
       Eigen::VectorXd du;
       if (f.ok) du = K.solve(-cur.r);
       stats.solve += since(t0);
+      stats.solve_cpu += cpu_now() - c0;
       if (!f.ok) {
         o.why = f.why;
         return o;

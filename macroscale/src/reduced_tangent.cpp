@@ -8,6 +8,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "sparse_cholmod.hpp"
+
 namespace knit::macro {
 
 namespace {
@@ -61,10 +63,18 @@ struct ReducedTangent::Factors {
   Eigen::LDLT<Eigen::MatrixXd, Eigen::Lower> dense_ldlt;
   PivotedSparseLU sparse_lu;
   Eigen::SimplicialLDLT<SpMat, Eigen::Lower> sparse_ldlt;
+  bool ldlt_analyzed = false;
+  SupernodalCholesky cholesky;
+  bool cholesky_active = false;  ///< the last factorization was the supernodal Cholesky
 };
 
-ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool symmetric, bool sparse)
-    : n_(dofs.num_free()), symmetric_(symmetric), sparse_(sparse), f_(std::make_unique<Factors>()) {
+ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool symmetric, bool sparse,
+                               bool supernodal)
+    : n_(dofs.num_free()),
+      symmetric_(symmetric),
+      sparse_(sparse),
+      supernodal_(symmetric && sparse && supernodal && SupernodalCholesky::available()),
+      f_(std::make_unique<Factors>()) {
   const int ne = m.num_elements();
   const int nd =
       m.num_elements() > 0 ? 3 * static_cast<int>(m.element_control_points(0).size()) : 0;
@@ -91,9 +101,37 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
         }
     return;
   }
+  build_pattern(g, nd);
+  if (supernodal_) {
+    // CHOLMOD's fill-reducing ordering, then the pattern and the scatter map rebuilt in that
+    // order: the Cholesky then takes the lower triangle as it is (natural ordering), without
+    // the permuted transpose it would otherwise form at every factorization.
+    perm_ = SupernodalCholesky::fill_reducing_ordering(sparse_matrix_);
+    if (static_cast<int>(perm_.size()) == n_) {
+      std::vector<int> inv(n_);
+      for (int k = 0; k < n_; ++k) inv[perm_[k]] = k;
+      for (int& x : g)
+        if (x >= 0) x = inv[x];
+      build_pattern(g, nd);
+    } else {
+      perm_.clear();
+    }
+  }
+  // Symbolic analysis, once per run (the LDLT's only when the Cholesky needs a fallback).
+  if (supernodal_) supernodal_ = n_ > 0 && f_->cholesky.analyze(sparse_matrix_);
+  if (!symmetric_)
+    f_->sparse_lu.analyzePattern(sparse_matrix_);
+  else if (!supernodal_)
+    analyze_ldlt();
+}
+
+void ReducedTangent::build_pattern(const std::vector<int>& g, int nd) {
+  auto wanted = [&](int gr, int gs) { return gr >= 0 && gs >= 0 && (!symmetric_ || gr >= gs); };
   // Pattern: per column the sorted rows of every element that couples them.
   std::vector<std::vector<int>> cols(n_);
   std::vector<int> ge;
+  const int ne = static_cast<int>(g.size() / std::max<size_t>(1, size_t(nd)));
+  map_.assign(static_cast<size_t>(ne) * block_, -1);
   for (int e = 0; e < ne; ++e) {
     ge.assign(g.begin() + size_t(e) * nd, g.begin() + size_t(e + 1) * nd);
     std::sort(ge.begin(), ge.end());
@@ -128,14 +166,19 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
         map_[size_t(e) * block_ + r + size_t(nd) * s] =
             static_cast<int>(std::lower_bound(b, end, gr) - K.innerIndexPtr());
       }
-  // Symbolic analysis, once per run.
-  if (symmetric_)
-    f_->sparse_ldlt.analyzePattern(K);
-  else
-    f_->sparse_lu.analyzePattern(K);
+}
+
+void ReducedTangent::analyze_ldlt() {
+  if (f_->ldlt_analyzed) return;
+  f_->sparse_ldlt.analyzePattern(sparse_matrix_);
+  f_->ldlt_analyzed = true;
 }
 
 ReducedTangent::~ReducedTangent() = default;
+
+bool ReducedTangent::supernodal_available() {
+  return SupernodalCholesky::available();
+}
 
 long ReducedTangent::stored_entries() const {
   return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
@@ -179,6 +222,16 @@ Factorization ReducedTangent::factorize() {
     return from_pivots(f_->dense_ldlt.vectorD(), true, "dense LDLT");
   }
   if (symmetric_) {
+    f_->cholesky_active = false;
+    if (supernodal_) {
+      const auto st = f_->cholesky.factorize(sparse_matrix_);
+      if (st == SupernodalCholesky::Status::kOk) {
+        f_->cholesky_active = true;
+        return from_pivots(f_->cholesky.pivots(), true, "supernodal Cholesky");
+      }
+      // Indefinite (or CHOLMOD failed): the LDLT below counts the negative pivots.
+    }
+    analyze_ldlt();
     f_->sparse_ldlt.factorize(sparse_matrix_);
     if (f_->sparse_ldlt.info() != Eigen::Success) {
       Factorization f;
@@ -204,11 +257,29 @@ Eigen::VectorXd ReducedTangent::solve(const Eigen::VectorXd& b) const {
   if (!sparse_)
     return symmetric_ ? Eigen::VectorXd(f_->dense_ldlt.solve(b))
                       : Eigen::VectorXd(f_->dense_lu.solve(b));
+  if (perm_.empty()) return solve_stored(b);
+  // Stored order k holds the unknown perm_[k].
+  Eigen::VectorXd bp(n_), x(n_);
+  for (int k = 0; k < n_; ++k) bp(k) = b(perm_[k]);
+  const Eigen::VectorXd xp = solve_stored(bp);
+  for (int k = 0; k < n_; ++k) x(perm_[k]) = xp(k);
+  return x;
+}
+
+Eigen::VectorXd ReducedTangent::solve_stored(const Eigen::VectorXd& b) const {
+  if (f_->cholesky_active) return f_->cholesky.solve(b);
   return symmetric_ ? Eigen::VectorXd(f_->sparse_ldlt.solve(b))
                     : Eigen::VectorXd(f_->sparse_lu.solve(b));
 }
 
 Eigen::VectorXd ReducedTangent::multiply(const Eigen::VectorXd& x) const {
+  if (sparse_ && !perm_.empty()) {
+    Eigen::VectorXd xp(n_), y(n_);
+    for (int k = 0; k < n_; ++k) xp(k) = x(perm_[k]);
+    const Eigen::VectorXd yp = sparse_matrix_.selfadjointView<Eigen::Lower>() * xp;
+    for (int k = 0; k < n_; ++k) y(perm_[k]) = yp(k);
+    return y;
+  }
   if (sparse_)
     return symmetric_ ? Eigen::VectorXd(sparse_matrix_.selfadjointView<Eigen::Lower>() * x)
                       : Eigen::VectorXd(sparse_matrix_ * x);

@@ -65,8 +65,8 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
           pt.ref = reference_point(dX, Eigen::Vector2d(u, v), scale_);
           pt.dA = w * pt.ref.jacobian;
           R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 6, nloc_) = sb.R;
-          el.Phi.conservativeResize(el.Phi.rows() + 5, nloc_);
-          el.Phi.bottomRows(5) = sb.R.bottomRows(5);
+          el.PhiT.conservativeResize(nloc_, el.PhiT.cols() + 5);
+          el.PhiT.rightCols(5) = sb.R.bottomRows(5).transpose();
           points_.push_back(pt);
           thetas.emplace_back(u, v);
         }
@@ -149,8 +149,12 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
   Eigen::Matrix<double, Eigen::Dynamic, 3> xloc(nl, 3), fe(nl, 3);
   Eigen::Matrix<double, 6, 15> G = Eigen::Matrix<double, 6, 15>::Zero();
   std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
-  Eigen::MatrixXd Y, Kij(nl, nl);
-  if (tangent) Y.resize(5 * maxq, nl);
+  // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked, Kall = Phi^T W^T.
+  Eigen::MatrixXd W, Kall;
+  if (tangent) {
+    W.resize(9 * nl, 5 * maxq);
+    Kall.resize(nl, 9 * nl);
+  }
   for (int e = e0; e < e1; ++e) {
     const Element& el = elements_[e];
     for (int l = 0; l < nl; ++l) {
@@ -164,7 +168,16 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       const int pid = el.first_point + q;
       const Point& pt = points_[pid];
       const auto R = R_.block(0, static_cast<Eigen::Index>(pid) * nl, 6, nl);
-      const SurfaceDerivs dx = R * xloc;
+      // dx = R xloc as a sum of outer products (contiguous columns of R, no GEMM call).
+      Eigen::Matrix<double, 6, 1> d0 = Eigen::Matrix<double, 6, 1>::Zero(), d1 = d0, d2 = d0;
+      for (int l = 0; l < nl; ++l) {
+        const Eigen::Matrix<double, 6, 1> r = R.col(l);
+        d0 += r * xloc(l, 0);
+        d1 += r * xloc(l, 1);
+        d2 += r * xloc(l, 2);
+      }
+      SurfaceDerivs dx;
+      dx << d0, d1, d2;
       const CurrentPoint c = current_point(dx, pt.ref);
       if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite())
         return false;
@@ -196,7 +209,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       NM << N, M;
       const Eigen::Matrix<double, 15, 1> g = pt.dA * (G.transpose() * NM);
       const Eigen::Map<const Eigen::Matrix<double, 3, 5>> gm(g.data());
-      fe.noalias() += R.bottomRows(5).transpose() * gm.transpose();
+      fe.noalias() += R.bottomRows(5).transpose().lazyProduct(gm.transpose());
       if (!tangent) continue;
       // Material part H = G^T D G with D the covariant section tangent.
       Eigen::Matrix<double, 6, 6> D;
@@ -245,25 +258,61 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
     for (int l = 0; l < nl; ++l) out.fe.col(e).segment<3>(3 * l) = fe.row(l).transpose();
     out.element_energy(e) = energy;
     if (!tangent) continue;
-    // K(3l+i, 3m+j) = sum_q Phi_q^T H_q(i-th, j-th components) Phi_q: one GEMM per (i, j).
+    // K(3l+i, 3m+j) = sum_q sum_fk Phi_f(l) H_q(3f+i, 3k+j) Phi_k(m): per pair (i, j) the
+    // columns (H Phi)^T (one axpy of length nloc per (f, k), vectorized), then all pairs in one
+    // GEMM Phi^T [ (H Phi)_ij^T ... ] (nloc x 5 nq times 5 nq x pairs nloc).
     const int nq = el.num_points;
-    const Eigen::MatrixXd& Phi = el.Phi;
-    Eigen::MatrixXd& Ke = out.Ke[e];
-    for (int i = 0; i < 3; ++i) {
-      for (int j = symmetric ? i : 0; j < 3; ++j) {
-        for (int q = 0; q < nq; ++q) {
-          Eigen::Matrix<double, 5, 5> h;
-          for (int f = 0; f < 5; ++f)
-            for (int k = 0; k < 5; ++k) h(f, k) = Hs[q](3 * f + i, 3 * k + j);
-          Y.middleRows(5 * q, 5).noalias() = h * Phi.middleRows(5 * q, 5);
-        }
-        Kij.noalias() = Phi.topRows(5 * nq).transpose() * Y.topRows(5 * nq);
-        for (int m = 0; m < nl; ++m)
-          for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) = Kij(l, m);
-        if (symmetric && j != i)
-          for (int m = 0; m < nl; ++m)
-            for (int l = 0; l < nl; ++l) Ke(3 * m + j, 3 * l + i) = Kij(l, m);
+    const Eigen::MatrixXd& PhiT = el.PhiT;
+    // Symmetric: the off-diagonal pairs (0,1), (0,2), (1,2) first, then the diagonal ones,
+    // whose blocks are symmetric: only their lower triangles are computed.
+    int pairs = 0;
+    int pi[9], pj[9];
+    for (int i = 0; i < 3; ++i)
+      for (int j = symmetric ? i + 1 : 0; j < 3; ++j) {
+        pi[pairs] = i;
+        pj[pairs++] = j;
       }
+    const int full = pairs;  // pairs computed as full blocks
+    if (symmetric)
+      for (int i = 0; i < 3; ++i) {
+        pi[pairs] = i;
+        pj[pairs++] = i;
+      }
+    const Eigen::Index ldw = W.rows();
+    for (int q = 0; q < nq; ++q) {
+      const Mat15& Hq = Hs[q];
+      const double* c0 = PhiT.data() + static_cast<Eigen::Index>(5 * q) * nl;
+      const double *c1 = c0 + nl, *c2 = c1 + nl, *c3 = c2 + nl, *c4 = c3 + nl;
+      for (int p = 0; p < pairs; ++p)
+        for (int f = 0; f < 5; ++f) {
+          const int row = 3 * f + pi[p], cj = pj[p];
+          const double h0 = Hq(row, cj), h1 = Hq(row, 3 + cj), h2 = Hq(row, 6 + cj),
+                       h3 = Hq(row, 9 + cj), h4 = Hq(row, 12 + cj);
+          double* w = W.data() + (5 * q + f) * ldw + p * nl;
+          for (int l = 0; l < nl; ++l)
+            w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
+        }
+    }
+    const auto Phi5 = PhiT.leftCols(5 * nq);
+    Kall.leftCols(full * nl).noalias() = Phi5 * W.topLeftCorner(full * nl, 5 * nq).transpose();
+    for (int p = full; p < pairs; ++p)
+      Kall.middleCols(p * nl, nl).triangularView<Eigen::Lower>() =
+          Phi5 * W.block(p * nl, 0, nl, 5 * nq).transpose();
+    Eigen::MatrixXd& Ke = out.Ke[e];
+    for (int p = 0; p < pairs; ++p) {
+      const int i = pi[p], j = pj[p];
+      const auto Kij = Kall.middleCols(p * nl, nl);
+      if (p >= full) {  // symmetric diagonal block from its lower triangle
+        for (int m = 0; m < nl; ++m)
+          for (int l = m; l < nl; ++l)
+            Ke(3 * l + i, 3 * m + i) = Ke(3 * m + i, 3 * l + i) = Kij(l, m);
+        continue;
+      }
+      for (int m = 0; m < nl; ++m)
+        for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) = Kij(l, m);
+      if (symmetric)
+        for (int m = 0; m < nl; ++m)
+          for (int l = 0; l < nl; ++l) Ke(3 * m + j, 3 * l + i) = Kij(l, m);
     }
   }
   return true;

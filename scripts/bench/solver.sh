@@ -5,7 +5,10 @@
 #  * the Sze cantilever at 16x1, 32x1, 64x1 with the defaults (target: 64x1/16x1 <= 4.5);
 #  * the tensile patch at p = 4, 8 x 40 elements (1,584 DOFs, 40 steps; targets <= 5 s on one
 #    core, <= 15 ms per Newton iteration) and 16 x 100 elements (6,240 DOFs; <= 60 ms per
-#    iteration), with the time per Newton iteration split into assembly and solve.
+#    iteration), with the time per Newton iteration split into assembly and solve, as wall
+#    and as CPU time (on a loaded machine the CPU figures of the one-thread runs are the cost);
+#    each also with the SimplicialLDLT instead of CHOLMOD's supernodal Cholesky.
+# Figures of 30 Nov 2026: docs/solver.md "Benchmark".
 # Usage: scripts/bench/solver.sh [BUILD_DIR] [CATCH_TEST_NAME_FILTER]
 set -euo pipefail
 BUILD_DIR=${1:-build}

@@ -307,6 +307,32 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(fs::exists(d / ("other.partial-" + dead)));
 }
 
+TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its target",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("stale_tmp");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string dead = std::to_string(999999999);
+  auto make = [&](const std::string& name) { std::ofstream(d / name) << "partial"; };
+  make(".db.h5.tmp-" + dead + "-0");                          // dead writer: removed
+  make(".db.h5.tmp-" + dead + "-17");                         // dead writer: removed
+  make(".db.h5.tmp-1-0");                                     // pid 1 lives: kept
+  make(".db.h5.tmp-" + dead);                                 // no counter: not our pattern
+  make(".db.h5.tmp-" + dead + "-x");                          // not a counter
+  make(".other.h5.tmp-" + dead + "-0");                       // another target
+  fs::create_directories(d / (".db.h5.tmp-" + dead + "-3"));  // a directory: kept
+  knit::io::write_file_atomically(d / "db.h5", "new");
+  CHECK(slurp(d / "db.h5") == "new");
+  CHECK_FALSE(fs::exists(d / (".db.h5.tmp-" + dead + "-0")));
+  CHECK_FALSE(fs::exists(d / (".db.h5.tmp-" + dead + "-17")));
+  CHECK(fs::exists(d / ".db.h5.tmp-1-0"));
+  CHECK(fs::exists(d / (".db.h5.tmp-" + dead)));
+  CHECK(fs::exists(d / (".db.h5.tmp-" + dead + "-x")));
+  CHECK(fs::exists(d / (".other.h5.tmp-" + dead + "-0")));
+  CHECK(fs::is_directory(d / (".db.h5.tmp-" + dead + "-3")));
+  fs::remove_all(d);
+}
+
 TEST_CASE("Output sizes: parsed from the command line, printed in decimal units",
           "[unit][io][atomic]") {
   CHECK(knit::io::parse_size("2G", "--max") == 2'000'000'000u);

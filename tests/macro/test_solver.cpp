@@ -59,30 +59,36 @@ RunResult run(const json& j, const std::function<void(Case&)>& edit = {}) {
 
 }  // namespace
 
-TEST_CASE("dense LU, sparse LU, dense LDLT and sparse LDLT give the same load-strain curve",
-          "[unit]") {
+TEST_CASE(
+    "dense LU, sparse LU, dense LDLT, sparse LDLT and the supernodal Cholesky give the same "
+    "load-strain curve",
+    "[unit]") {
   json j = verification_case("sze_cantilever.json");
   j["refinement"]["elements"] = {6, 1};
   j["solver"]["steps"] = 4;
   struct Path {
     LinearSolver solver;
-    bool symmetric;
+    bool symmetric, supernodal;
   };
-  const Path paths[4] = {{LinearSolver::kDense, false},
-                         {LinearSolver::kSparse, false},
-                         {LinearSolver::kDense, true},
-                         {LinearSolver::kSparse, true}};
+  const Path paths[5] = {{LinearSolver::kDense, false, false},
+                         {LinearSolver::kSparse, false, false},
+                         {LinearSolver::kDense, true, false},
+                         {LinearSolver::kSparse, true, false},
+                         {LinearSolver::kSparse, true, true}};
   std::vector<RunResult> r;
   for (const Path& p : paths) {
     r.push_back(run(j, [&](Case& c) {
       c.solver.linear_solver = p.solver;
       c.solver.symmetric = p.symmetric;
+      c.solver.supernodal = p.supernodal;
     }));
     REQUIRE(r.back().report.status == RunStatus::kCompleted);
     CHECK(r.back().report.stats.sparse == (p.solver == LinearSolver::kSparse));
     CHECK(r.back().report.stats.symmetric == p.symmetric);
+    CHECK(r.back().report.stats.supernodal ==
+          (p.supernodal && ReducedTangent::supernodal_available()));
   }
-  for (int k = 1; k < 4; ++k) {
+  for (int k = 1; k < 5; ++k) {
     REQUIRE(r[k].rows.size() == r[0].rows.size());
     for (size_t s = 0; s < r[0].rows.size(); ++s) {
       const StepRow &a = r[0].rows[s], &b = r[k].rows[s];
@@ -95,6 +101,7 @@ TEST_CASE("dense LU, sparse LU, dense LDLT and sparse LDLT give the same load-st
   // The symmetric paths report the inertia: the cantilever stays stable.
   CHECK(r[2].rows.back().negative_pivots == 0);
   CHECK(r[3].rows.back().negative_pivots == 0);
+  CHECK(r[4].rows.back().negative_pivots == 0);
   CHECK(r[0].rows.back().negative_pivots == -1);
 }
 
@@ -103,9 +110,12 @@ TEST_CASE("LDLT inertia: a strip compressed past its limit point reports negativ
   // 1-D SVK bar: P = E A s (s^2 - 1)/2 peaks at the stretch s = 1/sqrt(3) = 0.577. The end is
   // moved by -5 (s = 0.5) in 10 steps: s = 0.95, ..., 0.6 stable, 0.55 and 0.5 past the limit.
   const json bc = json::parse(R"({"edge": "u1", "fix": ["y", "z"], "prescribe": {"x": -5.0}})");
-  const bool sparse = GENERATE(false, true);
+  // Dense LDLT, sparse SimplicialLDLT, and the supernodal Cholesky, which stops at the first
+  // non-positive pivot and hands over to the SimplicialLDLT to count them.
+  const int path = GENERATE(0, 1, 2);
   const RunResult r = run(strip(bc, true), [&](Case& c) {
-    c.solver.linear_solver = sparse ? LinearSolver::kSparse : LinearSolver::kDense;
+    c.solver.linear_solver = path == 0 ? LinearSolver::kDense : LinearSolver::kSparse;
+    c.solver.supernodal = path == 2;
   });
   INFO(r.report.message);
   REQUIRE(r.report.status == RunStatus::kCompleted);  // a negative eigenvalue is a status

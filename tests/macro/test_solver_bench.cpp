@@ -27,10 +27,12 @@ struct Timing {
   RunReport report;
 };
 
-Timing time_case(const json& j, LinearSolver solver, bool symmetric, int threads) {
+Timing time_case(const json& j, LinearSolver solver, bool symmetric, int threads,
+                 bool supernodal = true) {
   Case c = parse_case(j.dump(), "bench.json");
   c.solver.linear_solver = solver;
   c.solver.symmetric = symmetric;
+  c.solver.supernodal = supernodal;
   c.threads = threads;
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();
@@ -46,12 +48,14 @@ void print(const char* label, const Timing& t) {
   const SolverStats& s = t.report.stats;
   const double it = std::max<long>(1, s.iterations);
   std::printf(
-      "solver %-34s n=%5d %s %s thr=%d  wall %7.3f s cpu %7.3f s  %4ld it  per it: %6.2f ms "
+      "solver %-36s n=%5d %s %-5s thr=%d  wall %7.3f s cpu %7.3f s  %4ld it  per it: %6.2f ms "
       "assembly "
-      "%6.2f ms solve  (+%5.2f ms residuals)  setup %.3f s  %s\n",
-      label, s.unknowns, s.sparse ? "sparse" : "dense ", s.symmetric ? "LDLT" : "LU  ", s.threads,
-      t.wall, t.cpu, s.iterations, 1e3 * s.assembly / it, 1e3 * s.solve / it,
-      1e3 * s.residuals / it, s.setup,
+      "%6.2f ms solve  (+%5.2f ms residuals)  setup %.3f s  cpu per it: %6.2f ms assembly %6.2f "
+      "ms solve  %s\n",
+      label, s.unknowns, s.sparse ? "sparse" : "dense ",
+      s.supernodal ? "LLT" : (s.symmetric ? "LDLT" : "LU"), s.threads, t.wall, t.cpu, s.iterations,
+      1e3 * s.assembly / it, 1e3 * s.solve / it, 1e3 * s.residuals / it, s.setup,
+      1e3 * s.assembly_cpu / it, 1e3 * s.solve_cpu / it,
       t.report.status == RunStatus::kCompleted ? "" : t.report.message.c_str());
 }
 
@@ -90,19 +94,30 @@ TEST_CASE("bench: Sze cantilever 16x1, 32x1, 64x1 (p = 3)", "[.bench_solver]") {
   }
 }
 
-TEST_CASE("bench: shell cases of ~1,500 and ~6,000 unknowns", "[.bench_solver]") {
+json tensile_p4(int nu, int nv, int steps) {
   json j = verification_case("tensile_svk.json");
   j["refinement"]["degree"] = 4;
-  j["refinement"]["elements"] = {8, 40};
-  j["solver"]["steps"] = 40;
+  j["refinement"]["elements"] = {nu, nv};
+  j["solver"]["steps"] = steps;
+  return j;
+}
+
+TEST_CASE("bench: tensile p4 8x40 (1,584 DOFs)", "[.bench_solver]") {
+  const json j = tensile_p4(8, 40, 40);
   print("tensile p4 8x40 40 steps 1 thread", time_case(j, LinearSolver::kAuto, true, 1));
+  print("tensile p4 8x40 40 st. simplicial 1 thr",
+        time_case(j, LinearSolver::kAuto, true, 1, false));
   print("tensile p4 8x40 40 steps LU 1 thr", time_case(j, LinearSolver::kAuto, false, 1));
   print("tensile p4 8x40 40 steps auto thr", time_case(j, LinearSolver::kAuto, true, 0));
   std::printf(
       "solver targets (1,584 dofs): <= 5 s for 40 steps on one core, <= 15 ms per iteration\n");
-  j["refinement"]["elements"] = {16, 100};
-  j["solver"]["steps"] = 5;
+}
+
+TEST_CASE("bench: tensile p4 16x100 (6,240 DOFs)", "[.bench_solver]") {
+  const json j = tensile_p4(16, 100, 5);
   print("tensile p4 16x100 5 steps 1 thread", time_case(j, LinearSolver::kAuto, true, 1));
+  print("tensile p4 16x100 5 st. simplicial 1 thr",
+        time_case(j, LinearSolver::kAuto, true, 1, false));
   print("tensile p4 16x100 5 steps auto thr", time_case(j, LinearSolver::kAuto, true, 0));
   print("tensile p4 16x100 5 steps LU auto", time_case(j, LinearSolver::kAuto, false, 0));
   std::printf("solver target (~6,000 dofs): <= 60 ms per iteration\n");

@@ -28,7 +28,8 @@
 namespace knit::io {
 
 /// One output file written to "<dir>/.<name>.tmp-<pid>-<n>" and renamed over the target on
-/// commit(). Not copyable; movable.
+/// commit(). Not copyable; movable. The constructor removes stale temporaries of the same
+/// target left by killed processes (regular files of that name whose pid is dead).
 class AtomicFile {
  public:
   /// The target's directory must exist (throws std::runtime_error otherwise).

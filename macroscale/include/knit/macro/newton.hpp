@@ -67,6 +67,9 @@ struct SolverOptions {
   /// false: LU even for a hyperelastic material (to compare the paths; the line search and
   /// everything else stay the same).
   bool symmetric = true;
+  /// Sparse symmetric path: CHOLMOD's supernodal Cholesky while the tangent is positive
+  /// definite (SimplicialLDLT otherwise); false: always SimplicialLDLT (to compare the paths).
+  bool supernodal = true;
 };
 
 struct StepResult {
@@ -96,10 +99,14 @@ struct SolverStats {
   double assembly = 0.0;   ///< element tangents and forces + scatter into the reduced matrix
   double solve = 0.0;      ///< numeric factorization and triangular solves
   double residuals = 0.0;  ///< residual-only evaluations
+  /// CPU seconds (all threads) of assembly and solve: on a loaded machine the cost of a
+  /// one-thread run, where the wall time also counts the waits for a core.
+  double assembly_cpu = 0.0, solve_cpu = 0.0;
   int unknowns = 0;
   long stored_entries = 0;  ///< of the reduced matrix
   bool sparse = false, symmetric = false;
-  int threads = 1;  ///< assembly threads
+  bool supernodal = false;  ///< the sparse symmetric path tries the supernodal Cholesky
+  int threads = 1;          ///< assembly threads
 };
 
 struct RunReport {

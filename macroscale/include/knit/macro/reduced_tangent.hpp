@@ -11,10 +11,13 @@
 //   unsymmetric (a material that is not hyperelastic, e.g. the eq. 17 response surface):
 //     dense PartialPivLU, sparse SparseLU (COLAMD ordering);
 //   symmetric (a hyperelastic material: C = d2W/dE2, the shell tangent is a Hessian):
-//     only the lower triangle is assembled; dense LDLT (diagonal pivoting), sparse
-//     SimplicialLDLT (AMD ordering). The inertia of the reduced tangent is the number of
-//     negative entries of D (Sylvester's law of inertia: P K P^T = L D L^T is a congruence):
-//     a negative count means the equilibrium is unstable (past a limit or bifurcation point).
+//     only the lower triangle is assembled; dense LDLT (diagonal pivoting), sparse: the
+//     supernodal Cholesky L L^T of CHOLMOD (sparse_cholmod.hpp; ordering by CHOLMOD, AMD or
+//     METIS) while the tangent is positive definite, Eigen's SimplicialLDLT (AMD ordering)
+//     when it is not (the Cholesky stops at the first non-positive pivot) or without CHOLMOD. The
+//     inertia of the reduced tangent is the number of negative entries of D (Sylvester's law of
+//     inertia: P K P^T = L D L^T is a congruence): a negative count means the equilibrium is
+//     unstable (past a limit or bifurcation point).
 // Singularity is detected from the factorization's pivots (min |pivot| / max |pivot| below
 // kSingularPivotRatio), not from a condition estimate (which cost 11 % of a run).
 #pragma once
@@ -54,7 +57,10 @@ class ReducedTangent {
 
   /// `symmetric`: assemble the lower triangle only and factorize by LDLT (the element
   /// tangents must be symmetric). `sparse`: sparse storage and factorization.
-  ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse);
+  /// `supernodal` (sparse symmetric only): try CHOLMOD's supernodal Cholesky first (ignored
+  /// when the build has no CHOLMOD).
+  ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse,
+                 bool supernodal = true);
   ~ReducedTangent();
   ReducedTangent(const ReducedTangent&) = delete;
   ReducedTangent& operator=(const ReducedTangent&) = delete;
@@ -62,6 +68,11 @@ class ReducedTangent {
   int size() const { return n_; }
   bool symmetric() const { return symmetric_; }
   bool sparse() const { return sparse_; }
+  /// Whether the sparse symmetric path factorizes by the supernodal Cholesky (with the
+  /// SimplicialLDLT as the fallback for indefinite tangents).
+  bool supernodal() const { return supernodal_; }
+  /// Whether the build has the supernodal Cholesky (CHOLMOD found at configure time).
+  static bool supernodal_available();
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
   long stored_entries() const;
 
@@ -79,13 +90,23 @@ class ReducedTangent {
   /// scatter of the dense and sparse paths.
   void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const;
 
+  void analyze_ldlt();  ///< symbolic analysis of the SimplicialLDLT (once, when first needed)
+  /// The compressed-column pattern of the reduced matrix and the scatter map, from the
+  /// (stored) index g of every local DOF of every element (nd per element, -1 if constrained).
+  void build_pattern(const std::vector<int>& g, int nd);
+  /// Solve in the stored order.
+  Eigen::VectorXd solve_stored(const Eigen::VectorXd& b) const;
+
   int n_ = 0;
-  bool symmetric_ = false, sparse_ = false;
+  bool symmetric_ = false, sparse_ = false, supernodal_ = false;
   int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
   std::vector<int> map_;  ///< block_ entries per element: value index or -1
+  /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
+  /// fill-reducing ordering); empty: the natural order.
+  std::vector<int> perm_;
   Eigen::MatrixXd dense_;
   Eigen::SparseMatrix<double> sparse_matrix_;
-  struct Factors;  ///< the four Eigen factorizations (reduced_tangent.cpp)
+  struct Factors;  ///< the Eigen factorizations and the Cholesky (reduced_tangent.cpp)
   std::unique_ptr<Factors> f_;
 };
 

@@ -22,8 +22,8 @@
 // Every term is a bilinear form in Phi = (R_1, R_2, R_11, R_12, R_22) of the two control points,
 // so per quadrature point a 15 x 15 matrix H (Phi-index x component) holds the whole tangent:
 //   K(3l+i, 3m+j) = sum_q sum_fg Phi_f(l) H_q(3f+i, 3g+j) Phi_g(m)
-// which is evaluated per element as 9 (6 if the material tangent is symmetric) matrix products
-// Phi^T (H Phi) over all its quadrature points.
+// which is evaluated per element as one matrix product Phi^T [(H Phi)_ij^T ...] over all its
+// quadrature points for the 9 component pairs (i, j) (6 if the material tangent is symmetric).
 #pragma once
 
 #include <Eigen/Core>
@@ -113,7 +113,8 @@ class ShellModel {
   struct Element {
     Eigen::VectorXi cp;
     int first_point = 0, num_points = 0;
-    Eigen::MatrixXd Phi;  ///< (5 num_points) x nloc: R_1, R_2, R_11, R_12, R_22 at each point
+    /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f).
+    Eigen::MatrixXd PhiT;
   };
   struct Point {
     ReferencePoint ref;

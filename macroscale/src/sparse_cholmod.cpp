@@ -1,0 +1,176 @@
+// CHOLMOD adapter (sparse_cholmod.hpp): the only file that includes CHOLMOD's headers.
+#include "sparse_cholmod.hpp"
+
+#ifdef KNIT_HAVE_CHOLMOD
+#include <cholmod.h>
+#include <dlfcn.h>
+#endif
+
+#include <algorithm>
+#include <limits>
+
+namespace knit::macro {
+
+#ifdef KNIT_HAVE_CHOLMOD
+
+namespace {
+
+/// Debian's CHOLMOD runs a few short loops of the supernodal factorization in OpenMP parallel
+/// regions with a built-in thread count (num_threads(4)); on a busy 2-core machine waking
+/// those threads cost more than the loops (a 1,440-unknown run: 5.2 s CPU with them limited
+/// to one thread, 5.7-6.0 s without). The BLAS calls, where the work is, are serial anyway. A
+/// max-active-levels of 0 makes every parallel region of the calling thread run on that
+/// thread alone. Looked up at run time: present only when CHOLMOD brought libgomp along.
+void serial_openmp_regions() {
+  using SetLevels = void (*)(int);
+  static const auto set_levels =
+      reinterpret_cast<SetLevels>(::dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  if (set_levels) set_levels(0);
+}
+
+/// A view of Eigen's compressed lower triangle as a CHOLMOD matrix (no copy; stype -1: only
+/// the lower triangle is referenced).
+cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
+  cholmod_sparse s{};
+  s.nrow = static_cast<size_t>(A.rows());
+  s.ncol = static_cast<size_t>(A.cols());
+  s.nzmax = static_cast<size_t>(A.nonZeros());
+  s.p = const_cast<int*>(A.outerIndexPtr());
+  s.i = const_cast<int*>(A.innerIndexPtr());
+  s.x = const_cast<double*>(A.valuePtr());
+  s.stype = -1;
+  s.itype = CHOLMOD_INT;
+  s.xtype = CHOLMOD_REAL;
+  s.dtype = CHOLMOD_DOUBLE;
+  s.sorted = 1;
+  s.packed = 1;
+  return s;
+}
+
+}  // namespace
+
+struct SupernodalCholesky::Impl {
+  cholmod_common c{};
+  cholmod_factor* L = nullptr;
+  /// natural: take the matrix in its order (no ordering, no postorder).
+  explicit Impl(bool natural) {
+    cholmod_start(&c);
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.print = 0;
+    c.error_handler = nullptr;
+    c.quick_return_if_not_posdef = 1;
+    if (natural) {
+      c.nmethods = 1;
+      c.method[0].ordering = CHOLMOD_NATURAL;
+      c.postorder = 0;
+    }
+  }
+  ~Impl() {
+    if (L) cholmod_free_factor(&L, &c);
+    cholmod_finish(&c);
+  }
+};
+
+bool SupernodalCholesky::available() {
+  return true;
+}
+
+std::vector<int> SupernodalCholesky::fill_reducing_ordering(
+    const Eigen::SparseMatrix<double>& lower) {
+  Impl impl(false);
+  cholmod_sparse A = view(lower);
+  impl.L = cholmod_analyze(&A, &impl.c);
+  if (!impl.L || impl.c.status != CHOLMOD_OK) return {};
+  const int* perm = static_cast<const int*>(impl.L->Perm);
+  return std::vector<int>(perm, perm + impl.L->n);
+}
+
+SupernodalCholesky::SupernodalCholesky() : impl_(std::make_unique<Impl>(true)) {}
+SupernodalCholesky::~SupernodalCholesky() = default;
+
+bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>& lower) {
+  if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
+  cholmod_sparse A = view(lower);
+  impl_->L = cholmod_analyze(&A, &impl_->c);
+  return impl_->L != nullptr && impl_->c.status == CHOLMOD_OK;
+}
+
+SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
+  if (!impl_->L) return Status::kFailed;
+  serial_openmp_regions();
+  cholmod_sparse A = view(lower);
+  cholmod_factorize(&A, impl_->L, &impl_->c);
+  if (impl_->c.status == CHOLMOD_NOT_POSDEF) return Status::kNotPositiveDefinite;
+  if (impl_->c.status != CHOLMOD_OK || !impl_->L->is_super || !impl_->L->is_ll)
+    return Status::kFailed;
+  return Status::kOk;
+}
+
+Eigen::VectorXd SupernodalCholesky::pivots() const {
+  const cholmod_factor* L = impl_->L;
+  Eigen::VectorXd d(static_cast<Eigen::Index>(L->n));
+  const int* super = static_cast<const int*>(L->super);
+  const int* pi = static_cast<const int*>(L->pi);
+  const int* px = static_cast<const int*>(L->px);
+  const double* x = static_cast<const double*>(L->x);
+  // Supernode s: columns super[s] .. super[s+1]-1, a dense column-major block of
+  // pi[s+1] - pi[s] rows starting at x + px[s], its top square the diagonal block.
+  for (size_t s = 0; s < L->nsuper; ++s) {
+    const int nrow = pi[s + 1] - pi[s];
+    for (int k = super[s]; k < super[s + 1]; ++k) {
+      const int j = k - super[s];
+      const double l = x[px[s] + j + static_cast<long>(j) * nrow];
+      d(k) = l * l;
+    }
+  }
+  return d;
+}
+
+Eigen::VectorXd SupernodalCholesky::solve(const Eigen::VectorXd& b) const {
+  cholmod_dense B{};
+  B.nrow = static_cast<size_t>(b.size());
+  B.ncol = 1;
+  B.nzmax = B.nrow;
+  B.d = B.nrow;
+  B.x = const_cast<double*>(b.data());
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  auto& c = const_cast<cholmod_common&>(impl_->c);
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, impl_->L, &B, &c);
+  Eigen::VectorXd x(b.size());
+  if (X) {
+    std::copy_n(static_cast<const double*>(X->x), b.size(), x.data());
+    cholmod_free_dense(&X, &c);
+  } else {
+    x.setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+  return x;
+}
+
+#else  // without CHOLMOD: never used (available() is false)
+
+struct SupernodalCholesky::Impl {};
+bool SupernodalCholesky::available() {
+  return false;
+}
+SupernodalCholesky::SupernodalCholesky() = default;
+SupernodalCholesky::~SupernodalCholesky() = default;
+std::vector<int> SupernodalCholesky::fill_reducing_ordering(const Eigen::SparseMatrix<double>&) {
+  return {};
+}
+bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>&) {
+  return false;
+}
+SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>&) {
+  return Status::kFailed;
+}
+Eigen::VectorXd SupernodalCholesky::pivots() const {
+  return {};
+}
+Eigen::VectorXd SupernodalCholesky::solve(const Eigen::VectorXd& b) const {
+  return Eigen::VectorXd::Constant(b.size(), std::numeric_limits<double>::quiet_NaN());
+}
+
+#endif
+
+}  // namespace knit::macro

@@ -1,0 +1,55 @@
+// Supernodal sparse Cholesky factorization of a symmetric positive definite matrix by CHOLMOD
+// (SuiteSparse; T. A. Davis, Y. Chen, W. W. Hager, S. Rajamanickam, "Algorithm 887: CHOLMOD,
+// supernodal sparse Cholesky factorization and update/downdate", ACM TOMS 35 (2008) 22).
+// The adapter: CHOLMOD's headers are included in sparse_cholmod.cpp only. Without CHOLMOD
+// (configured with -DKNIT_WITH_CHOLMOD=OFF or not found) available() is false and the shell
+// uses Eigen's SimplicialLDLT.
+//
+// Used by ReducedTangent on the sparse symmetric path: the fill-reducing ordering (chosen by
+// CHOLMOD among AMD and METIS) and the symbolic analysis (supernodal elimination tree) once per
+// run,
+// then per Newton iteration a numeric supernodal L L^T. An indefinite matrix (past a limit or
+// bifurcation point) makes factorize() return kNotPositiveDefinite; the caller then uses an
+// LDL^T that counts the negative pivots.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+namespace knit::macro {
+
+class SupernodalCholesky {
+ public:
+  enum class Status { kOk, kNotPositiveDefinite, kFailed };
+
+  /// Whether CHOLMOD was found at configure time.
+  static bool available();
+
+  SupernodalCholesky();
+  ~SupernodalCholesky();
+  SupernodalCholesky(const SupernodalCholesky&) = delete;
+  SupernodalCholesky& operator=(const SupernodalCholesky&) = delete;
+
+  /// CHOLMOD's fill-reducing ordering of the pattern of `lower` (the lower triangle of a
+  /// symmetric matrix in compressed columns, sorted row indices; AMD, or METIS when AMD's
+  /// fill is high, postordered): row k of the factor is row perm[k] of the matrix. Empty if
+  /// CHOLMOD failed (or is absent).
+  static std::vector<int> fill_reducing_ordering(const Eigen::SparseMatrix<double>& lower);
+  /// Symbolic analysis of the pattern of `lower`, taken in its own order (permute it by
+  /// fill_reducing_ordering() first). Returns false if CHOLMOD failed (or is absent).
+  bool analyze(const Eigen::SparseMatrix<double>& lower);
+  /// Numeric factorization P A P^T = L L^T of a matrix with the analyzed pattern.
+  Status factorize(const Eigen::SparseMatrix<double>& lower);
+  /// The pivots d_k = L_kk^2 (the D of the equivalent L D L^T), in elimination order.
+  Eigen::VectorXd pivots() const;
+  /// x = A^-1 b with the last successful factorization.
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace knit::macro
