@@ -239,8 +239,8 @@ def checks(d):
         add(Check(key, S, st, "symmetric", f"<= {rc.TOL_SYMMETRY:g} on every mesh", got,
                   all(s[idx] is not None and s[idx] <= rc.TOL_SYMMETRY for s in sym)))
     add(rc.check_convergence("mesh321", S, "diagonal test: the load-strain curve converges under "
-                             "h-refinement (h = 2 vs h = 4; the corner load is a point load, "
-                             "see docs/reproduction.md)", d.curve(MESH321[2]), d.curve(MESH321[4]),
+                             "h-refinement (h = 2 vs h = 4; the corner conditions act on a 5 mm "
+                             "pad, see docs/reproduction.md)", d.curve(MESH321[2]), d.curve(MESH321[4]),
                              target, (MESH321[2], MESH321[4])))
 
     # -- 3.2.2 ------------------------------------------------------------------------------------
