@@ -138,7 +138,6 @@ TEST_CASE("energy line search: the full step first, backtracking decreases Pi", 
       load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/sze_cantilever.json");
   const Problem p = setup_problem(c);
   const ShellModel& m = *p.model;
-  const int n = p.dofs.num_free();
   ShellModel::Evaluation ev;
   const Eigen::VectorXd u0 = Eigen::VectorXd::Zero(m.num_dofs());
   m.evaluate(u0, true, ev);
