@@ -1,0 +1,248 @@
+#!/usr/bin/python3
+"""What limits the energy law's held-out error (issue 11, "Fit quality")?
+
+For each requested loop length of a material database this prints, beside the stored energy
+law's own held-out figures, three law-independent references computed from the same cell data:
+
+  * convex bound: the smallest delta such that SOME convex strain energy W reproduces the
+    cell's stresses at the sampled states within delta (fraction of the stress range). It is a
+    linear program over the convex-interpolation conditions (every ordered pair i, j)
+        W_j >= W_i + S'_i . (e_j - e_i),   |S'_ic - S_ic| <= delta * range,
+    solved with HiGHS on every `--stride`-th state of every path, fitted and held-out ones
+    (fewer states give fewer constraints, so the figure is a LOWER bound of the true one);
+  * free energy: S = grad W with W a tensor-product cubic B-spline over the box (not convex),
+    least squares with a second-difference smoothing, trained on the fit paths only;
+  * free interpolant: each of S11, S22, S12 its own spline of the same basis (no energy at
+    all), trained likewise.
+
+The two free fits are the best a smooth law could hope to do on states that did not enter the
+fit: if they miss the held-out states too, the misses come from the sampling (states far from
+every fitted path), not from the law's family. Errors are max-norm over (S11, S22, S12)
+divided by the stress range of docs/database.md (largest max - min of a component over the
+loop length's fit data); the threshold is 5 %.
+
+Usage: /usr/bin/python3 scripts/fit_bounds.py DATABASE.h5 [--loops 0 4] [--stride 3]
+       /usr/bin/python3 scripts/fit_bounds.py --self-check
+Needs python3-numpy, python3-scipy (>= 1.8 for HiGHS and BSpline.design_matrix), python3-h5py.
+"""
+import argparse
+import sys
+
+import numpy as np
+from scipy.interpolate import BSpline
+from scipy.optimize import linprog
+from scipy.sparse import coo_matrix, vstack
+
+THRESHOLD = 0.05
+
+
+def load_paths(f, loop):
+    """[(set, e (n x 3, e3 = 2 E12), S (n x 3))] of the converged steps of /loop_<loop>/raw."""
+    g = f["loop_%d/raw" % loop]
+    out = []
+    for name in sorted(g):
+        ok = g[name]["status"][:] == 0
+        e = g[name]["E"][:][ok].copy()
+        e[:, 2] *= 2.0
+        s = g[name].attrs.get("set", "paper")
+        out.append((s.decode() if isinstance(s, bytes) else str(s), e, g[name]["S"][:][ok]))
+    return out
+
+
+def stress_range(paths):
+    s = np.concatenate([p[2] for p in paths if p[0] != "holdout"])
+    return max(s[:, c].max() - s[:, c].min() for c in range(3))
+
+
+def convex_bound(e, s, rng):
+    """Smallest delta (fraction of rng) of a convex W through (e_i, S'_i); the origin is added
+    as a stress-free state. Returns (delta, status message)."""
+    e = np.vstack([np.zeros(3), e])
+    s = np.vstack([np.zeros(3), s])
+    n = len(e)
+    nv = 4 * n + 1
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    m = i != j
+    i, j = i[m], j[m]
+    p = len(i)
+    d = e[j] - e[i]
+    rows = np.repeat(np.arange(p), 5)
+    cols = np.stack([i, j, n + 3 * i, n + 3 * i + 1, n + 3 * i + 2], 1).ravel()
+    vals = np.stack([np.ones(p), -np.ones(p), d[:, 0], d[:, 1], d[:, 2]], 1).ravel()
+    pairs = coo_matrix((vals, (rows, cols)), shape=(p, nv))
+    k = np.arange(3 * n)
+    both = np.concatenate([k, k])
+    delta_col = np.concatenate([n + k, np.full(3 * n, nv - 1)])
+    upper = coo_matrix((np.concatenate([np.ones(3 * n), -np.full(3 * n, rng)]),
+                        (both, delta_col)), shape=(3 * n, nv))
+    lower = coo_matrix((np.concatenate([-np.ones(3 * n), -np.full(3 * n, rng)]),
+                        (both, delta_col)), shape=(3 * n, nv))
+    a = vstack([pairs, upper, lower]).tocsr()
+    b = np.concatenate([np.zeros(p), s.ravel(), -s.ravel()])
+    c = np.zeros(nv)
+    c[-1] = 1.0
+    bounds = [(None, None)] * nv
+    bounds[0] = (0.0, 0.0)
+    bounds[-1] = (0.0, None)
+    r = linprog(c, A_ub=a, b_ub=b, bounds=bounds, method="highs")
+    if r.status != 0:
+        return float("nan"), r.message
+    return float(r.x[-1]), "optimal"
+
+
+class SplineBox:
+    """Tensor-product cubic B-splines over the strain box, n functions per axis."""
+
+    def __init__(self, e, n, p=3):
+        self.lo = e.min(0) - 0.05
+        self.hi = e.max(0) + 0.05
+        self.n, self.p = n, p
+
+    def _axis(self, x, k, deriv):
+        t = np.concatenate([[self.lo[k]] * self.p, np.linspace(self.lo[k], self.hi[k],
+                                                               self.n - self.p + 1),
+                            [self.hi[k]] * self.p])
+        b = BSpline(t, np.eye(self.n), self.p, extrapolate=False)
+        v = np.nan_to_num(b(np.clip(x, self.lo[k], self.hi[k]), nu=deriv))
+        return v
+
+    def matrix(self, e, deriv_axis=-1):
+        a = [self._axis(e[:, k], k, 1 if k == deriv_axis else 0) for k in range(3)]
+        return np.einsum("pi,pj,pk->pijk", *a).reshape(len(e), -1)
+
+    def smoothing(self, lam):
+        eye = np.eye(self.n)
+        d2 = np.diff(eye, 2, axis=0)
+        blocks = [np.kron(np.kron(d2, eye), eye), np.kron(np.kron(eye, d2), eye),
+                  np.kron(np.kron(eye, eye), d2)]
+        return np.sqrt(lam) * np.vstack(blocks)
+
+
+def free_fits(train_e, train_s, test_e, n, lam):
+    """Held-out predictions of the free energy (S = grad W) and of the free interpolant."""
+    box = SplineBox(np.vstack([train_e, test_e]), n)
+    reg = box.smoothing(lam)
+    zeros = np.zeros(len(reg))
+    grads = [box.matrix(train_e, c) for c in range(3)]
+    x = np.linalg.lstsq(np.vstack(grads + [reg]), np.concatenate([train_s.T.ravel(), zeros]),
+                        rcond=None)[0]
+    energy = np.stack([box.matrix(test_e, c) @ x for c in range(3)], 1)
+    v, vt = box.matrix(train_e), box.matrix(test_e)
+    interp = np.stack([vt @ np.linalg.lstsq(np.vstack([v, reg]),
+                                            np.concatenate([train_s[:, c], zeros]),
+                                            rcond=None)[0] for c in range(3)], 1)
+    return energy, interp
+
+
+def summary(err):
+    return "%3d / %3d within 5 %%, max %5.1f %%" % (np.sum(err <= THRESHOLD), len(err),
+                                                     100 * err.max())
+
+
+def energy_law_stress(f, loop_length, e):
+    """S of the stored ridge-spline law (knit/material/energy_law.hpp) at e (n x 3)."""
+    g = f["energy_law"]
+    dirs, fun = g["directions"][:], g["function_of"][:]
+    coef, srange = g["coefficients"][:], g["s_range"][:]
+    p, lp = int(g.attrs["s_degree"]), int(g.attrs["l_degree"])
+    lk = g["l_knots"][:]
+    nl = len(lk) - lp - 1
+    ns = coef.shape[1] // nl
+    ml = BSpline(lk, np.eye(nl), lp)(np.clip(loop_length, lk[0], lk[-1]))
+    out = float(g.attrs["floor"]) * e
+    for k, d in enumerate(dirs):
+        a, b = srange[fun[k]]
+        t = np.concatenate([[a] * p, np.linspace(a, b, ns - p + 1), [b] * p])
+        second = BSpline(t, coef[fun[k]].reshape(nl, ns).T @ ml, p)
+        first = second.antiderivative(1)
+        x = e @ d
+        xc = np.clip(x, a, b)
+        fp = (first(xc) - first(0.0) + np.where(x < a, second(a) * (x - a), 0.0) +
+              np.where(x > b, second(b) * (x - b), 0.0))
+        out += fp[:, None] * d[None, :]
+    return out
+
+
+def analyse(f, loop, stride, n, lam):
+    paths = load_paths(f, loop)
+    loop_length = float(f["loop_lengths"][loop])
+    rng = stress_range(paths)
+    fit = [p for p in paths if p[0] != "holdout"]
+    held = [p for p in paths if p[0] == "holdout"]
+    if not held:
+        print("l = %.2f mm: no held-out paths" % loop_length)
+        return
+    tr_e = np.concatenate([p[1] for p in fit])
+    tr_s = np.concatenate([p[2] for p in fit])
+    te_e = np.concatenate([p[1] for p in held])
+    te_s = np.concatenate([p[2] for p in held])
+    energy, interp = free_fits(tr_e, tr_s, te_e, n, lam)
+    err = lambda s: np.abs(s - te_s).max(1) / rng  # noqa: E731
+    sub_e = np.concatenate([p[1][stride - 1::stride] for p in paths])
+    sub_s = np.concatenate([p[2][stride - 1::stride] for p in paths])
+    delta, status = convex_bound(sub_e, sub_s, rng)
+    print("l = %.2f mm (stress range %.2f MPa), %d held-out states of %d paths:" %
+          (loop_length, rng, len(te_e), len(held)))
+    if "energy_law" in f:
+        print("  stored energy law           : %s" % summary(err(energy_law_stress(f, loop_length,
+                                                                                  te_e))))
+    print("  free energy (grad of spline): %s" % summary(err(energy)))
+    print("  free interpolant (no energy): %s" % summary(err(interp)))
+    print("  convex bound, %d states incl. held-out, in-sample: delta* >= %.2f %% (%s)" %
+          (len(sub_e) + 1, 100 * delta, status))
+
+
+def self_check():
+    """The bound must be ~0 for the gradient of a convex W and > 0 when monotonicity fails."""
+    rng = np.random.default_rng(1)
+    e = rng.uniform(-0.3, 0.3, (60, 3))
+    c = np.array([[4.0, 1.0, 0.0], [1.0, 3.0, 0.5], [0.0, 0.5, 2.0]])
+    s = e @ c + 2.0 * e ** 3
+    ok_delta, _ = convex_bound(e, s, 10.0)
+    bad = s.copy()
+    bad[:, 0] = -bad[:, 0]  # S11 decreasing in E11: no convex W
+    bad_delta, _ = convex_bound(e, bad, 10.0)
+    print("self-check: convex data delta* = %.2e, non-monotone data delta* = %.3f" %
+          (ok_delta, bad_delta))
+    if not (ok_delta < 1e-6 and bad_delta > 0.01):
+        print("self-check FAILED", file=sys.stderr)
+        return 1
+    return 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("database", nargs="?")
+    ap.add_argument("--loops", type=int, nargs="+", default=None,
+                    help="loop indices (default: the first and the last)")
+    ap.add_argument("--stride", type=int, default=3,
+                    help="every STRIDE-th state of each path enters the convex bound (3)")
+    ap.add_argument("--spline-functions", type=int, default=8,
+                    help="B-spline functions per strain axis of the free fits (8)")
+    ap.add_argument("--smoothing", type=float, default=1e-3,
+                    help="second-difference smoothing of the free fits (1e-3)")
+    ap.add_argument("--self-check", action="store_true")
+    a = ap.parse_args()
+    if a.self_check:
+        return self_check()
+    if not a.database:
+        ap.error("a database is required (or --self-check)")
+    import h5py
+    try:
+        f = h5py.File(a.database, "r")
+    except OSError as err:
+        print("fit_bounds.py: %s: %s" % (a.database, err), file=sys.stderr)
+        return 2
+    count = len(f["loop_lengths"])
+    loops = a.loops if a.loops is not None else sorted({0, count - 1})
+    for loop in loops:
+        if not 0 <= loop < count:
+            print("fit_bounds.py: %s: no /loop_%d (%d loop lengths)" % (a.database, loop, count),
+                  file=sys.stderr)
+            return 2
+        analyse(f, loop, a.stride, a.spline_functions, a.smoothing)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
