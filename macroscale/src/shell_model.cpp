@@ -223,7 +223,9 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       if ((D - D.transpose()).cwiseAbs().maxCoeff() > 1e-12 * D.cwiseAbs().maxCoeff())
         symmetric = false;
       Mat15& H = Hs[q];
-      H.noalias() = G.transpose() * (pt.dA * D) * G;
+      // Coefficient-based products (a GEMM call with packing cost more at 15 x 6 x 15).
+      const Eigen::Matrix<double, 6, 15> DG = (pt.dA * D).lazyProduct(G);
+      H.noalias() = G.transpose().lazyProduct(DG);
       // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
       const double c11 = M(0), c22 = M(1), c12 = 2.0 * M(2);
       const Vec3 v = c11 * c.a11 + c22 * c.a22 + c12 * c.a12;
@@ -290,18 +292,22 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
     kin.full = full;
     kernel::element_tangent_blocks(kin, W.data(), KT.data());
     Eigen::MatrixXd& Ke = out.Ke[e];
+    // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)
+    // and, for a symmetric law, the mirror Ke(3 m + j, 3 l + i) likewise.
     const Eigen::Index ldw = KT.rows();
+    const double* kt = KT.data();
     for (int p = 0; p < pairs; ++p) {
       const int i = pi[p], j = pj[p];
+      const bool tri = p >= full;  // symmetric diagonal block from its lower triangle
+      for (int m = 0; m < nl; ++m) {
+        double* col = Ke.data() + (3 * m + j) * Ke.rows() + i;  // col[3 l] = Ke(3 l + i, 3 m + j)
+        for (int l = tri ? m : 0; l < nl; ++l) col[3 * l] = kt[l * ldw + p * nl + m];
+      }
+      if (!symmetric) continue;
       for (int l = 0; l < nl; ++l) {
-        const double* Kl = KT.data() + l * ldw + p * nl;  // Kl[m] = K_ij(l, m)
-        if (p >= full) {  // symmetric diagonal block from its lower triangle
-          for (int m = 0; m <= l; ++m) Ke(3 * l + i, 3 * m + i) = Ke(3 * m + i, 3 * l + i) = Kl[m];
-          continue;
-        }
-        for (int m = 0; m < nl; ++m) Ke(3 * l + i, 3 * m + j) = Kl[m];
-        if (symmetric)
-          for (int m = 0; m < nl; ++m) Ke(3 * m + j, 3 * l + i) = Kl[m];
+        double* col = Ke.data() + (3 * l + i) * Ke.rows() + j;  // col[3 m] = Ke(3 m + j, 3 l + i)
+        const double* Kl = kt + l * ldw + p * nl;               // Kl[m] = K_ij(l, m)
+        for (int m = 0; m < (tri ? l : nl); ++m) col[3 * m] = Kl[m];
       }
     }
   }
