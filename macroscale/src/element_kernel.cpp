@@ -10,60 +10,62 @@ namespace knit::macro::kernel {
 
 namespace {
 
-/// Four doubles: two SSE2 registers in the default version, one AVX2 register in x86-64-v3.
+/// Vectors of doubles (GCC vector extensions): v4 for the AVX2 version (one register), v2 for
+/// the default SSE2 version (one register; a v4 there is emulated by pairs, slower).
 typedef double v4 __attribute__((vector_size(32)));
+typedef double v2 __attribute__((vector_size(16)));
 
-inline __attribute__((always_inline)) v4 load4(const double* p) {
-  v4 v;
+template <typename V>
+inline __attribute__((always_inline)) V load(const double* p) {
+  V v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
-inline __attribute__((always_inline)) void store4(double* p, v4 v) {
+template <typename V>
+inline __attribute__((always_inline)) void store(double* p, V v) {
   std::memcpy(p, &v, sizeof v);
 }
-inline __attribute__((always_inline)) v4 splat(double x) {
-  return v4{x, x, x, x};
+template <typename V>
+inline __attribute__((always_inline)) V splat(double x) {
+  V v;
+  for (int i = 0; i < int(sizeof v / sizeof x); ++i) v[i] = x;
+  return v;
 }
 
-/// KT(c, l) = sum_k W(c, k) PhiT(l, k) for rows c in [c_begin, c_end) (rounded up to 8) and
-/// all padded columns l, in tiles of 8 rows x 4 columns (8 accumulators). tri_origin >= 0:
-/// only the tiles holding some c - tri_origin <= l (a lower triangle). Always inlined, so it
-/// is compiled for the instruction set of each version of its caller.
+/// KT(c, l) = sum_k W(c, k) PhiT(l, k) for rows c in [c_begin, c_end) (rounded up to the
+/// tile) and all padded columns l, in tiles of CV vectors V of rows x 4 columns (4 CV
+/// accumulators: 8 of the 16 registers with CV = 2; tiles of 8 rows for AVX2, 4 for SSE2).
+/// tri_origin >= 0: only the tiles holding some c - tri_origin <= l (a lower triangle).
+/// Always inlined, so it is compiled for the instruction set of its caller.
+template <typename V, int CV>
 inline __attribute__((always_inline)) void product_rows(const double* W, const double* PhiT,
                                                         double* KT, int ldw, int nlp, int nk,
                                                         int c_begin, int c_end, int tri_origin) {
   for (int l0 = 0; l0 < nlp; l0 += 4)
-    for (int c0 = c_begin; c0 < c_end; c0 += 8) {
+    for (int c0 = c_begin; c0 < c_end; c0 += CV * int(sizeof(V) / sizeof(double))) {
       if (tri_origin >= 0 && c0 - tri_origin > l0 + 3) break;  // all m > l: upper triangle
-      v4 a00 = splat(0.0), a01 = a00, a10 = a00, a11 = a00, a20 = a00, a21 = a00, a30 = a00,
-         a31 = a00;
+      constexpr int lanes = sizeof(V) / sizeof(double);
+      V acc[4][CV];
+      for (int j = 0; j < 4; ++j)
+        for (int h = 0; h < CV; ++h) acc[j][h] = splat<V>(0.0);
       const double* w = W + c0;
       const double* b = PhiT + l0;
       for (int k = 0; k < nk; ++k, w += ldw, b += nlp) {
-        const v4 x0 = load4(w), x1 = load4(w + 4);
-        const v4 b0 = splat(b[0]), b1 = splat(b[1]), b2 = splat(b[2]), b3 = splat(b[3]);
-        a00 += x0 * b0;
-        a01 += x1 * b0;
-        a10 += x0 * b1;
-        a11 += x1 * b1;
-        a20 += x0 * b2;
-        a21 += x1 * b2;
-        a30 += x0 * b3;
-        a31 += x1 * b3;
+        V x[CV];
+        for (int h = 0; h < CV; ++h) x[h] = load<V>(w + lanes * h);
+        for (int j = 0; j < 4; ++j) {
+          const V bj = splat<V>(b[j]);
+          for (int h = 0; h < CV; ++h) acc[j][h] += x[h] * bj;
+        }
       }
       double* out = KT + static_cast<long>(l0) * ldw + c0;
-      store4(out, a00);
-      store4(out + 4, a01);
-      store4(out + ldw, a10);
-      store4(out + ldw + 4, a11);
-      store4(out + 2 * ldw, a20);
-      store4(out + 2 * ldw + 4, a21);
-      store4(out + 3 * ldw, a30);
-      store4(out + 3 * ldw + 4, a31);
+      for (int j = 0; j < 4; ++j)
+        for (int h = 0; h < CV; ++h) store<V>(out + j * ldw + lanes * h, acc[j][h]);
     }
 }
 
 /// The kernel's body, compiled into each version below.
+template <typename V, int CV>
 inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in, double* W,
                                                   double* KT) {
   const int nl = in.nl, nlp = padded_functions(nl), ldw = workspace_rows(nl);
@@ -86,18 +88,18 @@ inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in,
   }
   // Rows c: the whole pairs [0, full) as one range, then each triangular pair on its own (in
   // increasing order: a tile's overrun into the next pair is overwritten by that pair).
-  if (in.full > 0) product_rows(W, in.PhiT, KT, ldw, nlp, nk, 0, in.full * nl, -1);
+  if (in.full > 0) product_rows<V, CV>(W, in.PhiT, KT, ldw, nlp, nk, 0, in.full * nl, -1);
   for (int p = in.full; p < in.pairs; ++p)
-    product_rows(W, in.PhiT, KT, ldw, nlp, nk, p * nl, (p + 1) * nl, p * nl);
+    product_rows<V, CV>(W, in.PhiT, KT, ldw, nlp, nk, p * nl, (p + 1) * nl, p * nl);
 }
 
 __attribute__((target("arch=x86-64-v3"))) void blocks_v3(const ElementTangentInput& in, double* W,
                                                          double* KT) {
-  blocks(in, W, KT);
+  blocks<v4, 2>(in, W, KT);
 }
 
 void blocks_default(const ElementTangentInput& in, double* W, double* KT) {
-  blocks(in, W, KT);
+  blocks<v2, 2>(in, W, KT);
 }
 
 }  // namespace

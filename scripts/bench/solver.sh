@@ -7,7 +7,8 @@
 #    targets <= 5 s on one core, <= 15 ms per Newton iteration) and 16 x 100 elements
 #    (6,240 DOFs, 6,000 unknowns; <= 60 ms per iteration), with the time per Newton
 #    iteration split into assembly and solve, as wall and as CPU time (on a loaded machine
-#    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT instead of CHOLMOD's supernodal Cholesky.
+#    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT
+#    instead of CHOLMOD's supernodal Cholesky.
 # Figures of 30 Nov 2026: docs/solver.md "Benchmark". A solver change must leave the results
 # unchanged: run the same case before and after and compare the two results.h5 with
 # scripts/bench/compare_results.py (1e-8 relative).
