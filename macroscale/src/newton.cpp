@@ -114,28 +114,49 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   int cutbacks = 0, step = 0, last_negative = -1;
   ShellModel::Evaluation ev, trial;
 
-  // Residual (and potential) at (uf, lam).
-  auto residual = [&](const Eigen::VectorXd& uf, double lam, State& s) {
-    const auto t0 = Clock::now();
-    ++stats.evaluations;
-    const Eigen::VectorXd u = dofs.expand(uf, lam);
-    model.evaluate(u, false, trial);
-    stats.residuals += since(t0);
-    if (!trial.ok) return Eval::kDegenerate;
-    s.r = dofs.reduce(trial.fint) - lam * fext_red;
+  // The state (residual, reference force, potential) at u = expand(uf, lam) from an evaluation
+  // there.
+  auto state_from = [&](const ShellModel::Evaluation& E, const Eigen::VectorXd& u, double lam,
+                        State& s) {
+    if (!E.ok) return Eval::kDegenerate;
+    s.r = dofs.reduce(E.fint) - lam * fext_red;
     double react = 0.0;
     for (int d = 0; d < dofs.num_dofs(); ++d)
-      if (dofs.constrained(d)) react += trial.fint(d) * trial.fint(d);
+      if (dofs.constrained(d)) react += E.fint(d) * E.fint(d);
     s.ref = std::max(std::abs(lam) * fext_norm, std::sqrt(react));
     s.norm = s.r.norm();
     if (hyper) {
       const double wext = lam * fext.dot(u);
-      s.Pi = trial.energy - wext;
-      s.Pi_scale = std::abs(trial.energy) + std::abs(wext);
+      s.Pi = E.energy - wext;
+      s.Pi_scale = std::abs(E.energy) + std::abs(wext);
     }
     if (!std::isfinite(s.norm) || !std::isfinite(s.ref) || (hyper && !std::isfinite(s.Pi)))
       return Eval::kNonFinite;
     return Eval::kOk;
+  };
+  // Where `trial` and `ev` were last evaluated (empty: not valid), so that an evaluation at the
+  // same displacement is reused (bitwise the same result: f_int does not depend on whether the
+  // tangent was computed, nor on the number of threads).
+  Eigen::VectorXd trial_u, ev_u;
+  // Residual (and potential) at (uf, lam).
+  auto residual = [&](const Eigen::VectorXd& uf, double lam, State& s) {
+    const auto t0 = Clock::now();
+    ++stats.evaluations;
+    trial_u = dofs.expand(uf, lam);
+    model.evaluate(trial_u, false, trial);
+    stats.residuals += since(t0);
+    return state_from(trial, trial_u, lam, s);
+  };
+  // Tangent (with the residual) at (uf, lam), timed as assembly.
+  auto tangent = [&](const Eigen::VectorXd& uf, double lam) {
+    const auto t0 = Clock::now();
+    const double c0 = cpu_now();
+    ev_u = dofs.expand(uf, lam);
+    model.evaluate(ev_u, true, ev);
+    if (ev.ok) K.assemble(ev.Ke);
+    stats.assembly += since(t0);
+    stats.assembly_cpu += cpu_now() - c0;
+    return ev.ok;
   };
   auto why_not = [](Eval e, const State& s) {
     if (e == Eval::kDegenerate)
@@ -150,7 +171,12 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   auto newton = [&](double lam, Eigen::VectorXd& uf, bool energy_search) {
     StepOutcome o;
     State cur, next;
-    Eval st = residual(uf, lam, cur);
+    // The first iterate with its tangent: a step rarely converges at its predictor, and when it
+    // does the symmetric path factorizes this tangent anyway (for the inertia); this saves the
+    // residual-only evaluation at the start of every step.
+    tangent(uf, lam);
+    Eval st = state_from(ev, ev_u, lam, cur);
+    bool have_tangent = ev.ok;
     for (int it = 0;; ++it) {
       if (st != Eval::kOk) {
         o.why = why_not(st, cur);
@@ -178,18 +204,13 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         return o;
       }
       ++stats.iterations;
-      auto t0 = Clock::now();
-      double c0 = cpu_now();
-      model.evaluate(dofs.expand(uf, lam), true, ev);
-      if (!ev.ok) {
+      if (!have_tangent && !tangent(uf, lam)) {
         o.why = why_not(Eval::kDegenerate, cur);
         return o;
       }
-      K.assemble(ev.Ke);
-      stats.assembly += since(t0);
-      stats.assembly_cpu += cpu_now() - c0;
-      t0 = Clock::now();
-      c0 = cpu_now();
+      have_tangent = false;
+      const auto t0 = Clock::now();
+      const double c0 = cpu_now();
       const Factorization f = K.factorize();
       Eigen::VectorXd du;
       if (f.ok) du = K.solve(-cur.r);
@@ -294,9 +315,9 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     }
     if (o.converged) {
       if (o.negative_pivots == -2 && K.symmetric()) {
-        // No factorization in this step (converged at once): the inertia at this state.
-        model.evaluate(dofs.expand(uf, lam1), true, ev);
-        K.assemble(ev.Ke);
+        // No factorization in this step (converged at once): the inertia at this state (its
+        // tangent is assembled already when the step's first evaluation was here).
+        if (ev_u.size() == 0 || ev_u != dofs.expand(uf, lam1)) tangent(uf, lam1);
         const Factorization f = K.factorize();
         o.negative_pivots = f.ok ? f.negative_pivots : last_negative;
       }
@@ -313,8 +334,16 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       sr.residual = o.residual;
       sr.negative_pivots = last_negative;
       sr.u = dofs.expand(ufree, lambda);
-      model.evaluate(sr.u, false, trial);
-      sr.fint = trial.fint;
+      // The internal forces at the converged state: usually evaluated there already.
+      if (trial_u.size() > 0 && trial_u == sr.u && trial.ok)
+        sr.fint = trial.fint;
+      else if (ev_u.size() > 0 && ev_u == sr.u && ev.ok)
+        sr.fint = ev.fint;
+      else {
+        model.evaluate(sr.u, false, trial);
+        trial_u = sr.u;
+        sr.fint = trial.fint;
+      }
       sr.seconds = since(t0);
       report.converged_steps = step;
       report.last_lambda = lambda;

@@ -99,6 +99,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
           const int gr = g[size_t(e) * nd + r], gs = g[size_t(e) * nd + s];
           if (wanted(gr, gs)) map_[size_t(e) * block_ + r + size_t(nd) * s] = gr + n_ * gs;
         }
+    compact_map();
     return;
   }
   build_pattern(g, nd);
@@ -123,6 +124,24 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
     f_->sparse_lu.analyzePattern(sparse_matrix_);
   else if (!supernodal_)
     analyze_ldlt();
+  compact_map();
+}
+
+void ReducedTangent::compact_map() {
+  const size_t ne = block_ > 0 ? map_.size() / static_cast<size_t>(block_) : 0;
+  scatter_begin_.assign(ne + 1, 0);
+  scatter_src_.clear();
+  scatter_dst_.clear();
+  for (size_t e = 0; e < ne; ++e) {
+    for (int k = 0; k < block_; ++k) {
+      const int dst = map_[e * block_ + k];
+      if (dst < 0) continue;
+      scatter_src_.push_back(k);
+      scatter_dst_.push_back(dst);
+    }
+    scatter_begin_[e + 1] = scatter_src_.size();
+  }
+  std::vector<int>().swap(map_);
 }
 
 void ReducedTangent::build_pattern(const std::vector<int>& g, int nd) {
@@ -185,12 +204,12 @@ long ReducedTangent::stored_entries() const {
 }
 
 void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const {
-  const int ne = static_cast<int>(Ke.size());
-  for (int e = 0; e < ne; ++e) {
-    const int* map = map_.data() + static_cast<size_t>(e) * block_;
+  const size_t ne = std::min(Ke.size(), scatter_begin_.size() - 1);
+  const int* src = scatter_src_.data();
+  const int* dst = scatter_dst_.data();
+  for (size_t e = 0; e < ne; ++e) {
     const double* k = Ke[e].data();
-    for (int i = 0; i < block_; ++i)
-      if (map[i] >= 0) values[map[i]] += k[i];
+    for (size_t t = scatter_begin_[e]; t < scatter_begin_[e + 1]; ++t) values[dst[t]] += k[src[t]];
   }
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <thread>
 
+#include "knit/macro/element_kernel.hpp"
 #include "knit/spline/quadrature.hpp"
 
 namespace knit::macro {
@@ -65,8 +66,9 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
           pt.ref = reference_point(dX, Eigen::Vector2d(u, v), scale_);
           pt.dA = w * pt.ref.jacobian;
           R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 6, nloc_) = sb.R;
-          el.PhiT.conservativeResize(nloc_, el.PhiT.cols() + 5);
-          el.PhiT.rightCols(5) = sb.R.bottomRows(5).transpose();
+          el.PhiT.conservativeResize(kernel::padded_functions(nloc_), el.PhiT.cols() + 5);
+          el.PhiT.rightCols(5).setZero();
+          el.PhiT.rightCols(5).topRows(nloc_) = sb.R.bottomRows(5).transpose();
           points_.push_back(pt);
           thetas.emplace_back(u, v);
         }
@@ -149,11 +151,12 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
   Eigen::Matrix<double, Eigen::Dynamic, 3> xloc(nl, 3), fe(nl, 3);
   Eigen::Matrix<double, 6, 15> G = Eigen::Matrix<double, 6, 15>::Zero();
   std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
-  // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked, Kall = Phi^T W^T.
-  Eigen::MatrixXd W, Kall;
+  // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked; KT = W Phi
+  // (element_kernel.hpp). Zeroed once: the kernel reads padding rows it never writes.
+  Eigen::MatrixXd W, KT;
   if (tangent) {
-    W.resize(9 * nl, 5 * maxq);
-    Kall.resize(nl, 9 * nl);
+    W.setZero(kernel::workspace_rows(nl), 5 * maxq);
+    KT.setZero(kernel::workspace_rows(nl), kernel::padded_functions(nl));
   }
   for (int e = e0; e < e1; ++e) {
     const Element& el = elements_[e];
@@ -220,7 +223,9 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
       if ((D - D.transpose()).cwiseAbs().maxCoeff() > 1e-12 * D.cwiseAbs().maxCoeff())
         symmetric = false;
       Mat15& H = Hs[q];
-      H.noalias() = G.transpose() * (pt.dA * D) * G;
+      // Coefficient-based products (a GEMM call with packing cost more at 15 x 6 x 15).
+      const Eigen::Matrix<double, 6, 15> DG = (pt.dA * D).lazyProduct(G);
+      H.noalias() = G.transpose().lazyProduct(DG);
       // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
       const double c11 = M(0), c22 = M(1), c12 = 2.0 * M(2);
       const Vec3 v = c11 * c.a11 + c22 * c.a22 + c12 * c.a12;
@@ -259,10 +264,8 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
     out.element_energy(e) = energy;
     if (!tangent) continue;
     // K(3l+i, 3m+j) = sum_q sum_fk Phi_f(l) H_q(3f+i, 3k+j) Phi_k(m): per pair (i, j) the
-    // columns (H Phi)^T (one axpy of length nloc per (f, k), vectorized), then all pairs in one
-    // GEMM Phi^T [ (H Phi)_ij^T ... ] (nloc x 5 nq times 5 nq x pairs nloc).
-    const int nq = el.num_points;
-    const Eigen::MatrixXd& PhiT = el.PhiT;
+    // columns (H Phi)^T, then all pairs in one product (element_kernel.hpp: plain loops, an
+    // AVX2/FMA version chosen at run time).
     // Symmetric: the off-diagonal pairs (0,1), (0,2), (1,2) first, then the diagonal ones,
     // whose blocks are symmetric: only their lower triangles are computed.
     int pairs = 0;
@@ -278,41 +281,34 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
         pi[pairs] = i;
         pj[pairs++] = i;
       }
-    const Eigen::Index ldw = W.rows();
-    for (int q = 0; q < nq; ++q) {
-      const Mat15& Hq = Hs[q];
-      const double* c0 = PhiT.data() + static_cast<Eigen::Index>(5 * q) * nl;
-      const double *c1 = c0 + nl, *c2 = c1 + nl, *c3 = c2 + nl, *c4 = c3 + nl;
-      for (int p = 0; p < pairs; ++p)
-        for (int f = 0; f < 5; ++f) {
-          const int row = 3 * f + pi[p], cj = pj[p];
-          const double h0 = Hq(row, cj), h1 = Hq(row, 3 + cj), h2 = Hq(row, 6 + cj),
-                       h3 = Hq(row, 9 + cj), h4 = Hq(row, 12 + cj);
-          double* w = W.data() + (5 * q + f) * ldw + p * nl;
-          for (int l = 0; l < nl; ++l)
-            w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
-        }
-    }
-    const auto Phi5 = PhiT.leftCols(5 * nq);
-    Kall.leftCols(full * nl).noalias() = Phi5 * W.topLeftCorner(full * nl, 5 * nq).transpose();
-    for (int p = full; p < pairs; ++p)
-      Kall.middleCols(p * nl, nl).triangularView<Eigen::Lower>() =
-          Phi5 * W.block(p * nl, 0, nl, 5 * nq).transpose();
+    kernel::ElementTangentInput kin;
+    kin.nl = nl;
+    kin.nq = el.num_points;
+    kin.PhiT = el.PhiT.data();
+    kin.H = Hs[0].data();
+    kin.pairs = pairs;
+    kin.pi = pi;
+    kin.pj = pj;
+    kin.full = full;
+    kernel::element_tangent_blocks(kin, W.data(), KT.data());
     Eigen::MatrixXd& Ke = out.Ke[e];
+    // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)
+    // and, for a symmetric law, the mirror Ke(3 m + j, 3 l + i) likewise.
+    const Eigen::Index ldw = KT.rows();
+    const double* kt = KT.data();
     for (int p = 0; p < pairs; ++p) {
       const int i = pi[p], j = pj[p];
-      const auto Kij = Kall.middleCols(p * nl, nl);
-      if (p >= full) {  // symmetric diagonal block from its lower triangle
-        for (int m = 0; m < nl; ++m)
-          for (int l = m; l < nl; ++l)
-            Ke(3 * l + i, 3 * m + i) = Ke(3 * m + i, 3 * l + i) = Kij(l, m);
-        continue;
+      const bool tri = p >= full;  // symmetric diagonal block from its lower triangle
+      for (int m = 0; m < nl; ++m) {
+        double* col = Ke.data() + (3 * m + j) * Ke.rows() + i;  // col[3 l] = Ke(3 l + i, 3 m + j)
+        for (int l = tri ? m : 0; l < nl; ++l) col[3 * l] = kt[l * ldw + p * nl + m];
       }
-      for (int m = 0; m < nl; ++m)
-        for (int l = 0; l < nl; ++l) Ke(3 * l + i, 3 * m + j) = Kij(l, m);
-      if (symmetric)
-        for (int m = 0; m < nl; ++m)
-          for (int l = 0; l < nl; ++l) Ke(3 * m + j, 3 * l + i) = Kij(l, m);
+      if (!symmetric) continue;
+      for (int l = 0; l < nl; ++l) {
+        double* col = Ke.data() + (3 * l + i) * Ke.rows() + j;  // col[3 m] = Ke(3 m + j, 3 l + i)
+        const double* Kl = kt + l * ldw + p * nl;               // Kl[m] = K_ij(l, m)
+        for (int m = 0; m < (tri ? l : nl); ++m) col[3 * m] = Kl[m];
+      }
     }
   }
   return true;

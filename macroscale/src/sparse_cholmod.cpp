@@ -28,6 +28,22 @@ void serial_openmp_regions() {
   if (set_levels) set_levels(0);
 }
 
+/// OpenBLAS (Debian's libopenblas0-pthread behind libblas.so.3, scripts/setup.sh) starts one
+/// thread per core for every BLAS call; beside the assembly threads and other processes on a
+/// 2-core machine its spinning threads cost more than they gave (a 1,440-unknown run: 27 % of
+/// the samples in the kernel's scheduler and sched_yield). One BLAS thread: the factorization
+/// runs on the calling thread. Looked up at run time: absent with another BLAS.
+void serial_blas() {
+  using SetThreads = void (*)(int);
+  static const auto set_threads =
+      reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  static const bool once = [] {
+    if (set_threads) set_threads(1);
+    return true;
+  }();
+  (void)once;
+}
+
 /// A view of Eigen's compressed lower triangle as a CHOLMOD matrix (no copy; stype -1: only
 /// the lower triangle is referenced).
 cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
@@ -98,6 +114,7 @@ bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>& lower) {
 SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
   if (!impl_->L) return Status::kFailed;
   serial_openmp_regions();
+  serial_blas();
   cholmod_sparse A = view(lower);
   cholmod_factorize(&A, impl_->L, &impl_->c);
   if (impl_->c.status == CHOLMOD_NOT_POSDEF) return Status::kNotPositiveDefinite;

@@ -3,12 +3,15 @@
 #  * dense/sparse crossover: the Sze cantilever (p = 3) at 2..32 x 1 elements with every
 #    linear-solver path (dense/sparse x LU/LDLT), one thread;
 #  * the Sze cantilever at 16x1, 32x1, 64x1 with the defaults (target: 64x1/16x1 <= 4.5);
-#  * the tensile patch at p = 4, 8 x 40 elements (1,584 DOFs, 40 steps; targets <= 5 s on one
-#    core, <= 15 ms per Newton iteration) and 16 x 100 elements (6,240 DOFs; <= 60 ms per
-#    iteration), with the time per Newton iteration split into assembly and solve, as wall
-#    and as CPU time (on a loaded machine the CPU figures of the one-thread runs are the cost);
-#    each also with the SimplicialLDLT instead of CHOLMOD's supernodal Cholesky.
-# Figures of 30 Nov 2026: docs/solver.md "Benchmark".
+#  * the tensile patch at p = 4, 8 x 40 elements (1,584 DOFs, 1,440 unknowns, 40 steps;
+#    targets <= 5 s on one core, <= 15 ms per Newton iteration) and 16 x 100 elements
+#    (6,240 DOFs, 6,000 unknowns; <= 60 ms per iteration), with the time per Newton
+#    iteration split into assembly and solve, as wall and as CPU time (on a loaded machine
+#    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT
+#    instead of CHOLMOD's supernodal Cholesky.
+# Figures of 30 Nov 2026: docs/solver.md "Benchmark". A solver change must leave the results
+# unchanged: run the same case before and after and compare the two results.h5 with
+# scripts/bench/compare_results.py (1e-8 relative).
 # Usage: scripts/bench/solver.sh [BUILD_DIR] [CATCH_TEST_NAME_FILTER]
 set -euo pipefail
 BUILD_DIR=${1:-build}

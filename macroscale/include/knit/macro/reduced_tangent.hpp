@@ -86,8 +86,8 @@ class ReducedTangent {
   Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
 
  private:
-  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k: the one
-  /// scatter of the dense and sparse paths.
+  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k (the
+  /// compacted map, scatter_*): the one scatter of the dense and sparse paths.
   void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const;
 
   void analyze_ldlt();  ///< symbolic analysis of the SimplicialLDLT (once, when first needed)
@@ -100,7 +100,13 @@ class ReducedTangent {
   int n_ = 0;
   bool symmetric_ = false, sparse_ = false, supernodal_ = false;
   int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
-  std::vector<int> map_;  ///< block_ entries per element: value index or -1
+  std::vector<int> map_;  ///< block_ entries per element: value index or -1 (construction only)
+  /// The scatter map without its -1 entries (half of them on the symmetric path): element e's
+  /// entries t in [scatter_begin_[e], scatter_begin_[e + 1]) add Ke[e].data()[scatter_src_[t]]
+  /// to values[scatter_dst_[t]].
+  std::vector<size_t> scatter_begin_;
+  std::vector<int> scatter_src_, scatter_dst_;
+  void compact_map();  ///< map_ -> scatter_* (then frees map_)
   /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;

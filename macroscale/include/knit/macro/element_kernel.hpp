@@ -1,0 +1,54 @@
+// The hot loop of the shell element tangent (shell_model.hpp "Element kernel"), on raw arrays:
+//
+//   K_ij(l, m) = sum_q sum_fg Phi_f(l, q) H_q(3f+i, 3g+j) Phi_g(m, q)
+//
+// for the component pairs (i, j) of one element, as W = [(H_q Phi)_ij] (plain axpy loops) and
+// one product Phi^T W^T in register tiles of 8 x 4 (GCC vector extensions). Compiled twice
+// (GCC's target attribute): for x86-64-v3 (AVX2 + FMA) and for the default x86-64, chosen at
+// run time by the CPU; the binary still runs on any x86-64. The file includes no Eigen
+// (Eigen's inline functions compiled for two instruction sets in one program would clash:
+// compiling shell_model.cpp alone with -mavx2 crashed), and it is compiled with
+// -ffp-contract=fast (macroscale/CMakeLists.txt) so that a * b + c becomes one FMA in the
+// AVX2 version. The two versions differ by round-off only (tested).
+#pragma once
+
+namespace knit::macro::kernel {
+
+/// Padding of the element's local-function count nl: rows of PhiT and of the output are
+/// allocated for padded_functions(nl) (the extra rows of PhiT must be zero).
+constexpr int padded_functions(int nl) {
+  return (nl + 3) / 4 * 4;
+}
+/// Rows of the workspace W: 9 component pairs of nl plus the overrun of the last 8-wide tile.
+constexpr int workspace_rows(int nl) {
+  return 9 * nl + 8;
+}
+
+struct ElementTangentInput {
+  int nl = 0;                    ///< local functions (control points) of the element
+  int nq = 0;                    ///< quadrature points
+  const double* PhiT = nullptr;  ///< padded_functions(nl) x 5 nq, column 5 q + f: Phi_f at q
+  const double* H = nullptr;     ///< nq matrices 15 x 15 (column-major, 225 apart)
+  int pairs = 0;                 ///< component pairs (i, j) to compute
+  const int* pi = nullptr;       ///< their i
+  const int* pj = nullptr;       ///< their j
+  int full = 0;  ///< pairs [0, full) are computed whole; pairs [full, pairs) (diagonal pairs of
+                 ///< a symmetric tangent) only where l >= m (their lower triangle)
+};
+
+enum class Isa {
+  kAuto,       ///< x86-64-v3 when the CPU has it, else the default
+  kDefault,    ///< SSE2 (any x86-64)
+  kX86_64_v3,  ///< AVX2 + FMA (falls back to the default on a CPU without them)
+};
+/// Whether this CPU runs the x86-64-v3 version (AVX2, FMA, BMI2).
+bool cpu_has_x86_64_v3();
+
+/// Fills KT (workspace_rows(nl) x padded_functions(nl), column-major):
+///   KT(p nl + m, l) = K_{pi[p] pj[p]}(l, m)
+/// for every pair p; W is workspace of workspace_rows(nl) x 5 nq doubles whose padding rows
+/// must be finite (zero them once). Entries outside the computed triangle are unspecified.
+void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT,
+                            Isa isa = Isa::kAuto);
+
+}  // namespace knit::macro::kernel
