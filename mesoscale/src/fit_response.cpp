@@ -118,6 +118,10 @@ std::string loss_name(Loss l) {
   return l == Loss::kHuber ? "huber" : (l == Loss::kCauchy ? "cauchy" : "none");
 }
 
+std::string initial_stiffness_name(InitialStiffness k) {
+  return k == InitialStiffness::kFit ? "fit" : "first_step";
+}
+
 }  // namespace
 
 bool in_paper_fit(const RawPath& r) {
@@ -149,7 +153,8 @@ std::string FitOptions::to_json() const {
                       {"loss_scale", loss_scale},
                       {"optimize_foot_points", optimize_foot_points},
                       {"foot_point_penalty", foot_point_penalty},
-                      {"max_iterations", max_iterations}};
+                      {"max_iterations", max_iterations},
+                      {"initial_stiffness", initial_stiffness_name(initial_stiffness)}};
   return j.dump();
 }
 
@@ -183,7 +188,8 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
                                 "shear_degree",       "shear_control_points",
                                 "smoothing",          "loss",
                                 "loss_scale",         "optimize_foot_points",
-                                "foot_point_penalty", "max_iterations"};
+                                "foot_point_penalty", "max_iterations",
+                                "initial_stiffness"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
@@ -202,6 +208,16 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
     if (!j["optimize_foot_points"].is_boolean())
       throw InputError(file, "/optimize_foot_points", "must be true or false");
     o.optimize_foot_points = j["optimize_foot_points"].get<bool>();
+  }
+  if (j.contains("initial_stiffness")) {
+    const auto& v = j["initial_stiffness"];
+    const std::string k = v.is_string() ? v.get<std::string>() : "";
+    if (k == "first_step")
+      o.initial_stiffness = InitialStiffness::kFirstStep;
+    else if (k == "fit")
+      o.initial_stiffness = InitialStiffness::kFit;
+    else
+      throw InputError(file, "/initial_stiffness", "must be \"first_step\" or \"fit\"");
   }
   if (j.contains("loss")) {
     const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
@@ -341,6 +357,28 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   }
   if (!(sE > 0.0)) return refuse("all biaxial strains are zero");
   if (!(sS > 0.0)) sS = 1.0;
+  // The initial stiffness: least-squares secant of the first converged step of every path,
+  // C_init = (sum S_d E_d^T)(sum E_d E_d^T)^-1 (the fan has >= 2 distinct directions).
+  const bool pin_initial = o.initial_stiffness == InitialStiffness::kFirstStep;
+  Eigen::Matrix2d C_init = Eigen::Matrix2d::Zero();
+  if (pin_initial) {
+    Eigen::Matrix2d EE = Eigen::Matrix2d::Zero(), SE = Eigen::Matrix2d::Zero();
+    for (const auto& f : fan) {
+      const RawPath& r = *f.p;
+      for (int k = 0; k < r.steps(); ++k)
+        if (r.status[k] == 0) {
+          const Eigen::Vector2d e = r.E.row(k).head<2>().transpose();
+          EE += e * e.transpose();
+          SE += r.S.row(k).head<2>().transpose() * e.transpose();
+          break;
+        }
+    }
+    C_init = SE * EE.inverse();
+    if (!C_init.allFinite())
+      return refuse(
+          "the first load steps of the fan do not determine an initial stiffness (their strains "
+          "are parallel or zero); use \"initial_stiffness\": \"fit\"");
+  }
 
   // ---- the surface fit (xi fixed; alternated with foot-point updates if asked) ----------------
   ResponseSurfaceData& sf = out.surface;
@@ -396,6 +434,19 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     out.ceres_iterations += static_cast<int>(summary.iterations.size());
+    if (summary.IsSolutionUsable() && pin_initial && n2 > 1) {
+      // Second stage: row 1 of the S-surface tied to the initial stiffness, S_i1 = C_init E_i1
+      // (E_i1 as fitted: the E residuals do not depend on S), the rest of S refitted.
+      for (int i = 0; i < n1; ++i) {
+        double* Pi = &P[4 * (i + n1)];
+        const Eigen::Vector2d s1 = C_init * Eigen::Vector2d(Pi[0], Pi[1]);
+        Pi[2] = s1(0);
+        Pi[3] = s1(1);
+        problem.SetParameterBlockConstant(Pi);
+      }
+      ceres::Solve(so, &problem, &summary);
+      out.ceres_iterations += static_cast<int>(summary.iterations.size());
+    }
     if (!summary.IsSolutionUsable()) {
       out.status = FitStatus::kSolverFailed;
       out.reason = "Ceres: " + summary.message;
@@ -457,6 +508,16 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     sf.E12_ctrl(0) = 0.0;
   }
   std::vector<double> Q(ns, 0.0);
+  // The initial shear stiffness: the first converged shear step's secant times E12_1.
+  bool pin_shear = false;
+  if (pin_initial && ns > 2)
+    for (int k = 0; k < shear->steps(); ++k)
+      if (shear->status[k] == 0 && shear->E(k, 2) != 0.0) {
+        Q[1] = shear->S(k, 2) / shear->E(k, 2) * sf.E12_ctrl(1);
+        pin_shear = std::isfinite(Q[1]);
+        if (!pin_shear) Q[1] = 0.0;
+        break;
+      }
   {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -487,6 +548,7 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
             new LinearCombinationCost({rw, -2 * rw, rw}, Eigen::VectorXd::Zero(1), inv), nullptr,
             {&Q[a - 1], &Q[a], &Q[a + 1]});
     problem.SetParameterBlockConstant(&Q[0]);
+    if (pin_shear) problem.SetParameterBlockConstant(&Q[1]);
     ceres::Solver::Options so;
     configure_solver(so, o);
     so.linear_solver_type = ceres::DENSE_QR;

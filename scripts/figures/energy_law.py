@@ -10,7 +10,6 @@ numerically from 0 on a fine grid (a plot, not the C++ evaluator).
 
 Usage: energy_law.py --database DB.h5 --loop-length 6.5 --out fig06e_energy_law.png
 """
-import argparse
 import os
 import sys
 
@@ -22,7 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from surfaces import basis, pick_loop  # noqa: E402
+from surfaces import basis, database_figure_args, pick_loop  # noqa: E402
 
 
 def uniform_clamped(p, n, a, b):
@@ -71,11 +70,7 @@ class Law:
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--database", required=True)
-    ap.add_argument("--loop-length", type=float, default=6.5)
-    ap.add_argument("--out", required=True)
-    a = ap.parse_args()
+    a = database_figure_args()
     with h5py.File(a.database, "r") as f:
         if "energy_law" not in f:
             sys.exit(f"{a.database}: /energy_law: group missing (run `knit-meso fit "

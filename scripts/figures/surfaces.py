@@ -50,12 +50,17 @@ def pick_loop(f, l):
     return k, float(ls[k])
 
 
-def main():
+def database_figure_args():
+    """The command line of the database figures: --database, --loop-length (6.5), --out."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--database", required=True)
     ap.add_argument("--loop-length", type=float, default=6.5)
     ap.add_argument("--out", required=True)
-    a = ap.parse_args()
+    return ap.parse_args()
+
+
+def main():
+    a = database_figure_args()
     with h5py.File(a.database, "r") as f:
         k, l = pick_loop(f, a.loop_length)
         g = f[f"loop_{k}"]

@@ -22,14 +22,8 @@ TEST_CASE("fuzz: mutated database files load or throw InputError", "[unit][fuzz]
   const fs::path dir =
       fs::path(KNIT_BINARY_DIR) / "test_tmp" / ("fuzz_db_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  Database db;
-  db.provenance = current_provenance();
-  db.generator = "test";
-  db.sweep_input = "{\"a\": 1}";
-  db.yarn = {{"diameter", 0.38}};
-  LoopLengthEntry e;
-  e.loop_length = 5.0;
-  e.cell = {1.26, 0.88, 0.76};
+  Database db = testing::make_test_database("{\"a\": 1}");
+  LoopLengthEntry e = testing::make_test_entry(5.0);
   for (const auto& p : default_load_paths(2)) {
     RawPath r;
     r.path = p;

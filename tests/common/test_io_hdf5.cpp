@@ -400,14 +400,8 @@ TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, nami
           "[unit][io][hdf5]") {
   // Issue 14: this ran to completion with 18.6 N instead of 41.4 N.
   using namespace knit::material;
-  Database db;
-  db.provenance = current_provenance();
-  db.generator = "test";
-  db.sweep_input = "{}";
-  db.yarn = {{"diameter", 0.38}};
-  LoopLengthEntry e;
-  e.loop_length = 5.0;
-  e.cell = {1.26, 0.88, 0.76};
+  Database db = testing::make_test_database();
+  LoopLengthEntry e = testing::make_test_entry(5.0);
   e.surface = testing::make_test_surface(1.0);
   e.diagnostics.options_json = "{}";
   db.entries.push_back(e);

@@ -1,12 +1,15 @@
 // Test helper: a valid response surface without the fitter (Schoenberg quasi-interpolation of
 // a known law on the default fan of load paths: control point (i, j) takes the strain of the
-// fan at the Greville abscissae (g_i, g_j) and the law's stress there). Shared by the common
-// and macro material tests.
+// fan at the Greville abscissae (g_i, g_j) and the law's stress there), and the test databases
+// built from it. Shared by the common and macro material tests.
 #pragma once
 
 #include <Eigen/Core>
 #include <cmath>
+#include <string>
+#include <vector>
 
+#include "knit/material/database.hpp"
 #include "knit/material/load_paths.hpp"
 #include "knit/material/response_surface.hpp"
 #include "knit/spline/bspline_basis.hpp"
@@ -66,6 +69,38 @@ inline Eigen::Matrix3d fd_tangent(const ResponseSurface& rs, const Eigen::Vector
     C.col(c) = (rs.evaluate(Ep).S - rs.evaluate(Em).S) / (2 * h);
   }
   return C;
+}
+
+/// A database as the tests write it (provenance, generator "test", the sweep input, the yarn
+/// diameter), without loop-length entries.
+inline Database make_test_database(std::string sweep_input = "{}") {
+  Database db;
+  db.provenance = current_provenance();
+  db.generator = "test";
+  db.sweep_input = std::move(sweep_input);
+  db.yarn = {{"diameter", 0.38}};
+  return db;
+}
+
+/// A loop-length entry with the 5 mm-like cell of the database tests (w, c, t in mm), no data.
+inline LoopLengthEntry make_test_entry(double loop_length = 5.0) {
+  LoopLengthEntry e;
+  e.loop_length = loop_length;
+  e.cell = {1.26, 0.88, 0.76};
+  return e;
+}
+
+/// The stiffening test law fitted at every loop length, scaled by k = (4.5/l)^2 (no cells).
+inline Database make_test_law_database(const std::vector<double>& loop_lengths = {4.5, 5.0, 5.5,
+                                                                                  6.0, 6.5}) {
+  Database db = make_test_database();
+  for (double l : loop_lengths) {
+    LoopLengthEntry e;
+    e.loop_length = l;
+    e.surface = make_test_surface(std::pow(4.5 / l, 2));
+    db.entries.push_back(e);
+  }
+  return db;
 }
 
 }  // namespace knit::material::testing

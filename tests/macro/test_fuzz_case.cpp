@@ -34,16 +34,8 @@ fs::path fuzz_root() {
       fs::path(KNIT_BINARY_DIR) / "test_tmp" / ("fuzz_case_" + std::to_string(::getpid()));
   fs::create_directories(root / "cases" / "paper");
   fs::create_directories(root / "out");
-  knit::material::Database db;
-  db.provenance = knit::material::current_provenance();
-  db.generator = "test";
-  for (double l : {4.5, 5.0, 5.5, 6.0, 6.5}) {
-    knit::material::LoopLengthEntry e;
-    e.loop_length = l;
-    e.surface = knit::material::testing::make_test_surface(std::pow(4.5 / l, 2));
-    db.entries.push_back(e);
-  }
-  knit::material::write_database(root / "out" / "database.h5", db);
+  knit::material::write_database(root / "out" / "database.h5",
+                                 knit::material::testing::make_test_law_database());
   return root;
 }
 }  // namespace

@@ -8,6 +8,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/macro/knit_material.hpp"
 #include "knit/mechanics/voigt.hpp"
+#include "knit_material_test_util.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;
@@ -22,18 +23,10 @@ std::shared_ptr<const LoopLengthFamily> test_family() {
 }
 // l graded linearly 4.5 -> 6.5 in theta1, alpha constant.
 KnitMaterial graded(double alpha, double l0 = 4.5, double l1 = 6.5) {
-  ScalarFieldSpec l;
-  l.degree_u = 1;
-  l.knots_u = {0, 0, 1, 1};
-  l.values = {l0, l1};
-  return KnitMaterial(test_family(), make_scalar_field(l),
+  return KnitMaterial(test_family(), make_scalar_field(knit::testing::graded_stitch_value(l0, l1)),
                       make_scalar_field(ScalarFieldSpec::constant(alpha)));
 }
-MaterialPoint at(double t1, double t2) {
-  MaterialPoint p;
-  p.theta = {t1, t2};
-  return p;
-}
+using knit::testing::at;
 }  // namespace
 
 TEST_CASE("knit material: tangent equals finite differences of S (graded, rotated)", "[unit]") {
@@ -44,14 +37,7 @@ TEST_CASE("knit material: tangent equals finite differences of S (graded, rotate
         Eigen::Vector3d(0.02, 0.4, -0.5)}) {
     const auto p = at(0.37, 0.5);
     const auto r = m.evaluate(E, p);
-    Eigen::Matrix3d Cfd;
-    const double h = 1e-7;
-    for (int c = 0; c < 3; ++c) {
-      Eigen::Vector3d Ep = E, Em = E;
-      Ep(c) += h;
-      Em(c) -= h;
-      Cfd.col(c) = (m.evaluate(Ep, p).S - m.evaluate(Em, p).S) / (2 * h);
-    }
+    const Eigen::Matrix3d Cfd = knit::testing::central_differences(m, E, p, 1e-7).C;
     INFO("E = " << E.transpose());
     CHECK((r.C - Cfd).norm() <= 1e-5 * Cfd.norm());
   }

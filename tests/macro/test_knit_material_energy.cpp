@@ -16,6 +16,7 @@
 #include "knit/macro/knit_material.hpp"
 #include "knit/material/database.hpp"
 #include "knit/mechanics/voigt.hpp"
+#include "knit_material_test_util.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;
@@ -23,19 +24,11 @@ namespace fs = std::filesystem;
 
 namespace {
 KnitMaterial energy_material(double alpha) {
-  ScalarFieldSpec l;
-  l.degree_u = 1;
-  l.knots_u = {0, 0, 1, 1};
-  l.values = {4.5, 6.5};
   auto law = std::make_shared<const EnergyLaw>(testing::make_test_energy_law());
-  return KnitMaterial(nullptr, law, make_scalar_field(l),
+  return KnitMaterial(nullptr, law, make_scalar_field(knit::testing::graded_stitch_value()),
                       make_scalar_field(ScalarFieldSpec::constant(alpha)));
 }
-MaterialPoint at(double t1, double t2) {
-  MaterialPoint p;
-  p.theta = {t1, t2};
-  return p;
-}
+using knit::testing::at;
 }  // namespace
 
 TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded, rotated)",
@@ -51,17 +44,9 @@ TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded,
       const auto r = m.evaluate(E, p);
       REQUIRE(std::isfinite(r.W));
       REQUIRE(r.C == r.C.transpose());
-      Eigen::Matrix3d Cfd;
-      Eigen::Vector3d Sfd;
-      const double h = 1e-6;
-      for (int c = 0; c < 3; ++c) {
-        Eigen::Vector3d Ep = E, Em = E;
-        Ep(c) += h;
-        Em(c) -= h;
-        const auto rp = m.evaluate(Ep, p), rm = m.evaluate(Em, p);
-        Cfd.col(c) = (rp.S - rm.S) / (2 * h);
-        Sfd(c) = (rp.W - rm.W) / (2 * h);
-      }
+      const auto fd = knit::testing::central_differences(m, E, p, 1e-6);
+      const Eigen::Matrix3d& Cfd = fd.C;
+      const Eigen::Vector3d& Sfd = fd.S;
       INFO("alpha " << alpha << ", E = " << E.transpose());
       CHECK((r.C - Cfd).norm() <= 1e-6 * (1 + Cfd.norm()));
       CHECK((r.S - Sfd).norm() <= 1e-6 * (1 + Sfd.norm()));

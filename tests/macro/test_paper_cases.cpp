@@ -37,16 +37,7 @@ std::string paper_test_database() {
     const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
     fs::create_directories(dir);
     const fs::path f = dir / ("paper_cases_db_" + std::to_string(::getpid()) + ".h5");
-    knit::material::Database db;
-    db.provenance = knit::material::current_provenance();
-    db.generator = "test";
-    for (double l : {4.5, 5.0, 5.5, 6.0, 6.5}) {
-      knit::material::LoopLengthEntry e;
-      e.loop_length = l;
-      e.surface = knit::material::testing::make_test_surface(std::pow(4.5 / l, 2));
-      db.entries.push_back(e);
-    }
-    knit::material::write_database(f, db);
+    knit::material::write_database(f, knit::material::testing::make_test_law_database());
     struct Remove {
       fs::path p;
       ~Remove() {

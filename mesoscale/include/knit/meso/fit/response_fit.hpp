@@ -20,6 +20,22 @@
 // (so E12(u) = u * E12_max exactly), S12 control values fitted with S12(0) = 0 held, the same
 // smoothness penalty and loss.
 //
+// Initial stiffness (documented choice, `initial_stiffness`). The data say nothing below the
+// first load step, and the cell's response is slack there and then stiffens abruptly (contact
+// engagement): a free cubic fit rings across that kink, and with the stress scaled by its
+// largest value nothing holds the first span, so the tangent at small strains came out with
+// the wrong sign (4.5 mm of the gamma/w = 0.225 database: C22 = -0.12 MPa along the wale,
+// C33 = -0.67 MPa; at 6.5 mm indefinite in every direction) and the shell's first load step
+// diverged. With "first_step" (default) the first row of control points above the edge is
+// tied to one initial stiffness, S_i1 = C_init E_i1 (row 1 of the E-surface), with C_init the
+// least-squares secant of the first converged step of every path of the fan,
+// C_init E_d(first) ~ S_d(first); the S12 curve's first control value likewise is the first
+// shear step's secant times E12_1. dS/dxi2 at xi2 = 0 is then C_init dE/dxi2 in every
+// direction, so the law's tangent at E -> 0 is C_init whatever the direction (continuous at
+// the origin) and equals the data's first secant. The E-surface is fitted first (E and S are
+// independent least-squares problems; with a robust loss row 1 of E is held at the first
+// solve), then the S-surface with row 1 held. "fit": the former free fit.
+//
 // Refusals (status != kOk, with the reason): fewer biaxial paths or steps than degree + 1,
 // fewer than n_ctrl distinct data values in a direction without smoothing, non-finite data, a
 // path without converged steps, two paths in the same direction, a fan of 180 degrees or
@@ -35,6 +51,12 @@ namespace knit::meso::fit {
 
 enum class Loss { kNone, kHuber, kCauchy };
 
+/// How the law's stiffness at E = 0 is set (see the header comment).
+enum class InitialStiffness {
+  kFirstStep,  ///< tied to the least-squares secant of the first converged load steps
+  kFit         ///< left to the fit (the first control row is free)
+};
+
 struct FitOptions {
   int degree1 = 3, degree2 = 3;  ///< xi1 (path fan), xi2 (step fraction)
   int n_ctrl1 = 11, n_ctrl2 = 11;
@@ -45,6 +67,7 @@ struct FitOptions {
   bool optimize_foot_points = false;
   double foot_point_penalty = 1e-4;  ///< mu: keeps xi_d near its grid value
   int max_iterations = 100;
+  InitialStiffness initial_stiffness = InitialStiffness::kFirstStep;
 
   /// Empty if valid, else the reason.
   std::string validate() const;
