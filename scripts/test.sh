@@ -13,6 +13,7 @@ echo "== tests (Release) =="
 (cd "$root/build" && ctest --output-on-failure --parallel "$jobs")
 
 echo "== unit tests under ASan + UBSan =="
+# Only test files with a [unit] test are compiled in this build (tests/CMakeLists.txt).
 san="$root/build-sanitize"
 gen=()
 command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
