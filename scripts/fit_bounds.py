@@ -23,15 +23,20 @@ loop length's fit data); the threshold is 5 %.
 
 Usage: /usr/bin/python3 scripts/fit_bounds.py DATABASE.h5 [--loops 0 4] [--stride 3]
        /usr/bin/python3 scripts/fit_bounds.py --self-check
-Needs python3-numpy, python3-scipy (>= 1.8 for HiGHS and BSpline.design_matrix), python3-h5py.
+Needs python3-numpy, python3-scipy (>= 1.8 for HiGHS), python3-h5py and python3-matplotlib
+(the stored law is evaluated by scripts/figures/energy_law.py).
 """
 import argparse
+import os
 import sys
 
 import numpy as np
 from scipy.interpolate import BSpline
 from scipy.optimize import linprog
 from scipy.sparse import coo_matrix, vstack
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
+from energy_law import Law as EnergyLaw  # noqa: E402  (the stored law, re-evaluated)
 
 THRESHOLD = 0.05
 
@@ -139,30 +144,6 @@ def summary(err):
                                                      100 * err.max())
 
 
-def energy_law_stress(f, loop_length, e):
-    """S of the stored ridge-spline law (knit/material/energy_law.hpp) at e (n x 3)."""
-    g = f["energy_law"]
-    dirs, fun = g["directions"][:], g["function_of"][:]
-    coef, srange = g["coefficients"][:], g["s_range"][:]
-    p, lp = int(g.attrs["s_degree"]), int(g.attrs["l_degree"])
-    lk = g["l_knots"][:]
-    nl = len(lk) - lp - 1
-    ns = coef.shape[1] // nl
-    ml = BSpline(lk, np.eye(nl), lp)(np.clip(loop_length, lk[0], lk[-1]))
-    out = float(g.attrs["floor"]) * e
-    for k, d in enumerate(dirs):
-        a, b = srange[fun[k]]
-        t = np.concatenate([[a] * p, np.linspace(a, b, ns - p + 1), [b] * p])
-        second = BSpline(t, coef[fun[k]].reshape(nl, ns).T @ ml, p)
-        first = second.antiderivative(1)
-        x = e @ d
-        xc = np.clip(x, a, b)
-        fp = (first(xc) - first(0.0) + np.where(x < a, second(a) * (x - a), 0.0) +
-              np.where(x > b, second(b) * (x - b), 0.0))
-        out += fp[:, None] * d[None, :]
-    return out
-
-
 def analyse(f, loop, stride, n, lam):
     paths = load_paths(f, loop)
     loop_length = float(f["loop_lengths"][loop])
@@ -184,8 +165,8 @@ def analyse(f, loop, stride, n, lam):
     print("l = %.2f mm (stress range %.2f MPa), %d held-out states of %d paths:" %
           (loop_length, rng, len(te_e), len(held)))
     if "energy_law" in f:
-        print("  stored energy law           : %s" % summary(err(energy_law_stress(f, loop_length,
-                                                                                  te_e))))
+        law = EnergyLaw(f["energy_law"], loop_length)
+        print("  stored energy law           : %s" % summary(err(law.eval(te_e)[1])))
     print("  free energy (grad of spline): %s" % summary(err(energy)))
     print("  free interpolant (no energy): %s" % summary(err(interp)))
     print("  convex bound, %d states incl. held-out, in-sample: delta* >= %.2f %% (%s)" %
