@@ -96,9 +96,52 @@ Eigen::Matrix2d upper_gradient_for(double E11, double E22, double E12) {
   return F;
 }
 
+namespace {
+/// Gradient paths from 0 to the strain states point(i) (i = 1, 2, ..., in [0, 1)^3) mapped
+/// onto `b` (E12 over [-E12_max, E12_max]); states without an upper-triangular F with some
+/// margin (1 + 2 E11 <= 0.01 or 1 + 2 E22 - b^2 <= 0.01), and those whose area ratio
+/// J = det F is below `min_J`, are skipped.
+template <class Point>
+std::vector<LoadPath> paths_to_points(const StrainBox& b, int count, int steps,
+                                      const std::string& set, double min_J, Point point) {
+  std::vector<LoadPath> paths;
+  for (int i = 1; static_cast<int>(paths.size()) < count && i < 100000; ++i) {
+    const Eigen::Vector3d u = point(i);
+    const double E11 = b.E11_min + u(0) * (b.E11_max - b.E11_min);
+    const double E22 = b.E22_min + u(1) * (b.E22_max - b.E22_min);
+    const double E12 = (2.0 * u(2) - 1.0) * b.E12_max;
+    const double a2 = 1.0 + 2.0 * E11, bb = 4.0 * E12 * E12 / a2;
+    if (!(a2 > 0.01) || !(1.0 + 2.0 * E22 - bb > 0.01)) continue;
+    const Eigen::Matrix2d F = upper_gradient_for(E11, E22, E12);
+    if (F.determinant() < min_J) continue;
+    LoadPath p;
+    p.kind = PathKind::kGradient;
+    p.H = F - Eigen::Matrix2d::Identity();
+    p.steps = steps;
+    p.set = set;
+    paths.push_back(p);
+  }
+  return paths;
+}
+}  // namespace
+
+Eigen::Vector3d fill_point(int i) {
+  constexpr double g = 1.22074408460575947536;  // plastic number: g^4 = g + 1
+  const Eigen::Vector3d a(1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g));
+  Eigen::Vector3d u;
+  for (int k = 0; k < 3; ++k) {
+    const double x = 0.5 + static_cast<double>(i) * a(k);
+    u(k) = x - std::floor(x);
+  }
+  return u;
+}
+
 std::vector<LoadPath> coverage_load_paths(const CoverageOptions& o) {
-  if (o.directions < 0 || o.biaxial_steps < 1 || o.uniaxial_steps < 1 || o.gradient_steps < 1)
-    throw std::invalid_argument("coverage paths: directions >= 0 and steps >= 1 required");
+  if (o.directions < 0 || o.biaxial_steps < 1 || o.uniaxial_steps < 1 || o.gradient_steps < 1 ||
+      o.fill_count < 0 || o.fill_steps < 1 || !(o.fill_min_J >= 0.0 && o.fill_min_J < 1.0))
+    throw std::invalid_argument(
+        "coverage paths: directions >= 0, fill_count >= 0, steps >= 1 and 0 <= fill_min_J < 1 "
+        "required");
   const StrainBox& b = o.box;
   if (!(b.E11_min < 0 && b.E11_max > 0 && b.E22_min < 0 && b.E22_max > 0 && b.E12_max > 0))
     throw std::invalid_argument("coverage paths: the box must contain E = 0 in its interior");
@@ -137,27 +180,18 @@ std::vector<LoadPath> coverage_load_paths(const CoverageOptions& o) {
     p.set = "coverage";
     paths.push_back(p);
   }
+  const auto fill =
+      paths_to_points(b, o.fill_count, o.fill_steps, "coverage", o.fill_min_J, fill_point);
+  paths.insert(paths.end(), fill.begin(), fill.end());
   return paths;
 }
 
 std::vector<LoadPath> holdout_load_paths(const StrainBox& b, int count, int steps) {
   if (count < 0 || steps < 1)
     throw std::invalid_argument("holdout paths: count >= 0 and steps >= 1 required");
-  std::vector<LoadPath> paths;
-  for (int i = 1; static_cast<int>(paths.size()) < count && i < 100000; ++i) {
-    const double E11 = b.E11_min + halton(i, 2) * (b.E11_max - b.E11_min);
-    const double E22 = b.E22_min + halton(i, 3) * (b.E22_max - b.E22_min);
-    const double E12 = (2.0 * halton(i, 5) - 1.0) * b.E12_max;
-    const double a2 = 1.0 + 2.0 * E11, bb = 4.0 * E12 * E12 / a2;
-    if (!(a2 > 0.01) || !(1.0 + 2.0 * E22 - bb > 0.01)) continue;
-    LoadPath p;
-    p.kind = PathKind::kGradient;
-    p.H = upper_gradient_for(E11, E22, E12) - Eigen::Matrix2d::Identity();
-    p.steps = steps;
-    p.set = "holdout";
-    paths.push_back(p);
-  }
-  return paths;
+  return paths_to_points(b, count, steps, "holdout", 0.0, [](int i) {
+    return Eigen::Vector3d(halton(i, 2), halton(i, 3), halton(i, 5));
+  });
 }
 
 Eigen::Matrix2d green_lagrange(const Eigen::Matrix2d& F) {

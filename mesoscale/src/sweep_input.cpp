@@ -63,6 +63,9 @@ material::CoverageOptions read_coverage(const nlohmann::json& c, const material:
   o.biaxial_steps = c.value("biaxial_steps", o.biaxial_steps);
   o.uniaxial_steps = c.value("uniaxial_steps", o.uniaxial_steps);
   o.gradient_steps = c.value("gradient_steps", o.gradient_steps);
+  o.fill_count = c.value("fill_count", o.fill_count);
+  o.fill_steps = c.value("fill_steps", o.fill_steps);
+  o.fill_min_J = c.value("fill_min_J", o.fill_min_J);
   if (c.contains("gamma_deg")) o.gamma = c.at("gamma_deg").get<double>() * kPi / 180.0;
   if (c.contains("stretch")) {
     o.stretch.clear();

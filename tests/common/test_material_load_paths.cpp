@@ -90,6 +90,46 @@ TEST_CASE("load paths: coverage fills the circle to the box edge, held-out point
   CHECK(E(0, 1) == Approx(0.3));
 }
 
+TEST_CASE("load paths: quasi-random fill paths cover the box apart from the held-out points",
+          "[unit]") {
+  CoverageOptions o;
+  o.fill_count = 48;
+  o.fill_steps = 6;
+  const auto cov = coverage_load_paths(o);
+  REQUIRE(cov.size() == 2 + 16 + 7 + 48);
+  const auto hold = holdout_load_paths(o.box, 24, 6);
+  int octant[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (std::size_t k = 2 + 16 + 7; k < cov.size(); ++k) {
+    const LoadPath& p = cov[k];
+    CHECK(p.set == "coverage");
+    CHECK(p.kind == PathKind::kGradient);
+    CHECK(p.steps == 6);
+    const Eigen::Matrix2d E = green_lagrange(deformation_gradient(p, 1.0));
+    CHECK(o.box.contains(E(0, 0), E(1, 1), E(0, 1)));
+    CHECK(deformation_gradient(p, 1.0).determinant() >= 0.5);
+    ++octant[(E(0, 0) > 0) + 2 * (E(1, 1) > 0) + 4 * (E(0, 1) > 0)];
+    // No fill path ends near a held-out state (distance in strain, relative to the box).
+    for (const LoadPath& h : hold) {
+      const Eigen::Matrix2d Eh = green_lagrange(deformation_gradient(h, 1.0));
+      CHECK((E - Eh).norm() > 0.01);
+    }
+  }
+  // Every sign combination of (E11, E22, E12) is visited, biaxial compression with shear too.
+  for (int q = 0; q < 8; ++q) CHECK(octant[q] >= 2);
+  // The R3 recurrence: frac(1/2 + i / g^k), g^4 = g + 1.
+  const Eigen::Vector3d u1 = fill_point(1);
+  CHECK(u1(0) == Approx(0.5 + 1.0 / 1.22074408460575947536 - 1.0));
+  for (int i = 1; i < 200; ++i) CHECK((fill_point(i).array() >= 0.0).all());
+  // Without the area floor the sequence reaches the locked corner (J < 0.5) within 48 points.
+  o.fill_min_J = 0.0;
+  int locked = 0;
+  for (const LoadPath& p : coverage_load_paths(o))
+    if (deformation_gradient(p, 1.0).determinant() < 0.5) ++locked;
+  CHECK(locked >= 1);
+  o.fill_steps = 0;
+  CHECK_THROWS_AS(coverage_load_paths(o), std::invalid_argument);
+}
+
 namespace {
 fs::path tmp(const std::string& name) {
   const fs::path d = fs::path(KNIT_BINARY_DIR) / "test_tmp";

@@ -90,6 +90,13 @@ TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
   CHECK(hold == 24);
   CHECK(d.runner == RunnerKind::kCell);
   CHECK(d.fit_options.n_ctrl1 == 11);
+  // The dense input: the default plus 48 quasi-random fill paths (coverage, 6 steps).
+  const auto dense = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/dense.json");
+  REQUIRE(dense.paths.size() == d.paths.size() + 48);
+  int fill = 0;
+  for (const auto& p : dense.paths)
+    fill += p.set == "coverage" && p.kind == knit::material::PathKind::kGradient && p.steps == 6;
+  CHECK(fill == 48);
   const auto r = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/reduced.json");
   CHECK(r.loop_lengths.size() == 1);
   CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12, -1, -1, -1, -1});

@@ -58,7 +58,15 @@ struct StrainBox {
 ///     in the directions theta_k = 2 pi k / directions (k = 0.., the full circle incl. biaxial
 ///     compression and the anticlastic quadrants);
 ///   * gradient paths F = I + t H, H = [[e1, sin g], [0, e2]] for the (e1, e2) of `stretch`
-///     (shear combined with stretch; (e1, e2) = uniaxial-like states too), g = `gamma`.
+///     (shear combined with stretch; (e1, e2) = uniaxial-like states too), g = `gamma`;
+///   * `fill_count` gradient paths of `fill_steps` steps to quasi-random strain states of the
+///     whole box (E12 of both signs): the R3 sequence (fill_point), a different low-discrepancy
+///     sequence than the held-out paths' Halton points, so no fill path ends on a held-out state.
+///     They sample shear combined with stretch and compression throughout the box, where the
+///     rays above leave gaps (issue 11, docs/database.md "Fit"). States whose area ratio
+///     J = det F is below `fill_min_J` (0.5) are skipped: there the cell locks up (one fill
+///     state at J = 0.19 reached S = 114 MPa, 5x the stress range of every other state, just
+///     before its path diverged); the held-out states all have J >= 0.56.
 struct CoverageOptions {
   StrainBox box;
   int directions = 16;  ///< biaxial directions on the full circle (22.5 deg)
@@ -67,6 +75,8 @@ struct CoverageOptions {
   /// (e1, e2) of the gradient paths (displacement gradients F11 - 1, F22 - 1).
   std::vector<Eigen::Vector2d> stretch = {{0.0, 0.0},   {0.2, 0.0},  {0.0, 0.25}, {0.25, -0.12},
                                           {-0.12, 0.3}, {0.15, 0.2}, {-0.1, -0.1}};
+  int fill_count = 0, fill_steps = 6;  ///< quasi-random fill paths (0 = none)
+  double fill_min_J = 0.5;             ///< skip fill states with det F below this
 };
 std::vector<LoadPath> coverage_load_paths(const CoverageOptions& opt);
 
@@ -83,6 +93,12 @@ Eigen::Matrix2d upper_gradient_for(double E11, double E22, double E12);
 
 /// Point i (i >= 1) of the Halton sequence in base b (radical inverse), in [0, 1).
 double halton(int i, int base);
+
+/// Point i (i >= 1) of the R3 additive recurrence in [0, 1)^3: frac(1/2 + i (1/g, 1/g^2, 1/g^3))
+/// with g = 1.2207440846... the plastic number (g^4 = g + 1), the three-dimensional analogue of
+/// the golden-ratio sequence (M. Roberts, "The unreasonable effectiveness of quasirandom
+/// sequences", 2018).
+Eigen::Vector3d fill_point(int i);
 
 /// The 13 default paths (12 biaxial + 1 shear), `steps` increments each.
 std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = 0.40, double e_min = -0.15,
