@@ -93,8 +93,11 @@ enum class StopReason { kNone, kCutbacks, kIncrementFloor, kWorkCap };
 
 /// Where the time of a run went (wall seconds), for benchmarks.
 struct SolverStats {
-  long iterations = 0;     ///< Newton iterations (tangent + solve), failed attempts included
-  long evaluations = 0;    ///< residual-only evaluations (line search, convergence checks)
+  long iterations = 0;   ///< Newton iterations (tangent + solve), failed attempts included
+  long evaluations = 0;  ///< residual-only evaluations (line search, convergence checks)
+  /// Tangents completed from the point states of the residual-only evaluation at the same
+  /// state (ShellModel::tangent_from) instead of a full evaluation.
+  long tangents_reused = 0;
   double setup = 0.0;      ///< scatter map, pattern and symbolic analysis (once)
   double assembly = 0.0;   ///< element tangents and forces + scatter into the reduced matrix
   double solve = 0.0;      ///< numeric factorization and triangular solves

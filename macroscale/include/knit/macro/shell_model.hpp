@@ -81,6 +81,17 @@ class ShellModel {
   /// ~2 ms, 20x the cost of starting the threads.
   static constexpr double kAutoThreadWork = 2.0e5;
 
+  /// What a residual evaluation keeps per quadrature point (evaluate(..., keep_points)) so that
+  /// the tangent at the same displacement (tangent_from) needs no second pass through the
+  /// kinematics and the material: the current base vectors and their derivatives, |a1 x a2|,
+  /// the covariant resultants and the section tangents (local Cartesian Voigt, column-major).
+  struct PointState {
+    double a1[3], a2[3], a3[3], a11[3], a22[3], a12[3];
+    double j;
+    double N[3], M[3];
+    double A[9], B[9], D[9];
+  };
+
   struct Evaluation {
     Eigen::VectorXd fint;             ///< internal force vector (num_dofs)
     std::vector<Eigen::MatrixXd> Ke;  ///< element tangents (3 nloc square, local DOF 3 l + i)
@@ -90,11 +101,19 @@ class ShellModel {
     bool ok = true;                  ///< false if the current configuration degenerated
     Eigen::MatrixXd fe;              ///< workspace: element force vectors (3 nloc x elements)
     Eigen::VectorXd element_energy;  ///< workspace: element energies
+    std::vector<PointState> points;  ///< per quadrature point, if kept (keep_points)
+    bool has_points = false;         ///< `points` belong to this evaluation
   };
   /// Internal forces and energy at displacement u (num_dofs), with the element tangents if
   /// `tangent`. Element results are summed in element order, so the result is bitwise the
   /// same for any number of threads.
-  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const;
+  /// `keep_points` (without `tangent`): also keep the PointStates for tangent_from.
+  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
+                bool keep_points = false) const;
+  /// The evaluation with tangent at the displacement of `from` (evaluated with keep_points, ok):
+  /// the element tangents from its point states, fint, energy and ok copied. Bitwise the same
+  /// as evaluate(u, true, out) (the same operations on the same numbers).
+  void tangent_from(const Evaluation& from, Evaluation& out) const;
   /// Psi(u) alone (NaN unless hyperelastic, or if the configuration degenerated).
   double energy(const Eigen::VectorXd& u) const;
 
@@ -120,8 +139,20 @@ class ShellModel {
     ReferencePoint ref;
     double dA = 0.0;  ///< quadrature weight x Jacobian
   };
-  bool evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent,
+  enum class Pass { kResidual, kResidualKeep, kTangent, kTangentFromStates };
+  /// Runs evaluate_range over the elements on assembly_threads() threads; false if any range
+  /// failed.
+  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
+                  Evaluation& out) const;
+  bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
                       Evaluation& out) const;
+  /// Residual part at one point: the point state, dA psi, and the element force
+  /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
+  /// configuration degenerated there.
+  bool residual_point(int pid, const double* xloc, PointState& s, double& energy, double* fe) const;
+  /// The 15 x 15 matrix H at one point (column-major) from its state; clears `symmetric` if
+  /// the section tangent is not.
+  void point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const;
   SectionResponse section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
                           const Eigen::Vector2d& theta, int point_id) const;
 
