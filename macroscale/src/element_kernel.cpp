@@ -64,6 +64,65 @@ inline __attribute__((always_inline)) void product_rows(const double* W, const d
     }
 }
 
+/// out(c, j) = sum_k X(c, k) B(j, k) for rows c in [0, rows) (rounded up to the tile) and the
+/// NJ columns j, X(c, k) = X[k xs + c], B(j, k) = B[k NJ + j], out(c, j) = out[j os + c]; tiles
+/// of CV vectors of rows x NJ columns (NJ <= 6 with CV = 2: at most 12 accumulators). The two
+/// steps of the sum-factorized product.
+template <typename V, int CV, int NJ>
+inline __attribute__((always_inline)) void narrow_product(const double* X, long xs, const double* B,
+                                                          int nk, double* out, long os, int rows) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  for (int c0 = 0; c0 < rows; c0 += CV * lanes) {
+    V acc[NJ][CV];
+    for (int j = 0; j < NJ; ++j)
+      for (int h = 0; h < CV; ++h) acc[j][h] = splat<V>(0.0);
+    const double* x = X + c0;
+    const double* b = B;
+    for (int k = 0; k < nk; ++k, x += xs, b += NJ) {
+      V xv[CV];
+      for (int h = 0; h < CV; ++h) xv[h] = load<V>(x + lanes * h);
+      for (int j = 0; j < NJ; ++j) {
+        const V bj = splat<V>(b[j]);
+        for (int h = 0; h < CV; ++h) acc[j][h] += xv[h] * bj;
+      }
+    }
+    for (int j = 0; j < NJ; ++j)
+      for (int h = 0; h < CV; ++h) store<V>(out + j * os + c0 + lanes * h, acc[j][h]);
+  }
+}
+
+/// narrow_product with NJ = nj (2 <= nj <= 6), chosen at run time.
+template <typename V, int CV, int NJ = 2>
+inline __attribute__((always_inline)) void narrow_product_n(int nj, const double* X, long xs,
+                                                            const double* B, int nk, double* out,
+                                                            long os, int rows) {
+  if constexpr (NJ < 6) {
+    if (nj != NJ) {
+      narrow_product_n<V, CV, NJ + 1>(nj, X, xs, B, nk, out, os, rows);
+      return;
+    }
+  }
+  narrow_product<V, CV, NJ>(X, xs, B, nk, out, os, rows);
+}
+
+/// Sum-factorized Phi^T W^T (element_kernel.hpp, ElementTangentInput::Au):
+///   Y(c, (5 qv + f) nu + lu) = sum_qu a_{du(f)}(lu, qu) W(c, 5 (qu + nqu qv) + f)
+///   KT(c, lu + nu lv)        = sum_{qv, f} b_{dv(f)}(lv, qv) Y(c, (5 qv + f) nu + lu)
+template <typename V, int CV>
+inline __attribute__((always_inline)) void factorized_product(const ElementTangentInput& in,
+                                                              const double* W, double* KT) {
+  constexpr int kDu[5] = {1, 0, 2, 1, 0};
+  const long ldw = workspace_rows(in.nl);
+  const int rows = in.pairs * in.nl, nu = in.nu, nqu = in.nqu;
+  for (int qv = 0; qv < in.nqv; ++qv)
+    for (int f = 0; f < 5; ++f)
+      narrow_product_n<V, CV>(nu, W + (5L * nqu * qv + f) * ldw, 5 * ldw, in.Au + kDu[f] * nqu * nu,
+                              nqu, in.Y + (5L * qv + f) * nu * ldw, ldw, rows);
+  for (int lu = 0; lu < nu; ++lu)
+    narrow_product_n<V, CV>(in.nv, in.Y + lu * ldw, nu * ldw, in.Bk, 5 * in.nqv, KT + lu * ldw,
+                            nu * ldw, rows);
+}
+
 /// The kernel's body, compiled into each version below.
 template <typename V, int CV>
 inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in, double* W,
@@ -85,6 +144,10 @@ inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in,
         for (int l = 0; l < nl; ++l)
           w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
       }
+  }
+  if (in.Au && in.Bk && in.Y && sum_factorized(in.nu, in.nv)) {
+    factorized_product<V, CV>(in, W, KT);
+    return;
   }
   // Rows c: the whole pairs [0, full) as one range, then each triangular pair on its own (in
   // increasing order: a tile's overrun into the next pair is overwritten by that pair).

@@ -72,6 +72,54 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
     }
   }
   material_->bind_points(thetas);
+  nqu_ = nqu, nqv_ = nqv;
+  factorize_elements(su, sv, gu, gv);
+}
+
+void ShellModel::factorize_elements(const std::vector<std::pair<double, double>>& su,
+                                    const std::vector<std::pair<double, double>>& sv,
+                                    const spline::QuadratureRule& gu,
+                                    const spline::QuadratureRule& gv) {
+  // Phi_f(lu + nu lv, qu + nqu qv) = a_du(lu, qu) b_dv(lv, qv) for a B-spline surface (the
+  // local functions u fastest, the points u fastest); a rational surface or another ordering
+  // fails the check below and keeps the direct product.
+  const int nu = surface_.basis_u().degree() + 1, nv = surface_.basis_v().degree() + 1;
+  if (!kernel::sum_factorized(nu, nv)) return;
+  constexpr int kDu[5] = {1, 0, 2, 1, 0}, kDv[5] = {0, 1, 0, 1, 2};
+  const int nqu = nqu_, nqv = nqv_;
+  Eigen::MatrixXd du(3, nu), dv(3, nv);
+  double err = 0.0, big = 0.0;
+  int e = 0;
+  for (const auto& [v0, v1] : sv) {
+    for (const auto& [u0, u1] : su) {
+      Element& el = elements_[e++];
+      el.Au.assign(static_cast<size_t>(3) * nqu * nu, 0.0);
+      el.Bk.assign(static_cast<size_t>(5) * nqv * nv, 0.0);
+      for (int a = 0; a < nqu; ++a) {
+        surface_.basis_u().eval(0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu.points[a], 2, du);
+        for (int d = 0; d < 3; ++d)
+          for (int lu = 0; lu < nu; ++lu) el.Au[(d * nqu + a) * nu + lu] = du(d, lu);
+      }
+      for (int b = 0; b < nqv; ++b) {
+        surface_.basis_v().eval(0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv.points[b], 2, dv);
+        for (int f = 0; f < 5; ++f)
+          for (int lv = 0; lv < nv; ++lv) el.Bk[(5 * b + f) * nv + lv] = dv(kDv[f], lv);
+      }
+      for (int b = 0; b < nqv; ++b)
+        for (int a = 0; a < nqu; ++a)
+          for (int f = 0; f < 5; ++f)
+            for (int lv = 0; lv < nv; ++lv)
+              for (int lu = 0; lu < nu; ++lu) {
+                const double phi = el.PhiT(lu + nu * lv, 5 * (a + nqu * b) + f);
+                const double t = el.Au[(kDu[f] * nqu + a) * nu + lu] * el.Bk[(5 * b + f) * nv + lv];
+                err = std::max(err, std::abs(phi - t));
+                big = std::max(big, std::abs(phi));
+              }
+    }
+  }
+  factorized_ = err <= 1e-12 * big;
+  if (!factorized_)
+    for (Element& el : elements_) el.Au.clear(), el.Bk.clear();
 }
 
 SectionResponse ShellModel::section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
@@ -366,10 +414,12 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
   std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
   // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked; KT = W Phi
   // (element_kernel.hpp). Zeroed once: the kernel reads padding rows it never writes.
-  Eigen::MatrixXd W, KT;
+  Eigen::MatrixXd W, KT, Y;
   if (tangent) {
     W.setZero(kernel::workspace_rows(nl), 5 * maxq);
     KT.setZero(kernel::workspace_rows(nl), kernel::padded_functions(nl));
+    if (factorized_)
+      Y.setZero(kernel::workspace_rows(nl), 5 * nqv_ * (surface_.basis_u().degree() + 1));
   }
   PointState local;
   for (int e = e0; e < e1; ++e) {
@@ -424,6 +474,15 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
     kin.pi = pi;
     kin.pj = pj;
     kin.full = full;
+    if (factorized_) {
+      kin.Au = el.Au.data();
+      kin.Bk = el.Bk.data();
+      kin.nu = surface_.basis_u().degree() + 1;
+      kin.nv = surface_.basis_v().degree() + 1;
+      kin.nqu = nqu_;
+      kin.nqv = nqv_;
+      kin.Y = Y.data();
+    }
     kernel::element_tangent_blocks(kin, W.data(), KT.data());
     Eigen::MatrixXd& Ke = out.Ke[e];
     // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)

@@ -15,6 +15,9 @@ namespace {
 struct Problem {
   int nl, nq;
   std::vector<double> PhiT, H;
+  // Tensor-product factors (element_kernel.hpp, ElementTangentInput::Au), if any.
+  int nu = 0, nv = 0, nqu = 0, nqv = 0;
+  std::vector<double> Au, Bk;
 };
 
 Problem random_problem(int nl, int nq, unsigned seed) {
@@ -26,6 +29,32 @@ Problem random_problem(int nl, int nq, unsigned seed) {
   for (int k = 0; k < 5 * nq; ++k)
     for (int l = 0; l < nl; ++l) p.PhiT[size_t(k) * nlp + l] = u(gen);
   for (double& h : p.H) h = u(gen);
+  return p;
+}
+
+/// A random tensor-product element: Phi_f(lu + nu lv, qu + nqu qv) = a_du(lu, qu) b_dv(lv, qv).
+Problem random_tensor_problem(int nu, int nv, int nqu, int nqv, unsigned seed) {
+  Problem p = random_problem(nu * nv, nqu * nqv, seed);
+  std::mt19937 gen(seed + 1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  p.nu = nu, p.nv = nv, p.nqu = nqu, p.nqv = nqv;
+  p.Au.resize(size_t(3) * nqu * nu);
+  std::vector<double> b(size_t(3) * nqv * nv);  // b[(d nqv + qv) nv + lv]
+  for (double& x : p.Au) x = u(gen);
+  for (double& x : b) x = u(gen);
+  const int du[5] = {1, 0, 2, 1, 0}, dv[5] = {0, 1, 0, 1, 2};
+  const int nlp = kernel::padded_functions(p.nl);
+  p.Bk.resize(size_t(5) * nqv * nv);
+  for (int qv = 0; qv < nqv; ++qv)
+    for (int f = 0; f < 5; ++f)
+      for (int lv = 0; lv < nv; ++lv) {
+        const double bv = b[size_t(dv[f] * nqv + qv) * nv + lv];
+        p.Bk[size_t(5 * qv + f) * nv + lv] = bv;
+        for (int qu = 0; qu < nqu; ++qu)
+          for (int lu = 0; lu < nu; ++lu)
+            p.PhiT[size_t(5 * (qu + nqu * qv) + f) * nlp + lu + nu * lv] =
+                p.Au[size_t(du[f] * nqu + qu) * nu + lu] * bv;
+      }
   return p;
 }
 
@@ -60,6 +89,14 @@ double kernel_error(const Problem& p, bool symmetric, kernel::Isa isa) {
   in.pi = pi;
   in.pj = pj;
   in.full = full;
+  std::vector<double> Y;
+  if (!p.Au.empty()) {
+    Y.assign(size_t(ldw) * 5 * p.nqv * p.nu, 0.0);
+    in.Au = p.Au.data();
+    in.Bk = p.Bk.data();
+    in.nu = p.nu, in.nv = p.nv, in.nqu = p.nqu, in.nqv = p.nqv;
+    in.Y = Y.data();
+  }
   kernel::element_tangent_blocks(in, W.data(), KT.data(), isa);
   double err = 0.0, scale = 0.0;
   for (int k = 0; k < pairs; ++k)
@@ -87,4 +124,24 @@ TEST_CASE("element kernel: both instruction-set versions match the direct sum", 
         const Problem p = random_problem(s[0], s[1], 7u + unsigned(s[0]));
         CHECK(kernel_error(p, symmetric, isa) < 1e-13);
       }
+}
+
+TEST_CASE(
+    "element kernel: the sum-factorized product of a tensor-product element matches the "
+    "direct sum",
+    "[unit]") {
+  // p = 4 (5 x 5 functions and points), p = 2, an anisotropic 6 x 3 element with 4 x 2
+  // points, and 7 x 2 functions (outside sum_factorized: the direct product).
+  const int shapes[4][4] = {{5, 5, 5, 5}, {3, 3, 3, 3}, {6, 3, 4, 2}, {7, 2, 3, 3}};
+  std::vector<kernel::Isa> isas = {kernel::Isa::kDefault};
+  if (kernel::cpu_has_x86_64_v3()) isas.push_back(kernel::Isa::kX86_64_v3);
+  for (const auto& s : shapes)
+    for (const bool symmetric : {true, false})
+      for (const kernel::Isa isa : isas) {
+        CAPTURE(s[0], s[1], s[2], s[3], symmetric, int(isa));
+        const Problem p = random_tensor_problem(s[0], s[1], s[2], s[3], 11u + unsigned(s[0]));
+        CHECK(kernel_error(p, symmetric, isa) < 1e-13);
+      }
+  CHECK(kernel::sum_factorized(5, 5));
+  CHECK_FALSE(kernel::sum_factorized(7, 2));
 }

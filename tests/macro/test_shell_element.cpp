@@ -47,6 +47,8 @@ TEST_CASE("shell tangent matches finite differences of the residual at a deforme
   const bool rational = GENERATE(false, true);
   auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
   ShellModel m(curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, rational), 0.1, mat);
+  // A B-spline patch takes the sum-factorized kernel, a rational one the direct product.
+  CHECK(m.sum_factorized() == !rational);
   const Eigen::VectorXd u = random_displacement(m.num_dofs(), 0.1, 7);
   CHECK(fd_tangent_error(m, u) < 1e-6);
 }

@@ -34,6 +34,7 @@
 #include "knit/macro/patch.hpp"
 #include "knit/macro/section.hpp"
 #include "knit/macro/shell_kinematics.hpp"
+#include "knit/spline/quadrature.hpp"
 #include "knit/spline/surface.hpp"
 
 namespace knit::macro {
@@ -72,6 +73,9 @@ class ShellModel {
   int num_quadrature_points() const { return static_cast<int>(points_.size()); }
   /// Control points of element e (the (pu+1)(pv+1) functions non-zero on it).
   const Eigen::VectorXi& element_control_points(int e) const { return elements_[e].cp; }
+  /// Whether the element tangents use the sum-factorized kernel (a B-spline surface of degree
+  /// 1..5 per direction; element_kernel.hpp).
+  bool sum_factorized() const { return factorized_; }
   /// n >= 1 threads, 0 automatic (see ShellOptions::threads).
   void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
   /// The number of threads evaluate() uses with a tangent.
@@ -134,6 +138,8 @@ class ShellModel {
     int first_point = 0, num_points = 0;
     /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f).
     Eigen::MatrixXd PhiT;
+    /// Tensor-product factors of PhiT (kernel::ElementTangentInput::Au, Bk), if factorized_.
+    std::vector<double> Au, Bk;
   };
   struct Point {
     ReferencePoint ref;
@@ -144,6 +150,9 @@ class ShellModel {
   /// failed.
   bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
                   Evaluation& out) const;
+  void factorize_elements(const std::vector<std::pair<double, double>>& su,
+                          const std::vector<std::pair<double, double>>& sv,
+                          const spline::QuadratureRule& gu, const spline::QuadratureRule& gv);
   bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
                       Evaluation& out) const;
   /// Residual part at one point: the point state, dA psi, and the element force
@@ -165,6 +174,10 @@ class ShellModel {
   std::vector<Point> points_;
   Eigen::MatrixXd R_;  ///< 6 x (nloc * num points): basis derivatives at every quadrature point
   double scale_ = 1.0;
+  /// Every element's Phi is the tensor product of its 1D bases (a B-spline surface, checked
+  /// numerically) and small enough for the sum-factorized kernel.
+  bool factorized_ = false;
+  int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
 };
 
 }  // namespace knit::macro
