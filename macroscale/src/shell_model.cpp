@@ -207,27 +207,9 @@ double ShellModel::energy(const Eigen::VectorXd& u) const {
 
 namespace {
 
-inline void cross3(const double* a, const double* b, double* c) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-inline double dot3(const double* a, const double* b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 inline void copy3(const Eigen::Vector3d& v, double* d) {
   d[0] = v(0), d[1] = v(1), d[2] = v(2);
 }
-/// w = v - (v . a3) a3 with v = M0 a11 + M1 a22 + 2 M2 a12 (the bending resultants applied
-/// to the second derivatives); returns v . a3.
-double bending_vector(const ShellModel::PointState& s, double* v, double* w) {
-  for (int i = 0; i < 3; ++i)
-    v[i] = s.M[0] * s.a11[i] + s.M[1] * s.a22[i] + 2.0 * s.M[2] * s.a12[i];
-  const double va3 = dot3(v, s.a3);
-  for (int i = 0; i < 3; ++i) w[i] = v[i] - va3 * s.a3[i];
-  return va3;
-}
-
 }  // namespace
 
 bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, double& energy,
@@ -259,9 +241,9 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
   //   g_1 = N11 a1 + N12 a2 + a3_,1 term,  a3_,(l,i) . v summed: -P_alpha^T v = -Q_alpha^T w / j
   //   with Q1^T w = a2 x w, Q2^T w = w x a1; g_11 = -M11 a3, g_12 = -2 M12 a3, g_22 = -M22 a3.
   double v[3], w[3], q1[3], q2[3], g[15];
-  bending_vector(s, v, w);
-  cross3(s.a2, w, q1);
-  cross3(w, s.a1, q2);
+  kernel::bending_vector(s, v, w);
+  kernel::cross3(s.a2, w, q1);
+  kernel::cross3(w, s.a1, q2);
   const double ij = 1.0 / s.j, dA = pt.dA;
   for (int i = 0; i < 3; ++i) {
     g[i] = dA * (N(0) * s.a1[i] + N(2) * s.a2[i] - ij * q1[i]);
@@ -283,121 +265,7 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
 
 void ShellModel::point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const {
   const Point& pt = points_[pid];
-  const double dA = pt.dA, ij = 1.0 / s.j;
-  // Q_alpha e_i: Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i; Pr = I - a3 a3^T; P_alpha = Pr Q_alpha / j,
-  // so that a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i). Row-major 3 x 3.
-  double Q[2][3][3], P[2][3][3];
-  for (int i = 0; i < 3; ++i) {
-    double e[3] = {0.0, 0.0, 0.0}, c1[3], c2[3];
-    e[i] = 1.0;
-    cross3(e, s.a2, c1);
-    cross3(s.a1, e, c2);
-    for (int k = 0; k < 3; ++k) Q[0][k][i] = c1[k], Q[1][k][i] = c2[k];
-  }
-  for (int al = 0; al < 2; ++al)
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < 3; ++i) {
-        const double a3Q = s.a3[0] * Q[al][0][i] + s.a3[1] * Q[al][1][i] + s.a3[2] * Q[al][2][i];
-        P[al][k][i] = ij * (Q[al][k][i] - s.a3[k] * a3Q);
-      }
-  // G (6 x 15): strain variations B(:, 3l+i) = sum_f Phi_f(l) G(:, 3f+i), rows eps11, eps22,
-  // 2eps12, kap11, kap22, 2kap12. Nonzero: columns 0-5 (f = R_1, R_2) and -a3 (or -2 a3) in
-  // the bending row of each second derivative: f = 2 (R_11) row 3, f = 3 (R_12) row 5 (x2),
-  // f = 4 (R_22) row 4.
-  double G[6][6] = {};
-  const double* ak[3] = {s.a11, s.a22, s.a12};
-  const double ck[3] = {1.0, 1.0, 2.0};
-  for (int i = 0; i < 3; ++i) {
-    G[0][i] = s.a1[i];
-    G[2][i] = s.a2[i];
-    G[1][3 + i] = s.a2[i];
-    G[2][3 + i] = s.a1[i];
-    for (int k = 0; k < 3; ++k)
-      for (int al = 0; al < 2; ++al)
-        G[3 + k][3 * al + i] =
-            -ck[k] * (ak[k][0] * P[al][0][i] + ak[k][1] * P[al][1][i] + ak[k][2] * P[al][2][i]);
-  }
-  constexpr int kRow[3] = {3, 5, 4};  // bending row of f = 2, 3, 4
-  constexpr double kScale[3] = {1.0, 2.0, 1.0};
-  // Covariant section tangent Dc = [[T^T A T, T^T B T], [T^T B T, T^T D T]] (column-major
-  // 6 x 6), scaled by dA.
-  const Eigen::Matrix3d& T = pt.ref.T;
-  double Dc[36];
-  const double* blocks[3] = {s.A, s.B, s.D};
-  const int at[4][2] = {{0, 0}, {0, 3}, {3, 0}, {3, 3}};
-  const int which[4] = {0, 1, 1, 2};
-  double dmax = 0.0;
-  for (int b = 0; b < 4; ++b) {
-    const Eigen::Map<const Eigen::Matrix3d> X(blocks[which[b]]);
-    const Eigen::Matrix3d Y = T.transpose() * X * T;
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) {
-        Dc[(at[b][0] + r) + 6 * (at[b][1] + c)] = Y(r, c);
-        dmax = std::max(dmax, std::abs(Y(r, c)));
-      }
-  }
-  for (int c = 0; c < 6; ++c)
-    for (int r = 0; r < c; ++r)
-      if (std::abs(Dc[r + 6 * c] - Dc[c + 6 * r]) > 1e-12 * dmax) symmetric = false;
-  // E = dA Dc G (6 x 15): columns 0-5 full, column 3f+i of f >= 2 is Dc(:, row f) x G entry.
-  double E[15][6];
-  for (int col = 0; col < 6; ++col)
-    for (int r = 0; r < 6; ++r) {
-      double acc = 0.0;
-      for (int k = 0; k < 6; ++k) acc += Dc[r + 6 * k] * G[k][col];
-      E[col][r] = dA * acc;
-    }
-  for (int f = 2; f < 5; ++f)
-    for (int i = 0; i < 3; ++i) {
-      const double gi = -kScale[f - 2] * s.a3[i];
-      for (int r = 0; r < 6; ++r) E[3 * f + i][r] = dA * Dc[r + 6 * kRow[f - 2]] * gi;
-    }
-  // Material part H = G^T E (column-major 15 x 15).
-  for (int col = 0; col < 15; ++col) {
-    double* Hc = H + 15 * col;
-    const double* Ec = E[col];
-    for (int a = 0; a < 6; ++a) {
-      double acc = 0.0;
-      for (int r = 0; r < 6; ++r) acc += G[r][a] * Ec[r];
-      Hc[a] = acc;
-    }
-    for (int f = 2; f < 5; ++f)
-      for (int i = 0; i < 3; ++i) Hc[3 * f + i] = -kScale[f - 2] * s.a3[i] * Ec[kRow[f - 2]];
-  }
-  // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
-  double v[3], w[3];
-  const double va3 = bending_vector(s, v, w);
-  double t[2][3], h[2][3];
-  cross3(s.a2, s.a3, t[0]);  // t_alpha = a3^T Q_alpha
-  cross3(s.a3, s.a1, t[1]);
-  cross3(s.a2, w, h[0]);  // h_alpha = v^T P_alpha = w^T Q_alpha / j
-  cross3(w, s.a1, h[1]);
-  for (int k = 0; k < 3; ++k) h[0][k] *= ij, h[1][k] *= ij;
-  const double Wm[3][3] = {{0.0, w[2], -w[1]}, {-w[2], 0.0, w[0]}, {w[1], -w[0], 0.0}};
-  for (int al = 0; al < 2; ++al)
-    for (int be = 0; be < 2; ++be) {
-      const double Nab = al == be ? s.N[al] : s.N[2];
-      const double sw = al == be ? 0.0 : (al == 0 ? -ij : ij);
-      for (int jj = 0; jj < 3; ++jj)
-        for (int i = 0; i < 3; ++i) {
-          const double QP =
-              Q[al][0][i] * P[be][0][jj] + Q[al][1][i] * P[be][1][jj] + Q[al][2][i] * P[be][2][jj];
-          double gab = ij * (t[al][i] * h[be][jj] + h[al][i] * t[be][jj] + va3 * QP);
-          if (i == jj) gab += Nab;
-          gab += sw * Wm[i][jj];
-          H[(3 * al + i) + 15 * (3 * be + jj)] += dA * gab;
-        }
-    }
-  // m : (a_ab,r . a3_,s + a_ab,s . a3_,r): second-derivative functions f = 2, 3, 4.
-  const double cf[3] = {s.M[0], 2.0 * s.M[2], s.M[1]};
-  for (int f = 0; f < 3; ++f)
-    for (int be = 0; be < 2; ++be)
-      for (int jj = 0; jj < 3; ++jj)
-        for (int i = 0; i < 3; ++i) {
-          const double X = -dA * cf[f] * P[be][i][jj];
-          H[(3 * (f + 2) + i) + 15 * (3 * be + jj)] += X;
-          H[(3 * be + jj) + 15 * (3 * (f + 2) + i)] += X;
-        }
+  kernel::point_matrix(s, pt.ref.T.data(), pt.dA, H, symmetric);
 }
 
 bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass,

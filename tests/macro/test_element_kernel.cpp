@@ -13,7 +13,7 @@ using namespace knit::macro;
 namespace {
 
 struct Problem {
-  int nl, nq;
+  int nl = 0, nq = 0;
   std::vector<double> PhiT, H;
   // Tensor-product factors (element_kernel.hpp, ElementTangentInput::Au), if any.
   int nu = 0, nv = 0, nqu = 0, nqv = 0;
@@ -24,8 +24,10 @@ Problem random_problem(int nl, int nq, unsigned seed) {
   std::mt19937 gen(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const int nlp = kernel::padded_functions(nl);
-  Problem p{nl, nq, std::vector<double>(size_t(nlp) * 5 * nq, 0.0),
-            std::vector<double>(size_t(225) * nq)};
+  Problem p;
+  p.nl = nl, p.nq = nq;
+  p.PhiT.assign(size_t(nlp) * 5 * nq, 0.0);
+  p.H.resize(size_t(225) * nq);
   for (int k = 0; k < 5 * nq; ++k)
     for (int l = 0; l < nl; ++l) p.PhiT[size_t(k) * nlp + l] = u(gen);
   for (double& h : p.H) h = u(gen);
@@ -144,4 +146,42 @@ TEST_CASE(
       }
   CHECK(kernel::sum_factorized(5, 5));
   CHECK_FALSE(kernel::sum_factorized(7, 2));
+}
+
+TEST_CASE("element kernel: the point matrix H agrees between the instruction-set versions",
+          "[unit]") {
+  // Correctness of H itself: the shell tangent against finite differences
+  // (test_shell_element.cpp); here the x86-64-v3 (FMA) build of the same code against the
+  // default one, to round-off.
+  if (!kernel::cpu_has_x86_64_v3()) return;
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  kernel::PointState s;
+  for (double* v : {s.a1, s.a2, s.a11, s.a22, s.a12, s.N, s.M})
+    for (int i = 0; i < 3; ++i) v[i] = u(gen);
+  double a3[3];
+  kernel::cross3(s.a1, s.a2, a3);
+  s.j = std::sqrt(a3[0] * a3[0] + a3[1] * a3[1] + a3[2] * a3[2]);
+  for (int i = 0; i < 3; ++i) s.a3[i] = a3[i] / s.j;
+  double T[9];
+  for (double& t : T) t = u(gen);
+  for (const bool sym : {true, false}) {
+    for (double* X : {s.A, s.B, s.D})
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c <= r; ++c) X[r + 3 * c] = X[c + 3 * r] = u(gen);
+    if (!sym) s.D[1] += 0.5;
+    double H0[225], H1[225];
+    bool sym0 = true, sym1 = true;
+    kernel::point_matrix(s, T, 0.7, H0, sym0, kernel::Isa::kDefault);
+    kernel::point_matrix(s, T, 0.7, H1, sym1, kernel::Isa::kX86_64_v3);
+    CHECK(sym0 == sym);
+    CHECK(sym1 == sym);
+    double err = 0.0, big = 0.0;
+    for (int k = 0; k < 225; ++k) {
+      err = std::max(err, std::abs(H0[k] - H1[k]));
+      big = std::max(big, std::abs(H0[k]));
+    }
+    CAPTURE(err, big);
+    CHECK(err <= 1e-13 * big);
+  }
 }

@@ -54,6 +54,32 @@ constexpr bool sum_factorized(int nu, int nv) {
   return nu >= 2 && nu <= 6 && nv >= 2 && nv <= 6;
 }
 
+/// What a residual evaluation keeps per quadrature point (ShellModel::evaluate(..., keep_points))
+/// so that the tangent at the same displacement (ShellModel::tangent_from) needs no second pass
+/// through the kinematics and the material: the current base vectors and their derivatives, |a1 x
+/// a2|, the covariant resultants and the section tangents (local Cartesian Voigt, column-major).
+struct PointState {
+  double a1[3], a2[3], a3[3], a11[3], a22[3], a12[3];
+  double j;
+  double N[3], M[3];
+  double A[9], B[9], D[9];
+};
+
+inline void cross3(const double* a, const double* b, double* c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+/// w = v - (v . a3) a3 with v = M11 a11 + M22 a22 + 2 M12 a12 (the bending resultants applied
+/// to the second derivatives); returns v . a3.
+inline double bending_vector(const PointState& s, double* v, double* w) {
+  for (int i = 0; i < 3; ++i)
+    v[i] = s.M[0] * s.a11[i] + s.M[1] * s.a22[i] + 2.0 * s.M[2] * s.a12[i];
+  const double va3 = v[0] * s.a3[0] + v[1] * s.a3[1] + v[2] * s.a3[2];
+  for (int i = 0; i < 3; ++i) w[i] = v[i] - va3 * s.a3[i];
+  return va3;
+}
+
 enum class Isa {
   kAuto,       ///< x86-64-v3 when the CPU has it, else the default
   kDefault,    ///< SSE2 (any x86-64)
@@ -68,5 +94,12 @@ bool cpu_has_x86_64_v3();
 /// must be finite (zero them once). Entries outside the computed triangle are unspecified.
 void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT,
                             Isa isa = Isa::kAuto);
+
+/// The 15 x 15 matrix H of one quadrature point (shell_model.hpp; column-major) from its
+/// state, T the covariant-to-Cartesian Voigt map (column-major 3 x 3) and dA the weighted
+/// area element; clears `symmetric` if the section tangent is not symmetric. Raw arrays,
+/// compiled for both instruction sets like the kernel.
+void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
+                  Isa isa = Isa::kAuto);
 
 }  // namespace knit::macro::kernel

@@ -30,6 +30,7 @@
 #include <memory>
 #include <vector>
 
+#include "knit/macro/element_kernel.hpp"
 #include "knit/macro/material.hpp"
 #include "knit/macro/patch.hpp"
 #include "knit/macro/section.hpp"
@@ -85,16 +86,8 @@ class ShellModel {
   /// ~2 ms, 20x the cost of starting the threads.
   static constexpr double kAutoThreadWork = 2.0e5;
 
-  /// What a residual evaluation keeps per quadrature point (evaluate(..., keep_points)) so that
-  /// the tangent at the same displacement (tangent_from) needs no second pass through the
-  /// kinematics and the material: the current base vectors and their derivatives, |a1 x a2|,
-  /// the covariant resultants and the section tangents (local Cartesian Voigt, column-major).
-  struct PointState {
-    double a1[3], a2[3], a3[3], a11[3], a22[3], a12[3];
-    double j;
-    double N[3], M[3];
-    double A[9], B[9], D[9];
-  };
+  /// What a residual evaluation keeps per quadrature point (element_kernel.hpp).
+  using PointState = kernel::PointState;
 
   struct Evaluation {
     Eigen::VectorXd fint;             ///< internal force vector (num_dofs)
