@@ -141,10 +141,12 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   // Residual (and potential) at (uf, lam).
   auto residual = [&](const Eigen::VectorXd& uf, double lam, State& s) {
     const auto t0 = Clock::now();
+    const double c0 = cpu_now();
     ++stats.evaluations;
     trial_u = dofs.expand(uf, lam);
     model.evaluate(trial_u, false, trial, /*keep_points=*/true);
     stats.residuals += since(t0);
+    stats.residuals_cpu += cpu_now() - c0;
     return state_from(trial, trial_u, lam, s);
   };
   // Tangent (with the residual) at (uf, lam), timed as assembly. At the point of the last

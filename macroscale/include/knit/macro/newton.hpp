@@ -102,9 +102,9 @@ struct SolverStats {
   double assembly = 0.0;   ///< element tangents and forces + scatter into the reduced matrix
   double solve = 0.0;      ///< numeric factorization and triangular solves
   double residuals = 0.0;  ///< residual-only evaluations
-  /// CPU seconds (all threads) of assembly and solve: on a loaded machine the cost of a
+  /// CPU seconds (all threads) of assembly, solve and residuals: on a loaded machine the cost of a
   /// one-thread run, where the wall time also counts the waits for a core.
-  double assembly_cpu = 0.0, solve_cpu = 0.0;
+  double assembly_cpu = 0.0, solve_cpu = 0.0, residuals_cpu = 0.0;
   int unknowns = 0;
   long stored_entries = 0;  ///< of the reduced matrix
   bool sparse = false, symmetric = false;
