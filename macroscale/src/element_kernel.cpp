@@ -1,6 +1,8 @@
 // The shell element tangent's hot loop (element_kernel.hpp); no Eigen in this file.
 #include "knit/macro/element_kernel.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 // The vector type never crosses a call (every helper is always inlined): no ABI concern.
@@ -64,6 +66,65 @@ inline __attribute__((always_inline)) void product_rows(const double* W, const d
     }
 }
 
+/// out(c, j) = sum_k X(c, k) B(j, k) for rows c in [0, rows) (rounded up to the tile) and the
+/// NJ columns j, X(c, k) = X[k xs + c], B(j, k) = B[k NJ + j], out(c, j) = out[j os + c]; tiles
+/// of CV vectors of rows x NJ columns (NJ <= 6 with CV = 2: at most 12 accumulators). The two
+/// steps of the sum-factorized product.
+template <typename V, int CV, int NJ>
+inline __attribute__((always_inline)) void narrow_product(const double* X, long xs, const double* B,
+                                                          int nk, double* out, long os, int rows) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  for (int c0 = 0; c0 < rows; c0 += CV * lanes) {
+    V acc[NJ][CV];
+    for (int j = 0; j < NJ; ++j)
+      for (int h = 0; h < CV; ++h) acc[j][h] = splat<V>(0.0);
+    const double* x = X + c0;
+    const double* b = B;
+    for (int k = 0; k < nk; ++k, x += xs, b += NJ) {
+      V xv[CV];
+      for (int h = 0; h < CV; ++h) xv[h] = load<V>(x + lanes * h);
+      for (int j = 0; j < NJ; ++j) {
+        const V bj = splat<V>(b[j]);
+        for (int h = 0; h < CV; ++h) acc[j][h] += xv[h] * bj;
+      }
+    }
+    for (int j = 0; j < NJ; ++j)
+      for (int h = 0; h < CV; ++h) store<V>(out + j * os + c0 + lanes * h, acc[j][h]);
+  }
+}
+
+/// narrow_product with NJ = nj (2 <= nj <= 6), chosen at run time.
+template <typename V, int CV, int NJ = 2>
+inline __attribute__((always_inline)) void narrow_product_n(int nj, const double* X, long xs,
+                                                            const double* B, int nk, double* out,
+                                                            long os, int rows) {
+  if constexpr (NJ < 6) {
+    if (nj != NJ) {
+      narrow_product_n<V, CV, NJ + 1>(nj, X, xs, B, nk, out, os, rows);
+      return;
+    }
+  }
+  narrow_product<V, CV, NJ>(X, xs, B, nk, out, os, rows);
+}
+
+/// Sum-factorized Phi^T W^T (element_kernel.hpp, ElementTangentInput::Au):
+///   Y(c, (5 qv + f) nu + lu) = sum_qu a_{du(f)}(lu, qu) W(c, 5 (qu + nqu qv) + f)
+///   KT(c, lu + nu lv)        = sum_{qv, f} b_{dv(f)}(lv, qv) Y(c, (5 qv + f) nu + lu)
+template <typename V, int CV>
+inline __attribute__((always_inline)) void factorized_product(const ElementTangentInput& in,
+                                                              const double* W, double* KT) {
+  constexpr int kDu[5] = {1, 0, 2, 1, 0};
+  const long ldw = workspace_rows(in.nl);
+  const int rows = in.pairs * in.nl, nu = in.nu, nqu = in.nqu;
+  for (int qv = 0; qv < in.nqv; ++qv)
+    for (int f = 0; f < 5; ++f)
+      narrow_product_n<V, CV>(nu, W + (5L * nqu * qv + f) * ldw, 5 * ldw, in.Au + kDu[f] * nqu * nu,
+                              nqu, in.Y + (5L * qv + f) * nu * ldw, ldw, rows);
+  for (int lu = 0; lu < nu; ++lu)
+    narrow_product_n<V, CV>(in.nv, in.Y + lu * ldw, nu * ldw, in.Bk, 5 * in.nqv, KT + lu * ldw,
+                            nu * ldw, rows);
+}
+
 /// The kernel's body, compiled into each version below.
 template <typename V, int CV>
 inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in, double* W,
@@ -86,11 +147,151 @@ inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in,
           w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
       }
   }
+  if (in.Au && in.Bk && in.Y && sum_factorized(in.nu, in.nv)) {
+    factorized_product<V, CV>(in, W, KT);
+    return;
+  }
   // Rows c: the whole pairs [0, full) as one range, then each triangular pair on its own (in
   // increasing order: a tile's overrun into the next pair is overwritten by that pair).
   if (in.full > 0) product_rows<V, CV>(W, in.PhiT, KT, ldw, nlp, nk, 0, in.full * nl, -1);
   for (int p = in.full; p < in.pairs; ++p)
     product_rows<V, CV>(W, in.PhiT, KT, ldw, nlp, nk, p * nl, (p + 1) * nl, p * nl);
+}
+
+/// point_matrix (element_kernel.hpp), compiled into each version below.
+inline __attribute__((always_inline)) void point_matrix_body(const PointState& s, const double* T,
+                                                             double dA, double* H,
+                                                             bool& symmetric) {
+  const double ij = 1.0 / s.j;
+  // Q_alpha e_i: Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i; Pr = I - a3 a3^T; P_alpha = Pr Q_alpha / j,
+  // so that a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i). Row-major 3 x 3.
+  double Q[2][3][3], P[2][3][3];
+  for (int i = 0; i < 3; ++i) {
+    double e[3] = {0.0, 0.0, 0.0}, c1[3], c2[3];
+    e[i] = 1.0;
+    cross3(e, s.a2, c1);
+    cross3(s.a1, e, c2);
+    for (int k = 0; k < 3; ++k) Q[0][k][i] = c1[k], Q[1][k][i] = c2[k];
+  }
+  for (int al = 0; al < 2; ++al)
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) {
+        const double a3Q = s.a3[0] * Q[al][0][i] + s.a3[1] * Q[al][1][i] + s.a3[2] * Q[al][2][i];
+        P[al][k][i] = ij * (Q[al][k][i] - s.a3[k] * a3Q);
+      }
+  // G (6 x 15): strain variations B(:, 3l+i) = sum_f Phi_f(l) G(:, 3f+i), rows eps11, eps22,
+  // 2eps12, kap11, kap22, 2kap12. Nonzero: columns 0-5 (f = R_1, R_2) and -a3 (or -2 a3) in
+  // the bending row of each second derivative: f = 2 (R_11) row 3, f = 3 (R_12) row 5 (x2),
+  // f = 4 (R_22) row 4.
+  double G[6][6] = {};
+  const double* ak[3] = {s.a11, s.a22, s.a12};
+  const double ck[3] = {1.0, 1.0, 2.0};
+  for (int i = 0; i < 3; ++i) {
+    G[0][i] = s.a1[i];
+    G[2][i] = s.a2[i];
+    G[1][3 + i] = s.a2[i];
+    G[2][3 + i] = s.a1[i];
+    for (int k = 0; k < 3; ++k)
+      for (int al = 0; al < 2; ++al)
+        G[3 + k][3 * al + i] =
+            -ck[k] * (ak[k][0] * P[al][0][i] + ak[k][1] * P[al][1][i] + ak[k][2] * P[al][2][i]);
+  }
+  constexpr int kRow[3] = {3, 5, 4};  // bending row of f = 2, 3, 4
+  constexpr double kScale[3] = {1.0, 2.0, 1.0};
+  // Covariant section tangent Dc = [[T^T A T, T^T B T], [T^T B T, T^T D T]] (column-major
+  // 6 x 6), scaled by dA.
+  double Dc[36];
+  const double* blocks[3] = {s.A, s.B, s.D};
+  const int at[4][2] = {{0, 0}, {0, 3}, {3, 0}, {3, 3}};
+  const int which[4] = {0, 1, 1, 2};
+  double dmax = 0.0;
+  for (int b = 0; b < 4; ++b) {
+    const double* X = blocks[which[b]];  // column-major 3 x 3
+    double Z[9];                         // X T
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r)
+        Z[r + 3 * c] = X[r] * T[3 * c] + X[r + 3] * T[1 + 3 * c] + X[r + 6] * T[2 + 3 * c];
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) {
+        const double y =
+            T[3 * r] * Z[3 * c] + T[1 + 3 * r] * Z[1 + 3 * c] + T[2 + 3 * r] * Z[2 + 3 * c];
+        Dc[(at[b][0] + r) + 6 * (at[b][1] + c)] = y;
+        dmax = std::max(dmax, std::abs(y));
+      }
+  }
+  for (int c = 0; c < 6; ++c)
+    for (int r = 0; r < c; ++r)
+      if (std::abs(Dc[r + 6 * c] - Dc[c + 6 * r]) > 1e-12 * dmax) symmetric = false;
+  // E = dA Dc G (6 x 15): columns 0-5 full, column 3f+i of f >= 2 is Dc(:, row f) x G entry.
+  double E[15][6];
+  for (int col = 0; col < 6; ++col)
+    for (int r = 0; r < 6; ++r) {
+      double acc = 0.0;
+      for (int k = 0; k < 6; ++k) acc += Dc[r + 6 * k] * G[k][col];
+      E[col][r] = dA * acc;
+    }
+  for (int f = 2; f < 5; ++f)
+    for (int i = 0; i < 3; ++i) {
+      const double gi = -kScale[f - 2] * s.a3[i];
+      for (int r = 0; r < 6; ++r) E[3 * f + i][r] = dA * Dc[r + 6 * kRow[f - 2]] * gi;
+    }
+  // Material part H = G^T E (column-major 15 x 15).
+  for (int col = 0; col < 15; ++col) {
+    double* Hc = H + 15 * col;
+    const double* Ec = E[col];
+    for (int a = 0; a < 6; ++a) {
+      double acc = 0.0;
+      for (int r = 0; r < 6; ++r) acc += G[r][a] * Ec[r];
+      Hc[a] = acc;
+    }
+    for (int f = 2; f < 5; ++f)
+      for (int i = 0; i < 3; ++i) Hc[3 * f + i] = -kScale[f - 2] * s.a3[i] * Ec[kRow[f - 2]];
+  }
+  // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
+  double v[3], w[3];
+  const double va3 = bending_vector(s, v, w);
+  double t[2][3], h[2][3];
+  cross3(s.a2, s.a3, t[0]);  // t_alpha = a3^T Q_alpha
+  cross3(s.a3, s.a1, t[1]);
+  cross3(s.a2, w, h[0]);  // h_alpha = v^T P_alpha = w^T Q_alpha / j
+  cross3(w, s.a1, h[1]);
+  for (int k = 0; k < 3; ++k) h[0][k] *= ij, h[1][k] *= ij;
+  const double Wm[3][3] = {{0.0, w[2], -w[1]}, {-w[2], 0.0, w[0]}, {w[1], -w[0], 0.0}};
+  for (int al = 0; al < 2; ++al)
+    for (int be = 0; be < 2; ++be) {
+      const double Nab = al == be ? s.N[al] : s.N[2];
+      const double sw = al == be ? 0.0 : (al == 0 ? -ij : ij);
+      for (int jj = 0; jj < 3; ++jj)
+        for (int i = 0; i < 3; ++i) {
+          const double QP =
+              Q[al][0][i] * P[be][0][jj] + Q[al][1][i] * P[be][1][jj] + Q[al][2][i] * P[be][2][jj];
+          double gab = ij * (t[al][i] * h[be][jj] + h[al][i] * t[be][jj] + va3 * QP);
+          if (i == jj) gab += Nab;
+          gab += sw * Wm[i][jj];
+          H[(3 * al + i) + 15 * (3 * be + jj)] += dA * gab;
+        }
+    }
+  // m : (a_ab,r . a3_,s + a_ab,s . a3_,r): second-derivative functions f = 2, 3, 4.
+  const double cf[3] = {s.M[0], 2.0 * s.M[2], s.M[1]};
+  for (int f = 0; f < 3; ++f)
+    for (int be = 0; be < 2; ++be)
+      for (int jj = 0; jj < 3; ++jj)
+        for (int i = 0; i < 3; ++i) {
+          const double X = -dA * cf[f] * P[be][i][jj];
+          H[(3 * (f + 2) + i) + 15 * (3 * be + jj)] += X;
+          H[(3 * be + jj) + 15 * (3 * (f + 2) + i)] += X;
+        }
+}
+
+__attribute__((target("arch=x86-64-v3"))) void point_matrix_v3(const PointState& s, const double* T,
+                                                               double dA, double* H,
+                                                               bool& symmetric) {
+  point_matrix_body(s, T, dA, H, symmetric);
+}
+
+void point_matrix_default(const PointState& s, const double* T, double dA, double* H,
+                          bool& symmetric) {
+  point_matrix_body(s, T, dA, H, symmetric);
 }
 
 __attribute__((target("arch=x86-64-v3"))) void blocks_v3(const ElementTangentInput& in, double* W,
@@ -119,6 +320,15 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
     blocks_v3(in, W, KT);
   else
     blocks_default(in, W, KT);
+}
+
+void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
+                  Isa isa) {
+  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
+  if (isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3())
+    point_matrix_v3(s, T, dA, H, symmetric);
+  else
+    point_matrix_default(s, T, dA, H, symmetric);
 }
 
 }  // namespace knit::macro::kernel

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <thread>
 
 #include "knit/macro/element_kernel.hpp"
@@ -13,12 +14,6 @@
 namespace knit::macro {
 
 namespace {
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d S;
-  S << 0, -a(2), a(1), a(2), 0, -a(0), -a(1), a(0), 0;
-  return S;
-}
 
 /// Gauss points of every non-empty span of U, as (span start, span end) pairs.
 std::vector<std::pair<double, double>> spans(const std::vector<double>& U) {
@@ -77,6 +72,54 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
     }
   }
   material_->bind_points(thetas);
+  nqu_ = nqu, nqv_ = nqv;
+  factorize_elements(su, sv, gu, gv);
+}
+
+void ShellModel::factorize_elements(const std::vector<std::pair<double, double>>& su,
+                                    const std::vector<std::pair<double, double>>& sv,
+                                    const spline::QuadratureRule& gu,
+                                    const spline::QuadratureRule& gv) {
+  // Phi_f(lu + nu lv, qu + nqu qv) = a_du(lu, qu) b_dv(lv, qv) for a B-spline surface (the
+  // local functions u fastest, the points u fastest); a rational surface or another ordering
+  // fails the check below and keeps the direct product.
+  const int nu = surface_.basis_u().degree() + 1, nv = surface_.basis_v().degree() + 1;
+  if (!kernel::sum_factorized(nu, nv)) return;
+  constexpr int kDu[5] = {1, 0, 2, 1, 0}, kDv[5] = {0, 1, 0, 1, 2};
+  const int nqu = nqu_, nqv = nqv_;
+  Eigen::MatrixXd du(3, nu), dv(3, nv);
+  double err = 0.0, big = 0.0;
+  int e = 0;
+  for (const auto& [v0, v1] : sv) {
+    for (const auto& [u0, u1] : su) {
+      Element& el = elements_[e++];
+      el.Au.assign(static_cast<size_t>(3) * nqu * nu, 0.0);
+      el.Bk.assign(static_cast<size_t>(5) * nqv * nv, 0.0);
+      for (int a = 0; a < nqu; ++a) {
+        surface_.basis_u().eval(0.5 * (u0 + u1) + 0.5 * (u1 - u0) * gu.points[a], 2, du);
+        for (int d = 0; d < 3; ++d)
+          for (int lu = 0; lu < nu; ++lu) el.Au[(d * nqu + a) * nu + lu] = du(d, lu);
+      }
+      for (int b = 0; b < nqv; ++b) {
+        surface_.basis_v().eval(0.5 * (v0 + v1) + 0.5 * (v1 - v0) * gv.points[b], 2, dv);
+        for (int f = 0; f < 5; ++f)
+          for (int lv = 0; lv < nv; ++lv) el.Bk[(5 * b + f) * nv + lv] = dv(kDv[f], lv);
+      }
+      for (int b = 0; b < nqv; ++b)
+        for (int a = 0; a < nqu; ++a)
+          for (int f = 0; f < 5; ++f)
+            for (int lv = 0; lv < nv; ++lv)
+              for (int lu = 0; lu < nu; ++lu) {
+                const double phi = el.PhiT(lu + nu * lv, 5 * (a + nqu * b) + f);
+                const double t = el.Au[(kDu[f] * nqu + a) * nu + lu] * el.Bk[(5 * b + f) * nv + lv];
+                err = std::max(err, std::abs(phi - t));
+                big = std::max(big, std::abs(phi));
+              }
+    }
+  }
+  factorized_ = err <= 1e-12 * big;
+  if (!factorized_)
+    for (Element& el : elements_) el.Au.clear(), el.Bk.clear();
 }
 
 SectionResponse ShellModel::section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
@@ -96,30 +139,44 @@ int ShellModel::assembly_threads() const {
   return std::max(1, std::min(n, num_elements()));
 }
 
-void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const {
+bool ShellModel::run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
+                            Evaluation& out) const {
+  const int ne = num_elements();
+  const int nth = assembly_threads();
+  if (nth == 1) return evaluate_range(0, ne, u, pass, from, out);
+  std::vector<char> oks(nth, 1);
+  std::vector<std::thread> pool;
+  for (int k = 1; k < nth; ++k) {
+    const int e0 = ne * k / nth, e1 = ne * (k + 1) / nth;
+    pool.emplace_back([&, k, e0, e1] { oks[k] = evaluate_range(e0, e1, u, pass, from, out); });
+  }
+  oks[0] = evaluate_range(0, ne / nth, u, pass, from, out);
+  for (auto& th : pool) th.join();
+  bool ok = true;
+  for (char o : oks) ok = ok && o;
+  return ok;
+}
+
+namespace {
+void allocate_tangents(std::vector<Eigen::MatrixXd>& Ke, int ne, int n) {
+  Ke.resize(ne);
+  for (auto& K : Ke) K.resize(n, n);
+}
+}  // namespace
+
+void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
+                          bool keep_points) const {
   const int ne = num_elements();
   out.fe.resize(3 * nloc_, ne);
   out.element_energy.resize(ne);
-  if (tangent) {
-    out.Ke.resize(elements_.size());
-    for (auto& K : out.Ke) K.resize(3 * nloc_, 3 * nloc_);
-  }
-  const int nth = assembly_threads();
-  bool ok = true;
-  if (nth == 1) {
-    ok = evaluate_range(0, ne, u, tangent, out);
-  } else {
-    std::vector<char> oks(nth, 1);
-    std::vector<std::thread> pool;
-    for (int k = 1; k < nth; ++k) {
-      const int e0 = ne * k / nth, e1 = ne * (k + 1) / nth;
-      pool.emplace_back([&, k, e0, e1] { oks[k] = evaluate_range(e0, e1, u, tangent, out); });
-    }
-    oks[0] = evaluate_range(0, ne / nth, u, tangent, out);
-    for (auto& th : pool) th.join();
-    for (char o : oks) ok = ok && o;
-  }
+  if (tangent) allocate_tangents(out.Ke, ne, 3 * nloc_);
+  const bool keep = keep_points && !tangent;
+  if (keep) out.points.resize(points_.size());
+  out.has_points = false;
+  const bool ok = run_ranges(
+      &u, tangent ? Pass::kTangent : (keep ? Pass::kResidualKeep : Pass::kResidual), nullptr, out);
   out.ok = ok;
+  out.has_points = ok && keep;
   out.fint.setZero(num_dofs());
   out.energy = material_->hyperelastic() ? 0.0 : std::numeric_limits<double>::quiet_NaN();
   if (!ok) return;
@@ -132,136 +189,131 @@ void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& ou
   }
 }
 
+void ShellModel::tangent_from(const Evaluation& from, Evaluation& out) const {
+  if (!from.ok || !from.has_points)
+    throw std::logic_error("ShellModel::tangent_from: the evaluation kept no point states");
+  out.fint = from.fint;
+  out.energy = from.energy;
+  out.has_points = false;
+  allocate_tangents(out.Ke, num_elements(), 3 * nloc_);
+  out.ok = run_ranges(nullptr, Pass::kTangentFromStates, &from, out);
+}
+
 double ShellModel::energy(const Eigen::VectorXd& u) const {
   Evaluation ev;
   evaluate(u, false, ev);
   return ev.ok ? ev.energy : std::numeric_limits<double>::quiet_NaN();
 }
 
-bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent,
-                                Evaluation& out) const {
-  using Mat3 = Eigen::Matrix3d;
-  using Vec3 = Eigen::Vector3d;
+namespace {
+
+inline void copy3(const Eigen::Vector3d& v, double* d) {
+  d[0] = v(0), d[1] = v(1), d[2] = v(2);
+}
+}  // namespace
+
+bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, double& energy,
+                                double* fe) const {
+  const int nl = nloc_;
+  const Point& pt = points_[pid];
+  const double* R = R_.data() + static_cast<Eigen::Index>(pid) * nl * 6;  // R[6 l + r]
+  // dx = R xloc as a sum of outer products (contiguous columns of R).
+  double d[3][6] = {};
+  for (int l = 0; l < nl; ++l)
+    for (int i = 0; i < 3; ++i)
+      for (int r = 0; r < 6; ++r) d[i][r] += R[6 * l + r] * xloc[3 * l + i];
+  SurfaceDerivs dx;
+  for (int i = 0; i < 3; ++i)
+    for (int r = 0; r < 6; ++r) dx(r, i) = d[i][r];
+  const CurrentPoint c = current_point(dx, pt.ref);
+  if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) return false;
+  const Eigen::Matrix3d& T = pt.ref.T;
+  const SectionResponse sr = section(T * c.eps, T * c.kap, pt.ref.theta, pid);
+  const Eigen::Vector3d N = T.transpose() * sr.n, M = T.transpose() * sr.m;
+  energy += pt.dA * sr.psi;
+  copy3(c.a1, s.a1), copy3(c.a2, s.a2), copy3(c.a3, s.a3);
+  copy3(c.a11, s.a11), copy3(c.a22, s.a22), copy3(c.a12, s.a12);
+  copy3(N, s.N), copy3(M, s.M);
+  s.j = c.j;
+  for (int k = 0; k < 9; ++k)
+    s.A[k] = sr.A.data()[k], s.B[k] = sr.B.data()[k], s.D[k] = sr.D.data()[k];
+  // g = dA G^T (N, M) (G: point_matrix), per function f = R_1, R_2, R_11, R_12, R_22:
+  //   g_1 = N11 a1 + N12 a2 + a3_,1 term,  a3_,(l,i) . v summed: -P_alpha^T v = -Q_alpha^T w / j
+  //   with Q1^T w = a2 x w, Q2^T w = w x a1; g_11 = -M11 a3, g_12 = -2 M12 a3, g_22 = -M22 a3.
+  double v[3], w[3], q1[3], q2[3], g[15];
+  kernel::bending_vector(s, v, w);
+  kernel::cross3(s.a2, w, q1);
+  kernel::cross3(w, s.a1, q2);
+  const double ij = 1.0 / s.j, dA = pt.dA;
+  for (int i = 0; i < 3; ++i) {
+    g[i] = dA * (N(0) * s.a1[i] + N(2) * s.a2[i] - ij * q1[i]);
+    g[3 + i] = dA * (N(1) * s.a2[i] + N(2) * s.a1[i] - ij * q2[i]);
+    g[6 + i] = -dA * M(0) * s.a3[i];
+    g[9 + i] = -dA * 2.0 * M(2) * s.a3[i];
+    g[12 + i] = -dA * M(1) * s.a3[i];
+  }
+  for (int l = 0; l < nl; ++l) {
+    const double* Phi = R + 6 * l + 1;
+    for (int i = 0; i < 3; ++i) {
+      double acc = 0.0;
+      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
+      fe[3 * l + i] += acc;
+    }
+  }
+  return true;
+}
+
+void ShellModel::point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const {
+  const Point& pt = points_[pid];
+  kernel::point_matrix(s, pt.ref.T.data(), pt.dA, H, symmetric);
+}
+
+bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass,
+                                const Evaluation* from, Evaluation& out) const {
   using Mat15 = Eigen::Matrix<double, 15, 15>;
   const Eigen::MatrixXd& P = surface_.control_points();
   const int nl = nloc_;
+  const bool tangent = pass == Pass::kTangent || pass == Pass::kTangentFromStates;
+  const bool stored = pass == Pass::kTangentFromStates;
   int maxq = 0;
   for (int e = e0; e < e1; ++e) maxq = std::max(maxq, elements_[e].num_points);
   // Workspace (allocated once per call and thread, never inside the point loop).
-  Eigen::Matrix<double, Eigen::Dynamic, 3> xloc(nl, 3), fe(nl, 3);
-  Eigen::Matrix<double, 6, 15> G = Eigen::Matrix<double, 6, 15>::Zero();
+  std::vector<double> xloc(3 * nl), fe(3 * nl);
   std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
   // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked; KT = W Phi
   // (element_kernel.hpp). Zeroed once: the kernel reads padding rows it never writes.
-  Eigen::MatrixXd W, KT;
+  Eigen::MatrixXd W, KT, Y;
   if (tangent) {
     W.setZero(kernel::workspace_rows(nl), 5 * maxq);
     KT.setZero(kernel::workspace_rows(nl), kernel::padded_functions(nl));
+    if (factorized_)
+      Y.setZero(kernel::workspace_rows(nl), 5 * nqv_ * (surface_.basis_u().degree() + 1));
   }
+  PointState local;
   for (int e = e0; e < e1; ++e) {
     const Element& el = elements_[e];
-    for (int l = 0; l < nl; ++l) {
-      const int a = el.cp(l);
-      xloc.row(l) = P.row(a) + u.segment<3>(3 * a).transpose();
-    }
-    fe.setZero();
-    double energy = 0.0;
     bool symmetric = true;
-    for (int q = 0; q < el.num_points; ++q) {
-      const int pid = el.first_point + q;
-      const Point& pt = points_[pid];
-      const auto R = R_.block(0, static_cast<Eigen::Index>(pid) * nl, 6, nl);
-      // dx = R xloc as a sum of outer products (contiguous columns of R, no GEMM call).
-      Eigen::Matrix<double, 6, 1> d0 = Eigen::Matrix<double, 6, 1>::Zero(), d1 = d0, d2 = d0;
+    if (!stored) {
       for (int l = 0; l < nl; ++l) {
-        const Eigen::Matrix<double, 6, 1> r = R.col(l);
-        d0 += r * xloc(l, 0);
-        d1 += r * xloc(l, 1);
-        d2 += r * xloc(l, 2);
+        const int a = el.cp(l);
+        for (int i = 0; i < 3; ++i) xloc[3 * l + i] = P(a, i) + (*u)(3 * a + i);
       }
-      SurfaceDerivs dx;
-      dx << d0, d1, d2;
-      const CurrentPoint c = current_point(dx, pt.ref);
-      if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite())
-        return false;
-      const Mat3& T = pt.ref.T;
-      const SectionResponse sr = section(T * c.eps, T * c.kap, pt.ref.theta, pid);
-      const Vec3 N = T.transpose() * sr.n, M = T.transpose() * sr.m;
-      energy += pt.dA * sr.psi;
-      // a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i) with P_alpha = (I - a3 a3^T) Q_alpha / j,
-      // Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i.
-      const Mat3 Q1 = -skew(c.a2), Q2 = skew(c.a1);
-      const Mat3 Pr = Mat3::Identity() - c.a3 * c.a3.transpose();
-      const Mat3 P1 = Pr * Q1 / c.j, P2 = Pr * Q2 / c.j;
-      // Strain derivatives B(:, 3l+i) = sum_f Phi_f(l) G(:, 3f+i), Phi = (R_1, R_2, R_11, R_12,
-      // R_22) (rows 1-5 of the basis), rows of B: eps11, eps22, 2eps12, kap11, kap22, 2kap12.
-      G.block<1, 3>(0, 0) = c.a1.transpose();
-      G.block<1, 3>(2, 0) = c.a2.transpose();
-      G.block<1, 3>(1, 3) = c.a2.transpose();
-      G.block<1, 3>(2, 3) = c.a1.transpose();
-      G.block<1, 3>(3, 0) = -c.a11.transpose() * P1;
-      G.block<1, 3>(4, 0) = -c.a22.transpose() * P1;
-      G.block<1, 3>(5, 0) = -2.0 * c.a12.transpose() * P1;
-      G.block<1, 3>(3, 3) = -c.a11.transpose() * P2;
-      G.block<1, 3>(4, 3) = -c.a22.transpose() * P2;
-      G.block<1, 3>(5, 3) = -2.0 * c.a12.transpose() * P2;
-      G.block<1, 3>(3, 6) = -c.a3.transpose();
-      G.block<1, 3>(5, 9) = -2.0 * c.a3.transpose();
-      G.block<1, 3>(4, 12) = -c.a3.transpose();
-      Eigen::Matrix<double, 6, 1> NM;
-      NM << N, M;
-      const Eigen::Matrix<double, 15, 1> g = pt.dA * (G.transpose() * NM);
-      const Eigen::Map<const Eigen::Matrix<double, 3, 5>> gm(g.data());
-      fe.noalias() += R.bottomRows(5).transpose().lazyProduct(gm.transpose());
-      if (!tangent) continue;
-      // Material part H = G^T D G with D the covariant section tangent.
-      Eigen::Matrix<double, 6, 6> D;
-      D.block<3, 3>(0, 0) = T.transpose() * sr.A * T;
-      D.block<3, 3>(0, 3) = T.transpose() * sr.B * T;
-      D.block<3, 3>(3, 0) = D.block<3, 3>(0, 3);
-      D.block<3, 3>(3, 3) = T.transpose() * sr.D * T;
-      if ((D - D.transpose()).cwiseAbs().maxCoeff() > 1e-12 * D.cwiseAbs().maxCoeff())
-        symmetric = false;
-      Mat15& H = Hs[q];
-      // Coefficient-based products (a GEMM call with packing cost more at 15 x 6 x 15).
-      const Eigen::Matrix<double, 6, 15> DG = (pt.dA * D).lazyProduct(G);
-      H.noalias() = G.transpose().lazyProduct(DG);
-      // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
-      const double c11 = M(0), c22 = M(1), c12 = 2.0 * M(2);
-      const Vec3 v = c11 * c.a11 + c22 * c.a22 + c12 * c.a12;
-      const double va3 = v.dot(c.a3);
-      const Vec3 w = v - va3 * c.a3;
-      const double ij = 1.0 / c.j;
-      const Eigen::RowVector3d t1 = c.a3.transpose() * Q1, t2 = c.a3.transpose() * Q2;
-      const Eigen::RowVector3d h1 = v.transpose() * P1, h2 = v.transpose() * P2;
-      const Eigen::RowVector3d* tv[2] = {&t1, &t2};
-      const Eigen::RowVector3d* hv[2] = {&h1, &h2};
-      const Mat3* Qv[2] = {&Q1, &Q2};
-      const Mat3* Pv[2] = {&P1, &P2};
-      const Mat3 W = -skew(w);  // W(i, j) = eps_ijk w_k
-      for (int al = 0; al < 2; ++al) {
-        for (int be = 0; be < 2; ++be) {
-          Mat3 Gab = ij * (tv[al]->transpose() * (*hv[be]) + hv[al]->transpose() * (*tv[be]) +
-                           va3 * Qv[al]->transpose() * (*Pv[be]));
-          const double Nab = al == be ? N(al) : N(2);
-          Gab.diagonal().array() += Nab;
-          if (al == 0 && be == 1) Gab -= ij * W;
-          if (al == 1 && be == 0) Gab += ij * W;
-          H.block<3, 3>(3 * al, 3 * be) += pt.dA * Gab;
-        }
+      std::fill(fe.begin(), fe.end(), 0.0);
+      double energy = 0.0;
+      for (int q = 0; q < el.num_points; ++q) {
+        const int pid = el.first_point + q;
+        PointState& s = pass == Pass::kResidualKeep ? out.points[pid] : local;
+        if (!residual_point(pid, xloc.data(), s, energy, fe.data())) return false;
+        if (tangent) point_matrix(pid, s, Hs[q].data(), symmetric);
       }
-      // m : (a_ab,r . a3_,s + a_ab,s . a3_,r): second-derivative functions f = 2, 3, 4.
-      const double cf[3] = {c11, c12, c22};
-      for (int f = 0; f < 3; ++f) {
-        for (int be = 0; be < 2; ++be) {
-          const Mat3 X = (-pt.dA * cf[f]) * (*Pv[be]);
-          H.block<3, 3>(3 * (f + 2), 3 * be) += X;
-          H.block<3, 3>(3 * be, 3 * (f + 2)) += X.transpose();
-        }
+      std::copy(fe.begin(), fe.end(), out.fe.col(e).data());
+      out.element_energy(e) = energy;
+    } else {
+      for (int q = 0; q < el.num_points; ++q) {
+        const int pid = el.first_point + q;
+        point_matrix(pid, from->points[pid], Hs[q].data(), symmetric);
       }
     }
-    for (int l = 0; l < nl; ++l) out.fe.col(e).segment<3>(3 * l) = fe.row(l).transpose();
-    out.element_energy(e) = energy;
     if (!tangent) continue;
     // K(3l+i, 3m+j) = sum_q sum_fk Phi_f(l) H_q(3f+i, 3k+j) Phi_k(m): per pair (i, j) the
     // columns (H Phi)^T, then all pairs in one product (element_kernel.hpp: plain loops, an
@@ -290,6 +342,15 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool t
     kin.pi = pi;
     kin.pj = pj;
     kin.full = full;
+    if (factorized_) {
+      kin.Au = el.Au.data();
+      kin.Bk = el.Bk.data();
+      kin.nu = surface_.basis_u().degree() + 1;
+      kin.nv = surface_.basis_v().degree() + 1;
+      kin.nqu = nqu_;
+      kin.nqv = nqv_;
+      kin.Y = Y.data();
+    }
     kernel::element_tangent_blocks(kin, W.data(), KT.data());
     Eigen::MatrixXd& Ke = out.Ke[e];
     // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)

@@ -13,19 +13,50 @@ using namespace knit::macro;
 namespace {
 
 struct Problem {
-  int nl, nq;
+  int nl = 0, nq = 0;
   std::vector<double> PhiT, H;
+  // Tensor-product factors (element_kernel.hpp, ElementTangentInput::Au), if any.
+  int nu = 0, nv = 0, nqu = 0, nqv = 0;
+  std::vector<double> Au, Bk;
 };
 
 Problem random_problem(int nl, int nq, unsigned seed) {
   std::mt19937 gen(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const int nlp = kernel::padded_functions(nl);
-  Problem p{nl, nq, std::vector<double>(size_t(nlp) * 5 * nq, 0.0),
-            std::vector<double>(size_t(225) * nq)};
+  Problem p;
+  p.nl = nl, p.nq = nq;
+  p.PhiT.assign(size_t(nlp) * 5 * nq, 0.0);
+  p.H.resize(size_t(225) * nq);
   for (int k = 0; k < 5 * nq; ++k)
     for (int l = 0; l < nl; ++l) p.PhiT[size_t(k) * nlp + l] = u(gen);
   for (double& h : p.H) h = u(gen);
+  return p;
+}
+
+/// A random tensor-product element: Phi_f(lu + nu lv, qu + nqu qv) = a_du(lu, qu) b_dv(lv, qv).
+Problem random_tensor_problem(int nu, int nv, int nqu, int nqv, unsigned seed) {
+  Problem p = random_problem(nu * nv, nqu * nqv, seed);
+  std::mt19937 gen(seed + 1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  p.nu = nu, p.nv = nv, p.nqu = nqu, p.nqv = nqv;
+  p.Au.resize(size_t(3) * nqu * nu);
+  std::vector<double> b(size_t(3) * nqv * nv);  // b[(d nqv + qv) nv + lv]
+  for (double& x : p.Au) x = u(gen);
+  for (double& x : b) x = u(gen);
+  const int du[5] = {1, 0, 2, 1, 0}, dv[5] = {0, 1, 0, 1, 2};
+  const int nlp = kernel::padded_functions(p.nl);
+  p.Bk.resize(size_t(5) * nqv * nv);
+  for (int qv = 0; qv < nqv; ++qv)
+    for (int f = 0; f < 5; ++f)
+      for (int lv = 0; lv < nv; ++lv) {
+        const double bv = b[size_t(dv[f] * nqv + qv) * nv + lv];
+        p.Bk[size_t(5 * qv + f) * nv + lv] = bv;
+        for (int qu = 0; qu < nqu; ++qu)
+          for (int lu = 0; lu < nu; ++lu)
+            p.PhiT[size_t(5 * (qu + nqu * qv) + f) * nlp + lu + nu * lv] =
+                p.Au[size_t(du[f] * nqu + qu) * nu + lu] * bv;
+      }
   return p;
 }
 
@@ -60,6 +91,14 @@ double kernel_error(const Problem& p, bool symmetric, kernel::Isa isa) {
   in.pi = pi;
   in.pj = pj;
   in.full = full;
+  std::vector<double> Y;
+  if (!p.Au.empty()) {
+    Y.assign(size_t(ldw) * 5 * p.nqv * p.nu, 0.0);
+    in.Au = p.Au.data();
+    in.Bk = p.Bk.data();
+    in.nu = p.nu, in.nv = p.nv, in.nqu = p.nqu, in.nqv = p.nqv;
+    in.Y = Y.data();
+  }
   kernel::element_tangent_blocks(in, W.data(), KT.data(), isa);
   double err = 0.0, scale = 0.0;
   for (int k = 0; k < pairs; ++k)
@@ -87,4 +126,62 @@ TEST_CASE("element kernel: both instruction-set versions match the direct sum", 
         const Problem p = random_problem(s[0], s[1], 7u + unsigned(s[0]));
         CHECK(kernel_error(p, symmetric, isa) < 1e-13);
       }
+}
+
+TEST_CASE(
+    "element kernel: the sum-factorized product of a tensor-product element matches the "
+    "direct sum",
+    "[unit]") {
+  // p = 4 (5 x 5 functions and points), p = 2, an anisotropic 6 x 3 element with 4 x 2
+  // points, and 7 x 2 functions (outside sum_factorized: the direct product).
+  const int shapes[4][4] = {{5, 5, 5, 5}, {3, 3, 3, 3}, {6, 3, 4, 2}, {7, 2, 3, 3}};
+  std::vector<kernel::Isa> isas = {kernel::Isa::kDefault};
+  if (kernel::cpu_has_x86_64_v3()) isas.push_back(kernel::Isa::kX86_64_v3);
+  for (const auto& s : shapes)
+    for (const bool symmetric : {true, false})
+      for (const kernel::Isa isa : isas) {
+        CAPTURE(s[0], s[1], s[2], s[3], symmetric, int(isa));
+        const Problem p = random_tensor_problem(s[0], s[1], s[2], s[3], 11u + unsigned(s[0]));
+        CHECK(kernel_error(p, symmetric, isa) < 1e-13);
+      }
+  CHECK(kernel::sum_factorized(5, 5));
+  CHECK_FALSE(kernel::sum_factorized(7, 2));
+}
+
+TEST_CASE("element kernel: the point matrix H agrees between the instruction-set versions",
+          "[unit]") {
+  // Correctness of H itself: the shell tangent against finite differences
+  // (test_shell_element.cpp); here the x86-64-v3 (FMA) build of the same code against the
+  // default one, to round-off.
+  if (!kernel::cpu_has_x86_64_v3()) return;
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  kernel::PointState s;
+  for (double* v : {s.a1, s.a2, s.a11, s.a22, s.a12, s.N, s.M})
+    for (int i = 0; i < 3; ++i) v[i] = u(gen);
+  double a3[3];
+  kernel::cross3(s.a1, s.a2, a3);
+  s.j = std::sqrt(a3[0] * a3[0] + a3[1] * a3[1] + a3[2] * a3[2]);
+  for (int i = 0; i < 3; ++i) s.a3[i] = a3[i] / s.j;
+  double T[9];
+  for (double& t : T) t = u(gen);
+  for (const bool sym : {true, false}) {
+    for (double* X : {s.A, s.B, s.D})
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c <= r; ++c) X[r + 3 * c] = X[c + 3 * r] = u(gen);
+    if (!sym) s.D[1] += 0.5;
+    double H0[225], H1[225];
+    bool sym0 = true, sym1 = true;
+    kernel::point_matrix(s, T, 0.7, H0, sym0, kernel::Isa::kDefault);
+    kernel::point_matrix(s, T, 0.7, H1, sym1, kernel::Isa::kX86_64_v3);
+    CHECK(sym0 == sym);
+    CHECK(sym1 == sym);
+    double err = 0.0, big = 0.0;
+    for (int k = 0; k < 225; ++k) {
+      err = std::max(err, std::abs(H0[k] - H1[k]));
+      big = std::max(big, std::abs(H0[k]));
+    }
+    CAPTURE(err, big);
+    CHECK(err <= 1e-13 * big);
+  }
 }

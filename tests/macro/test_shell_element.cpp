@@ -47,6 +47,8 @@ TEST_CASE("shell tangent matches finite differences of the residual at a deforme
   const bool rational = GENERATE(false, true);
   auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
   ShellModel m(curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, rational), 0.1, mat);
+  // A B-spline patch takes the sum-factorized kernel, a rational one the direct product.
+  CHECK(m.sum_factorized() == !rational);
   const Eigen::VectorXd u = random_displacement(m.num_dofs(), 0.1, 7);
   CHECK(fd_tangent_error(m, u) < 1e-6);
 }
@@ -163,6 +165,30 @@ TEST_CASE("two assembly threads give the same result as one", "[unit]") {
   m.set_threads(3);
   m.evaluate(u, false, e2);
   CHECK((e1.fint - e2.fint).norm() == 0.0);
+}
+
+TEST_CASE("the tangent completed from a residual evaluation's point states is the tangent",
+          "[unit]") {
+  // ShellModel::tangent_from (Newton's tangent at an accepted trial point) against a full
+  // evaluation with tangent: the same operations on the same numbers, bitwise equal.
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  ShellModel m(curved_patch(2, 3, 2, 2, 2.0, 1.5, 0.4, true), 0.1, mat);
+  const Eigen::VectorXd u = random_displacement(m.num_dofs(), 0.1, 11);
+  const int threads = GENERATE(1, 2);
+  m.set_threads(threads);
+  ShellModel::Evaluation full, res, done;
+  m.evaluate(u, true, full);
+  m.evaluate(u, false, res);
+  CHECK_FALSE(res.has_points);
+  CHECK_THROWS_AS(m.tangent_from(res, done), std::logic_error);
+  m.evaluate(u, false, res, true);
+  REQUIRE(res.has_points);
+  m.tangent_from(res, done);
+  REQUIRE(done.ok);
+  CHECK((done.fint - full.fint).norm() == 0.0);
+  CHECK(done.energy == full.energy);
+  CHECK((dense_tangent(m, done) - dense_tangent(m, full)).norm() == 0.0);
+  CHECK(dense_tangent(m, full).norm() > 0.0);
 }
 
 TEST_CASE("a degenerate reference geometry is reported with its location", "[unit]") {

@@ -103,6 +103,10 @@ TEST_CASE(
   // tangent, the converged state's forces are reused (plain Newton converges in every step
   // here, no line search). Before: 41 evaluations for 38 iterations.
   for (const RunResult& x : r) CHECK(x.report.stats.evaluations <= x.report.stats.iterations);
+  // Every tangent after a step's first is completed from the residual evaluation at the
+  // accepted trial point (ShellModel::tangent_from): one full evaluation per step.
+  for (const RunResult& x : r)
+    CHECK(x.report.stats.iterations - x.report.stats.tangents_reused == long(x.rows.size()));
   // The symmetric paths report the inertia: the cantilever stays stable.
   CHECK(r[2].rows.back().negative_pivots == 0);
   CHECK(r[3].rows.back().negative_pivots == 0);

@@ -93,15 +93,18 @@ enum class StopReason { kNone, kCutbacks, kIncrementFloor, kWorkCap };
 
 /// Where the time of a run went (wall seconds), for benchmarks.
 struct SolverStats {
-  long iterations = 0;     ///< Newton iterations (tangent + solve), failed attempts included
-  long evaluations = 0;    ///< residual-only evaluations (line search, convergence checks)
+  long iterations = 0;   ///< Newton iterations (tangent + solve), failed attempts included
+  long evaluations = 0;  ///< residual-only evaluations (line search, convergence checks)
+  /// Tangents completed from the point states of the residual-only evaluation at the same
+  /// state (ShellModel::tangent_from) instead of a full evaluation.
+  long tangents_reused = 0;
   double setup = 0.0;      ///< scatter map, pattern and symbolic analysis (once)
   double assembly = 0.0;   ///< element tangents and forces + scatter into the reduced matrix
   double solve = 0.0;      ///< numeric factorization and triangular solves
   double residuals = 0.0;  ///< residual-only evaluations
-  /// CPU seconds (all threads) of assembly and solve: on a loaded machine the cost of a
+  /// CPU seconds (all threads) of assembly, solve and residuals: on a loaded machine the cost of a
   /// one-thread run, where the wall time also counts the waits for a core.
-  double assembly_cpu = 0.0, solve_cpu = 0.0;
+  double assembly_cpu = 0.0, solve_cpu = 0.0, residuals_cpu = 0.0;
   int unknowns = 0;
   long stored_entries = 0;  ///< of the reduced matrix
   bool sparse = false, symmetric = false;

@@ -30,10 +30,12 @@
 #include <memory>
 #include <vector>
 
+#include "knit/macro/element_kernel.hpp"
 #include "knit/macro/material.hpp"
 #include "knit/macro/patch.hpp"
 #include "knit/macro/section.hpp"
 #include "knit/macro/shell_kinematics.hpp"
+#include "knit/spline/quadrature.hpp"
 #include "knit/spline/surface.hpp"
 
 namespace knit::macro {
@@ -72,6 +74,9 @@ class ShellModel {
   int num_quadrature_points() const { return static_cast<int>(points_.size()); }
   /// Control points of element e (the (pu+1)(pv+1) functions non-zero on it).
   const Eigen::VectorXi& element_control_points(int e) const { return elements_[e].cp; }
+  /// Whether the element tangents use the sum-factorized kernel (a B-spline surface of degree
+  /// 1..5 per direction; element_kernel.hpp).
+  bool sum_factorized() const { return factorized_; }
   /// n >= 1 threads, 0 automatic (see ShellOptions::threads).
   void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
   /// The number of threads evaluate() uses with a tangent.
@@ -80,6 +85,9 @@ class ShellModel {
   /// every hardware thread: measured on 2 cores, a tangent evaluation of this size takes
   /// ~2 ms, 20x the cost of starting the threads.
   static constexpr double kAutoThreadWork = 2.0e5;
+
+  /// What a residual evaluation keeps per quadrature point (element_kernel.hpp).
+  using PointState = kernel::PointState;
 
   struct Evaluation {
     Eigen::VectorXd fint;             ///< internal force vector (num_dofs)
@@ -90,11 +98,19 @@ class ShellModel {
     bool ok = true;                  ///< false if the current configuration degenerated
     Eigen::MatrixXd fe;              ///< workspace: element force vectors (3 nloc x elements)
     Eigen::VectorXd element_energy;  ///< workspace: element energies
+    std::vector<PointState> points;  ///< per quadrature point, if kept (keep_points)
+    bool has_points = false;         ///< `points` belong to this evaluation
   };
   /// Internal forces and energy at displacement u (num_dofs), with the element tangents if
   /// `tangent`. Element results are summed in element order, so the result is bitwise the
   /// same for any number of threads.
-  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out) const;
+  /// `keep_points` (without `tangent`): also keep the PointStates for tangent_from.
+  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
+                bool keep_points = false) const;
+  /// The evaluation with tangent at the displacement of `from` (evaluated with keep_points, ok):
+  /// the element tangents from its point states, fint, energy and ok copied. Bitwise the same
+  /// as evaluate(u, true, out) (the same operations on the same numbers).
+  void tangent_from(const Evaluation& from, Evaluation& out) const;
   /// Psi(u) alone (NaN unless hyperelastic, or if the configuration degenerated).
   double energy(const Eigen::VectorXd& u) const;
 
@@ -115,13 +131,30 @@ class ShellModel {
     int first_point = 0, num_points = 0;
     /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f).
     Eigen::MatrixXd PhiT;
+    /// Tensor-product factors of PhiT (kernel::ElementTangentInput::Au, Bk), if factorized_.
+    std::vector<double> Au, Bk;
   };
   struct Point {
     ReferencePoint ref;
     double dA = 0.0;  ///< quadrature weight x Jacobian
   };
-  bool evaluate_range(int e0, int e1, const Eigen::VectorXd& u, bool tangent,
+  enum class Pass { kResidual, kResidualKeep, kTangent, kTangentFromStates };
+  /// Runs evaluate_range over the elements on assembly_threads() threads; false if any range
+  /// failed.
+  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
+                  Evaluation& out) const;
+  void factorize_elements(const std::vector<std::pair<double, double>>& su,
+                          const std::vector<std::pair<double, double>>& sv,
+                          const spline::QuadratureRule& gu, const spline::QuadratureRule& gv);
+  bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
                       Evaluation& out) const;
+  /// Residual part at one point: the point state, dA psi, and the element force
+  /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
+  /// configuration degenerated there.
+  bool residual_point(int pid, const double* xloc, PointState& s, double& energy, double* fe) const;
+  /// The 15 x 15 matrix H at one point (column-major) from its state; clears `symmetric` if
+  /// the section tangent is not.
+  void point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const;
   SectionResponse section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
                           const Eigen::Vector2d& theta, int point_id) const;
 
@@ -134,6 +167,10 @@ class ShellModel {
   std::vector<Point> points_;
   Eigen::MatrixXd R_;  ///< 6 x (nloc * num points): basis derivatives at every quadrature point
   double scale_ = 1.0;
+  /// Every element's Phi is the tensor product of its 1D bases (a B-spline surface, checked
+  /// numerically) and small enough for the sum-factorized kernel.
+  bool factorized_ = false;
+  int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
 };
 
 }  // namespace knit::macro
