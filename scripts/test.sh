@@ -18,6 +18,8 @@ san="$root/build-sanitize"
 gen=()
 command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
 # -O1 with line tables only: what ASan recommends, and about half the compile time of -O2 -g.
+# (Build type None: KNIT_OPT_HOT/KNIT_OPT_COLD are empty, so every file gets these flags; the
+# unity groups of the sources and tests apply as in Release. docs/build.md.)
 cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
   -DKNIT_SANITIZE=ON >/dev/null
 cmake --build "$san" --parallel "$jobs"

@@ -24,6 +24,9 @@
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/run.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::macro::cmd_design {
 namespace {
 
 struct Options {
@@ -128,3 +131,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::macro::cmd_design

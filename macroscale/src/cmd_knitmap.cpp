@@ -15,6 +15,9 @@
 #include "knit/core/errors.hpp"
 #include "knit/macro/knitmap.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::macro::cmd_knitmap {
 namespace {
 
 struct Options {
@@ -49,3 +52,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::macro::cmd_knitmap

@@ -17,6 +17,9 @@
 #include "knit/io/output_target.hpp"
 #include "knit/macro/run.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::macro::cmd_run {
 namespace {
 
 struct Options {
@@ -60,3 +63,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::macro::cmd_run

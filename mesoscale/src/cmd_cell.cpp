@@ -23,6 +23,9 @@
 #include "knit/meso/cell/output.hpp"
 #include "knit/meso/homog/cell_config.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::meso::cmd_cell {
 namespace {
 
 struct Options {
@@ -135,3 +138,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::meso::cmd_cell

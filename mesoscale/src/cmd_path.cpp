@@ -30,6 +30,9 @@
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/path.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::meso::cmd_path {
 namespace {
 
 struct Options {
@@ -192,3 +195,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::meso::cmd_path

@@ -12,6 +12,9 @@
 #include "knit/io/output_target.hpp"
 #include "knit/meso/rod/rod_case.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::meso::cmd_rod {
 namespace {
 
 struct Options {
@@ -48,3 +51,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::meso::cmd_rod

@@ -21,6 +21,9 @@
 #include "knit/io/output_target.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
+// A named namespace per command: the cmd_*.cpp files share one unity translation unit
+// (docs/build.md), and each defines its own Options, run and reg.
+namespace knit::meso::cmd_sweep {
 namespace {
 
 struct Cli {
@@ -157,3 +160,4 @@ knit::cli::SubcommandRegistrar reg(
     });
 
 }  // namespace
+}  // namespace knit::meso::cmd_sweep
