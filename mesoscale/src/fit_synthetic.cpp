@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "knit/material/load_paths.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 
 namespace knit::meso::fit {
@@ -18,16 +19,6 @@ namespace {
 
 double stretch_of(double green) {
   return std::sqrt(1.0 + 2.0 * green);
-}
-
-/// Radical inverse of k in base b (Halton sequence).
-double halton(int k, int b) {
-  double f = 1.0, r = 0.0;
-  for (int i = k; i > 0; i /= b) {
-    f /= b;
-    r += f * (i % b);
-  }
-  return r;
 }
 
 }  // namespace
@@ -83,8 +74,8 @@ std::vector<material::LoadPath> synthetic_coverage_paths(int steps, double e_max
   for (int k = 1; k <= holdout; ++k) {
     LoadPath p;
     p.kind = PathKind::kGradient;
-    p.H << -0.12 + 0.38 * halton(k, 2), 0.35 * (2 * halton(k, 5) - 1), 0.0,
-        -0.12 + 0.38 * halton(k, 3);
+    p.H << -0.12 + 0.38 * material::halton(k, 2), 0.35 * (2 * material::halton(k, 5) - 1), 0.0,
+        -0.12 + 0.38 * material::halton(k, 3);
     p.steps = 1;
     p.set = "holdout";
     out.push_back(p);
