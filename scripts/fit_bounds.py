@@ -36,7 +36,7 @@ from scipy.optimize import linprog
 from scipy.sparse import coo_matrix, vstack
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from energy_law import Law as EnergyLaw  # noqa: E402  (the stored law, re-evaluated)
+from energy_law import load_law  # noqa: E402  (the stored law, re-evaluated)
 
 THRESHOLD = 0.05
 
@@ -165,7 +165,7 @@ def analyse(f, loop, stride, n, lam):
     print("l = %.2f mm (stress range %.2f MPa), %d held-out states of %d paths:" %
           (loop_length, rng, len(te_e), len(held)))
     if "energy_law" in f:
-        law = EnergyLaw(f["energy_law"], loop_length)
+        law = load_law(f["energy_law"], loop_length)
         print("  stored energy law           : %s" % summary(err(law.eval(te_e)[1])))
     print("  free energy (grad of spline): %s" % summary(err(energy)))
     print("  free interpolant (no energy): %s" % summary(err(interp)))

@@ -66,6 +66,18 @@ RidgeDirections default_ridge_directions() {
 
 void validate(const EnergyLawData& d) {
   auto fail = [](const std::string& m) { throw std::invalid_argument("energy law: " + m); };
+  if (!(std::isfinite(d.l_min) && std::isfinite(d.l_max) && d.l_min > 0 && d.l_max >= d.l_min))
+    fail("loop-length range must be finite, positive and increasing");
+  if (!(std::isfinite(d.floor) && d.floor >= 0.0)) fail("floor must be finite and >= 0");
+  if (!d.box_min.allFinite() || !d.box_max.allFinite() ||
+      (d.box_min.array() > d.box_max.array()).any())
+    fail("data strain box must be finite with min <= max");
+  if (d.family == EnergyFamily::kNetwork) {
+    if (const std::string why = d.network.validate(); !why.empty()) fail("network: " + why);
+    if (d.network.l_knots.front() > d.l_min || d.network.l_knots.back() < d.l_max)
+      fail("network: loop-length knots must cover [l_min, l_max]");
+    return;
+  }
   const Eigen::Index K = d.directions.d.rows();
   if (K < 1) fail("no directions");
   if (static_cast<Eigen::Index>(d.directions.function_of.size()) != K)
@@ -85,8 +97,6 @@ void validate(const EnergyLawData& d) {
     const std::string why = d.grid(g).validate();
     if (!why.empty()) fail("function " + std::to_string(g) + ": " + why);
   }
-  if (!(std::isfinite(d.l_min) && std::isfinite(d.l_max) && d.l_min > 0 && d.l_max >= d.l_min))
-    fail("loop-length range must be finite, positive and increasing");
   try {
     spline::validate_knots(d.l_knots, d.l_degree);
   } catch (const std::exception& e) {
@@ -100,15 +110,11 @@ void validate(const EnergyLawData& d) {
   if (!d.coefficients.allFinite()) fail("coefficients must be finite");
   if ((d.coefficients.array() < 0.0).any())
     fail("coefficients must be >= 0 (f'' >= 0 keeps W convex)");
-  if (!(std::isfinite(d.floor) && d.floor >= 0.0)) fail("floor must be finite and >= 0");
-  if (!d.box_min.allFinite() || !d.box_max.allFinite() ||
-      (d.box_min.array() > d.box_max.array()).any())
-    fail("data strain box must be finite with min <= max");
 }
 
 EnergyLaw::EnergyLaw(EnergyLawData d) : d_(std::move(d)) {
   validate(d_);
-  lb_ = spline::BSplineBasis(d_.l_degree, d_.l_knots);
+  if (d_.family == EnergyFamily::kRidge) lb_ = spline::BSplineBasis(d_.l_degree, d_.l_knots);
 }
 
 Eigen::VectorXd EnergyLaw::l_basis(double l, int derivative) const {
@@ -127,6 +133,24 @@ Eigen::VectorXd EnergyLaw::ridge_coefficients(int g, double l, int derivative) c
 EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative)
     : l_(l), floor_(d.floor), P_(d.s_degree + 2), box_min_(d.box_min), box_max_(d.box_max) {
   const EnergyLaw law(d);
+  if (d.family == EnergyFamily::kNetwork) {
+    network_ = true;
+    net_ = NetworkLawAt(d.network.shape, d.network.theta_at(l));
+    if (with_l_derivative) {
+      // dS/dl = (dS/dtheta) dtheta/dl by central differences along dtheta/dl (theta(l) is
+      // piecewise linear, so this is the derivative of the span that holds l).
+      net_h_ = 1e-6;  // mm: truncation below the round-off eps |S| / h here
+      std::vector<double> lo = net_.theta(), hi = lo;
+      const std::vector<double> dt = d.network.theta_at(l, 1);
+      for (std::size_t k = 0; k < lo.size(); ++k) {
+        lo[k] -= net_h_ * dt[k];
+        hi[k] += net_h_ * dt[k];
+      }
+      net_lo_ = NetworkLawAt(d.network.shape, lo);
+      net_hi_ = NetworkLawAt(d.network.shape, hi);
+    }
+    return;
+  }
   const int G = d.functions();
   std::vector<std::size_t> offset(static_cast<std::size_t>(G));
   for (int g = 0; g < G; ++g) {
@@ -176,7 +200,17 @@ void EnergyLawAt::accumulate(const Eigen::Vector3d& e, EnergyResponse& r) const 
   r.C(1, 2) = r.C(2, 1) = C12;
 }
 
+EnergyResponse EnergyLawAt::evaluate_network(const Eigen::Vector3d& e) const {
+  const NetworkResponse n = net_.evaluate(e);
+  EnergyResponse r;
+  r.W = n.W + 0.5 * floor_ * e.squaredNorm();
+  r.S = n.S + floor_ * e;
+  r.C = n.C + floor_ * Eigen::Matrix3d::Identity();
+  return r;
+}
+
 EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
+  if (network_) return evaluate_network(e);
   EnergyResponse r;
   r.W = 0.5 * floor_ * e.squaredNorm();
   r.S = floor_ * e;
@@ -205,6 +239,10 @@ EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
 }
 
 Eigen::Vector3d EnergyLawAt::dS_dl(const Eigen::Vector3d& e) const {
+  if (network_) {
+    if (!(net_h_ > 0.0)) throw std::logic_error("EnergyLawAt: built without the l-derivative");
+    return (net_hi_.evaluate(e).S - net_lo_.evaluate(e).S) / (2.0 * net_h_);
+  }
   if (dpoly_.empty()) throw std::logic_error("EnergyLawAt: built without the l-derivative");
   Eigen::Vector3d dS = Eigen::Vector3d::Zero();
   for (const Dir& k : dirs_) {

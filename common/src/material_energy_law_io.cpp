@@ -17,34 +17,53 @@ std::vector<double> to_vec(const Eigen::VectorXd& v) {
 
 void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyFitDiagnostics& dg) {
   io::H5Group g = root.create_group(kEnergyLawGroup);
-  g.set_attribute(".", "law",
-                  "W(e; l) = sum_k f_g(k)(d_k . e; l) + floor/2 |e|^2, S = dW/de, C = d2W/de2; "
-                  "f_g'' = sum_ij coefficients[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l) >= 0, "
-                  "f_g(0) = f_g'(0) = 0");
   g.set_attribute(".", "strain", "e = (E11, E22, 2 E12) (Voigt, Green-Lagrange, material frame)");
   g.set_attribute(".", "units", "W MPa (N mm/mm^3), S and C MPa, l mm");
-  g.set_attribute(".", "s_degree", law.s_degree);
-  g.set_attribute(".", "s_spans", law.s_spans);
-  g.set_attribute(".", "l_degree", law.l_degree);
   g.set_attribute(".", "l_min", law.l_min);
   g.set_attribute(".", "l_max", law.l_max);
   g.set_attribute(".", "floor", law.floor);
-  g.write("directions", RowMatrixX(law.directions.d));
-  g.set_attribute("directions", "columns", "d_k (unit) in e = (E11, E22, 2 E12)");
-  g.write("function_of", law.directions.function_of);
-  g.set_attribute("function_of", "values", "index g of the ridge function of direction k");
-  g.write("s_range", RowMatrixX(law.s_range));
-  g.set_attribute("s_range", "columns",
-                  "a_g, b_g: uniform clamped knots of f_g'' on [a_g, b_g] (s_spans spans)");
-  g.write("l_knots", law.l_knots);
-  g.set_attribute("l_knots", "units", "mm (clamped knot vector of degree l_degree)");
-  g.write("coefficients", RowMatrixX(law.coefficients));
-  g.set_attribute("coefficients", "index",
-                  "row g, column i + n_s j (n_s = s_spans + s_degree); MPa, >= 0");
   g.write("box_min", law.box_min);
   g.write("box_max", law.box_max);
   g.set_attribute("box_min", "units", "e = (E11, E22, 2 E12): the data strain box");
   g.set_attribute("box_max", "units", "e = (E11, E22, 2 E12): the data strain box");
+  if (law.family == EnergyFamily::kNetwork) {
+    const NetworkShape& sh = law.network.shape;
+    g.set_attribute(".", "family", "network");
+    g.set_attribute(".", "law",
+                    "W(e; l) = 1/2 (N(e) + N(M e)) - N(0) - S_N0 . e + floor/2 |e|^2, M = diag(1, "
+                    "1, -1); N(e) = sum_j w_j sigma(z_j) + sum_i w1_i sigma(y_i) + 1/2 e^T L L^T "
+                    "e, y = A0 e + b0, z = V sigma(y) + A1 e + b1; V, w, w1 >= 0; theta(l) "
+                    "piecewise linear between l_knots (knit/material/convex_network.hpp)");
+    g.set_attribute(".", "h1", sh.h1);
+    g.set_attribute(".", "h2", sh.h2);
+    g.write("l_knots", law.network.l_knots);
+    g.set_attribute("l_knots", "units", "mm (theta piecewise linear in l between these)");
+    g.write("theta", RowMatrixX(law.network.theta));
+    g.set_attribute("theta", "layout",
+                    "row j: theta at l_knots[j] = A0 (h1 x 3, row-major), b0 (h1), w1 (h1), V (h2 x "
+                    "h1, row-major), A1 (h2 x 3), b1 (h2), w (h2), L (3 x 3, row-major)");
+  } else {
+    g.set_attribute(".", "family", "ridge");
+    g.set_attribute(".", "law",
+                    "W(e; l) = sum_k f_g(k)(d_k . e; l) + floor/2 |e|^2, S = dW/de, C = d2W/de2; "
+                    "f_g'' = sum_ij coefficients[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l) >= 0, "
+                    "f_g(0) = f_g'(0) = 0");
+    g.set_attribute(".", "s_degree", law.s_degree);
+    g.set_attribute(".", "s_spans", law.s_spans);
+    g.set_attribute(".", "l_degree", law.l_degree);
+    g.write("directions", RowMatrixX(law.directions.d));
+    g.set_attribute("directions", "columns", "d_k (unit) in e = (E11, E22, 2 E12)");
+    g.write("function_of", law.directions.function_of);
+    g.set_attribute("function_of", "values", "index g of the ridge function of direction k");
+    g.write("s_range", RowMatrixX(law.s_range));
+    g.set_attribute("s_range", "columns",
+                    "a_g, b_g: uniform clamped knots of f_g'' on [a_g, b_g] (s_spans spans)");
+    g.write("l_knots", law.l_knots);
+    g.set_attribute("l_knots", "units", "mm (clamped knot vector of degree l_degree)");
+    g.write("coefficients", RowMatrixX(law.coefficients));
+    g.set_attribute("coefficients", "index",
+                    "row g, column i + n_s j (n_s = s_spans + s_degree); MPa, >= 0");
+  }
 
   io::H5Group d = g.create_group("diagnostics");
   const auto n = static_cast<Eigen::Index>(dg.per_loop.size());
@@ -88,24 +107,42 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
   const std::string g = kEnergyLawGroup;
   std::string where = g;
   try {
-    for (const char* n :
-         {"directions", "function_of", "s_range", "l_knots", "coefficients", "box_min", "box_max"})
+    // Format version 2 has no "family" attribute: its laws are ridge laws.
+    const std::string family =
+        root.has_attribute(g, "family") ? root.attribute_string(g, "family") : "ridge";
+    if (family != "ridge" && family != "network")
+      throw InputError(file, g, "attribute family is \"" + family +
+                                    "\"; this build reads \"ridge\" and \"network\"");
+    law.family = family == "network" ? EnergyFamily::kNetwork : EnergyFamily::kRidge;
+    const std::vector<const char*> needed =
+        law.family == EnergyFamily::kNetwork
+            ? std::vector<const char*>{"l_knots", "theta", "box_min", "box_max"}
+            : std::vector<const char*>{"directions", "function_of", "s_range", "l_knots",
+                                       "coefficients", "box_min", "box_max"};
+    for (const char* n : needed)
       if (!root.is_dataset(g + "/" + n)) throw InputError(file, g + "/" + n, "dataset missing");
-    law.s_degree = root.attribute_int(g, "s_degree");
-    law.s_spans = root.attribute_int(g, "s_spans");
-    law.l_degree = root.attribute_int(g, "l_degree");
     law.l_min = root.attribute_double(g, "l_min");
     law.l_max = root.attribute_double(g, "l_max");
     law.floor = root.attribute_double(g, "floor");
-    law.directions.d = root.read_matrix(g + "/directions");
-    if (law.directions.d.cols() != 3)
-      throw InputError(file, g + "/directions", "must have 3 columns");
-    law.directions.function_of = root.read_ints(g + "/function_of");
-    const RowMatrixX sr = root.read_matrix(g + "/s_range");
-    if (sr.cols() != 2) throw InputError(file, g + "/s_range", "must have 2 columns");
-    law.s_range = sr;
-    law.l_knots = root.read_doubles(g + "/l_knots");
-    law.coefficients = root.read_matrix(g + "/coefficients");
+    if (law.family == EnergyFamily::kNetwork) {
+      law.network.shape.h1 = root.attribute_int(g, "h1");
+      law.network.shape.h2 = root.attribute_int(g, "h2");
+      law.network.l_knots = root.read_doubles(g + "/l_knots");
+      law.network.theta = root.read_matrix(g + "/theta");
+    } else {
+      law.s_degree = root.attribute_int(g, "s_degree");
+      law.s_spans = root.attribute_int(g, "s_spans");
+      law.l_degree = root.attribute_int(g, "l_degree");
+      law.directions.d = root.read_matrix(g + "/directions");
+      if (law.directions.d.cols() != 3)
+        throw InputError(file, g + "/directions", "must have 3 columns");
+      law.directions.function_of = root.read_ints(g + "/function_of");
+      const RowMatrixX sr = root.read_matrix(g + "/s_range");
+      if (sr.cols() != 2) throw InputError(file, g + "/s_range", "must have 2 columns");
+      law.s_range = sr;
+      law.l_knots = root.read_doubles(g + "/l_knots");
+      law.coefficients = root.read_matrix(g + "/coefficients");
+    }
     const auto bmin = root.read_doubles(g + "/box_min"), bmax = root.read_doubles(g + "/box_max");
     if (bmin.size() != 3 || bmax.size() != 3)
       throw InputError(file, g + "/box_min", "box_min and box_max need 3 values");

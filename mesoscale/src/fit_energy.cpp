@@ -11,6 +11,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
+#include "fit_energy_data.hpp"
 #include "knit/spline/knot_vector.hpp"
 
 namespace knit::meso::fit {
@@ -42,12 +43,7 @@ class SqrtInformationCost : public ceres::CostFunction {
   Eigen::VectorXd z_;
 };
 
-struct Point {
-  Eigen::Vector3d e, S;  // Voigt strain, stress
-  double l;
-  std::size_t loop;   // entry index
-  double set_weight;  // weight_uniaxial / weight_paper / 1 (see EnergyFitOptions)
-};
+using detail::Point;
 
 std::string loss_name(Loss l) {
   return l == Loss::kHuber ? "huber" : (l == Loss::kCauchy ? "cauchy" : "none");
@@ -121,6 +117,50 @@ struct Design {
   }
 };
 
+/// Squared-residual weights of the data (EnergyFitOptions: set weight, relative errors).
+std::vector<double> data_weights(const std::vector<Point>& pts, const EnergyFitOptions& o,
+                                 double sS) {
+  std::vector<double> base(pts.size(), 1.0);
+  for (std::size_t p = 0; p < pts.size(); ++p) {
+    double f = pts[p].set_weight;
+    if (o.weight_relative > 0.0)
+      f *= (1.0 + o.weight_relative) / (pts[p].S.norm() / sS + o.weight_relative);
+    base[p] = f * f;
+  }
+  return base;
+}
+
+/// The network family's part of fit_energy_law (the front end has set floor, range and box).
+EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
+                                 const std::vector<double>& ls, const std::vector<Point>& pts,
+                                 double sS, double sE, int skipped, EnergyFitSummary& out) {
+  EnergyLawData& law = out.law;
+  law.family = material::EnergyFamily::kNetwork;
+  law.directions = {};
+  law.s_range.resize(0, 2);
+  law.l_knots.clear();
+  law.coefficients.resize(0, 0);
+  const std::string why =
+      detail::fit_network(law, ls, pts, data_weights(pts, o, sS), sS, sE, o, out.ceres_iterations);
+  if (why.empty()) {
+    try {
+      material::validate(law);
+    } catch (const std::exception& e) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = e.what();
+      return out;
+    }
+  } else {
+    out.status = FitStatus::kSolverFailed;
+    out.reason = why;
+    return out;
+  }
+  out.diagnostics = diagnose_energy_law(law, db);
+  out.diagnostics.points_skipped = skipped;
+  out.diagnostics.options_json = o.to_json();
+  return out;
+}
+
 }  // namespace
 
 std::string EnergyFitOptions::validate() const {
@@ -142,6 +182,13 @@ std::string EnergyFitOptions::validate() const {
   if (!(weight_paper > 0.0 && weight_paper <= 1e3)) return "weight_paper must be in (0, 1000]";
   for (const auto& d : directions)
     if (!d.allFinite() || d.norm() == 0.0) return "directions must be finite and non-zero";
+  if (family != "ridge" && family != "network") return "family must be \"ridge\" or \"network\"";
+  if (hidden1 < 1 || hidden1 > 64 || hidden2 < 1 || hidden2 > 64)
+    return "hidden1 and hidden2 must be in 1..64";
+  if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
+  if (seed < 0) return "seed must be >= 0";
+  if (network_iterations < 1 || network_iterations > 1000000)
+    return "network_iterations must be in 1..1000000";
   return {};
 }
 
@@ -160,7 +207,13 @@ std::string EnergyFitOptions::to_json() const {
                       {"max_iterations", max_iterations},
                       {"weight_relative", weight_relative},
                       {"weight_uniaxial", weight_uniaxial},
-                      {"weight_paper", weight_paper}};
+                      {"weight_paper", weight_paper},
+                      {"family", family},
+                      {"hidden1", hidden1},
+                      {"hidden2", hidden2},
+                      {"l_coupling", l_coupling},
+                      {"seed", seed},
+                      {"network_iterations", network_iterations}};
   if (!directions.empty()) {
     nlohmann::json d = nlohmann::json::array();
     for (const auto& v : directions) d.push_back({v(0), v(1), v(2)});
@@ -183,7 +236,9 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
       "s_degree",   "s_spans",         "l_degree",        "l_control_points",
       "s_margin",   "floor",           "floor_relative",  "smoothing",
       "loss",       "loss_scale",      "loss_rounds",     "max_iterations",
-      "directions", "weight_relative", "weight_uniaxial", "weight_paper"};
+      "directions", "weight_relative", "weight_uniaxial", "weight_paper",
+      "family",     "hidden1",         "hidden2",         "l_coupling",
+      "seed",       "network_iterations"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
@@ -212,6 +267,16 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("weight_relative", o.weight_relative);
   get_double("weight_uniaxial", o.weight_uniaxial);
   get_double("weight_paper", o.weight_paper);
+  get_int("hidden1", o.hidden1);
+  get_int("hidden2", o.hidden2);
+  get_double("l_coupling", o.l_coupling);
+  get_int("seed", o.seed);
+  get_int("network_iterations", o.network_iterations);
+  if (j.contains("family")) {
+    if (!j["family"].is_string())
+      throw InputError(file, pointer + "/family", "must be \"ridge\" or \"network\"");
+    o.family = j["family"].get<std::string>();
+  }
   if (j.contains("loss")) {
     const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
     if (l == "none")
@@ -303,6 +368,8 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
                     ? spline::uniform_knots(law.l_degree, nl - law.l_degree, law.l_min, law.l_max)
                     : std::vector<double>{law.l_min - 0.5, law.l_min + 0.5};
   law.floor = o.floor >= 0.0 ? o.floor : o.floor_relative * sK;
+  if (o.family == "network") return finish_network(db, o, ls, pts, sS, sE, skipped, out);
+
 
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);
@@ -311,13 +378,7 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   // relative error measure, (1 + c) / (|S_p| / sS + c), so that the slack states (|S| of a few
   // 0.01 MPa, where the macroscale patches spend their first strains) are not drowned by the
   // jammed corners of the box (|S| ~ 10-30 MPa).
-  std::vector<double> base(pts.size(), 1.0);
-  for (std::size_t p = 0; p < pts.size(); ++p) {
-    double f = pts[p].set_weight;
-    if (o.weight_relative > 0.0)
-      f *= (1.0 + o.weight_relative) / (pts[p].S.norm() / sS + o.weight_relative);
-    base[p] = f * f;
-  }
+  const std::vector<double> base = data_weights(pts, o, sS);
   std::vector<double> w = base;
   double wsum = 0.0;
   for (double b : base) wsum += b;
@@ -516,8 +577,13 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     return os.str();
   }
   const auto& d = s.diagnostics;
-  os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
-     << " functions, floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue
+  if (s.law.family == material::EnergyFamily::kNetwork)
+    os << "  energy law (input-convex network, hidden layers " << s.law.network.shape.h1 << " and "
+       << s.law.network.shape.h2 << ", " << s.law.network.l_knots.size() << " loop-length knots";
+  else
+    os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
+       << " functions";
+  os << ", floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue
      << " MPa, " << s.ceres_iterations << " Ceres iterations):\n";
   for (const auto& p : d.per_loop)
     os << "    l = " << p.loop_length << " mm: " << p.points << " states, rms (S11, S22, S12) "

@@ -6,7 +6,8 @@ states as crosses), from /energy_law of the material database.
 
 The law is re-evaluated here from the stored coefficients (schemas/database.layout.json):
 f_g'' = sum_ij c[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l); f' and f are integrated
-numerically from 0 on a fine grid (a plot, not the C++ evaluator).
+numerically from 0 on a fine grid (a plot, not the C++ evaluator). A network-family law
+(attribute family = "network") is evaluated in closed form (NetworkLaw).
 
 Usage: energy_law.py --database DB.h5 --loop-length 6.5 --out fig06e_energy_law.png
 """
@@ -69,6 +70,61 @@ class Law:
         return W, S
 
 
+def _sigma(x):
+    """The network's activation and its derivative (knit/material/convex_network.hpp)."""
+    xc = np.clip(x, -1.0, 1.0)
+    s = np.where(x >= 1.0, x, np.where(x <= -1.0, 0.0,
+                                       0.75 * (xc**2 / 2 - xc**4 / 12) + xc / 2 + 3.0 / 16))
+    ds = np.where(x >= 1.0, 1.0, np.where(x <= -1.0, 0.0, 0.75 * (xc - xc**3 / 3) + 0.5))
+    return s, ds
+
+
+class NetworkLaw:
+    """The network family of /energy_law (attribute family = "network"), re-evaluated."""
+
+    def __init__(self, g, l):
+        h1, h2 = int(g.attrs["h1"]), int(g.attrs["h2"])
+        knots, theta = np.array(g["l_knots"]), np.array(g["theta"])
+        t = np.array([np.interp(l, knots, theta[:, k]) for k in range(theta.shape[1])])
+        o = 0
+        self.A0 = t[o:o + 3 * h1].reshape(h1, 3); o += 3 * h1
+        self.b0 = t[o:o + h1]; o += h1
+        self.w1 = t[o:o + h1]; o += h1
+        self.V = t[o:o + h2 * h1].reshape(h2, h1); o += h2 * h1
+        self.A1 = t[o:o + 3 * h2].reshape(h2, 3); o += 3 * h2
+        self.b1 = t[o:o + h2]; o += h2
+        self.w = t[o:o + h2]; o += h2
+        L = t[o:o + 9].reshape(3, 3)
+        self.Q = L @ L.T
+        self.floor = float(g.attrs["floor"])
+        W0, S0 = self._raw(np.zeros((1, 3)))
+        self.W0, self.S0 = W0[0], np.array([S0[0, 0], S0[0, 1], 0.0])
+
+    def _raw(self, e):
+        h, dh = _sigma(e @ self.A0.T + self.b0)
+        u, du = _sigma(h @ self.V.T + e @ self.A1.T + self.b1)
+        W = u @ self.w + h @ self.w1 + 0.5 * np.einsum("...i,ij,...j->...", e, self.Q, e)
+        kappa = self.w1 + (du * self.w) @ self.V
+        S = (kappa * dh) @ self.A0 + (du * self.w) @ self.A1 + e @ self.Q
+        return W, S
+
+    def eval(self, e):
+        """W and S at strains e (..., 3) = (E11, E22, 2E12)."""
+        M = np.array([1.0, 1.0, -1.0])
+        Wa, Sa = self._raw(e)
+        Wb, Sb = self._raw(e * M)
+        W = 0.5 * (Wa + Wb) - self.W0 - e @ self.S0 + 0.5 * self.floor * np.sum(e * e, axis=-1)
+        S = 0.5 * (Sa + Sb * M) - self.S0 + self.floor * e
+        return W, S
+
+
+def load_law(g, l):
+    """The stored law of /energy_law at loop length l, either family."""
+    fam = g.attrs.get("family", "ridge")
+    fam = fam.decode() if isinstance(fam, bytes) else str(fam)
+    return NetworkLaw(g, l) if fam == "network" else Law(g, l)
+
+
 def main():
     a = database_figure_args()
     with h5py.File(a.database, "r") as f:
@@ -76,7 +132,8 @@ def main():
             sys.exit(f"{a.database}: /energy_law: group missing (run `knit-meso fit "
                      f"{a.database} --law energy`)")
         k, l = pick_loop(f, a.loop_length)
-        law = Law(f["energy_law"], l)
+        law = load_law(f["energy_law"], l)
+        family = "input-convex network" if isinstance(law, NetworkLaw) else "convex ridge-spline"
         box_min, box_max = np.array(f["energy_law/box_min"]), np.array(f["energy_law/box_max"])
         pts, held = [], []
         raw = f[f"loop_{k}/raw"]
@@ -114,7 +171,7 @@ def main():
         axk.set_ylabel("E22 (wale)")
         axk.set_title(f"{title}, l = {l:g} mm, E12 = 0")
         axk.legend(loc="lower right", fontsize=7)
-    fig.suptitle("Energy-based law (convex ridge-spline W; dashed: data strain box)")
+    fig.suptitle(f"Energy-based law ({family} W; dashed: data strain box)")
     fig.savefig(a.out, dpi=130)
     print(f"wrote {a.out}")
 

@@ -33,4 +33,40 @@ inline EnergyLawData make_test_energy_law(unsigned seed = 7, double floor = 0.02
   return d;
 }
 
+/// A valid network-family law (knit/material/convex_network.hpp): random parameters with the
+/// weights V, w, w1 >= 0 (some exact zeros), three knots over 4.5-6.5 mm, magnitudes chosen so
+/// that strains |e| <~ 0.6 reach all three pieces of the activation.
+inline EnergyLawData make_test_network_law(unsigned seed = 7, double floor = 0.02, int h1 = 6,
+                                           int h2 = 4) {
+  EnergyLawData d;
+  d.family = EnergyFamily::kNetwork;
+  d.network.shape.h1 = h1;
+  d.network.shape.h2 = h2;
+  d.network.l_knots = {4.5, 5.5, 6.5};
+  const NetworkShape& sh = d.network.shape;
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  d.network.theta.resize(3, sh.size());
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < sh.size(); ++k) {
+      double v;
+      if (sh.nonnegative(k))
+        v = u(gen) < 0.15 ? 0.0 : (k >= sh.w() ? 3.0 : 1.0) * u(gen);
+      else if (k < sh.b0() || (k >= sh.a1() && k < sh.b1()))
+        v = 3.0 * n(gen);  // first-layer and passthrough weights (1/strain)
+      else if (k >= sh.L())
+        v = 0.5 * n(gen);
+      else
+        v = 2.0 * u(gen) - 1.0;  // biases
+      d.network.theta(j, k) = v;
+    }
+  d.l_min = 4.5;
+  d.l_max = 6.5;
+  d.floor = floor;
+  d.box_min << -0.3, -0.3, -0.5;
+  d.box_max << 0.45, 0.45, 0.5;
+  return d;
+}
+
 }  // namespace knit::material::testing

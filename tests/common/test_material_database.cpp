@@ -110,11 +110,11 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
     {
       auto f = knit::io::H5File::open_rw(bad);
-      f.set_attribute(".", "format_version", 3);
+      f.set_attribute(".", "format_version", 4);
     }
     CHECK_THROWS_WITH(
         read_database(bad),
-        Catch::Contains("format_version 3 is not supported (this build reads versions 1 to 2)"));
+        Catch::Contains("format_version 4 is not supported (this build reads versions 1 to 3)"));
   }
   SECTION("missing group") {
     const auto bad = tmp("nogroup.h5");

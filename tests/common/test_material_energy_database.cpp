@@ -60,7 +60,7 @@ TEST_CASE("database v2: the energy law round trip", "[unit]") {
   const Database db = db_with_law();
   write_database(file, db);
   const Database back = read_database(file, false);
-  CHECK(back.format_version == 2);
+  CHECK(back.format_version == kDatabaseFormatVersion);
   REQUIRE(back.energy_law);
   const EnergyLawData &a = *db.energy_law, &b = *back.energy_law;
   CHECK(b.directions.d == a.directions.d);
@@ -156,5 +156,66 @@ TEST_CASE("database v2: bad /energy_law content is refused with its HDF5 path", 
     }
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("/energy_law: ") &&
                                               Catch::Contains("does not cover /loop_lengths"));
+  }
+}
+
+TEST_CASE("database v3: the network law round trip", "[unit]") {
+  const auto file = tmp("network_roundtrip.h5");
+  Database db = db_with_law();
+  db.energy_law = testing::make_test_network_law();
+  write_database(file, db);
+  {
+    const auto f = knit::io::H5File::open_read(file);
+    CHECK(f.attribute_string("/energy_law", "family") == "network");
+    CHECK_FALSE(f.exists("/energy_law/coefficients"));  // no ridge datasets beside it
+  }
+  const Database back = read_database(file, false);
+  REQUIRE(back.energy_law);
+  const EnergyLawData &a = *db.energy_law, &b = *back.energy_law;
+  CHECK(b.family == EnergyFamily::kNetwork);
+  CHECK(b.network.shape.h1 == a.network.shape.h1);
+  CHECK(b.network.shape.h2 == a.network.shape.h2);
+  CHECK(b.network.l_knots == a.network.l_knots);
+  CHECK(b.network.theta == a.network.theta);
+  CHECK(b.floor == a.floor);
+  CHECK(b.box_max == a.box_max);
+  const auto ea = EnergyLaw(a).at(5.1).evaluate({0.1, -0.05, 0.2});
+  const auto eb = EnergyLaw(b).at(5.1).evaluate({0.1, -0.05, 0.2});
+  CHECK(ea.S == eb.S);
+  CHECK(ea.C == eb.C);
+}
+
+TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit]") {
+  Database db = db_with_law();
+  db.energy_law = testing::make_test_network_law();
+  const auto good = tmp("network_good.h5");
+  write_database(good, db);
+  const auto bad = tmp("network_bad.h5");
+  fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+  SECTION("a negative weight (a non-convex law)") {
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      RowMatrixX t = f.read_matrix("/energy_law/theta");
+      t(1, db.energy_law->network.shape.V()) = -0.1;
+      f.write("/energy_law/theta", t);
+    }
+    CHECK_THROWS_WITH(read_database(bad), Catch::Contains("network_bad.h5: /energy_law: ") &&
+                                              Catch::Contains("V, w, w1 must be >= 0"));
+  }
+  SECTION("an unknown family") {
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      f.set_attribute("/energy_law", "family", "spline3d");
+    }
+    CHECK_THROWS_WITH(read_database(bad), Catch::Contains("network_bad.h5: /energy_law: ") &&
+                                              Catch::Contains("family is \"spline3d\""));
+  }
+  SECTION("a missing dataset") {
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      f.remove("/energy_law/theta");
+    }
+    CHECK_THROWS_WITH(read_database(bad),
+                      Catch::Contains("network_bad.h5: /energy_law/theta: dataset missing"));
   }
 }

@@ -87,7 +87,10 @@ const std::vector<double> kRadii = {0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4,
 }  // namespace
 
 TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[unit]") {
-  const EnergyLawData data = testing::make_test_energy_law();
+  // Both families: the ridge-spline sum and the input-convex network.
+  const bool network = GENERATE(false, true);
+  const EnergyLawData data =
+      network ? testing::make_test_network_law() : testing::make_test_energy_law();
   const EnergyLaw law(data);
   // The test law's ridge coefficients reach about 2 MPa on 24 directions: |C| <~ 50 MPa. FD
   // steps: central differences with h = 1e-6 have truncation h^2 |S'''| and round-off
@@ -143,7 +146,7 @@ TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[uni
           ++count;
         }
     }
-    INFO("l = " << l << ", " << count << " strains: FD(C) " << worst_fd_C << ", FD(S) "
+    INFO((network ? "network" : "ridge") << " law, l = " << l << ", " << count << " strains: FD(C) " << worst_fd_C << ", FD(S) "
                 << worst_fd_S << ", Lipschitz ratio " << worst_lipschitz << ", min eig "
                 << min_eig);
     CHECK(worst_fd_C < tol_fd);

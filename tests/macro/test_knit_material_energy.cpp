@@ -23,8 +23,9 @@ using namespace knit::material;
 namespace fs = std::filesystem;
 
 namespace {
-KnitMaterial energy_material(double alpha) {
-  auto law = std::make_shared<const EnergyLaw>(testing::make_test_energy_law());
+KnitMaterial energy_material(double alpha, bool network = false) {
+  auto law = std::make_shared<const EnergyLaw>(network ? testing::make_test_network_law()
+                                                       : testing::make_test_energy_law());
   return KnitMaterial(nullptr, law, make_scalar_field(knit::testing::graded_stitch_value()),
                       make_scalar_field(ScalarFieldSpec::constant(alpha)));
 }
@@ -33,8 +34,9 @@ using knit::testing::at;
 
 TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded, rotated)",
           "[unit]") {
+  const bool network = GENERATE(false, true);  // both families of the law
   for (double alpha : {0.0, 0.4, -1.1}) {
-    const KnitMaterial m = energy_material(alpha);
+    const KnitMaterial m = energy_material(alpha, network);
     CHECK(m.hyperelastic());
     CHECK(m.law() == "energy");
     const auto p = at(0.37, 0.5);
@@ -47,7 +49,7 @@ TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded,
       const auto fd = knit::testing::central_differences(m, E, p, 1e-6);
       const Eigen::Matrix3d& Cfd = fd.C;
       const Eigen::Vector3d& Sfd = fd.S;
-      INFO("alpha " << alpha << ", E = " << E.transpose());
+      INFO((network ? "network" : "ridge") << " law, alpha " << alpha << ", E = " << E.transpose());
       CHECK((r.C - Cfd).norm() <= 1e-6 * (1 + Cfd.norm()));
       CHECK((r.S - Sfd).norm() <= 1e-6 * (1 + Sfd.norm()));
     }
@@ -57,10 +59,11 @@ TEST_CASE("knit material, energy law: W, S = dW/dE, C = dS/dE symmetric (graded,
 TEST_CASE("knit material, energy law: W is invariant under the rotation", "[unit]") {
   // The same physical strain state seen in the shell frame rotated by alpha: the shell strain
   // is E = T_E(alpha)^-1 E_hat; W and the material-frame stress must not change.
-  const KnitMaterial m0 = energy_material(0.0);
+  const bool network = GENERATE(false, true);
+  const KnitMaterial m0 = energy_material(0.0, network);
   const auto p = at(0.61, 0.2);
   for (double alpha : {0.3, 1.2, -2.0}) {
-    const KnitMaterial ma = energy_material(alpha);
+    const KnitMaterial ma = energy_material(alpha, network);
     for (const Eigen::Vector3d& Ehat :
          {Eigen::Vector3d(0.2, -0.05, 0.1), Eigen::Vector3d(-0.1, 0.3, -0.3)}) {
       const Eigen::Vector3d E = knit::mech::T_E(alpha).inverse() * Ehat;

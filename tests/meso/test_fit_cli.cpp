@@ -61,7 +61,7 @@ TEST_CASE("knit-meso synth writes the energy law; fit --law energy adds it to a 
   CHECK_FALSE(knit::material::read_database(db, false).energy_law);
   REQUIRE(run("fit " + db.string() + " --law energy") == 0);
   const auto b = knit::material::read_database(db, false);
-  CHECK(b.format_version == 2);
+  CHECK(b.format_version == knit::material::kDatabaseFormatVersion);
   REQUIRE(b.energy_law);
   CHECK(b.entries[0].surface);  // untouched
   std::ofstream(dir / "cli_energy_opts.json") << R"({"s_spans": -1})";

@@ -28,8 +28,9 @@
 
 namespace knit::material {
 
-/// Version 2 adds the energy-based law (/energy_law); version 1 files still load (without it).
-inline constexpr int kDatabaseFormatVersion = 2;
+/// Version 2 adds the energy-based law (/energy_law); version 3 its "family" attribute and the
+/// network family (version 2 laws are ridge laws). Versions 1 and 2 still load.
+inline constexpr int kDatabaseFormatVersion = 3;
 inline constexpr const char* kDatabaseFormatName = "knitscale-material-database";
 
 using RowMatrixX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "knit/material/convex_network.hpp"
 #include "knit/material/ridge_spline.hpp"
 #include "knit/spline/bspline_basis.hpp"
 
@@ -56,8 +57,16 @@ RidgeDirections mirror_closed(const std::vector<Eigen::Vector3d>& base);
 ///  * shear-coupled (1, 0, +-1), (0, 1, +-1), (1, -1, +-1) and pure shear (0, 0, +-1).
 RidgeDirections default_ridge_directions();
 
-/// The stored law (what /energy_law of the database holds).
+/// The law's family: the convex ridge-spline sum above, or the input-convex network
+/// (knit/material/convex_network.hpp). Both are convex for every stored parameter set.
+enum class EnergyFamily { kRidge, kNetwork };
+
+/// The stored law (what /energy_law of the database holds). The ridge fields (directions ..
+/// coefficients) are used by family kRidge, `network` by kNetwork; floor, the loop-length range
+/// and the box by both.
 struct EnergyLawData {
+  EnergyFamily family = EnergyFamily::kRidge;
+  NetworkLawData network;
   RidgeDirections directions;
   int s_degree = 3, s_spans = 8;
   Eigen::MatrixX2d s_range;  ///< per function: [a_g, b_g] (a_g < 0 < b_g)
@@ -112,12 +121,17 @@ class EnergyLawAt {
   };
   template <int P>
   void accumulate(const Eigen::Vector3d& e, EnergyResponse& r) const;
+  EnergyResponse evaluate_network(const Eigen::Vector3d& e) const;
 
   double l_ = 0.0, floor_ = 0.0;
   int P_ = 5;  ///< polynomial degree of f (s_degree + 2)
   std::vector<Dir> dirs_;
   std::vector<double> poly_, dpoly_;
   Eigen::Vector3d box_min_, box_max_;
+  bool network_ = false;
+  NetworkLawAt net_;
+  NetworkLawAt net_lo_, net_hi_;  ///< theta(l) -/+ h dtheta/dl, for dS_dl (network family)
+  double net_h_ = 0.0;
 };
 
 /// The family over l: validated data and the l-basis.

@@ -39,6 +39,16 @@
 namespace knit::meso::fit {
 
 struct EnergyFitOptions {
+  /// "ridge" (the convex ridge-spline sum) or "network" (the input-convex network,
+  /// knit/material/convex_network.hpp; fitted by mesoscale/src/fit_network.cpp).
+  std::string family = "ridge";
+  /// Network family: hidden layer sizes, the coupling of neighbouring loop lengths' parameters
+  /// (penalty l_coupling |theta_j+1 - theta_j|^2, so theta(l) interpolates sensibly between the
+  /// fitted loop lengths), the seed of the initial parameters, and L-BFGS iterations.
+  int hidden1 = 16, hidden2 = 8;
+  double l_coupling = 1e-4;
+  int seed = 1;
+  int network_iterations = 4000;
   /// Ridge directions before mirror closure; empty = material::default_ridge_directions().
   std::vector<Eigen::Vector3d> directions;
   int s_degree = 3, s_spans = 12;

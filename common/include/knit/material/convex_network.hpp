@@ -1,0 +1,119 @@
+// The input-convex network of the energy-based law (issue 11, "a richer convex family"): a
+// strain-energy density N(e; theta) that is convex in e = (E11, E22, 2 E12) for EVERY parameter
+// set theta whose weights V, w, w1 are nonnegative (Amos, Xu & Kolter, "Input Convex Neural
+// Networks", ICML 2017, Prop. 1), with two hidden layers:
+//
+//   y_i = a0_i . e + b0_i,                h_i = sigma(y_i)                       i = 1..h1
+//   z_j = sum_i V_ji h_i + a1_j . e + b1_j,  u_j = sigma(z_j)                    j = 1..h2
+//   N(e) = sum_j w_j u_j + sum_i w1_i h_i + 1/2 e^T L L^T e,      V, w, w1 >= 0,
+//
+// and sigma convex and nondecreasing (below). Derivatives in closed form:
+//   grad z_j = sum_i V_ji h'_i a0_i + a1_j,   kappa_i = w1_i + sum_j w_j u'_j V_ji  (>= 0)
+//   S = dN/de = sum_i kappa_i h'_i a0_i + sum_j w_j u'_j a1_j + L L^T e
+//   C = d2N/de2 = sum_j w_j u''_j grad z_j grad z_j^T + sum_i kappa_i h''_i a0_i a0_i^T + L L^T,
+// a sum of positive semidefinite terms (u'', h'', kappa >= 0): C is symmetric and convex by
+// construction, like the ridge law's.
+//
+// The law of the database (EnergyLawData with family kNetwork, knit/material/energy_law.hpp)
+// uses N mirror-averaged and normalized (W even in E12 = orthotropy in the course/wale frame;
+// W(0) = 0 and S(0) = 0 for a stress-free reference cell):
+//   W(e) = 1/2 (N(e) + N(M e)) - N(0) - S_N0 . e + floor/2 |e|^2,   M = diag(1, 1, -1),
+// with S_N0 = 1/2 (S_N(0) + M S_N(0)); subtracting an affine function keeps W convex.
+//
+// sigma: a C2 "smoothed ReLU" with a compact curvature bump (choice documented in
+// docs/database.md): sigma'' = 3/4 (1 - x^2) on [-1, 1] and 0 outside, so sigma = 0 for x <= -1,
+// sigma = x for x >= 1. It costs a few multiplications (no exp/log as softplus would), and its
+// second derivative is continuous, so S is C1 and C continuous.
+//
+// Loop length: one parameter set theta_j per knot l_j (the database's loop lengths), theta(l)
+// piecewise linear in l between knots (clamped outside). Nonnegativity survives the
+// interpolation, so W(., l) is convex at every l of the range, not only at the knots.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace knit::material {
+
+/// sigma, sigma', sigma'' of the activation at x (see above).
+inline void network_activation(double x, double& s, double& ds, double& dds) {
+  if (x <= -1.0) {
+    s = ds = dds = 0.0;
+  } else if (x >= 1.0) {
+    s = x;
+    ds = 1.0;
+    dds = 0.0;
+  } else {
+    const double x2 = x * x;
+    s = 0.75 * (0.5 * x2 - x2 * x2 / 12.0) + 0.5 * x + 3.0 / 16.0;
+    ds = 0.75 * (x - x2 * x / 3.0) + 0.5;
+    dds = 0.75 * (1.0 - x2);
+  }
+}
+
+/// Sizes and the layout of one parameter vector theta (offsets into it).
+struct NetworkShape {
+  int h1 = 16, h2 = 8;
+  int a0() const { return 0; }             ///< h1 x 3, row-major (a0_i)
+  int b0() const { return 3 * h1; }        ///< h1
+  int w1() const { return 4 * h1; }        ///< h1, >= 0
+  int V() const { return 5 * h1; }         ///< h2 x h1, row-major (V_ji at j * h1 + i), >= 0
+  int a1() const { return 5 * h1 + h2 * h1; }       ///< h2 x 3, row-major
+  int b1() const { return a1() + 3 * h2; }          ///< h2
+  int w() const { return b1() + h2; }               ///< h2, >= 0
+  int L() const { return w() + h2; }                ///< 3 x 3, row-major
+  int size() const { return L() + 9; }
+  /// Empty if valid, else the reason.
+  std::string validate() const;
+  /// True if entry k of theta must be >= 0 (V, w, w1).
+  bool nonnegative(int k) const {
+    return (k >= w1() && k < V() + h2 * h1) || (k >= w() && k < L());
+  }
+};
+
+struct NetworkResponse {
+  double W = 0.0;
+  Eigen::Vector3d S = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+};
+
+/// N, dN/de and d2N/de2 of the raw network (not mirror-averaged) at e. theta: shape.size().
+/// with_C = false skips C (the fit needs S only).
+NetworkResponse network_evaluate(const NetworkShape& shape, const double* theta,
+                                 const Eigen::Vector3d& e, bool with_C = true);
+
+/// Reverse mode: grad += d(g . S_N(e; theta))/d theta (the fit's gradient, by hand; checked
+/// against finite differences in tests/test_material_convex_network.cpp).
+void network_stress_gradient(const NetworkShape& shape, const double* theta,
+                             const Eigen::Vector3d& e, const Eigen::Vector3d& g, double* grad);
+
+/// The mirror-averaged, normalized law at one theta (see above), floor excluded.
+class NetworkLawAt {
+ public:
+  NetworkLawAt() = default;
+  NetworkLawAt(const NetworkShape& shape, std::vector<double> theta);
+  /// W, S, C at e (material frame, e finite). Allocation-free.
+  NetworkResponse evaluate(const Eigen::Vector3d& e) const;
+  const std::vector<double>& theta() const { return theta_; }
+
+ private:
+  NetworkShape shape_;
+  std::vector<double> theta_;
+  double W0_ = 0.0;
+  Eigen::Vector3d S0_ = Eigen::Vector3d::Zero();
+};
+
+/// The network family over l: knots and one theta per knot.
+struct NetworkLawData {
+  NetworkShape shape;
+  std::vector<double> l_knots;  ///< strictly increasing, mm (the fitted loop lengths)
+  Eigen::MatrixXd theta;        ///< row j: theta at l_knots[j] (shape.size() columns)
+  /// Empty if valid (sizes, finite, V, w, w1 >= 0, knots increasing), else the reason.
+  std::string validate() const;
+  /// theta(l), piecewise linear in l between knots, clamped outside; derivative = 1: dtheta/dl
+  /// (of the span that holds l; zero outside the knots).
+  std::vector<double> theta_at(double l, int derivative = 0) const;
+};
+
+}  // namespace knit::material

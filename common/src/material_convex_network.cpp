@@ -1,0 +1,204 @@
+// The input-convex network of the energy-based law (see knit/material/convex_network.hpp).
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "knit/material/convex_network.hpp"
+
+namespace knit::material {
+
+namespace {
+
+constexpr int kMaxUnits = 64;  // per layer: the evaluation keeps its work arrays on the stack
+
+/// Upper triangle of C += c a a^T.
+inline void add_outer(Eigen::Matrix3d& C, double c, const Eigen::Vector3d& a) {
+  const double c0 = c * a(0), c1 = c * a(1);
+  C(0, 0) += c0 * a(0);
+  C(0, 1) += c0 * a(1);
+  C(0, 2) += c0 * a(2);
+  C(1, 1) += c1 * a(1);
+  C(1, 2) += c1 * a(2);
+  C(2, 2) += c * a(2) * a(2);
+}
+
+}  // namespace
+
+std::string NetworkShape::validate() const {
+  if (h1 < 1 || h1 > kMaxUnits || h2 < 1 || h2 > kMaxUnits)
+    return "hidden layer sizes must be in 1.." + std::to_string(kMaxUnits);
+  return {};
+}
+
+NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                                 bool with_C) {
+  std::array<double, kMaxUnits> h, dh, ddh, kappa;
+  const double *a0 = th + sh.a0(), *b0 = th + sh.b0(), *w1 = th + sh.w1(), *V = th + sh.V(),
+               *a1 = th + sh.a1(), *b1 = th + sh.b1(), *w = th + sh.w(), *L = th + sh.L();
+  const int H1 = sh.h1, H2 = sh.h2;
+  NetworkResponse r;
+  for (int i = 0; i < H1; ++i) {
+    const double* a = a0 + 3 * i;
+    network_activation(a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i], h[i], dh[i], ddh[i]);
+    r.W += w1[i] * h[i];
+    kappa[i] = w1[i];
+  }
+  for (int j = 0; j < H2; ++j) {
+    const double* a = a1 + 3 * j;
+    const double* v = V + j * H1;
+    double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b1[j];
+    for (int i = 0; i < H1; ++i) z += v[i] * h[i];
+    double u, du, ddu;
+    network_activation(z, u, du, ddu);
+    r.W += w[j] * u;
+    const double wdu = w[j] * du;
+    for (int i = 0; i < H1; ++i) kappa[i] += wdu * v[i];
+    r.S += wdu * Eigen::Vector3d(a[0], a[1], a[2]);
+    if (with_C && ddu != 0.0) {
+      Eigen::Vector3d g(a[0], a[1], a[2]);
+      for (int i = 0; i < H1; ++i) {
+        const double c = v[i] * dh[i];
+        g += c * Eigen::Vector3d(a0[3 * i], a0[3 * i + 1], a0[3 * i + 2]);
+      }
+      add_outer(r.C, w[j] * ddu, g);
+    }
+  }
+  for (int i = 0; i < H1; ++i) {
+    const Eigen::Vector3d a(a0[3 * i], a0[3 * i + 1], a0[3 * i + 2]);
+    r.S += (kappa[i] * dh[i]) * a;
+    if (with_C && ddh[i] != 0.0) add_outer(r.C, kappa[i] * ddh[i], a);
+  }
+  // C was accumulated in its upper triangle: mirror it (symmetric to the last bit).
+  r.C(1, 0) = r.C(0, 1);
+  r.C(2, 0) = r.C(0, 2);
+  r.C(2, 1) = r.C(1, 2);
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Lm(L);
+  Eigen::Matrix3d Q = Lm * Lm.transpose();
+  Q(1, 0) = Q(0, 1);
+  Q(2, 0) = Q(0, 2);
+  Q(2, 1) = Q(1, 2);
+  r.W += 0.5 * e.dot(Q * e);
+  r.S += Q * e;
+  if (with_C) r.C += Q;
+  return r;
+}
+
+void network_stress_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                             const Eigen::Vector3d& g, double* grad) {
+  // F = g . S. With alpha_i = a0_i . g, beta_j = a1_j . g, gamma_j = grad z_j . g:
+  //   F = sum_i w1_i h'_i alpha_i + sum_j w_j u'_j gamma_j + g^T L L^T e,
+  // zeta_j = dF/dz_j = w_j u''_j gamma_j, omega_j = dF/dgamma_j = w_j u'_j,
+  // eta_i = dF/dy_i = h'_i sum_j zeta_j V_ji + h''_i kappa_i alpha_i.
+  std::array<double, kMaxUnits> h, dh, ddh, alpha, kappa, back;
+  const double *a0 = th + sh.a0(), *b0 = th + sh.b0(), *w1 = th + sh.w1(), *V = th + sh.V(),
+               *a1 = th + sh.a1(), *b1 = th + sh.b1(), *w = th + sh.w(), *L = th + sh.L();
+  const int H1 = sh.h1, H2 = sh.h2;
+  for (int i = 0; i < H1; ++i) {
+    const double* a = a0 + 3 * i;
+    network_activation(a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i], h[i], dh[i], ddh[i]);
+    alpha[i] = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
+    kappa[i] = w1[i];
+    back[i] = 0.0;
+    grad[sh.w1() + i] += dh[i] * alpha[i];
+  }
+  for (int j = 0; j < H2; ++j) {
+    const double* a = a1 + 3 * j;
+    const double* v = V + j * H1;
+    double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b1[j];
+    double gamma = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
+    for (int i = 0; i < H1; ++i) {
+      z += v[i] * h[i];
+      gamma += v[i] * dh[i] * alpha[i];
+    }
+    double u, du, ddu;
+    network_activation(z, u, du, ddu);
+    const double zeta = w[j] * ddu * gamma, omega = w[j] * du;
+    grad[sh.w() + j] += du * gamma;
+    grad[sh.b1() + j] += zeta;
+    for (int c = 0; c < 3; ++c) grad[sh.a1() + 3 * j + c] += zeta * e(c) + omega * g(c);
+    double* gv = grad + sh.V() + j * H1;
+    for (int i = 0; i < H1; ++i) {
+      gv[i] += zeta * h[i] + omega * dh[i] * alpha[i];
+      back[i] += zeta * v[i];
+      kappa[i] += omega * v[i];
+    }
+  }
+  for (int i = 0; i < H1; ++i) {
+    const double eta = dh[i] * back[i] + ddh[i] * kappa[i] * alpha[i];
+    grad[sh.b0() + i] += eta;
+    const double kd = kappa[i] * dh[i];
+    for (int c = 0; c < 3; ++c) grad[sh.a0() + 3 * i + c] += eta * e(c) + kd * g(c);
+  }
+  // g^T L L^T e: d/dL = g (L^T e)^T + e (L^T g)^T.
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Lm(L);
+  const Eigen::Vector3d Le = Lm.transpose() * e, Lg = Lm.transpose() * g;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) grad[sh.L() + 3 * r + c] += g(r) * Le(c) + e(r) * Lg(c);
+}
+
+NetworkLawAt::NetworkLawAt(const NetworkShape& shape, std::vector<double> theta)
+    : shape_(shape), theta_(std::move(theta)) {
+  const NetworkResponse n0 = network_evaluate(shape_, theta_.data(), Eigen::Vector3d::Zero(), false);
+  W0_ = n0.W;
+  S0_ = Eigen::Vector3d(n0.S(0), n0.S(1), 0.0);  // 1/2 (S + M S) at e = 0
+}
+
+NetworkResponse NetworkLawAt::evaluate(const Eigen::Vector3d& e) const {
+  const Eigen::Vector3d me(e(0), e(1), -e(2));
+  const NetworkResponse a = network_evaluate(shape_, theta_.data(), e);
+  const NetworkResponse b = network_evaluate(shape_, theta_.data(), me);
+  NetworkResponse r;
+  r.W = 0.5 * (a.W + b.W) - W0_ - S0_.dot(e);
+  r.S = 0.5 * (a.S + Eigen::Vector3d(b.S(0), b.S(1), -b.S(2))) - S0_;
+  // M C(Me) M flips the signs of the (1,3), (2,3) entries.
+  Eigen::Matrix3d cb = b.C;
+  cb(0, 2) = cb(2, 0) = -b.C(0, 2);
+  cb(1, 2) = cb(2, 1) = -b.C(1, 2);
+  r.C = 0.5 * (a.C + cb);
+  return r;
+}
+
+std::string NetworkLawData::validate() const {
+  if (const std::string why = shape.validate(); !why.empty()) return why;
+  const auto n = static_cast<Eigen::Index>(l_knots.size());
+  if (n < 1) return "no loop-length knot";
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!std::isfinite(l_knots[static_cast<std::size_t>(j)]) ||
+        !(l_knots[static_cast<std::size_t>(j)] > 0.0))
+      return "loop-length knots must be finite and positive";
+    if (j > 0 && !(l_knots[static_cast<std::size_t>(j)] > l_knots[static_cast<std::size_t>(j - 1)]))
+      return "loop-length knots must be strictly increasing";
+  }
+  if (theta.rows() != n || theta.cols() != shape.size())
+    return "theta must be knots x " + std::to_string(shape.size()) + " (h1 = " +
+           std::to_string(shape.h1) + ", h2 = " + std::to_string(shape.h2) + ")";
+  if (!theta.allFinite()) return "theta must be finite";
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (int k = 0; k < shape.size(); ++k)
+      if (shape.nonnegative(k) && theta(j, k) < 0.0)
+        return "theta row " + std::to_string(j) + " column " + std::to_string(k) +
+               ": the weights V, w, w1 must be >= 0 (they keep W convex)";
+  return {};
+}
+
+std::vector<double> NetworkLawData::theta_at(double l, int derivative) const {
+  const auto n = static_cast<Eigen::Index>(l_knots.size());
+  std::vector<double> out(static_cast<std::size_t>(shape.size()), 0.0);
+  if (n == 1 || l <= l_knots.front() || l >= l_knots.back()) {
+    if (derivative != 0) return out;
+    const Eigen::Index j = (n == 1 || l <= l_knots.front()) ? 0 : n - 1;
+    for (int k = 0; k < shape.size(); ++k) out[static_cast<std::size_t>(k)] = theta(j, k);
+    return out;
+  }
+  const auto it = std::upper_bound(l_knots.begin(), l_knots.end(), l);
+  const auto j = static_cast<Eigen::Index>(it - l_knots.begin()) - 1;  // l in [l_j, l_j+1)
+  const double dl = l_knots[static_cast<std::size_t>(j + 1)] - l_knots[static_cast<std::size_t>(j)];
+  const double t = (l - l_knots[static_cast<std::size_t>(j)]) / dl;
+  for (int k = 0; k < shape.size(); ++k)
+    out[static_cast<std::size_t>(k)] = derivative == 0
+                                           ? (1.0 - t) * theta(j, k) + t * theta(j + 1, k)
+                                           : (theta(j + 1, k) - theta(j, k)) / dl;
+  return out;
+}
+
+}  // namespace knit::material

@@ -1,0 +1,27 @@
+// Internal to the energy-law fits (fit_energy.cpp: ridge family and the shared front end;
+// fit_network.cpp: network family): the data points and the network fit's entry point.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "knit/meso/fit/energy_fit.hpp"
+
+namespace knit::meso::fit::detail {
+
+struct Point {
+  Eigen::Vector3d e, S;  // Voigt strain, stress
+  double l;
+  std::size_t loop;   // entry index
+  double set_weight;  // weight_uniaxial / weight_paper / 1 (see EnergyFitOptions)
+};
+
+/// Fits law.network (law.floor, l_min, l_max, box already set) to the points, with the
+/// squared-residual weights `weight` (one per point), stress scale sS and strain scale sE.
+/// Returns the reason on failure (empty on success); `iterations` counts L-BFGS iterations.
+std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
+                        const std::vector<Point>& pts, const std::vector<double>& weight,
+                        double sS, double sE, const EnergyFitOptions& o, int& iterations);
+
+}  // namespace knit::meso::fit::detail

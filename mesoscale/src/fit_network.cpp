@@ -1,0 +1,200 @@
+// Fit of the network family of the energy-based law (knit/material/convex_network.hpp) with
+// Ceres' L-BFGS (ceres::GradientProblemSolver). Ceres is included in the fit files only.
+//
+// Unknowns: phi_j, one vector per loop length l_j of the database (the knots of theta(l)); the
+// weights that must stay nonnegative (V, w, w1) are phi^2 (so any phi gives a convex law), the
+// others are phi itself. Scaled variables: x = e / sE, t = (S - floor e) / sS (the network is
+// fitted in these and converted to mm/MPa units at the end). Objective:
+//
+//   f = 1/(3 sum w) sum_p w_p |S_W(x_p; theta_j(p)) - t_p|^2
+//       + l_coupling / n_theta sum_j |phi_j+1 - phi_j|^2,
+//
+// S_W the stress of the mirror-averaged, normalized law (S(0) = 0). The gradient is exact
+// (network_stress_gradient, reverse mode by hand, checked against finite differences in
+// tests/common/test_material_convex_network.cpp); each objective evaluation costs about three
+// network passes per point. The initial phi is drawn from a seeded normal distribution (same for
+// every knot, so the knots start coupled), with positive first-layer biases so that the smoothed
+// ReLUs start in their curved or linear part.
+#include <ceres/ceres.h>
+
+#include <cmath>
+#include <random>
+
+#include "fit_energy_data.hpp"
+#include "knit/material/convex_network.hpp"
+
+namespace knit::meso::fit::detail {
+
+namespace {
+
+using material::NetworkShape;
+
+class NetworkObjective : public ceres::FirstOrderFunction {
+ public:
+  NetworkObjective(NetworkShape shape, int knots, std::vector<Eigen::Vector3d> x,
+                   std::vector<Eigen::Vector3d> t, std::vector<double> w, std::vector<int> knot,
+                   double coupling)
+      : sh_(shape),
+        n_(knots),
+        x_(std::move(x)),
+        t_(std::move(t)),
+        w_(std::move(w)),
+        knot_(std::move(knot)),
+        coupling_(coupling),
+        theta_(static_cast<std::size_t>(knots * shape.size())),
+        gtheta_(theta_.size()) {
+    double sum = 0.0;
+    for (double v : w_) sum += v;
+    scale_ = 1.0 / (3.0 * sum);
+  }
+  int NumParameters() const override { return n_ * sh_.size(); }
+
+  /// theta of all knots from phi (squares where nonnegative).
+  void to_theta(const double* phi, double* theta) const {
+    const int P = sh_.size();
+    for (int j = 0; j < n_; ++j)
+      for (int k = 0; k < P; ++k) {
+        const double v = phi[j * P + k];
+        theta[j * P + k] = sh_.nonnegative(k) ? v * v : v;
+      }
+  }
+
+  bool Evaluate(const double* phi, double* cost, double* grad) const override {
+    const int P = sh_.size();
+    to_theta(phi, theta_.data());
+    std::fill(gtheta_.begin(), gtheta_.end(), 0.0);
+    double f = 0.0;
+    std::vector<Eigen::Vector3d> S0(static_cast<std::size_t>(n_)), G0(static_cast<std::size_t>(n_));
+    for (int j = 0; j < n_; ++j) {
+      const material::NetworkResponse r0 = material::network_evaluate(
+          sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(), false);
+      S0[static_cast<std::size_t>(j)] = Eigen::Vector3d(r0.S(0), r0.S(1), 0.0);
+      G0[static_cast<std::size_t>(j)].setZero();
+    }
+    for (std::size_t p = 0; p < x_.size(); ++p) {
+      const int j = knot_[p];
+      const double* th = theta_.data() + j * P;
+      const Eigen::Vector3d& x = x_[p];
+      const Eigen::Vector3d mx(x(0), x(1), -x(2));
+      const Eigen::Vector3d sa = material::network_evaluate(sh_, th, x, false).S;
+      const Eigen::Vector3d sb = material::network_evaluate(sh_, th, mx, false).S;
+      const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
+                                S0[static_cast<std::size_t>(j)] - t_[p];
+      f += scale_ * w_[p] * s.squaredNorm();
+      if (!grad) continue;
+      const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s;  // d f / d S_W
+      double* gt = gtheta_.data() + j * P;
+      material::network_stress_gradient(sh_, th, x, 0.5 * g, gt);
+      material::network_stress_gradient(sh_, th, mx, 0.5 * Eigen::Vector3d(g(0), g(1), -g(2)), gt);
+      G0[static_cast<std::size_t>(j)] -= Eigen::Vector3d(g(0), g(1), 0.0);
+    }
+    if (grad) {
+      for (int j = 0; j < n_; ++j)
+        material::network_stress_gradient(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(),
+                                          G0[static_cast<std::size_t>(j)],
+                                          gtheta_.data() + j * P);
+      for (int j = 0; j < n_; ++j)
+        for (int k = 0; k < P; ++k) {
+          const int i = j * P + k;
+          grad[i] = sh_.nonnegative(k) ? 2.0 * phi[i] * gtheta_[static_cast<std::size_t>(i)]
+                                       : gtheta_[static_cast<std::size_t>(i)];
+        }
+    }
+    const double c = coupling_ / P;
+    for (int j = 0; j + 1 < n_; ++j)
+      for (int k = 0; k < P; ++k) {
+        const double d = phi[(j + 1) * P + k] - phi[j * P + k];
+        f += c * d * d;
+        if (grad) {
+          grad[(j + 1) * P + k] += 2.0 * c * d;
+          grad[j * P + k] -= 2.0 * c * d;
+        }
+      }
+    *cost = f;
+    return std::isfinite(f);
+  }
+
+ private:
+  NetworkShape sh_;
+  int n_;
+  std::vector<Eigen::Vector3d> x_, t_;
+  std::vector<double> w_;
+  std::vector<int> knot_;
+  double coupling_, scale_ = 1.0;
+  mutable std::vector<double> theta_, gtheta_;
+};
+
+/// Initial phi of one knot (see the file comment).
+std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
+  std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<double> phi(static_cast<std::size_t>(sh.size()));
+  auto at = [&](int k) -> double& { return phi[static_cast<std::size_t>(k)]; };
+  for (int k = 0; k < 3 * sh.h1; ++k) at(sh.a0() + k) = n01(rng);
+  for (int k = 0; k < sh.h1; ++k) at(sh.b0() + k) = 0.5 + 0.5 * n01(rng);
+  for (int k = 0; k < sh.h1; ++k) at(sh.w1() + k) = 0.5 + 0.1 * n01(rng);
+  for (int k = 0; k < sh.h2 * sh.h1; ++k) at(sh.V() + k) = 0.45 + 0.1 * n01(rng);
+  for (int k = 0; k < 3 * sh.h2; ++k) at(sh.a1() + k) = n01(rng);
+  for (int k = 0; k < sh.h2; ++k) at(sh.b1() + k) = 0.5 * n01(rng);
+  for (int k = 0; k < sh.h2; ++k) at(sh.w() + k) = 0.55 + 0.1 * n01(rng);
+  for (int k = 0; k < 9; ++k) at(sh.L() + k) = (k % 4 == 0) ? 0.3 : 0.0;
+  return phi;
+}
+
+}  // namespace
+
+std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
+                        const std::vector<Point>& pts, const std::vector<double>& weight,
+                        double sS, double sE, const EnergyFitOptions& o, int& iterations) {
+  NetworkShape sh;
+  sh.h1 = o.hidden1;
+  sh.h2 = o.hidden2;
+  if (const std::string why = sh.validate(); !why.empty()) return "invalid options: " + why;
+  const int n = static_cast<int>(loop_lengths.size()), P = sh.size();
+  std::vector<Eigen::Vector3d> x, t;
+  std::vector<int> knot;
+  for (const Point& p : pts) {
+    x.push_back(p.e / sE);
+    t.push_back((p.S - law.floor * p.e) / sS);
+    knot.push_back(static_cast<int>(p.loop));
+  }
+  const std::vector<double> phi0 = initial_phi(sh, o.seed);
+  std::vector<double> phi(static_cast<std::size_t>(n * P));
+  for (int j = 0; j < n; ++j) std::copy(phi0.begin(), phi0.end(), phi.begin() + j * P);
+
+  auto* objective = new NetworkObjective(sh, n, std::move(x), std::move(t), weight, std::move(knot),
+                                         o.l_coupling);
+  ceres::GradientProblem problem(objective);  // takes ownership
+  ceres::GradientProblemSolver::Options so;
+  so.line_search_direction_type = ceres::LBFGS;
+  so.max_lbfgs_rank = 50;
+  so.max_num_iterations = o.network_iterations;
+  so.function_tolerance = 1e-14;
+  so.gradient_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-14;
+  so.logging_type = ceres::SILENT;
+  ceres::GradientProblemSolver::Summary summary;
+  ceres::Solve(so, problem, phi.data(), &summary);
+  iterations += static_cast<int>(summary.iterations.size());
+  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost))
+    return "Ceres (L-BFGS): " + summary.message;
+
+  // theta in scaled variables -> mm / MPa: N(e) = sS sE N^(e / sE).
+  std::vector<double> theta(phi.size());
+  objective->to_theta(phi.data(), theta.data());
+  law.network.shape = sh;
+  law.network.l_knots = loop_lengths;
+  law.network.theta.resize(n, P);
+  const double wscale = sS * sE, lscale = std::sqrt(sS / sE);
+  for (int j = 0; j < n; ++j)
+    for (int k = 0; k < P; ++k) {
+      double v = theta[static_cast<std::size_t>(j * P + k)];
+      if ((k >= sh.a0() && k < sh.b0()) || (k >= sh.a1() && k < sh.b1())) v /= sE;
+      if ((k >= sh.w1() && k < sh.V()) || (k >= sh.w() && k < sh.L())) v *= wscale;
+      if (k >= sh.L()) v *= lscale;
+      law.network.theta(j, k) = v;
+    }
+  return {};
+}
+
+}  // namespace knit::meso::fit::detail

@@ -1,0 +1,172 @@
+// The input-convex network of the energy-based law (knit/material/convex_network.hpp): the
+// activation, the closed-form S and C against finite differences, convexity for any
+// nonnegative weights, the fit's reverse-mode gradient against finite differences, the
+// mirror-averaged law and its l-derivative, and validation.
+#include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "knit/material/energy_law.hpp"
+#include "test_energy_util.hpp"
+
+using namespace knit::material;
+
+namespace {
+
+std::vector<double> random_theta(const NetworkShape& sh, unsigned seed) {
+  return testing::make_test_network_law(seed, 0.0, sh.h1, sh.h2).network.theta_at(5.0);
+}
+
+}  // namespace
+
+TEST_CASE("convex network: the activation is C2, convex and nondecreasing", "[unit]") {
+  double s, ds, dds;
+  // The pieces meet with equal value, slope and curvature at -1 and 1.
+  for (double x0 : {-1.0, 1.0}) {
+    double sl, dsl, ddsl, sr, dsr, ddsr;
+    network_activation(x0 - 1e-12, sl, dsl, ddsl);
+    network_activation(x0 + 1e-12, sr, dsr, ddsr);
+    CHECK(std::abs(sl - sr) < 1e-11);
+    CHECK(std::abs(dsl - dsr) < 1e-11);
+    CHECK(std::abs(ddsl - ddsr) < 1e-11);
+  }
+  network_activation(-1.0, s, ds, dds);
+  CHECK((s == 0.0 && ds == 0.0 && dds == 0.0));
+  network_activation(2.5, s, ds, dds);
+  CHECK((s == 2.5 && ds == 1.0 && dds == 0.0));
+  for (double x = -1.5; x <= 1.5; x += 0.01) {
+    network_activation(x, s, ds, dds);
+    REQUIRE(ds >= 0.0);
+    REQUIRE(dds >= 0.0);
+    // Derivatives by central differences: sigma''' = -3/2 x jumps at -1 and 1, so a step
+    // that straddles them errs by up to h max|sigma'''| = 1.5 h.
+    const double h = 1e-6;
+    double sp, dsp, ddsp, sm, dsm, ddsm;
+    network_activation(x + h, sp, dsp, ddsp);
+    network_activation(x - h, sm, dsm, ddsm);
+    REQUIRE(std::abs((sp - sm) / (2 * h) - ds) < 1e-8);
+    REQUIRE(std::abs((dsp - dsm) / (2 * h) - dds) < 1.5e-6);
+  }
+}
+
+TEST_CASE("convex network: S and C of the raw network equal finite differences", "[unit]") {
+  NetworkShape sh;
+  sh.h1 = 7;
+  sh.h2 = 5;
+  const std::vector<double> th = random_theta(sh, 3);
+  std::mt19937 gen(2);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  const double h = 1e-6;
+  double worst_S = 0.0, worst_C = 0.0, min_eig = 1e300;
+  for (int k = 0; k < 500; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    const NetworkResponse r = network_evaluate(sh, th.data(), e);
+    REQUIRE(r.C == r.C.transpose());
+    min_eig = std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
+    CHECK(network_evaluate(sh, th.data(), e, false).S == r.S);
+    Eigen::Matrix3d Cfd;
+    Eigen::Vector3d Sfd;
+    for (int j = 0; j < 3; ++j) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d(j) = h;
+      const NetworkResponse p = network_evaluate(sh, th.data(), e + d),
+                            m = network_evaluate(sh, th.data(), e - d);
+      Sfd(j) = (p.W - m.W) / (2 * h);
+      Cfd.col(j) = (p.S - m.S) / (2 * h);
+    }
+    worst_S = std::max(worst_S, (Sfd - r.S).norm() / (1 + r.S.norm()));
+    worst_C = std::max(worst_C, (Cfd - r.C).norm() / (1 + r.C.norm()));
+  }
+  INFO("FD(S) " << worst_S << ", FD(C) " << worst_C << ", min eig " << min_eig);
+  CHECK(worst_S < 1e-7);
+  CHECK(worst_C < 1e-6);
+  // Convex for nonnegative V, w, w1 (the theorem the law relies on); -1e-12: round-off.
+  CHECK(min_eig >= -1e-12);
+}
+
+TEST_CASE("convex network: the fit's reverse-mode gradient equals finite differences", "[unit]") {
+  NetworkShape sh;
+  sh.h1 = 5;
+  sh.h2 = 3;
+  std::vector<double> th = random_theta(sh, 9);
+  std::mt19937 gen(4);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen)), g(u(gen), u(gen), u(gen));
+    std::vector<double> grad(th.size(), 0.0);
+    network_stress_gradient(sh, th.data(), e, g, grad.data());
+    for (std::size_t k = 0; k < th.size(); ++k) {
+      const double h = 1e-6, keep = th[k];
+      th[k] = keep + h;
+      const double fp = g.dot(network_evaluate(sh, th.data(), e, false).S);
+      th[k] = keep - h;
+      const double fm = g.dot(network_evaluate(sh, th.data(), e, false).S);
+      th[k] = keep;
+      INFO("trial " << trial << ", parameter " << k);
+      REQUIRE(std::abs((fp - fm) / (2 * h) - grad[k]) <= 1e-6 * (1 + std::abs(grad[k])));
+    }
+  }
+}
+
+TEST_CASE("convex network: the law is stress-free at 0, even in E12, convex", "[unit]") {
+  const EnergyLaw law(testing::make_test_network_law(5, 0.03));
+  std::mt19937 gen(8);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  for (double l : {4.5, 5.0, 5.5, 6.1, 6.5}) {
+    const EnergyLawAt at = law.at(l);
+    const EnergyResponse r0 = at.evaluate(Eigen::Vector3d::Zero());
+    CHECK(r0.W == 0.0);
+    CHECK(r0.S.norm() == 0.0);
+    for (int k = 0; k < 500; ++k) {
+      const Eigen::Vector3d e(u(gen), u(gen), u(gen)), m(e(0), e(1), -e(2));
+      const EnergyResponse a = at.evaluate(e), b = at.evaluate(m);
+      REQUIRE(std::abs(a.W - b.W) <= 1e-13 * (1 + std::abs(a.W)));
+      REQUIRE(std::abs(a.S(1) - b.S(1)) <= 1e-13 * (1 + a.S.norm()));
+      REQUIRE(std::abs(a.S(2) + b.S(2)) <= 1e-13 * (1 + a.S.norm()));
+      REQUIRE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(a.C).eigenvalues()(0) >=
+              0.03 * (1 - 1e-9));
+    }
+  }
+}
+
+TEST_CASE("convex network: dS/dl equals the finite difference in l", "[unit]") {
+  const EnergyLaw law(testing::make_test_network_law());
+  std::mt19937 gen(6);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  const double h = 1e-6;
+  for (double l : {4.6, 5.2, 5.9, 6.4}) {  // inside the spans (theta is piecewise linear in l)
+    const EnergyLawAt at = law.at(l, true), p = law.at(l + h), m = law.at(l - h);
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+      const Eigen::Vector3d fd = (p.evaluate(e).S - m.evaluate(e).S) / (2 * h);
+      const Eigen::Vector3d dS = at.dS_dl(e);
+      REQUIRE((fd - dS).norm() <= 1e-6 * (1 + dS.norm()));
+    }
+  }
+  CHECK_THROWS_AS(law.at(5.0).dS_dl(Eigen::Vector3d::Zero()), std::logic_error);
+}
+
+TEST_CASE("convex network: validation refuses bad data", "[unit]") {
+  const EnergyLawData good = testing::make_test_network_law();
+  CHECK_NOTHROW(validate(good));
+  auto refuses = [&](auto&& change, const std::string& what) {
+    EnergyLawData d = good;
+    change(d);
+    CHECK_THROWS_WITH(validate(d), Catch::Contains(what));
+  };
+  const NetworkShape& sh = good.network.shape;
+  refuses([&](EnergyLawData& d) { d.network.theta(1, sh.V() + 2) = -1e-9; }, "must be >= 0");
+  refuses([&](EnergyLawData& d) { d.network.theta(0, sh.w()) = -1.0; }, "must be >= 0");
+  refuses([&](EnergyLawData& d) { d.network.theta(2, sh.w1()) = -0.5; }, "must be >= 0");
+  refuses([&](EnergyLawData& d) { d.network.theta(0, 0) = std::nan(""); }, "finite");
+  refuses([&](EnergyLawData& d) { d.network.l_knots = {4.5, 4.5, 6.5}; }, "strictly increasing");
+  refuses([&](EnergyLawData& d) { d.network.l_knots = {4.6, 5.5, 6.5}; }, "cover");
+  refuses([&](EnergyLawData& d) { d.network.theta.conservativeResize(3, sh.size() - 1); },
+          "theta must be");
+  refuses([&](EnergyLawData& d) { d.network.shape.h1 = 0; }, "hidden layer sizes");
+  // Negative entries where no sign is required are fine (biases, first-layer weights, L).
+  EnergyLawData ok = good;
+  ok.network.theta(0, sh.b0()) = -3.0;
+  ok.network.theta(0, sh.L()) = -2.0;
+  CHECK_NOTHROW(validate(ok));
+}
