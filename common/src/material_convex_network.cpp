@@ -138,15 +138,125 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
 
 NetworkLawAt::NetworkLawAt(const NetworkShape& shape, std::vector<double> theta)
     : shape_(shape), theta_(std::move(theta)) {
-  const NetworkResponse n0 = network_evaluate(shape_, theta_.data(), Eigen::Vector3d::Zero(), false);
+  const int H1 = shape_.h1, H2 = shape_.h2;
+  const double* th = theta_.data();
+  packed_.assign(static_cast<std::size_t>(11 * H1 + H2 * H1 + 5 * H2), 0.0);
+  double* q = packed_.data();
+  for (int i = 0; i < H1; ++i) {
+    const double* a = th + shape_.a0() + 3 * i;
+    q[i] = a[0];
+    q[H1 + i] = a[1];
+    q[2 * H1 + i] = a[2];
+    q[3 * H1 + i] = th[shape_.b0() + i];
+    q[4 * H1 + i] = th[shape_.w1() + i];
+    q[5 * H1 + i] = a[0] * a[0];
+    q[6 * H1 + i] = a[0] * a[1];
+    q[7 * H1 + i] = a[0] * a[2];
+    q[8 * H1 + i] = a[1] * a[1];
+    q[9 * H1 + i] = a[1] * a[2];
+    q[10 * H1 + i] = a[2] * a[2];
+  }
+  std::copy(th + shape_.V(), th + shape_.V() + H2 * H1, q + 11 * H1);
+  std::copy(th + shape_.a1(), th + shape_.a1() + 3 * H2, q + 11 * H1 + H2 * H1);
+  std::copy(th + shape_.b1(), th + shape_.b1() + H2, q + 11 * H1 + H2 * H1 + 3 * H2);
+  std::copy(th + shape_.w(), th + shape_.w() + H2, q + 11 * H1 + H2 * H1 + 4 * H2);
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Lm(th + shape_.L());
+  Q_ = Lm * Lm.transpose();
+  Q_(1, 0) = Q_(0, 1);
+  Q_(2, 0) = Q_(0, 2);
+  Q_(2, 1) = Q_(1, 2);
+  const NetworkResponse n0 = pass(Eigen::Vector3d::Zero());
   W0_ = n0.W;
   S0_ = Eigen::Vector3d(n0.S(0), n0.S(1), 0.0);  // 1/2 (S + M S) at e = 0
 }
 
+namespace {
+
+using ArrayMap = Eigen::Map<Eigen::ArrayXd>;
+using ConstArrayMap = Eigen::Map<const Eigen::ArrayXd>;
+
+/// The activation on a whole layer: the pieces of network_activation in branch-free form (the
+/// compiler vectorizes it), exactly 0 for x <= -1; equal to network_activation to round-off.
+inline void activation_layer(const ArrayMap& x, ArrayMap& s, ArrayMap& ds, ArrayMap& dds) {
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const double xi = x(i), xc = std::min(std::max(xi, -1.0), 1.0), x2 = xc * xc;
+    const bool dead = xi <= -1.0;
+    s(i) =
+        dead ? 0.0
+             : 0.75 * (0.5 * x2 - x2 * x2 / 12.0) + 0.5 * xc + 3.0 / 16.0 + std::max(xi - 1.0, 0.0);
+    ds(i) = dead ? 0.0 : 0.75 * (xc - x2 * xc / 3.0) + 0.5;
+    dds(i) = 0.75 * (1.0 - x2);
+  }
+}
+
+}  // namespace
+
+NetworkResponse NetworkLawAt::pass(const Eigen::Vector3d& e) const {
+  const int H1 = shape_.h1, H2 = shape_.h2;
+  std::array<double, kMaxUnits> yb, hb, dhb, ddhb, tb, zb, ub, dub, ddub, wb;
+  const double* q = packed_.data();
+  const ConstArrayMap c0(q, H1), c1(q + H1, H1), c2(q + 2 * H1, H1), b0(q + 3 * H1, H1),
+      w1(q + 4 * H1, H1);
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> V(
+      q + 11 * H1, H2, H1);
+  const double* a1 = q + 11 * H1 + H2 * H1;
+  const ConstArrayMap b1(a1 + 3 * H2, H2), w(a1 + 4 * H2, H2);
+  ArrayMap y(yb.data(), H1), h(hb.data(), H1), dh(dhb.data(), H1), ddh(ddhb.data(), H1),
+      t(tb.data(), H1), z(zb.data(), H2), u(ub.data(), H2), du(dub.data(), H2),
+      ddu(ddub.data(), H2), wd(wb.data(), H2);
+  y = c0 * e(0) + c1 * e(1) + c2 * e(2) + b0;
+  activation_layer(y, h, dh, ddh);
+  z.matrix().noalias() = V * h.matrix();
+  for (int j = 0; j < H2; ++j)
+    z(j) += a1[3 * j] * e(0) + a1[3 * j + 1] * e(1) + a1[3 * j + 2] * e(2);
+  z += b1;
+  activation_layer(z, u, du, ddu);
+  NetworkResponse r;
+  r.W = (w * u).sum() + (w1 * h).sum() + 0.5 * e.dot(Q_ * e);
+  wd = w * du;
+  // kappa = w1 + V^T (w du), kept in t; then t = kappa h' for S.
+  t.matrix().noalias() = V.transpose() * wd.matrix();
+  t += w1;
+  // C, second-layer part first (needs h' only): grad z_j = sum_i V_ji h'_i a0_i + a1_j, for the
+  // units in their curved part (u''_j > 0).
+  for (int j = 0; j < H2; ++j) {
+    if (ddu(j) == 0.0) continue;
+    const auto vj = V.row(j).array() * dh.transpose();
+    Eigen::Vector3d g((vj * c0.transpose()).sum() + a1[3 * j],
+                      (vj * c1.transpose()).sum() + a1[3 * j + 1],
+                      (vj * c2.transpose()).sum() + a1[3 * j + 2]);
+    add_outer(r.C, w(j) * ddu(j), g);
+  }
+  // First-layer part: sum_i kappa_i h''_i a0_i a0_i^T from the column products.
+  const ConstArrayMap p00(q + 5 * H1, H1), p01(q + 6 * H1, H1), p02(q + 7 * H1, H1),
+      p11(q + 8 * H1, H1), p12(q + 9 * H1, H1), p22(q + 10 * H1, H1);
+  y = t * ddh;  // reuse y: kappa h''
+  r.C(0, 0) += (y * p00).sum();
+  r.C(0, 1) += (y * p01).sum();
+  r.C(0, 2) += (y * p02).sum();
+  r.C(1, 1) += (y * p11).sum();
+  r.C(1, 2) += (y * p12).sum();
+  r.C(2, 2) += (y * p22).sum();
+  t *= dh;  // kappa h'
+  r.S = Eigen::Vector3d((t * c0).sum(), (t * c1).sum(), (t * c2).sum()) + Q_ * e;
+  for (int j = 0; j < H2; ++j)
+    r.S += wd(j) * Eigen::Vector3d(a1[3 * j], a1[3 * j + 1], a1[3 * j + 2]);
+  r.C(0, 0) += Q_(0, 0);
+  r.C(0, 1) += Q_(0, 1);
+  r.C(0, 2) += Q_(0, 2);
+  r.C(1, 1) += Q_(1, 1);
+  r.C(1, 2) += Q_(1, 2);
+  r.C(2, 2) += Q_(2, 2);
+  r.C(1, 0) = r.C(0, 1);
+  r.C(2, 0) = r.C(0, 2);
+  r.C(2, 1) = r.C(1, 2);
+  return r;
+}
+
 NetworkResponse NetworkLawAt::evaluate(const Eigen::Vector3d& e) const {
   const Eigen::Vector3d me(e(0), e(1), -e(2));
-  const NetworkResponse a = network_evaluate(shape_, theta_.data(), e);
-  const NetworkResponse b = network_evaluate(shape_, theta_.data(), me);
+  const NetworkResponse a = pass(e);
+  const NetworkResponse b = pass(me);
   NetworkResponse r;
   r.W = 0.5 * (a.W + b.W) - W0_ - S0_.dot(e);
   r.S = 0.5 * (a.S + Eigen::Vector3d(b.S(0), b.S(1), -b.S(2))) - S0_;
@@ -170,8 +280,8 @@ std::string NetworkLawData::validate() const {
       return "loop-length knots must be strictly increasing";
   }
   if (theta.rows() != n || theta.cols() != shape.size())
-    return "theta must be knots x " + std::to_string(shape.size()) + " (h1 = " +
-           std::to_string(shape.h1) + ", h2 = " + std::to_string(shape.h2) + ")";
+    return "theta must be knots x " + std::to_string(shape.size()) +
+           " (h1 = " + std::to_string(shape.h1) + ", h2 = " + std::to_string(shape.h2) + ")";
   if (!theta.allFinite()) return "theta must be finite";
   for (Eigen::Index j = 0; j < n; ++j)
     for (int k = 0; k < shape.size(); ++k)

@@ -39,15 +39,17 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
     g.write("l_knots", law.network.l_knots);
     g.set_attribute("l_knots", "units", "mm (theta piecewise linear in l between these)");
     g.write("theta", RowMatrixX(law.network.theta));
-    g.set_attribute("theta", "layout",
-                    "row j: theta at l_knots[j] = A0 (h1 x 3, row-major), b0 (h1), w1 (h1), V (h2 x "
-                    "h1, row-major), A1 (h2 x 3), b1 (h2), w (h2), L (3 x 3, row-major)");
+    g.set_attribute(
+        "theta", "layout",
+        "row j: theta at l_knots[j] = A0 (h1 x 3, row-major), b0 (h1), w1 (h1), V (h2 x "
+        "h1, row-major), A1 (h2 x 3), b1 (h2), w (h2), L (3 x 3, row-major)");
   } else {
     g.set_attribute(".", "family", "ridge");
-    g.set_attribute(".", "law",
-                    "W(e; l) = sum_k f_g(k)(d_k . e; l) + floor/2 |e|^2, S = dW/de, C = d2W/de2; "
-                    "f_g'' = sum_ij coefficients[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l) >= 0, "
-                    "f_g(0) = f_g'(0) = 0");
+    g.set_attribute(
+        ".", "law",
+        "W(e; l) = sum_k f_g(k)(d_k . e; l) + floor/2 |e|^2, S = dW/de, C = d2W/de2; "
+        "f_g'' = sum_ij coefficients[g, i + n_s j] N_i(clamp(s, a_g, b_g)) M_j(l) >= 0, "
+        "f_g(0) = f_g'(0) = 0");
     g.set_attribute(".", "s_degree", law.s_degree);
     g.set_attribute(".", "s_spans", law.s_spans);
     g.set_attribute(".", "l_degree", law.l_degree);
@@ -111,14 +113,15 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
     const std::string family =
         root.has_attribute(g, "family") ? root.attribute_string(g, "family") : "ridge";
     if (family != "ridge" && family != "network")
-      throw InputError(file, g, "attribute family is \"" + family +
-                                    "\"; this build reads \"ridge\" and \"network\"");
+      throw InputError(
+          file, g,
+          "attribute family is \"" + family + "\"; this build reads \"ridge\" and \"network\"");
     law.family = family == "network" ? EnergyFamily::kNetwork : EnergyFamily::kRidge;
     const std::vector<const char*> needed =
         law.family == EnergyFamily::kNetwork
             ? std::vector<const char*>{"l_knots", "theta", "box_min", "box_max"}
-            : std::vector<const char*>{"directions", "function_of", "s_range", "l_knots",
-                                       "coefficients", "box_min", "box_max"};
+            : std::vector<const char*>{"directions",   "function_of", "s_range", "l_knots",
+                                       "coefficients", "box_min",     "box_max"};
     for (const char* n : needed)
       if (!root.is_dataset(g + "/" + n)) throw InputError(file, g + "/" + n, "dataset missing");
     law.l_min = root.attribute_double(g, "l_min");

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fit_energy_data.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
-#include "fit_energy_data.hpp"
 #include "knit/spline/knot_vector.hpp"
 
 namespace knit::meso::fit {
@@ -130,6 +130,29 @@ std::vector<double> data_weights(const std::vector<Point>& pts, const EnergyFitO
   return base;
 }
 
+/// The common tail of both families: validate the fitted law (a failure is the solver's), then
+/// its diagnostics against the database. `why` non-empty: the fit itself failed.
+EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int skipped,
+                             const std::string& why, EnergyFitSummary& out) {
+  std::string reason = why;
+  if (reason.empty()) {
+    try {
+      material::validate(out.law);
+    } catch (const std::exception& e) {
+      reason = e.what();
+    }
+  }
+  if (!reason.empty()) {
+    out.status = FitStatus::kSolverFailed;
+    out.reason = reason;
+    return out;
+  }
+  out.diagnostics = diagnose_energy_law(out.law, db);
+  out.diagnostics.points_skipped = skipped;
+  out.diagnostics.options_json = o.to_json();
+  return out;
+}
+
 /// The network family's part of fit_energy_law (the front end has set floor, range and box).
 EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
                                  const std::vector<double>& ls, const std::vector<Point>& pts,
@@ -142,23 +165,7 @@ EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
   law.coefficients.resize(0, 0);
   const std::string why =
       detail::fit_network(law, ls, pts, data_weights(pts, o, sS), sS, sE, o, out.ceres_iterations);
-  if (why.empty()) {
-    try {
-      material::validate(law);
-    } catch (const std::exception& e) {
-      out.status = FitStatus::kSolverFailed;
-      out.reason = e.what();
-      return out;
-    }
-  } else {
-    out.status = FitStatus::kSolverFailed;
-    out.reason = why;
-    return out;
-  }
-  out.diagnostics = diagnose_energy_law(law, db);
-  out.diagnostics.points_skipped = skipped;
-  out.diagnostics.options_json = o.to_json();
-  return out;
+  return finish_fit(db, o, skipped, why, out);
 }
 
 }  // namespace
@@ -232,13 +239,14 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   }
   if (!j.is_object()) throw InputError(file, pointer, "energy-fit options must be a JSON object");
   EnergyFitOptions o;
-  static const char* known[] = {
-      "s_degree",   "s_spans",         "l_degree",        "l_control_points",
-      "s_margin",   "floor",           "floor_relative",  "smoothing",
-      "loss",       "loss_scale",      "loss_rounds",     "max_iterations",
-      "directions", "weight_relative", "weight_uniaxial", "weight_paper",
-      "family",     "hidden1",         "hidden2",         "l_coupling",
-      "seed",       "network_iterations"};
+  static const char* known[] = {"s_degree",          "s_spans",         "l_degree",
+                                "l_control_points",  "s_margin",        "floor",
+                                "floor_relative",    "smoothing",       "loss",
+                                "loss_scale",        "loss_rounds",     "max_iterations",
+                                "directions",        "weight_relative", "weight_uniaxial",
+                                "weight_paper",      "family",          "hidden1",
+                                "hidden2",           "l_coupling",      "seed",
+                                "network_iterations"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
@@ -320,11 +328,13 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
 
   // ---- layout: directions, scales, s-ranges, l-basis, floor, box -------------------------
   EnergyLawData& law = out.law;
-  try {
-    law.directions = o.directions.empty() ? material::default_ridge_directions()
-                                          : material::mirror_closed(o.directions);
-  } catch (const std::exception& e) {
-    return refuse(std::string("invalid options: ") + e.what());
+  if (o.family == "ridge") {
+    try {
+      law.directions = o.directions.empty() ? material::default_ridge_directions()
+                                            : material::mirror_closed(o.directions);
+    } catch (const std::exception& e) {
+      return refuse(std::string("invalid options: ") + e.what());
+    }
   }
   const int G = law.functions();
   double sS = 0.0, sE = 0.0;
@@ -369,7 +379,6 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
                     : std::vector<double>{law.l_min - 0.5, law.l_min + 0.5};
   law.floor = o.floor >= 0.0 ? o.floor : o.floor_relative * sK;
   if (o.family == "network") return finish_network(db, o, ls, pts, sS, sE, skipped, out);
-
 
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);
@@ -459,17 +468,7 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   }
   law.coefficients.resize(G, ns * nl);
   for (int g = 0; g < G; ++g) law.coefficients.row(g) = x.segment(g * ns * nl, ns * nl).transpose();
-  try {
-    material::validate(law);
-  } catch (const std::exception& e) {
-    out.status = FitStatus::kSolverFailed;
-    out.reason = e.what();
-    return out;
-  }
-  out.diagnostics = diagnose_energy_law(law, db);
-  out.diagnostics.points_skipped = skipped;
-  out.diagnostics.options_json = o.to_json();
-  return out;
+  return finish_fit(db, o, skipped, {}, out);
 }
 
 EnergyFitSummary fit_energy_database(Database& db, const EnergyFitOptions& options) {
@@ -583,8 +582,8 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
   else
     os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
        << " functions";
-  os << ", floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue
-     << " MPa, " << s.ceres_iterations << " Ceres iterations):\n";
+  os << ", floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue << " MPa, "
+     << s.ceres_iterations << " Ceres iterations):\n";
   for (const auto& p : d.per_loop)
     os << "    l = " << p.loop_length << " mm: " << p.points << " states, rms (S11, S22, S12) "
        << p.rms(0) << ", " << p.rms(1) << ", " << p.rms(2) << " MPa, max " << p.max(0) << ", "

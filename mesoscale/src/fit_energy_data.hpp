@@ -21,7 +21,7 @@ struct Point {
 /// squared-residual weights `weight` (one per point), stress scale sS and strain scale sE.
 /// Returns the reason on failure (empty on success); `iterations` counts L-BFGS iterations.
 std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
-                        const std::vector<Point>& pts, const std::vector<double>& weight,
-                        double sS, double sE, const EnergyFitOptions& o, int& iterations);
+                        const std::vector<Point>& pts, const std::vector<double>& weight, double sS,
+                        double sE, const EnergyFitOptions& o, int& iterations);
 
 }  // namespace knit::meso::fit::detail

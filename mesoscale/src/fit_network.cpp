@@ -66,8 +66,8 @@ class NetworkObjective : public ceres::FirstOrderFunction {
     double f = 0.0;
     std::vector<Eigen::Vector3d> S0(static_cast<std::size_t>(n_)), G0(static_cast<std::size_t>(n_));
     for (int j = 0; j < n_; ++j) {
-      const material::NetworkResponse r0 = material::network_evaluate(
-          sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(), false);
+      const material::NetworkResponse r0 =
+          material::network_evaluate(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(), false);
       S0[static_cast<std::size_t>(j)] = Eigen::Vector3d(r0.S(0), r0.S(1), 0.0);
       G0[static_cast<std::size_t>(j)].setZero();
     }
@@ -91,8 +91,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
     if (grad) {
       for (int j = 0; j < n_; ++j)
         material::network_stress_gradient(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(),
-                                          G0[static_cast<std::size_t>(j)],
-                                          gtheta_.data() + j * P);
+                                          G0[static_cast<std::size_t>(j)], gtheta_.data() + j * P);
       for (int j = 0; j < n_; ++j)
         for (int k = 0; k < P; ++k) {
           const int i = j * P + k;
@@ -144,8 +143,8 @@ std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
 }  // namespace
 
 std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
-                        const std::vector<Point>& pts, const std::vector<double>& weight,
-                        double sS, double sE, const EnergyFitOptions& o, int& iterations) {
+                        const std::vector<Point>& pts, const std::vector<double>& weight, double sS,
+                        double sE, const EnergyFitOptions& o, int& iterations) {
   NetworkShape sh;
   sh.h1 = o.hidden1;
   sh.h2 = o.hidden2;

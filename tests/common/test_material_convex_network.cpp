@@ -1,7 +1,7 @@
 // The input-convex network of the energy-based law (knit/material/convex_network.hpp): the
 // activation, the closed-form S and C against finite differences, convexity for any
 // nonnegative weights, the fit's reverse-mode gradient against finite differences, the
-// mirror-averaged law and its l-derivative, and validation.
+// mirror-averaged law, and validation (its l-derivative: test_material_energy_law.cpp).
 #include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <random>
@@ -62,7 +62,8 @@ TEST_CASE("convex network: S and C of the raw network equal finite differences",
     const Eigen::Vector3d e(u(gen), u(gen), u(gen));
     const NetworkResponse r = network_evaluate(sh, th.data(), e);
     REQUIRE(r.C == r.C.transpose());
-    min_eig = std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
+    min_eig =
+        std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
     CHECK(network_evaluate(sh, th.data(), e, false).S == r.S);
     Eigen::Matrix3d Cfd;
     Eigen::Vector3d Sfd;
@@ -127,23 +128,6 @@ TEST_CASE("convex network: the law is stress-free at 0, even in E12, convex", "[
               0.03 * (1 - 1e-9));
     }
   }
-}
-
-TEST_CASE("convex network: dS/dl equals the finite difference in l", "[unit]") {
-  const EnergyLaw law(testing::make_test_network_law());
-  std::mt19937 gen(6);
-  std::uniform_real_distribution<double> u(-0.5, 0.5);
-  const double h = 1e-6;
-  for (double l : {4.6, 5.2, 5.9, 6.4}) {  // inside the spans (theta is piecewise linear in l)
-    const EnergyLawAt at = law.at(l, true), p = law.at(l + h), m = law.at(l - h);
-    for (int k = 0; k < 200; ++k) {
-      const Eigen::Vector3d e(u(gen), u(gen), u(gen));
-      const Eigen::Vector3d fd = (p.evaluate(e).S - m.evaluate(e).S) / (2 * h);
-      const Eigen::Vector3d dS = at.dS_dl(e);
-      REQUIRE((fd - dS).norm() <= 1e-6 * (1 + dS.norm()));
-    }
-  }
-  CHECK_THROWS_AS(law.at(5.0).dS_dl(Eigen::Vector3d::Zero()), std::logic_error);
 }
 
 TEST_CASE("convex network: validation refuses bad data", "[unit]") {

@@ -54,15 +54,15 @@ inline void network_activation(double x, double& s, double& ds, double& dds) {
 
 /// Sizes and the layout of one parameter vector theta (offsets into it).
 struct NetworkShape {
-  int h1 = 16, h2 = 8;
-  int a0() const { return 0; }             ///< h1 x 3, row-major (a0_i)
-  int b0() const { return 3 * h1; }        ///< h1
-  int w1() const { return 4 * h1; }        ///< h1, >= 0
-  int V() const { return 5 * h1; }         ///< h2 x h1, row-major (V_ji at j * h1 + i), >= 0
-  int a1() const { return 5 * h1 + h2 * h1; }       ///< h2 x 3, row-major
-  int b1() const { return a1() + 3 * h2; }          ///< h2
-  int w() const { return b1() + h2; }               ///< h2, >= 0
-  int L() const { return w() + h2; }                ///< 3 x 3, row-major
+  int h1 = 12, h2 = 6;
+  int a0() const { return 0; }                 ///< h1 x 3, row-major (a0_i)
+  int b0() const { return 3 * h1; }            ///< h1
+  int w1() const { return 4 * h1; }            ///< h1, >= 0
+  int V() const { return 5 * h1; }             ///< h2 x h1, row-major (V_ji at j * h1 + i), >= 0
+  int a1() const { return 5 * h1 + h2 * h1; }  ///< h2 x 3, row-major
+  int b1() const { return a1() + 3 * h2; }     ///< h2
+  int w() const { return b1() + h2; }          ///< h2, >= 0
+  int L() const { return w() + h2; }           ///< 3 x 3, row-major
   int size() const { return L() + 9; }
   /// Empty if valid, else the reason.
   std::string validate() const;
@@ -88,7 +88,10 @@ NetworkResponse network_evaluate(const NetworkShape& shape, const double* theta,
 void network_stress_gradient(const NetworkShape& shape, const double* theta,
                              const Eigen::Vector3d& e, const Eigen::Vector3d& g, double* grad);
 
-/// The mirror-averaged, normalized law at one theta (see above), floor excluded.
+/// The mirror-averaged, normalized law at one theta (see above), floor excluded. Holds theta
+/// re-laid out for vectorized evaluation (first-layer weights by column, their pairwise
+/// products precomputed), so evaluate() is a few matrix-vector products per network pass;
+/// it equals network_evaluate() to round-off (tested).
 class NetworkLawAt {
  public:
   NetworkLawAt() = default;
@@ -98,8 +101,15 @@ class NetworkLawAt {
   const std::vector<double>& theta() const { return theta_; }
 
  private:
+  /// N, S_N, C_N of the raw network at e from the packed layout (the fast path).
+  NetworkResponse pass(const Eigen::Vector3d& e) const;
+
   NetworkShape shape_;
   std::vector<double> theta_;
+  /// Packed: c0, c1, c2 (columns of A0), b0, w1, p00, p01, p02, p11, p12, p22 (products of
+  /// the columns), each h1 long; then V (h2 x h1, row-major), a1 (h2 x 3), b1, w (h2 each).
+  std::vector<double> packed_;
+  Eigen::Matrix3d Q_ = Eigen::Matrix3d::Zero();
   double W0_ = 0.0;
   Eigen::Vector3d S0_ = Eigen::Vector3d::Zero();
 };

@@ -41,11 +41,11 @@ namespace knit::meso::fit {
 struct EnergyFitOptions {
   /// "ridge" (the convex ridge-spline sum) or "network" (the input-convex network,
   /// knit/material/convex_network.hpp; fitted by mesoscale/src/fit_network.cpp).
-  std::string family = "ridge";
+  std::string family = "network";
   /// Network family: hidden layer sizes, the coupling of neighbouring loop lengths' parameters
   /// (penalty l_coupling |theta_j+1 - theta_j|^2, so theta(l) interpolates sensibly between the
   /// fitted loop lengths), the seed of the initial parameters, and L-BFGS iterations.
-  int hidden1 = 16, hidden2 = 8;
+  int hidden1 = 12, hidden2 = 6;
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
