@@ -1,10 +1,14 @@
-// The persistent assembly threads (thread_pool.hpp) and the shell's per-thread workspaces kept
-// across evaluations and models (shell_model.cpp: no allocation after the first call).
+// The persistent assembly threads (thread_pool.hpp), the shell's per-thread workspaces kept
+// across evaluations and models (shell_model.cpp: no allocation after the first call) and the
+// scatter into the reduced tangent split by value range between threads (reduced_tangent.hpp).
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <random>
 #include <stdexcept>
 
+#include "knit/macro/case.hpp"
+#include "knit/macro/reduced_tangent.hpp"
+#include "knit/macro/run.hpp"
 #include "knit/macro/thread_pool.hpp"
 #include "shell_test_util.hpp"
 
@@ -83,5 +87,36 @@ TEST_CASE("the shell's kept workspaces give the result of fresh ones across mode
       REQUIRE(again.ok);
       CHECK((again.fint - first[k].fint).norm() == 0.0);
       CHECK((dense_tangent(m, again) - dense_tangent(m, first[k])).norm() == 0.0);
+    }
+}
+
+TEST_CASE("the scatter split between threads gives the one-thread matrix bitwise", "[unit]") {
+  // Every storage (dense / sparse, LU / lower triangle) of the Sze cantilever's tangent at a
+  // deformed state, assembled on 1, 2 and 3 threads: K x bitwise the same (each value is
+  // summed in element order by the thread that owns it).
+  Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/sze_cantilever.json");
+  const Problem p = setup_problem(c);
+  ShellModel& m = *p.model;
+  ShellModel::Evaluation ev;
+  m.evaluate(random_u(m.num_dofs(), 9), true, ev);
+  REQUIRE(ev.ok);
+  const Eigen::VectorXd x = random_u(p.dofs.num_free(), 10);
+  for (const bool sparse : {false, true})
+    for (const bool symmetric : {false, true}) {
+      m.set_threads(1);
+      ReducedTangent K1(m, p.dofs, symmetric, sparse);
+      REQUIRE(K1.scatter_threads() == 1);
+      K1.assemble(ev.Ke);
+      K1.assemble(ev.Ke);  // values reset by assemble
+      const Eigen::VectorXd y1 = K1.multiply(x);
+      REQUIRE(y1.norm() > 0.0);
+      for (const int threads : {2, 3}) {
+        m.set_threads(threads);
+        ReducedTangent K(m, p.dofs, symmetric, sparse);
+        CHECK(K.scatter_threads() == threads);
+        K.assemble(ev.Ke);
+        K.assemble(ev.Ke);
+        CHECK((K.multiply(x) - y1).norm() == 0.0);
+      }
     }
 }
