@@ -98,8 +98,10 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
 /// The 15 x 15 matrix H of one quadrature point (shell_model.hpp; column-major) from its
 /// state, T the covariant-to-Cartesian Voigt map (column-major 3 x 3) and dA the weighted
 /// area element; clears `symmetric` if the section tangent is not symmetric. Raw arrays,
-/// compiled for both instruction sets like the kernel.
+/// compiled for both instruction sets like the kernel. `use_symmetry` (default): where the
+/// section tangent is symmetric, H's material part is computed below its diagonal and
+/// mirrored (equal to the full product to round-off; false: the full product, the reference).
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
-                  Isa isa = Isa::kAuto);
+                  Isa isa = Isa::kAuto, bool use_symmetry = true);
 
 }  // namespace knit::macro::kernel
