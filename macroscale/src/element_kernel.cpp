@@ -312,6 +312,44 @@ void blocks_default(const ElementTangentInput& in, double* W, double* KT) {
   blocks<v2, 2>(in, W, KT);
 }
 
+/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version.
+inline __attribute__((always_inline)) void derivatives_body(const double* R, const double* x,
+                                                            int nl, double* d) {
+  double acc[3][6] = {};
+  for (int l = 0; l < nl; ++l)
+    for (int i = 0; i < 3; ++i)
+      for (int r = 0; r < 6; ++r) acc[i][r] += R[6 * l + r] * x[3 * l + i];
+  for (int i = 0; i < 3; ++i)
+    for (int r = 0; r < 6; ++r) d[6 * i + r] = acc[i][r];
+}
+
+inline __attribute__((always_inline)) void forces_body(const double* R, const double* g, int nl,
+                                                       double* fe) {
+  for (int l = 0; l < nl; ++l) {
+    const double* Phi = R + 6 * l + 1;
+    for (int i = 0; i < 3; ++i) {
+      double acc = 0.0;
+      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
+      fe[3 * l + i] += acc;
+    }
+  }
+}
+
+__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* R, const double* x,
+                                                              int nl, double* d) {
+  derivatives_body(R, x, nl, d);
+}
+void derivatives_default(const double* R, const double* x, int nl, double* d) {
+  derivatives_body(R, x, nl, d);
+}
+__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* R, const double* g, int nl,
+                                                         double* fe) {
+  forces_body(R, g, nl, fe);
+}
+void forces_default(const double* R, const double* g, int nl, double* fe) {
+  forces_body(R, g, nl, fe);
+}
+
 }  // namespace
 
 bool cpu_has_x86_64_v3() {
@@ -338,6 +376,31 @@ void point_matrix(const PointState& s, const double* T, double dA, double* H, bo
     point_matrix_v3(s, T, dA, H, symmetric, use_symmetry);
   else
     point_matrix_default(s, T, dA, H, symmetric, use_symmetry);
+}
+
+}  // namespace knit::macro::kernel
+
+namespace knit::macro::kernel {
+
+namespace {
+bool use_v3(Isa isa) {
+  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
+  return isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3();
+}
+}  // namespace
+
+void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa) {
+  if (use_v3(isa))
+    derivatives_v3(R, x, nl, d);
+  else
+    derivatives_default(R, x, nl, d);
+}
+
+void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa) {
+  if (use_v3(isa))
+    forces_v3(R, g, nl, fe);
+  else
+    forces_default(R, g, nl, fe);
 }
 
 }  // namespace knit::macro::kernel

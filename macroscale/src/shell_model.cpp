@@ -245,14 +245,10 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
   const int nl = nloc_;
   const Point& pt = points_[pid];
   const double* R = R_.data() + static_cast<Eigen::Index>(pid) * nl * 6;  // R[6 l + r]
-  // dx = R xloc as a sum of outer products (contiguous columns of R).
-  double d[3][6] = {};
-  for (int l = 0; l < nl; ++l)
-    for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 6; ++r) d[i][r] += R[6 * l + r] * xloc[3 * l + i];
-  SurfaceDerivs dx;
-  for (int i = 0; i < 3; ++i)
-    for (int r = 0; r < 6; ++r) dx(r, i) = d[i][r];
+  // dx = R xloc as a sum of outer products (contiguous columns of R; element_kernel.cpp, built
+  // for both instruction sets).
+  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r
+  kernel::current_derivatives(R, xloc, nl, dx.data());
   const CurrentPoint c = current_point(dx, pt.ref);
   if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) return false;
   const Eigen::Matrix3d& T = pt.ref.T;
@@ -280,14 +276,7 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
     g[9 + i] = -dA * 2.0 * M(2) * s.a3[i];
     g[12 + i] = -dA * M(1) * s.a3[i];
   }
-  for (int l = 0; l < nl; ++l) {
-    const double* Phi = R + 6 * l + 1;
-    for (int i = 0; i < 3; ++i) {
-      double acc = 0.0;
-      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
-      fe[3 * l + i] += acc;
-    }
-  }
+  kernel::add_point_forces(R, g, nl, fe);
   return true;
 }
 
