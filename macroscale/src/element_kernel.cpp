@@ -160,8 +160,8 @@ inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in,
 
 /// point_matrix (element_kernel.hpp), compiled into each version below.
 inline __attribute__((always_inline)) void point_matrix_body(const PointState& s, const double* T,
-                                                             double dA, double* H,
-                                                             bool& symmetric) {
+                                                             double dA, double* H, bool& symmetric,
+                                                             bool use_symmetry) {
   const double ij = 1.0 / s.j;
   // Q_alpha e_i: Q1 e_i = e_i x a2, Q2 e_i = a1 x e_i; Pr = I - a3 a3^T; P_alpha = Pr Q_alpha / j,
   // so that a3_,(l,i) = R1_l P1(:, i) + R2_l P2(:, i). Row-major 3 x 3.
@@ -219,9 +219,14 @@ inline __attribute__((always_inline)) void point_matrix_body(const PointState& s
         dmax = std::max(dmax, std::abs(y));
       }
   }
+  bool sym_here = true;
   for (int c = 0; c < 6; ++c)
     for (int r = 0; r < c; ++r)
-      if (std::abs(Dc[r + 6 * c] - Dc[c + 6 * r]) > 1e-12 * dmax) symmetric = false;
+      if (std::abs(Dc[r + 6 * c] - Dc[c + 6 * r]) > 1e-12 * dmax) sym_here = false;
+  if (!sym_here) symmetric = false;
+  // A symmetric section tangent gives a symmetric material part G^T E: its lower triangle
+  // (rows a >= col) computed, the upper mirrored (~40 % of the multiplications of H).
+  const bool lower = use_symmetry && sym_here;
   // E = dA Dc G (6 x 15): columns 0-5 full, column 3f+i of f >= 2 is Dc(:, row f) x G entry.
   double E[15][6];
   for (int col = 0; col < 6; ++col)
@@ -235,18 +240,22 @@ inline __attribute__((always_inline)) void point_matrix_body(const PointState& s
       const double gi = -kScale[f - 2] * s.a3[i];
       for (int r = 0; r < 6; ++r) E[3 * f + i][r] = dA * Dc[r + 6 * kRow[f - 2]] * gi;
     }
-  // Material part H = G^T E (column-major 15 x 15).
+  // Material part H = G^T E (column-major 15 x 15), the lower triangle only if `lower`.
   for (int col = 0; col < 15; ++col) {
     double* Hc = H + 15 * col;
     const double* Ec = E[col];
-    for (int a = 0; a < 6; ++a) {
+    for (int a = lower ? std::min(col, 6) : 0; a < 6; ++a) {
       double acc = 0.0;
       for (int r = 0; r < 6; ++r) acc += G[r][a] * Ec[r];
       Hc[a] = acc;
     }
     for (int f = 2; f < 5; ++f)
-      for (int i = 0; i < 3; ++i) Hc[3 * f + i] = -kScale[f - 2] * s.a3[i] * Ec[kRow[f - 2]];
+      for (int i = 0; i < 3; ++i)
+        if (!lower || 3 * f + i >= col) Hc[3 * f + i] = -kScale[f - 2] * s.a3[i] * Ec[kRow[f - 2]];
   }
+  if (lower)
+    for (int col = 1; col < 15; ++col)
+      for (int a = 0; a < col; ++a) H[a + 15 * col] = H[col + 15 * a];
   // Geometric part: n : eps_,rs + m : kappa_,rs (the variations listed in shell_model.hpp).
   double v[3], w[3];
   const double va3 = bending_vector(s, v, w);
@@ -285,13 +294,13 @@ inline __attribute__((always_inline)) void point_matrix_body(const PointState& s
 
 __attribute__((target("arch=x86-64-v3"))) void point_matrix_v3(const PointState& s, const double* T,
                                                                double dA, double* H,
-                                                               bool& symmetric) {
-  point_matrix_body(s, T, dA, H, symmetric);
+                                                               bool& symmetric, bool use_symmetry) {
+  point_matrix_body(s, T, dA, H, symmetric, use_symmetry);
 }
 
 void point_matrix_default(const PointState& s, const double* T, double dA, double* H,
-                          bool& symmetric) {
-  point_matrix_body(s, T, dA, H, symmetric);
+                          bool& symmetric, bool use_symmetry) {
+  point_matrix_body(s, T, dA, H, symmetric, use_symmetry);
 }
 
 __attribute__((target("arch=x86-64-v3"))) void blocks_v3(const ElementTangentInput& in, double* W,
@@ -301,6 +310,44 @@ __attribute__((target("arch=x86-64-v3"))) void blocks_v3(const ElementTangentInp
 
 void blocks_default(const ElementTangentInput& in, double* W, double* KT) {
   blocks<v2, 2>(in, W, KT);
+}
+
+/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version.
+inline __attribute__((always_inline)) void derivatives_body(const double* R, const double* x,
+                                                            int nl, double* d) {
+  double acc[3][6] = {};
+  for (int l = 0; l < nl; ++l)
+    for (int i = 0; i < 3; ++i)
+      for (int r = 0; r < 6; ++r) acc[i][r] += R[6 * l + r] * x[3 * l + i];
+  for (int i = 0; i < 3; ++i)
+    for (int r = 0; r < 6; ++r) d[6 * i + r] = acc[i][r];
+}
+
+inline __attribute__((always_inline)) void forces_body(const double* R, const double* g, int nl,
+                                                       double* fe) {
+  for (int l = 0; l < nl; ++l) {
+    const double* Phi = R + 6 * l + 1;
+    for (int i = 0; i < 3; ++i) {
+      double acc = 0.0;
+      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
+      fe[3 * l + i] += acc;
+    }
+  }
+}
+
+__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* R, const double* x,
+                                                              int nl, double* d) {
+  derivatives_body(R, x, nl, d);
+}
+void derivatives_default(const double* R, const double* x, int nl, double* d) {
+  derivatives_body(R, x, nl, d);
+}
+__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* R, const double* g, int nl,
+                                                         double* fe) {
+  forces_body(R, g, nl, fe);
+}
+void forces_default(const double* R, const double* g, int nl, double* fe) {
+  forces_body(R, g, nl, fe);
 }
 
 }  // namespace
@@ -323,12 +370,37 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
 }
 
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
-                  Isa isa) {
+                  Isa isa, bool use_symmetry) {
   if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
   if (isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3())
-    point_matrix_v3(s, T, dA, H, symmetric);
+    point_matrix_v3(s, T, dA, H, symmetric, use_symmetry);
   else
-    point_matrix_default(s, T, dA, H, symmetric);
+    point_matrix_default(s, T, dA, H, symmetric, use_symmetry);
+}
+
+}  // namespace knit::macro::kernel
+
+namespace knit::macro::kernel {
+
+namespace {
+bool use_v3(Isa isa) {
+  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
+  return isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3();
+}
+}  // namespace
+
+void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa) {
+  if (use_v3(isa))
+    derivatives_v3(R, x, nl, d);
+  else
+    derivatives_default(R, x, nl, d);
+}
+
+void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa) {
+  if (use_v3(isa))
+    forces_v3(R, g, nl, fe);
+  else
+    forces_default(R, g, nl, fe);
 }
 
 }  // namespace knit::macro::kernel

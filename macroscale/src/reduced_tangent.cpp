@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "knit/macro/thread_pool.hpp"
 #include "sparse_cholmod.hpp"
 
 namespace knit::macro {
@@ -74,6 +75,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
       symmetric_(symmetric),
       sparse_(sparse),
       supernodal_(symmetric && sparse && supernodal && SupernodalCholesky::available()),
+      threads_(m.assembly_threads()),
       f_(std::make_unique<Factors>()) {
   const int ne = m.num_elements();
   const int nd =
@@ -99,7 +101,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
           const int gr = g[size_t(e) * nd + r], gs = g[size_t(e) * nd + s];
           if (wanted(gr, gs)) map_[size_t(e) * block_ + r + size_t(nd) * s] = gr + n_ * gs;
         }
-    compact_map();
+    compact_map(static_cast<long>(n_) * n_);
     return;
   }
   build_pattern(g, nd);
@@ -124,23 +126,40 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
     f_->sparse_lu.analyzePattern(sparse_matrix_);
   else if (!supernodal_)
     analyze_ldlt();
-  compact_map();
+  compact_map(sparse_matrix_.nonZeros());
 }
 
-void ReducedTangent::compact_map() {
+void ReducedTangent::compact_map(long values) {
   const size_t ne = block_ > 0 ? map_.size() / static_cast<size_t>(block_) : 0;
-  scatter_begin_.assign(ne + 1, 0);
+  const int T = std::max(1, threads_);
+  // Cuts of the value range into T parts of about equal numbers of entries.
+  cut_.assign(T + 1, values);
+  cut_[0] = 0;
+  if (T > 1) {
+    std::vector<int> count(values, 0);
+    long total = 0;
+    for (int dst : map_)
+      if (dst >= 0) ++count[dst], ++total;
+    long seen = 0;
+    int t = 1;
+    for (long v = 0; v < values && t < T; ++v) {
+      seen += count[v];
+      while (t < T && seen * T >= total * t) cut_[t++] = v + 1;
+    }
+  }
+  scatter_begin_.assign(ne * T + 1, 0);
   scatter_src_.clear();
   scatter_dst_.clear();
-  for (size_t e = 0; e < ne; ++e) {
-    for (int k = 0; k < block_; ++k) {
-      const int dst = map_[e * block_ + k];
-      if (dst < 0) continue;
-      scatter_src_.push_back(k);
-      scatter_dst_.push_back(dst);
+  for (size_t e = 0; e < ne; ++e)
+    for (int t = 0; t < T; ++t) {
+      for (int k = 0; k < block_; ++k) {
+        const int dst = map_[e * block_ + k];
+        if (dst < cut_[t] || dst >= cut_[t + 1]) continue;  // also dst = -1
+        scatter_src_.push_back(k);
+        scatter_dst_.push_back(dst);
+      }
+      scatter_begin_[e * T + t + 1] = scatter_src_.size();
     }
-    scatter_begin_[e + 1] = scatter_src_.size();
-  }
   std::vector<int>().swap(map_);
 }
 
@@ -203,25 +222,25 @@ long ReducedTangent::stored_entries() const {
   return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
 }
 
-void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const {
-  const size_t ne = std::min(Ke.size(), scatter_begin_.size() - 1);
+void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values, int t) const {
+  const int T = std::max(1, threads_);
+  std::fill(values + cut_[t], values + cut_[t + 1], 0.0);
+  const size_t ne = std::min(Ke.size(), (scatter_begin_.size() - 1) / T);
   const int* src = scatter_src_.data();
   const int* dst = scatter_dst_.data();
   for (size_t e = 0; e < ne; ++e) {
     const double* k = Ke[e].data();
-    for (size_t t = scatter_begin_[e]; t < scatter_begin_[e + 1]; ++t) values[dst[t]] += k[src[t]];
+    for (size_t i = scatter_begin_[e * T + t]; i < scatter_begin_[e * T + t + 1]; ++i)
+      values[dst[i]] += k[src[i]];
   }
 }
 
 void ReducedTangent::assemble(const std::vector<Eigen::MatrixXd>& Ke) {
-  if (sparse_) {
-    double* v = sparse_matrix_.valuePtr();
-    std::fill(v, v + sparse_matrix_.nonZeros(), 0.0);
-    scatter(Ke, v);
-  } else {
-    dense_.setZero();
-    scatter(Ke, dense_.data());
-  }
+  double* v = sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
+  if (threads_ <= 1)
+    scatter(Ke, v, 0);
+  else
+    ThreadPool::shared().run(threads_, [&](int t) { scatter(Ke, v, t); });
 }
 
 Factorization ReducedTangent::factorize() {

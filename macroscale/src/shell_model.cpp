@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "knit/macro/element_kernel.hpp"
+#include "knit/macro/thread_pool.hpp"
 #include "knit/spline/quadrature.hpp"
 
 namespace knit::macro {
@@ -73,6 +74,7 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   }
   material_->bind_points(thetas);
   nqu_ = nqu, nqv_ = nqv;
+  for (const Element& el : elements_) max_points_ = std::max(max_points_, el.num_points);
   factorize_elements(su, sv, gu, gv);
 }
 
@@ -139,21 +141,47 @@ int ShellModel::assembly_threads() const {
   return std::max(1, std::min(n, num_elements()));
 }
 
+/// Workspace of one thread (no allocation in evaluate_range): the element's control point
+/// positions and forces, the point matrices H, and the kernel's W, KT, Y (element_kernel.hpp;
+/// zeroed whenever their layout changes: the kernel reads padding rows it never writes).
+struct ShellModel::Workspace {
+  std::vector<double> xloc, fe, H, W, KT, Y;
+  PointState local;
+  int nl = -1, maxq = -1;
+  bool factorized = false;
+};
+
+ShellModel::Workspace& ShellModel::workspace() const {
+  // Per thread and kept for the life of the thread: the assembly threads are a persistent
+  // pool and the caller's thread lives on, so the next evaluation (of this or another model
+  // of no larger elements) finds its memory mapped already (the design's many small models).
+  thread_local Workspace w;
+  const int nl = nloc_;
+  if (w.nl != nl || w.maxq != max_points_ || w.factorized != factorized_) {
+    const size_t rows = kernel::workspace_rows(nl);
+    w.xloc.assign(3 * nl, 0.0);
+    w.fe.assign(3 * nl, 0.0);
+    w.H.assign(size_t(225) * max_points_, 0.0);
+    w.W.assign(rows * 5 * max_points_, 0.0);
+    w.KT.assign(rows * kernel::padded_functions(nl), 0.0);
+    w.Y.assign(factorized_ ? rows * 5 * nqv_ * (surface_.basis_u().degree() + 1) : 0, 0.0);
+    w.nl = nl, w.maxq = max_points_, w.factorized = factorized_;
+  }
+  return w;
+}
+
 bool ShellModel::run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
                             Evaluation& out) const {
   const int ne = num_elements();
   const int nth = assembly_threads();
-  if (nth == 1) return evaluate_range(0, ne, u, pass, from, out);
+  if (nth == 1) return evaluate_range(0, ne, u, pass, from, out, workspace());
+  // The process-wide pool: threads started once, not per call.
   std::vector<char> oks(nth, 1);
-  std::vector<std::thread> pool;
-  for (int k = 1; k < nth; ++k) {
-    const int e0 = ne * k / nth, e1 = ne * (k + 1) / nth;
-    pool.emplace_back([&, k, e0, e1] { oks[k] = evaluate_range(e0, e1, u, pass, from, out); });
-  }
-  oks[0] = evaluate_range(0, ne / nth, u, pass, from, out);
-  for (auto& th : pool) th.join();
+  ThreadPool::shared().run(nth, [&](int k) {
+    oks[k] = evaluate_range(ne * k / nth, ne * (k + 1) / nth, u, pass, from, out, workspace());
+  });
   bool ok = true;
-  for (char o : oks) ok = ok && o;
+  for (int k = 0; k < nth; ++k) ok = ok && oks[k];
   return ok;
 }
 
@@ -217,14 +245,10 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
   const int nl = nloc_;
   const Point& pt = points_[pid];
   const double* R = R_.data() + static_cast<Eigen::Index>(pid) * nl * 6;  // R[6 l + r]
-  // dx = R xloc as a sum of outer products (contiguous columns of R).
-  double d[3][6] = {};
-  for (int l = 0; l < nl; ++l)
-    for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 6; ++r) d[i][r] += R[6 * l + r] * xloc[3 * l + i];
-  SurfaceDerivs dx;
-  for (int i = 0; i < 3; ++i)
-    for (int r = 0; r < 6; ++r) dx(r, i) = d[i][r];
+  // dx = R xloc as a sum of outer products (contiguous columns of R; element_kernel.cpp, built
+  // for both instruction sets).
+  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r
+  kernel::current_derivatives(R, xloc, nl, dx.data());
   const CurrentPoint c = current_point(dx, pt.ref);
   if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) return false;
   const Eigen::Matrix3d& T = pt.ref.T;
@@ -252,14 +276,7 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
     g[9 + i] = -dA * 2.0 * M(2) * s.a3[i];
     g[12 + i] = -dA * M(1) * s.a3[i];
   }
-  for (int l = 0; l < nl; ++l) {
-    const double* Phi = R + 6 * l + 1;
-    for (int i = 0; i < 3; ++i) {
-      double acc = 0.0;
-      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
-      fe[3 * l + i] += acc;
-    }
-  }
+  kernel::add_point_forces(R, g, nl, fe);
   return true;
 }
 
@@ -269,27 +286,16 @@ void ShellModel::point_matrix(int pid, const PointState& s, double* H, bool& sym
 }
 
 bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass,
-                                const Evaluation* from, Evaluation& out) const {
-  using Mat15 = Eigen::Matrix<double, 15, 15>;
+                                const Evaluation* from, Evaluation& out, Workspace& ws) const {
   const Eigen::MatrixXd& P = surface_.control_points();
   const int nl = nloc_;
   const bool tangent = pass == Pass::kTangent || pass == Pass::kTangentFromStates;
   const bool stored = pass == Pass::kTangentFromStates;
-  int maxq = 0;
-  for (int e = e0; e < e1; ++e) maxq = std::max(maxq, elements_[e].num_points);
-  // Workspace (allocated once per call and thread, never inside the point loop).
-  std::vector<double> xloc(3 * nl), fe(3 * nl);
-  std::vector<Mat15, Eigen::aligned_allocator<Mat15>> Hs(tangent ? maxq : 0);
-  // W: the 9 products (H_q Phi)^T of the component pairs (i, j) stacked; KT = W Phi
-  // (element_kernel.hpp). Zeroed once: the kernel reads padding rows it never writes.
-  Eigen::MatrixXd W, KT, Y;
-  if (tangent) {
-    W.setZero(kernel::workspace_rows(nl), 5 * maxq);
-    KT.setZero(kernel::workspace_rows(nl), kernel::padded_functions(nl));
-    if (factorized_)
-      Y.setZero(kernel::workspace_rows(nl), 5 * nqv_ * (surface_.basis_u().degree() + 1));
-  }
-  PointState local;
+  // The thread's workspace (Workspace: sized once per model, never allocated here).
+  std::vector<double>& xloc = ws.xloc;
+  std::vector<double>& fe = ws.fe;
+  double* Hs = ws.H.data();
+  PointState& local = ws.local;
   for (int e = e0; e < e1; ++e) {
     const Element& el = elements_[e];
     bool symmetric = true;
@@ -304,14 +310,14 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
         const int pid = el.first_point + q;
         PointState& s = pass == Pass::kResidualKeep ? out.points[pid] : local;
         if (!residual_point(pid, xloc.data(), s, energy, fe.data())) return false;
-        if (tangent) point_matrix(pid, s, Hs[q].data(), symmetric);
+        if (tangent) point_matrix(pid, s, Hs + 225 * q, symmetric);
       }
       std::copy(fe.begin(), fe.end(), out.fe.col(e).data());
       out.element_energy(e) = energy;
     } else {
       for (int q = 0; q < el.num_points; ++q) {
         const int pid = el.first_point + q;
-        point_matrix(pid, from->points[pid], Hs[q].data(), symmetric);
+        point_matrix(pid, from->points[pid], Hs + 225 * q, symmetric);
       }
     }
     if (!tangent) continue;
@@ -337,7 +343,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
     kin.nl = nl;
     kin.nq = el.num_points;
     kin.PhiT = el.PhiT.data();
-    kin.H = Hs[0].data();
+    kin.H = Hs;
     kin.pairs = pairs;
     kin.pi = pi;
     kin.pj = pj;
@@ -349,14 +355,14 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
       kin.nv = surface_.basis_v().degree() + 1;
       kin.nqu = nqu_;
       kin.nqv = nqv_;
-      kin.Y = Y.data();
+      kin.Y = ws.Y.data();
     }
-    kernel::element_tangent_blocks(kin, W.data(), KT.data());
+    kernel::element_tangent_blocks(kin, ws.W.data(), ws.KT.data());
     Eigen::MatrixXd& Ke = out.Ke[e];
     // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)
     // and, for a symmetric law, the mirror Ke(3 m + j, 3 l + i) likewise.
-    const Eigen::Index ldw = KT.rows();
-    const double* kt = KT.data();
+    const Eigen::Index ldw = kernel::workspace_rows(nl);
+    const double* kt = ws.KT.data();
     for (int p = 0; p < pairs; ++p) {
       const int i = pi[p], j = pj[p];
       const bool tri = p >= full;  // symmetric diagonal block from its lower triangle

@@ -9,7 +9,7 @@
 #    iteration split into assembly and solve, as wall and as CPU time (on a loaded machine
 #    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT
 #    instead of CHOLMOD's supernodal Cholesky.
-# Figures of 30 Nov 2026: docs/solver.md "Benchmark". A solver change must leave the results
+# Figures of 30 Nov 2026: docs/solver.md "Benchmark" (rounds 1-3). A solver change must leave the results
 # unchanged: run the same case before and after and compare the two results.h5 with
 # scripts/bench/compare_results.py (1e-8 relative).
 # Usage: scripts/bench/solver.sh [BUILD_DIR] [CATCH_TEST_NAME_FILTER]
@@ -20,4 +20,8 @@ if [[ ! -x "$exe" ]]; then
   echo "solver bench: $exe not found (build test_macro first)" >&2
   exit 1
 fi
+# The machine is shared: the load average beside the figures (the CPU times of the one-thread
+# runs are the costs; wall times, and the two-thread gain, only mean something when idle).
+echo "solver start $(date -u +%H:%M:%S) UTC, load average $(cut -d' ' -f1-3 /proc/loadavg)"
 "$exe" "${2:-[.bench_solver]}" | grep '^solver'
+echo "solver end $(date -u +%H:%M:%S) UTC, load average $(cut -d' ' -f1-3 /proc/loadavg)"

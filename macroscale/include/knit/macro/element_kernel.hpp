@@ -98,8 +98,19 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
 /// The 15 x 15 matrix H of one quadrature point (shell_model.hpp; column-major) from its
 /// state, T the covariant-to-Cartesian Voigt map (column-major 3 x 3) and dA the weighted
 /// area element; clears `symmetric` if the section tangent is not symmetric. Raw arrays,
-/// compiled for both instruction sets like the kernel.
+/// compiled for both instruction sets like the kernel. `use_symmetry` (default): where the
+/// section tangent is symmetric, H's material part is computed below its diagonal and
+/// mirrored (equal to the full product to round-off; false: the full product, the reference).
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
-                  Isa isa = Isa::kAuto);
+                  Isa isa = Isa::kAuto, bool use_symmetry = true);
+
+/// The residual's two loops over the element's functions at one point, compiled for both
+/// instruction sets like the kernel (the rest of shell_model.cpp is built for the default
+/// x86-64): R holds the nl functions' (R, R_1, R_2, R_11, R_12, R_22) at R[6 l + r].
+///   current_derivatives: d[6 i + r] = sum_l R[6 l + r] x[3 l + i]   (dx = R x, column-major
+///                        6 x 3)
+///   add_point_forces:    fe[3 l + i] += sum_f R[6 l + 1 + f] g[3 f + i]   (f = 0..4)
+void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa = Isa::kAuto);
+void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa = Isa::kAuto);
 
 }  // namespace knit::macro::kernel

@@ -76,8 +76,13 @@ class ReducedTangent {
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
   long stored_entries() const;
 
-  /// Scatters the element tangents into the reduced matrix (values reset first).
+  /// Scatters the element tangents into the reduced matrix (values reset first), on the
+  /// model's assembly threads (ShellModel::assembly_threads() when this was built): each
+  /// thread owns a contiguous range of the values, and every value is summed in element
+  /// order, so the matrix is bitwise the same for any number of threads.
   void assemble(const std::vector<Eigen::MatrixXd>& Ke);
+  /// Threads of assemble().
+  int scatter_threads() const { return threads_; }
   /// Numeric factorization of the assembled matrix (the symbolic analysis is reused).
   Factorization factorize();
   /// Solves with the last successful factorization.
@@ -86,9 +91,10 @@ class ReducedTangent {
   Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
 
  private:
-  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k (the
-  /// compacted map, scatter_*): the one scatter of the dense and sparse paths.
-  void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values) const;
+  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k with the
+  /// value in part t's range [cut_[t], cut_[t + 1]) (the compacted map, scatter_*), after
+  /// zeroing that range: the one scatter of the dense and sparse paths, part t on thread t.
+  void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values, int t) const;
 
   void analyze_ldlt();  ///< symbolic analysis of the SimplicialLDLT (once, when first needed)
   /// The compressed-column pattern of the reduced matrix and the scatter map, from the
@@ -101,12 +107,17 @@ class ReducedTangent {
   bool symmetric_ = false, sparse_ = false, supernodal_ = false;
   int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
   std::vector<int> map_;  ///< block_ entries per element: value index or -1 (construction only)
-  /// The scatter map without its -1 entries (half of them on the symmetric path): element e's
-  /// entries t in [scatter_begin_[e], scatter_begin_[e + 1]) add Ke[e].data()[scatter_src_[t]]
-  /// to values[scatter_dst_[t]].
+  /// The scatter map without its -1 entries (half of them on the symmetric path), split into
+  /// threads_ parts by value index: the entries i in [scatter_begin_[e threads_ + t],
+  /// scatter_begin_[e threads_ + t + 1]) of element e and part t add Ke[e].data()[scatter_src_[i]]
+  /// to values[scatter_dst_[i]]; part t's values are [cut_[t], cut_[t + 1]) (equal shares of
+  /// the entries).
   std::vector<size_t> scatter_begin_;
   std::vector<int> scatter_src_, scatter_dst_;
-  void compact_map();  ///< map_ -> scatter_* (then frees map_)
+  std::vector<long> cut_;
+  int threads_ = 1;
+  /// map_ -> scatter_* in `threads` parts of the `values` values (then frees map_).
+  void compact_map(long values);
   /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;

@@ -103,7 +103,9 @@ class ShellModel {
   };
   /// Internal forces and energy at displacement u (num_dofs), with the element tangents if
   /// `tangent`. Element results are summed in element order, so the result is bitwise the
-  /// same for any number of threads.
+  /// same for any number of threads. The workspaces are per thread and kept (no allocation
+  /// after the first call), the assembly threads are a process-wide pool (ThreadPool::shared():
+  /// concurrent evaluations of several models take turns on it).
   /// `keep_points` (without `tangent`): also keep the PointStates for tangent_from.
   void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
                 bool keep_points = false) const;
@@ -146,8 +148,12 @@ class ShellModel {
   void factorize_elements(const std::vector<std::pair<double, double>>& su,
                           const std::vector<std::pair<double, double>>& sv,
                           const spline::QuadratureRule& gu, const spline::QuadratureRule& gv);
+  /// Workspace of evaluate_range, one per thread (thread_local: kept across calls and models).
+  struct Workspace;
+  /// The calling thread's workspace, sized (and zeroed) for this model when it does not fit.
+  Workspace& workspace() const;
   bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                      Evaluation& out) const;
+                      Evaluation& out, Workspace& ws) const;
   /// Residual part at one point: the point state, dA psi, and the element force
   /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
   /// configuration degenerated there.
@@ -171,6 +177,7 @@ class ShellModel {
   /// numerically) and small enough for the sum-factorized kernel.
   bool factorized_ = false;
   int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
+  int max_points_ = 0;     ///< quadrature points of the largest element
 };
 
 }  // namespace knit::macro
