@@ -104,7 +104,6 @@ $(OUT)/cells/%/cell.json: $(MESO)
 	@"$(MESO)" cell --loop-length $* --out $(OUT)/cells/$* > $(LOGS)/cell_$*.log 2>&1
 
 # ---- figures ----------------------------------------------------------------------------------
-PLOT := $(PY) $(FIGPY)/plots.py --results $(RES)
 FIGURES :=
 # $(call draw,COMMAND,OUT.png): a figure script that fails does not stop the pipeline: the
 # error goes to logs/figures/NAME.log and the PNG says the figure is missing; the placeholder is
@@ -114,22 +113,38 @@ draw = mkdir -p $(FIG) $(LOGS)/figures; $(1) > $(LOGS)/figures/$(notdir $(basena
   $(PY) $(FIGPY)/plots.py --results $(RES) placeholder --title "$(notdir $(2))" --message "the figure script failed (logs/figures)" --out $(2) \
   && touch -d @0 $(2); }
 
+# The figures of knit-macro's results (plots.py deformed / fields / load) are drawn in two
+# batches, one Python process each (scripts/figures/batch.py: the imports of matplotlib and
+# numpy cost more than most figures; docs/build.md): PLOT_A (the deformed shapes) and PLOT_B
+# (fields and load curves) side by side with -j2. A batch is redrawn as a whole when one of its
+# inputs changes; a failed figure becomes a placeholder as above.
+PLOT_A_FIGS :=
+PLOT_A_DEPS :=
+PLOT_A_JOBS :=
+PLOT_B_FIGS :=
+PLOT_B_DEPS :=
+PLOT_B_JOBS :=
+PLOTJOB = '$(FIG)/$(1).png $(FIGPY)/plots.py --results $(RES) $(2)'
+
 define deformed # name, case, field, step-strain (or "last"), title
 FIGURES += $(FIG)/$(1).png
-$(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@$$(call draw,$(PLOT) deformed --case $(2) --field $(3) --at $(4) --title "$(5)" --out $$@,$$@)
+PLOT_A_FIGS += $(FIG)/$(1).png
+PLOT_A_DEPS += $(call st,$(2))
+PLOT_A_JOBS += $(call PLOTJOB,$(1),deformed --case $(2) --field $(3) --at $(4) --title "$(5)")
 endef
 
 define fields # name, case, title
 FIGURES += $(FIG)/$(1).png
-$(FIG)/$(1).png: $(call st,$(2)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@$$(call draw,$(PLOT) fields --case $(2) --title "$(3)" --out $$@,$$@)
+PLOT_B_FIGS += $(FIG)/$(1).png
+PLOT_B_DEPS += $(call st,$(2))
+PLOT_B_JOBS += $(call PLOTJOB,$(1),fields --case $(2) --title "$(3)")
 endef
 
 define load # name, title, cases...
 FIGURES += $(FIG)/$(1).png
-$(FIG)/$(1).png: $(call st,$(3)) $(FIGPY)/plots.py $(FIGPY)/results.py
-	@$$(call draw,$(PLOT) load --title "$(2)" --out $$@ $(3),$$@)
+PLOT_B_FIGS += $(FIG)/$(1).png
+PLOT_B_DEPS += $(call st,$(3))
+PLOT_B_JOBS += $(call PLOTJOB,$(1),load --title "$(2)" $(3))
 endef
 
 # Fig. 5: unit cells (needs `knit-meso cell`).
@@ -139,15 +154,15 @@ $(FIG)/fig05_cells.png: $(OUT)/cells/4.5/cell.json $(OUT)/cells/6.5/cell.json $(
 	@$(call draw,$(PY) $(FIGPY)/cells.py --out $@ $(OUT)/cells/4.5 $(OUT)/cells/6.5,$@)
 endif
 
-# Fig. 6: response surfaces at 6.5 mm with the data points.
-FIGURES += $(FIG)/fig06_response_surfaces.png
-$(FIG)/fig06_response_surfaces.png: $(DB) $(FIGPY)/surfaces.py
-	@$(call draw,$(PY) $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5 --out $@,$@)
-
-# Beside Fig. 6: the energy-based law (W, S11, S22 at 6.5 mm with the data; issue 11).
-FIGURES += $(FIG)/fig06e_energy_law.png
-$(FIG)/fig06e_energy_law.png: $(DB) $(FIGPY)/energy_law.py $(FIGPY)/surfaces.py
-	@$(call draw,$(PY) $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5 --out $@,$@)
+# Fig. 6: response surfaces at 6.5 mm with the data points, and beside it the energy-based law
+# (W, S11, S22 at 6.5 mm with the data; issue 11): one batch (scripts/figures/batch.py).
+DB_FIGS := $(FIG)/fig06_response_surfaces.png $(FIG)/fig06e_energy_law.png
+FIGURES += $(DB_FIGS)
+$(DB_FIGS) &: $(DB) $(FIGPY)/surfaces.py $(FIGPY)/energy_law.py $(FIGPY)/batch.py
+	@mkdir -p $(FIG) $(LOGS)/figures
+	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures \
+	  '$(FIG)/fig06_response_surfaces.png $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5' \
+	  '$(FIG)/fig06e_energy_law.png $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5'
 
 # Sect. 3.1.2 (Fig. 7)
 $(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22)))
@@ -188,6 +203,15 @@ $(eval $(call fields,fig16b_hypar_fields,s323_hypar_tension,Fig. 16b: stitch val
 $(eval $(call deformed,fig16c_hypar_tension_E12,s323_hypar_tension,E12,last,Fig. 16c: diagonal tension ~21 % (E12)))
 $(eval $(call deformed,fig16d_hypar_compression_E12,s323_hypar_compression,E12,last,Fig. 16d: diagonal compression ~14 % (E12)))
 
+# The two batches of plots.py figures (grouped targets: one recipe draws all of a batch).
+PLOT_SCRIPTS := $(FIGPY)/plots.py $(FIGPY)/results.py $(FIGPY)/batch.py
+$(PLOT_A_FIGS) &: $(sort $(PLOT_A_DEPS)) $(PLOT_SCRIPTS)
+	@mkdir -p $(FIG) $(LOGS)/figures
+	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures $(PLOT_A_JOBS)
+$(PLOT_B_FIGS) &: $(sort $(PLOT_B_DEPS)) $(PLOT_SCRIPTS)
+	@mkdir -p $(FIG) $(LOGS)/figures
+	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures $(PLOT_B_JOBS)
+
 # Sensitivity (issue #12): only when the calibration study has written its table.
 ifneq ($(wildcard $(SENSITIVITY)),)
 FIGURES += $(FIG)/sensitivity.png
@@ -207,8 +231,6 @@ $(OUT)/knitmap/%/summary.txt: $(OUT)/cases/%.json $(DB) $(MACRO)
 	@mkdir -p $(OUT)/knitmap $(LOGS)
 	@"$(MACRO)" knitmap $< --output $(OUT)/knitmap/$* > $(LOGS)/knitmap_$*.log 2>&1 \
 	  || { echo "knitmap: $* failed, see $(LOGS)/knitmap_$*.log"; exit 1; }
-$(FIG)/knitmap_%.png: $(OUT)/knitmap/%/summary.txt $(FIGPY)/knitmap.py
-	@$(call draw,$(PY) $(FIGPY)/knitmap.py $(OUT)/knitmap/$* --title "knitting map: $*" --out $@,$@)
 .PHONY: knitmaps
 knitmaps: $(KNITMAP_SUMMARIES) $(KNITMAP_FIGURES)
 
@@ -235,8 +257,16 @@ $(OUT)/design/%.status: $(DESIGN_INPUTS) $(DB) $(MACRO)
 	echo "{\"design\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
 	if [ $$rc -ne 0 ]; then echo "design: $* exited with $$rc (see $(LOGS)/design_$*.log)"; fi
 DESIGN_FIG_ARGS_graded_wale := --section E22
-$(FIG)/design_%.png: $(OUT)/design/%.status $(FIGPY)/design.py
-	@$(call draw,$(PY) $(FIGPY)/design.py $(OUT)/design/$* $(DESIGN_FIG_ARGS_$*) --title "design: $*" --out $@,$@)
+# The design figures, and the knitting-map figures (`knitmaps`, not part of `all`): one batch
+# each (scripts/figures/batch.py, as the plots above).
+DESIGN_JOB = '$(FIG)/design_$(1).png $(FIGPY)/design.py $(OUT)/design/$(1) $(DESIGN_FIG_ARGS_$(1)) --title "design: $(1)"'
+KNITMAP_JOB = '$(FIG)/knitmap_$(1).png $(FIGPY)/knitmap.py $(OUT)/knitmap/$(1) --title "knitting map: $(1)"'
+$(DESIGN_FIGURES) &: $(DESIGN_STATUS) $(FIGPY)/design.py $(FIGPY)/batch.py
+	@mkdir -p $(FIG) $(LOGS)/figures
+	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures $(foreach d,$(DESIGNS),$(call DESIGN_JOB,$(d)))
+$(KNITMAP_FIGURES) &: $(KNITMAP_SUMMARIES) $(FIGPY)/knitmap.py $(FIGPY)/batch.py
+	@mkdir -p $(FIG) $(LOGS)/figures
+	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures $(foreach k,$(KNITMAPS),$(call KNITMAP_JOB,$(k)))
 .PHONY: designs
 designs: $(DESIGN_STATUS) $(DESIGN_FIGURES)
 # The resolved inputs are kept (not intermediates): a second run does nothing.

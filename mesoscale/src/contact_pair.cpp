@@ -5,7 +5,53 @@
 #include <algorithm>
 #include <cmath>
 
+#include "knit/spline/basis.hpp"
+
 namespace knit::meso::contact {
+
+namespace {
+
+/// y = sum_j N(i, j) Q(j, :) for one row i of N, summed in the order of Eigen's row-major GEMV
+/// kernel with 2-wide packets (SSE2, the build's x86-64 target), which the former expression
+/// `(N.row(i) * Q).transpose()` called: even and odd j in two lanes, the lanes added, then the
+/// odd tail. Bit for bit the same numbers, without the kernel's call and copy overhead for
+/// these 1 x (p+1) x 3 products (a third of the closest-point search's time).
+template <class NMat, class QBlock>
+Eigen::Vector3d row_times(const NMat& N, int i, const QBlock& Q) {
+  const int n = static_cast<int>(Q.rows());
+  Eigen::Vector3d y;
+  for (int c = 0; c < 3; ++c) {
+    double s0 = 0.0, s1 = 0.0;
+    int j = 0;
+    for (; j + 2 <= n; j += 2) {
+      s0 = s0 + N(i, j) * Q(j, c);
+      s1 = s1 + N(i, j + 1) * Q(j + 1, c);
+    }
+    double cc = s0 + s1;
+    for (; j < n; ++j) cc += N(i, j) * Q(j, c);
+    y(c) = 0.0 + cc;
+  }
+  return y;
+}
+
+// The chain at u in copy k: N (3 x (p+1): N, N_u, N_uu) and x, x_u, x_uu. N is a dynamic-size
+// matrix or a Map of one over caller storage (project() evaluates into a stack buffer: no heap
+// allocation per Newton step of the closest-point search).
+template <class NMat>
+int eval_chain_at(const Chain& c, double u, int k, NMat& N, Eigen::Vector3d& x,
+                  Eigen::Vector3d& x_u, Eigen::Vector3d& x_uu) {
+  const int p = c.basis->degree();
+  const double ut = std::clamp(u - k, c.basis->lo(), c.basis->hi());
+  const int first = c.basis->eval(ut, std::min(2, p), N.topRows(std::min(2, p) + 1));
+  if (p < 2) N.row(2).setZero();
+  const auto Q = c.Q->middleRows(first, p + 1);
+  x = row_times(N, 0, Q) + k * c.a1 + c.t;
+  x_u = row_times(N, 1, Q);
+  x_uu = row_times(N, 2, Q);
+  return first;
+}
+
+}  // namespace
 
 ChainPoint eval_chain(const Chain& c, double u, int k) {
   const int p = c.basis->degree();
@@ -13,13 +59,7 @@ ChainPoint eval_chain(const Chain& c, double u, int k) {
   cp.u = u;
   cp.k = k;
   cp.N.resize(3, p + 1);
-  const double ut = std::clamp(u - k, c.basis->lo(), c.basis->hi());
-  cp.first = c.basis->eval(ut, std::min(2, p), cp.N.topRows(std::min(2, p) + 1));
-  if (p < 2) cp.N.row(2).setZero();
-  const auto Q = c.Q->middleRows(cp.first, p + 1);
-  cp.x = (cp.N.row(0) * Q).transpose() + k * c.a1 + c.t;
-  cp.x_u = (cp.N.row(1) * Q).transpose();
-  cp.x_uu = (cp.N.row(2) * Q).transpose();
+  cp.first = eval_chain_at(c, u, k, cp.N, cp.x, cp.x_u, cp.x_uu);
   return cp;
 }
 
@@ -28,9 +68,12 @@ Projection project(const Chain& c, const Eigen::Vector3d& xs, int k, double lo, 
   Projection pr;
   pr.k = k;
   double u = std::clamp(u0, lo, hi);
+  double buf[3 * (spline::kMaxDegree + 1)];
+  Eigen::Map<Eigen::MatrixXd> N(buf, 3, c.basis->degree() + 1);
+  ChainPoint cp;  // x, x_u, x_uu only (N lives in buf)
   for (int it = 0; it < 30; ++it) {
     pr.iterations = it + 1;
-    const ChainPoint cp = eval_chain(c, u, k);
+    eval_chain_at(c, u, k, N, cp.x, cp.x_u, cp.x_uu);
     const Eigen::Vector3d r = xs - cp.x;
     const double phi = r.dot(cp.x_u);
     const double phiu = -cp.x_u.squaredNorm() + r.dot(cp.x_uu);
@@ -43,7 +86,7 @@ Projection project(const Chain& c, const Eigen::Vector3d& xs, int k, double lo, 
     u = un;
     if (step < 1e-14 * std::max(1.0, std::abs(u))) break;
   }
-  const ChainPoint cp = eval_chain(c, u, k);
+  eval_chain_at(c, u, k, N, cp.x, cp.x_u, cp.x_uu);
   const Eigen::Vector3d r = xs - cp.x;
   pr.u = u;
   pr.distance = r.norm();

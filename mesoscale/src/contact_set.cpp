@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "knit/spline/knot_vector.hpp"
 #include "knit/spline/quadrature.hpp"
@@ -93,6 +94,26 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) cons
   return out;
 }
 
+namespace {
+bool same_bits(const double* a, const double* b, Eigen::Index n) {
+  return std::memcmp(a, b, static_cast<std::size_t>(n) * sizeof(double)) == 0;
+}
+}  // namespace
+
+const std::vector<ContactSet::Found>& ContactSet::found(const Eigen::MatrixXd& Q) {
+  SearchCache& c = search_cache_;
+  if (c.valid && c.Q.rows() == Q.rows() && c.Q.cols() == Q.cols() &&
+      same_bits(c.Q.data(), Q.data(), Q.size()) && same_bits(c.a1.data(), a1_.data(), 3) &&
+      same_bits(c.a2.data(), a2_.data(), 3))
+    return c.found;
+  c.found = search(Q);
+  c.Q = Q;
+  c.a1 = a1_;
+  c.a2 = a2_;
+  c.valid = true;
+  return c.found;
+}
+
 double ContactSet::anchor_for(const Found& f) {
   const int key = 3 * f.point + f.course + 1;
   double* best = nullptr;
@@ -131,7 +152,7 @@ int ContactSet::capture_reference(const rod::RodSystem& sys, const Eigen::Vector
   reference_.assign(reference_.size(), {});
   if (opt_.reference != ContactOptions::Reference::kInitialOverlap) return 0;
   int n = 0;
-  for (const Found& f : search(positions(sys, x)))
+  for (const Found& f : found(positions(sys, x)))
     if (f.pr.distance < opt_.d) {
       reference_[3 * f.point + f.course + 1].emplace_back(f.pr.u, f.pr.distance - opt_.d);
       ++n;
@@ -151,7 +172,7 @@ void ContactSet::visit(const rod::RodSystem& sys, const Eigen::VectorXd& x, bool
   const Eigen::MatrixXd Q = positions(sys, x);
   PenaltyLaw law = opt_.penalty;
   law.k_N *= scale_;
-  for (const Found& f : search(Q)) {
+  for (const Found& f : found(Q)) {
     const Chain ch = chain(Q, f.course);
     const int p = basis_.degree();
     const Eigen::Vector3d xs =
@@ -257,7 +278,7 @@ void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   history_ = std::move(next);
   pending_.assign(history_.size(), {});
   // The references follow their pairs (sliding); open pairs keep their last u_r.
-  for (const Found& f : search(positions(sys, x)))
+  for (const Found& f : found(positions(sys, x)))
     if (f.pr.distance < opt_.d)
       if (Eigen::Vector2d* ref = reference_for(f)) (*ref)(0) = f.pr.u;
   last_dissipation_ = D;

@@ -128,6 +128,10 @@ class ContactSet : public rod::ExternalContribution {
     Projection pr;
   };
   std::vector<Found> search(const Eigen::MatrixXd& Q) const;
+  /// search(Q) at the current periods, remembered for the last (Q, a1, a2): a converged state
+  /// is searched by the Newton's last residual, commit() (twice) and homogenization
+  /// (active_pairs()); the search is a pure function of them, so the result is reused.
+  const std::vector<Found>& found(const Eigen::MatrixXd& Q);
   Chain chain(const Eigen::MatrixXd& Q, int course) const;
   double anchor_for(const Found& f);
   /// The reference (u_r, g_r) matched by f, or nullptr.
@@ -151,6 +155,12 @@ class ContactSet : public rod::ExternalContribution {
   // reference_[slave*3 + course+1]: (u_r, g_r) of the stress-free reference pairs
   std::vector<std::vector<Eigen::Vector2d>> reference_;
   double dissipation_ = 0, last_dissipation_ = 0;
+  struct SearchCache {
+    bool valid = false;
+    Eigen::MatrixXd Q;
+    Eigen::Vector3d a1, a2;
+    std::vector<Found> found;
+  } search_cache_;
 };
 
 }  // namespace knit::meso::contact
