@@ -217,6 +217,8 @@ void KnitMaterial::reset_stats() {
   for (auto& c : counts_) c = 0;
   outside_box_ = 0;
   failed_ = 0;
+  audit_evaluations_ = 0;
+  audit_outside_ = 0;
   for (int k = 0; k < 3; ++k) {
     visited_[k] = std::numeric_limits<double>::infinity();
     visited_[k + 3] = -std::numeric_limits<double>::infinity();

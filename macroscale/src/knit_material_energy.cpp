@@ -97,9 +97,14 @@ MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,
     atomic_min(visited_[k], Ehat(k));
     atomic_max(visited_[k + 3], Ehat(k));
   }
-  if (!law.inside_box(Ehat)) {
+  const bool inside = law.inside_box(Ehat);
+  if (!inside) {
     outside_box_.fetch_add(1, std::memory_order_relaxed);
     record(theta, Ehat, 1);
+  }
+  if (audit_.load(std::memory_order_relaxed)) {
+    audit_evaluations_.fetch_add(1, std::memory_order_relaxed);
+    if (!inside) audit_outside_.fetch_add(1, std::memory_order_relaxed);
   }
   const material::EnergyResponse r = law.evaluate(Ehat);
   out.W = r.W;
@@ -134,6 +139,13 @@ std::string KnitMaterial::energy_report() const {
      << "], E22 [" << box.box_min(1) << ", " << box.box_max(1) << "], 2E12 [" << box.box_min(2)
      << ", " << box.box_max(2) << "])";
   if (s.failed) os << "; " << s.failed << " failed (non-finite strain)";
+  // Newton's trial iterates may wander far outside the box before the line search rejects
+  // them; the converged states are what the fabric reaches.
+  if (const long n = audit_evaluations_.load(); n > 0) {
+    const long k = audit_outside_.load();
+    os << "\n  at converged states: " << k << " of " << n << " evaluations extrapolated ("
+       << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)";
+  }
   os << "\n  visited material-frame strain box: E11 [" << s.visited_min(0) << ", "
      << s.visited_max(0) << "], E22 [" << s.visited_min(1) << ", " << s.visited_max(1)
      << "], 2E12 [" << s.visited_min(2) << ", " << s.visited_max(2) << "]";

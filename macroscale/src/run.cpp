@@ -114,7 +114,13 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
                                     : corner_region(c.surface, r.corner, r.radius));
   int outputs = 0;
   Eigen::VectorXd last_written;
+  ShellModel::Evaluation audit;
   res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
+    // Where the converged state lies in the material's data (one residual pass per step).
+    if (c.material->begin_converged_audit()) {
+      m.evaluate(s.u, false, audit);
+      c.material->end_converged_audit();
+    }
     StepRow row;
     row.step = s.step;
     row.lambda = s.lambda;

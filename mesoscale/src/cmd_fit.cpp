@@ -30,8 +30,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
           ->check(CLI::IsMember({"energy", "paper", "both"}));
       sub.add_option("--options", o->options,
                      "paper-law fit options (JSON file; defaults otherwise)");
-      sub.add_option("--energy-options", o->energy_options,
-                     "energy-law fit options (JSON file; defaults otherwise)");
+      sub.add_option(
+          "--energy-options", o->energy_options,
+          "energy-law fit options (JSON file; defaults otherwise: the input-convex network family, "
+          "docs/database.md; {\"family\": \"ridge\"} for the ridge-spline law)");
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       return [o]() -> int {
         using namespace knit::meso::fit;

@@ -97,12 +97,22 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   const std::string rep = m.report();
   CHECK_THAT(rep, Catch::Contains("1 extrapolated") &&
                       Catch::Contains("visited material-frame strain box: E11 [-0.2, 0.6]"));
+  CHECK_THAT(rep, !Catch::Contains("at converged states"));  // no audit yet
+  // The converged-state audit counts only what is evaluated between begin and end.
+  REQUIRE(m.begin_converged_audit());
+  m.evaluate({0.7, 0.0, 0.0}, p);  // extrapolated
+  m.evaluate({0.1, 0.1, 0.0}, p);
+  m.end_converged_audit();
+  m.evaluate({0.8, 0.0, 0.0}, p);  // after the audit: counted in the totals only
+  CHECK(m.energy_stats().outside_box == 3);
+  CHECK_THAT(m.report(), Catch::Contains("at converged states: 1 of 2 evaluations extrapolated"));
   CHECK(m.failed_evaluations() == 0);
   const auto bad = m.evaluate({NAN, 0.0, 0.0}, p);
   CHECK(m.failed_evaluations() == 1);
   CHECK(bad.S.allFinite());
   m.reset_stats();
   CHECK(m.energy_stats().evaluations == 0);
+  CHECK_THAT(m.report(), !Catch::Contains("at converged states"));
 }
 
 namespace {

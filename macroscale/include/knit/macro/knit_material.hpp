@@ -102,6 +102,13 @@ class KnitMaterial : public Material {
   std::vector<std::pair<std::string, double>> output_fields(
       const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const override;
   std::string report() const override;
+  /// Energy law only: counts the evaluations between begin and end apart (see Material).
+  bool begin_converged_audit() const override {
+    if (!energy_) return false;
+    audit_.store(true);
+    return true;
+  }
+  void end_converged_audit() const override { audit_.store(false); }
 
   double stitch_value(const Eigen::Vector2d& theta) const;
   double knitting_angle(const Eigen::Vector2d& theta) const;
@@ -164,6 +171,9 @@ class KnitMaterial : public Material {
   /// Laws built with their l-derivative (dS_dl() only; the runs do not pay for it).
   mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_dl_cache_;
   mutable std::atomic<long> outside_box_{0}, failed_{0};
+  /// The converged-state audit (energy law): on/off, evaluations and extrapolated ones.
+  mutable std::atomic<bool> audit_{false};
+  mutable std::atomic<long> audit_evaluations_{0}, audit_outside_{0};
   /// Visited box: min of (E11, E22, 2E12) in [0..2], max in [3..5].
   mutable std::array<std::atomic<double>, 6> visited_;
   spline::SplineSurface l_field_, a_field_;

@@ -76,6 +76,13 @@ class Material {
   /// A human-readable summary for the end of a run (e.g. how often and where a response
   /// surface was extrapolated). Empty by default.
   virtual std::string report() const { return {}; }
+
+  /// Converged-state audit: between begin (returning true if the material counts anything)
+  /// and end, evaluations are also counted apart, so that the report can say where the
+  /// CONVERGED states lie, not only where Newton's trial iterates went. The run evaluates the
+  /// residual once more at each converged step inside the audit (run.cpp).
+  virtual bool begin_converged_audit() const { return false; }
+  virtual void end_converged_audit() const {}
 };
 
 }  // namespace knit::macro
