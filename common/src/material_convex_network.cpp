@@ -175,18 +175,10 @@ namespace {
 using ArrayMap = Eigen::Map<Eigen::ArrayXd>;
 using ConstArrayMap = Eigen::Map<const Eigen::ArrayXd>;
 
-/// The activation on a whole layer: the pieces of network_activation in branch-free form (the
-/// compiler vectorizes it), exactly 0 for x <= -1; equal to network_activation to round-off.
+/// The activation on a whole layer (network_activation per unit: one formula for both paths;
+/// a branch-free copy of it measured no faster).
 inline void activation_layer(const ArrayMap& x, ArrayMap& s, ArrayMap& ds, ArrayMap& dds) {
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    const double xi = x(i), xc = std::min(std::max(xi, -1.0), 1.0), x2 = xc * xc;
-    const bool dead = xi <= -1.0;
-    s(i) =
-        dead ? 0.0
-             : 0.75 * (0.5 * x2 - x2 * x2 / 12.0) + 0.5 * xc + 3.0 / 16.0 + std::max(xi - 1.0, 0.0);
-    ds(i) = dead ? 0.0 : 0.75 * (xc - x2 * xc / 3.0) + 0.5;
-    dds(i) = 0.75 * (1.0 - x2);
-  }
+  for (Eigen::Index i = 0; i < x.size(); ++i) network_activation(x(i), s(i), ds(i), dds(i));
 }
 
 }  // namespace

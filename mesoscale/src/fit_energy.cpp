@@ -157,12 +157,8 @@ EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int 
 EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
                                  const std::vector<double>& ls, const std::vector<Point>& pts,
                                  double sS, double sE, int skipped, EnergyFitSummary& out) {
-  EnergyLawData& law = out.law;
+  EnergyLawData& law = out.law;  // the ridge fields stay empty (the network comes first)
   law.family = material::EnergyFamily::kNetwork;
-  law.directions = {};
-  law.s_range.resize(0, 2);
-  law.l_knots.clear();
-  law.coefficients.resize(0, 0);
   const std::string why =
       detail::fit_network(law, ls, pts, data_weights(pts, o, sS), sS, sE, o, out.ceres_iterations);
   return finish_fit(db, o, skipped, why, out);
@@ -352,6 +348,14 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   if (!(sS > 0.0) || !(sE > 0.0))
     return refuse("/loop_0/raw: every usable step has zero strain or zero stress");
   const double sK = sS / sE;
+  std::vector<double> ls;
+  for (const auto& e : db.entries) ls.push_back(e.loop_length);
+  law.l_min = ls.front();
+  law.l_max = ls.back();
+  law.floor = o.floor >= 0.0 ? o.floor : o.floor_relative * sK;
+  if (o.family == "network") return finish_network(db, o, ls, pts, sS, sE, skipped, out);
+
+  // ---- ridge layout: s-ranges of the functions, l-knots -----------------------------------
   law.s_degree = o.s_degree;
   law.s_spans = o.s_spans;
   law.s_range.resize(G, 2);
@@ -368,17 +372,11 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
     const double w = std::max(hi - lo, 1e-3 * sE), m = o.s_margin * w;
     law.s_range.row(g) << std::min(lo - m, -0.01 * w), std::max(hi + m, 0.01 * w);
   }
-  std::vector<double> ls;
-  for (const auto& e : db.entries) ls.push_back(e.loop_length);
-  law.l_min = ls.front();
-  law.l_max = ls.back();
   const int nl = std::min<int>(o.l_control_points, static_cast<int>(ls.size()));
   law.l_degree = std::min(o.l_degree, nl - 1);
   law.l_knots = law.l_max > law.l_min
                     ? spline::uniform_knots(law.l_degree, nl - law.l_degree, law.l_min, law.l_max)
                     : std::vector<double>{law.l_min - 0.5, law.l_min + 0.5};
-  law.floor = o.floor >= 0.0 ? o.floor : o.floor_relative * sK;
-  if (o.family == "network") return finish_network(db, o, ls, pts, sS, sE, skipped, out);
 
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);

@@ -11,6 +11,15 @@
 
 using namespace knit::material;
 
+namespace {
+/// CPU time of this thread (s): the machine is shared, wall time would count other processes.
+double thread_cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+}  // namespace
+
 TEST_CASE("bench: response-surface evaluations per second", "[.bench]") {
   const ResponseSurface rs(testing::make_test_surface());
   std::mt19937 gen(1);
@@ -23,19 +32,13 @@ TEST_CASE("bench: response-surface evaluations per second", "[.bench]") {
   const int n = 2'000'000;
   double sink = 0.0;
   long iters = 0;
-  // CPU time of this thread: the machine is shared, wall time would count other processes.
-  auto cpu = [] {
-    timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-  };
-  const double c0 = cpu();
+  const double c0 = thread_cpu_seconds();
   for (int k = 0; k < n; ++k) {
     const auto ev = rs.evaluate(E[k & 4095]);
     sink += ev.S(0) + ev.C(0, 0);
     iters += ev.iterations;
   }
-  const double dt = cpu() - c0;
+  const double dt = thread_cpu_seconds() - c0;
   std::printf(
       "material evaluation: %.3g per second per core (target >= 1e6), mean Newton "
       "iterations %.2f [sink %g]\n",
@@ -98,17 +101,12 @@ TEST_CASE("bench: energy-law evaluations per second", "[.bench]") {
     for (int k = 0; k < 4096; ++k) E.emplace_back(u(gen), u(gen), u(gen));
     const int n = 4'000'000;
     double sink = 0.0;
-    auto cpu = [] {
-      timespec ts;
-      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-      return ts.tv_sec + 1e-9 * ts.tv_nsec;
-    };
-    const double c0 = cpu();
+    const double c0 = thread_cpu_seconds();
     for (int k = 0; k < n; ++k) {
       const EnergyResponse r = at.evaluate(E[k & 4095]);
       sink += r.W + r.S(0) + r.C(0, 1);
     }
-    const double dt = cpu() - c0;
+    const double dt = thread_cpu_seconds() - c0;
     std::printf(
         "energy-law evaluation (%s): %.3g per second per core (W, S, C; target >= 2e6) [sink %g]\n",
         network ? "network 12/6" : "ridge", n / dt, sink);

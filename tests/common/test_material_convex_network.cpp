@@ -85,6 +85,34 @@ TEST_CASE("convex network: S and C of the raw network equal finite differences",
   CHECK(min_eig >= -1e-12);
 }
 
+TEST_CASE("convex network: the packed evaluation equals the reference network", "[unit]") {
+  // NetworkLawAt (the law's fast path) against the mirror average of network_evaluate, the
+  // formula of knit/material/convex_network.hpp written out.
+  NetworkShape sh;
+  sh.h1 = 9;
+  sh.h2 = 5;
+  const std::vector<double> th = random_theta(sh, 12);
+  const NetworkLawAt law(sh, th);
+  const NetworkResponse z = network_evaluate(sh, th.data(), Eigen::Vector3d::Zero());
+  const Eigen::Vector3d S0(z.S(0), z.S(1), 0.0);
+  const Eigen::Matrix3d M = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
+  std::mt19937 gen(13);
+  std::uniform_real_distribution<double> u(-0.7, 0.7);
+  for (int k = 0; k < 500; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    const NetworkResponse a = network_evaluate(sh, th.data(), e),
+                          b = network_evaluate(sh, th.data(), M * e);
+    const double W = 0.5 * (a.W + b.W) - z.W - S0.dot(e);
+    const Eigen::Vector3d S = 0.5 * (a.S + M * b.S) - S0;
+    const Eigen::Matrix3d C = 0.5 * (a.C + M * b.C * M);
+    const NetworkResponse r = law.evaluate(e);
+    INFO("e = " << e.transpose());
+    REQUIRE(std::abs(r.W - W) <= 1e-13 * (1 + std::abs(W)));
+    REQUIRE((r.S - S).norm() <= 1e-13 * (1 + S.norm()));
+    REQUIRE((r.C - C).norm() <= 1e-13 * (1 + C.norm()));
+  }
+}
+
 TEST_CASE("convex network: the fit's reverse-mode gradient equals finite differences", "[unit]") {
   NetworkShape sh;
   sh.h1 = 5;
