@@ -50,6 +50,10 @@ TEST_CASE("energy fit: recovers the synthetic hyperelastic law within 3 % of the
   // of the range (measured: largest error 0.65 %).
   CHECK(d.holdout_points == 3 * 24);
   CHECK(d.holdout_within_5_percent == d.holdout_points);
+  // Per held-out run (one state each here): every run counted, all within 5 %.
+  CHECK(d.holdout_runs == 3 * 24);
+  CHECK(d.holdout_runs_within_5_percent == d.holdout_runs);
+  CHECK(d.holdout_run_ends_within_5_percent == d.holdout_runs);
   CHECK(d.holdout_max_relative < 0.02);
   // Convex at every l by construction; the floor is the smallest eigenvalue.
   CHECK((s.law.coefficients.array() >= 0.0).all());

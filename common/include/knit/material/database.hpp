@@ -105,6 +105,10 @@ struct EnergyFitDiagnostics {
   int holdout_within_5_percent = 0;  ///< held-out states whose largest error is <= 5 % of the range
   Eigen::Vector3d holdout_rms = Eigen::Vector3d::Zero(), holdout_max = Eigen::Vector3d::Zero();
   double holdout_max_relative = 0.0;
+  /// Held-out cell runs (paths of set "holdout", each to one quasi-random state of the box):
+  /// how many, how many are within 5 % of the range at every converged step, and how many at
+  /// their last converged step (the run's target state). Printed, not stored.
+  int holdout_runs = 0, holdout_runs_within_5_percent = 0, holdout_run_ends_within_5_percent = 0;
   int points_used = 0, points_skipped = 0;
   double min_eigenvalue = 0.0;  ///< smallest eigenvalue of C over the fit data (>= floor)
   std::string options_json;
