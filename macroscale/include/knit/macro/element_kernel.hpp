@@ -2,10 +2,11 @@
 //
 //   K_ij(l, m) = sum_q sum_fg Phi_f(l, q) H_q(3f+i, 3g+j) Phi_g(m, q)
 //
-// for the component pairs (i, j) of one element, as W = [(H_q Phi)_ij] (plain axpy loops) and
-// one product Phi^T W^T in register tiles of 8 x 4 (GCC vector extensions). Compiled twice
-// (GCC's target attribute): for x86-64-v3 (AVX2 + FMA) and for the default x86-64, chosen at
-// run time by the CPU; the binary still runs on any x86-64. The file includes no Eigen
+// for the component pairs (i, j) of one element, as W = [(H_q Phi)_ij] (per point, the point's
+// Phi columns held in registers) and one product Phi^T W^T in register tiles (GCC vector
+// extensions). Compiled three times (GCC's target attribute): for x86-64-v4 (AVX-512), for
+// x86-64-v3 (AVX2 + FMA) and for the default x86-64, the widest the CPU has chosen at run time;
+// the binary still runs on any x86-64. The file includes no Eigen
 // (Eigen's inline functions compiled for two instruction sets in one program would clash:
 // compiling shell_model.cpp alone with -mavx2 crashed), and it is compiled with
 // -ffp-contract=fast (macroscale/CMakeLists.txt) so that a * b + c becomes one FMA in the
@@ -15,13 +16,15 @@
 namespace knit::macro::kernel {
 
 /// Padding of the element's local-function count nl: rows of PhiT and of the output are
-/// allocated for padded_functions(nl) (the extra rows of PhiT must be zero).
+/// allocated for padded_functions(nl) (the extra rows of PhiT must be zero): a multiple of 8,
+/// one AVX-512 vector.
 constexpr int padded_functions(int nl) {
-  return (nl + 3) / 4 * 4;
+  return (nl + 7) / 8 * 8;
 }
-/// Rows of the workspace W: 9 component pairs of nl plus the overrun of the last 8-wide tile.
+/// Rows of the workspace W: 9 component pairs of nl plus the overrun of the last 16-wide tile
+/// (AVX-512; 8 for AVX2).
 constexpr int workspace_rows(int nl) {
-  return 9 * nl + 8;
+  return (9 * nl + 16 + 7) / 8 * 8;
 }
 
 struct ElementTangentInput {
@@ -81,12 +84,17 @@ inline double bending_vector(const PointState& s, double* v, double* w) {
 }
 
 enum class Isa {
-  kAuto,       ///< x86-64-v3 when the CPU has it, else the default
+  kAuto,       ///< the widest the CPU has: x86-64-v4, else x86-64-v3, else the default
   kDefault,    ///< SSE2 (any x86-64)
   kX86_64_v3,  ///< AVX2 + FMA (falls back to the default on a CPU without them)
+  kX86_64_v4,  ///< AVX-512 F/DQ/CD/BW/VL (falls back to x86-64-v3, then the default)
 };
 /// Whether this CPU runs the x86-64-v3 version (AVX2, FMA, BMI2).
 bool cpu_has_x86_64_v3();
+/// Whether this CPU runs the x86-64-v4 version (x86-64-v3 and AVX-512 F, DQ, CD, BW, VL).
+bool cpu_has_x86_64_v4();
+/// The version `isa` runs on this CPU (kAuto and unsupported versions resolved).
+Isa resolve(Isa isa);
 
 /// Fills KT (workspace_rows(nl) x padded_functions(nl), column-major):
 ///   KT(p nl + m, l) = K_{pi[p] pj[p]}(l, m)
