@@ -30,13 +30,14 @@ template <typename V>
 inline __attribute__((always_inline)) void store(double* p, V v) {
   std::memcpy(p, &v, sizeof v);
 }
-/// x in every lane. 512-bit vectors: as a scalar operand of a vector operation (one
-/// vbroadcastsd; the lane-by-lane assignment made GCC emit masked inserts, the AVX-512 kernel
-/// then ran slower than the AVX2 one); the narrower ones as before (the same code as measured).
+/// x in every lane. 512-bit vectors: lane 0 shuffled into all (one vbroadcastsd; the lane-by-lane
+/// assignment, and x - V{}, made GCC emit eight masked inserts: the AVX-512 kernel then ran
+/// slower than the AVX2 one; V{} + x costs a scalar add first); the narrower ones as before.
 template <typename V>
 inline __attribute__((always_inline)) V splat(double x) {
   if constexpr (sizeof(V) == 64) {
-    return V{} + x;
+    const V v{x};  // x in lane 0, then broadcast (one vbroadcastsd)
+    return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
   } else {
     V v;
     for (int i = 0; i < int(sizeof v / sizeof x); ++i) v[i] = x;
