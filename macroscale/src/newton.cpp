@@ -157,13 +157,15 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     const auto t0 = Clock::now();
     const double c0 = cpu_now();
     ev_u = dofs.expand(uf, lam);
+    // The element tangents go straight into K (ReducedTangent::begin_assembly).
+    K.begin_assembly(model);
     if (trial.has_points && trial_u.size() > 0 && trial_u == ev_u) {
-      model.tangent_from(trial, ev);
+      model.tangent_from(trial, ev, &K);
       ++stats.tangents_reused;
     } else {
-      model.evaluate(ev_u, true, ev);
+      model.evaluate(ev_u, true, ev, false, &K);
     }
-    if (ev.ok) K.assemble(ev.Ke);
+    if (ev.ok) K.end_assembly();
     stats.assembly += since(t0);
     stats.assembly_cpu += cpu_now() - c0;
     return ev.ok;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "knit/macro/thread_pool.hpp"
 #include "sparse_cholmod.hpp"
@@ -147,6 +148,33 @@ void ReducedTangent::compact_map(long values) {
       while (t < T && seen * T >= total * t) cut_[t++] = v + 1;
     }
   }
+  // The direct scatter: the first thread whose elements touch each value; an entry of a
+  // later thread to that value is held back.
+  {
+    std::vector<int> first(values, T);
+    for (int t = 0; t < T; ++t) {
+      const auto [e0, e1] = ShellModel::element_range(static_cast<int>(ne), t, T);
+      for (size_t k = size_t(e0) * block_; k < size_t(e1) * block_; ++k)
+        if (map_[k] >= 0) first[map_[k]] = std::min(first[map_[k]], t);
+    }
+    direct_begin_.assign(ne + 1, 0);
+    held_begin_.assign(ne + 1, 0);
+    direct_src_.clear(), direct_dst_.clear(), held_src_.clear(), held_dst_.clear();
+    for (int t = 0; t < T; ++t) {
+      const auto [e0, e1] = ShellModel::element_range(static_cast<int>(ne), t, T);
+      for (int e = e0; e < e1; ++e) {
+        for (int k = 0; k < block_; ++k) {
+          const int dst = map_[size_t(e) * block_ + k];
+          if (dst < 0) continue;
+          (first[dst] == t ? direct_src_ : held_src_).push_back(k);
+          (first[dst] == t ? direct_dst_ : held_dst_).push_back(dst);
+        }
+        direct_begin_[e + 1] = direct_src_.size();
+        held_begin_[e + 1] = held_src_.size();
+      }
+    }
+    held_.assign(held_src_.size(), 0.0);
+  }
   scatter_begin_.assign(ne * T + 1, 0);
   scatter_src_.clear();
   scatter_dst_.clear();
@@ -235,8 +263,35 @@ void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* val
   }
 }
 
+double* ReducedTangent::values() {
+  return sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
+}
+
+void ReducedTangent::begin_assembly(const ShellModel& model) {
+  if (model.assembly_threads() != threads_)
+    throw std::logic_error(
+        "ReducedTangent::begin_assembly: the model's assembly threads changed since the "
+        "reduced tangent was built");
+  const long nv = sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : long(n_) * n_;
+  std::fill(values(), values() + nv, 0.0);
+}
+
+void ReducedTangent::element(int e, int /*thread*/, const double* kt, const int* map) {
+  double* v = values();
+  const int* src = direct_src_.data();
+  const int* dst = direct_dst_.data();
+  for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[map[src[i]]];
+  for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[map[held_src_[i]]];
+}
+
+void ReducedTangent::end_assembly() {
+  // In thread order, each thread's elements in order (compact_map stored them so).
+  double* v = values();
+  for (size_t i = 0; i < held_.size(); ++i) v[held_dst_[i]] += held_[i];
+}
+
 void ReducedTangent::assemble(const std::vector<Eigen::MatrixXd>& Ke) {
-  double* v = sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
+  double* v = values();
   if (threads_ <= 1)
     scatter(Ke, v, 0);
   else

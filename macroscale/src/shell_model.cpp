@@ -76,6 +76,26 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   nqu_ = nqu, nqv_ = nqv;
   for (const Element& el : elements_) max_points_ = std::max(max_points_, el.num_points);
   factorize_elements(su, sv, gu, gv);
+  // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l) for pair p = (i, j); symmetric layout:
+  // pairs (0,1), (0,2), (1,2), (0,0), (1,1), (2,2), K_ij(l, m) = K_ji(m, l) for i > j, and a
+  // diagonal pair's K(l, m) = K(m, l) read where l >= m (all that evaluate_range's copy reads).
+  const int nl = nloc_, nd = 3 * nl, ldw = kernel::workspace_rows(nl);
+  constexpr int kSymPair[3][3] = {{3, 0, 1}, {0, 4, 2}, {1, 2, 5}};
+  for (const bool sym : {false, true}) {
+    std::vector<int>& map = kt_map_[sym];
+    map.resize(static_cast<size_t>(nd) * nd);
+    for (int m = 0; m < nl; ++m)
+      for (int j = 0; j < 3; ++j)
+        for (int l = 0; l < nl; ++l)
+          for (int i = 0; i < 3; ++i) {
+            int at = l * ldw + (3 * i + j) * nl + m;
+            if (sym) {
+              const int p = kSymPair[i][j];
+              at = (i < j || (i == j && l >= m)) ? l * ldw + p * nl + m : m * ldw + p * nl + l;
+            }
+            map[(3 * l + i) + static_cast<size_t>(nd) * (3 * m + j)] = at;
+          }
+  }
 }
 
 void ShellModel::factorize_elements(const std::vector<std::pair<double, double>>& su,
@@ -171,15 +191,13 @@ ShellModel::Workspace& ShellModel::workspace() const {
 }
 
 bool ShellModel::run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                            Evaluation& out) const {
-  const int ne = num_elements();
+                            Evaluation& out, ElementTangentSink* sink) const {
   const int nth = assembly_threads();
-  if (nth == 1) return evaluate_range(0, ne, u, pass, from, out, workspace());
+  if (nth == 1) return evaluate_range(0, 1, u, pass, from, out, sink, workspace());
   // The process-wide pool: threads started once, not per call.
   std::vector<char> oks(nth, 1);
-  ThreadPool::shared().run(nth, [&](int k) {
-    oks[k] = evaluate_range(ne * k / nth, ne * (k + 1) / nth, u, pass, from, out, workspace());
-  });
+  ThreadPool::shared().run(
+      nth, [&](int k) { oks[k] = evaluate_range(k, nth, u, pass, from, out, sink, workspace()); });
   bool ok = true;
   for (int k = 0; k < nth; ++k) ok = ok && oks[k];
   return ok;
@@ -192,17 +210,20 @@ void allocate_tangents(std::vector<Eigen::MatrixXd>& Ke, int ne, int n) {
 }
 }  // namespace
 
-void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
-                          bool keep_points) const {
+void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out, bool keep_points,
+                          ElementTangentSink* sink) const {
   const int ne = num_elements();
   out.fe.resize(3 * nloc_, ne);
   out.element_energy.resize(ne);
-  if (tangent) allocate_tangents(out.Ke, ne, 3 * nloc_);
+  if (!tangent) sink = nullptr;
+  if (tangent && !sink) allocate_tangents(out.Ke, ne, 3 * nloc_);
+  if (sink) out.Ke.clear();
   const bool keep = keep_points && !tangent;
   if (keep) out.points.resize(points_.size());
   out.has_points = false;
-  const bool ok = run_ranges(
-      &u, tangent ? Pass::kTangent : (keep ? Pass::kResidualKeep : Pass::kResidual), nullptr, out);
+  const bool ok =
+      run_ranges(&u, tangent ? Pass::kTangent : (keep ? Pass::kResidualKeep : Pass::kResidual),
+                 nullptr, out, sink);
   out.ok = ok;
   out.has_points = ok && keep;
   out.fint.setZero(num_dofs());
@@ -217,14 +238,18 @@ void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& ou
   }
 }
 
-void ShellModel::tangent_from(const Evaluation& from, Evaluation& out) const {
+void ShellModel::tangent_from(const Evaluation& from, Evaluation& out,
+                              ElementTangentSink* sink) const {
   if (!from.ok || !from.has_points)
     throw std::logic_error("ShellModel::tangent_from: the evaluation kept no point states");
   out.fint = from.fint;
   out.energy = from.energy;
   out.has_points = false;
-  allocate_tangents(out.Ke, num_elements(), 3 * nloc_);
-  out.ok = run_ranges(nullptr, Pass::kTangentFromStates, &from, out);
+  if (sink)
+    out.Ke.clear();
+  else
+    allocate_tangents(out.Ke, num_elements(), 3 * nloc_);
+  out.ok = run_ranges(nullptr, Pass::kTangentFromStates, &from, out, sink);
 }
 
 double ShellModel::energy(const Eigen::VectorXd& u) const {
@@ -285,8 +310,10 @@ void ShellModel::point_matrix(int pid, const PointState& s, double* H, bool& sym
   kernel::point_matrix(s, pt.ref.T.data(), pt.dA, H, symmetric);
 }
 
-bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass,
-                                const Evaluation* from, Evaluation& out, Workspace& ws) const {
+bool ShellModel::evaluate_range(int thread, int threads, const Eigen::VectorXd* u, Pass pass,
+                                const Evaluation* from, Evaluation& out, ElementTangentSink* sink,
+                                Workspace& ws) const {
+  const auto [e0, e1] = element_range(num_elements(), thread, threads);
   const Eigen::MatrixXd& P = surface_.control_points();
   const int nl = nloc_;
   const bool tangent = pass == Pass::kTangent || pass == Pass::kTangentFromStates;
@@ -358,6 +385,10 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
       kin.Y = ws.Y.data();
     }
     kernel::element_tangent_blocks(kin, ws.W.data(), ws.KT.data());
+    if (sink) {
+      sink->element(e, thread, ws.KT.data(), kt_map_[symmetric].data());
+      continue;
+    }
     Eigen::MatrixXd& Ke = out.Ke[e];
     // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)
     // and, for a symmetric law, the mirror Ke(3 m + j, 3 l + i) likewise.

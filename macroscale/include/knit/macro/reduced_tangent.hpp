@@ -48,7 +48,7 @@ struct Factorization {
   double pivot_ratio = 0.0;  ///< min |pivot| / max |pivot|
 };
 
-class ReducedTangent {
+class ReducedTangent : public ElementTangentSink {
  public:
   /// Pivot ratio below which the tangent counts as singular. Round-off leaves a pivot of
   /// ~1e-16 max|pivot| on an exactly singular matrix; the thinnest shells here (h/L = 1e-2)
@@ -61,7 +61,7 @@ class ReducedTangent {
   /// when the build has no CHOLMOD).
   ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse,
                  bool supernodal = true);
-  ~ReducedTangent();
+  ~ReducedTangent() override;
   ReducedTangent(const ReducedTangent&) = delete;
   ReducedTangent& operator=(const ReducedTangent&) = delete;
 
@@ -83,6 +83,19 @@ class ReducedTangent {
   void assemble(const std::vector<Eigen::MatrixXd>& Ke);
   /// Threads of assemble().
   int scatter_threads() const { return threads_; }
+
+  /// Assembly straight from the element kernel (no element tangents stored): begin_assembly()
+  /// zeroes the values, `model`.evaluate(u, true, ev, false, this) (or tangent_from) scatters
+  /// each element tangent where the kernel leaves it (element(), on the assembly thread that
+  /// computed it), end_assembly() adds the entries held back. Thread t adds an entry directly
+  /// when no element of an earlier thread touches its value, and holds it back otherwise; the
+  /// held-back ones are added after the threads joined, in thread, element and entry order. So
+  /// every value is summed in element order, as by assemble(): the matrix is bitwise the same
+  /// (tested). `model` must use the assembly threads it had when this was built (else
+  /// std::logic_error).
+  void begin_assembly(const ShellModel& model);
+  void element(int e, int thread, const double* kt, const int* map) override;
+  void end_assembly();
   /// Numeric factorization of the assembled matrix (the symbolic analysis is reused).
   Factorization factorize();
   /// Solves with the last successful factorization.
@@ -116,8 +129,17 @@ class ReducedTangent {
   std::vector<int> scatter_src_, scatter_dst_;
   std::vector<long> cut_;
   int threads_ = 1;
-  /// map_ -> scatter_* in `threads` parts of the `values` values (then frees map_).
+  /// map_ -> scatter_* in `threads` parts of the `values` values and the direct scatter's
+  /// entries below (then frees map_).
   void compact_map(long values);
+  /// The direct scatter (begin_assembly): element e's entries [direct_begin_[e],
+  /// direct_begin_[e + 1]) add its tangent's entry direct_src_[i] (r + nd s) to
+  /// values[direct_dst_[i]]; its held-back entries [held_begin_[e], held_begin_[e + 1]) are
+  /// copied to held_[i] and added to values[held_dst_[i]] by end_assembly().
+  std::vector<size_t> direct_begin_, held_begin_;
+  std::vector<int> direct_src_, direct_dst_, held_src_, held_dst_;
+  std::vector<double> held_;
+  double* values();
   /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;

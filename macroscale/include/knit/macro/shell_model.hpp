@@ -59,6 +59,18 @@ struct ShellSample {
   Eigen::Vector3d m = Eigen::Vector3d::Zero();      ///< bending moments N mm/mm
 };
 
+/// Receives each element tangent where the kernel leaves it, instead of a copy into
+/// ShellModel::Evaluation::Ke (ReducedTangent scatters it into the reduced matrix from there: at
+/// p = 4 no 45 KB per element written to memory and read back). Entry (r, s) of element e's
+/// tangent (local DOFs r = 3 l + i, s) is kt[map[r + 3 nloc s]]. element() is called on
+/// assembly thread `thread` of `threads`, which evaluates the elements
+/// ShellModel::element_range(ne, thread, threads) in increasing order.
+class ElementTangentSink {
+ public:
+  virtual ~ElementTangentSink() = default;
+  virtual void element(int e, int thread, const double* kt, const int* map) = 0;
+};
+
 class ShellModel {
  public:
   /// Throws DegenerateGeometryError if the Jacobian vanishes at a quadrature point.
@@ -81,6 +93,10 @@ class ShellModel {
   void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
   /// The number of threads evaluate() uses with a tangent.
   int assembly_threads() const;
+  /// The elements [first, second) that thread k of n evaluates (of ne elements).
+  static std::pair<int, int> element_range(int ne, int k, int n) {
+    return {static_cast<int>(long(ne) * k / n), static_cast<int>(long(ne) * (k + 1) / n)};
+  }
   /// Element work (quadrature points x local DOFs^2) above which the automatic setting uses
   /// every hardware thread: measured on 2 cores, a tangent evaluation of this size takes
   /// ~2 ms, 20x the cost of starting the threads.
@@ -107,12 +123,14 @@ class ShellModel {
   /// after the first call), the assembly threads are a process-wide pool (ThreadPool::shared():
   /// concurrent evaluations of several models take turns on it).
   /// `keep_points` (without `tangent`): also keep the PointStates for tangent_from.
-  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
-                bool keep_points = false) const;
+  /// `sink` (with `tangent`): each element tangent goes to the sink, out.Ke is left empty.
+  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out, bool keep_points = false,
+                ElementTangentSink* sink = nullptr) const;
   /// The evaluation with tangent at the displacement of `from` (evaluated with keep_points, ok):
   /// the element tangents from its point states, fint, energy and ok copied. Bitwise the same
-  /// as evaluate(u, true, out) (the same operations on the same numbers).
-  void tangent_from(const Evaluation& from, Evaluation& out) const;
+  /// as evaluate(u, true, out) (the same operations on the same numbers). `sink`: as in evaluate.
+  void tangent_from(const Evaluation& from, Evaluation& out,
+                    ElementTangentSink* sink = nullptr) const;
   /// Psi(u) alone (NaN unless hyperelastic, or if the configuration degenerated).
   double energy(const Eigen::VectorXd& u) const;
 
@@ -143,8 +161,8 @@ class ShellModel {
   enum class Pass { kResidual, kResidualKeep, kTangent, kTangentFromStates };
   /// Runs evaluate_range over the elements on assembly_threads() threads; false if any range
   /// failed.
-  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                  Evaluation& out) const;
+  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from, Evaluation& out,
+                  ElementTangentSink* sink) const;
   void factorize_elements(const std::vector<std::pair<double, double>>& su,
                           const std::vector<std::pair<double, double>>& sv,
                           const spline::QuadratureRule& gu, const spline::QuadratureRule& gv);
@@ -152,8 +170,9 @@ class ShellModel {
   struct Workspace;
   /// The calling thread's workspace, sized (and zeroed) for this model when it does not fit.
   Workspace& workspace() const;
-  bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                      Evaluation& out, Workspace& ws) const;
+  bool evaluate_range(int thread, int threads, const Eigen::VectorXd* u, Pass pass,
+                      const Evaluation* from, Evaluation& out, ElementTangentSink* sink,
+                      Workspace& ws) const;
   /// Residual part at one point: the point state, dA psi, and the element force
   /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
   /// configuration degenerated there.
@@ -178,6 +197,10 @@ class ShellModel {
   bool factorized_ = false;
   int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
   int max_points_ = 0;     ///< quadrature points of the largest element
+  /// Where entry (r, s) of an element tangent is in the kernel's output KT
+  /// (element_tangent_blocks), for the symmetric layout ([1]: 6 component pairs, the diagonal
+  /// ones possibly as lower triangles) and the full one ([0]: 9 pairs).
+  std::vector<int> kt_map_[2];
 };
 
 }  // namespace knit::macro
