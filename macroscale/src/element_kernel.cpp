@@ -357,50 +357,75 @@ void blocks_default(const ElementTangentInput& in, double* W, double* KT) {
   blocks<v2, 2>(in, W, KT);
 }
 
-/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version.
-inline __attribute__((always_inline)) void derivatives_body(const double* R, const double* x,
-                                                            int nl, double* d) {
-  double acc[3][6] = {};
-  for (int l = 0; l < nl; ++l)
-    for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 6; ++r) acc[i][r] += R[6 * l + r] * x[3 * l + i];
-  for (int i = 0; i < 3; ++i)
-    for (int r = 0; r < 6; ++r) d[6 * i + r] = acc[i][r];
+/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version:
+/// contiguous vectors of l (V: one register), a lane sum at the end.
+template <typename V>
+inline __attribute__((always_inline)) double lane_sum(V v) {
+  double s = 0.0;
+  for (int k = 0; k < int(sizeof(V) / sizeof(double)); ++k) s += v[k];
+  return s;
 }
 
-inline __attribute__((always_inline)) void forces_body(const double* R, const double* g, int nl,
-                                                       double* fe) {
-  for (int l = 0; l < nl; ++l) {
-    const double* Phi = R + 6 * l + 1;
+template <typename V>
+inline __attribute__((always_inline)) void derivatives_body(const double* Phi, const double* xT,
+                                                            int nl, double* d) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  const int nlp = padded_functions(nl);
+  V acc[3][5];
+  for (int i = 0; i < 3; ++i)
+    for (int f = 0; f < 5; ++f) acc[i][f] = splat<V>(0.0);
+  for (int l0 = 0; l0 < nlp; l0 += lanes) {
+    const V x0 = load<V>(xT + l0), x1 = load<V>(xT + nlp + l0), x2 = load<V>(xT + 2 * nlp + l0);
+    for (int f = 0; f < 5; ++f) {
+      const V p = load<V>(Phi + f * nlp + l0);
+      acc[0][f] += p * x0;
+      acc[1][f] += p * x1;
+      acc[2][f] += p * x2;
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    d[6 * i] = 0.0;  // the position: not needed
+    for (int f = 0; f < 5; ++f) d[6 * i + 1 + f] = lane_sum(acc[i][f]);
+  }
+}
+
+template <typename V>
+inline __attribute__((always_inline)) void forces_body(const double* Phi, const double* g, int nl,
+                                                       double* feT) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  const int nlp = padded_functions(nl);
+  for (int l0 = 0; l0 < nlp; l0 += lanes) {
+    V p[5];
+    for (int f = 0; f < 5; ++f) p[f] = load<V>(Phi + f * nlp + l0);
     for (int i = 0; i < 3; ++i) {
-      double acc = 0.0;
-      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
-      fe[3 * l + i] += acc;
+      V a = load<V>(feT + i * nlp + l0);
+      for (int f = 0; f < 5; ++f) a += p[f] * splat<V>(g[3 * f + i]);
+      store<V>(feT + i * nlp + l0, a);
     }
   }
 }
 
-__attribute__((target("arch=x86-64-v4"))) void derivatives_v4(const double* R, const double* x,
+__attribute__((target("arch=x86-64-v4"))) void derivatives_v4(const double* Phi, const double* xT,
                                                               int nl, double* d) {
-  derivatives_body(R, x, nl, d);
+  derivatives_body<v8>(Phi, xT, nl, d);
 }
-__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* R, const double* x,
+__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* Phi, const double* xT,
                                                               int nl, double* d) {
-  derivatives_body(R, x, nl, d);
+  derivatives_body<v4>(Phi, xT, nl, d);
 }
-void derivatives_default(const double* R, const double* x, int nl, double* d) {
-  derivatives_body(R, x, nl, d);
+void derivatives_default(const double* Phi, const double* xT, int nl, double* d) {
+  derivatives_body<v2>(Phi, xT, nl, d);
 }
-__attribute__((target("arch=x86-64-v4"))) void forces_v4(const double* R, const double* g, int nl,
-                                                         double* fe) {
-  forces_body(R, g, nl, fe);
+__attribute__((target("arch=x86-64-v4"))) void forces_v4(const double* Phi, const double* g, int nl,
+                                                         double* feT) {
+  forces_body<v8>(Phi, g, nl, feT);
 }
-__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* R, const double* g, int nl,
-                                                         double* fe) {
-  forces_body(R, g, nl, fe);
+__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* Phi, const double* g, int nl,
+                                                         double* feT) {
+  forces_body<v4>(Phi, g, nl, feT);
 }
-void forces_default(const double* R, const double* g, int nl, double* fe) {
-  forces_body(R, g, nl, fe);
+void forces_default(const double* Phi, const double* g, int nl, double* feT) {
+  forces_body<v2>(Phi, g, nl, feT);
 }
 
 }  // namespace
@@ -451,12 +476,12 @@ void point_matrix(const PointState& s, const double* T, double dA, double* H, bo
            use_symmetry);
 }
 
-void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa) {
-  dispatch(isa, derivatives_v4, derivatives_v3, derivatives_default, R, x, nl, d);
+void current_derivatives(const double* Phi, const double* xT, int nl, double* d, Isa isa) {
+  dispatch(isa, derivatives_v4, derivatives_v3, derivatives_default, Phi, xT, nl, d);
 }
 
-void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa) {
-  dispatch(isa, forces_v4, forces_v3, forces_default, R, g, nl, fe);
+void add_point_forces(const double* Phi, const double* g, int nl, double* feT, Isa isa) {
+  dispatch(isa, forces_v4, forces_v3, forces_default, Phi, g, nl, feT);
 }
 
 }  // namespace knit::macro::kernel

@@ -41,7 +41,7 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   const int nel = static_cast<int>(su.size() * sv.size());
   elements_.resize(nel);
   points_.reserve(static_cast<size_t>(nel) * nqu * nqv);
-  R_.resize(6, static_cast<Eigen::Index>(nloc_) * nel * nqu * nqv);
+  R_.resize(1, static_cast<Eigen::Index>(nloc_) * nel * nqu * nqv);
   spline::SurfaceBasis sb;
   std::vector<Eigen::Vector2d> thetas;
   int e = 0;
@@ -61,7 +61,7 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
           Point pt;
           pt.ref = reference_point(dX, Eigen::Vector2d(u, v), scale_);
           pt.dA = w * pt.ref.jacobian;
-          R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 6, nloc_) = sb.R;
+          R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 1, nloc_) = sb.R.row(0);
           el.PhiT.conservativeResize(kernel::padded_functions(nloc_), el.PhiT.cols() + 5);
           el.PhiT.rightCols(5).setZero();
           el.PhiT.rightCols(5).topRows(nloc_) = sb.R.bottomRows(5).transpose();
@@ -179,8 +179,8 @@ ShellModel::Workspace& ShellModel::workspace() const {
   const int nl = nloc_;
   if (w.nl != nl || w.maxq != max_points_ || w.factorized != factorized_) {
     const size_t rows = kernel::workspace_rows(nl);
-    w.xloc.assign(3 * nl, 0.0);
-    w.fe.assign(3 * nl, 0.0);
+    w.xloc.assign(3 * kernel::padded_functions(nl), 0.0);
+    w.fe.assign(3 * kernel::padded_functions(nl), 0.0);
     w.H.assign(size_t(225) * max_points_, 0.0);
     w.W.assign(rows * 5 * max_points_, 0.0);
     w.KT.assign(rows * kernel::padded_functions(nl), 0.0);
@@ -265,15 +265,14 @@ inline void copy3(const Eigen::Vector3d& v, double* d) {
 }
 }  // namespace
 
-bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, double& energy,
-                                double* fe) const {
+bool ShellModel::residual_point(int pid, const double* Phi, const double* xT, PointState& s,
+                                double& energy, double* feT) const {
   const int nl = nloc_;
   const Point& pt = points_[pid];
-  const double* R = R_.data() + static_cast<Eigen::Index>(pid) * nl * 6;  // R[6 l + r]
-  // dx = R xloc as a sum of outer products (contiguous columns of R; element_kernel.cpp, built
-  // for both instruction sets).
-  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r
-  kernel::current_derivatives(R, xloc, nl, dx.data());
+  // dx = R x over contiguous vectors of the element's functions (element_kernel.cpp, built for
+  // each instruction set).
+  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r (row 0 not computed)
+  kernel::current_derivatives(Phi, xT, nl, dx.data());
   const CurrentPoint c = current_point(dx, pt.ref);
   if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) return false;
   const Eigen::Matrix3d& T = pt.ref.T;
@@ -301,7 +300,7 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
     g[9 + i] = -dA * 2.0 * M(2) * s.a3[i];
     g[12 + i] = -dA * M(1) * s.a3[i];
   }
-  kernel::add_point_forces(R, g, nl, fe);
+  kernel::add_point_forces(Phi, g, nl, feT);
   return true;
 }
 
@@ -318,9 +317,12 @@ bool ShellModel::evaluate_range(int thread, int threads, const Eigen::VectorXd* 
   const int nl = nloc_;
   const bool tangent = pass == Pass::kTangent || pass == Pass::kTangentFromStates;
   const bool stored = pass == Pass::kTangentFromStates;
-  // The thread's workspace (Workspace: sized once per model, never allocated here).
-  std::vector<double>& xloc = ws.xloc;
-  std::vector<double>& fe = ws.fe;
+  // The thread's workspace (Workspace: sized once per model, never allocated here). xT and feT:
+  // the element's control points and forces, component-major with padded_functions(nl) rows
+  // (the kernel's layout; the padding stays zero).
+  const int nlp = kernel::padded_functions(nl);
+  std::vector<double>& xT = ws.xloc;
+  std::vector<double>& feT = ws.fe;
   double* Hs = ws.H.data();
   PointState& local = ws.local;
   for (int e = e0; e < e1; ++e) {
@@ -329,17 +331,20 @@ bool ShellModel::evaluate_range(int thread, int threads, const Eigen::VectorXd* 
     if (!stored) {
       for (int l = 0; l < nl; ++l) {
         const int a = el.cp(l);
-        for (int i = 0; i < 3; ++i) xloc[3 * l + i] = P(a, i) + (*u)(3 * a + i);
+        for (int i = 0; i < 3; ++i) xT[i * nlp + l] = P(a, i) + (*u)(3 * a + i);
       }
-      std::fill(fe.begin(), fe.end(), 0.0);
+      std::fill(feT.begin(), feT.end(), 0.0);
       double energy = 0.0;
       for (int q = 0; q < el.num_points; ++q) {
         const int pid = el.first_point + q;
         PointState& s = pass == Pass::kResidualKeep ? out.points[pid] : local;
-        if (!residual_point(pid, xloc.data(), s, energy, fe.data())) return false;
+        const double* Phi = el.PhiT.data() + 5L * q * nlp;
+        if (!residual_point(pid, Phi, xT.data(), s, energy, feT.data())) return false;
         if (tangent) point_matrix(pid, s, Hs + 225 * q, symmetric);
       }
-      std::copy(fe.begin(), fe.end(), out.fe.col(e).data());
+      double* fe = out.fe.col(e).data();
+      for (int l = 0; l < nl; ++l)
+        for (int i = 0; i < 3; ++i) fe[3 * l + i] = feT[i * nlp + l];
       out.element_energy(e) = energy;
     } else {
       for (int q = 0; q < el.num_points; ++q) {

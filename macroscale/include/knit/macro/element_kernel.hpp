@@ -112,13 +112,18 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
                   Isa isa = Isa::kAuto, bool use_symmetry = true);
 
-/// The residual's two loops over the element's functions at one point, compiled for both
-/// instruction sets like the kernel (the rest of shell_model.cpp is built for the default
-/// x86-64): R holds the nl functions' (R, R_1, R_2, R_11, R_12, R_22) at R[6 l + r].
-///   current_derivatives: d[6 i + r] = sum_l R[6 l + r] x[3 l + i]   (dx = R x, column-major
-///                        6 x 3)
-///   add_point_forces:    fe[3 l + i] += sum_f R[6 l + 1 + f] g[3 f + i]   (f = 0..4)
-void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa = Isa::kAuto);
-void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa = Isa::kAuto);
+/// The residual's two loops over the element's functions at one point, compiled for each
+/// instruction set like the kernel (the rest of shell_model.cpp is built for the default
+/// x86-64), in the layout of the kernel's PhiT: Phi holds the point's five columns
+/// Phi_f(l) = Phi[f nlp + l] (f = R_1, R_2, R_11, R_12, R_22; nlp = padded_functions(nl), the
+/// padding zero), xT the element's current control points x_i(l) = xT[i nlp + l] (padding
+/// zero), feT the element forces fe_i(l) = feT[i nlp + l]:
+///   current_derivatives: d[6 i + 1 + f] = sum_l Phi_f(l) x_i(l)  (dx = R x, column-major 6 x 3;
+///                        row 0, the position, is set to 0: not needed)
+///   add_point_forces:    fe_i(l) += sum_f Phi_f(l) g[3 f + i]
+void current_derivatives(const double* Phi, const double* xT, int nl, double* d,
+                         Isa isa = Isa::kAuto);
+void add_point_forces(const double* Phi, const double* g, int nl, double* feT,
+                      Isa isa = Isa::kAuto);
 
 }  // namespace knit::macro::kernel

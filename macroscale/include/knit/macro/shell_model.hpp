@@ -174,9 +174,11 @@ class ShellModel {
                       const Evaluation* from, Evaluation& out, ElementTangentSink* sink,
                       Workspace& ws) const;
   /// Residual part at one point: the point state, dA psi, and the element force
-  /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
-  /// configuration degenerated there.
-  bool residual_point(int pid, const double* xloc, PointState& s, double& energy, double* fe) const;
+  /// contributions fe_i(l) += sum_f Phi_f(l) g(3f+i) (Phi: the point's columns of PhiT; xT and
+  /// feT: the element's control points and forces, kernel::current_derivatives' layout). False
+  /// if the configuration degenerated there.
+  bool residual_point(int pid, const double* Phi, const double* xT, PointState& s, double& energy,
+                      double* feT) const;
   /// The 15 x 15 matrix H at one point (column-major) from its state; clears `symmetric` if
   /// the section tangent is not.
   void point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const;
@@ -190,7 +192,9 @@ class ShellModel {
   int nloc_ = 0;
   std::vector<Element> elements_;
   std::vector<Point> points_;
-  Eigen::MatrixXd R_;  ///< 6 x (nloc * num points): basis derivatives at every quadrature point
+  /// 1 x (nloc * num points): the basis functions at every quadrature point (area loads; the
+  /// derivatives are in each Element's PhiT)
+  Eigen::MatrixXd R_;
   double scale_ = 1.0;
   /// Every element's Phi is the tensor product of its 1D bases (a B-spline surface, checked
   /// numerically) and small enough for the sum-factorized kernel.
