@@ -99,6 +99,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   stats.sparse = sparse;
   stats.symmetric = K.symmetric();
   stats.supernodal = K.supernodal();
+  stats.ordering = K.ordering();
   stats.threads = model.assembly_threads();
 
   const int nsteps = std::max(1, opt.steps);

@@ -110,7 +110,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
     // CHOLMOD's fill-reducing ordering, then the pattern and the scatter map rebuilt in that
     // order: the Cholesky then takes the lower triangle as it is (natural ordering), without
     // the permuted transpose it would otherwise form at every factorization.
-    perm_ = SupernodalCholesky::fill_reducing_ordering(sparse_matrix_);
+    perm_ = SupernodalCholesky::fill_reducing_ordering(sparse_matrix_, &ordering_);
     if (static_cast<int>(perm_.size()) == n_) {
       std::vector<int> inv(n_);
       for (int k = 0; k < n_; ++k) inv[perm_[k]] = k;
@@ -119,6 +119,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
       build_pattern(g, nd);
     } else {
       perm_.clear();
+      ordering_ = "natural";
     }
   }
   // Symbolic analysis, once per run (the LDLT's only when the Cholesky needs a fallback).

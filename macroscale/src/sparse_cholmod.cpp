@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 
 namespace knit::macro {
 
@@ -105,7 +106,7 @@ bool SupernodalCholesky::available() {
 }
 
 std::vector<int> SupernodalCholesky::fill_reducing_ordering(
-    const Eigen::SparseMatrix<double>& lower) {
+    const Eigen::SparseMatrix<double>& lower, std::string* chosen) {
   // CHOLMOD's choice (AMD or METIS: the least fill) and the matrix's own order, the one with
   // fewer flops. The shell's DOFs are numbered along the patch's rows of control points: a
   // band of ~(p + 1) rows, which for a strip meshed along its short side is the better order
@@ -122,6 +123,14 @@ std::vector<int> SupernodalCholesky::fill_reducing_ordering(
     const int* perm = static_cast<const int*>(impl.L->Perm);
     best.assign(perm, perm + impl.L->n);
     best_flops = impl.c.fl;
+    if (chosen) {
+      const int method = impl.c.method[impl.c.selected].ordering;
+      *chosen = o == Ordering::kNatural     ? "natural"
+                : method == CHOLMOD_METIS   ? "METIS"
+                : method == CHOLMOD_NESDIS  ? "NESDIS"
+                : method == CHOLMOD_NATURAL ? "natural"
+                                            : "AMD";
+    }
   }
   return best;
 }
@@ -197,7 +206,8 @@ bool SupernodalCholesky::available() {
 }
 SupernodalCholesky::SupernodalCholesky() = default;
 SupernodalCholesky::~SupernodalCholesky() = default;
-std::vector<int> SupernodalCholesky::fill_reducing_ordering(const Eigen::SparseMatrix<double>&) {
+std::vector<int> SupernodalCholesky::fill_reducing_ordering(const Eigen::SparseMatrix<double>&,
+                                                            std::string*) {
   return {};
 }
 bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>&) {

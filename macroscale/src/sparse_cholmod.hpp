@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace knit::macro {
@@ -36,7 +37,9 @@ class SupernodalCholesky {
   /// matrix in compressed columns, sorted row indices): CHOLMOD's (AMD, or METIS when AMD's
   /// fill is high) or the matrix's own order, whichever needs fewer flops, postordered. Row k
   /// of the factor is row perm[k] of the matrix. Empty if CHOLMOD failed (or is absent).
-  static std::vector<int> fill_reducing_ordering(const Eigen::SparseMatrix<double>& lower);
+  /// `chosen`: set to the ordering taken ("natural", "AMD", "METIS").
+  static std::vector<int> fill_reducing_ordering(const Eigen::SparseMatrix<double>& lower,
+                                                 std::string* chosen = nullptr);
   /// Symbolic analysis of the pattern of `lower`, taken in its own order (permute it by
   /// fill_reducing_ordering() first). Returns false if CHOLMOD failed (or is absent).
   bool analyze(const Eigen::SparseMatrix<double>& lower);

@@ -71,6 +71,10 @@ class ReducedTangent : public ElementTangentSink {
   /// Whether the sparse symmetric path factorizes by the supernodal Cholesky (with the
   /// SimplicialLDLT as the fallback for indefinite tangents).
   bool supernodal() const { return supernodal_; }
+  /// The supernodal path's fill-reducing ordering ("natural": the DOF order, "AMD", "METIS";
+  /// SupernodalCholesky::fill_reducing_ordering takes the one with the fewest flops); empty on
+  /// the other paths.
+  const std::string& ordering() const { return ordering_; }
   /// Whether the build has the supernodal Cholesky (CHOLMOD found at configure time).
   static bool supernodal_available();
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
@@ -143,6 +147,7 @@ class ReducedTangent : public ElementTangentSink {
   /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;
+  std::string ordering_;
   Eigen::MatrixXd dense_;
   Eigen::SparseMatrix<double> sparse_matrix_;
   struct Factors;  ///< the Eigen factorizations and the Cholesky (reduced_tangent.cpp)
