@@ -134,21 +134,6 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
 void ReducedTangent::compact_map(long values) {
   const size_t ne = block_ > 0 ? map_.size() / static_cast<size_t>(block_) : 0;
   const int T = std::max(1, threads_);
-  // Cuts of the value range into T parts of about equal numbers of entries.
-  cut_.assign(T + 1, values);
-  cut_[0] = 0;
-  if (T > 1) {
-    std::vector<int> count(values, 0);
-    long total = 0;
-    for (int dst : map_)
-      if (dst >= 0) ++count[dst], ++total;
-    long seen = 0;
-    int t = 1;
-    for (long v = 0; v < values && t < T; ++v) {
-      seen += count[v];
-      while (t < T && seen * T >= total * t) cut_[t++] = v + 1;
-    }
-  }
   // The direct scatter: the first thread whose elements touch each value; an entry of a
   // later thread to that value is held back.
   {
@@ -176,19 +161,6 @@ void ReducedTangent::compact_map(long values) {
     }
     held_.assign(held_src_.size(), 0.0);
   }
-  scatter_begin_.assign(ne * T + 1, 0);
-  scatter_src_.clear();
-  scatter_dst_.clear();
-  for (size_t e = 0; e < ne; ++e)
-    for (int t = 0; t < T; ++t) {
-      for (int k = 0; k < block_; ++k) {
-        const int dst = map_[e * block_ + k];
-        if (dst < cut_[t] || dst >= cut_[t + 1]) continue;  // also dst = -1
-        scatter_src_.push_back(k);
-        scatter_dst_.push_back(dst);
-      }
-      scatter_begin_[e * T + t + 1] = scatter_src_.size();
-    }
   std::vector<int>().swap(map_);
 }
 
@@ -251,19 +223,6 @@ long ReducedTangent::stored_entries() const {
   return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
 }
 
-void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values, int t) const {
-  const int T = std::max(1, threads_);
-  std::fill(values + cut_[t], values + cut_[t + 1], 0.0);
-  const size_t ne = std::min(Ke.size(), (scatter_begin_.size() - 1) / T);
-  const int* src = scatter_src_.data();
-  const int* dst = scatter_dst_.data();
-  for (size_t e = 0; e < ne; ++e) {
-    const double* k = Ke[e].data();
-    for (size_t i = scatter_begin_[e * T + t]; i < scatter_begin_[e * T + t + 1]; ++i)
-      values[dst[i]] += k[src[i]];
-  }
-}
-
 double* ReducedTangent::values() {
   return sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
 }
@@ -273,6 +232,10 @@ void ReducedTangent::begin_assembly(const ShellModel& model) {
     throw std::logic_error(
         "ReducedTangent::begin_assembly: the model's assembly threads changed since the "
         "reduced tangent was built");
+  zero_values();
+}
+
+void ReducedTangent::zero_values() {
   const long nv = sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : long(n_) * n_;
   std::fill(values(), values() + nv, 0.0);
 }
@@ -281,8 +244,13 @@ void ReducedTangent::element(int e, int /*thread*/, const double* kt, const int*
   double* v = values();
   const int* src = direct_src_.data();
   const int* dst = direct_dst_.data();
-  for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[map[src[i]]];
-  for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[map[held_src_[i]]];
+  if (map) {
+    for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[map[src[i]]];
+    for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[map[held_src_[i]]];
+  } else {
+    for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[src[i]];
+    for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[held_src_[i]];
+  }
 }
 
 void ReducedTangent::end_assembly() {
@@ -292,11 +260,19 @@ void ReducedTangent::end_assembly() {
 }
 
 void ReducedTangent::assemble(const std::vector<Eigen::MatrixXd>& Ke) {
-  double* v = values();
+  // The direct scatter's split, reading the stored tangents (map: the identity).
+  zero_values();
+  const int ne = std::min(static_cast<int>(direct_begin_.size()) - 1, static_cast<int>(Ke.size()));
+  const int total = static_cast<int>(direct_begin_.size()) - 1;
+  auto part = [&](int t) {
+    const auto [e0, e1] = ShellModel::element_range(total, t, threads_);
+    for (int e = e0; e < std::min(e1, ne); ++e) element(e, t, Ke[e].data(), nullptr);
+  };
   if (threads_ <= 1)
-    scatter(Ke, v, 0);
+    part(0);
   else
-    ThreadPool::shared().run(threads_, [&](int t) { scatter(Ke, v, t); });
+    ThreadPool::shared().run(threads_, part);
+  end_assembly();
 }
 
 Factorization ReducedTangent::factorize() {
