@@ -47,6 +47,9 @@ struct ShellOptions {
   /// kAutoThreadWork, one otherwise.
   int threads = 0;
   int quadrature_points = -1;  ///< per direction and element; -1: p + 1
+  /// Elements with the same basis derivatives at their points share one copy (ShellModel::
+  /// distinct_bases()); false: each its own (the reference of the test).
+  bool share_bases = true;
 };
 
 /// Fields at one sample point of the mid-surface (outputs), all in the local Cartesian frame
@@ -89,6 +92,8 @@ class ShellModel {
   /// Whether the element tangents use the sum-factorized kernel (a B-spline surface of degree
   /// 1..5 per direction; element_kernel.hpp).
   bool sum_factorized() const { return factorized_; }
+  /// Distinct tables of basis derivatives at the elements' points (ShellOptions::share_bases).
+  int distinct_bases() const { return static_cast<int>(phis_.size()); }
   /// n >= 1 threads, 0 automatic (see ShellOptions::threads).
   void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
   /// The number of threads evaluate() uses with a tangent.
@@ -149,8 +154,10 @@ class ShellModel {
   struct Element {
     Eigen::VectorXi cp;
     int first_point = 0, num_points = 0;
-    /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f).
+    /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f); only
+    /// while the model is built, then shared: phis_[phi].
     Eigen::MatrixXd PhiT;
+    int phi = -1;
     /// Tensor-product factors of PhiT (kernel::ElementTangentInput::Au, Bk), if factorized_.
     std::vector<double> Au, Bk;
   };
@@ -201,6 +208,9 @@ class ShellModel {
   bool factorized_ = false;
   int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
   int max_points_ = 0;     ///< quadrature points of the largest element
+  /// The distinct PhiT of the elements (share_phis).
+  std::vector<Eigen::MatrixXd> phis_;
+  void share_phis();
   /// Where entry (r, s) of an element tangent is in the kernel's output KT
   /// (element_tangent_blocks), for the symmetric layout ([1]: 6 component pairs, the diagonal
   /// ones possibly as lower triangles) and the full one ([0]: 9 pairs).
