@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 // The vector type never crosses a call (every helper is always inlined): no ABI concern.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -12,8 +13,10 @@ namespace knit::macro::kernel {
 
 namespace {
 
-/// Vectors of doubles (GCC vector extensions): v4 for the AVX2 version (one register), v2 for
-/// the default SSE2 version (one register; a v4 there is emulated by pairs, slower).
+/// Vectors of doubles (GCC vector extensions): v8 for the AVX-512 version, v4 for the AVX2
+/// version, v2 for the default SSE2 version (one register each; a wider vector than the
+/// instruction set's is emulated by pairs, slower).
+typedef double v8 __attribute__((vector_size(64)));
 typedef double v4 __attribute__((vector_size(32)));
 typedef double v2 __attribute__((vector_size(16)));
 
@@ -27,16 +30,25 @@ template <typename V>
 inline __attribute__((always_inline)) void store(double* p, V v) {
   std::memcpy(p, &v, sizeof v);
 }
+/// x in every lane. 512-bit vectors: lane 0 shuffled into all (one vbroadcastsd; the lane-by-lane
+/// assignment, and x - V{}, made GCC emit eight masked inserts: the AVX-512 kernel then ran
+/// slower than the AVX2 one; V{} + x costs a scalar add first); the narrower ones as before.
 template <typename V>
 inline __attribute__((always_inline)) V splat(double x) {
-  V v;
-  for (int i = 0; i < int(sizeof v / sizeof x); ++i) v[i] = x;
-  return v;
+  if constexpr (sizeof(V) == 64) {
+    const V v{x};  // x in lane 0, then broadcast (one vbroadcastsd)
+    return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
+  } else {
+    V v;
+    for (int i = 0; i < int(sizeof v / sizeof x); ++i) v[i] = x;
+    return v;
+  }
 }
 
 /// KT(c, l) = sum_k W(c, k) PhiT(l, k) for rows c in [c_begin, c_end) (rounded up to the
 /// tile) and all padded columns l, in tiles of CV vectors V of rows x 4 columns (4 CV
-/// accumulators: 8 of the 16 registers with CV = 2; tiles of 8 rows for AVX2, 4 for SSE2).
+/// accumulators: 8 of the 16 registers with CV = 2; tiles of 16 rows for AVX-512, 8 for AVX2, 4
+/// for SSE2).
 /// tri_origin >= 0: only the tiles holding some c - tri_origin <= l (a lower triangle).
 /// Always inlined, so it is compiled for the instruction set of its caller.
 template <typename V, int CV>
@@ -125,28 +137,50 @@ inline __attribute__((always_inline)) void factorized_product(const ElementTange
                             nu * ldw, rows);
 }
 
+/// W(p nl + l, 5 q + f) = sum_g H_q(3 f + i, 3 g + j) Phi_g(l, q), (i, j) = pair p: per point
+/// q and chunk of LC vectors of l, the five columns Phi_g(chunk, q) are held in registers
+/// while every (pair, f) of the point is computed from them (one store per output vector
+/// instead of five loads). Vectors in [nl, padded_functions(nl)) run into the next pair's
+/// first rows (with zeros: PhiT's padding): the chunks are taken last to first, so the next
+/// pair's own first chunk overwrites them later; the last pair's overrun stays in W's padding
+/// rows (workspace_rows).
+template <typename V, int LC>
+inline __attribute__((always_inline)) void w_columns(const ElementTangentInput& in, double* W) {
+  constexpr int lanes = sizeof(V) / sizeof(double), chunk = LC * lanes;
+  const int nl = in.nl, nlp = padded_functions(nl), ldw = workspace_rows(nl);
+  const int chunks = (nl + chunk - 1) / chunk;
+  for (int q = 0; q < in.nq; ++q) {
+    const double* Hq = in.H + 225 * q;
+    const double* Phi = in.PhiT + 5L * q * nlp;
+    for (int ch = chunks - 1; ch >= 0; --ch) {
+      const int l0 = ch * chunk;
+      V c[5][LC];
+      for (int g = 0; g < 5; ++g)
+        for (int h = 0; h < LC; ++h)
+          c[g][h] = l0 + lanes * h < nlp ? load<V>(Phi + g * nlp + l0 + lanes * h) : splat<V>(0.0);
+      for (int p = 0; p < in.pairs; ++p)
+        for (int f = 0; f < 5; ++f) {
+          const int row = 3 * f + in.pi[p], cj = in.pj[p];
+          const V h0 = splat<V>(Hq[row + 15 * cj]), h1 = splat<V>(Hq[row + 15 * (3 + cj)]),
+                  h2 = splat<V>(Hq[row + 15 * (6 + cj)]), h3 = splat<V>(Hq[row + 15 * (9 + cj)]),
+                  h4 = splat<V>(Hq[row + 15 * (12 + cj)]);
+          double* w = W + static_cast<long>(5 * q + f) * ldw + p * nl + l0;
+          for (int h = 0; h < LC; ++h)
+            if (l0 + lanes * h < nlp)
+              store<V>(w + lanes * h,
+                       h0 * c[0][h] + h1 * c[1][h] + h2 * c[2][h] + h3 * c[3][h] + h4 * c[4][h]);
+        }
+    }
+  }
+}
+
 /// The kernel's body, compiled into each version below.
 template <typename V, int CV>
 inline __attribute__((always_inline)) void blocks(const ElementTangentInput& in, double* W,
                                                   double* KT) {
   const int nl = in.nl, nlp = padded_functions(nl), ldw = workspace_rows(nl);
   const int nk = 5 * in.nq;
-  // W(p nl + l, 5 q + f) = sum_g H_q(3 f + i, 3 g + j) Phi_g(l, q), (i, j) = pair p.
-  for (int q = 0; q < in.nq; ++q) {
-    const double* Hq = in.H + 225 * q;
-    const double* c0 = in.PhiT + 5 * q * nlp;
-    const double *c1 = c0 + nlp, *c2 = c1 + nlp, *c3 = c2 + nlp, *c4 = c3 + nlp;
-    for (int p = 0; p < in.pairs; ++p)
-      for (int f = 0; f < 5; ++f) {
-        const int row = 3 * f + in.pi[p], cj = in.pj[p];
-        const double h0 = Hq[row + 15 * cj], h1 = Hq[row + 15 * (3 + cj)],
-                     h2 = Hq[row + 15 * (6 + cj)], h3 = Hq[row + 15 * (9 + cj)],
-                     h4 = Hq[row + 15 * (12 + cj)];
-        double* w = W + static_cast<long>(5 * q + f) * ldw + p * nl;
-        for (int l = 0; l < nl; ++l)
-          w[l] = h0 * c0[l] + h1 * c1[l] + h2 * c2[l] + h3 * c3[l] + h4 * c4[l];
-      }
-  }
+  w_columns<V, (sizeof(V) == 64 ? 4 : 2)>(in, W);
   if (in.Au && in.Bk && in.Y && sum_factorized(in.nu, in.nv)) {
     factorized_product<V, CV>(in, W, KT);
     return;
@@ -292,6 +326,12 @@ inline __attribute__((always_inline)) void point_matrix_body(const PointState& s
         }
 }
 
+__attribute__((target("arch=x86-64-v4"))) void point_matrix_v4(const PointState& s, const double* T,
+                                                               double dA, double* H,
+                                                               bool& symmetric, bool use_symmetry) {
+  point_matrix_body(s, T, dA, H, symmetric, use_symmetry);
+}
+
 __attribute__((target("arch=x86-64-v3"))) void point_matrix_v3(const PointState& s, const double* T,
                                                                double dA, double* H,
                                                                bool& symmetric, bool use_symmetry) {
@@ -303,6 +343,11 @@ void point_matrix_default(const PointState& s, const double* T, double dA, doubl
   point_matrix_body(s, T, dA, H, symmetric, use_symmetry);
 }
 
+__attribute__((target("arch=x86-64-v4"))) void blocks_v4(const ElementTangentInput& in, double* W,
+                                                         double* KT) {
+  blocks<v8, 2>(in, W, KT);
+}
+
 __attribute__((target("arch=x86-64-v3"))) void blocks_v3(const ElementTangentInput& in, double* W,
                                                          double* KT) {
   blocks<v4, 2>(in, W, KT);
@@ -312,42 +357,75 @@ void blocks_default(const ElementTangentInput& in, double* W, double* KT) {
   blocks<v2, 2>(in, W, KT);
 }
 
-/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version.
-inline __attribute__((always_inline)) void derivatives_body(const double* R, const double* x,
-                                                            int nl, double* d) {
-  double acc[3][6] = {};
-  for (int l = 0; l < nl; ++l)
-    for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 6; ++r) acc[i][r] += R[6 * l + r] * x[3 * l + i];
-  for (int i = 0; i < 3; ++i)
-    for (int r = 0; r < 6; ++r) d[6 * i + r] = acc[i][r];
+/// current_derivatives and add_point_forces (element_kernel.hpp), compiled into each version:
+/// contiguous vectors of l (V: one register), a lane sum at the end.
+template <typename V>
+inline __attribute__((always_inline)) double lane_sum(V v) {
+  double s = 0.0;
+  for (int k = 0; k < int(sizeof(V) / sizeof(double)); ++k) s += v[k];
+  return s;
 }
 
-inline __attribute__((always_inline)) void forces_body(const double* R, const double* g, int nl,
-                                                       double* fe) {
-  for (int l = 0; l < nl; ++l) {
-    const double* Phi = R + 6 * l + 1;
+template <typename V>
+inline __attribute__((always_inline)) void derivatives_body(const double* Phi, const double* xT,
+                                                            int nl, double* d) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  const int nlp = padded_functions(nl);
+  V acc[3][5];
+  for (int i = 0; i < 3; ++i)
+    for (int f = 0; f < 5; ++f) acc[i][f] = splat<V>(0.0);
+  for (int l0 = 0; l0 < nlp; l0 += lanes) {
+    const V x0 = load<V>(xT + l0), x1 = load<V>(xT + nlp + l0), x2 = load<V>(xT + 2 * nlp + l0);
+    for (int f = 0; f < 5; ++f) {
+      const V p = load<V>(Phi + f * nlp + l0);
+      acc[0][f] += p * x0;
+      acc[1][f] += p * x1;
+      acc[2][f] += p * x2;
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    d[6 * i] = 0.0;  // the position: not needed
+    for (int f = 0; f < 5; ++f) d[6 * i + 1 + f] = lane_sum(acc[i][f]);
+  }
+}
+
+template <typename V>
+inline __attribute__((always_inline)) void forces_body(const double* Phi, const double* g, int nl,
+                                                       double* feT) {
+  constexpr int lanes = sizeof(V) / sizeof(double);
+  const int nlp = padded_functions(nl);
+  for (int l0 = 0; l0 < nlp; l0 += lanes) {
+    V p[5];
+    for (int f = 0; f < 5; ++f) p[f] = load<V>(Phi + f * nlp + l0);
     for (int i = 0; i < 3; ++i) {
-      double acc = 0.0;
-      for (int f = 0; f < 5; ++f) acc += Phi[f] * g[3 * f + i];
-      fe[3 * l + i] += acc;
+      V a = load<V>(feT + i * nlp + l0);
+      for (int f = 0; f < 5; ++f) a += p[f] * splat<V>(g[3 * f + i]);
+      store<V>(feT + i * nlp + l0, a);
     }
   }
 }
 
-__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* R, const double* x,
+__attribute__((target("arch=x86-64-v4"))) void derivatives_v4(const double* Phi, const double* xT,
                                                               int nl, double* d) {
-  derivatives_body(R, x, nl, d);
+  derivatives_body<v8>(Phi, xT, nl, d);
 }
-void derivatives_default(const double* R, const double* x, int nl, double* d) {
-  derivatives_body(R, x, nl, d);
+__attribute__((target("arch=x86-64-v3"))) void derivatives_v3(const double* Phi, const double* xT,
+                                                              int nl, double* d) {
+  derivatives_body<v4>(Phi, xT, nl, d);
 }
-__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* R, const double* g, int nl,
-                                                         double* fe) {
-  forces_body(R, g, nl, fe);
+void derivatives_default(const double* Phi, const double* xT, int nl, double* d) {
+  derivatives_body<v2>(Phi, xT, nl, d);
 }
-void forces_default(const double* R, const double* g, int nl, double* fe) {
-  forces_body(R, g, nl, fe);
+__attribute__((target("arch=x86-64-v4"))) void forces_v4(const double* Phi, const double* g, int nl,
+                                                         double* feT) {
+  forces_body<v8>(Phi, g, nl, feT);
+}
+__attribute__((target("arch=x86-64-v3"))) void forces_v3(const double* Phi, const double* g, int nl,
+                                                         double* feT) {
+  forces_body<v4>(Phi, g, nl, feT);
+}
+void forces_default(const double* Phi, const double* g, int nl, double* feT) {
+  forces_body<v2>(Phi, g, nl, feT);
 }
 
 }  // namespace
@@ -361,46 +439,49 @@ bool cpu_has_x86_64_v3() {
   return v3;
 }
 
+bool cpu_has_x86_64_v4() {
+  static const bool v4 = [] {
+    __builtin_cpu_init();
+    return cpu_has_x86_64_v3() && __builtin_cpu_supports("avx512f") &&
+           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512cd") &&
+           __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+  }();
+  return v4;
+}
+
+Isa resolve(Isa isa) {
+  if (isa == Isa::kAuto) isa = Isa::kX86_64_v4;
+  if (isa == Isa::kX86_64_v4 && !cpu_has_x86_64_v4()) isa = Isa::kX86_64_v3;
+  if (isa == Isa::kX86_64_v3 && !cpu_has_x86_64_v3()) isa = Isa::kDefault;
+  return isa;
+}
+
+namespace {
+/// Calls the version of a kernel function that `isa` runs on this CPU.
+template <typename Fn, typename... Args>
+void dispatch(Isa isa, Fn v4, Fn v3, Fn plain, Args&&... args) {
+  const Isa run = resolve(isa);
+  const Fn fn = run == Isa::kX86_64_v4 ? v4 : (run == Isa::kX86_64_v3 ? v3 : plain);
+  fn(std::forward<Args>(args)...);
+}
+}  // namespace
+
 void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT, Isa isa) {
-  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
-  if (isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3())
-    blocks_v3(in, W, KT);
-  else
-    blocks_default(in, W, KT);
+  dispatch(isa, blocks_v4, blocks_v3, blocks_default, in, W, KT);
 }
 
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
                   Isa isa, bool use_symmetry) {
-  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
-  if (isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3())
-    point_matrix_v3(s, T, dA, H, symmetric, use_symmetry);
-  else
-    point_matrix_default(s, T, dA, H, symmetric, use_symmetry);
+  dispatch(isa, point_matrix_v4, point_matrix_v3, point_matrix_default, s, T, dA, H, symmetric,
+           use_symmetry);
 }
 
-}  // namespace knit::macro::kernel
-
-namespace knit::macro::kernel {
-
-namespace {
-bool use_v3(Isa isa) {
-  if (isa == Isa::kAuto) isa = cpu_has_x86_64_v3() ? Isa::kX86_64_v3 : Isa::kDefault;
-  return isa == Isa::kX86_64_v3 && cpu_has_x86_64_v3();
-}
-}  // namespace
-
-void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa) {
-  if (use_v3(isa))
-    derivatives_v3(R, x, nl, d);
-  else
-    derivatives_default(R, x, nl, d);
+void current_derivatives(const double* Phi, const double* xT, int nl, double* d, Isa isa) {
+  dispatch(isa, derivatives_v4, derivatives_v3, derivatives_default, Phi, xT, nl, d);
 }
 
-void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa) {
-  if (use_v3(isa))
-    forces_v3(R, g, nl, fe);
-  else
-    forces_default(R, g, nl, fe);
+void add_point_forces(const double* Phi, const double* g, int nl, double* feT, Isa isa) {
+  dispatch(isa, forces_v4, forces_v3, forces_default, Phi, g, nl, feT);
 }
 
 }  // namespace knit::macro::kernel

@@ -99,6 +99,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   stats.sparse = sparse;
   stats.symmetric = K.symmetric();
   stats.supernodal = K.supernodal();
+  stats.ordering = K.ordering();
   stats.threads = model.assembly_threads();
 
   const int nsteps = std::max(1, opt.steps);
@@ -157,13 +158,15 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     const auto t0 = Clock::now();
     const double c0 = cpu_now();
     ev_u = dofs.expand(uf, lam);
+    // The element tangents go straight into K (ReducedTangent::begin_assembly).
+    K.begin_assembly(model);
     if (trial.has_points && trial_u.size() > 0 && trial_u == ev_u) {
-      model.tangent_from(trial, ev);
+      model.tangent_from(trial, ev, &K);
       ++stats.tangents_reused;
     } else {
-      model.evaluate(ev_u, true, ev);
+      model.evaluate(ev_u, true, ev, false, &K);
     }
-    if (ev.ok) K.assemble(ev.Ke);
+    if (ev.ok) K.end_assembly();
     stats.assembly += since(t0);
     stats.assembly_cpu += cpu_now() - c0;
     return ev.ok;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "knit/macro/thread_pool.hpp"
 #include "sparse_cholmod.hpp"
@@ -109,7 +110,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
     // CHOLMOD's fill-reducing ordering, then the pattern and the scatter map rebuilt in that
     // order: the Cholesky then takes the lower triangle as it is (natural ordering), without
     // the permuted transpose it would otherwise form at every factorization.
-    perm_ = SupernodalCholesky::fill_reducing_ordering(sparse_matrix_);
+    perm_ = SupernodalCholesky::fill_reducing_ordering(sparse_matrix_, &ordering_);
     if (static_cast<int>(perm_.size()) == n_) {
       std::vector<int> inv(n_);
       for (int k = 0; k < n_; ++k) inv[perm_[k]] = k;
@@ -118,6 +119,7 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
       build_pattern(g, nd);
     } else {
       perm_.clear();
+      ordering_ = "natural";
     }
   }
   // Symbolic analysis, once per run (the LDLT's only when the Cholesky needs a fallback).
@@ -132,34 +134,33 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
 void ReducedTangent::compact_map(long values) {
   const size_t ne = block_ > 0 ? map_.size() / static_cast<size_t>(block_) : 0;
   const int T = std::max(1, threads_);
-  // Cuts of the value range into T parts of about equal numbers of entries.
-  cut_.assign(T + 1, values);
-  cut_[0] = 0;
-  if (T > 1) {
-    std::vector<int> count(values, 0);
-    long total = 0;
-    for (int dst : map_)
-      if (dst >= 0) ++count[dst], ++total;
-    long seen = 0;
-    int t = 1;
-    for (long v = 0; v < values && t < T; ++v) {
-      seen += count[v];
-      while (t < T && seen * T >= total * t) cut_[t++] = v + 1;
-    }
-  }
-  scatter_begin_.assign(ne * T + 1, 0);
-  scatter_src_.clear();
-  scatter_dst_.clear();
-  for (size_t e = 0; e < ne; ++e)
+  // The direct scatter: the first thread whose elements touch each value; an entry of a
+  // later thread to that value is held back.
+  {
+    std::vector<int> first(values, T);
     for (int t = 0; t < T; ++t) {
-      for (int k = 0; k < block_; ++k) {
-        const int dst = map_[e * block_ + k];
-        if (dst < cut_[t] || dst >= cut_[t + 1]) continue;  // also dst = -1
-        scatter_src_.push_back(k);
-        scatter_dst_.push_back(dst);
-      }
-      scatter_begin_[e * T + t + 1] = scatter_src_.size();
+      const auto [e0, e1] = ShellModel::element_range(static_cast<int>(ne), t, T);
+      for (size_t k = size_t(e0) * block_; k < size_t(e1) * block_; ++k)
+        if (map_[k] >= 0) first[map_[k]] = std::min(first[map_[k]], t);
     }
+    direct_begin_.assign(ne + 1, 0);
+    held_begin_.assign(ne + 1, 0);
+    direct_src_.clear(), direct_dst_.clear(), held_src_.clear(), held_dst_.clear();
+    for (int t = 0; t < T; ++t) {
+      const auto [e0, e1] = ShellModel::element_range(static_cast<int>(ne), t, T);
+      for (int e = e0; e < e1; ++e) {
+        for (int k = 0; k < block_; ++k) {
+          const int dst = map_[size_t(e) * block_ + k];
+          if (dst < 0) continue;
+          (first[dst] == t ? direct_src_ : held_src_).push_back(k);
+          (first[dst] == t ? direct_dst_ : held_dst_).push_back(dst);
+        }
+        direct_begin_[e + 1] = direct_src_.size();
+        held_begin_[e + 1] = held_src_.size();
+      }
+    }
+    held_.assign(held_src_.size(), 0.0);
+  }
   std::vector<int>().swap(map_);
 }
 
@@ -222,25 +223,56 @@ long ReducedTangent::stored_entries() const {
   return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
 }
 
-void ReducedTangent::scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values, int t) const {
-  const int T = std::max(1, threads_);
-  std::fill(values + cut_[t], values + cut_[t + 1], 0.0);
-  const size_t ne = std::min(Ke.size(), (scatter_begin_.size() - 1) / T);
-  const int* src = scatter_src_.data();
-  const int* dst = scatter_dst_.data();
-  for (size_t e = 0; e < ne; ++e) {
-    const double* k = Ke[e].data();
-    for (size_t i = scatter_begin_[e * T + t]; i < scatter_begin_[e * T + t + 1]; ++i)
-      values[dst[i]] += k[src[i]];
+double* ReducedTangent::values() {
+  return sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
+}
+
+void ReducedTangent::begin_assembly(const ShellModel& model) {
+  if (model.assembly_threads() != threads_)
+    throw std::logic_error(
+        "ReducedTangent::begin_assembly: the model's assembly threads changed since the "
+        "reduced tangent was built");
+  zero_values();
+}
+
+void ReducedTangent::zero_values() {
+  const long nv = sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : long(n_) * n_;
+  std::fill(values(), values() + nv, 0.0);
+}
+
+void ReducedTangent::element(int e, int /*thread*/, const double* kt, const int* map) {
+  double* v = values();
+  const int* src = direct_src_.data();
+  const int* dst = direct_dst_.data();
+  if (map) {
+    for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[map[src[i]]];
+    for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[map[held_src_[i]]];
+  } else {
+    for (size_t i = direct_begin_[e]; i < direct_begin_[e + 1]; ++i) v[dst[i]] += kt[src[i]];
+    for (size_t i = held_begin_[e]; i < held_begin_[e + 1]; ++i) held_[i] = kt[held_src_[i]];
   }
 }
 
+void ReducedTangent::end_assembly() {
+  // In thread order, each thread's elements in order (compact_map stored them so).
+  double* v = values();
+  for (size_t i = 0; i < held_.size(); ++i) v[held_dst_[i]] += held_[i];
+}
+
 void ReducedTangent::assemble(const std::vector<Eigen::MatrixXd>& Ke) {
-  double* v = sparse_ ? sparse_matrix_.valuePtr() : dense_.data();
+  // The direct scatter's split, reading the stored tangents (map: the identity).
+  zero_values();
+  const int ne = std::min(static_cast<int>(direct_begin_.size()) - 1, static_cast<int>(Ke.size()));
+  const int total = static_cast<int>(direct_begin_.size()) - 1;
+  auto part = [&](int t) {
+    const auto [e0, e1] = ShellModel::element_range(total, t, threads_);
+    for (int e = e0; e < std::min(e1, ne); ++e) element(e, t, Ke[e].data(), nullptr);
+  };
   if (threads_ <= 1)
-    scatter(Ke, v, 0);
+    part(0);
   else
-    ThreadPool::shared().run(threads_, [&](int t) { scatter(Ke, v, t); });
+    ThreadPool::shared().run(threads_, part);
+  end_assembly();
 }
 
 Factorization ReducedTangent::factorize() {

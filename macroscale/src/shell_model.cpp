@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <thread>
 
@@ -41,7 +42,7 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   const int nel = static_cast<int>(su.size() * sv.size());
   elements_.resize(nel);
   points_.reserve(static_cast<size_t>(nel) * nqu * nqv);
-  R_.resize(6, static_cast<Eigen::Index>(nloc_) * nel * nqu * nqv);
+  R_.resize(1, static_cast<Eigen::Index>(nloc_) * nel * nqu * nqv);
   spline::SurfaceBasis sb;
   std::vector<Eigen::Vector2d> thetas;
   int e = 0;
@@ -61,7 +62,7 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
           Point pt;
           pt.ref = reference_point(dX, Eigen::Vector2d(u, v), scale_);
           pt.dA = w * pt.ref.jacobian;
-          R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 6, nloc_) = sb.R;
+          R_.block(0, static_cast<Eigen::Index>(points_.size()) * nloc_, 1, nloc_) = sb.R.row(0);
           el.PhiT.conservativeResize(kernel::padded_functions(nloc_), el.PhiT.cols() + 5);
           el.PhiT.rightCols(5).setZero();
           el.PhiT.rightCols(5).topRows(nloc_) = sb.R.bottomRows(5).transpose();
@@ -76,6 +77,27 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   nqu_ = nqu, nqv_ = nqv;
   for (const Element& el : elements_) max_points_ = std::max(max_points_, el.num_points);
   factorize_elements(su, sv, gu, gv);
+  share_phis();
+  // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l) for pair p = (i, j); symmetric layout:
+  // pairs (0,1), (0,2), (1,2), (0,0), (1,1), (2,2), K_ij(l, m) = K_ji(m, l) for i > j, and a
+  // diagonal pair's K(l, m) = K(m, l) read where l >= m (all that evaluate_range's copy reads).
+  const int nl = nloc_, nd = 3 * nl, ldw = kernel::workspace_rows(nl);
+  constexpr int kSymPair[3][3] = {{3, 0, 1}, {0, 4, 2}, {1, 2, 5}};
+  for (const bool sym : {false, true}) {
+    std::vector<int>& map = kt_map_[sym];
+    map.resize(static_cast<size_t>(nd) * nd);
+    for (int m = 0; m < nl; ++m)
+      for (int j = 0; j < 3; ++j)
+        for (int l = 0; l < nl; ++l)
+          for (int i = 0; i < 3; ++i) {
+            int at = l * ldw + (3 * i + j) * nl + m;
+            if (sym) {
+              const int p = kSymPair[i][j];
+              at = (i < j || (i == j && l >= m)) ? l * ldw + p * nl + m : m * ldw + p * nl + l;
+            }
+            map[(3 * l + i) + static_cast<size_t>(nd) * (3 * m + j)] = at;
+          }
+  }
 }
 
 void ShellModel::factorize_elements(const std::vector<std::pair<double, double>>& su,
@@ -124,6 +146,34 @@ void ShellModel::factorize_elements(const std::vector<std::pair<double, double>>
     for (Element& el : elements_) el.Au.clear(), el.Bk.clear();
 }
 
+void ShellModel::share_phis() {
+  // Elements whose basis derivatives at their points agree (uniform knot spans away from the
+  // patch's edges: at p = 4, 16 x 100 elements, 49 distinct of 1,600) share one PhiT; the
+  // elements' 32 KB each (p = 4) were read by every residual and tangent pass (51 MB at
+  // 16 x 100). A candidate is found by its entries rounded to 1e-9 of its largest and taken
+  // when it agrees to 1e-13 (round-off of the basis evaluation at shifted knots); otherwise the
+  // element keeps its own.
+  std::map<std::vector<long long>, int> seen;
+  std::vector<long long> key;
+  for (Element& el : elements_) {
+    const Eigen::MatrixXd& P = el.PhiT;
+    const double big = P.size() > 0 ? P.cwiseAbs().maxCoeff() : 0.0;
+    key.resize(static_cast<size_t>(P.size()));
+    for (Eigen::Index k = 0; k < P.size(); ++k)
+      key[k] = big > 0.0 ? std::llround(P.data()[k] / big * 1e9) : 0;
+    const auto it = opt_.share_bases ? seen.find(key) : seen.end();
+    if (it != seen.end() && phis_[it->second].cols() == P.cols() &&
+        (phis_[it->second] - P).cwiseAbs().maxCoeff() <= 1e-13 * big) {
+      el.phi = it->second;
+    } else {
+      el.phi = static_cast<int>(phis_.size());
+      phis_.push_back(P);
+      seen.emplace(key, el.phi);
+    }
+    el.PhiT.resize(0, 0);
+  }
+}
+
 SectionResponse ShellModel::section(const Eigen::Vector3d& Ec, const Eigen::Vector3d& Kc,
                                     const Eigen::Vector2d& theta, int point_id) const {
   MaterialPoint where;
@@ -159,8 +209,8 @@ ShellModel::Workspace& ShellModel::workspace() const {
   const int nl = nloc_;
   if (w.nl != nl || w.maxq != max_points_ || w.factorized != factorized_) {
     const size_t rows = kernel::workspace_rows(nl);
-    w.xloc.assign(3 * nl, 0.0);
-    w.fe.assign(3 * nl, 0.0);
+    w.xloc.assign(3 * kernel::padded_functions(nl), 0.0);
+    w.fe.assign(3 * kernel::padded_functions(nl), 0.0);
     w.H.assign(size_t(225) * max_points_, 0.0);
     w.W.assign(rows * 5 * max_points_, 0.0);
     w.KT.assign(rows * kernel::padded_functions(nl), 0.0);
@@ -171,15 +221,13 @@ ShellModel::Workspace& ShellModel::workspace() const {
 }
 
 bool ShellModel::run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                            Evaluation& out) const {
-  const int ne = num_elements();
+                            Evaluation& out, ElementTangentSink* sink) const {
   const int nth = assembly_threads();
-  if (nth == 1) return evaluate_range(0, ne, u, pass, from, out, workspace());
+  if (nth == 1) return evaluate_range(0, 1, u, pass, from, out, sink, workspace());
   // The process-wide pool: threads started once, not per call.
   std::vector<char> oks(nth, 1);
-  ThreadPool::shared().run(nth, [&](int k) {
-    oks[k] = evaluate_range(ne * k / nth, ne * (k + 1) / nth, u, pass, from, out, workspace());
-  });
+  ThreadPool::shared().run(
+      nth, [&](int k) { oks[k] = evaluate_range(k, nth, u, pass, from, out, sink, workspace()); });
   bool ok = true;
   for (int k = 0; k < nth; ++k) ok = ok && oks[k];
   return ok;
@@ -192,17 +240,20 @@ void allocate_tangents(std::vector<Eigen::MatrixXd>& Ke, int ne, int n) {
 }
 }  // namespace
 
-void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
-                          bool keep_points) const {
+void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out, bool keep_points,
+                          ElementTangentSink* sink) const {
   const int ne = num_elements();
   out.fe.resize(3 * nloc_, ne);
   out.element_energy.resize(ne);
-  if (tangent) allocate_tangents(out.Ke, ne, 3 * nloc_);
+  if (!tangent) sink = nullptr;
+  if (tangent && !sink) allocate_tangents(out.Ke, ne, 3 * nloc_);
+  if (sink) out.Ke.clear();
   const bool keep = keep_points && !tangent;
   if (keep) out.points.resize(points_.size());
   out.has_points = false;
-  const bool ok = run_ranges(
-      &u, tangent ? Pass::kTangent : (keep ? Pass::kResidualKeep : Pass::kResidual), nullptr, out);
+  const bool ok =
+      run_ranges(&u, tangent ? Pass::kTangent : (keep ? Pass::kResidualKeep : Pass::kResidual),
+                 nullptr, out, sink);
   out.ok = ok;
   out.has_points = ok && keep;
   out.fint.setZero(num_dofs());
@@ -217,14 +268,18 @@ void ShellModel::evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& ou
   }
 }
 
-void ShellModel::tangent_from(const Evaluation& from, Evaluation& out) const {
+void ShellModel::tangent_from(const Evaluation& from, Evaluation& out,
+                              ElementTangentSink* sink) const {
   if (!from.ok || !from.has_points)
     throw std::logic_error("ShellModel::tangent_from: the evaluation kept no point states");
   out.fint = from.fint;
   out.energy = from.energy;
   out.has_points = false;
-  allocate_tangents(out.Ke, num_elements(), 3 * nloc_);
-  out.ok = run_ranges(nullptr, Pass::kTangentFromStates, &from, out);
+  if (sink)
+    out.Ke.clear();
+  else
+    allocate_tangents(out.Ke, num_elements(), 3 * nloc_);
+  out.ok = run_ranges(nullptr, Pass::kTangentFromStates, &from, out, sink);
 }
 
 double ShellModel::energy(const Eigen::VectorXd& u) const {
@@ -240,15 +295,14 @@ inline void copy3(const Eigen::Vector3d& v, double* d) {
 }
 }  // namespace
 
-bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, double& energy,
-                                double* fe) const {
+bool ShellModel::residual_point(int pid, const double* Phi, const double* xT, PointState& s,
+                                double& energy, double* feT) const {
   const int nl = nloc_;
   const Point& pt = points_[pid];
-  const double* R = R_.data() + static_cast<Eigen::Index>(pid) * nl * 6;  // R[6 l + r]
-  // dx = R xloc as a sum of outer products (contiguous columns of R; element_kernel.cpp, built
-  // for both instruction sets).
-  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r
-  kernel::current_derivatives(R, xloc, nl, dx.data());
+  // dx = R x over contiguous vectors of the element's functions (element_kernel.cpp, built for
+  // each instruction set).
+  SurfaceDerivs dx;  // 6 x 3 column-major: dx(r, i) at 6 i + r (row 0 not computed)
+  kernel::current_derivatives(Phi, xT, nl, dx.data());
   const CurrentPoint c = current_point(dx, pt.ref);
   if (!(c.j > 1e-12 * pt.ref.jacobian) || !c.eps.allFinite() || !c.kap.allFinite()) return false;
   const Eigen::Matrix3d& T = pt.ref.T;
@@ -276,7 +330,7 @@ bool ShellModel::residual_point(int pid, const double* xloc, PointState& s, doub
     g[9 + i] = -dA * 2.0 * M(2) * s.a3[i];
     g[12 + i] = -dA * M(1) * s.a3[i];
   }
-  kernel::add_point_forces(R, g, nl, fe);
+  kernel::add_point_forces(Phi, g, nl, feT);
   return true;
 }
 
@@ -285,15 +339,20 @@ void ShellModel::point_matrix(int pid, const PointState& s, double* H, bool& sym
   kernel::point_matrix(s, pt.ref.T.data(), pt.dA, H, symmetric);
 }
 
-bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass,
-                                const Evaluation* from, Evaluation& out, Workspace& ws) const {
+bool ShellModel::evaluate_range(int thread, int threads, const Eigen::VectorXd* u, Pass pass,
+                                const Evaluation* from, Evaluation& out, ElementTangentSink* sink,
+                                Workspace& ws) const {
+  const auto [e0, e1] = element_range(num_elements(), thread, threads);
   const Eigen::MatrixXd& P = surface_.control_points();
   const int nl = nloc_;
   const bool tangent = pass == Pass::kTangent || pass == Pass::kTangentFromStates;
   const bool stored = pass == Pass::kTangentFromStates;
-  // The thread's workspace (Workspace: sized once per model, never allocated here).
-  std::vector<double>& xloc = ws.xloc;
-  std::vector<double>& fe = ws.fe;
+  // The thread's workspace (Workspace: sized once per model, never allocated here). xT and feT:
+  // the element's control points and forces, component-major with padded_functions(nl) rows
+  // (the kernel's layout; the padding stays zero).
+  const int nlp = kernel::padded_functions(nl);
+  std::vector<double>& xT = ws.xloc;
+  std::vector<double>& feT = ws.fe;
   double* Hs = ws.H.data();
   PointState& local = ws.local;
   for (int e = e0; e < e1; ++e) {
@@ -302,17 +361,20 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
     if (!stored) {
       for (int l = 0; l < nl; ++l) {
         const int a = el.cp(l);
-        for (int i = 0; i < 3; ++i) xloc[3 * l + i] = P(a, i) + (*u)(3 * a + i);
+        for (int i = 0; i < 3; ++i) xT[i * nlp + l] = P(a, i) + (*u)(3 * a + i);
       }
-      std::fill(fe.begin(), fe.end(), 0.0);
+      std::fill(feT.begin(), feT.end(), 0.0);
       double energy = 0.0;
       for (int q = 0; q < el.num_points; ++q) {
         const int pid = el.first_point + q;
         PointState& s = pass == Pass::kResidualKeep ? out.points[pid] : local;
-        if (!residual_point(pid, xloc.data(), s, energy, fe.data())) return false;
+        const double* Phi = phis_[el.phi].data() + 5L * q * nlp;
+        if (!residual_point(pid, Phi, xT.data(), s, energy, feT.data())) return false;
         if (tangent) point_matrix(pid, s, Hs + 225 * q, symmetric);
       }
-      std::copy(fe.begin(), fe.end(), out.fe.col(e).data());
+      double* fe = out.fe.col(e).data();
+      for (int l = 0; l < nl; ++l)
+        for (int i = 0; i < 3; ++i) fe[3 * l + i] = feT[i * nlp + l];
       out.element_energy(e) = energy;
     } else {
       for (int q = 0; q < el.num_points; ++q) {
@@ -342,7 +404,7 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
     kernel::ElementTangentInput kin;
     kin.nl = nl;
     kin.nq = el.num_points;
-    kin.PhiT = el.PhiT.data();
+    kin.PhiT = phis_[el.phi].data();
     kin.H = Hs;
     kin.pairs = pairs;
     kin.pi = pi;
@@ -358,6 +420,10 @@ bool ShellModel::evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass p
       kin.Y = ws.Y.data();
     }
     kernel::element_tangent_blocks(kin, ws.W.data(), ws.KT.data());
+    if (sink) {
+      sink->element(e, thread, ws.KT.data(), kt_map_[symmetric].data());
+      continue;
+    }
     Eigen::MatrixXd& Ke = out.Ke[e];
     // Ke(3 l + i, 3 m + j) = K_ij(l, m) = KT(p nl + m, l): written down Ke's columns (stride 3)
     // and, for a symmetric law, the mirror Ke(3 m + j, 3 l + i) likewise.

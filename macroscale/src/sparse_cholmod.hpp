@@ -5,10 +5,10 @@
 // (configured with -DKNIT_WITH_CHOLMOD=OFF or not found) available() is false and the shell
 // uses Eigen's SimplicialLDLT.
 //
-// Used by ReducedTangent on the sparse symmetric path: the fill-reducing ordering (chosen by
-// CHOLMOD among AMD and METIS) and the symbolic analysis (supernodal elimination tree) once per
-// run,
-// then per Newton iteration a numeric supernodal L L^T. An indefinite matrix (past a limit or
+// Used by ReducedTangent on the sparse symmetric path: the fill-reducing ordering (CHOLMOD's
+// AMD or METIS, or the matrix's own order: the fewest flops) and the symbolic analysis
+// (supernodal elimination tree) once per run, then per Newton iteration a numeric supernodal
+// L L^T. An indefinite matrix (past a limit or
 // bifurcation point) makes factorize() return kNotPositiveDefinite; the caller then uses an
 // LDL^T that counts the negative pivots.
 #pragma once
@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace knit::macro {
@@ -32,11 +33,13 @@ class SupernodalCholesky {
   SupernodalCholesky(const SupernodalCholesky&) = delete;
   SupernodalCholesky& operator=(const SupernodalCholesky&) = delete;
 
-  /// CHOLMOD's fill-reducing ordering of the pattern of `lower` (the lower triangle of a
-  /// symmetric matrix in compressed columns, sorted row indices; AMD, or METIS when AMD's
-  /// fill is high, postordered): row k of the factor is row perm[k] of the matrix. Empty if
-  /// CHOLMOD failed (or is absent).
-  static std::vector<int> fill_reducing_ordering(const Eigen::SparseMatrix<double>& lower);
+  /// The fill-reducing ordering of the pattern of `lower` (the lower triangle of a symmetric
+  /// matrix in compressed columns, sorted row indices): CHOLMOD's (AMD, or METIS when AMD's
+  /// fill is high) or the matrix's own order, whichever needs fewer flops, postordered. Row k
+  /// of the factor is row perm[k] of the matrix. Empty if CHOLMOD failed (or is absent).
+  /// `chosen`: set to the ordering taken ("natural", "AMD", "METIS").
+  static std::vector<int> fill_reducing_ordering(const Eigen::SparseMatrix<double>& lower,
+                                                 std::string* chosen = nullptr);
   /// Symbolic analysis of the pattern of `lower`, taken in its own order (permute it by
   /// fill_reducing_ordering() first). Returns false if CHOLMOD failed (or is absent).
   bool analyze(const Eigen::SparseMatrix<double>& lower);

@@ -9,7 +9,7 @@
 #    iteration split into assembly and solve, as wall and as CPU time (on a loaded machine
 #    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT
 #    instead of CHOLMOD's supernodal Cholesky.
-# Figures of 30 Nov 2026: docs/solver.md "Benchmark" (rounds 1-3). A solver change must leave the results
+# Figures of 30 Nov 2026: docs/solver.md "Benchmark" (rounds 1-4). A solver change must leave the results
 # unchanged: run the same case before and after and compare the two results.h5 with
 # scripts/bench/compare_results.py (1e-8 relative).
 # Usage: scripts/bench/solver.sh [BUILD_DIR] [CATCH_TEST_NAME_FILTER]

@@ -60,6 +60,14 @@ Problem random_tensor_problem(int nu, int nv, int nqu, int nqv, unsigned seed) {
   return p;
 }
 
+/// The instruction-set versions this CPU runs.
+std::vector<kernel::Isa> available_isas() {
+  std::vector<kernel::Isa> isas = {kernel::Isa::kDefault};
+  if (kernel::cpu_has_x86_64_v3()) isas.push_back(kernel::Isa::kX86_64_v3);
+  if (kernel::cpu_has_x86_64_v4()) isas.push_back(kernel::Isa::kX86_64_v4);
+  return isas;
+}
+
 /// K_ij(l, m) = sum_q sum_fg Phi_f(l, q) H_q(3f+i, 3g+j) Phi_g(m, q), summed directly.
 double reference(const Problem& p, int i, int j, int l, int m) {
   const int nlp = kernel::padded_functions(p.nl);
@@ -117,8 +125,7 @@ TEST_CASE("element kernel: both instruction-set versions match the direct sum", 
   // p = 4 (25 functions, 25 points: padding in l and in the row tiles), p = 2 (9, 9), and an
   // odd 6 x 4 = 24-function element with 12 points.
   const int shapes[3][2] = {{25, 25}, {9, 9}, {24, 12}};
-  std::vector<kernel::Isa> isas = {kernel::Isa::kDefault};
-  if (kernel::cpu_has_x86_64_v3()) isas.push_back(kernel::Isa::kX86_64_v3);
+  const std::vector<kernel::Isa> isas = available_isas();
   for (const auto& s : shapes)
     for (const bool symmetric : {true, false})
       for (const kernel::Isa isa : isas) {
@@ -135,8 +142,7 @@ TEST_CASE(
   // p = 4 (5 x 5 functions and points), p = 2, an anisotropic 6 x 3 element with 4 x 2
   // points, and 7 x 2 functions (outside sum_factorized: the direct product).
   const int shapes[4][4] = {{5, 5, 5, 5}, {3, 3, 3, 3}, {6, 3, 4, 2}, {7, 2, 3, 3}};
-  std::vector<kernel::Isa> isas = {kernel::Isa::kDefault};
-  if (kernel::cpu_has_x86_64_v3()) isas.push_back(kernel::Isa::kX86_64_v3);
+  const std::vector<kernel::Isa> isas = available_isas();
   for (const auto& s : shapes)
     for (const bool symmetric : {true, false})
       for (const kernel::Isa isa : isas) {
@@ -151,8 +157,8 @@ TEST_CASE(
 TEST_CASE("element kernel: the point matrix H agrees between the instruction-set versions",
           "[unit]") {
   // Correctness of H itself: the shell tangent against finite differences
-  // (test_shell_element.cpp); here the x86-64-v3 (FMA) build of the same code against the
-  // default one, to round-off.
+  // (test_shell_element.cpp); here the x86-64-v3 (FMA) and x86-64-v4 (AVX-512) builds of the
+  // same code against the default one, to round-off.
   if (!kernel::cpu_has_x86_64_v3()) return;
   std::mt19937 gen(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -171,21 +177,24 @@ TEST_CASE("element kernel: the point matrix H agrees between the instruction-set
         for (int c = 0; c <= r; ++c) X[r + 3 * c] = X[c + 3 * r] = u(gen);
     if (!sym) s.D[1] += 0.5;
     double H0[225], H1[225];
-    bool sym0 = true, sym1 = true;
+    bool sym0 = true;
     kernel::point_matrix(s, T, 0.7, H0, sym0, kernel::Isa::kDefault);
-    kernel::point_matrix(s, T, 0.7, H1, sym1, kernel::Isa::kX86_64_v3);
     CHECK(sym0 == sym);
-    CHECK(sym1 == sym);
-    double err = 0.0, big = 0.0;
-    for (int k = 0; k < 225; ++k) {
-      err = std::max(err, std::abs(H0[k] - H1[k]));
-      big = std::max(big, std::abs(H0[k]));
+    for (const auto isa : available_isas()) {
+      bool sym1 = true;
+      kernel::point_matrix(s, T, 0.7, H1, sym1, isa);
+      CHECK(sym1 == sym);
+      double err = 0.0, big = 0.0;
+      for (int k = 0; k < 225; ++k) {
+        err = std::max(err, std::abs(H0[k] - H1[k]));
+        big = std::max(big, std::abs(H0[k]));
+      }
+      CAPTURE(int(isa), err, big);
+      CHECK(err <= 1e-13 * big);
     }
-    CAPTURE(err, big);
-    CHECK(err <= 1e-13 * big);
     // The material part from its lower triangle (symmetric section tangent) against the full
-    // product G^T E (the reference), both instruction sets.
-    for (const auto isa : {kernel::Isa::kDefault, kernel::Isa::kX86_64_v3}) {
+    // product G^T E (the reference), every instruction set.
+    for (const auto isa : available_isas()) {
       double Hf[225], Hl[225];
       bool symf = true, syml = true;
       kernel::point_matrix(s, T, 0.7, Hf, symf, isa, false);
@@ -205,37 +214,40 @@ TEST_CASE("element kernel: the point matrix H agrees between the instruction-set
   }
 }
 
-TEST_CASE("element kernel: the residual's loops agree with the plain sums in both versions",
+TEST_CASE("element kernel: the residual's loops agree with the plain sums in every version",
           "[unit]") {
-  // kernel::current_derivatives (dx = R x) and kernel::add_point_forces (fe += Phi^T g) against
-  // the plain triple sums, for the default and the x86-64-v3 build, 1e-13 relative.
+  // kernel::current_derivatives (dx = R x) and kernel::add_point_forces (fe += Phi^T g), in the
+  // PhiT layout (component-major, padded_functions(nl) rows, zero padding), against the plain
+  // sums, for every instruction set this CPU runs, 1e-13 relative.
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (const int nl : {4, 9, 25, 36}) {
-    std::vector<double> R(6 * nl), x(3 * nl), g(15), fe0(3 * nl);
-    for (double& v : R) v = u(gen);
-    for (double& v : x) v = u(gen);
+    const int nlp = kernel::padded_functions(nl);
+    std::vector<double> Phi(5 * nlp, 0.0), xT(3 * nlp, 0.0), g(15), fe0(3 * nlp, 0.0);
+    for (int l = 0; l < nl; ++l) {
+      for (int f = 0; f < 5; ++f) Phi[f * nlp + l] = u(gen);
+      for (int i = 0; i < 3; ++i) xT[i * nlp + l] = u(gen), fe0[i * nlp + l] = u(gen);
+    }
     for (double& v : g) v = u(gen);
-    for (double& v : fe0) v = u(gen);
     double dref[18] = {};
     std::vector<double> feref = fe0;
     for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 6; ++r)
-        for (int l = 0; l < nl; ++l) dref[6 * i + r] += R[6 * l + r] * x[3 * l + i];
+      for (int f = 0; f < 5; ++f)
+        for (int l = 0; l < nl; ++l) dref[6 * i + 1 + f] += Phi[f * nlp + l] * xT[i * nlp + l];
     for (int l = 0; l < nl; ++l)
       for (int i = 0; i < 3; ++i)
-        for (int f = 0; f < 5; ++f) feref[3 * l + i] += R[6 * l + 1 + f] * g[3 * f + i];
-    for (const auto isa : {kernel::Isa::kDefault, kernel::Isa::kX86_64_v3}) {
+        for (int f = 0; f < 5; ++f) feref[i * nlp + l] += Phi[f * nlp + l] * g[3 * f + i];
+    for (const auto isa : available_isas()) {
       double d[18];
-      kernel::current_derivatives(R.data(), x.data(), nl, d, isa);
+      kernel::current_derivatives(Phi.data(), xT.data(), nl, d, isa);
       std::vector<double> fe = fe0;
-      kernel::add_point_forces(R.data(), g.data(), nl, fe.data(), isa);
+      kernel::add_point_forces(Phi.data(), g.data(), nl, fe.data(), isa);
       double ed = 0.0, bd = 0.0, ef = 0.0, bf = 0.0;
       for (int k = 0; k < 18; ++k)
         ed = std::max(ed, std::abs(d[k] - dref[k])), bd = std::max(bd, std::abs(dref[k]));
-      for (int k = 0; k < 3 * nl; ++k)
+      for (int k = 0; k < 3 * nlp; ++k)
         ef = std::max(ef, std::abs(fe[k] - feref[k])), bf = std::max(bf, std::abs(feref[k]));
-      CAPTURE(nl, ed, bd, ef, bf);
+      CAPTURE(nl, int(isa), ed, bd, ef, bf);
       CHECK(ed <= 1e-13 * bd);
       CHECK(ef <= 1e-13 * bf);
     }

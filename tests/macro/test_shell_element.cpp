@@ -207,3 +207,34 @@ TEST_CASE("a degenerate reference geometry is reported with its location", "[uni
     CHECK(std::string(e.what()).find("theta1, theta2") != std::string::npos);
   }
 }
+
+TEST_CASE("elements sharing their basis tables give the tangent and forces of their own tables",
+          "[unit]") {
+  // A curved p = 4 B-spline patch of 10 x 10 uniform elements: the interior elements' basis
+  // derivatives agree, so ShellOptions::share_bases keeps 81 tables for 100 elements (9 per
+  // direction: 4 spans at each edge differ); the internal forces, energy and element tangents at a
+  // deformed state agree with those of the model whose elements keep their own tables (the
+  // reference) to round-off.
+  const spline::SplineSurface flat = curved_patch(4, 4, 10, 10, 1.0, 1.0, 0.3, false);
+  auto mat = std::make_shared<SaintVenantKirchhoff>(3.0, 0.3);
+  ShellOptions own;
+  own.share_bases = false;
+  const ShellModel shared(flat, 0.1, mat), reference(flat, 0.1, mat, own);
+  CHECK(shared.distinct_bases() == 49);
+  CHECK(reference.distinct_bases() == shared.num_elements());
+  Eigen::VectorXd u = Eigen::VectorXd::Random(shared.num_dofs()) * 0.05;
+  ShellModel::Evaluation a, b;
+  shared.evaluate(u, true, a);
+  reference.evaluate(u, true, b);
+  REQUIRE(a.ok);
+  REQUIRE(b.ok);
+  CHECK((a.fint - b.fint).norm() <= 1e-13 * b.fint.norm());
+  CHECK(std::abs(a.energy - b.energy) <= 1e-13 * std::abs(b.energy));
+  double err = 0.0, big = 0.0;
+  for (int e = 0; e < shared.num_elements(); ++e) {
+    err = std::max(err, (a.Ke[e] - b.Ke[e]).cwiseAbs().maxCoeff());
+    big = std::max(big, b.Ke[e].cwiseAbs().maxCoeff());
+  }
+  CAPTURE(err, big);
+  CHECK(err <= 1e-13 * big);
+}

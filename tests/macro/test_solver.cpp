@@ -114,6 +114,39 @@ TEST_CASE(
   CHECK(r[0].rows.back().negative_pivots == -1);
 }
 
+TEST_CASE("the supernodal Cholesky in the DOF order (a strip meshed along its short side)",
+          "[unit]") {
+  // The tensile strip at p = 4, 3 x 12 elements: the DOFs numbered along the short side are a
+  // band that needs fewer flops than AMD, so fill_reducing_ordering keeps that order; the Sze
+  // cantilever (meshed along its long side) gets AMD. The natural-order Cholesky against the
+  // SimplicialLDLT (AMD, the reference): the same load-strain curve.
+  json j = verification_case("tensile_svk.json");
+  j["refinement"]["degree"] = 4;
+  j["refinement"]["elements"] = {3, 12};
+  j["solver"]["steps"] = 2;
+  const RunResult a = run(j, [](Case& c) { c.solver.linear_solver = LinearSolver::kSparse; });
+  const RunResult b = run(j, [](Case& c) {
+    c.solver.linear_solver = LinearSolver::kSparse;
+    c.solver.supernodal = false;
+  });
+  REQUIRE(a.report.status == RunStatus::kCompleted);
+  REQUIRE(b.report.status == RunStatus::kCompleted);
+  if (ReducedTangent::supernodal_available()) CHECK(a.report.stats.ordering == "natural");
+  CHECK_FALSE(b.report.stats.supernodal);
+  REQUIRE(a.rows.size() == b.rows.size());
+  for (size_t s = 0; s < a.rows.size(); ++s) {
+    CHECK(a.rows[s].iterations == b.rows[s].iterations);
+    CHECK(std::abs(a.rows[s].reactions[0] - b.rows[s].reactions[0]) <=
+          1e-8 * std::abs(b.rows[s].reactions[0]));
+    CHECK((a.rows[s].points[0] - b.rows[s].points[0]).norm() <= 1e-8 * b.rows[s].points[0].norm());
+  }
+  json sze = verification_case("sze_cantilever.json");
+  sze["refinement"]["elements"] = {16, 1};
+  sze["solver"]["steps"] = 1;
+  const RunResult c = run(sze, [](Case& x) { x.solver.linear_solver = LinearSolver::kSparse; });
+  if (ReducedTangent::supernodal_available()) CHECK(c.report.stats.ordering == "AMD");
+}
+
 TEST_CASE("LDLT inertia: a strip compressed past its limit point reports negative pivots",
           "[unit]") {
   // 1-D SVK bar: P = E A s (s^2 - 1)/2 peaks at the stretch s = 1/sqrt(3) = 0.577. The end is

@@ -48,12 +48,13 @@ void print(const char* label, const Timing& t) {
   const SolverStats& s = t.report.stats;
   const double it = std::max<long>(1, s.iterations);
   std::printf(
-      "solver %-36s n=%5d %s %-5s thr=%d  wall %7.3f s cpu %7.3f s  %4ld it  per it: %6.2f ms "
+      "solver %-36s n=%5d %s %-5s %-7s thr=%d  wall %7.3f s cpu %7.3f s  %4ld it  per it: %6.2f ms "
       "assembly "
       "%6.2f ms solve  (+%5.2f ms residuals)  setup %.3f s  cpu per it: %6.2f ms assembly %6.2f "
       "ms solve %5.2f ms residuals  (%ld tangents from residual passes)  %s\n",
       label, s.unknowns, s.sparse ? "sparse" : "dense ",
-      s.supernodal ? "LLT" : (s.symmetric ? "LDLT" : "LU"), s.threads, t.wall, t.cpu, s.iterations,
+      s.supernodal ? "LLT" : (s.symmetric ? "LDLT" : "LU"),
+      s.ordering.empty() ? "-" : s.ordering.c_str(), s.threads, t.wall, t.cpu, s.iterations,
       1e3 * s.assembly / it, 1e3 * s.solve / it, 1e3 * s.residuals / it, s.setup,
       1e3 * s.assembly_cpu / it, 1e3 * s.solve_cpu / it, 1e3 * s.residuals_cpu / it,
       s.tangents_reused, t.report.status == RunStatus::kCompleted ? "" : t.report.message.c_str());

@@ -2,10 +2,11 @@
 //
 //   K_ij(l, m) = sum_q sum_fg Phi_f(l, q) H_q(3f+i, 3g+j) Phi_g(m, q)
 //
-// for the component pairs (i, j) of one element, as W = [(H_q Phi)_ij] (plain axpy loops) and
-// one product Phi^T W^T in register tiles of 8 x 4 (GCC vector extensions). Compiled twice
-// (GCC's target attribute): for x86-64-v3 (AVX2 + FMA) and for the default x86-64, chosen at
-// run time by the CPU; the binary still runs on any x86-64. The file includes no Eigen
+// for the component pairs (i, j) of one element, as W = [(H_q Phi)_ij] (per point, the point's
+// Phi columns held in registers) and one product Phi^T W^T in register tiles (GCC vector
+// extensions). Compiled three times (GCC's target attribute): for x86-64-v4 (AVX-512), for
+// x86-64-v3 (AVX2 + FMA) and for the default x86-64, the widest the CPU has chosen at run time;
+// the binary still runs on any x86-64. The file includes no Eigen
 // (Eigen's inline functions compiled for two instruction sets in one program would clash:
 // compiling shell_model.cpp alone with -mavx2 crashed), and it is compiled with
 // -ffp-contract=fast (macroscale/CMakeLists.txt) so that a * b + c becomes one FMA in the
@@ -15,13 +16,15 @@
 namespace knit::macro::kernel {
 
 /// Padding of the element's local-function count nl: rows of PhiT and of the output are
-/// allocated for padded_functions(nl) (the extra rows of PhiT must be zero).
+/// allocated for padded_functions(nl) (the extra rows of PhiT must be zero): a multiple of 8,
+/// one AVX-512 vector.
 constexpr int padded_functions(int nl) {
-  return (nl + 3) / 4 * 4;
+  return (nl + 7) / 8 * 8;
 }
-/// Rows of the workspace W: 9 component pairs of nl plus the overrun of the last 8-wide tile.
+/// Rows of the workspace W: 9 component pairs of nl plus the overrun of the last 16-wide tile
+/// (AVX-512; 8 for AVX2).
 constexpr int workspace_rows(int nl) {
-  return 9 * nl + 8;
+  return (9 * nl + 16 + 7) / 8 * 8;
 }
 
 struct ElementTangentInput {
@@ -81,12 +84,17 @@ inline double bending_vector(const PointState& s, double* v, double* w) {
 }
 
 enum class Isa {
-  kAuto,       ///< x86-64-v3 when the CPU has it, else the default
+  kAuto,       ///< the widest the CPU has: x86-64-v4, else x86-64-v3, else the default
   kDefault,    ///< SSE2 (any x86-64)
   kX86_64_v3,  ///< AVX2 + FMA (falls back to the default on a CPU without them)
+  kX86_64_v4,  ///< AVX-512 F/DQ/CD/BW/VL (falls back to x86-64-v3, then the default)
 };
 /// Whether this CPU runs the x86-64-v3 version (AVX2, FMA, BMI2).
 bool cpu_has_x86_64_v3();
+/// Whether this CPU runs the x86-64-v4 version (x86-64-v3 and AVX-512 F, DQ, CD, BW, VL).
+bool cpu_has_x86_64_v4();
+/// The version `isa` runs on this CPU (kAuto and unsupported versions resolved).
+Isa resolve(Isa isa);
 
 /// Fills KT (workspace_rows(nl) x padded_functions(nl), column-major):
 ///   KT(p nl + m, l) = K_{pi[p] pj[p]}(l, m)
@@ -104,13 +112,18 @@ void element_tangent_blocks(const ElementTangentInput& in, double* W, double* KT
 void point_matrix(const PointState& s, const double* T, double dA, double* H, bool& symmetric,
                   Isa isa = Isa::kAuto, bool use_symmetry = true);
 
-/// The residual's two loops over the element's functions at one point, compiled for both
-/// instruction sets like the kernel (the rest of shell_model.cpp is built for the default
-/// x86-64): R holds the nl functions' (R, R_1, R_2, R_11, R_12, R_22) at R[6 l + r].
-///   current_derivatives: d[6 i + r] = sum_l R[6 l + r] x[3 l + i]   (dx = R x, column-major
-///                        6 x 3)
-///   add_point_forces:    fe[3 l + i] += sum_f R[6 l + 1 + f] g[3 f + i]   (f = 0..4)
-void current_derivatives(const double* R, const double* x, int nl, double* d, Isa isa = Isa::kAuto);
-void add_point_forces(const double* R, const double* g, int nl, double* fe, Isa isa = Isa::kAuto);
+/// The residual's two loops over the element's functions at one point, compiled for each
+/// instruction set like the kernel (the rest of shell_model.cpp is built for the default
+/// x86-64), in the layout of the kernel's PhiT: Phi holds the point's five columns
+/// Phi_f(l) = Phi[f nlp + l] (f = R_1, R_2, R_11, R_12, R_22; nlp = padded_functions(nl), the
+/// padding zero), xT the element's current control points x_i(l) = xT[i nlp + l] (padding
+/// zero), feT the element forces fe_i(l) = feT[i nlp + l]:
+///   current_derivatives: d[6 i + 1 + f] = sum_l Phi_f(l) x_i(l)  (dx = R x, column-major 6 x 3;
+///                        row 0, the position, is set to 0: not needed)
+///   add_point_forces:    fe_i(l) += sum_f Phi_f(l) g[3 f + i]
+void current_derivatives(const double* Phi, const double* xT, int nl, double* d,
+                         Isa isa = Isa::kAuto);
+void add_point_forces(const double* Phi, const double* g, int nl, double* feT,
+                      Isa isa = Isa::kAuto);
 
 }  // namespace knit::macro::kernel

@@ -109,6 +109,7 @@ struct SolverStats {
   long stored_entries = 0;  ///< of the reduced matrix
   bool sparse = false, symmetric = false;
   bool supernodal = false;  ///< the sparse symmetric path tries the supernodal Cholesky
+  std::string ordering;     ///< its fill-reducing ordering (ReducedTangent::ordering())
   int threads = 1;          ///< assembly threads
 };
 

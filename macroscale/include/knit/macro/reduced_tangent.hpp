@@ -48,7 +48,7 @@ struct Factorization {
   double pivot_ratio = 0.0;  ///< min |pivot| / max |pivot|
 };
 
-class ReducedTangent {
+class ReducedTangent : public ElementTangentSink {
  public:
   /// Pivot ratio below which the tangent counts as singular. Round-off leaves a pivot of
   /// ~1e-16 max|pivot| on an exactly singular matrix; the thinnest shells here (h/L = 1e-2)
@@ -61,7 +61,7 @@ class ReducedTangent {
   /// when the build has no CHOLMOD).
   ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse,
                  bool supernodal = true);
-  ~ReducedTangent();
+  ~ReducedTangent() override;
   ReducedTangent(const ReducedTangent&) = delete;
   ReducedTangent& operator=(const ReducedTangent&) = delete;
 
@@ -71,18 +71,38 @@ class ReducedTangent {
   /// Whether the sparse symmetric path factorizes by the supernodal Cholesky (with the
   /// SimplicialLDLT as the fallback for indefinite tangents).
   bool supernodal() const { return supernodal_; }
+  /// The supernodal path's fill-reducing ordering ("natural": the DOF order, "AMD", "METIS";
+  /// SupernodalCholesky::fill_reducing_ordering takes the one with the fewest flops); empty on
+  /// the other paths.
+  const std::string& ordering() const { return ordering_; }
   /// Whether the build has the supernodal Cholesky (CHOLMOD found at configure time).
   static bool supernodal_available();
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
   long stored_entries() const;
 
   /// Scatters the element tangents into the reduced matrix (values reset first), on the
-  /// model's assembly threads (ShellModel::assembly_threads() when this was built): each
-  /// thread owns a contiguous range of the values, and every value is summed in element
-  /// order, so the matrix is bitwise the same for any number of threads.
+  /// model's assembly threads (ShellModel::assembly_threads() when this was built), split as
+  /// the direct assembly below (each thread its elements' entries, the ones to values of an
+  /// earlier thread's elements held back and added after): every value is summed in element
+  /// order, so the matrix is bitwise the same for any number of threads. The one scatter of
+  /// the dense and sparse paths.
   void assemble(const std::vector<Eigen::MatrixXd>& Ke);
   /// Threads of assemble().
   int scatter_threads() const { return threads_; }
+
+  /// Assembly straight from the element kernel (no element tangents stored): begin_assembly()
+  /// zeroes the values, `model`.evaluate(u, true, ev, false, this) (or tangent_from) scatters
+  /// each element tangent where the kernel leaves it (element(), on the assembly thread that
+  /// computed it), end_assembly() adds the entries held back. Thread t adds an entry directly
+  /// when no element of an earlier thread touches its value, and holds it back otherwise; the
+  /// held-back ones are added after the threads joined, in thread, element and entry order. So
+  /// every value is summed in element order, as by assemble(): the matrix is bitwise the same
+  /// (tested). `model` must use the assembly threads it had when this was built (else
+  /// std::logic_error).
+  void begin_assembly(const ShellModel& model);
+  /// (map nullptr: kt is the element tangent itself, column-major.)
+  void element(int e, int thread, const double* kt, const int* map) override;
+  void end_assembly();
   /// Numeric factorization of the assembled matrix (the symbolic analysis is reused).
   Factorization factorize();
   /// Solves with the last successful factorization.
@@ -91,11 +111,6 @@ class ReducedTangent {
   Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
 
  private:
-  /// values[map[e][k]] += Ke[e].data()[k] for every element e and mapped entry k with the
-  /// value in part t's range [cut_[t], cut_[t + 1]) (the compacted map, scatter_*), after
-  /// zeroing that range: the one scatter of the dense and sparse paths, part t on thread t.
-  void scatter(const std::vector<Eigen::MatrixXd>& Ke, double* values, int t) const;
-
   void analyze_ldlt();  ///< symbolic analysis of the SimplicialLDLT (once, when first needed)
   /// The compressed-column pattern of the reduced matrix and the scatter map, from the
   /// (stored) index g of every local DOF of every element (nd per element, -1 if constrained).
@@ -107,20 +122,23 @@ class ReducedTangent {
   bool symmetric_ = false, sparse_ = false, supernodal_ = false;
   int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
   std::vector<int> map_;  ///< block_ entries per element: value index or -1 (construction only)
-  /// The scatter map without its -1 entries (half of them on the symmetric path), split into
-  /// threads_ parts by value index: the entries i in [scatter_begin_[e threads_ + t],
-  /// scatter_begin_[e threads_ + t + 1]) of element e and part t add Ke[e].data()[scatter_src_[i]]
-  /// to values[scatter_dst_[i]]; part t's values are [cut_[t], cut_[t + 1]) (equal shares of
-  /// the entries).
-  std::vector<size_t> scatter_begin_;
-  std::vector<int> scatter_src_, scatter_dst_;
-  std::vector<long> cut_;
   int threads_ = 1;
-  /// map_ -> scatter_* in `threads` parts of the `values` values (then frees map_).
+  /// map_ -> the scatter's entries below, without the -1 entries (half of them on the
+  /// symmetric path), for the element split of threads_ threads (then frees map_).
   void compact_map(long values);
+  /// The direct scatter (begin_assembly): element e's entries [direct_begin_[e],
+  /// direct_begin_[e + 1]) add its tangent's entry direct_src_[i] (r + nd s) to
+  /// values[direct_dst_[i]]; its held-back entries [held_begin_[e], held_begin_[e + 1]) are
+  /// copied to held_[i] and added to values[held_dst_[i]] by end_assembly().
+  std::vector<size_t> direct_begin_, held_begin_;
+  std::vector<int> direct_src_, direct_dst_, held_src_, held_dst_;
+  std::vector<double> held_;
+  double* values();
+  void zero_values();
   /// Supernodal path: stored row/column k of the sparse matrix is unknown perm_[k] (CHOLMOD's
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;
+  std::string ordering_;
   Eigen::MatrixXd dense_;
   Eigen::SparseMatrix<double> sparse_matrix_;
   struct Factors;  ///< the Eigen factorizations and the Cholesky (reduced_tangent.cpp)

@@ -47,6 +47,9 @@ struct ShellOptions {
   /// kAutoThreadWork, one otherwise.
   int threads = 0;
   int quadrature_points = -1;  ///< per direction and element; -1: p + 1
+  /// Elements with the same basis derivatives at their points share one copy (ShellModel::
+  /// distinct_bases()); false: each its own (the reference of the test).
+  bool share_bases = true;
 };
 
 /// Fields at one sample point of the mid-surface (outputs), all in the local Cartesian frame
@@ -57,6 +60,18 @@ struct ShellSample {
   Eigen::Vector3d kappa = Eigen::Vector3d::Zero();  ///< curvature change (k11, k22, 2k12)
   Eigen::Vector3d n = Eigen::Vector3d::Zero();      ///< membrane forces N/mm
   Eigen::Vector3d m = Eigen::Vector3d::Zero();      ///< bending moments N mm/mm
+};
+
+/// Receives each element tangent where the kernel leaves it, instead of a copy into
+/// ShellModel::Evaluation::Ke (ReducedTangent scatters it into the reduced matrix from there: at
+/// p = 4 no 45 KB per element written to memory and read back). Entry (r, s) of element e's
+/// tangent (local DOFs r = 3 l + i, s) is kt[map[r + 3 nloc s]]. element() is called on
+/// assembly thread `thread` of `threads`, which evaluates the elements
+/// ShellModel::element_range(ne, thread, threads) in increasing order.
+class ElementTangentSink {
+ public:
+  virtual ~ElementTangentSink() = default;
+  virtual void element(int e, int thread, const double* kt, const int* map) = 0;
 };
 
 class ShellModel {
@@ -77,10 +92,16 @@ class ShellModel {
   /// Whether the element tangents use the sum-factorized kernel (a B-spline surface of degree
   /// 1..5 per direction; element_kernel.hpp).
   bool sum_factorized() const { return factorized_; }
+  /// Distinct tables of basis derivatives at the elements' points (ShellOptions::share_bases).
+  int distinct_bases() const { return static_cast<int>(phis_.size()); }
   /// n >= 1 threads, 0 automatic (see ShellOptions::threads).
   void set_threads(int n) { opt_.threads = n < 0 ? 0 : n; }
   /// The number of threads evaluate() uses with a tangent.
   int assembly_threads() const;
+  /// The elements [first, second) that thread k of n evaluates (of ne elements).
+  static std::pair<int, int> element_range(int ne, int k, int n) {
+    return {static_cast<int>(long(ne) * k / n), static_cast<int>(long(ne) * (k + 1) / n)};
+  }
   /// Element work (quadrature points x local DOFs^2) above which the automatic setting uses
   /// every hardware thread: measured on 2 cores, a tangent evaluation of this size takes
   /// ~2 ms, 20x the cost of starting the threads.
@@ -107,12 +128,14 @@ class ShellModel {
   /// after the first call), the assembly threads are a process-wide pool (ThreadPool::shared():
   /// concurrent evaluations of several models take turns on it).
   /// `keep_points` (without `tangent`): also keep the PointStates for tangent_from.
-  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out,
-                bool keep_points = false) const;
+  /// `sink` (with `tangent`): each element tangent goes to the sink, out.Ke is left empty.
+  void evaluate(const Eigen::VectorXd& u, bool tangent, Evaluation& out, bool keep_points = false,
+                ElementTangentSink* sink = nullptr) const;
   /// The evaluation with tangent at the displacement of `from` (evaluated with keep_points, ok):
   /// the element tangents from its point states, fint, energy and ok copied. Bitwise the same
-  /// as evaluate(u, true, out) (the same operations on the same numbers).
-  void tangent_from(const Evaluation& from, Evaluation& out) const;
+  /// as evaluate(u, true, out) (the same operations on the same numbers). `sink`: as in evaluate.
+  void tangent_from(const Evaluation& from, Evaluation& out,
+                    ElementTangentSink* sink = nullptr) const;
   /// Psi(u) alone (NaN unless hyperelastic, or if the configuration degenerated).
   double energy(const Eigen::VectorXd& u) const;
 
@@ -131,8 +154,10 @@ class ShellModel {
   struct Element {
     Eigen::VectorXi cp;
     int first_point = 0, num_points = 0;
-    /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f).
+    /// nloc x (5 num_points): R_1, R_2, R_11, R_12, R_22 at each point (column 5 q + f); only
+    /// while the model is built, then shared: phis_[phi].
     Eigen::MatrixXd PhiT;
+    int phi = -1;
     /// Tensor-product factors of PhiT (kernel::ElementTangentInput::Au, Bk), if factorized_.
     std::vector<double> Au, Bk;
   };
@@ -143,8 +168,8 @@ class ShellModel {
   enum class Pass { kResidual, kResidualKeep, kTangent, kTangentFromStates };
   /// Runs evaluate_range over the elements on assembly_threads() threads; false if any range
   /// failed.
-  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                  Evaluation& out) const;
+  bool run_ranges(const Eigen::VectorXd* u, Pass pass, const Evaluation* from, Evaluation& out,
+                  ElementTangentSink* sink) const;
   void factorize_elements(const std::vector<std::pair<double, double>>& su,
                           const std::vector<std::pair<double, double>>& sv,
                           const spline::QuadratureRule& gu, const spline::QuadratureRule& gv);
@@ -152,12 +177,15 @@ class ShellModel {
   struct Workspace;
   /// The calling thread's workspace, sized (and zeroed) for this model when it does not fit.
   Workspace& workspace() const;
-  bool evaluate_range(int e0, int e1, const Eigen::VectorXd* u, Pass pass, const Evaluation* from,
-                      Evaluation& out, Workspace& ws) const;
+  bool evaluate_range(int thread, int threads, const Eigen::VectorXd* u, Pass pass,
+                      const Evaluation* from, Evaluation& out, ElementTangentSink* sink,
+                      Workspace& ws) const;
   /// Residual part at one point: the point state, dA psi, and the element force
-  /// contributions fe(l, i) += sum_f Phi_f(l) g(3f+i) (fe: nl x 3 row-major). False if the
-  /// configuration degenerated there.
-  bool residual_point(int pid, const double* xloc, PointState& s, double& energy, double* fe) const;
+  /// contributions fe_i(l) += sum_f Phi_f(l) g(3f+i) (Phi: the point's columns of PhiT; xT and
+  /// feT: the element's control points and forces, kernel::current_derivatives' layout). False
+  /// if the configuration degenerated there.
+  bool residual_point(int pid, const double* Phi, const double* xT, PointState& s, double& energy,
+                      double* feT) const;
   /// The 15 x 15 matrix H at one point (column-major) from its state; clears `symmetric` if
   /// the section tangent is not.
   void point_matrix(int pid, const PointState& s, double* H, bool& symmetric) const;
@@ -171,13 +199,22 @@ class ShellModel {
   int nloc_ = 0;
   std::vector<Element> elements_;
   std::vector<Point> points_;
-  Eigen::MatrixXd R_;  ///< 6 x (nloc * num points): basis derivatives at every quadrature point
+  /// 1 x (nloc * num points): the basis functions at every quadrature point (area loads; the
+  /// derivatives are in each Element's PhiT)
+  Eigen::MatrixXd R_;
   double scale_ = 1.0;
   /// Every element's Phi is the tensor product of its 1D bases (a B-spline surface, checked
   /// numerically) and small enough for the sum-factorized kernel.
   bool factorized_ = false;
   int nqu_ = 0, nqv_ = 0;  ///< quadrature points per direction
   int max_points_ = 0;     ///< quadrature points of the largest element
+  /// The distinct PhiT of the elements (share_phis).
+  std::vector<Eigen::MatrixXd> phis_;
+  void share_phis();
+  /// Where entry (r, s) of an element tangent is in the kernel's output KT
+  /// (element_tangent_blocks), for the symmetric layout ([1]: 6 component pairs, the diagonal
+  /// ones possibly as lower triangles) and the full one ([0]: 9 pairs).
+  std::vector<int> kt_map_[2];
 };
 
 }  // namespace knit::macro
