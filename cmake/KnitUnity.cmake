@@ -39,12 +39,17 @@ endfunction()
 if(CMAKE_BUILD_TYPE STREQUAL "Release")
   set(knit_hot_default -O3)
   set(knit_cold_default -O1)
+  set(knit_tests_default -O1)
 else()
   set(knit_hot_default "")
   set(knit_cold_default "")
+  set(knit_tests_default "")
 endif()
 set(KNIT_OPT_HOT "${knit_hot_default}" CACHE STRING "Compile options of the numerical kernels (Release: -O3)")
 set(KNIT_OPT_COLD "${knit_cold_default}" CACHE STRING "Compile options of the run-once code: CLI, input, output, reports (Release: -O1)")
+# The test files (tests/CMakeLists.txt): their compile time is mostly the front end (Catch2's
+# macros, Eigen and JSON templates), their run time mostly the library code they call.
+set(KNIT_OPT_TESTS "${knit_tests_default}" CACHE STRING "Compile options of the test files (Release: -O1)")
 
 # knit_split_cold(<hot var> <cold var> <source dir> <stems...>): splits the list in <hot var>
 # into the sources <source dir>/<stem>.cpp (appended to <cold var>) and the rest (left in
@@ -64,7 +69,7 @@ function(knit_split_cold hot_var cold_var dir)
   set(${cold_var} ${cold} PARENT_SCOPE)
 endfunction()
 
-# knit_opt_level(<target> HOT|COLD): the target's sources get KNIT_OPT_HOT or KNIT_OPT_COLD
+# knit_opt_level(<target> HOT|COLD|TESTS): the target's sources get KNIT_OPT_<level>
 # (after the build type's flags, so they win).
 function(knit_opt_level target level)
   if(KNIT_OPT_${level})

@@ -18,10 +18,13 @@ san="$root/build-sanitize"
 gen=()
 command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
 # -O1 with line tables only: what ASan recommends, and about half the compile time of -O2 -g.
-# (Build type None: KNIT_OPT_HOT/KNIT_OPT_COLD are empty, so every file gets these flags; the
-# unity groups of the sources and tests apply as in Release. docs/build.md.)
+# The code that runs once per process (CLI, input, output, Catch2's runner: KNIT_OPT_COLD) and
+# the test files (KNIT_OPT_TESTS) at -Og: under ASan + UBSan they compile in ~35-50 % less time
+# than at -O1 (-O0 saves no more, and made the tests that refine or fuzz cases several times
+# slower); the library's numerical code, where the tests spend their time, stays at -O1
+# (KNIT_OPT_HOT empty). Build type None; the unity groups apply as in Release (docs/build.md).
 cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
-  -DKNIT_SANITIZE=ON >/dev/null
+  -DKNIT_OPT_COLD=-Og -DKNIT_OPT_TESTS=-Og -DKNIT_SANITIZE=ON >/dev/null
 cmake --build "$san" --parallel "$jobs"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
