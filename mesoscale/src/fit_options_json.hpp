@@ -1,0 +1,35 @@
+// Reading the fit options' numbers from JSON (knit-meso fit --options / --energy-options, the
+// sweep's "fit" and "energy_fit"): one place for the type and range checks of both fits.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "knit/core/errors.hpp"
+
+namespace knit::meso::fit {
+
+/// j[key] into v if present: an integer that fits an int, checked before narrowing
+/// (get<int>() of 4294967297 gave 1: issue 14). Errors name file and pointer + "/" + key.
+inline void read_int_option(const nlohmann::json& j, const char* key, const std::string& file,
+                            const std::string& pointer, int& v) {
+  if (!j.contains(key)) return;
+  const nlohmann::json& x = j[key];
+  const std::string p = pointer + "/" + key;
+  if (!x.is_number_integer()) throw InputError(file, p, "must be an integer");
+  if (x.is_number_unsigned() ? x.get<unsigned long long>() > 2147483647ull
+                             : (x.get<long long>() < -2147483648ll ||
+                                x.get<long long>() > 2147483647ll))
+    throw InputError(file, p, "must fit a 32-bit integer, got " + x.dump());
+  v = x.get<int>();
+}
+
+/// j[key] into v if present: a number (JSON has no NaN or infinity; 1e400 fails the parse).
+inline void read_double_option(const nlohmann::json& j, const char* key, const std::string& file,
+                               const std::string& pointer, double& v) {
+  if (!j.contains(key)) return;
+  if (!j[key].is_number()) throw InputError(file, pointer + "/" + key, "must be a number");
+  v = j[key].get<double>();
+}
+
+}  // namespace knit::meso::fit
