@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fit_energy_data.hpp"
+#include "fit_options_json.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -247,16 +248,9 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
       throw InputError(file, pointer + "/" + it.key(), "unknown energy-fit option");
-  auto get_int = [&](const char* k, int& v) {
-    if (!j.contains(k)) return;
-    if (!j[k].is_number_integer()) throw InputError(file, pointer + "/" + k, "must be an integer");
-    v = j[k].get<int>();
-  };
-  auto get_double = [&](const char* k, double& v) {
-    if (!j.contains(k)) return;
-    if (!j[k].is_number()) throw InputError(file, pointer + "/" + k, "must be a number");
-    v = j[k].get<double>();
-  };
+  auto get_int = [&](const char* k, int& v) { read_int_option(j, k, file, pointer, v); };
+  auto get_double = [&](const char* k, double& v) { read_double_option(j, k, file, pointer, v); };
+
   get_int("s_degree", o.s_degree);
   get_int("s_spans", o.s_spans);
   get_int("l_degree", o.l_degree);

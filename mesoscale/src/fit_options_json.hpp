@@ -17,9 +17,9 @@ inline void read_int_option(const nlohmann::json& j, const char* key, const std:
   const nlohmann::json& x = j[key];
   const std::string p = pointer + "/" + key;
   if (!x.is_number_integer()) throw InputError(file, p, "must be an integer");
-  if (x.is_number_unsigned() ? x.get<unsigned long long>() > 2147483647ull
-                             : (x.get<long long>() < -2147483648ll ||
-                                x.get<long long>() > 2147483647ll))
+  if (x.is_number_unsigned()
+          ? x.get<unsigned long long>() > 2147483647ull
+          : (x.get<long long>() < -2147483648ll || x.get<long long>() > 2147483647ll))
     throw InputError(file, p, "must fit a 32-bit integer, got " + x.dump());
   v = x.get<int>();
 }

@@ -11,6 +11,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "fit_options_json.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -167,22 +168,9 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
   }
   if (!j.is_object()) throw InputError(file, "", "fit options must be a JSON object");
   FitOptions o;
-  auto get_int = [&](const char* k, int& v) {
-    if (!j.contains(k)) return;
-    if (!j[k].is_number_integer())
-      throw InputError(file, std::string("/") + k, "must be an integer");
-    // Range before narrowing: get<int>() of 4294967297 gave 1 (issue 14).
-    if (j[k].is_number_unsigned()
-            ? j[k].get<unsigned long long>() > 2147483647ull
-            : (j[k].get<long long>() < -2147483648ll || j[k].get<long long>() > 2147483647ll))
-      throw InputError(file, std::string("/") + k, "must fit a 32-bit integer, got " + j[k].dump());
-    v = j[k].get<int>();
-  };
-  auto get_double = [&](const char* k, double& v) {
-    if (!j.contains(k)) return;
-    if (!j[k].is_number()) throw InputError(file, std::string("/") + k, "must be a number");
-    v = j[k].get<double>();
-  };
+  auto get_int = [&](const char* k, int& v) { read_int_option(j, k, file, "", v); };
+  auto get_double = [&](const char* k, double& v) { read_double_option(j, k, file, "", v); };
+
   static const char* known[] = {"degree_1",           "degree_2",
                                 "control_points_1",   "control_points_2",
                                 "shear_degree",       "shear_control_points",

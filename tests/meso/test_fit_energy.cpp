@@ -9,6 +9,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/material/energy_law.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
+#include "knit/meso/fit/response_fit.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 
 using namespace knit::meso::fit;
@@ -212,6 +213,11 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("family must be"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 0})", "f.json"),
                       Catch::Contains("hidden1 and hidden2"));
+    // Range before narrowing: 2^32 + 12 was read as 12 (the same check as the eq. 17 fit's).
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 4294967308})", "f.json"),
+                      Catch::Contains("/hidden1") && Catch::Contains("32-bit"));
+    CHECK_THROWS_WITH(FitOptions::from_json(R"({"degree_1": 4294967299})", "f.json"),
+                      Catch::Contains("/degree_1") && Catch::Contains("32-bit"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"smooth": 1})", "f.json"),
                       Catch::Contains("/smooth: unknown energy-fit option"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"directions": [[1, 0]]})", "f.json"),
