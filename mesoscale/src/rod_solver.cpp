@@ -1,6 +1,8 @@
 // Newton-Raphson with SparseLU and load stepping with cut-back (see solver.hpp).
 #include "knit/meso/rod/solver.hpp"
 
+#include "knit/meso/rod/triplet_assembler.hpp"
+
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
@@ -11,9 +13,11 @@ namespace {
 
 // The symbolic analysis (column ordering, elimination tree) depends on the sparsity pattern
 // only; it is reused across Newton iterations and load steps while the pattern is unchanged
-// (contact may change it: then it is redone). One workspace per thread.
+// (contact may change it: then it is redone). The matrix is assembled with a reused pattern
+// (TripletAssembler). One workspace per thread.
 struct LinearWorkspace {
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  TripletAssembler assembler;
   std::vector<int> outer, inner;
   bool analyzed = false;
 
@@ -55,7 +59,6 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
   NewtonReport rep;
   const int N = sys.num_dofs();
   Eigen::VectorXd F(N);
-  Eigen::SparseMatrix<double> J(N, N);
   std::vector<Eigen::Triplet<double>> trip;
   thread_local LinearWorkspace ws;
   auto& lu = ws.lu;
@@ -86,8 +89,7 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
       rep.message = "maximum number of iterations reached";
       return rep;
     }
-    J.setFromTriplets(trip.begin(), trip.end());
-    J.makeCompressed();
+    const Eigen::SparseMatrix<double>& J = ws.assembler.build(trip, N);
     if (!ws.same_pattern(J)) ws.analyze(J);
     lu.factorize(J);
     if (lu.info() != Eigen::Success) {
