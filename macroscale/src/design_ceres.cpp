@@ -140,7 +140,7 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.linear_solver_type = ceres::DENSE_QR;
   o.max_num_iterations = opt.max_iterations;
   o.parameter_tolerance = opt.x_tolerance;
-  o.function_tolerance = 1e-6;  // relative change of J: the last digits do not matter
+  o.function_tolerance = opt.function_tolerance;  // relative change of J
   o.gradient_tolerance = 1e-12;
   o.logging_type = ceres::SILENT;
   o.minimizer_progress_to_stdout = false;

@@ -42,6 +42,7 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, bool co
 DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options) {
   OptimizeOptions o = options;
   o.max_iterations = d.optimizer.max_iterations;
+  o.function_tolerance = d.optimizer.function_tolerance;
   return d.optimizer.method == DesignOptimizerSpec::Method::kCeres
              ? optimize_design_ceres(d, o)
              : optimize_design_projected(d, o);
@@ -108,6 +109,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
       const DesignEvaluation e = evaluate_design(d, xt);
       count(e);
       if (e.status == RunStatus::kCompleted && e.J <= cur.J + 1e-4 * dir_dot) {
+        if (cur.J - e.J <= opt.function_tolerance * cur.J) converged = true;
         res.x = xt;
         cur = e;
         accepted = true;
@@ -117,6 +119,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
       }
     }
     record(it);
+    if (converged) break;
     if (!accepted) {
       if (moved) res.message = "no descent step found (the best design is kept)";
       converged = converged || moved;

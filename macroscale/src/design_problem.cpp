@@ -235,6 +235,13 @@ void read_optimizer(const json& j, const std::string& file, DesignOptimizerSpec&
       throw InputError(file, "/optimizer/max_iterations", "must be an integer in 1..10000");
     o.max_iterations = static_cast<int>(n);
   }
+  if (j.contains("function_tolerance")) {
+    const double t = number(j.at("function_tolerance"), file, "/optimizer/function_tolerance");
+    if (!(t > 0 && t < 1))
+      throw InputError(file, "/optimizer/function_tolerance",
+                       "must be a fraction of J in (0, 1), e.g. 1e-6");
+    o.function_tolerance = t;
+  }
 }
 
 }  // namespace

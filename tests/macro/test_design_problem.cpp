@@ -127,6 +127,10 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
                     {"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}])",
                 kObjs),
          "/variables/1/indices");
+  expect("function_tolerance.json",
+         R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
+             R"(, "optimizer": {"function_tolerance": 0}})",
+         "/optimizer/function_tolerance");
   expect("unknown_key.json",
          R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
              R"(, "optimizer": "lbfgs"})",
@@ -192,5 +196,13 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
     CHECK(r.x[0] >= 4.5);
     CHECK(r.x[0] <= 6.5);
     CHECK(r.history.back().J < r.history.front().J);
+    // A loose function tolerance stops at the first step that lowers J by less than 99 % of J
+    // (Ceres then keeps the point before that step; the projected gradient takes it).
+    DesignProblem loose = twin;
+    loose.optimizer.function_tolerance = 0.99;
+    const DesignResult l = optimize_design(loose);
+    CHECK(l.status == DesignStatus::kConverged);
+    CHECK(l.history.size() < r.history.size());
+    CHECK(l.history.back().J <= l.history.front().J);
   }
 }

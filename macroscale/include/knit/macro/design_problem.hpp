@@ -48,6 +48,9 @@ struct DesignOptimizerSpec {
   enum class Method { kCeres, kProjectedGradient };
   Method method = Method::kCeres;
   int max_iterations = 30;
+  /// Converged when an accepted step lowers J by less than this fraction of J (choice: 1e-6,
+  /// the last digits do not matter; a larger value stops a slow tail earlier).
+  double function_tolerance = 1e-6;
 };
 
 struct DesignProblem {
@@ -110,12 +113,14 @@ namespace knit::macro {
 ///    the variable with the largest gradient by 10 % of its bound interval; accepted steps
 ///    double the next trial, rejected ones halve it.
 /// Both stop when a step changes no variable by more than `x_tolerance` times its interval,
-/// or after `max_iterations`. The result's status: kConverged, kIterationLimit,
+/// when an accepted step lowers J by less than `function_tolerance` times J, or after
+/// `max_iterations`. The result's status: kConverged, kIterationLimit,
 /// kInfeasible (converged with J above `feasible` x J0 and a variable on a bound: the target
 /// is out of reach inside the bounds; the best design is kept) or kFailed (a solve failed).
 struct OptimizeOptions {
   int max_iterations = 30;
   double x_tolerance = 1e-6;
+  double function_tolerance = 1e-6;
   /// J / J0 below which a converged design counts as meeting its targets.
   double feasible = 1e-6;
 };
