@@ -18,6 +18,7 @@ namespace {
 struct LinearWorkspace {
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
   TripletAssembler assembler;
+  std::vector<Eigen::Triplet<double>> trip;
   std::vector<int> outer, inner;
   bool analyzed = false;
 
@@ -59,8 +60,9 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
   NewtonReport rep;
   const int N = sys.num_dofs();
   Eigen::VectorXd F(N);
-  std::vector<Eigen::Triplet<double>> trip;
   thread_local LinearWorkspace ws;
+  // The list keeps its capacity from call to call (the cell's lists reach 250,000 triplets).
+  std::vector<Eigen::Triplet<double>>& trip = ws.trip;
   auto& lu = ws.lu;
   trip.reserve(static_cast<size_t>(N) * 40);
   for (int it = 0;; ++it) {
