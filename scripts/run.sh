@@ -13,15 +13,17 @@ if [ -f "$root/scripts/pipeline.mk" ]; then
   # step, which needs knit-meso only) runs while knit-macro is compiled: the cores idle at
   # neither's serial ends (the last compiles and links; the sweep's last cases and its fit).
   # docs/build.md "Main job".
+  # The background job also draws what needs knit-meso only (make target meso: Figs. 5 and 6,
+  # the sensitivity figure) once the database is there.
   "$root/scripts/build.sh" "$root/build" knit-meso
-  "${pipeline[@]}" database &
+  "${pipeline[@]}" meso &
   db_pid=$!
   build_rc=0
   "$root/scripts/build.sh" "$root/build" knit-macro || build_rc=$?
   db_rc=0
   wait "$db_pid" || db_rc=$?
   [ "$build_rc" -eq 0 ] || { echo "run: building knit-macro failed"; exit "$build_rc"; }
-  [ "$db_rc" -eq 0 ] || { echo "run: the material database failed (see $out/logs)"; exit "$db_rc"; }
+  [ "$db_rc" -eq 0 ] || { echo "run: the material database (make target meso) failed (see $out/logs)"; exit "$db_rc"; }
   "${pipeline[@]}" -j"$(nproc)" all
   grep -m1 '^\*\*Summary' "$out/report.md" | sed 's/\*\*//g; s/^/run: /' || true
   echo "run: report in $out/report.md (figures in $out/figures, results in $out/results)"
