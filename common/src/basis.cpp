@@ -1,6 +1,7 @@
 #include "knit/spline/basis.hpp"
 
 #include <cassert>
+#include <type_traits>
 
 namespace knit::spline {
 
@@ -21,11 +22,15 @@ void basis_funs(int span, double u, int p, const std::vector<double>& U, double*
   }
 }
 
-void ders_basis_funs(int span, double u, int p, int nder, const std::vector<double>& U,
-                     Eigen::Ref<Eigen::MatrixXd> ders) {
-  // Algorithm A2.3 (DersBasisFuns), The NURBS Book p. 72.
-  assert(p <= kMaxDegree && "knit: degree above kMaxDegree");
-  assert(ders.rows() == nder + 1 && ders.cols() == p + 1);
+namespace {
+
+// Algorithm A2.3 (DersBasisFuns), The NURBS Book p. 72, for a degree P and an order ND that are
+// either ints or std::integral_constant: with constants the compiler unrolls the loops (the
+// cell's closest-point search evaluates quartic bases with two derivatives millions of times),
+// with the same operations in the same order, so the results are bitwise the same.
+template <class P, class ND>
+void ders_basis_funs_impl(int span, double u, P p, ND nder, const std::vector<double>& U,
+                          Eigen::Ref<Eigen::MatrixXd> ders) {
   double ndu[kMaxDegree + 1][kMaxDegree + 1];
   double a[2][kMaxDegree + 1];
   double left[kMaxDegree + 1], right[kMaxDegree + 1];
@@ -75,6 +80,20 @@ void ders_basis_funs(int span, double u, int p, int nder, const std::vector<doub
   }
   for (int k = n + 1; k <= nder; ++k)
     for (int j = 0; j <= p; ++j) ders(k, j) = 0.0;
+}
+
+template <int V>
+using Int = std::integral_constant<int, V>;
+
+}  // namespace
+
+void ders_basis_funs(int span, double u, int p, int nder, const std::vector<double>& U,
+                     Eigen::Ref<Eigen::MatrixXd> ders) {
+  assert(p <= kMaxDegree && "knit: degree above kMaxDegree");
+  assert(ders.rows() == nder + 1 && ders.cols() == p + 1);
+  if (p == 4 && nder == 2) return ders_basis_funs_impl(span, u, Int<4>{}, Int<2>{}, U, ders);
+  if (p == 3 && nder == 2) return ders_basis_funs_impl(span, u, Int<3>{}, Int<2>{}, U, ders);
+  ders_basis_funs_impl(span, u, p, nder, U, ders);
 }
 
 void rationalize_1d(const double* w, Eigen::Ref<Eigen::MatrixXd> ders) {

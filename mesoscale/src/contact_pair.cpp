@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "knit/spline/basis.hpp"
 
@@ -16,9 +17,9 @@ namespace {
 /// `(N.row(i) * Q).transpose()` called: even and odd j in two lanes, the lanes added, then the
 /// odd tail. Bit for bit the same numbers, without the kernel's call and copy overhead for
 /// these 1 x (p+1) x 3 products (a third of the closest-point search's time).
-template <class NMat, class QBlock>
-Eigen::Vector3d row_times(const NMat& N, int i, const QBlock& Q) {
-  const int n = static_cast<int>(Q.rows());
+/// The number of rows n is an int or a std::integral_constant (unrolled loops, the same sums).
+template <class NMat, class QBlock, class Rows>
+Eigen::Vector3d row_times_n(const NMat& N, int i, const QBlock& Q, Rows n) {
   Eigen::Vector3d y;
   for (int c = 0; c < 3; ++c) {
     double s0 = 0.0, s1 = 0.0;
@@ -32,6 +33,13 @@ Eigen::Vector3d row_times(const NMat& N, int i, const QBlock& Q) {
     y(c) = 0.0 + cc;
   }
   return y;
+}
+
+template <class NMat, class QBlock>
+Eigen::Vector3d row_times(const NMat& N, int i, const QBlock& Q) {
+  const int n = static_cast<int>(Q.rows());
+  if (n == 5) return row_times_n(N, i, Q, std::integral_constant<int, 5>{});  // quartic yarns
+  return row_times_n(N, i, Q, n);
 }
 
 // The chain at u in copy k: N (3 x (p+1): N, N_u, N_uu) and x, x_u, x_uu. N is a dynamic-size

@@ -118,12 +118,16 @@ def draw(rows, out, params=None):
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
     height = 2.3 * len(panels)
-    fig.subplots_adjust(top=1 - 0.5 / height, hspace=0.3)
+    width = 3.2 * len(params)
+    # Fixed margins (in inches, as fractions of the figure) instead of bbox_inches="tight",
+    # which draws all the axes twice (11 of the script's 14 CPU s were those two draws).
+    fig.subplots_adjust(top=1 - 0.5 / height, bottom=0.55 / height, left=0.75 / width,
+                        right=1 - 0.15 / width, hspace=0.3, wspace=0.3)
     fig.suptitle("Observables against the unit-cell parameters (others at their defaults)",
                  y=1 - 0.15 / height)
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     tmp = out + ".tmp.png"
-    fig.savefig(tmp, dpi=80, bbox_inches="tight")
+    fig.savefig(tmp, dpi=80)
     plt.close(fig)
     os.replace(tmp, out)
 

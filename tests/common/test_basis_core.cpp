@@ -2,7 +2,9 @@
 // the exact quarter circle, evaluation at both ends of the domain.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 
+#include "knit/spline/basis.hpp"
 #include "knit/spline/bspline_basis.hpp"
 #include "knit/spline/curve.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -49,6 +51,27 @@ TEST_CASE("basis derivatives match finite differences", "[unit][spline]") {
       const Eigen::VectorXd fd = (b.eval_all(u + h, k - 1) - b.eval_all(u - h, k - 1)) / (2 * h);
       CHECK((d - fd).cwiseAbs().maxCoeff() < 1e-5 * std::max(1.0, d.cwiseAbs().maxCoeff()));
     }
+  }
+}
+
+TEST_CASE("the unrolled cubic and quartic kernels equal the general one bit for bit",
+          "[unit][spline]") {
+  // ders_basis_funs has fixed-degree paths for (p, nder) = (3, 2) and (4, 2) (the yarns'
+  // closest-point search); nder = 3 takes the general path, whose first three rows are the same
+  // operations in the same order.
+  const int p = GENERATE(3, 4);
+  std::vector<double> U(p + 1, 0.0);
+  for (double k : {0.07, 0.3, 0.3, 0.55, 0.81}) U.push_back(k);
+  U.insert(U.end(), p + 1, 1.0);
+  for (double u = 0.0; u <= 1.0; u += 0.0137) {
+    const int span = find_span(static_cast<int>(U.size()) - p - 1, p, u, U);
+    Eigen::MatrixXd fixed(3, p + 1), general(4, p + 1);
+    ders_basis_funs(span, u, p, 2, U, fixed);
+    ders_basis_funs(span, u, p, 3, U, general);
+    INFO("p = " << p << ", u = " << u);
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j <= p; ++j)
+        CHECK(std::memcmp(&fixed(k, j), &general(k, j), sizeof(double)) == 0);
   }
 }
 

@@ -58,10 +58,10 @@ SweepOptions quiet(const std::filesystem::path& out) {
 TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
   const auto d = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/default.json");
   CHECK(d.loop_lengths == std::vector<double>{4.5, 5.0, 5.5, 6.0, 6.5});
-  // The paper's 13 paths, then 2 uniaxial + 16 biaxial + 7 gradient coverage paths and 24
-  // held-out paths (issue 11).
-  REQUIRE(d.paths.size() == 13 + 25 + 24);
-  CHECK(make_jobs(d).size() == 5 * 62);
+  // The paper's 13 paths, then 2 uniaxial + 16 biaxial + 7 gradient coverage paths and 12
+  // held-out paths (issue 11; 60 held-out runs over the five loop lengths).
+  REQUIRE(d.paths.size() == 13 + 25 + 12);
+  CHECK(make_jobs(d).size() == 5 * 50);
   CHECK_FALSE(d.subtract_residual);
   // the shared definition (knit/material/load_paths.hpp) is used, not a copy
   const auto shared = knit::material::default_load_paths(20);
@@ -87,12 +87,13 @@ TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
   CHECK(uni == 2);
   CHECK(bi == 16);
   CHECK(grad == 7);
-  CHECK(hold == 24);
+  CHECK(hold == 12);
   CHECK(d.runner == RunnerKind::kCell);
   CHECK(d.fit_options.n_ctrl1 == 11);
-  // The dense input: the default plus 48 quasi-random fill paths (coverage, 6 steps).
+  // The dense input: the default plus 48 quasi-random fill paths (coverage, 6 steps), with the
+  // fuller held-out check (24 paths per loop length, the default's 12 and 12 more).
   const auto dense = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/dense.json");
-  REQUIRE(dense.paths.size() == d.paths.size() + 48);
+  REQUIRE(dense.paths.size() == d.paths.size() + 48 + 12);
   int fill = 0;
   for (const auto& p : dense.paths)
     fill += p.set == "coverage" && p.kind == knit::material::PathKind::kGradient && p.steps == 6;
