@@ -19,8 +19,9 @@ bool bitwise_equal(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatr
   if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
   const auto nnz = static_cast<std::size_t>(a.nonZeros());
   const auto outer = static_cast<std::size_t>(a.outerSize() + 1);
-  return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outer * sizeof(int)) == 0 &&
-         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), nnz * sizeof(int)) == 0 &&
+  if (std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outer * sizeof(int)) != 0) return false;
+  if (nnz == 0) return true;  // the index and value arrays may be null (memcmp must not see them)
+  return std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), nnz * sizeof(int)) == 0 &&
          std::memcmp(a.valuePtr(), b.valuePtr(), nnz * sizeof(double)) == 0;
 }
 
