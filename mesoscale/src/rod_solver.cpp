@@ -92,7 +92,8 @@ NewtonReport solve_newton(const RodSystem& sys, Eigen::VectorXd& x, double lambd
       return rep;
     }
     const Eigen::SparseMatrix<double>& J = ws.assembler.build(trip, N);
-    if (!ws.same_pattern(J)) ws.analyze(J);
+    // An unchanged pattern is the one analysed last (the assembler says so without comparing).
+    if ((ws.assembler.pattern_changed() || !ws.analyzed) && !ws.same_pattern(J)) ws.analyze(J);
     lu.factorize(J);
     if (lu.info() != Eigen::Success) {
       rep.message = "singular Jacobian";

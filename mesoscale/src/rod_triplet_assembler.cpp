@@ -50,8 +50,8 @@ void TripletAssembler::make_pattern(const std::vector<Eigen::Triplet<double>>& t
   count_.assign(static_cast<std::size_t>(n) + 1, 0);
   for (const int r : rows_) ++count_[static_cast<std::size_t>(r) + 1];
   for (int i = 0; i < n; ++i) count_[i + 1] += count_[i];
-  std::vector<int> by_row(m);
-  for (std::size_t k = 0; k < m; ++k) by_row[count_[rows_[k]]++] = static_cast<int>(k);
+  by_row_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) by_row_[count_[rows_[k]]++] = static_cast<int>(k);
   J_.resize(n, n);
   J_.resizeNonZeros(static_cast<Eigen::Index>(m));
   int* outer = J_.outerIndexPtr();
@@ -60,7 +60,7 @@ void TripletAssembler::make_pattern(const std::vector<Eigen::Triplet<double>>& t
   for (const int c : cols_) ++outer[c + 1];
   for (int i = 0; i < n; ++i) outer[i + 1] += outer[i];
   count_.assign(outer, outer + n);  // fill cursor per column
-  for (const int k : by_row) {
+  for (const int k : by_row_) {
     const int e = count_[cols_[k]]++;
     inner[e] = rows_[k];
     map_[static_cast<std::size_t>(rows_[k]) * n + cols_[k]] = e;

@@ -41,7 +41,7 @@ class TripletAssembler {
   std::vector<int> map_;             // row * n + col -> entry, -1 if not in the pattern
   std::vector<std::uint32_t> seen_;  // per entry: the pass that last assigned it
   std::uint32_t pass_ = 0;
-  std::vector<int> rows_, cols_, count_;  // scratch of make_pattern
+  std::vector<int> rows_, cols_, count_, by_row_;  // scratch of make_pattern
   bool changed_ = true;
   long pattern_builds_ = 0, value_passes_ = 0;
 };
