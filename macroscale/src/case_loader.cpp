@@ -314,7 +314,7 @@ void read_solver(const Reader& r, const json& root, Case& c) {
   const json& s = root.at("solver");
   r.keys(s, "/solver",
          {"steps", "tolerance", "absolute_tolerance", "max_iterations", "max_cutbacks",
-          "line_search", "threads", "thickness_integration", "description"});
+          "line_search", "line_search_first", "threads", "thickness_integration", "description"});
   SolverOptions& o = c.solver;
   if (s.contains("steps")) o.steps = r.integer(s.at("steps"), "/solver/steps", 1, 100000);
   if (s.contains("tolerance")) o.tolerance = r.positive(s.at("tolerance"), "/solver/tolerance");
@@ -326,6 +326,8 @@ void read_solver(const Reader& r, const json& root, Case& c) {
     o.max_cutbacks = r.integer(s.at("max_cutbacks"), "/solver/max_cutbacks", 0, 40);
   if (s.contains("line_search"))
     o.line_search = r.boolean(s.at("line_search"), "/solver/line_search");
+  if (s.contains("line_search_first"))
+    o.line_search_first = r.boolean(s.at("line_search_first"), "/solver/line_search_first");
   if (s.contains("threads")) c.threads = r.integer(s.at("threads"), "/solver/threads", 1, 64);
   if (s.contains("thickness_integration")) {
     const std::string ti = r.string(s.at("thickness_integration"), "/solver/thickness_integration");

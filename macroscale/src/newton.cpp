@@ -313,14 +313,15 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       uf += ((lam1 - lambda) / (lambda - lambda_prev)) * (ufree - ufree_prev);
     // Hyperelastic: plain Newton first (the energy search slowed the Sze cantilever from 60 to
     // 82 iterations by cutting overshooting steps that Newton recovers from), then the step
-    // again with the energy line search, then without the predictor; otherwise the
-    // predictor, then without it.
+    // again with the energy line search (line_search_first: the other way round), then
+    // without the predictor; otherwise the predictor, then without it.
     const Eigen::VectorXd uf0 = uf;
     const bool search = hyper && opt.line_search;
-    StepOutcome o = newton(lam1, uf, false);
-    if (!o.converged && !o.work_cap && search) {
+    const bool search_first = search && opt.line_search_first;
+    StepOutcome o = newton(lam1, uf, search_first);
+    if (!o.converged && !o.work_cap && search) {  // the other of the two
       uf = uf0;
-      o = newton(lam1, uf, true);
+      o = newton(lam1, uf, !search_first);
     }
     if (!o.converged && !o.work_cap && step > 0) {  // retry without the predictor
       uf = ufree;

@@ -321,3 +321,35 @@ TEST_CASE("output.vtk false writes no VTU or PVD files", "[unit]") {
   CHECK(s.str().find("stability: the tangent was positive definite") != std::string::npos);
   fs::remove_all(d);
 }
+
+TEST_CASE("line_search_first: the energy search from a step's first attempt, same solution",
+          "[unit]") {
+  // The Sze cantilever in 4 steps: plain Newton's full steps raise Pi and recover (docs/solver.md);
+  // with /solver/line_search_first the search backtracks them from the start: other iterates,
+  // the same converged states (tolerance 1e-8 of the residual).
+  json j = verification_case("sze_cantilever.json");
+  j["refinement"]["elements"] = {6, 1};
+  j["solver"]["steps"] = 4;
+  const RunResult plain = run(j);
+  j["solver"]["line_search_first"] = true;
+  const RunResult first = run(j);
+  REQUIRE(plain.report.status == RunStatus::kCompleted);
+  REQUIRE(first.report.status == RunStatus::kCompleted);
+  REQUIRE(first.rows.size() == plain.rows.size());  // no cut-back either way
+  for (size_t s = 0; s < plain.rows.size(); ++s) {
+    const StepRow &a = plain.rows[s], &b = first.rows[s];
+    CHECK(a.lambda == b.lambda);
+    CHECK((a.points[0] - b.points[0]).norm() <= 1e-6 * a.points[0].norm());
+  }
+  // Backtracking costs residual evaluations beyond one per iteration (plain Newton: at most one).
+  CHECK(plain.report.stats.evaluations <= plain.report.stats.iterations);
+  CHECK(first.report.stats.evaluations > first.report.stats.iterations);
+  // Not a boolean: named by its JSON pointer.
+  j["solver"]["line_search_first"] = "yes";
+  try {
+    parse_case(j.dump(), "bad.json");
+    FAIL("a string was accepted as /solver/line_search_first");
+  } catch (const std::exception& e) {
+    CHECK_THAT(e.what(), Catch::StartsWith("bad.json: /solver/line_search_first"));
+  }
+}

@@ -25,6 +25,7 @@
 //    the quadratic through Pi(0), Pi'(0) and Pi(alpha), alpha in [0.1, 0.5] of the last one.
 //    (Searching in every iteration turned the Sze cantilever's 60 iterations into 82: Newton
 //    recovers from overshooting steps that raise Pi, the search only slows it down.)
+//    `line_search_first` (a case's choice) searches first and tries plain Newton second.
 //  * otherwise: when the full step increases ||r|| and does not halve g(alpha) = du . r(u +
 //    alpha du), secant iterations on g (Matthies & Strang 1979).
 //
@@ -60,6 +61,12 @@ struct SolverOptions {
   /// 0: 20 x steps x max_iterations.
   long max_total_iterations = 0;
   bool line_search = true;
+  /// Hyperelastic materials: the energy line search from the first attempt of every load step,
+  /// plain Newton only when that fails (the default is the other way round; needs line_search). For
+  /// shells whose membrane goes slack (bending-dominated, e.g. the hyperbolic paraboloid in
+  /// tension): plain Newton's overshooting iterates visit strains far outside the material law's
+  /// data before it recovers; the search keeps Pi from rising (docs/solver.md).
+  bool line_search_first = false;
   LinearSolver linear_solver = LinearSolver::kAuto;
   /// Dense up to this many unknowns with kAuto. Measured crossover (scripts/bench/solver.sh,
   /// Sze cantilever refinements, 2-core machine): sparse is faster from ~150 unknowns on.
