@@ -340,6 +340,62 @@ def verdicts(runs, tmp):
     return rep, {c.key: c for c in rep.checks()}
 
 
+def law_check_failures(tmp):
+    """report.law_checks on a synthetic database and logs: all four checks pass on the
+    baseline, each variant fails exactly its own check, a database without an energy law gives
+    no rows."""
+    import h5py
+    out = []
+    db = os.path.join(tmp, "law.h5")
+    logs = os.path.join(tmp, "law_logs")
+    os.makedirs(logs, exist_ok=True)
+
+    def write(rms=(0.02, 0.03), mx=(0.04, 0.045), h=(24, 24, 0.04), extra=(10, 20), energy=True):
+        with h5py.File(db, "w") as f:
+            if energy:
+                d = f.create_group("energy_law/diagnostics")
+                d["loop_length"] = [4.5, 6.5]
+                d["rms_relative"] = list(rms)
+                d["max_relative"] = list(mx)
+                d.attrs["holdout_points"] = h[0]
+                d.attrs["holdout_within_5_percent"] = h[1]
+                d.attrs["holdout_max_relative"] = h[2]
+        for name, k in zip(("a", "b"), extra):
+            path = os.path.join(logs, name + ".log")
+            if k is None:
+                if os.path.exists(path):
+                    os.remove(path)
+                continue
+            with open(path, "w") as f:
+                f.write("step    1  load factor 1\n"
+                        f"knit material (energy law): 1000 evaluations; {k} extrapolated "
+                        f"({k / 10} %, outside the data strain box ...)\n"
+                        "  at converged states: 0 of 100 evaluations extrapolated (0 %)\n")
+
+    def verdicts():
+        return [r[3] for r in report.law_checks(db, logs, ["a", "b"])]
+
+    write()
+    if verdicts() != [True, True, True, True]:
+        out.append(f"law checks: the baseline gives {verdicts()}")
+    variants = [("rms 6 %", dict(rms=(0.02, 0.06)), 0),
+                ("largest error 5.5 %", dict(mx=(0.055, 0.045)), 1),
+                ("one held-out state at 5.2 %", dict(h=(24, 23, 0.052)), 2),
+                ("no held-out states", dict(h=(0, 0, float("nan"))), 2),
+                ("a case with 2.1 % extrapolated", dict(extra=(10, 21)), 3),
+                ("a case without its material report", dict(extra=(10, None)), 3)]
+    for name, kw, k in variants:
+        write(**kw)
+        want = [True] * 4
+        want[k] = False
+        if verdicts() != want:
+            out.append(f"law checks, {name}: {verdicts()} instead of {want}")
+    write(energy=False)
+    if report.law_checks(db, logs, ["a", "b"]):
+        out.append("law checks: rows for a database without an energy law")
+    return out
+
+
 def main():
     failures = []
     tmp = tempfile.mkdtemp(prefix="knit_report_test_")
@@ -425,6 +481,8 @@ def main():
             failures.append("a table with a wrong header was accepted")
         except ValueError:
             pass
+        # -- the material law's checks (issue 11): each one made to fail ------------------------
+        failures.extend(law_check_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
