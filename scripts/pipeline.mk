@@ -280,7 +280,6 @@ figures: $(FIGURES) knitmaps designs
 # being compiled (the last compiles and links leave a core idle), so that `all` then only runs
 # the cases, designs, their figures and the report.
 MESO_ONLY := $(DB) $(DB_FIGS) $(filter $(FIG)/fig05_cells.png $(FIG)/sensitivity.png,$(FIGURES))
-.PHONY: meso
 meso: $(MESO_ONLY)
 
 # ---- report -----------------------------------------------------------------------------------

@@ -101,12 +101,13 @@ LAW_BOUND = 0.05  # issue 11: errors within 5 % of the stress range
 EXTRAPOLATION_BOUND = 0.02  # issue 11: <= 2 % extrapolated material evaluations in every case
 
 
-def law_checks(db_path, logs_dir, names):
+def law_checks(db_path, extrapolations):
     """Issue 11's acceptance of the energy-based law, as checks that can fail: the fit's error
     per loop length against the cell data (RMS and maximum, % of that loop length's stress
     range), the held-out cell states (every one within 5 %), and the extrapolated material
     evaluations of every case (all evaluations, trial iterates included). Reads
-    /energy_law/diagnostics of the database and knit-macro's logs. Returns a list of
+    /energy_law/diagnostics of the database; `extrapolations` maps each case to
+    extrapolation() of its knit-macro log (None: no material report). Returns a list of
     (statement, threshold, measured, ok); empty when the database has no energy law (the
     paper's eq. 17 law or the synthetic stand-in)."""
     rows = []
@@ -139,8 +140,7 @@ def law_checks(db_path, logs_dir, names):
                  f"{h_in} of {h_n} (largest {100 * h_max:.1f} %)" if h_n else "none in the database",
                  h_n > 0 and h_in == h_n))
     worst, worst_case, missing = -1.0, None, []
-    for n in names:
-        ex = extrapolation(os.path.join(logs_dir, n + ".log"))
+    for n, ex in sorted(extrapolations.items()):
         if ex is None:
             missing.append(n)
             continue
@@ -425,7 +425,10 @@ class Report:
         nfail = sum(1 for c in self.rows if c.ok is False)
         ninfo = sum(1 for c in self.rows if c.ok is None)
         ndone = sum(1 for n in names if self.r(n).completed)
-        law = law_checks(db_path, os.path.join(self.out, "logs"), names)
+        # Each log is read once: for the law's check and for the runs table below.
+        extrapolations = {n: extrapolation(os.path.join(self.out, "logs", n + ".log"))
+                          for n in names}
+        law = law_checks(db_path, extrapolations)
         law_pass = sum(1 for r in law if r[3])
         law_text = (f"; material law: {law_pass} of {len(law)} checks pass" if law else "")
         L.append(f"**Summary:** {npass} of {npass + nfail} checks of the paper's statements pass, "
@@ -496,7 +499,7 @@ class Report:
             fe = r.strain()[-1] if r.ok and steps else float("nan")
             fl = r.load()[-1] if r.ok and steps else float("nan")
             total += r.seconds if math.isfinite(r.seconds) else 0.0
-            ex = extrapolation(os.path.join(self.out, "logs", n + ".log"))
+            ex = extrapolations[n]
             exs = "n/a" if ex is None else (f"{100 * ex[1] / max(1, ex[0]):.1f} % of {ex[0]}"
                                            + (f" ({'; '.join(ex[2])})" if ex[2] else ""))
             L.append(f"| {n} | {st} | {steps} | {fmt(100 * fe, 1)} % | {fmt(fl, 3)} | "
