@@ -42,7 +42,8 @@ THRESHOLD = 0.05
 
 
 def load_paths(f, loop):
-    """[(set, e (n x 3, e3 = 2 E12), S (n x 3))] of the converged steps of /loop_<loop>/raw."""
+    """[(set, e (n x 3, e3 = 2 E12), S (n x 3), kind, axis)] of the converged steps of
+    /loop_<loop>/raw."""
     g = f["loop_%d/raw" % loop]
     out = []
     for name in sorted(g):
@@ -50,7 +51,10 @@ def load_paths(f, loop):
         e = g[name]["E"][:][ok].copy()
         e[:, 2] *= 2.0
         s = g[name].attrs.get("set", "paper")
-        out.append((s.decode() if isinstance(s, bytes) else str(s), e, g[name]["S"][:][ok]))
+        kind = g[name].attrs.get("kind", "biaxial")
+        kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+        out.append((s.decode() if isinstance(s, bytes) else str(s), e, g[name]["S"][:][ok], kind,
+                    int(g[name].attrs.get("axis", 0))))
     return out
 
 
@@ -59,11 +63,18 @@ def stress_range(paths):
     return max(s[:, c].max() - s[:, c].min() for c in range(3))
 
 
-def convex_bound(e, s, rng):
+def convex_bound(e, s, rng, fixed=None):
     """Smallest delta (fraction of rng) of a convex W through (e_i, S'_i); the origin is added
-    as a stress-free state. Returns (delta, status message)."""
+    as a stress-free state. `fixed` (n x 3, NaN = none): a tolerance of its own (MPa) for some
+    states, |S'_ic - S_ic| <= fixed_ic instead of delta * rng. Returns (delta, status message)."""
     e = np.vstack([np.zeros(3), e])
     s = np.vstack([np.zeros(3), s])
+    tol = np.full(3 * len(e), np.nan)
+    if fixed is not None:
+        tol[3:] = np.asarray(fixed, dtype=float).ravel()
+    own = ~np.isnan(tol)
+    dcoef = np.where(own, 0.0, -rng)
+    slack = np.where(own, tol, 0.0)
     n = len(e)
     nv = 4 * n + 1
     i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
@@ -78,12 +89,12 @@ def convex_bound(e, s, rng):
     k = np.arange(3 * n)
     both = np.concatenate([k, k])
     delta_col = np.concatenate([n + k, np.full(3 * n, nv - 1)])
-    upper = coo_matrix((np.concatenate([np.ones(3 * n), -np.full(3 * n, rng)]),
+    upper = coo_matrix((np.concatenate([np.ones(3 * n), dcoef]),
                         (both, delta_col)), shape=(3 * n, nv))
-    lower = coo_matrix((np.concatenate([-np.ones(3 * n), -np.full(3 * n, rng)]),
+    lower = coo_matrix((np.concatenate([-np.ones(3 * n), dcoef]),
                         (both, delta_col)), shape=(3 * n, nv))
     a = vstack([pairs, upper, lower]).tocsr()
-    b = np.concatenate([np.zeros(p), s.ravel(), -s.ravel()])
+    b = np.concatenate([np.zeros(p), s.ravel() + slack, -s.ravel() + slack])
     c = np.zeros(nv)
     c[-1] = 1.0
     bounds = [(None, None)] * nv
@@ -144,7 +155,21 @@ def summary(err):
                                                      100 * err.max())
 
 
-def analyse(f, loop, stride, n, lam):
+def uniaxial_tolerances(paths, stride, rho):
+    """The `fixed` argument of convex_bound for the sub-sampled states: on the uniaxial-stress
+    paths every component within rho times the state's axial stress (the lateral one too: the
+    law's own lateral contraction needs its lateral stress near zero); NaN elsewhere."""
+    out = []
+    for p in paths:
+        sub = p[2][stride - 1::stride]
+        t = np.full(sub.shape, np.nan)
+        if p[3] == "uniaxial":
+            t[:] = rho * np.abs(sub[:, p[4]])[:, None]
+        out.append(t)
+    return np.concatenate(out)
+
+
+def analyse(f, loop, stride, n, lam, uniaxial_relative=None):
     paths = load_paths(f, loop)
     loop_length = float(f["loop_lengths"][loop])
     rng = stress_range(paths)
@@ -171,6 +196,12 @@ def analyse(f, loop, stride, n, lam):
     print("  free interpolant (no energy): %s" % summary(err(interp)))
     print("  convex bound, %d states incl. held-out, in-sample: delta* >= %.2f %% (%s)" %
           (len(sub_e) + 1, 100 * delta, status))
+    if uniaxial_relative is not None:
+        fixed = uniaxial_tolerances(paths, stride, uniaxial_relative)
+        d2, st2 = convex_bound(sub_e, sub_s, rng, fixed)
+        print("  convex bound with the uniaxial-stress states within %.0f %% of their axial "
+              "stress (%d states): delta* >= %.2f %% (%s)" %
+              (100 * uniaxial_relative, int(np.sum(~np.isnan(fixed[:, 0]))), 100 * d2, st2))
 
 
 def self_check():
@@ -183,9 +214,14 @@ def self_check():
     bad = s.copy()
     bad[:, 0] = -bad[:, 0]  # S11 decreasing in E11: no convex W
     bad_delta, _ = convex_bound(e, bad, 10.0)
-    print("self-check: convex data delta* = %.2e, non-monotone data delta* = %.3f" %
-          (ok_delta, bad_delta))
-    if not (ok_delta < 1e-6 and bad_delta > 0.01):
+    # States with tolerances of their own: loose ones free the non-monotone data entirely,
+    # zero ones keep the convex data exact.
+    loose_delta, _ = convex_bound(e, bad, 10.0, np.full(bad.shape, 1e3))
+    exact_delta, _ = convex_bound(e, s, 10.0, np.zeros(s.shape))
+    print("self-check: convex data delta* = %.2e, non-monotone data delta* = %.3f; with loose "
+          "tolerances of their own %.2e, with exact ones (convex data) %.2e" %
+          (ok_delta, bad_delta, loose_delta, exact_delta))
+    if not (ok_delta < 1e-6 and bad_delta > 0.01 and loose_delta < 1e-6 and exact_delta < 1e-6):
         print("self-check FAILED", file=sys.stderr)
         return 1
     return 0
@@ -202,6 +238,9 @@ def main():
                     help="B-spline functions per strain axis of the free fits (8)")
     ap.add_argument("--smoothing", type=float, default=1e-3,
                     help="second-difference smoothing of the free fits (1e-3)")
+    ap.add_argument("--uniaxial-relative", type=float, default=None, metavar="RHO",
+                    help="also the convex bound with the uniaxial-stress paths' states held "
+                         "within RHO times their axial stress (relative, not delta * range)")
     ap.add_argument("--self-check", action="store_true")
     a = ap.parse_args()
     if a.self_check:
@@ -221,7 +260,7 @@ def main():
             print("fit_bounds.py: %s: no /loop_%d (%d loop lengths)" % (a.database, loop, count),
                   file=sys.stderr)
             return 2
-        analyse(f, loop, a.stride, a.spline_functions, a.smoothing)
+        analyse(f, loop, a.stride, a.spline_functions, a.smoothing, a.uniaxial_relative)
     return 0
 
 

@@ -75,7 +75,8 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
                 r.S.row(s).transpose(),
                 entry.loop_length,
                 k,
-                sw};
+                sw,
+                r.path.kind == material::PathKind::kUniaxial ? r.path.axis : -1};
         if (!p.e.allFinite() || !p.S.allFinite())
           return material::raw_path_location(k, q) + ": step " + std::to_string(s + 1) +
                  " is marked converged but its E or S is not finite";
@@ -193,6 +194,10 @@ std::string EnergyFitOptions::validate() const {
   if (seed < 0) return "seed must be >= 0";
   if (network_iterations < 1 || network_iterations > 1000000)
     return "network_iterations must be in 1..1000000";
+  if (!(tube >= 0.0 && tube <= 1.0))
+    return "tube must be in [0, 1] (a fraction of the stress range; 0: off)";
+  if (!(tube_uniaxial <= 1.0)) return "tube_uniaxial must be <= 1 (< 0: the same as tube)";
+  if (!(tube_weight >= 0.0 && tube_weight <= 1e9)) return "tube_weight must be in [0, 1e9]";
   return {};
 }
 
@@ -217,7 +222,10 @@ std::string EnergyFitOptions::to_json() const {
                       {"hidden2", hidden2},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
-                      {"network_iterations", network_iterations}};
+                      {"network_iterations", network_iterations},
+                      {"tube", tube},
+                      {"tube_weight", tube_weight},
+                      {"tube_uniaxial", tube_uniaxial}};
   if (!directions.empty()) {
     nlohmann::json d = nlohmann::json::array();
     for (const auto& v : directions) d.push_back({v(0), v(1), v(2)});
@@ -236,14 +244,31 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   }
   if (!j.is_object()) throw InputError(file, pointer, "energy-fit options must be a JSON object");
   EnergyFitOptions o;
-  static const char* known[] = {"s_degree",          "s_spans",         "l_degree",
-                                "l_control_points",  "s_margin",        "floor",
-                                "floor_relative",    "smoothing",       "loss",
-                                "loss_scale",        "loss_rounds",     "max_iterations",
-                                "directions",        "weight_relative", "weight_uniaxial",
-                                "weight_paper",      "family",          "hidden1",
-                                "hidden2",           "l_coupling",      "seed",
-                                "network_iterations"};
+  static const char* known[] = {"s_degree",
+                                "s_spans",
+                                "l_degree",
+                                "l_control_points",
+                                "s_margin",
+                                "floor",
+                                "floor_relative",
+                                "smoothing",
+                                "loss",
+                                "loss_scale",
+                                "loss_rounds",
+                                "max_iterations",
+                                "directions",
+                                "weight_relative",
+                                "weight_uniaxial",
+                                "weight_paper",
+                                "family",
+                                "hidden1",
+                                "hidden2",
+                                "l_coupling",
+                                "seed",
+                                "network_iterations",
+                                "tube",
+                                "tube_weight",
+                                "tube_uniaxial"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (std::find_if(std::begin(known), std::end(known),
                      [&](const char* k) { return it.key() == k; }) == std::end(known))
@@ -270,6 +295,9 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("l_coupling", o.l_coupling);
   get_int("seed", o.seed);
   get_int("network_iterations", o.network_iterations);
+  get_double("tube", o.tube);
+  get_double("tube_weight", o.tube_weight);
+  get_double("tube_uniaxial", o.tube_uniaxial);
   if (j.contains("family")) {
     if (!j["family"].is_string())
       throw InputError(file, pointer + "/family", "must be \"ridge\" or \"network\"");

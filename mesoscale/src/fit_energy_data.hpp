@@ -15,6 +15,7 @@ struct Point {
   double l;
   std::size_t loop;   // entry index
   double set_weight;  // weight_uniaxial / weight_paper / 1 (see EnergyFitOptions)
+  int axis = -1;      // a state of a uniaxial-stress path: its axis (0 course, 1 wale); else -1
 };
 
 /// Fits law.network (law.floor, l_min, l_max, box already set) to the points, with the

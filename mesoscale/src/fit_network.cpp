@@ -17,6 +17,7 @@
 // ReLUs start in their curved or linear part.
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -33,7 +34,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
  public:
   NetworkObjective(NetworkShape shape, int knots, std::vector<Eigen::Vector3d> x,
                    std::vector<Eigen::Vector3d> t, std::vector<double> w, std::vector<int> knot,
-                   double coupling)
+                   double coupling, std::vector<double> tube, double tube_weight)
       : sh_(shape),
         n_(knots),
         x_(std::move(x)),
@@ -41,6 +42,8 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         w_(std::move(w)),
         knot_(std::move(knot)),
         coupling_(coupling),
+        tube_(std::move(tube)),
+        tube_weight_(tube_weight / (3.0 * static_cast<double>(x_.size()))),
         theta_(static_cast<std::size_t>(knots * shape.size())),
         gtheta_(theta_.size()) {
     double sum = 0.0;
@@ -81,8 +84,17 @@ class NetworkObjective : public ceres::FirstOrderFunction {
       const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
                                 S0[static_cast<std::size_t>(j)] - t_[p];
       f += scale_ * w_[p] * s.squaredNorm();
+      // The tube: each component's excess over tau_j, squared (C1), unweighted.
+      Eigen::Vector3d gt_tube = Eigen::Vector3d::Zero();
+      if (tube_weight_ > 0.0)
+        for (int c = 0; c < 3; ++c) {
+          const double ex = std::abs(s(c)) - tube_[p];
+          if (ex <= 0.0) continue;
+          f += tube_weight_ * ex * ex;
+          gt_tube(c) = 2.0 * tube_weight_ * ex * (s(c) < 0.0 ? -1.0 : 1.0);
+        }
       if (!grad) continue;
-      const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s;  // d f / d S_W
+      const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s + gt_tube;  // d f / d S_W
       double* gt = gtheta_.data() + j * P;
       material::network_stress_gradient(sh_, th, x, 0.5 * g, gt);
       material::network_stress_gradient(sh_, th, mx, 0.5 * Eigen::Vector3d(g(0), g(1), -g(2)), gt);
@@ -119,7 +131,10 @@ class NetworkObjective : public ceres::FirstOrderFunction {
   std::vector<Eigen::Vector3d> x_, t_;
   std::vector<double> w_;
   std::vector<int> knot_;
-  double coupling_, scale_ = 1.0;
+  double coupling_;
+  std::vector<double> tube_;  // tau per point, scaled stress units
+  double tube_weight_;
+  double scale_ = 1.0;
   mutable std::vector<double> theta_, gtheta_;
 };
 
@@ -157,12 +172,33 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
     t.push_back((p.S - law.floor * p.e) / sS);
     knot.push_back(static_cast<int>(p.loop));
   }
+  // The tube's half-width per knot: `tube` times the knot's stress range (the diagnostics'
+  // range: the largest max - min of a component over that loop length's fit data), scaled.
+  std::vector<double> tube(static_cast<std::size_t>(n), 0.0);
+  {
+    std::vector<Eigen::Vector3d> lo(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(1e300)),
+        hi(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(-1e300));
+    for (const Point& p : pts) {
+      lo[p.loop] = lo[p.loop].cwiseMin(p.S);
+      hi[p.loop] = hi[p.loop].cwiseMax(p.S);
+    }
+    for (std::size_t j = 0; j < tube.size(); ++j)
+      tube[j] = hi[j](0) >= lo[j](0) ? (hi[j] - lo[j]).maxCoeff() / sS : 0.0;
+  }
+  std::vector<double> tube_of_point;
+  for (const Point& p : pts) {
+    double tau = o.tube * tube[p.loop];
+    if (p.axis >= 0 && o.tube_uniaxial >= 0.0)
+      tau = std::min(tau, o.tube_uniaxial * std::abs(p.S(p.axis)) / sS);
+    tube_of_point.push_back(tau);
+  }
   const std::vector<double> phi0 = initial_phi(sh, o.seed);
   std::vector<double> phi(static_cast<std::size_t>(n * P));
   for (int j = 0; j < n; ++j) std::copy(phi0.begin(), phi0.end(), phi.begin() + j * P);
 
-  auto* objective = new NetworkObjective(sh, n, std::move(x), std::move(t), weight, std::move(knot),
-                                         o.l_coupling);
+  auto* objective =
+      new NetworkObjective(sh, n, std::move(x), std::move(t), weight, std::move(knot), o.l_coupling,
+                           std::move(tube_of_point), o.tube > 0.0 ? o.tube_weight : 0.0);
   ceres::GradientProblem problem(objective);  // takes ownership
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;

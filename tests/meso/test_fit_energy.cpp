@@ -123,6 +123,34 @@ TEST_CASE("energy fit: the network fit gives the same law from the same seed", "
   CHECK(fit_network(db, 100, 2).law.network.theta != s.law.network.theta);
 }
 
+TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
+  // A network too small for the synthetic law (2 and 1 units) misses some states by far more
+  // than it misses most; the tube (EnergyFitOptions::tube) trades the rms for the largest error.
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  EnergyFitOptions o;
+  o.hidden1 = 2;
+  o.hidden2 = 1;
+  o.network_iterations = 400;
+  auto largest = [](const EnergyFitSummary& s) {
+    double m = 0.0;
+    for (const auto& p : s.diagnostics.per_loop) m = std::max(m, p.max_relative);
+    return m;
+  };
+  const EnergyFitSummary plain = fit_energy_law(db, o);
+  REQUIRE(plain.ok());
+  o.tube = 0.5 * largest(plain);
+  o.tube_weight = 1e4;
+  const EnergyFitSummary tube = fit_energy_law(db, o);
+  REQUIRE(tube.ok());
+  std::printf("tube: largest error %.2f %% of the range without, %.2f %% with a tube of %.2f %%\n",
+              100 * largest(plain), 100 * largest(tube), 100 * o.tube);
+  CHECK(largest(tube) < 0.8 * largest(plain));
+  CHECK(tube.diagnostics.min_eigenvalue >= tube.law.floor * (1 - 1e-9));
+  // The tube on the uniaxial states alone: a width < 0 there means "the same as tube".
+  o.tube_uniaxial = -1.0;
+  CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
+}
+
 TEST_CASE("energy fit: a robust loss and custom directions also fit", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
   EnergyFitOptions o = EnergyFitOptions::from_json(
@@ -211,6 +239,10 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("weight_uniaxial"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"family": "spline"})", "f.json"),
                       Catch::Contains("family must be"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube": 2})", "f.json"),
+                      Catch::Contains("tube must be in [0, 1]"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube_weight": -1})", "f.json"),
+                      Catch::Contains("tube_weight"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 0})", "f.json"),
                       Catch::Contains("hidden1 and hidden2"));
     // Range before narrowing: 2^32 + 12 was read as 12 (the same check as the eq. 17 fit's).
@@ -241,6 +273,9 @@ TEST_CASE("energy fit: the options round-trip through JSON", "[unit]") {
   o.hidden2 = 4;
   o.l_coupling = 0.5;
   o.seed = 3;
+  o.tube = 0.04;
+  o.tube_weight = 300;
+  o.tube_uniaxial = 0.01;
   const EnergyFitOptions b = EnergyFitOptions::from_json(o.to_json());
   CHECK(b.to_json() == o.to_json());
 }

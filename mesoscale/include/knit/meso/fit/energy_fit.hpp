@@ -49,6 +49,18 @@ struct EnergyFitOptions {
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
+  /// Network family: a tube around the data (choice, docs/database.md "The tube"). Each stress
+  /// component's error beyond tube * (the loop length's stress range) adds
+  /// tube_weight / (3 n) * excess^2 (scaled stresses, every point alike, whatever its data
+  /// weight): the weights decide the fit inside the tube, the tube bounds the largest error.
+  /// tube = 0: off.
+  double tube = 0.0;
+  double tube_weight = 100.0;
+  /// The tube's half-width on the uniaxial-stress paths' states, a fraction of each state's
+  /// own axial stress (every component, the lateral one too), at most `tube` times the range;
+  /// < 0: the same as the others'. The course-wise tensile curve of the loose cell stays below
+  /// 5 % of the range (6.5 mm: 0.65 of 20.8 MPa), so a tube of the range alone does not see it.
+  double tube_uniaxial = -1.0;
   /// Ridge directions before mirror closure; empty = material::default_ridge_directions().
   std::vector<Eigen::Vector3d> directions;
   int s_degree = 3, s_spans = 12;
