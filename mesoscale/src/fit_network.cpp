@@ -7,8 +7,11 @@
 // fitted in these and converted to mm/MPa units at the end). Objective:
 //
 //   f = 1/(3 sum w) sum_p w_p |S_W(x_p; theta_j(p)) - t_p|^2
-//       + l_coupling / n_theta sum_j |phi_j+1 - phi_j|^2,
+//       + l_coupling / n_theta sum_j |phi_j+1 - phi_j|^2
+//       + tube_weight / (3 n) sum_p sum_c max(0, |S_W,c - t_p,c| - tau_p)^2,
 //
+// the last term only with a tube (EnergyFitOptions::tube > 0; tau_p = tube x the loop length's
+// stress range / sS, on the uniaxial states at most tube_uniaxial x |own axial stress| / sS).
 // S_W the stress of the mirror-averaged, normalized law (S(0) = 0). The gradient is exact
 // (network_stress_gradient, reverse mode by hand, checked against finite differences in
 // tests/common/test_material_convex_network.cpp); each objective evaluation costs about three
