@@ -106,6 +106,26 @@ def convex_bound(e, s, rng, fixed=None):
     return float(r.x[-1]), "optimal"
 
 
+def monotonicity_bound(e, s, rng):
+    """A lower bound of the convex bound over ALL states, cheap enough for every one: the
+    gradient of a convex W is monotone, (S_i - S_j) . (e_i - e_j) >= 0, and perturbations
+    |d_ic| <= delta * rng change the product by at most 2 delta rng |e_i - e_j|_1, so each pair
+    needs delta >= -(S_i - S_j) . (e_i - e_j) / (2 rng |e_i - e_j|_1). The origin is added as a
+    stress-free state. Returns (delta, i, j) of the worst pair (indices into e, -1 = origin)."""
+    e = np.vstack([np.zeros(3), e])
+    s = np.vstack([np.zeros(3), s])
+    best, bi, bj = 0.0, -1, -1
+    for i in range(len(e)):
+        de = e[i] - e
+        num = -np.sum((s[i] - s) * de, axis=1)
+        den = 2.0 * rng * np.abs(de).sum(axis=1)
+        d = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+        j = int(np.argmax(d))
+        if d[j] > best:
+            best, bi, bj = float(d[j]), i - 1, j - 1
+    return best, bi, bj
+
+
 class SplineBox:
     """Tensor-product cubic B-splines over the strain box, n functions per axis."""
 
@@ -196,6 +216,13 @@ def analyse(f, loop, stride, n, lam, uniaxial_relative=None):
     print("  free interpolant (no energy): %s" % summary(err(interp)))
     print("  convex bound, %d states incl. held-out, in-sample: delta* >= %.2f %% (%s)" %
           (len(sub_e) + 1, 100 * delta, status))
+    all_e = np.concatenate([p[1] for p in paths])
+    all_s = np.concatenate([p[2] for p in paths])
+    mono, i, j = monotonicity_bound(all_e, all_s, rng)
+    state = lambda k: ("E = %s S = %s" % (np.round(all_e[k], 3), np.round(all_s[k], 2))  # noqa
+                       if k >= 0 else "the origin")
+    print("  monotonicity bound, all %d states: delta* >= %.2f %% (the pair %s and %s)" %
+          (len(all_e) + 1, 100 * mono, state(i), state(j)))
     if uniaxial_relative is not None:
         fixed = uniaxial_tolerances(paths, stride, uniaxial_relative)
         d2, st2 = convex_bound(sub_e, sub_s, rng, fixed)
@@ -218,10 +245,15 @@ def self_check():
     # zero ones keep the convex data exact.
     loose_delta, _ = convex_bound(e, bad, 10.0, np.full(bad.shape, 1e3))
     exact_delta, _ = convex_bound(e, s, 10.0, np.zeros(s.shape))
+    mono_ok, _, _ = monotonicity_bound(e, s, 10.0)
+    mono_bad, _, _ = monotonicity_bound(e, bad, 10.0)
+    print("self-check: monotonicity bound %.2e (convex data), %.3f (non-monotone data, at most "
+          "the convex bound)" % (mono_ok, mono_bad))
     print("self-check: convex data delta* = %.2e, non-monotone data delta* = %.3f; with loose "
           "tolerances of their own %.2e, with exact ones (convex data) %.2e" %
           (ok_delta, bad_delta, loose_delta, exact_delta))
-    if not (ok_delta < 1e-6 and bad_delta > 0.01 and loose_delta < 1e-6 and exact_delta < 1e-6):
+    if not (ok_delta < 1e-6 and bad_delta > 0.01 and loose_delta < 1e-6 and exact_delta < 1e-6
+            and mono_ok == 0.0 and 0.01 < mono_bad <= bad_delta + 1e-9):
         print("self-check FAILED", file=sys.stderr)
         return 1
     return 0
