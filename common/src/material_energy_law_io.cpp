@@ -69,7 +69,7 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
 
   io::H5Group d = g.create_group("diagnostics");
   const auto n = static_cast<Eigen::Index>(dg.per_loop.size());
-  Eigen::VectorXd l(n), range(n), maxrel(n), rmsrel(n);
+  Eigen::VectorXd l(n), range(n), maxrel(n), rmsrel(n), mono(n);
   std::vector<int> points;
   RowMatrixX rms(n, 3), mx(n, 3);
   for (Eigen::Index k = 0; k < n; ++k) {
@@ -78,6 +78,7 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
     range(k) = p.stress_range;
     maxrel(k) = p.max_relative;
     rmsrel(k) = p.rms_relative;
+    mono(k) = p.monotonicity_bound;
     points.push_back(p.points);
     rms.row(k) = p.rms.transpose();
     mx.row(k) = p.max.transpose();
@@ -89,6 +90,11 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
   d.write("stress_range", to_vec(range));
   d.write("max_relative", to_vec(maxrel));
   d.write("rms_relative", to_vec(rmsrel));
+  d.write("monotonicity_bound", to_vec(mono));
+  d.set_attribute("monotonicity_bound", "definition",
+                  "fraction of stress_range that any convex law misses at one state of the "
+                  "loop length's worst non-monotone pair of states: max over pairs of "
+                  "-(S_i - S_j).(e_i - e_j) / (2 stress_range |e_i - e_j|_1)");
   d.set_attribute("rms", "columns", "S11, S22, S12 (MPa); rows: loop_length");
   d.set_attribute("max", "columns", "S11, S22, S12 (MPa); rows: loop_length");
   d.set_attribute("stress_range", "definition",
@@ -162,10 +168,13 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
     const auto range = root.read_doubles(d + "/stress_range");
     const auto maxrel = root.read_doubles(d + "/max_relative");
     const auto rmsrel = root.read_doubles(d + "/rms_relative");
+    // Optional (session 10): older files have no monotonicity bound.
+    std::vector<double> mono;
+    if (root.exists(d + "/monotonicity_bound")) mono = root.read_doubles(d + "/monotonicity_bound");
     const auto n = l.size();
     if (pts.size() != n || range.size() != n || maxrel.size() != n || rmsrel.size() != n ||
         static_cast<std::size_t>(rms.rows()) != n || static_cast<std::size_t>(mx.rows()) != n ||
-        (n > 0 && (rms.cols() != 3 || mx.cols() != 3)))
+        (n > 0 && (rms.cols() != 3 || mx.cols() != 3)) || (!mono.empty() && mono.size() != n))
       throw InputError(file, d, "per-loop-length datasets differ in length");
     dg.per_loop.clear();
     for (std::size_t k = 0; k < n; ++k) {
@@ -177,6 +186,7 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
       p.stress_range = range[k];
       p.max_relative = maxrel[k];
       p.rms_relative = rmsrel[k];
+      if (!mono.empty()) p.monotonicity_bound = mono[k];
       dg.per_loop.push_back(p);
     }
     const auto hr = root.read_doubles(d + "/holdout_rms"),

@@ -569,6 +569,16 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       }
     }
     range[k] = pl.stress_range;
+    if (pl.stress_range > 0) {
+      std::vector<Eigen::Vector3d> e{Eigen::Vector3d::Zero()}, S{Eigen::Vector3d::Zero()};
+      for (const auto* set : {&pts, &held})
+        for (const auto& p : *set)
+          if (p.loop == k) {
+            e.push_back(p.e);
+            S.push_back(p.S);
+          }
+      pl.monotonicity_bound = monotonicity_bound(e, S, pl.stress_range);
+    }
     dg.points_used += pl.points;
     dg.per_loop.push_back(pl);
   }
@@ -607,6 +617,19 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
   return dg;
 }
 
+double monotonicity_bound(const std::vector<Eigen::Vector3d>& e,
+                          const std::vector<Eigen::Vector3d>& S, double range) {
+  double worst = 0.0;
+  if (!(range > 0.0) || e.size() != S.size()) return std::nan("");
+  for (std::size_t i = 0; i < e.size(); ++i)
+    for (std::size_t j = i + 1; j < e.size(); ++j) {
+      const Eigen::Vector3d de = e[i] - e[j];
+      const double l1 = de.cwiseAbs().sum();
+      if (l1 > 0.0) worst = std::max(worst, -(S[i] - S[j]).dot(de) / (2.0 * range * l1));
+    }
+  return worst;
+}
+
 std::string energy_fit_report(const EnergyFitSummary& s) {
   std::ostringstream os;
   if (!s.ok()) {
@@ -627,7 +650,9 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     os << "    l = " << p.loop_length << " mm: " << p.points << " states, rms (S11, S22, S12) "
        << p.rms(0) << ", " << p.rms(1) << ", " << p.rms(2) << " MPa, max " << p.max(0) << ", "
        << p.max(1) << ", " << p.max(2) << " MPa; max " << 100 * p.max_relative << " %, rms "
-       << 100 * p.rms_relative << " % of the stress range " << p.stress_range << " MPa\n";
+       << 100 * p.rms_relative << " % of the stress range " << p.stress_range
+       << " MPa; no convex law below " << 100 * p.monotonicity_bound
+       << " % (the data's monotonicity bound)\n";
   for (const auto& p : d.per_loop)
     if (p.uniaxial_end_ratio.array().isFinite().any())
       os << "    l = " << p.loop_length

@@ -40,6 +40,7 @@ Database db_with_law() {
     p.stress_range = 2.0;
     p.max_relative = 0.3;
     p.rms_relative = 0.15;
+    p.monotonicity_bound = 0.01 * l;
     dg.per_loop.push_back(p);
   }
   dg.holdout_points = 21;
@@ -81,6 +82,8 @@ TEST_CASE("database v2: the energy law round trip", "[unit]") {
   CHECK(dbk.per_loop[1].max == da.per_loop[1].max);
   CHECK(dbk.per_loop[0].rms == da.per_loop[0].rms);
   CHECK(dbk.per_loop[1].stress_range == 2.0);
+  CHECK(dbk.per_loop[0].monotonicity_bound == 0.045);
+  CHECK(dbk.per_loop[1].monotonicity_bound == 0.065);
   CHECK(dbk.holdout_points == 21);
   CHECK(dbk.holdout_within_5_percent == 20);
   CHECK(dbk.holdout_max == da.holdout_max);
@@ -92,6 +95,19 @@ TEST_CASE("database v2: the energy law round trip", "[unit]") {
   CHECK(ea.S == eb.S);
   CHECK(ea.W == eb.W);
   CHECK(&require_energy_law(back, file.string()) == &*back.energy_law);
+}
+
+TEST_CASE("database: diagnostics written before the monotonicity bound still load", "[unit]") {
+  const auto file = tmp("energy_no_mono.h5");
+  write_database(file, db_with_law());
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    f.remove("/energy_law/diagnostics/monotonicity_bound");
+  }
+  const Database back = read_database(file, false);
+  REQUIRE(back.energy_diagnostics.per_loop.size() == 2);
+  CHECK(std::isnan(back.energy_diagnostics.per_loop[0].monotonicity_bound));
+  CHECK(back.energy_diagnostics.per_loop[1].stress_range == 2.0);
 }
 
 TEST_CASE("database v1: loads, and asking it for the energy law names file and path", "[unit]") {

@@ -123,6 +123,27 @@ TEST_CASE("energy fit: the network fit gives the same law from the same seed", "
   CHECK(fit_network(db, 100, 2).law.network.theta != s.law.network.theta);
 }
 
+TEST_CASE("energy fit: the monotonicity bound of the data", "[unit]") {
+  // The gradient of a convex quadratic is monotone: no convex law need miss anything.
+  Eigen::Matrix3d C;
+  C << 4.0, 1.0, 0.0, 1.0, 3.0, 0.5, 0.0, 0.5, 2.0;
+  std::vector<Eigen::Vector3d> e, S;
+  for (int i = 0; i < 40; ++i) {
+    e.push_back(Eigen::Vector3d(std::sin(1.3 * i), std::cos(0.7 * i), std::sin(0.4 * i + 1)));
+    S.push_back(C * e.back());
+  }
+  CHECK(monotonicity_bound(e, S, 1.0) == 0.0);
+  // One state whose S11 falls as E11 rises from the origin: -(S_i - S_j).(e_i - e_j) = 1 over
+  // 2 range |de|_1 = 2 x 2 x 1: 0.25.
+  CHECK(monotonicity_bound({Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0)},
+                           {Eigen::Vector3d::Zero(), Eigen::Vector3d(-1, 0, 0)},
+                           2.0) == Approx(0.25).epsilon(1e-15));
+  CHECK(std::isnan(monotonicity_bound(e, S, 0.0)));
+  // In the fit's diagnostics: the synthetic law is convex and the cell is not involved.
+  const EnergyFitSummary s = fit_network(synthetic_coverage_db({4.5, 6.5}, 6), 50);
+  for (const auto& p : s.diagnostics.per_loop) CHECK(p.monotonicity_bound < 1e-12);
+}
+
 TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   // A network too small for the synthetic law (2 and 1 units) misses some states by far more
   // than it misses most; the tube (EnergyFitOptions::tube) trades the rms for the largest error.

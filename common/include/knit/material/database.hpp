@@ -92,6 +92,12 @@ struct EnergyFitDiagnostics {
     int points = 0;
     Eigen::Vector3d rms = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
     double stress_range = 0.0, max_relative = 0.0, rms_relative = 0.0;
+    /// The data's own floor for a convex law (fraction of stress_range): the largest
+    /// -(S_i - S_j) . (e_i - e_j) / (2 range |e_i - e_j|_1) over pairs of the loop length's
+    /// states, fitted and held out, and the stress-free origin. A convex W has a monotone
+    /// gradient, so it misses one state of such a pair by at least that much. NaN when unknown
+    /// (files written before session 10).
+    double monotonicity_bound = std::nan("");
     /// The law driven like the cell's uniaxial-stress paths (axial strain prescribed, lateral
     /// strain solved so that the law's lateral stress vanishes): law / cell axial stress at
     /// the last step, course (0) and wale (1); NaN without such a path. Printed, not stored.

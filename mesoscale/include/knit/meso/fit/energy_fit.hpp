@@ -38,6 +38,15 @@
 
 namespace knit::meso::fit {
 
+/// The data's own floor for any convex law, in units of `range` (docs/database.md "What
+/// convexity itself costs"): the gradient of a convex W is monotone, (S_i - S_j) . (e_i - e_j)
+/// >= 0, and stress errors |d_ic| <= delta * range change that product by at most
+/// 2 delta range |e_i - e_j|_1, so every pair needs
+/// delta >= -(S_i - S_j) . (e_i - e_j) / (2 range |e_i - e_j|_1). Returns the largest over all
+/// pairs (0 for monotone data). e = (E11, E22, 2E12); O(n^2), no allocation.
+double monotonicity_bound(const std::vector<Eigen::Vector3d>& e,
+                          const std::vector<Eigen::Vector3d>& S, double range);
+
 struct EnergyFitOptions {
   /// "ridge" (the convex ridge-spline sum) or "network" (the input-convex network,
   /// knit/material/convex_network.hpp; fitted by mesoscale/src/fit_network.cpp).
