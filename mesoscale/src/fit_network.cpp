@@ -87,7 +87,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
       const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
                                 S0[static_cast<std::size_t>(j)] - t_[p];
       f += scale_ * w_[p] * s.squaredNorm();
-      // The tube: each component's excess over tau_j, squared (C1), unweighted.
+      // The tube: each component's excess over tau_p, squared (C1), unweighted.
       Eigen::Vector3d gt_tube = Eigen::Vector3d::Zero();
       if (tube_weight_ > 0.0)
         for (int c = 0; c < 3; ++c) {
@@ -175,9 +175,9 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
     t.push_back((p.S - law.floor * p.e) / sS);
     knot.push_back(static_cast<int>(p.loop));
   }
-  // The tube's half-width per knot: `tube` times the knot's stress range (the diagnostics'
-  // range: the largest max - min of a component over that loop length's fit data), scaled.
-  std::vector<double> tube(static_cast<std::size_t>(n), 0.0);
+  // Each knot's stress range (the diagnostics' range: the largest max - min of a component over
+  // that loop length's fit data), scaled; the tube's half-width tau_p is `tube` times it.
+  std::vector<double> range(static_cast<std::size_t>(n), 0.0);
   {
     std::vector<Eigen::Vector3d> lo(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(1e300)),
         hi(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(-1e300));
@@ -185,12 +185,12 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
       lo[p.loop] = lo[p.loop].cwiseMin(p.S);
       hi[p.loop] = hi[p.loop].cwiseMax(p.S);
     }
-    for (std::size_t j = 0; j < tube.size(); ++j)
-      tube[j] = hi[j](0) >= lo[j](0) ? (hi[j] - lo[j]).maxCoeff() / sS : 0.0;
+    for (std::size_t j = 0; j < range.size(); ++j)
+      range[j] = hi[j](0) >= lo[j](0) ? (hi[j] - lo[j]).maxCoeff() / sS : 0.0;
   }
   std::vector<double> tube_of_point;
   for (const Point& p : pts) {
-    double tau = o.tube * tube[p.loop];
+    double tau = o.tube * range[p.loop];
     if (p.axis >= 0 && o.tube_uniaxial >= 0.0)
       tau = std::min(tau, o.tube_uniaxial * std::abs(p.S(p.axis)) / sS);
     tube_of_point.push_back(tau);
