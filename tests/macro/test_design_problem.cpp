@@ -4,17 +4,20 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "knit/core/errors.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit_test_database.hpp"
+#include "process_tmp.hpp"
 
 using namespace knit::macro;
 namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kDir = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "design_problem";
+const fs::path kDir = knit::testing::process_tmp_dir("design_problem");  // process_tmp.hpp
+const knit::testing::RemoveAtExit kRemoveDir{kDir};
 
 void write(const fs::path& f, const std::string& text) {
   fs::create_directories(f.parent_path());

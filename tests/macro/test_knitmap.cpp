@@ -6,11 +6,13 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include "knit/core/errors.hpp"
 #include "knit/macro/knitmap.hpp"
 #include "knit/material/database.hpp"
 #include "knit_test_database.hpp"
+#include "process_tmp.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;
@@ -18,7 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kDir = fs::path(KNIT_BINARY_DIR) / "test_tmp" / "knitmap";
+const fs::path kDir = knit::testing::process_tmp_dir("knitmap");  // process_tmp.hpp
+const knit::testing::RemoveAtExit kRemoveDir{kDir};
 
 double w_of(double l) {
   return knit::testing::synth_wale_width(l);
