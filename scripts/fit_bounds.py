@@ -2,7 +2,7 @@
 """What limits the energy law's held-out error (issue 11, "Fit quality")?
 
 For each requested loop length of a material database this prints, beside the stored energy
-law's own held-out figures, three law-independent references computed from the same cell data:
+law's own held-out figures, four law-independent references computed from the same cell data:
 
   * convex bound: the smallest delta such that SOME convex strain energy W reproduces the
     cell's stresses at the sampled states within delta (fraction of the stress range). It is a
@@ -10,6 +10,10 @@ law's own held-out figures, three law-independent references computed from the s
         W_j >= W_i + S'_i . (e_j - e_i),   |S'_ic - S_ic| <= delta * range,
     solved with HiGHS on every `--stride`-th state of every path, fitted and held-out ones
     (fewer states give fewer constraints, so the figure is a LOWER bound of the true one);
+    with `--uniaxial-relative RHO` a second program holds the uniaxial-stress paths' states
+    within RHO times their own axial stress instead;
+  * monotonicity bound: the same floor from the pairs of states alone (a convex W has a
+    monotone gradient), cheap enough for ALL states (docs/database.md);
   * free energy: S = grad W with W a tensor-product cubic B-spline over the box (not convex),
     least squares with a second-difference smoothing, trained on the fit paths only;
   * free interpolant: each of S11, S22, S12 its own spline of the same basis (no energy at
@@ -22,6 +26,7 @@ divided by the stress range of docs/database.md (largest max - min of a componen
 loop length's fit data); the threshold is 5 %.
 
 Usage: /usr/bin/python3 scripts/fit_bounds.py DATABASE.h5 [--loops 0 4] [--stride 3]
+           [--uniaxial-relative RHO]
        /usr/bin/python3 scripts/fit_bounds.py --self-check
 Needs python3-numpy, python3-scipy (>= 1.8 for HiGHS), python3-h5py and python3-matplotlib
 (the stored law is evaluated by scripts/figures/energy_law.py).
