@@ -6,10 +6,10 @@
 #include <fstream>
 #include <string>
 
+#include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit_test_database.hpp"
-#include "process_tmp.hpp"
 
 using namespace knit::macro;
 namespace fs = std::filesystem;

@@ -8,11 +8,11 @@
 #include <sstream>
 #include <string>
 
+#include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/knitmap.hpp"
 #include "knit/material/database.hpp"
 #include "knit_test_database.hpp"
-#include "process_tmp.hpp"
 
 using namespace knit::macro;
 using namespace knit::material;

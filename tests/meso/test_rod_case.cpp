@@ -1,7 +1,5 @@
 // The rod driver: every case in cases/rod/ runs and is compared with its reference numbers;
 // bad input gives exit code 2, a JSON-pointer message and no output.
-#include <unistd.h>
-
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -12,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "../process_tmp.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -19,8 +19,8 @@ namespace {
 const fs::path kBin = fs::path(KNIT_BIN_DIR) / "knit-meso";
 const fs::path kCases = fs::path(KNIT_SOURCE_DIR) / "cases" / "rod";
 // One directory per test process: CTest runs the test cases of this file side by side.
-const fs::path kTmp =
-    fs::path(KNIT_BINARY_DIR) / "test_tmp" / ("rod_" + std::to_string(::getpid()));
+const fs::path kTmp = knit::testing::process_tmp_dir("rod");
+const knit::testing::RemoveAtExit kRemoveTmp{kTmp};
 
 int run(const std::string& args, std::string* output = nullptr) {
   fs::create_directories(kTmp);
