@@ -42,30 +42,9 @@ from scipy.sparse import coo_matrix, vstack
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
 from energy_law import load_law  # noqa: E402  (the stored law, re-evaluated)
+from cell_paths import load_paths, stress_range  # noqa: E402  (scripts/cell_paths.py)
 
 THRESHOLD = 0.05
-
-
-def load_paths(f, loop):
-    """[(set, e (n x 3, e3 = 2 E12), S (n x 3), kind, axis)] of the converged steps of
-    /loop_<loop>/raw."""
-    g = f["loop_%d/raw" % loop]
-    out = []
-    for name in sorted(g):
-        ok = g[name]["status"][:] == 0
-        e = g[name]["E"][:][ok].copy()
-        e[:, 2] *= 2.0
-        s = g[name].attrs.get("set", "paper")
-        kind = g[name].attrs.get("kind", "biaxial")
-        kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-        out.append((s.decode() if isinstance(s, bytes) else str(s), e, g[name]["S"][:][ok], kind,
-                    int(g[name].attrs.get("axis", 0))))
-    return out
-
-
-def stress_range(paths):
-    s = np.concatenate([p[2] for p in paths if p[0] != "holdout"])
-    return max(s[:, c].max() - s[:, c].min() for c in range(3))
 
 
 def convex_bound(e, s, rng, fixed=None):

@@ -31,28 +31,21 @@ try:
 except ImportError:
     sys.exit("path_consistency.py: needs python3-h5py (run it with /usr/bin/python3)")
 
-
-def read_loop(group):
-    """Converged states of one /loop_k/raw group: e (n x 3), S (n x 3), path index, held-out."""
-    E, S, pid, held = [], [], [], []
-    for i, name in enumerate(sorted(group)):
-        p = group[name]
-        status, e, s = p["status"][()], p["E"][()], p["S"][()]
-        is_held = p.attrs.get("set", "") in ("holdout", b"holdout")
-        for j in range(len(status)):
-            if status[j] != 0:
-                continue
-            E.append([e[j, 0], e[j, 1], 2.0 * e[j, 2]])
-            S.append(s[j])
-            pid.append(i)
-            held.append(is_held)
-    return np.array(E), np.array(S), np.array(pid), np.array(held, dtype=bool)
+from cell_paths import load_paths, stress_range  # scripts/cell_paths.py
 
 
-def pairs(E, S, pid, held, radius):
-    """(difference / range, |e_a - e_b|, a, b) of every cross-path pair within radius."""
-    fit = ~held
-    rng = float((S[fit].max(0) - S[fit].min(0)).max())
+def read_loop(f, loop):
+    """Converged states of /loop_<loop>/raw (cell_paths.load_paths), fitted and held out:
+    e (n x 3), S (n x 3), path index, and the loop length's stress range."""
+    paths = load_paths(f, loop)
+    E = np.concatenate([p[1] for p in paths])
+    S = np.concatenate([p[2] for p in paths])
+    pid = np.concatenate([np.full(len(p[1]), i) for i, p in enumerate(paths)])
+    return E, S, pid, stress_range(paths)
+
+
+def pairs(E, S, pid, rng, radius):
+    """(difference / rng, |e_a - e_b|, a, b) of every cross-path pair within radius."""
     out = []
     for a in range(len(E)):
         d = np.linalg.norm(E[a + 1:] - E[a], axis=1)
@@ -60,7 +53,7 @@ def pairs(E, S, pid, held, radius):
             b = a + 1 + off
             out.append((float(np.abs(S[a] - S[b]).max()) / rng, float(d[off]), a, b))
     out.sort(reverse=True)
-    return rng, out
+    return out
 
 
 def main():
@@ -71,40 +64,37 @@ def main():
     a = ap.parse_args()
     try:
         f = h5py.File(a.database, "r")
-        loops = sorted((k for k in f if k.startswith("loop_") and k[5:].isdigit()),
-                       key=lambda k: int(k[5:]))
-        data = {k: read_loop(f[k]["raw"]) for k in loops}
-        ls = {k: float(f[k].attrs.get("loop_length", np.nan)) for k in loops}
-    except (OSError, KeyError) as e:
+        ls = [float(x) for x in f["loop_lengths"][()]]
+        data = [read_loop(f, k) for k in range(len(ls))]
+    except (OSError, KeyError, ValueError) as e:
         print(f"path_consistency.py: {a.database}: {e}", file=sys.stderr)
         return 2
-    if not loops:
-        print(f"path_consistency.py: {a.database}: no /loop_k/raw groups", file=sys.stderr)
+    if not data:
+        print(f"path_consistency.py: {a.database}: no loop lengths", file=sys.stderr)
         return 2
     if a.self_check:
-        E, S, pid, held = data[loops[0]]
-        rng, before = pairs(E, S, pid, held, a.radius)
+        E, S, pid, rng = data[0]
+        before = pairs(E, S, pid, rng, a.radius)
         if not before:
             print("self-check: no pair within the radius to perturb", file=sys.stderr)
             return 1
         victim = pid[before[0][2]]
         S = S.copy()
         S[pid == victim, 0] += 0.10 * rng
-        _, after = pairs(E, S, pid, held, a.radius)
+        after = pairs(E, S, pid, rng, a.radius)
         hit = [p for p in after if victim in (pid[p[2]], pid[p[3]]) and p[0] > 0.05]
-        print(f"self-check ({loops[0]}): +10 % of the range on S11 of path {victim}: "
+        print(f"self-check (loop_0): +10 % of the range on S11 of path {victim}: "
               f"{len(hit)} of its pairs now differ by > 5 % (largest before "
               f"{100 * before[0][0]:.1f} %)")
         return 0 if hit else 1
     print(f"{a.database}: pairs of states of different paths with |e_a - e_b| < {a.radius} "
           f"(e = (E11, E22, 2E12)); their largest stress difference, % of the stress range "
           f"(criterion of the fit: 5 %)")
-    for k in loops:
-        E, S, pid, held = data[k]
-        rng, out = pairs(E, S, pid, held, a.radius)
+    for k, (E, S, pid, rng) in enumerate(data):
+        out = pairs(E, S, pid, rng, a.radius)
         over = sum(1 for p in out if p[0] > 0.05)
         largest = f"{100 * out[0][0]:.1f} %" if out else "-"
-        print(f"  {k} (l = {ls[k]:g} mm): range {rng:.3g} MPa, {len(out)} pairs, "
+        print(f"  loop_{k} (l = {ls[k]:g} mm): range {rng:.3g} MPa, {len(out)} pairs, "
               f"{over} differ by > 5 %, largest {largest}")
         for diff, dist, i, j in out[:2]:
             print(f"      {100 * diff:.1f} % at e = {np.round(E[i], 3)} (|de| {dist:.4f}): "

@@ -17,6 +17,19 @@
 
 namespace knit::meso::fit {
 
+std::vector<double> detail::stress_ranges(const std::vector<Point>& pts, std::size_t loops) {
+  std::vector<Eigen::Vector3d> lo(loops, Eigen::Vector3d::Constant(1e300)),
+      hi(loops, Eigen::Vector3d::Constant(-1e300));
+  for (const Point& p : pts) {
+    lo[p.loop] = lo[p.loop].cwiseMin(p.S);
+    hi[p.loop] = hi[p.loop].cwiseMax(p.S);
+  }
+  std::vector<double> range(loops, 0.0);
+  for (std::size_t k = 0; k < loops; ++k)
+    if (hi[k](0) >= lo[k](0)) range[k] = (hi[k] - lo[k]).maxCoeff();
+  return range;
+}
+
 using material::Database;
 using material::EnergyFitDiagnostics;
 using material::EnergyLawData;
@@ -524,28 +537,25 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
   collect(db, pts, held, skipped);  // diagnostics of whatever is usable
   dg.points_skipped = skipped;
   dg.min_eigenvalue = std::numeric_limits<double>::infinity();
-  std::vector<double> range(db.entries.size(), 0.0);
+  const std::vector<double> range = detail::stress_ranges(pts, db.entries.size());
   for (std::size_t k = 0; k < db.entries.size(); ++k) {
     const material::EnergyLawAt at = family.at(db.entries[k].loop_length);
     EnergyFitDiagnostics::PerLoop pl;
     pl.loop_length = db.entries[k].loop_length;
-    Eigen::Vector3d smin = Eigen::Vector3d::Constant(1e300), smax = -smin,
-                    sq = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sq = Eigen::Vector3d::Zero();
     for (const auto& p : pts) {
       if (p.loop != k) continue;
       const material::EnergyResponse r = at.evaluate(p.e);
       const Eigen::Vector3d err = (r.S - p.S).cwiseAbs();
       pl.max = pl.max.cwiseMax(err);
       sq += err.cwiseProduct(err);
-      smin = smin.cwiseMin(p.S);
-      smax = smax.cwiseMax(p.S);
       dg.min_eigenvalue = std::min(
           dg.min_eigenvalue, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
       ++pl.points;
     }
     if (pl.points > 0) {
       pl.rms = (sq / pl.points).cwiseSqrt();
-      pl.stress_range = (smax - smin).maxCoeff();
+      pl.stress_range = range[k];
       if (pl.stress_range > 0) {
         pl.max_relative = pl.max.maxCoeff() / pl.stress_range;
         pl.rms_relative = pl.rms.maxCoeff() / pl.stress_range;
@@ -568,7 +578,6 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
         if (s == r.steps() - 1) pl.uniaxial_end_ratio(ax) = ratio;
       }
     }
-    range[k] = pl.stress_range;
     if (pl.stress_range > 0) {
       std::vector<Eigen::Vector3d> e{Eigen::Vector3d::Zero()}, S{Eigen::Vector3d::Zero()};
       for (const auto* set : {&pts, &held})

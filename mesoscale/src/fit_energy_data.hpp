@@ -18,6 +18,11 @@ struct Point {
   int axis = -1;      // a state of a uniaxial-stress path: its axis (0 course, 1 wale); else -1
 };
 
+/// The stress range of each loop length (entry index 0..loops-1): the largest max - min of a
+/// stress component over its points (MPa; 0 without points). The diagnostics' range, the
+/// denominator of the "% of the stress range" errors, and the network fit's tube width.
+std::vector<double> stress_ranges(const std::vector<Point>& pts, std::size_t loops);
+
 /// Fits law.network (law.floor, l_min, l_max, box already set) to the points, with the
 /// squared-residual weights `weight` (one per point), stress scale sS and strain scale sE.
 /// Returns the reason on failure (empty on success); `iterations` counts L-BFGS iterations.

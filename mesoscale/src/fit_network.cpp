@@ -175,19 +175,10 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
     t.push_back((p.S - law.floor * p.e) / sS);
     knot.push_back(static_cast<int>(p.loop));
   }
-  // Each knot's stress range (the diagnostics' range: the largest max - min of a component over
-  // that loop length's fit data), scaled; the tube's half-width tau_p is `tube` times it.
-  std::vector<double> range(static_cast<std::size_t>(n), 0.0);
-  {
-    std::vector<Eigen::Vector3d> lo(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(1e300)),
-        hi(static_cast<std::size_t>(n), Eigen::Vector3d::Constant(-1e300));
-    for (const Point& p : pts) {
-      lo[p.loop] = lo[p.loop].cwiseMin(p.S);
-      hi[p.loop] = hi[p.loop].cwiseMax(p.S);
-    }
-    for (std::size_t j = 0; j < range.size(); ++j)
-      range[j] = hi[j](0) >= lo[j](0) ? (hi[j] - lo[j]).maxCoeff() / sS : 0.0;
-  }
+  // Each knot's stress range (stress_ranges: the diagnostics' range), scaled; the tube's
+  // half-width tau_p is `tube` times it.
+  std::vector<double> range = stress_ranges(pts, static_cast<std::size_t>(n));
+  for (double& r : range) r /= sS;
   std::vector<double> tube_of_point;
   for (const Point& p : pts) {
     double tau = o.tube * range[p.loop];
