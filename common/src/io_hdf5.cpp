@@ -681,6 +681,12 @@ bool H5Group::has_attribute(const std::string& obj_path, const std::string& name
   return H5Aexists_by_name(id_.get(), h5name(obj_path).c_str(), name.c_str(), H5P_DEFAULT) > 0;
 }
 
+void H5Group::remove_attribute(const std::string& obj_path, const std::string& name) {
+  if (!has_attribute(obj_path, name)) fail(obj_path, "attribute " + name + " missing");
+  if (H5Adelete_by_name(id_.get(), h5name(obj_path).c_str(), name.c_str(), H5P_DEFAULT) < 0)
+    fail(obj_path, "cannot remove attribute " + name);
+}
+
 std::vector<std::string> H5Group::attribute_names(const std::string& obj_path) const {
   silence_hdf5();
   if (!exists(obj_path)) fail(obj_path, "object missing");

@@ -27,6 +27,8 @@ inline void add_outer(Eigen::Matrix3d& C, double c, const Eigen::Vector3d& a) {
 std::string NetworkShape::validate() const {
   if (h1 < 1 || h1 > kMaxUnits || h2 < 1 || h2 > kMaxUnits)
     return "hidden layer sizes must be in 1.." + std::to_string(kMaxUnits);
+  if (stiff1 < 0 || stiff1 > h1 || stiff2 < 0 || stiff2 > h2)
+    return "the stiffening units (stiff1, stiff2) must be in 0..h1 and 0..h2";
   return {};
 }
 
@@ -39,7 +41,8 @@ NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const
   NetworkResponse r;
   for (int i = 0; i < H1; ++i) {
     const double* a = a0 + 3 * i;
-    network_activation(a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i], h[i], dh[i], ddh[i]);
+    network_unit_activation(sh.stiffening1(i), a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i],
+                            h[i], dh[i], ddh[i]);
     r.W += w1[i] * h[i];
     kappa[i] = w1[i];
   }
@@ -49,7 +52,7 @@ NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const
     double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b1[j];
     for (int i = 0; i < H1; ++i) z += v[i] * h[i];
     double u, du, ddu;
-    network_activation(z, u, du, ddu);
+    network_unit_activation(sh.stiffening2(j), z, u, du, ddu);
     r.W += w[j] * u;
     const double wdu = w[j] * du;
     for (int i = 0; i < H1; ++i) kappa[i] += wdu * v[i];
@@ -95,7 +98,8 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
   const int H1 = sh.h1, H2 = sh.h2;
   for (int i = 0; i < H1; ++i) {
     const double* a = a0 + 3 * i;
-    network_activation(a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i], h[i], dh[i], ddh[i]);
+    network_unit_activation(sh.stiffening1(i), a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i],
+                            h[i], dh[i], ddh[i]);
     alpha[i] = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
     kappa[i] = w1[i];
     back[i] = 0.0;
@@ -111,7 +115,7 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
       gamma += v[i] * dh[i] * alpha[i];
     }
     double u, du, ddu;
-    network_activation(z, u, du, ddu);
+    network_unit_activation(sh.stiffening2(j), z, u, du, ddu);
     const double zeta = w[j] * ddu * gamma, omega = w[j] * du;
     grad[sh.w() + j] += du * gamma;
     grad[sh.b1() + j] += zeta;
@@ -176,9 +180,13 @@ using ArrayMap = Eigen::Map<Eigen::ArrayXd>;
 using ConstArrayMap = Eigen::Map<const Eigen::ArrayXd>;
 
 /// The activation on a whole layer (network_activation per unit: one formula for both paths;
-/// a branch-free copy of it measured no faster).
-inline void activation_layer(const ArrayMap& x, ArrayMap& s, ArrayMap& ds, ArrayMap& dds) {
-  for (Eigen::Index i = 0; i < x.size(); ++i) network_activation(x(i), s(i), ds(i), dds(i));
+/// a branch-free copy of it measured no faster); the last `stiff` units use rho.
+inline void activation_layer(const ArrayMap& x, ArrayMap& s, ArrayMap& ds, ArrayMap& dds,
+                             int stiff) {
+  const Eigen::Index n = x.size() - stiff;
+  for (Eigen::Index i = 0; i < n; ++i) network_activation(x(i), s(i), ds(i), dds(i));
+  for (Eigen::Index i = n; i < x.size(); ++i)
+    network_stiffening_activation(x(i), s(i), ds(i), dds(i));
 }
 
 }  // namespace
@@ -197,12 +205,12 @@ NetworkResponse NetworkLawAt::pass(const Eigen::Vector3d& e) const {
       t(tb.data(), H1), z(zb.data(), H2), u(ub.data(), H2), du(dub.data(), H2),
       ddu(ddub.data(), H2), wd(wb.data(), H2);
   y = c0 * e(0) + c1 * e(1) + c2 * e(2) + b0;
-  activation_layer(y, h, dh, ddh);
+  activation_layer(y, h, dh, ddh, shape_.stiff1);
   z.matrix().noalias() = V * h.matrix();
   for (int j = 0; j < H2; ++j)
     z(j) += a1[3 * j] * e(0) + a1[3 * j + 1] * e(1) + a1[3 * j + 2] * e(2);
   z += b1;
-  activation_layer(z, u, du, ddu);
+  activation_layer(z, u, du, ddu, shape_.stiff2);
   NetworkResponse r;
   r.W = (w * u).sum() + (w1 * h).sum() + 0.5 * e.dot(Q_ * e);
   wd = w * du;

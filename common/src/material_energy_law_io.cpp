@@ -29,13 +29,17 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
   if (law.family == EnergyFamily::kNetwork) {
     const NetworkShape& sh = law.network.shape;
     g.set_attribute(".", "family", "network");
-    g.set_attribute(".", "law",
-                    "W(e; l) = 1/2 (N(e) + N(M e)) - N(0) - S_N0 . e + floor/2 |e|^2, M = diag(1, "
-                    "1, -1); N(e) = sum_j w_j sigma(z_j) + sum_i w1_i sigma(y_i) + 1/2 e^T L L^T "
-                    "e, y = A0 e + b0, z = V sigma(y) + A1 e + b1; V, w, w1 >= 0; theta(l) "
-                    "piecewise linear between l_knots (knit/material/convex_network.hpp)");
+    g.set_attribute(
+        ".", "law",
+        "W(e; l) = 1/2 (N(e) + N(M e)) - N(0) - S_N0 . e + floor/2 |e|^2, M = diag(1, "
+        "1, -1); N(e) = sum_j w_j sigma(z_j) + sum_i w1_i sigma(y_i) + 1/2 e^T L L^T "
+        "e, y = A0 e + b0, z = V sigma(y) + A1 e + b1 (rho = max(0, x)^3 / 6 instead of "
+        "sigma on the last stiff1 and stiff2 units); V, w, w1 >= 0; theta(l) "
+        "piecewise linear between l_knots (knit/material/convex_network.hpp)");
     g.set_attribute(".", "h1", sh.h1);
     g.set_attribute(".", "h2", sh.h2);
+    g.set_attribute(".", "stiff1", sh.stiff1);
+    g.set_attribute(".", "stiff2", sh.stiff2);
     g.write("l_knots", law.network.l_knots);
     g.set_attribute("l_knots", "units", "mm (theta piecewise linear in l between these)");
     g.write("theta", RowMatrixX(law.network.theta));
@@ -136,6 +140,11 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
     if (law.family == EnergyFamily::kNetwork) {
       law.network.shape.h1 = root.attribute_int(g, "h1");
       law.network.shape.h2 = root.attribute_int(g, "h2");
+      // Optional (written since session 11): the stiffening units; 0 in older databases.
+      if (root.has_attribute(g, "stiff1"))
+        law.network.shape.stiff1 = root.attribute_int(g, "stiff1");
+      if (root.has_attribute(g, "stiff2"))
+        law.network.shape.stiff2 = root.attribute_int(g, "stiff2");
       law.network.l_knots = root.read_doubles(g + "/l_knots");
       law.network.theta = root.read_matrix(g + "/theta");
     } else {

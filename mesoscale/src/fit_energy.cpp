@@ -203,6 +203,8 @@ std::string EnergyFitOptions::validate() const {
   if (family != "ridge" && family != "network") return "family must be \"ridge\" or \"network\"";
   if (hidden1 < 1 || hidden1 > 64 || hidden2 < 1 || hidden2 > 64)
     return "hidden1 and hidden2 must be in 1..64";
+  if (stiff1 < 0 || stiff1 > hidden1 || stiff2 < 0 || stiff2 > hidden2)
+    return "stiff1 and stiff2 must be in 0..hidden1 and 0..hidden2";
   if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
   if (seed < 0) return "seed must be >= 0";
   if (network_iterations < 1 || network_iterations > 1000000)
@@ -233,6 +235,8 @@ std::string EnergyFitOptions::to_json() const {
                       {"family", family},
                       {"hidden1", hidden1},
                       {"hidden2", hidden2},
+                      {"stiff1", stiff1},
+                      {"stiff2", stiff2},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
                       {"network_iterations", network_iterations},
@@ -276,6 +280,8 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "family",
                                 "hidden1",
                                 "hidden2",
+                                "stiff1",
+                                "stiff2",
                                 "l_coupling",
                                 "seed",
                                 "network_iterations",
@@ -305,6 +311,8 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("weight_paper", o.weight_paper);
   get_int("hidden1", o.hidden1);
   get_int("hidden2", o.hidden2);
+  get_int("stiff1", o.stiff1);
+  get_int("stiff2", o.stiff2);
   get_double("l_coupling", o.l_coupling);
   get_int("seed", o.seed);
   get_int("network_iterations", o.network_iterations);
@@ -647,12 +655,16 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     return os.str();
   }
   const auto& d = s.diagnostics;
-  if (s.law.family == material::EnergyFamily::kNetwork)
-    os << "  energy law (input-convex network, hidden layers " << s.law.network.shape.h1 << " and "
-       << s.law.network.shape.h2 << ", " << s.law.network.l_knots.size() << " loop-length knots";
-  else
+  if (s.law.family == material::EnergyFamily::kNetwork) {
+    const material::NetworkShape& sh = s.law.network.shape;
+    os << "  energy law (input-convex network, hidden layers " << sh.h1 << " and " << sh.h2;
+    if (sh.stiff1 > 0 || sh.stiff2 > 0)
+      os << " (stiffening units " << sh.stiff1 << " and " << sh.stiff2 << ")";
+    os << ", " << s.law.network.l_knots.size() << " loop-length knots";
+  } else {
     os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
        << " functions";
+  }
   os << ", floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue << " MPa, "
      << s.ceres_iterations << " Ceres iterations):\n";
   for (const auto& p : d.per_loop)

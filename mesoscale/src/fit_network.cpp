@@ -166,6 +166,8 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   NetworkShape sh;
   sh.h1 = o.hidden1;
   sh.h2 = o.hidden2;
+  sh.stiff1 = o.stiff1;
+  sh.stiff2 = o.stiff2;
   if (const std::string why = sh.validate(); !why.empty()) return "invalid options: " + why;
   const int n = static_cast<int>(loop_lengths.size()), P = sh.size();
   std::vector<Eigen::Vector3d> x, t;

@@ -79,11 +79,27 @@ def _sigma(x):
     return s, ds
 
 
+def _rho(x):
+    """The stiffening activation max(0, x)^3 / 6 and its derivative (convex_network.hpp)."""
+    xp = np.maximum(x, 0.0)
+    return xp**3 / 6.0, 0.5 * xp**2
+
+
+def _layer(x, stiff):
+    """sigma on a layer's units, rho on its last `stiff` (option stiff1 / stiff2)."""
+    s, ds = _sigma(x)
+    if stiff > 0:
+        s[..., -stiff:], ds[..., -stiff:] = _rho(x[..., -stiff:])
+    return s, ds
+
+
 class NetworkLaw:
     """The network family of /energy_law (attribute family = "network"), re-evaluated."""
 
     def __init__(self, g, l):
         h1, h2 = int(g.attrs["h1"]), int(g.attrs["h2"])
+        self.stiff1 = int(g.attrs.get("stiff1", 0))
+        self.stiff2 = int(g.attrs.get("stiff2", 0))
         knots, theta = np.array(g["l_knots"]), np.array(g["theta"])
         t = np.array([np.interp(l, knots, theta[:, k]) for k in range(theta.shape[1])])
         o = 0
@@ -101,8 +117,8 @@ class NetworkLaw:
         self.W0, self.S0 = W0[0], np.array([S0[0, 0], S0[0, 1], 0.0])
 
     def _raw(self, e):
-        h, dh = _sigma(e @ self.A0.T + self.b0)
-        u, du = _sigma(h @ self.V.T + e @ self.A1.T + self.b1)
+        h, dh = _layer(e @ self.A0.T + self.b0, self.stiff1)
+        u, du = _layer(h @ self.V.T + e @ self.A1.T + self.b1, self.stiff2)
         W = u @ self.w + h @ self.w1 + 0.5 * np.einsum("...i,ij,...j->...", e, self.Q, e)
         kappa = self.w1 + (du * self.w) @ self.V
         S = (kappa * dh) @ self.A0 + (du * self.w) @ self.A1 + e @ self.Q

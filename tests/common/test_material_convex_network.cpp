@@ -19,6 +19,30 @@ std::vector<double> random_theta(const NetworkShape& sh, unsigned seed) {
 
 }  // namespace
 
+namespace {
+
+using Activation = void (*)(double, double&, double&, double&);
+
+/// Over [lo, hi] in steps of 0.01: nondecreasing and convex, and the first and second
+/// derivatives equal central differences of the value and the first derivative. tol_dds: a
+/// step h that straddles a jump J of the third derivative errs by up to h |J|.
+void check_activation(Activation f, double lo, double hi, double tol_dds) {
+  for (double x = lo; x <= hi; x += 0.01) {
+    double s, ds, dds;
+    f(x, s, ds, dds);
+    REQUIRE(ds >= 0.0);
+    REQUIRE(dds >= 0.0);
+    const double h = 1e-6;
+    double sp, dsp, ddsp, sm, dsm, ddsm;
+    f(x + h, sp, dsp, ddsp);
+    f(x - h, sm, dsm, ddsm);
+    REQUIRE(std::abs((sp - sm) / (2 * h) - ds) < 1e-8);
+    REQUIRE(std::abs((dsp - dsm) / (2 * h) - dds) < tol_dds);
+  }
+}
+
+}  // namespace
+
 TEST_CASE("convex network: the activation is C2, convex and nondecreasing", "[unit]") {
   double s, ds, dds;
   // The pieces meet with equal value, slope and curvature at -1 and 1.
@@ -34,25 +58,39 @@ TEST_CASE("convex network: the activation is C2, convex and nondecreasing", "[un
   CHECK((s == 0.0 && ds == 0.0 && dds == 0.0));
   network_activation(2.5, s, ds, dds);
   CHECK((s == 2.5 && ds == 1.0 && dds == 0.0));
-  for (double x = -1.5; x <= 1.5; x += 0.01) {
-    network_activation(x, s, ds, dds);
-    REQUIRE(ds >= 0.0);
-    REQUIRE(dds >= 0.0);
-    // Derivatives by central differences: sigma''' = -3/2 x jumps at -1 and 1, so a step
-    // that straddles them errs by up to h max|sigma'''| = 1.5 h.
-    const double h = 1e-6;
-    double sp, dsp, ddsp, sm, dsm, ddsm;
-    network_activation(x + h, sp, dsp, ddsp);
-    network_activation(x - h, sm, dsm, ddsm);
-    REQUIRE(std::abs((sp - sm) / (2 * h) - ds) < 1e-8);
-    REQUIRE(std::abs((dsp - dsm) / (2 * h) - dds) < 1.5e-6);
-  }
+  // The third derivative, -3/2 x, jumps by 1.5 at -1 and 1.
+  check_activation(network_activation, -1.5, 1.5, 1.5e-6);
 }
 
-TEST_CASE("convex network: S and C of the raw network equal finite differences", "[unit]") {
+TEST_CASE("convex network: the stiffening activation is C2, convex and nondecreasing", "[unit]") {
+  double s, ds, dds;
+  network_stiffening_activation(-0.5, s, ds, dds);
+  CHECK((s == 0.0 && ds == 0.0 && dds == 0.0));
+  network_stiffening_activation(2.0, s, ds, dds);
+  CHECK(s == Approx(8.0 / 6.0).epsilon(1e-15));
+  CHECK(ds == 2.0);
+  CHECK(dds == 2.0);
+  // The third derivative jumps from 0 to 1 at 0.
+  check_activation(network_stiffening_activation, -1.0, 2.0, 1e-6);
+}
+
+namespace {
+/// The shapes the tests below run on: without stiffening units, with some in either layer,
+/// and every unit of both layers stiffening.
+NetworkShape shape_with(int h1, int h2, int variant) {
   NetworkShape sh;
-  sh.h1 = 7;
-  sh.h2 = 5;
+  sh.h1 = h1;
+  sh.h2 = h2;
+  const int s1[] = {0, 2, 0, h1}, s2[] = {0, 0, 2, h2};
+  sh.stiff1 = s1[variant];
+  sh.stiff2 = s2[variant];
+  return sh;
+}
+}  // namespace
+
+TEST_CASE("convex network: S and C of the raw network equal finite differences", "[unit]") {
+  const NetworkShape sh = shape_with(7, 5, GENERATE(0, 1, 2, 3));
+  INFO("stiffening units " << sh.stiff1 << " and " << sh.stiff2);
   const std::vector<double> th = random_theta(sh, 3);
   std::mt19937 gen(2);
   std::uniform_real_distribution<double> u(-0.6, 0.6);
@@ -88,9 +126,8 @@ TEST_CASE("convex network: S and C of the raw network equal finite differences",
 TEST_CASE("convex network: the packed evaluation equals the reference network", "[unit]") {
   // NetworkLawAt (the law's fast path) against the mirror average of network_evaluate, the
   // formula of knit/material/convex_network.hpp written out.
-  NetworkShape sh;
-  sh.h1 = 9;
-  sh.h2 = 5;
+  const NetworkShape sh = shape_with(9, 5, GENERATE(0, 1, 2, 3));
+  INFO("stiffening units " << sh.stiff1 << " and " << sh.stiff2);
   const std::vector<double> th = random_theta(sh, 12);
   const NetworkLawAt law(sh, th);
   const NetworkResponse z = network_evaluate(sh, th.data(), Eigen::Vector3d::Zero());
@@ -114,9 +151,8 @@ TEST_CASE("convex network: the packed evaluation equals the reference network", 
 }
 
 TEST_CASE("convex network: the fit's reverse-mode gradient equals finite differences", "[unit]") {
-  NetworkShape sh;
-  sh.h1 = 5;
-  sh.h2 = 3;
+  const NetworkShape sh = shape_with(5, 3, GENERATE(0, 1, 2, 3));
+  INFO("stiffening units " << sh.stiff1 << " and " << sh.stiff2);
   std::vector<double> th = random_theta(sh, 9);
   std::mt19937 gen(4);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
@@ -176,6 +212,9 @@ TEST_CASE("convex network: validation refuses bad data", "[unit]") {
   refuses([&](EnergyLawData& d) { d.network.theta.conservativeResize(3, sh.size() - 1); },
           "theta must be");
   refuses([&](EnergyLawData& d) { d.network.shape.h1 = 0; }, "hidden layer sizes");
+  refuses([&](EnergyLawData& d) { d.network.shape.stiff2 = d.network.shape.h2 + 1; },
+          "stiffening units");
+  refuses([&](EnergyLawData& d) { d.network.shape.stiff1 = -1; }, "stiffening units");
   // Negative entries where no sign is required are fine (biases, first-layer weights, L).
   EnergyLawData ok = good;
   ok.network.theta(0, sh.b0()) = -3.0;

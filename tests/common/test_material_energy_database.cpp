@@ -179,6 +179,8 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   const auto file = tmp("network_roundtrip.h5");
   Database db = db_with_law();
   db.energy_law = testing::make_test_network_law();
+  db.energy_law->network.shape.stiff1 = 1;  // stiffening units (session 11) round-trip too
+  db.energy_law->network.shape.stiff2 = 2;
   write_database(file, db);
   {
     const auto f = knit::io::H5File::open_read(file);
@@ -191,6 +193,8 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   CHECK(b.family == EnergyFamily::kNetwork);
   CHECK(b.network.shape.h1 == a.network.shape.h1);
   CHECK(b.network.shape.h2 == a.network.shape.h2);
+  CHECK(b.network.shape.stiff1 == 1);
+  CHECK(b.network.shape.stiff2 == 2);
   CHECK(b.network.l_knots == a.network.l_knots);
   CHECK(b.network.theta == a.network.theta);
   CHECK(b.floor == a.floor);
@@ -199,6 +203,23 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   const auto eb = EnergyLaw(b).at(5.1).evaluate({0.1, -0.05, 0.2});
   CHECK(ea.S == eb.S);
   CHECK(ea.C == eb.C);
+}
+
+TEST_CASE("database v3: a network law written before the stiffening units still loads", "[unit]") {
+  const auto file = tmp("network_no_stiff.h5");
+  Database db = db_with_law();
+  db.energy_law = testing::make_test_network_law();
+  write_database(file, db);
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    f.remove_attribute("/energy_law", "stiff1");
+    f.remove_attribute("/energy_law", "stiff2");
+  }
+  const Database back = read_database(file, false);
+  REQUIRE(back.energy_law);
+  CHECK(back.energy_law->network.shape.stiff1 == 0);
+  CHECK(back.energy_law->network.shape.stiff2 == 0);
+  CHECK(back.energy_law->network.theta == db.energy_law->network.theta);
 }
 
 TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit]") {

@@ -172,6 +172,22 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
 }
 
+TEST_CASE("energy fit: stiffening units are fitted, stored and keep the law convex", "[unit]") {
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  EnergyFitOptions o;
+  o.hidden1 = 4;
+  o.hidden2 = 3;
+  o.stiff1 = 1;
+  o.stiff2 = 2;
+  o.network_iterations = 300;
+  const EnergyFitSummary s = fit_energy_law(db, o);
+  REQUIRE(s.ok());
+  CHECK(s.law.network.shape.stiff1 == 1);
+  CHECK(s.law.network.shape.stiff2 == 2);
+  CHECK(s.diagnostics.min_eigenvalue >= s.law.floor * (1 - 1e-9));
+  for (const auto& p : s.diagnostics.per_loop) CHECK(p.rms_relative < 0.05);
+}
+
 TEST_CASE("energy fit: a robust loss and custom directions also fit", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
   EnergyFitOptions o = EnergyFitOptions::from_json(
@@ -266,6 +282,8 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("tube_weight"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 0})", "f.json"),
                       Catch::Contains("hidden1 and hidden2"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden2": 4, "stiff2": 5})", "f.json"),
+                      Catch::Contains("stiff1 and stiff2"));
     // Range before narrowing: 2^32 + 12 was read as 12 (the same check as the eq. 17 fit's).
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 4294967308})", "f.json"),
                       Catch::Contains("/hidden1") && Catch::Contains("32-bit"));
@@ -292,6 +310,8 @@ TEST_CASE("energy fit: the options round-trip through JSON", "[unit]") {
   o.directions = {{1, 0, 0}, {0, 1, 0.5}};
   o.family = "ridge";
   o.hidden2 = 4;
+  o.stiff1 = 0;
+  o.stiff2 = 2;
   o.l_coupling = 0.5;
   o.seed = 3;
   o.tube = 0.04;
@@ -299,4 +319,5 @@ TEST_CASE("energy fit: the options round-trip through JSON", "[unit]") {
   o.tube_uniaxial = 0.01;
   const EnergyFitOptions b = EnergyFitOptions::from_json(o.to_json());
   CHECK(b.to_json() == o.to_json());
+  CHECK(b.stiff2 == 2);
 }

@@ -177,6 +177,9 @@ class H5Group {
                      const std::vector<double>& value);
 
   bool has_attribute(const std::string& obj_path, const std::string& name) const;
+  /// Removes attribute `name` of the object at obj_path (as an older writer would have left it
+  /// out); throws if there is none.
+  void remove_attribute(const std::string& obj_path, const std::string& name);
   std::vector<std::string> attribute_names(const std::string& obj_path = ".") const;
   std::string attribute_string(const std::string& obj_path, const std::string& name) const;
   /// Scalar or one-element numeric attribute.

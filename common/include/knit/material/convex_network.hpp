@@ -52,9 +52,38 @@ inline void network_activation(double x, double& s, double& ds, double& dds) {
   }
 }
 
+/// The stiffening activation (option `stiff1`/`stiff2`, session 11): rho(x) = max(0, x)^3 / 6,
+/// rho' = max(0, x)^2 / 2, rho'' = max(0, x). Convex and nondecreasing like sigma (so the network
+/// stays convex), C2 at 0, and its curvature grows without bound: one such unit gives a stiffness
+/// that rises linearly with its pre-activation, the shape of a jamming yarn network, where
+/// sigma's compact curvature bump needs many units to tile a rising stiffness.
+inline void network_stiffening_activation(double x, double& s, double& ds, double& dds) {
+  if (x <= 0.0) {
+    s = ds = dds = 0.0;
+  } else {
+    dds = x;
+    ds = 0.5 * x * x;
+    s = ds * x / 3.0;
+  }
+}
+
+/// The activation of a unit: sigma, or rho for the stiffening units.
+inline void network_unit_activation(bool stiffening, double x, double& s, double& ds, double& dds) {
+  if (stiffening)
+    network_stiffening_activation(x, s, ds, dds);
+  else
+    network_activation(x, s, ds, dds);
+}
+
 /// Sizes and the layout of one parameter vector theta (offsets into it).
 struct NetworkShape {
   int h1 = 12, h2 = 6;
+  /// The last stiff1 units of the first layer and the last stiff2 of the second use the
+  /// stiffening activation rho (0 = none: the law of sessions 6-10). The layout of theta does
+  /// not depend on them.
+  int stiff1 = 0, stiff2 = 0;
+  bool stiffening1(int i) const { return i >= h1 - stiff1; }
+  bool stiffening2(int j) const { return j >= h2 - stiff2; }
   int a0() const { return 0; }                 ///< h1 x 3, row-major (a0_i)
   int b0() const { return 3 * h1; }            ///< h1
   int w1() const { return 4 * h1; }            ///< h1, >= 0

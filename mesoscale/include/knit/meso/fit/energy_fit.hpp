@@ -55,6 +55,9 @@ struct EnergyFitOptions {
   /// (penalty l_coupling |theta_j+1 - theta_j|^2, so theta(l) interpolates sensibly between the
   /// fitted loop lengths), the seed of the initial parameters, and L-BFGS iterations.
   int hidden1 = 12, hidden2 = 6;
+  /// Network family: how many of each layer's units use the stiffening activation rho
+  /// (knit/material/convex_network.hpp; the last ones of the layer). 0: none.
+  int stiff1 = 0, stiff2 = 0;
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
