@@ -164,6 +164,17 @@ def law_checks(db_path, extrapolations):
     return rows
 
 
+def near_visited_text(db_path, res_dir):
+    """The law's errors at the cell states near the strains the runs visit
+    (scripts/law_near_visited.py; information beside the checks, not judged)."""
+    try:
+        import law_near_visited
+        text = law_near_visited.summary(law_near_visited.near_errors(db_path, res_dir))
+    except (OSError, KeyError, ValueError) as e:
+        text = f"Where the runs go: not computed ({e})."
+    return (text or "Where the runs go: no run wrote material-frame strains.") + "\n"
+
+
 class Data:
     """The pipeline's results, loaded on demand: curves and fields by case name."""
 
@@ -470,6 +481,7 @@ class Report:
             for statement, threshold, measured, ok in law:
                 L.append(f"| {md(statement)} | {md(threshold)} | {md(measured)} | {verdict(ok)} |")
             L.append("")
+            L.append(near_visited_text(db_path, os.path.join(self.out, "results")))
         L.append("## Statements of the paper against our numbers\n")
         L.append("Each check is a function of the loaded results (scripts/report_checks.py; "
                  "thresholds and their reasons in docs/reproduction.md). Curves are compared at "

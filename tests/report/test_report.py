@@ -410,6 +410,60 @@ def law_check_failures(tmp):
     return out
 
 
+def near_visited_failures(tmp):
+    """scripts/law_near_visited.py on a hand-made database whose law is S = 0 (a network with
+    all parameters 0 and no floor), so a state's error is |S_cell| / range: which states count
+    as near a visited strain (radius, the mirror in E12, tensor shear), and the numbers the
+    report prints."""
+    import h5py
+    import law_near_visited as lnv
+    out = []
+    db = os.path.join(tmp, "near.h5")
+    res = os.path.join(tmp, "near_results")
+    os.makedirs(os.path.join(res, "case"), exist_ok=True)
+    with h5py.File(os.path.join(res, "case", "results.h5"), "w") as f:
+        g = f.create_group("fields/step_0001")
+        g["E_course"], g["E_wale"], g["E_course_wale"] = [0.1, 0.3], [0.0, 0.3], [0.0, -0.05]
+    with h5py.File(db, "w") as f:
+        f["loop_lengths"] = [5.0]
+        law = f.create_group("energy_law")
+        law.attrs["family"] = "network"
+        law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, 0.0
+        law["l_knots"] = [5.0]
+        law["theta"] = np.zeros((1, 20))
+
+        def path(name, set_, E, S):
+            g = f.create_group(f"loop_0/raw/{name}")
+            g["E"], g["S"] = np.array(E, float), np.array(S, float)
+            g["status"] = np.zeros(len(E), dtype=int)
+            g.attrs["set"] = set_
+        # Stored E is tensor shear. Range of the fit data: S11 from 0.5 to 10 -> 9.5 MPa.
+        path("fit", "coverage", [[0.1, 0.0, 0.0], [0.6, 0.0, 0.0], [0.3, 0.3, 0.049]],
+             [[0.5, 0.0, 0.0], [10.0, 0.0, 0.0], [0.5, 0.76, 0.0]])
+        path("held", "holdout", [[0.13, 0.0, 0.0], [0.3, 0.3, 0.05], [-0.3, 0.0, 0.0]],
+             [[0.2, 0.0, 0.0], [0.0, 0.95, 0.0], [3.0, 0.0, 0.0]])
+    rows = lnv.near_errors(db, res, 0.05)
+    want = dict(fit_n=3, fit_near=2, hold_n=3, hold_near=2, hold_in=1)
+    got = {k: rows[0][k] for k in want} if rows else None
+    if got != want:
+        out.append(f"near visited: {got} instead of {want}")
+    # The near fit states' largest error: (0.3, 0.3, 0.049) is 0.001 in E12 from the mirror
+    # image (0.3, 0.3, 0.05) of the visited (0.3, 0.3, -0.05): 0.76 / 9.5 = 8 %.
+    if not rows or abs(rows[0]["fit_max"] - 0.08) > 1e-12:
+        out.append(f"near visited: fit_max {rows[0]['fit_max'] if rows else None}, want 0.08")
+    if not rows or abs(rows[0]["hold_max"] - 0.1) > 1e-12:
+        out.append(f"near visited: hold_max {rows[0]['hold_max'] if rows else None}, want 0.1")
+    text = lnv.summary(rows)
+    if "8.0 %" not in text or "1 of 2 held-out states" not in text:
+        out.append(f"near visited: the report's sentence misses its numbers: {text}")
+    # A smaller radius leaves the held-out state at 0.03 out.
+    rows = lnv.near_errors(db, res, 0.02)
+    if not rows or rows[0]["hold_near"] != 1:
+        out.append(f"near visited, radius 0.02: {rows[0]['hold_near'] if rows else None} "
+                   "held-out states near, want 1")
+    return out
+
+
 def main():
     failures = []
     tmp = tempfile.mkdtemp(prefix="knit_report_test_")
@@ -497,6 +551,7 @@ def main():
             pass
         # -- the material law's checks (issue 11): each one made to fail ------------------------
         failures.extend(law_check_failures(tmp))
+        failures.extend(near_visited_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
