@@ -134,9 +134,8 @@ def main():
     a = ap.parse_args()
     if not a.radius > 0:
         sys.exit(f"law_near_visited: --radius must be > 0 (got {a.radius})")
-    for path in (a.database,):
-        if not os.path.isfile(path):
-            sys.exit(f"law_near_visited: {path}: no such file")
+    if not os.path.isfile(a.database):
+        sys.exit(f"law_near_visited: {a.database}: no such file")
     rows = near_errors(a.database, a.results, a.radius)
     if not rows:
         sys.exit(f"law_near_visited: nothing to compare ({a.database}: no /energy_law, or no "

@@ -7,7 +7,9 @@
 //   z_j = sum_i V_ji h_i + a1_j . e + b1_j,  u_j = sigma(z_j)                    j = 1..h2
 //   N(e) = sum_j w_j u_j + sum_i w1_i h_i + 1/2 e^T L L^T e,      V, w, w1 >= 0,
 //
-// and sigma convex and nondecreasing (below). Derivatives in closed form:
+// and sigma convex and nondecreasing (below; the last stiff1 / stiff2 units of a layer may use
+// the stiffening activation rho instead, also convex and nondecreasing). Derivatives in closed
+// form (sigma standing for either):
 //   grad z_j = sum_i V_ji h'_i a0_i + a1_j,   kappa_i = w1_i + sum_j w_j u'_j V_ji  (>= 0)
 //   S = dN/de = sum_i kappa_i h'_i a0_i + sum_j w_j u'_j a1_j + L L^T e
 //   C = d2N/de2 = sum_j w_j u''_j grad z_j grad z_j^T + sum_i kappa_i h''_i a0_i a0_i^T + L L^T,
