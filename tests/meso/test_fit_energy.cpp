@@ -39,6 +39,15 @@ EnergyFitSummary fit_network(const Database& db, int iterations, int seed = 1) {
   return s;
 }
 
+/// Network-family options of a small network (h1 and h2 units) fitted for `iterations`.
+EnergyFitOptions small_network(int h1, int h2, int iterations) {
+  EnergyFitOptions o;
+  o.hidden1 = h1;
+  o.hidden2 = h2;
+  o.network_iterations = iterations;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("energy fit: recovers the synthetic hyperelastic law within 3 % of the range", "[unit]") {
@@ -148,10 +157,7 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   // A network too small for the synthetic law (2 and 1 units) misses some states by far more
   // than it misses most; the tube (EnergyFitOptions::tube) trades the rms for the largest error.
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  EnergyFitOptions o;
-  o.hidden1 = 2;
-  o.hidden2 = 1;
-  o.network_iterations = 400;
+  EnergyFitOptions o = small_network(2, 1, 400);
   auto largest = [](const EnergyFitSummary& s) {
     double m = 0.0;
     for (const auto& p : s.diagnostics.per_loop) m = std::max(m, p.max_relative);
@@ -174,12 +180,9 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
 
 TEST_CASE("energy fit: stiffening units are fitted, stored and keep the law convex", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  EnergyFitOptions o;
-  o.hidden1 = 4;
-  o.hidden2 = 3;
+  EnergyFitOptions o = small_network(4, 3, 300);
   o.stiff1 = 1;
   o.stiff2 = 2;
-  o.network_iterations = 300;
   const EnergyFitSummary s = fit_energy_law(db, o);
   REQUIRE(s.ok());
   CHECK(s.law.network.shape.stiff1 == 1);
