@@ -1,0 +1,225 @@
+#!/usr/bin/env python3
+"""Is the cell's stress at a path's end a function of the strain alone?
+
+Re-runs the end states of a material database's paths (the held-out ones by default) along
+other deformation paths to the same Green-Lagrange strain, and with finer steps, on the same
+cell, then compares the end stresses. A hyperelastic law (the energy-based law of issue 11)
+can only be judged at states where the cell gives one answer: where two paths to the same
+strain end at stresses that differ by more than the tolerance, the cell has more than one
+equilibrium there (jamming, buckling or stick-slip picks the branch), and no state function
+comes within the tolerance of both.
+
+For a path of kind "gradient" (F(t) = I + t H, end F = I + H) the twins are, each with
+`--steps-factor` times the steps:
+  * the same H (finer steps only),
+  * the symmetric stretch U = sqrt(F^T F) (F(t) = I + t (U - I)),
+  * the lower-triangular F with the same F^T F,
+all ending at the same E = (F^T F - I) / 2, through different intermediate states. A "biaxial"
+path (F diagonal, so all three coincide) gets the finer-step twin only; uniaxial-stress paths
+(stress-controlled) are skipped.
+
+Usage: cell_uniqueness.py DB.h5 [--set holdout] [--steps-factor 4] [--tol 0.05]
+                          [--work DIR] [--knit-meso PATH] [--threads 2]
+Runs `knit-meso sweep` once (no fit) with the database's own cell, runner and retry settings
+(its /sweep input_json) and writes nothing into DB.h5. Prints, per loop length and path end
+state, the spread of the end stresses over the original and its twins (largest difference of
+a stress component, % of the loop length's stress range, docs/database.md) and the stored
+law's error against each; a summary line counts the end states whose spread is within --tol
+and how many of those the law meets within 5 %. numpy, scipy (sqrtm not needed: 2 x 2 closed
+form) and h5py only: run with /usr/bin/python3.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
+from cell_paths import stress_range  # noqa: E402
+
+
+def _text(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def sym_sqrt2(C):
+    """The symmetric positive square root of a 2 x 2 symmetric positive definite matrix."""
+    s = np.sqrt(np.linalg.det(C))
+    t = np.sqrt(np.trace(C) + 2.0 * s)
+    return (C + s * np.eye(2)) / t
+
+
+def twin_gradients(H):
+    """End displacement gradients of the two other paths to the same strain as F = I + H:
+    the symmetric stretch U - I and the lower-triangular L - I (L^T L = F^T F)."""
+    F = np.eye(2) + np.asarray(H, dtype=float).reshape(2, 2)
+    C = F.T @ F
+    U = sym_sqrt2(C)
+    d = np.sqrt(C[1, 1])
+    c = C[0, 1] / d
+    L = np.array([[np.sqrt(C[0, 0] - c * c), 0.0], [c, d]])
+    return U - np.eye(2), L - np.eye(2)
+
+
+def green(H):
+    F = np.eye(2) + np.asarray(H, dtype=float).reshape(2, 2)
+    return 0.5 * (F.T @ F - np.eye(2))
+
+
+def selected_paths(f, which):
+    """[(name, kind, H or target, steps)] of /loop_0/raw whose set is `which` ("all": every
+    set), gradient and biaxial kinds only (the paths are the same at every loop length)."""
+    g = f["loop_0/raw"]
+    out = []
+    for name in sorted(g, key=lambda n: int(n.split("_")[-1])):
+        a = g[name].attrs
+        kind, s = _text(a.get("kind", "biaxial")), _text(a.get("set", "paper"))
+        if which != "all" and s != which:
+            continue
+        if kind == "gradient":
+            out.append((name, kind, np.array(a["H"], dtype=float).reshape(2, 2), int(a["steps"])))
+        elif kind == "biaxial":
+            out.append((name, kind, np.array(a["target"], dtype=float), int(a["steps"])))
+    return out
+
+
+def twin_extras(paths, factor):
+    """The sweep's extra paths for `paths` and, per path, the number of twins (in order)."""
+    extra, counts = [], []
+    for _, kind, x, steps in paths:
+        n = max(1, factor * steps)
+        if kind == "gradient":
+            U, L = twin_gradients(x)
+            for H in (x, U, L):
+                extra.append({"kind": "gradient", "H": np.round(H, 12).tolist(), "steps": n,
+                              "set": "holdout"})
+            counts.append(3)
+        else:
+            extra.append({"kind": "biaxial", "E11": float(x[0]), "E22": float(x[1]),
+                          "steps": n, "set": "holdout"})
+            counts.append(1)
+    return extra, counts
+
+
+def sweep_input(stored, extra):
+    """A sweep input with the stored input's loop lengths and cell, only the twins (plus the
+    one default path a preset must run) and no fit."""
+    s = {"description": "cell_uniqueness.py: twins of a database's path end states",
+         "loop_lengths": stored["loop_lengths"], "steps": 4,
+         "load_paths": {"preset": "default", "select": [12], "extra": extra},
+         "fit": False}
+    for key in ("runner", "cell", "residual_stress", "retry"):
+        if key in stored:
+            s[key] = stored[key]
+    return s
+
+
+def spreads(S_end, R):
+    """Largest difference of a stress component over the rows of S_end, / R."""
+    S_end = np.asarray(S_end, dtype=float)
+    return float((S_end.max(axis=0) - S_end.min(axis=0)).max() / R)
+
+
+def compare(db, tw, paths, counts, law_of=None, tol=0.05):
+    """Rows (loop length, name, end e, spread, law errors) and the summary counts."""
+    import h5py  # noqa: F401  (the files are open h5py objects)
+    from cell_paths import load_paths
+    rows = []
+    ls = np.array(db["loop_lengths"])
+    for k, l in enumerate(ls):
+        R = stress_range(load_paths(db, k))
+        g = tw["loop_%d/raw" % k]
+        names = sorted(g, key=lambda n: int(n.split("_")[-1]))[1:]  # [0]: the preset's path
+        law = law_of(l) if law_of else None
+        o = 0
+        for (name, _, _, _), n in zip(paths, counts):
+            orig = db["loop_%d/raw/%s" % (k, name)]
+            ok = orig["status"][:] == 0
+            twins = [g[names[o + j]] for j in range(n)]
+            o += n
+            if not ok[-1] or any(t["status"][-1] != 0 for t in twins):
+                rows.append((l, name, None, None, None))
+                continue
+            E = orig["E"][-1]
+            for t in twins:
+                if np.abs(t["E"][-1] - E).max() > 1e-6:
+                    raise SystemExit("error: twin of %s ends at E = %s, not %s" %
+                                     (name, t["E"][-1], E))
+            S = np.vstack([orig["S"][-1]] + [t["S"][-1] for t in twins])
+            e = np.array([E[0], E[1], 2.0 * E[2]])
+            err = None
+            if law is not None:
+                _, Sl = law.eval(e[None, :])
+                err = np.abs(S - Sl[0]).max(axis=1) / R
+            rows.append((l, name, e, spreads(S, R), err))
+    done = [r for r in rows if r[3] is not None]
+    unique = [r for r in done if r[3] <= tol]
+    summary = {"states": len(rows), "failed": len(rows) - len(done), "unique": len(unique),
+               "law_within": sum(1 for r in unique if r[4] is not None and r[4][0] <= 0.05),
+               "law_within_all": sum(1 for r in done if r[4] is not None and r[4][0] <= 0.05)}
+    return rows, summary
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("db", help="material database (HDF5) with raw paths and /sweep input_json")
+    ap.add_argument("--set", default="holdout", help="paths to check: holdout (default), "
+                    "coverage, paper or all")
+    ap.add_argument("--steps-factor", type=int, default=4, help="twins' steps / the path's")
+    ap.add_argument("--tol", type=float, default=0.05, help="spread that counts as one state "
+                    "(fraction of the stress range; default 0.05, the issue's criterion)")
+    ap.add_argument("--work", help="directory for the twins' sweep input and database "
+                    "(default: a new temporary directory, kept)")
+    ap.add_argument("--knit-meso", default=os.path.join(os.path.dirname(os.path.abspath(
+        __file__)), "..", "build", "bin", "knit-meso"))
+    ap.add_argument("--threads", type=int, default=2)
+    a = ap.parse_args(argv)
+    import h5py
+    from energy_law import load_law
+    if not os.path.isfile(a.db):
+        raise SystemExit("error: %s: no such file" % a.db)
+    db = h5py.File(a.db, "r")
+    if "sweep" not in db or "input_json" not in db["sweep"].attrs:
+        raise SystemExit("error: %s: /sweep has no attribute input_json (not a sweep's "
+                         "database)" % a.db)
+    stored = json.loads(_text(db["sweep"].attrs["input_json"]))
+    paths = selected_paths(db, a.set)
+    if not paths:
+        raise SystemExit("error: %s: no gradient or biaxial path of set %r in /loop_0/raw" %
+                         (a.db, a.set))
+    extra, counts = twin_extras(paths, a.steps_factor)
+    work = a.work or tempfile.mkdtemp(prefix="cell_uniqueness_")
+    os.makedirs(work, exist_ok=True)
+    inp, out = os.path.join(work, "twins.json"), os.path.join(work, "twins.h5")
+    with open(inp, "w") as fh:
+        json.dump(sweep_input(stored, extra), fh, indent=1)
+    print("running %d twin paths x %d loop lengths: %s sweep %s -o %s" %
+          (len(extra), len(stored["loop_lengths"]), a.knit_meso, inp, out), flush=True)
+    subprocess.run([a.knit_meso, "sweep", inp, "-o", out, "--threads", str(a.threads),
+                    "--force", "--plain", "--no-progress"], check=True)
+    law_of = (lambda l: load_law(db["energy_law"], l)) if "energy_law" in db else None
+    rows, summary = compare(db, h5py.File(out, "r"), paths, counts, law_of, a.tol)
+    print("%6s %-9s %-24s %8s  %s" % ("l mm", "path", "end (E11, E22, 2E12)", "spread",
+                                      "law error vs original / twins, % of range"))
+    for l, name, e, sp, err in rows:
+        if sp is None:
+            print("%6.2f %-9s (a run did not converge to the end)" % (l, name))
+            continue
+        mark = " *" if sp > a.tol else "  "
+        es = " ".join("%5.1f" % (100 * x) for x in err) if err is not None else "-"
+        print("%6.2f %-9s (%6.3f, %6.3f, %6.3f) %7.1f%%%s %s" % (l, name, e[0], e[1], e[2],
+                                                                100 * sp, mark, es))
+    print("summary: %d end states; %d with a twin that did not converge; %d are one state of "
+          "the cell (spread <= %.1f %% of the range, * above); the law is within 5 %% at %d "
+          "of those (at %d of all)" % (summary["states"], summary["failed"], summary["unique"],
+                                       100 * a.tol, summary["law_within"],
+                                       summary["law_within_all"]))
+    print("twins' sweep: %s" % out)
+
+
+if __name__ == "__main__":
+    main()
