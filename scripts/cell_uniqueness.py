@@ -25,8 +25,8 @@ Runs `knit-meso sweep` once (no fit) with the database's own cell, runner and re
 state, the spread of the end stresses over the original and its twins (largest difference of
 a stress component, % of the loop length's stress range, docs/database.md) and the stored
 law's error against each; a summary line counts the end states whose spread is within --tol
-and how many of those the law meets within 5 %. numpy, scipy (sqrtm not needed: 2 x 2 closed
-form) and h5py only: run with /usr/bin/python3.
+and how many of those the law meets within 5 %. numpy and h5py only: run with
+/usr/bin/python3 (tests/report/test_cell_uniqueness.py).
 """
 import argparse
 import json
