@@ -176,12 +176,12 @@ NetworkLawAt::NetworkLawAt(const NetworkShape& shape, std::vector<double> theta)
 
 namespace {
 
-/// The activation on a whole layer: network_activation per unit (one formula for both paths; a
-/// branch-free, vectorized copy measured 15-20 % slower on the benchmark's strains), rho on the
-/// last `stiff` units.
+/// The activation on a whole layer, per unit (its fast form; a branch-free, vectorized copy
+/// measured 15-20 % slower on the benchmark's strains); rho on the last `stiff` units.
 template <class X, class S>
 inline void activation_layer(const X& x, S& s, S& ds, S& dds, int stiff) {
-  for (Eigen::Index i = 0; i < x.size() - stiff; ++i) network_activation(x(i), s(i), ds(i), dds(i));
+  for (Eigen::Index i = 0; i < x.size() - stiff; ++i)
+    network_activation_impl<true>(x(i), s(i), ds(i), dds(i));
   for (Eigen::Index i = x.size() - stiff; i < x.size(); ++i)
     network_stiffening_activation(x(i), s(i), ds(i), dds(i));
 }

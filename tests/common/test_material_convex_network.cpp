@@ -60,6 +60,16 @@ TEST_CASE("convex network: the activation is C2, convex and nondecreasing", "[un
   CHECK((s == 2.5 && ds == 1.0 && dds == 0.0));
   // The third derivative, -3/2 x, jumps by 1.5 at -1 and 1.
   check_activation(network_activation, -1.5, 1.5, 1.5e-6);
+  // The evaluator's form (reciprocals for the divisions) is the same function to round-off.
+  check_activation(network_activation_impl<true>, -1.5, 1.5, 1.5e-6);
+  for (double x = -1.5; x <= 1.5; x += 0.001) {
+    double f, df, ddf;
+    network_activation(x, s, ds, dds);
+    network_activation_impl<true>(x, f, df, ddf);
+    REQUIRE(std::abs(f - s) <= 4e-16 * (1.0 + std::abs(s)));
+    REQUIRE(std::abs(df - ds) <= 4e-16);
+    REQUIRE(ddf == dds);
+  }
 }
 
 TEST_CASE("convex network: the stiffening activation is C2, convex and nondecreasing", "[unit]") {

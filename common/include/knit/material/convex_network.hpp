@@ -38,8 +38,14 @@
 
 namespace knit::material {
 
-/// sigma, sigma', sigma'' of the activation at x (see above).
-inline void network_activation(double x, double& s, double& ds, double& dds) {
+/// sigma, sigma', sigma'' of the activation at x (see above). kFast = true multiplies by the
+/// reciprocals of 12 and 3 where the reference divides (GCC keeps x / 12.0 a division, ~15
+/// cycles, without -ffast-math): the same function to round-off, used by the evaluator's inner
+/// loop (NetworkLawAt; session 12, +15 %). The fit keeps the divisions (kFast = false), so a
+/// fitted law is the same to the last bit as before: L-BFGS on this non-convex objective is
+/// sensitive enough that a change in the last bit moves the default fit to another minimum.
+template <bool kFast>
+inline void network_activation_impl(double x, double& s, double& ds, double& dds) {
   if (x <= -1.0) {
     s = ds = dds = 0.0;
   } else if (x >= 1.0) {
@@ -48,10 +54,17 @@ inline void network_activation(double x, double& s, double& ds, double& dds) {
     dds = 0.0;
   } else {
     const double x2 = x * x;
-    s = 0.75 * (0.5 * x2 - x2 * x2 / 12.0) + 0.5 * x + 3.0 / 16.0;
-    ds = 0.75 * (x - x2 * x / 3.0) + 0.5;
+    const double x4_12 = kFast ? x2 * x2 * (1.0 / 12.0) : x2 * x2 / 12.0;
+    const double x3_3 = kFast ? x2 * x * (1.0 / 3.0) : x2 * x / 3.0;
+    s = 0.75 * (0.5 * x2 - x4_12) + 0.5 * x + 3.0 / 16.0;
+    ds = 0.75 * (x - x3_3) + 0.5;
     dds = 0.75 * (1.0 - x2);
   }
+}
+
+/// The activation of the fit and of the reference network_evaluate.
+inline void network_activation(double x, double& s, double& ds, double& dds) {
+  network_activation_impl<false>(x, s, ds, dds);
 }
 
 /// The stiffening activation (option `stiff1`/`stiff2`, session 11): rho(x) = max(0, x)^3 / 6,
