@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # Material database benchmarks (issue #4): load time, material evaluations per second, and
 # knit tensile cases. Usage: scripts/bench/database.sh BUILD_DIR
+# The energy-law line also times the law of the main job's database (out/database.h5, or
+# KNIT_BENCH_DATABASE=FILE) when there is one.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${1:-$root/build}"
 bin="$build/bin"
+db="${KNIT_BENCH_DATABASE:-$root/out/database.h5}"
+[[ -f "$db" ]] && export KNIT_BENCH_DATABASE="$db"
 "$bin/test_common" "bench: response-surface evaluations per second" 2>/dev/null |
   grep "^material evaluation" || echo "material evaluation: n/a (test_common missing)"
 "$bin/test_common" "bench: energy-law evaluations per second" 2>/dev/null |

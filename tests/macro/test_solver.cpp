@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -352,4 +353,23 @@ TEST_CASE("line_search_first: the energy search from a step's first attempt, sam
   } catch (const std::exception& e) {
     CHECK_THAT(e.what(), Catch::StartsWith("bad.json: /solver/line_search_first"));
   }
+}
+
+TEST_CASE("Newton: the round-off floor, by the correction or by a stalled residual", "[unit]") {
+  const SolverOptions opt;  // tolerance 1e-8, absolute 1e-10, displacement 1e-8
+  const double ref = 0.4, bound = 1e3 * (opt.tolerance * ref + opt.absolute_tolerance);
+  const double inf = std::numeric_limits<double>::infinity();
+  // The correction at round-off: converged whatever the history, inside the window only.
+  CHECK(at_round_off_floor(4e-8, ref, 1e-9, inf, opt));
+  CHECK_FALSE(at_round_off_floor(2.0 * bound, ref, 1e-9, inf, opt));
+  // s323_hypar_tension: ||r|| stuck at 4.15e-8 N, |du| / |u| = 3e-8.
+  CHECK(at_round_off_floor(4.150e-8, ref, 3e-8, 4.150e-8, opt));
+  CHECK(at_round_off_floor(4.150e-8, ref, 3e-8, 4.19e-8, opt));  // 0.95 % lower
+  // ... but not while the residual still falls (by more than 1 % over two iterations),
+  CHECK_FALSE(at_round_off_floor(4.150e-8, ref, 3e-8, 4.3e-8, opt));
+  // nor before there are two earlier iterates, nor with a correction above 100 x 1e-8.
+  CHECK_FALSE(at_round_off_floor(4.150e-8, ref, 3e-8, inf, opt));
+  CHECK_FALSE(at_round_off_floor(4.150e-8, ref, 2e-6, 4.150e-8, opt));
+  // A stalled residual far above the tolerance is a failing step, not a floor.
+  CHECK_FALSE(at_round_off_floor(1e-4, ref, 3e-8, 1e-4, opt));
 }

@@ -153,6 +153,15 @@ struct EnergyLineSearch {
 EnergyLineSearch energy_line_search(const std::function<std::optional<double>(double)>& Pi,
                                     double Pi0, double g0, double Pi_scale);
 
+/// The round-off floor of a Newton iteration: the residual norm r (reference force ref) is
+/// within 1e3 of the tolerance (f_int's round-off can exceed tolerance * ref on very stiff
+/// problems) and the correction is at round-off, du_rel = ||du|| / ||u|| <=
+/// displacement_tolerance; or, when r has stopped falling (r >= 0.99 r2, r2 the residual of
+/// two iterations before), du_rel <= 100 displacement_tolerance (soft tangents map the floor to
+/// larger corrections). The step is then converged; iterating on would only reach
+/// max_iterations and cut the step back.
+bool at_round_off_floor(double r, double ref, double du_rel, double r2, const SolverOptions& opt);
+
 /// One line on the stability of a run for summaries: "tangent positive definite at every
 /// converged step", "unstable from step N (load factor x): k negative pivots at most", or
 /// "not available (unsymmetric tangent, LU)".
