@@ -126,7 +126,6 @@ def spreads(S_end, R):
 
 def compare(db, tw, paths, counts, law_of=None, tol=0.05):
     """Rows (loop length, name, end e, spread, law errors) and the summary counts."""
-    import h5py  # noqa: F401  (the files are open h5py objects)
     from cell_paths import load_paths
     rows = []
     ls = np.array(db["loop_lengths"])
