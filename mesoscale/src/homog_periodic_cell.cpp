@@ -18,6 +18,9 @@ using rod::Quat;
 
 namespace {
 
+/// Smallest sub-step of a cell step, as a fraction of the step (PeriodicCell::solve).
+constexpr double kMinSubstep = 1e-6;
+
 Matrix3d embed(const Matrix2d& F) {
   Matrix3d F3 = Matrix3d::Identity();
   F3.topLeftCorner<2, 2>() = F;
@@ -174,6 +177,16 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
       ++res.cutbacks;
       if (++halvings > opt_.max_cutbacks) break;
       inc *= 0.5;
+      // A limit point: each success resets `halvings`, so sub-steps that shrink towards a
+      // load fraction the cell cannot pass never exhaust max_cutbacks; once lam + inc == lam
+      // the same state "converges" for ever (session 12: course compression with shear, 4.5
+      // mm, stuck at 0.94117191743... of a step). Below kMinSubstep of the step: not converged.
+      if (inc < kMinSubstep) {
+        res.message = "sub-steps below " + std::to_string(kMinSubstep) +
+                      " of the step at load fraction " + std::to_string(lam) +
+                      " (a limit point: the cell does not pass this strain)";
+        break;
+      }
     }
   }
   StepResult h = homogenize(F_);

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 #include "knit/meso/homog/path.hpp"
 
@@ -171,4 +172,27 @@ TEST_CASE("cell Jacobian (rod + periodic rows + frictional contact) matches fini
       }
   INFO("max |J - FD| = " << err << " of " << scale);
   CHECK(err < 1e-5 * scale);
+}
+
+TEST_CASE("a step that meets a limit point ends, not converged, instead of sub-stepping for ever",
+          "[case]") {
+  // Course compression with shear at 4.5 mm (session 12; docs/unit-cell.md): F = I + t H,
+  // H = [[-0.3, sin 40 deg], [0, 0]], 8 steps. Step 7 stops at 0.9412 of its increment: each
+  // sub-step that converges resets the count of halvings, so the sub-steps shrank below round-off
+  // and the same state "converged" for ever (the sweep hung). Now the step fails with a message.
+  PeriodicCell cell(4.5, CellOptions{});
+  REQUIRE(cell.equilibrate().converged);
+  const double s = std::sin(40.0 * std::acos(-1.0) / 180.0);
+  int failed_step = 0;
+  std::string message;
+  for (int k = 1; k <= 8 && failed_step == 0; ++k) {
+    const double t = k / 8.0;
+    Eigen::Matrix2d F;
+    F << 1.0 - 0.3 * t, s * t, 0.0, 1.0;
+    const StepResult r = cell.solve(F);
+    if (!r.converged) failed_step = k, message = r.message;
+  }
+  INFO(message);
+  CHECK(failed_step == 7);
+  CHECK(message.find("limit point") != std::string::npos);
 }
