@@ -1,8 +1,8 @@
 // The periodic unit cell and its homogenized stresses (paper Sect. 2.1.2, eqs. 7-9):
 // residual stress at zero strain, the pure-shear strain identity, 4.5 mm stiffer than 6.5 mm,
 // non-negative friction dissipation, the energy balance of the boundary work, mirror symmetry
-// of +-gamma, and the full cell Jacobian (contact with friction, periodic rows) against finite
-// differences.
+// of +-gamma, the full cell Jacobian (contact with friction, periodic rows) against finite
+// differences, and a step that meets a limit point ending instead of sub-stepping for ever.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
