@@ -215,14 +215,16 @@ NetworkResponse pass_impl(const NetworkShape& shape, const double* q, const Eige
   // kappa = w1 + V^T (w du).
   const A1 kappa = (V.transpose().lazyProduct(wd.matrix())).array() + w1;
   // C, second-layer part: grad z_j = sum_i V_ji h'_i a0_i + a1_j = (V B + a1)_j, B = diag(h') A0,
-  // for the units in their curved part only (u''_j > 0).
-  Eigen::Matrix<double, N1, 3, 0, M1, 3> B(H1, 3);
-  B.col(0) = (dh * c0).matrix();
-  B.col(1) = (dh * c1).matrix();
-  B.col(2) = (dh * c2).matrix();
-  for (int j = 0; j < H2; ++j)
-    if (ddu(j) != 0.0)
-      add_outer(r.C, w(j) * ddu(j), (V.row(j).lazyProduct(B) + a1.row(j)).transpose());
+  // for the units in their curved part only (u''_j > 0; B only when there is one).
+  if ((ddu != 0.0).any()) {
+    Eigen::Matrix<double, N1, 3, 0, M1, 3> B(H1, 3);
+    B.col(0) = (dh * c0).matrix();
+    B.col(1) = (dh * c1).matrix();
+    B.col(2) = (dh * c2).matrix();
+    for (int j = 0; j < H2; ++j)
+      if (ddu(j) != 0.0)
+        add_outer(r.C, w(j) * ddu(j), (V.row(j).lazyProduct(B) + a1.row(j)).transpose());
+  }
   // First-layer part: sum_i kappa_i h''_i a0_i a0_i^T from the column products.
   const CA1 p00(q + 5 * H1, H1), p01(q + 6 * H1, H1), p02(q + 7 * H1, H1), p11(q + 8 * H1, H1),
       p12(q + 9 * H1, H1), p22(q + 10 * H1, H1);

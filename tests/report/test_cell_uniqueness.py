@@ -20,6 +20,8 @@ import tempfile
 import h5py
 import numpy as np
 
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, "scripts", "cell_uniqueness.py")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
@@ -88,14 +90,7 @@ class LinearLaw:
 
 
 def main():
-    failures = 0
-
-    def check(cond, what, out=""):
-        nonlocal failures
-        print(("ok   " if cond else "FAIL ") + what)
-        if not cond:
-            failures += 1
-            print(out)
+    check = Checklist()
 
     rng = np.random.default_rng(3)
     worst = 0.0
@@ -146,8 +141,7 @@ def main():
         check(r.returncode != 0 and "/sweep has no attribute input_json" in r.stderr,
               "a database without the sweep input is refused", r.stdout + r.stderr)
 
-    print("%d failure(s)" % failures)
-    return 1 if failures else 0
+    return check.exit_code()
 
 
 if __name__ == "__main__":

@@ -16,6 +16,8 @@ import tempfile
 import h5py
 import numpy as np
 
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, "scripts", "path_consistency.py")
 
@@ -48,14 +50,7 @@ def flagged(out):
 
 
 def main():
-    failures = 0
-
-    def check(cond, what, out=""):
-        nonlocal failures
-        print(("ok   " if cond else "FAIL ") + what)
-        if not cond:
-            failures += 1
-            print(out)
+    check = Checklist()
 
     with tempfile.TemporaryDirectory() as d:
         same, shifted = os.path.join(d, "same.h5"), os.path.join(d, "shifted.h5")
@@ -78,8 +73,7 @@ def main():
             f.write("not hdf5")
         rc, out = run(bad)
         check(rc == 2 and "not.h5" in out, "a file that is not a database: exit 2, named", out)
-    print("%d failure(s)" % failures)
-    return 1 if failures else 0
+    return check.exit_code()
 
 
 if __name__ == "__main__":
