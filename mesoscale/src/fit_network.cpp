@@ -188,13 +188,42 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
       tau = std::min(tau, o.tube_uniaxial * std::abs(p.S(p.axis)) / sS);
     tube_of_point.push_back(tau);
   }
+  // The softness prior: per knot, prior_points states of a Kronecker sequence (additive
+  // recurrence with the generalized golden ratio of dimension 3) in the box of that knot's fit
+  // data, target S_W = 0 (S = floor e), prior_weight x the mean data weight, outside the tube.
+  std::vector<double> w = weight;
+  if (o.prior_points > 0 && o.prior_weight > 0.0) {
+    double mean_w = 0.0;
+    for (double v : weight) mean_w += v;
+    mean_w /= static_cast<double>(std::max<std::size_t>(1, weight.size()));
+    const double g = 1.2207440846057596;  // x^4 = x + 1
+    const Eigen::Vector3d alpha(1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g));
+    for (int j = 0; j < n; ++j) {
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+      for (std::size_t p = 0; p < pts.size(); ++p)
+        if (knot[p] == j) {
+          lo = lo.cwiseMin(x[p]);
+          hi = hi.cwiseMax(x[p]);
+        }
+      if (!(lo.array() <= hi.array()).all()) continue;
+      for (int k = 1; k <= o.prior_points; ++k) {
+        Eigen::Vector3d u = (0.5 + k * alpha.array()).matrix();
+        for (int c = 0; c < 3; ++c) u(c) -= std::floor(u(c));
+        x.push_back(lo + u.cwiseProduct(hi - lo));
+        t.push_back(Eigen::Vector3d::Zero());
+        knot.push_back(j);
+        w.push_back(o.prior_weight * mean_w);
+        tube_of_point.push_back(1e300);
+      }
+    }
+  }
   const std::vector<double> phi0 = initial_phi(sh, o.seed);
   std::vector<double> phi(static_cast<std::size_t>(n * P));
   for (int j = 0; j < n; ++j) std::copy(phi0.begin(), phi0.end(), phi.begin() + j * P);
 
-  auto* objective =
-      new NetworkObjective(sh, n, std::move(x), std::move(t), weight, std::move(knot), o.l_coupling,
-                           std::move(tube_of_point), o.tube > 0.0 ? o.tube_weight : 0.0);
+  auto* objective = new NetworkObjective(sh, n, std::move(x), std::move(t), std::move(w),
+                                         std::move(knot), o.l_coupling, std::move(tube_of_point),
+                                         o.tube > 0.0 ? o.tube_weight : 0.0);
   ceres::GradientProblem problem(objective);  // takes ownership
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;

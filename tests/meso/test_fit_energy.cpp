@@ -178,6 +178,47 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
 }
 
+TEST_CASE("energy fit: the softness prior pulls the network towards the slack cell", "[unit]") {
+  // EnergyFitOptions::prior_points: quasi-random states of the data's box with the target
+  // S = floor e. A dominant prior (weight 10 x the mean data weight) must make the law softer
+  // across the box than the same fit without it; the prior states are not fit data (the
+  // diagnostics count the same states).
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  EnergyFitOptions o = small_network(4, 3, 300);
+  const EnergyFitSummary plain = fit_energy_law(db, o);
+  REQUIRE(plain.ok());
+  o.prior_points = 100;
+  o.prior_weight = 10.0;
+  const EnergyFitSummary prior = fit_energy_law(db, o);
+  REQUIRE(prior.ok());
+  // The mean of |S - floor e| (MPa) over a grid of the box of the synthetic paths.
+  auto excess = [](const EnergyFitSummary& s, double l) {
+    const material::EnergyLawAt at = material::EnergyLaw(s.law).at(l);
+    double sum = 0.0;
+    int n = 0;
+    for (double e1 = -0.1; e1 <= 0.301; e1 += 0.05)
+      for (double e2 = -0.1; e2 <= 0.301; e2 += 0.05)
+        for (double g : {0.0, 0.15, 0.3}) {
+          const Eigen::Vector3d e(e1, e2, g);
+          sum += (at.evaluate(e).S - s.law.floor * e).norm();
+          ++n;
+        }
+    return sum / n;
+  };
+  for (double l : {4.5, 6.5}) {
+    INFO("l = " << l << " mm: mean |S - floor e| " << excess(plain, l) << " MPa without the prior, "
+                << excess(prior, l) << " with it");
+    CHECK(excess(prior, l) < 0.5 * excess(plain, l));
+  }
+  REQUIRE(prior.diagnostics.per_loop.size() == plain.diagnostics.per_loop.size());
+  for (std::size_t k = 0; k < plain.diagnostics.per_loop.size(); ++k)
+    CHECK(prior.diagnostics.per_loop[k].points == plain.diagnostics.per_loop[k].points);
+  CHECK(prior.diagnostics.min_eigenvalue >= prior.law.floor * (1 - 1e-9));
+  CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
+  o.prior_points = -1;
+  CHECK_FALSE(o.validate().empty());
+}
+
 TEST_CASE("energy fit: stiffening units are fitted, stored and keep the law convex", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
   EnergyFitOptions o = small_network(4, 3, 300);

@@ -73,6 +73,13 @@ struct EnergyFitOptions {
   /// < 0: the same as the others'. The course-wise tensile curve of the loose cell stays below
   /// 5 % of the range (6.5 mm: 0.65 of 20.8 MPa), so a tube of the range alone does not see it.
   double tube_uniaxial = -1.0;
+  /// Network family: a softness prior (choice, docs/database.md "The softness prior"). n
+  /// quasi-random strain states per loop length (a Kronecker sequence in the box of that loop
+  /// length's fit data, not the held-out Halton states) enter the fit with the target
+  /// S = floor e (the slack cell) and prior_weight times the mean data weight each: where the
+  /// data say nothing the fit prefers the softest law. 0: off.
+  int prior_points = 0;
+  double prior_weight = 0.01;
   /// Ridge directions before mirror closure; empty = material::default_ridge_directions().
   std::vector<Eigen::Vector3d> directions;
   int s_degree = 3, s_spans = 12;
