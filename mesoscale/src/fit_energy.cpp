@@ -213,6 +213,8 @@ std::string EnergyFitOptions::validate() const {
     return "tube must be in [0, 1] (a fraction of the stress range; 0: off)";
   if (!(tube_uniaxial <= 1.0)) return "tube_uniaxial must be <= 1 (< 0: the same as tube)";
   if (!(tube_weight >= 0.0 && tube_weight <= 1e9)) return "tube_weight must be in [0, 1e9]";
+  if (!(tube_uniaxial_weight >= 0.0 && tube_uniaxial_weight <= 1e6))
+    return "tube_uniaxial_weight must be in [0, 1e6]";
   if (prior_points < 0 || prior_points > 100000) return "prior_points must be in 0..100000";
   if (!(prior_weight >= 0.0 && prior_weight <= 1e3)) return "prior_weight must be in [0, 1000]";
   return {};
@@ -245,6 +247,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"tube", tube},
                       {"tube_weight", tube_weight},
                       {"tube_uniaxial", tube_uniaxial},
+                      {"tube_uniaxial_weight", tube_uniaxial_weight},
                       {"prior_points", prior_points},
                       {"prior_weight", prior_weight}};
   if (!directions.empty()) {
@@ -292,6 +295,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "tube",
                                 "tube_weight",
                                 "tube_uniaxial",
+                                "tube_uniaxial_weight",
                                 "prior_points",
                                 "prior_weight"};
   for (auto it = j.begin(); it != j.end(); ++it)
@@ -325,6 +329,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("tube", o.tube);
   get_double("tube_weight", o.tube_weight);
   get_double("tube_uniaxial", o.tube_uniaxial);
+  get_double("tube_uniaxial_weight", o.tube_uniaxial_weight);
   get_int("prior_points", o.prior_points);
   get_double("prior_weight", o.prior_weight);
   if (j.contains("family")) {

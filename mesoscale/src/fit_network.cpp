@@ -8,10 +8,12 @@
 //
 //   f = 1/(3 sum w) sum_p w_p |S_W(x_p; theta_j(p)) - t_p|^2
 //       + l_coupling / n_theta sum_j |phi_j+1 - phi_j|^2
-//       + tube_weight / (3 n) sum_p sum_c max(0, |S_W,c - t_p,c| - tau_p)^2,
+//       + tube_weight / (3 n) sum_p m_p sum_c max(0, |S_W,c - t_p,c| - tau_p)^2,
 //
 // the last term only with a tube (EnergyFitOptions::tube > 0; tau_p = tube x the loop length's
-// stress range / sS, on the uniaxial states at most tube_uniaxial x |own axial stress| / sS).
+// stress range / sS, on the uniaxial states at most tube_uniaxial x |own axial stress| / sS;
+// m_p = tube_uniaxial_weight on the uniaxial states, 1 on the others). With the softness prior
+// (prior_points > 0) the sums also run over its states (target t = 0, no tube: m_p = 0).
 // S_W the stress of the mirror-averaged, normalized law (S(0) = 0). The gradient is exact
 // (network_stress_gradient, reverse mode by hand, checked against finite differences in
 // tests/common/test_material_convex_network.cpp); each objective evaluation costs about three
@@ -37,7 +39,8 @@ class NetworkObjective : public ceres::FirstOrderFunction {
  public:
   NetworkObjective(NetworkShape shape, int knots, std::vector<Eigen::Vector3d> x,
                    std::vector<Eigen::Vector3d> t, std::vector<double> w, std::vector<int> knot,
-                   double coupling, std::vector<double> tube, double tube_weight)
+                   double coupling, std::vector<double> tube, std::vector<double> tube_scale,
+                   double tube_weight)
       : sh_(shape),
         n_(knots),
         x_(std::move(x)),
@@ -46,6 +49,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         knot_(std::move(knot)),
         coupling_(coupling),
         tube_(std::move(tube)),
+        tube_scale_(std::move(tube_scale)),
         tube_weight_(tube_weight / (3.0 * static_cast<double>(x_.size()))),
         theta_(static_cast<std::size_t>(knots * shape.size())),
         gtheta_(theta_.size()) {
@@ -93,8 +97,9 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         for (int c = 0; c < 3; ++c) {
           const double ex = std::abs(s(c)) - tube_[p];
           if (ex <= 0.0) continue;
-          f += tube_weight_ * ex * ex;
-          gt_tube(c) = 2.0 * tube_weight_ * ex * (s(c) < 0.0 ? -1.0 : 1.0);
+          const double tw = tube_weight_ * tube_scale_[p];
+          f += tw * ex * ex;
+          gt_tube(c) = 2.0 * tw * ex * (s(c) < 0.0 ? -1.0 : 1.0);
         }
       if (!grad) continue;
       const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s + gt_tube;  // d f / d S_W
@@ -135,7 +140,8 @@ class NetworkObjective : public ceres::FirstOrderFunction {
   std::vector<double> w_;
   std::vector<int> knot_;
   double coupling_;
-  std::vector<double> tube_;  // tau per point, scaled stress units
+  std::vector<double> tube_;        // tau per point, scaled stress units
+  std::vector<double> tube_scale_;  // the tube penalty's weight per point, x tube_weight
   double tube_weight_;
   double scale_ = 1.0;
   mutable std::vector<double> theta_, gtheta_;
@@ -181,12 +187,13 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   // half-width tau_p is `tube` times it.
   std::vector<double> range = stress_ranges(pts, static_cast<std::size_t>(n));
   for (double& r : range) r /= sS;
-  std::vector<double> tube_of_point;
+  std::vector<double> tube_of_point, tube_scale;
   for (const Point& p : pts) {
     double tau = o.tube * range[p.loop];
     if (p.axis >= 0 && o.tube_uniaxial >= 0.0)
       tau = std::min(tau, o.tube_uniaxial * std::abs(p.S(p.axis)) / sS);
     tube_of_point.push_back(tau);
+    tube_scale.push_back(p.axis >= 0 ? o.tube_uniaxial_weight : 1.0);
   }
   // The softness prior: per knot, prior_points states of a Kronecker sequence (additive
   // recurrence with the generalized golden ratio of dimension 3) in the box of that knot's fit
@@ -214,6 +221,7 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
         knot.push_back(j);
         w.push_back(o.prior_weight * mean_w);
         tube_of_point.push_back(1e300);
+        tube_scale.push_back(0.0);
       }
     }
   }
@@ -223,7 +231,7 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
 
   auto* objective = new NetworkObjective(sh, n, std::move(x), std::move(t), std::move(w),
                                          std::move(knot), o.l_coupling, std::move(tube_of_point),
-                                         o.tube > 0.0 ? o.tube_weight : 0.0);
+                                         std::move(tube_scale), o.tube > 0.0 ? o.tube_weight : 0.0);
   ceres::GradientProblem problem(objective);  // takes ownership
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;

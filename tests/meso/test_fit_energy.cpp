@@ -176,6 +176,39 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   // The tube on the uniaxial states alone: a width < 0 there means "the same as tube".
   o.tube_uniaxial = -1.0;
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
+  // A narrow tube on the uniaxial-stress states (1 % of their own axial stress) with a heavier
+  // penalty there (tube_uniaxial_weight) brings the law's uniaxial curves closer to the data
+  // (the synthetic law's own uniaxial-stress paths, course and wale, added to the data).
+  SyntheticOptions so;
+  so.loop_lengths = {4.5, 6.5};
+  so.paths = knit::material::default_load_paths(6);
+  for (const auto& p : synthetic_coverage_paths(6)) so.paths.push_back(p);
+  for (int axis : {0, 1}) {
+    material::LoadPath u;
+    u.kind = material::PathKind::kUniaxial;
+    u.axis = axis;
+    u.target(axis) = 0.4;
+    u.steps = 8;
+    u.set = "coverage";
+    so.paths.push_back(u);
+  }
+  const Database with_uniaxial = synthetic_database(so);
+  auto uniaxial = [](const EnergyFitSummary& s) {
+    double m = 0.0;
+    for (const auto& p : s.diagnostics.per_loop) m = std::max(m, p.uniaxial_max_relative);
+    return m;
+  };
+  o.tube_uniaxial = 0.01;
+  const EnergyFitSummary alike = fit_energy_law(with_uniaxial, o);
+  o.tube_uniaxial_weight = 100.0;
+  const EnergyFitSummary heavy = fit_energy_law(with_uniaxial, o);
+  REQUIRE(alike.ok());
+  REQUIRE(heavy.ok());
+  std::printf(
+      "tube: largest uniaxial error %.2f %% with the uniaxial penalty alike, %.2f %% x 100\n",
+      100 * uniaxial(alike), 100 * uniaxial(heavy));
+  CHECK(uniaxial(heavy) < 0.8 * uniaxial(alike));
+  CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
 }
 
 TEST_CASE("energy fit: the softness prior pulls the network towards the slack cell", "[unit]") {
