@@ -13,7 +13,9 @@
 // the last term only with a tube (EnergyFitOptions::tube > 0; tau_p = tube x the loop length's
 // stress range / sS, on the uniaxial states at most tube_uniaxial x |own axial stress| / sS;
 // m_p = tube_uniaxial_weight on the uniaxial states, 1 on the others). With the softness prior
-// (prior_points > 0) the sums also run over its states (target t = 0, no tube: m_p = 0).
+// (prior_points > 0) the sums also run over its states (target t = 0, no tube: m_p = 0), and
+// both n and sum w count them (the tube fits with the prior in docs/database.md were measured
+// so).
 // S_W the stress of the mirror-averaged, normalized law (S(0) = 0). The gradient is exact
 // (network_stress_gradient, reverse mode by hand, checked against finite differences in
 // tests/common/test_material_convex_network.cpp); each objective evaluation costs about three

@@ -73,8 +73,9 @@ struct EnergyFitOptions {
   /// < 0: the same as the others'. The course-wise tensile curve of the loose cell stays below
   /// 5 % of the range (6.5 mm: 0.65 of 20.8 MPa), so a tube of the range alone does not see it.
   double tube_uniaxial = -1.0;
-  /// The uniaxial-stress paths' states' tube penalty, a multiple of tube_weight (1: alike).
-  /// Their excess is a fraction of a small stress, so at the same weight the corners win.
+  /// Network family, with a tube: the uniaxial-stress paths' states' tube penalty, a multiple
+  /// of tube_weight (1: alike). Their excess is a fraction of a small stress, so at the same
+  /// weight the jammed corners win (docs/database.md "The softness prior").
   double tube_uniaxial_weight = 1.0;
   /// Network family: a softness prior (choice, docs/database.md "The softness prior"). n
   /// quasi-random strain states per loop length (a Kronecker sequence in the box of that loop
