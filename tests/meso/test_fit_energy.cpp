@@ -2,6 +2,7 @@
 // hyperelastic law (knit/meso/fit/synthetic.hpp: W = k(l) (a1/2 E1^2 + a12 E1 E2 + a2/2 E2^2 +
 // b1/4 E1^4 + b2/4 E2^4 + g/4 (2E12)^2 + h/32 (2E12)^4), exactly a sum of ridge functions of
 // the default directions), its held-out errors, and its refusals.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -18,11 +19,23 @@ namespace material = knit::material;
 
 namespace {
 
-Database synthetic_coverage_db(std::vector<double> ls = {4.5, 5.5, 6.5}, int steps = 8) {
+/// The paper's paths and the synthetic coverage paths of `steps` steps; with uniaxial_steps > 0
+/// also the synthetic law's own uniaxial-stress paths (course and wale, to 0.4).
+Database synthetic_coverage_db(std::vector<double> ls = {4.5, 5.5, 6.5}, int steps = 8,
+                               int uniaxial_steps = 0) {
   SyntheticOptions so;
   so.loop_lengths = std::move(ls);
   so.paths = knit::material::default_load_paths(steps);
   for (const auto& p : synthetic_coverage_paths(steps)) so.paths.push_back(p);
+  for (int axis = 0; axis < 2 && uniaxial_steps > 0; ++axis) {
+    material::LoadPath u;
+    u.kind = material::PathKind::kUniaxial;
+    u.axis = axis;
+    u.target(axis) = 0.4;
+    u.steps = uniaxial_steps;
+    u.set = "coverage";
+    so.paths.push_back(u);
+  }
   return synthetic_database(so);
 }
 
@@ -176,38 +189,41 @@ TEST_CASE("energy fit: the tube bounds the network's largest error", "[unit]") {
   // The tube on the uniaxial states alone: a width < 0 there means "the same as tube".
   o.tube_uniaxial = -1.0;
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
+}
+
+TEST_CASE("energy fit: a heavier uniaxial tube brings the uniaxial curves closer", "[unit]") {
   // A narrow tube on the uniaxial-stress states (1 % of their own axial stress) with a heavier
   // penalty there (tube_uniaxial_weight) brings the law's uniaxial curves closer to the data
-  // (the synthetic law's own uniaxial-stress paths, course and wale, added to the data).
-  SyntheticOptions so;
-  so.loop_lengths = {4.5, 6.5};
-  so.paths = knit::material::default_load_paths(6);
-  for (const auto& p : synthetic_coverage_paths(6)) so.paths.push_back(p);
-  for (int axis : {0, 1}) {
-    material::LoadPath u;
-    u.kind = material::PathKind::kUniaxial;
-    u.axis = axis;
-    u.target(axis) = 0.4;
-    u.steps = 8;
-    u.set = "coverage";
-    so.paths.push_back(u);
-  }
-  const Database with_uniaxial = synthetic_database(so);
-  auto uniaxial = [](const EnergyFitSummary& s) {
+  // (the synthetic law's own uniaxial-stress paths, course and wale, added to the data). The
+  // network of the test above (2 and 1 units) lands in a different local minimum for every
+  // seed and tube width (one seed ends at 100 % either way); so the check is on the median
+  // over six seeds.
+  const Database with_uniaxial = synthetic_coverage_db({4.5, 6.5}, 6, 8);
+  EnergyFitOptions o = small_network(2, 1, 400);
+  o.tube = 0.13;
+  o.tube_weight = 1e4;
+  o.tube_uniaxial = 0.01;
+  auto uniaxial = [&](double weight, int seed) {
+    o.tube_uniaxial_weight = weight;
+    o.seed = seed;
+    const EnergyFitSummary s = fit_energy_law(with_uniaxial, o);
+    REQUIRE(s.ok());
     double m = 0.0;
     for (const auto& p : s.diagnostics.per_loop) m = std::max(m, p.uniaxial_max_relative);
     return m;
   };
-  o.tube_uniaxial = 0.01;
-  const EnergyFitSummary alike = fit_energy_law(with_uniaxial, o);
-  o.tube_uniaxial_weight = 100.0;
-  const EnergyFitSummary heavy = fit_energy_law(with_uniaxial, o);
-  REQUIRE(alike.ok());
-  REQUIRE(heavy.ok());
-  std::printf(
-      "tube: largest uniaxial error %.2f %% with the uniaxial penalty alike, %.2f %% x 100\n",
-      100 * uniaxial(alike), 100 * uniaxial(heavy));
-  CHECK(uniaxial(heavy) < 0.8 * uniaxial(alike));
+  std::vector<double> alike, heavy;
+  for (int seed = 1; seed <= 6; ++seed) {
+    alike.push_back(uniaxial(1.0, seed));
+    heavy.push_back(uniaxial(100.0, seed));
+    std::printf("tube: seed %d, largest uniaxial error %.2f %% alike, %.2f %% x 100\n", seed,
+                100 * alike.back(), 100 * heavy.back());
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  CHECK(median(heavy) < 0.5 * median(alike));
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
 }
 
