@@ -1,6 +1,5 @@
 // Fit of the energy-based law with Ceres (see knit/meso/fit/energy_fit.hpp). Ceres is included
 // in the fit files only (design/style.md habit 6).
-#include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -13,6 +12,7 @@
 #include "fit_options_json.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
+#include "knit/meso/fit/nnls.hpp"
 #include "knit/spline/knot_vector.hpp"
 
 namespace knit::meso::fit {
@@ -35,27 +35,6 @@ using material::EnergyFitDiagnostics;
 using material::EnergyLawData;
 
 namespace {
-
-/// r = R x - z: the square-root information form of a quadratic objective (one dense block).
-class SqrtInformationCost : public ceres::CostFunction {
- public:
-  SqrtInformationCost(Eigen::MatrixXd R, Eigen::VectorXd z) : R_(std::move(R)), z_(std::move(z)) {
-    set_num_residuals(static_cast<int>(z_.size()));
-    mutable_parameter_block_sizes()->push_back(static_cast<int>(R_.cols()));
-  }
-  bool Evaluate(double const* const* x, double* r, double** J) const override {
-    const Eigen::Map<const Eigen::VectorXd> xv(x[0], R_.cols());
-    Eigen::Map<Eigen::VectorXd>(r, R_.rows()) = R_ * xv - z_;
-    if (J && J[0])
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-          J[0], R_.rows(), R_.cols()) = R_;
-    return true;
-  }
-
- private:
-  Eigen::MatrixXd R_;
-  Eigen::VectorXd z_;
-};
 
 using detail::Point;
 
@@ -463,7 +442,6 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
         if (i + 2 < ns) add_diff(base + i, base + i + 1, base + i + 2);
         if (j + 2 < nl) add_diff(base + i, base + ns + i, base + 2 * ns + i);
       }
-  ceres::Solver::Summary summary;
   for (int round = 0; round < (o.loss == Loss::kNone ? 1 : o.loss_rounds); ++round) {
     Eigen::MatrixXd M = (o.smoothing * N / (sK * sK)) * DtD;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(P);
@@ -483,33 +461,19 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
       out.reason = "the normal matrix is not positive definite (non-finite data?)";
       return out;
     }
-    Eigen::MatrixXd R = llt.matrixU();
-    Eigen::VectorXd z = llt.matrixL().solve(rhs);
-    // Scale the unknowns to O(1): x = sK * y.
-    R *= sK;
-    ceres::Problem::Options po;
-    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(po);
-    Eigen::VectorXd y = x / sK;
-    problem.AddResidualBlock(new SqrtInformationCost(std::move(R), std::move(z)), nullptr,
-                             y.data());
-    for (int i = 0; i < P; ++i) problem.SetParameterLowerBound(y.data(), i, 0.0);
-    ceres::Solver::Options so;
-    so.max_num_iterations = o.max_iterations;
-    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    so.function_tolerance = 1e-13;
-    so.gradient_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-12;
-    so.logging_type = ceres::SILENT;
-    so.num_threads = 1;
-    ceres::Solve(so, &problem, &summary);
-    out.ceres_iterations += static_cast<int>(summary.iterations.size());
-    if (!summary.IsSolutionUsable()) {
+    // The exact minimizer over x >= 0 (active set, knit/meso/fit/nnls.hpp), in the unknowns
+    // y = x / sK, which are O(1). Until session 14 Ceres' bounded trust region solved this
+    // and stopped short of the optimum (KKT violation 5 % of |b|).
+    const NnlsResult qp = nnls_normal((sK * sK) * M, sK * rhs);
+    out.ceres_iterations += qp.iterations;
+    if (!qp.converged || !(qp.kkt <= 1e-8)) {
       out.status = FitStatus::kSolverFailed;
-      out.reason = "Ceres: " + summary.message;
+      out.reason = "the nonnegative least-squares solve did not converge (" +
+                   (qp.reason.empty() ? "KKT violation " + std::to_string(qp.kkt) : qp.reason) +
+                   ")";
       return out;
     }
-    x = (sK * y).cwiseMax(0.0);
+    x = sK * qp.x;
     if (o.loss == Loss::kNone) break;
     // IRLS weights of the loss on the scaled residual norm of each point.
     for (std::size_t p = 0; p < pts.size(); ++p) {
@@ -679,7 +643,10 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
        << " functions";
   }
   os << ", floor " << s.law.floor << " MPa, min eig(C) on the data " << d.min_eigenvalue << " MPa, "
-     << s.ceres_iterations << " Ceres iterations):\n";
+     << s.ceres_iterations
+     << (s.law.family == material::EnergyFamily::kNetwork ? " Ceres iterations"
+                                                          : " active-set solves")
+     << "):\n";
   for (const auto& p : d.per_loop)
     os << "    l = " << p.loop_length << " mm: " << p.points << " states, rms (S11, S22, S12) "
        << p.rms(0) << ", " << p.rms(1) << ", " << p.rms(2) << " MPa, max " << p.max(0) << ", "

@@ -11,11 +11,11 @@
 //     + lambda sum |second differences of c along s and along l / sK|^2,     x >= 0,
 // N = number of stress residuals, sS = largest |S| of the data, sK = sS / sE (sE = largest
 // |e|), w_p = 1 without a loss, IRLS weights of the Huber or Cauchy loss otherwise. Because
-// the data term is quadratic, it is condensed to its square-root information form
-// (R x - z, R^T R = normal matrix, a tiny ridge keeps it definite) and handed to Ceres as one
-// dense residual block with lower bounds 0 on every parameter. The nonnegativity makes every
-// fitted W convex at every l of the range (C >= floor I): a fit that cannot be made convex
-// cannot happen by construction.
+// the data term is quadratic, it is condensed to its normal equations (a tiny ridge keeps them
+// definite) and minimized over x >= 0 exactly, by an active-set method (knit/meso/fit/nnls.hpp;
+// Ceres with parameter bounds until session 14, which stopped short of the optimum). The
+// nonnegativity makes every fitted W convex at every l of the range (C >= floor I): a fit that
+// cannot be made convex cannot happen by construction.
 //
 // Choices (documented in docs/database.md, all configurable):
 //  * s-range of each function: the range of d_k . e over the data (both mirror directions),
@@ -95,6 +95,8 @@ struct EnergyFitOptions {
   Loss loss = Loss::kNone;
   double loss_scale = 0.05;  ///< in units of sS
   int loss_rounds = 4;       ///< IRLS rounds with a loss
+  /// Unused since session 14 (the ridge fit's active-set solve ends at its optimum; it was the
+  /// Ceres iteration limit); still accepted, so that older option files load.
   int max_iterations = 200;
   /// Data weights (choice, docs/database.md "Weights"): each state's squared stress residual
   /// is weighted by (set weight * (1 + c) / (|S| / sS + c))^2 with c = weight_relative (0: plain

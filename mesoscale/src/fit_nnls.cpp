@@ -1,0 +1,138 @@
+// Active-set nonnegative quadratic program (knit/meso/fit/nnls.hpp; Lawson & Hanson 1974,
+// ch. 23; Bro & de Jong 1997).
+#include "knit/meso/fit/nnls.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace knit::meso::fit {
+
+double kkt_violation(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, const Eigen::VectorXd& x) {
+  const Eigen::VectorXd g = M * x - b;
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    worst = std::max(worst, x(i) > 0.0 ? std::abs(g(i)) : std::max(0.0, -g(i)));
+  const double scale = std::max(b.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
+  return worst / scale;
+}
+
+namespace {
+
+/// s = argmin over the passive set P (s_i = 0 off P) of 1/2 s^T M s - b^T s: M_PP s_P = b_P.
+bool solve_passive(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, const std::vector<int>& P,
+                   Eigen::MatrixXd& work, Eigen::VectorXd& rhs, Eigen::VectorXd& s) {
+  const auto k = static_cast<Eigen::Index>(P.size());
+  work.resize(k, k);
+  rhs.resize(k);
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index r = 0; r < k; ++r) work(r, c) = M(P[r], P[c]);
+    rhs(c) = b(P[c]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(work);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::VectorXd sp = llt.solve(rhs);
+  s.setZero();
+  for (Eigen::Index c = 0; c < k; ++c) s(P[c]) = sp(c);
+  return sp.allFinite();
+}
+
+}  // namespace
+
+NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int max_iterations) {
+  const Eigen::Index n = b.size();
+  if (M.rows() != n || M.cols() != n)
+    throw std::invalid_argument("nnls_normal: M must be square with the size of b");
+  if (!M.allFinite() || !b.allFinite())
+    throw std::invalid_argument("nnls_normal: M and b must be finite");
+  NnlsResult out;
+  out.x = Eigen::VectorXd::Zero(n);
+  if (n == 0) {
+    out.converged = true;
+    return out;
+  }
+  const int limit = max_iterations > 0 ? max_iterations : static_cast<int>(3 * n + 50);
+  // A variable enters only if its descent direction is clearly positive: the gradient's round-off
+  // is ~ eps * |M|_inf * |x|_inf + eps * |b|_inf.
+  const double bmax = b.cwiseAbs().maxCoeff();
+  const double mmax = M.cwiseAbs().maxCoeff();
+  std::vector<char> passive(static_cast<std::size_t>(n), 0), refused(static_cast<std::size_t>(n), 0);
+  std::vector<int> P;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), s(n), w = b, rhs;
+  Eigen::MatrixXd work;
+  auto fail = [&](const std::string& why) {
+    out.x = x;
+    out.reason = why;
+    out.kkt = kkt_violation(M, b, x);
+    out.passive = static_cast<int>(P.size());
+    return out;
+  };
+  for (;;) {
+    const double tol =
+        64.0 * std::numeric_limits<double>::epsilon() * (mmax * x.cwiseAbs().maxCoeff() + bmax);
+    Eigen::Index j = -1;
+    double wmax = tol;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (!passive[i] && !refused[i] && w(i) > wmax) {
+        wmax = w(i);
+        j = i;
+      }
+    if (j < 0) break;  // KKT: every variable at its bound has g = -w >= -tol
+    passive[j] = 1;
+    P.push_back(static_cast<int>(j));
+    for (;;) {
+      if (++out.iterations > limit)
+        return fail("no convergence in " + std::to_string(limit) + " passive-set solves");
+      if (!solve_passive(M, b, P, work, rhs, s))
+        return fail("the passive-set matrix is not positive definite (is M?)");
+      double alpha = 1.0;
+      Eigen::Index block = -1;
+      for (int i : P)
+        if (s(i) <= 0.0) {
+          const double d = x(i) - s(i);  // x_i >= 0 >= s_i: d > 0, or d = 0 with x_i = s_i = 0
+          const double a = d > 0.0 ? x(i) / d : 0.0;
+          if (a < alpha) {
+            alpha = a;
+            block = i;
+          }
+        }
+      if (block < 0) {
+        x = s;
+        break;
+      }
+      // Step to the first bound met; the variables that reach it leave the passive set.
+      x += alpha * (s - x);
+      x(block) = 0.0;
+      std::vector<int> keep;
+      for (int i : P) {
+        if (x(i) <= 0.0) {
+          x(i) = 0.0;
+          passive[i] = 0;
+        } else {
+          keep.push_back(i);
+        }
+      }
+      P.swap(keep);
+      if (P.empty()) break;
+    }
+    if (passive[j]) {
+      std::fill(refused.begin(), refused.end(), 0);
+    } else {
+      // The entering variable was pushed back to its bound (its gain was round-off, or another
+      // bound cut the step first): skip it until a variable enters for good, so that the same
+      // choice is not made forever. The caller judges the end point by its KKT violation.
+      refused[j] = 1;
+    }
+    w = b - M * x;
+  }
+  out.x = x;
+  out.passive = static_cast<int>(P.size());
+  out.kkt = kkt_violation(M, b, x);
+  out.converged = true;
+  return out;
+}
+
+}  // namespace knit::meso::fit
