@@ -22,23 +22,57 @@ double kkt_violation(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, const E
 
 namespace {
 
-/// s = argmin over the passive set P (s_i = 0 off P) of 1/2 s^T M s - b^T s: M_PP s_P = b_P.
-bool solve_passive(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, const std::vector<int>& P,
-                   Eigen::MatrixXd& work, Eigen::VectorXd& rhs, Eigen::VectorXd& s) {
-  const auto k = static_cast<Eigen::Index>(P.size());
-  work.resize(k, k);
-  rhs.resize(k);
-  for (Eigen::Index c = 0; c < k; ++c) {
-    for (Eigen::Index r = 0; r < k; ++r) work(r, c) = M(P[r], P[c]);
-    rhs(c) = b(P[c]);
+/// The Cholesky factor L (lower, L L^T = M_PP) of the passive set P, in the order of P, kept
+/// in one preallocated n x n buffer: a variable that enters appends a row (O(k^2), the common
+/// step); variables that leave make it refactor (O(k^3)).
+class PassiveFactor {
+ public:
+  PassiveFactor(const Eigen::MatrixXd& M, const Eigen::VectorXd& b)
+      : M_(M), b_(b), L_(M.rows(), M.cols()), y_(M.rows()) {}
+
+  /// Appends variable j to P. False if M_PP would not be positive definite.
+  bool append(std::vector<int>& P, int j) {
+    const auto k = static_cast<Eigen::Index>(P.size());
+    for (Eigen::Index c = 0; c < k; ++c) y_(c) = M_(P[c], j);
+    auto l = y_.head(k);
+    L_.topLeftCorner(k, k).triangularView<Eigen::Lower>().solveInPlace(l);
+    const double d2 = M_(j, j) - l.squaredNorm();
+    if (!(d2 > 0.0)) return false;
+    L_.row(k).head(k) = l.transpose();
+    L_(k, k) = std::sqrt(d2);
+    P.push_back(j);
+    return true;
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(work);
-  if (llt.info() != Eigen::Success) return false;
-  const Eigen::VectorXd sp = llt.solve(rhs);
-  s.setZero();
-  for (Eigen::Index c = 0; c < k; ++c) s(P[c]) = sp(c);
-  return sp.allFinite();
-}
+
+  /// Refactors for the passive set P (after variables left it).
+  bool refactor(const std::vector<int>& P) {
+    const auto k = static_cast<Eigen::Index>(P.size());
+    for (Eigen::Index c = 0; c < k; ++c)
+      for (Eigen::Index r = c; r < k; ++r) L_(r, c) = M_(P[r], P[c]);
+    Eigen::Ref<Eigen::MatrixXd> block = L_.topLeftCorner(k, k);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(block);  // in place: no allocation
+    return llt.info() == Eigen::Success;
+  }
+
+  /// s = argmin over P (s_i = 0 off P) of 1/2 s^T M s - b^T s: L L^T s_P = b_P.
+  bool solve(const std::vector<int>& P, Eigen::VectorXd& s) {
+    const auto k = static_cast<Eigen::Index>(P.size());
+    for (Eigen::Index c = 0; c < k; ++c) y_(c) = b_(P[c]);
+    auto y = y_.head(k);
+    const auto Lk = L_.topLeftCorner(k, k).triangularView<Eigen::Lower>();
+    Lk.solveInPlace(y);
+    Lk.transpose().solveInPlace(y);
+    s.setZero();
+    for (Eigen::Index c = 0; c < k; ++c) s(P[c]) = y(c);
+    return y.allFinite();
+  }
+
+ private:
+  const Eigen::MatrixXd& M_;
+  const Eigen::VectorXd& b_;
+  Eigen::MatrixXd L_;
+  Eigen::VectorXd y_;
+};
 
 }  // namespace
 
@@ -59,10 +93,12 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int m
   // is ~ eps * |M|_inf * |x|_inf + eps * |b|_inf.
   const double bmax = b.cwiseAbs().maxCoeff();
   const double mmax = M.cwiseAbs().maxCoeff();
-  std::vector<char> passive(static_cast<std::size_t>(n), 0), refused(static_cast<std::size_t>(n), 0);
+  std::vector<char> passive(static_cast<std::size_t>(n), 0),
+      refused(static_cast<std::size_t>(n), 0);
   std::vector<int> P;
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), s(n), w = b, rhs;
-  Eigen::MatrixXd work;
+  P.reserve(static_cast<std::size_t>(n));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), s(n), w = b;
+  PassiveFactor factor(M, b);
   auto fail = [&](const std::string& why) {
     out.x = x;
     out.reason = why;
@@ -82,12 +118,12 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int m
       }
     if (j < 0) break;  // KKT: every variable at its bound has g = -w >= -tol
     passive[j] = 1;
-    P.push_back(static_cast<int>(j));
+    if (!factor.append(P, static_cast<int>(j)))
+      return fail("the passive-set matrix is not positive definite (is M?)");
     for (;;) {
       if (++out.iterations > limit)
         return fail("no convergence in " + std::to_string(limit) + " passive-set solves");
-      if (!solve_passive(M, b, P, work, rhs, s))
-        return fail("the passive-set matrix is not positive definite (is M?)");
+      if (!factor.solve(P, s)) return fail("the passive-set solve is not finite");
       double alpha = 1.0;
       Eigen::Index block = -1;
       for (int i : P)
@@ -117,6 +153,8 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int m
       }
       P.swap(keep);
       if (P.empty()) break;
+      if (!factor.refactor(P))
+        return fail("the passive-set matrix is not positive definite (is M?)");
     }
     if (passive[j]) {
       std::fill(refused.begin(), refused.end(), 0);
