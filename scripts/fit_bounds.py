@@ -36,13 +36,13 @@ import os
 import sys
 
 import numpy as np
-from scipy.interpolate import BSpline
 from scipy.optimize import linprog
 from scipy.sparse import coo_matrix, vstack
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
 from energy_law import load_law  # noqa: E402  (the stored law, re-evaluated)
 from cell_paths import load_paths, stress_range  # noqa: E402  (scripts/cell_paths.py)
+from free_fit import free_fits  # noqa: E402  (scripts/free_fit.py: the two free fits)
 
 THRESHOLD = 0.05
 
@@ -108,50 +108,6 @@ def monotonicity_bound(e, s, rng):
         if d[j] > best:
             best, bi, bj = float(d[j]), i - 1, j - 1
     return best, bi, bj
-
-
-class SplineBox:
-    """Tensor-product cubic B-splines over the strain box, n functions per axis."""
-
-    def __init__(self, e, n, p=3):
-        self.lo = e.min(0) - 0.05
-        self.hi = e.max(0) + 0.05
-        self.n, self.p = n, p
-
-    def _axis(self, x, k, deriv):
-        t = np.concatenate([[self.lo[k]] * self.p, np.linspace(self.lo[k], self.hi[k],
-                                                               self.n - self.p + 1),
-                            [self.hi[k]] * self.p])
-        b = BSpline(t, np.eye(self.n), self.p, extrapolate=False)
-        v = np.nan_to_num(b(np.clip(x, self.lo[k], self.hi[k]), nu=deriv))
-        return v
-
-    def matrix(self, e, deriv_axis=-1):
-        a = [self._axis(e[:, k], k, 1 if k == deriv_axis else 0) for k in range(3)]
-        return np.einsum("pi,pj,pk->pijk", *a).reshape(len(e), -1)
-
-    def smoothing(self, lam):
-        eye = np.eye(self.n)
-        d2 = np.diff(eye, 2, axis=0)
-        blocks = [np.kron(np.kron(d2, eye), eye), np.kron(np.kron(eye, d2), eye),
-                  np.kron(np.kron(eye, eye), d2)]
-        return np.sqrt(lam) * np.vstack(blocks)
-
-
-def free_fits(train_e, train_s, test_e, n, lam):
-    """Held-out predictions of the free energy (S = grad W) and of the free interpolant."""
-    box = SplineBox(np.vstack([train_e, test_e]), n)
-    reg = box.smoothing(lam)
-    zeros = np.zeros(len(reg))
-    grads = [box.matrix(train_e, c) for c in range(3)]
-    x = np.linalg.lstsq(np.vstack(grads + [reg]), np.concatenate([train_s.T.ravel(), zeros]),
-                        rcond=None)[0]
-    energy = np.stack([box.matrix(test_e, c) @ x for c in range(3)], 1)
-    v, vt = box.matrix(train_e), box.matrix(test_e)
-    interp = np.stack([vt @ np.linalg.lstsq(np.vstack([v, reg]),
-                                            np.concatenate([train_s[:, c], zeros]),
-                                            rcond=None)[0] for c in range(3)], 1)
-    return energy, interp
 
 
 def summary(err):

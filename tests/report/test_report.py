@@ -410,6 +410,61 @@ def law_check_failures(tmp):
     return out
 
 
+def held_out_reference_failures(tmp):
+    """report.held_out_reference on a hand-made database whose cell stress is a smooth function
+    of the strain (S = C e + quadratic terms): the free interpolant trained on the fit paths
+    predicts every held-out state; with one held-out path's S11 raised by 20 % of the stress
+    range it misses exactly that path's states; the text beside the verdict prints the count;
+    a database without raw paths gives no reference."""
+    import h5py
+    out = []
+    db = os.path.join(tmp, "ref.h5")
+    rng = np.random.default_rng(3)
+    C = np.array([[4.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 1.0]])
+
+    def stress(e):  # e = (E11, E22, 2 E12)
+        return e @ C + np.stack([e[:, 0] ** 2, e[:, 1] ** 2, e[:, 0] * e[:, 2]], 1)
+
+    ends = rng.uniform(-1, 1, (60, 3)) * [0.3, 0.3, 0.5]
+    held_ends = rng.uniform(-1, 1, (5, 3)) * [0.2, 0.2, 0.3]
+
+    def write(bump):
+        with h5py.File(db, "w") as f:
+            f["loop_lengths"] = [5.0]
+            g = f.create_group("loop_0/raw")
+            for i, (end, kind) in enumerate([(x, "coverage") for x in ends] +
+                                            [(x, "holdout") for x in held_ends]):
+                e = np.outer(np.linspace(1 / 6, 1, 6), end)
+                S = stress(e)
+                if kind == "holdout" and i == len(ends) and bump:
+                    S[:, 0] += bump
+                E = e.copy()
+                E[:, 2] *= 0.5  # stored as E12 (load_paths doubles it)
+                p = g.create_group("path_%02d" % i)
+                p["E"], p["S"], p["status"] = E, S, np.zeros(6, dtype=int)
+                p.attrs["set"], p.attrs["kind"] = kind, "gradient"
+        with h5py.File(db, "r") as f:
+            from cell_paths import load_paths, stress_range
+            return stress_range(load_paths(f, 0))
+
+    R = write(0.0)
+    ref = report.held_out_reference(db)
+    if ref is None or ref[:2] != (30, 30):
+        out.append(f"held-out reference, smooth data: {ref} instead of 30 of 30 within 5 %")
+    write(0.2 * R)
+    ref = report.held_out_reference(db)
+    if ref is None or ref[:2] != (24, 30) or not 0.15 < ref[2] < 0.25:
+        out.append(f"held-out reference, one path bumped by 20 % of the range: {ref} instead of "
+                   "24 of 30 within 5 % and a largest error near 20 %")
+    if "a free interpolant trained on the same fit paths" not in report.held_out_reference_text(db):
+        out.append("held-out reference: the text beside the verdict does not print it")
+    with h5py.File(db, "w") as f:
+        f["loop_lengths"] = [5.0]
+    if report.held_out_reference(db) is not None:
+        out.append("held-out reference: a database without raw paths gives one")
+    return out
+
+
 def near_visited_failures(tmp):
     """scripts/law_near_visited.py on a hand-made database whose law is S = 0 (a network with
     all parameters 0 and no floor), so a state's error is |S_cell| / range: which states count
@@ -552,6 +607,7 @@ def main():
         # -- the material law's checks (issue 11): each one made to fail ------------------------
         failures.extend(law_check_failures(tmp))
         failures.extend(near_visited_failures(tmp))
+        failures.extend(held_out_reference_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
