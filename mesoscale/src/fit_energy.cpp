@@ -47,14 +47,21 @@ bool is_holdout(const material::RawPath& r) {
 }
 
 /// Data of db: fit points and held-out points; the reason (with its HDF5 path) if unusable.
+/// Along a fitted path, the states from the first step where the cell gives way
+/// (cos(dS, de) < o.stable_min_cos, de and dS from the previous converged state, the first
+/// from the stress-free reference) on are left out and counted in `skipped`; `gave_way`
+/// (if given) lists where.
 std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Point>& held,
-                    int& skipped, const EnergyFitOptions& o = EnergyFitOptions()) {
+                    int& skipped, const EnergyFitOptions& o = EnergyFitOptions(),
+                    std::vector<std::string>* gave_way = nullptr) {
   skipped = 0;
   for (std::size_t k = 0; k < db.entries.size(); ++k) {
     const auto& entry = db.entries[k];
     int used = 0;
     for (std::size_t q = 0; q < entry.raw.size(); ++q) {
       const auto& r = entry.raw[q];
+      Eigen::Vector3d prev_e = Eigen::Vector3d::Zero(), prev_S = Eigen::Vector3d::Zero();
+      bool unstable = false;
       for (int s = 0; s < r.steps(); ++s) {
         if (r.status[static_cast<std::size_t>(s)] != 0) {
           ++skipped;
@@ -72,6 +79,22 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
         if (!p.e.allFinite() || !p.S.allFinite())
           return material::raw_path_location(k, q) + ": step " + std::to_string(s + 1) +
                  " is marked converged but its E or S is not finite";
+        if (!is_holdout(r) && !unstable && o.stable_min_cos >= -1.0) {
+          const Eigen::Vector3d de = p.e - prev_e, dS = p.S - prev_S;
+          const double n = de.norm() * dS.norm();
+          if (n > 0.0 && de.dot(dS) < o.stable_min_cos * n) {
+            unstable = true;
+            if (gave_way)
+              gave_way->push_back(material::raw_path_location(k, q) + " from step " +
+                                  std::to_string(s + 1));
+          }
+        }
+        prev_e = p.e;
+        prev_S = p.S;
+        if (unstable) {
+          ++skipped;
+          continue;
+        }
         (is_holdout(r) ? held : fit).push_back(p);
         if (!is_holdout(r)) ++used;
       }
@@ -141,7 +164,7 @@ EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int 
     out.reason = reason;
     return out;
   }
-  out.diagnostics = diagnose_energy_law(out.law, db);
+  out.diagnostics = diagnose_energy_law(out.law, db, o.stable_min_cos);
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();
   return out;
@@ -177,6 +200,8 @@ std::string EnergyFitOptions::validate() const {
   if (!(weight_uniaxial > 0.0 && weight_uniaxial <= 1e3))
     return "weight_uniaxial must be in (0, 1000]";
   if (!(weight_paper > 0.0 && weight_paper <= 1e3)) return "weight_paper must be in (0, 1000]";
+  if (!(std::isfinite(stable_min_cos) && stable_min_cos <= 1.0))
+    return "stable_min_cos must be finite and <= 1 (below -1: keep every state)";
   for (const auto& d : directions)
     if (!d.allFinite() || d.norm() == 0.0) return "directions must be finite and non-zero";
   if (family != "ridge" && family != "network") return "family must be \"ridge\" or \"network\"";
@@ -215,6 +240,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"weight_relative", weight_relative},
                       {"weight_uniaxial", weight_uniaxial},
                       {"weight_paper", weight_paper},
+                      {"stable_min_cos", stable_min_cos},
                       {"family", family},
                       {"hidden1", hidden1},
                       {"hidden2", hidden2},
@@ -263,6 +289,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "weight_relative",
                                 "weight_uniaxial",
                                 "weight_paper",
+                                "stable_min_cos",
                                 "family",
                                 "hidden1",
                                 "hidden2",
@@ -298,6 +325,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("weight_relative", o.weight_relative);
   get_double("weight_uniaxial", o.weight_uniaxial);
   get_double("weight_paper", o.weight_paper);
+  get_double("stable_min_cos", o.stable_min_cos);
   get_int("hidden1", o.hidden1);
   get_int("hidden2", o.hidden2);
   get_int("stiff1", o.stiff1);
@@ -355,7 +383,8 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   if (db.entries.empty()) return refuse("/loop_lengths: no loop length to fit");
   std::vector<Point> pts, held;
   int skipped = 0;
-  if (const std::string why = collect(db, pts, held, skipped, o); !why.empty()) return refuse(why);
+  if (const std::string why = collect(db, pts, held, skipped, o, &out.gave_way); !why.empty())
+    return refuse(why);
 
   // ---- layout: directions, scales, s-ranges, l-basis, floor, box -------------------------
   EnergyLawData& law = out.law;
@@ -514,12 +543,15 @@ double uniaxial_axial_stress(const material::EnergyLawAt& at, int axis, double e
   return std::nan("");
 }
 
-EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Database& db) {
+EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Database& db,
+                                         double stable_min_cos) {
   EnergyFitDiagnostics dg;
   const material::EnergyLaw family(law);
   std::vector<Point> pts, held;
   int skipped = 0;
-  collect(db, pts, held, skipped);  // diagnostics of whatever is usable
+  EnergyFitOptions o;
+  o.stable_min_cos = stable_min_cos;
+  collect(db, pts, held, skipped, o);  // diagnostics of whatever is usable
   dg.points_skipped = skipped;
   dg.min_eigenvalue = std::numeric_limits<double>::infinity();
   const std::vector<double> range = detail::stress_ranges(pts, db.entries.size());
@@ -654,6 +686,12 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
        << 100 * p.rms_relative << " % of the stress range " << p.stress_range
        << " MPa; no convex law below " << 100 * p.monotonicity_bound
        << " % (the data's monotonicity bound)\n";
+  if (!s.gave_way.empty()) {
+    os << "    left out where the cell gave way (cos(dS, de) < stable_min_cos, "
+       << s.gave_way.size() << " path(s)):";
+    for (const auto& g : s.gave_way) os << " " << g << (&g == &s.gave_way.back() ? "" : ",");
+    os << "\n";
+  }
   for (const auto& p : d.per_loop)
     if (p.uniaxial_end_ratio.array().isFinite().any())
       os << "    l = " << p.loop_length

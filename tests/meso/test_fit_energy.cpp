@@ -284,6 +284,46 @@ TEST_CASE("energy fit: stiffening units are fitted, stored and keep the law conv
   for (const auto& p : s.diagnostics.per_loop) CHECK(p.rms_relative < 0.05);
 }
 
+TEST_CASE("energy fit: states where the cell gives way are left out of the fit", "[unit]") {
+  // On the synthetic law (convex: dS . de > 0 on every step) nothing is left out. Then one
+  // coverage path's stress falls at its third step (the cell "gives way": dS . de < 0): that
+  // step and the rest of the path leave the fit and its diagnostics, and the report names
+  // them; with stable_min_cos below -1 they are kept, and the law misses the fallen states.
+  Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  EnergyFitOptions o;
+  o.family = "ridge";
+  const EnergyFitSummary clean = fit_energy_law(db, o);
+  REQUIRE(clean.ok());
+  CHECK(clean.gave_way.empty());
+  std::size_t q = 0;
+  while (q < db.entries[0].raw.size() &&
+         (db.entries[0].raw[q].path.set != "coverage" || db.entries[0].raw[q].steps() < 6))
+    ++q;
+  REQUIRE(q < db.entries[0].raw.size());
+  auto& r = db.entries[0].raw[q];
+  for (int s = 2; s < r.steps(); ++s) r.S.row(s) = 0.3 * r.S.row(1);  // falls, then stays
+  const EnergyFitSummary cut = fit_energy_law(db, o);
+  REQUIRE(cut.ok());
+  REQUIRE(cut.gave_way.size() == 1);
+  CHECK(cut.gave_way[0] == knit::material::raw_path_location(0, q) + " from step 3");
+  CHECK(cut.diagnostics.points_skipped == clean.diagnostics.points_skipped + r.steps() - 2);
+  CHECK(cut.diagnostics.per_loop[0].points == clean.diagnostics.per_loop[0].points - 4);
+  CHECK(energy_fit_report(cut).find("gave way") != std::string::npos);
+  // The law fitted without the fallen states follows the rest as before.
+  CHECK(cut.diagnostics.per_loop[0].max_relative < 0.03);
+  o.stable_min_cos = -2.0;
+  const EnergyFitSummary kept = fit_energy_law(db, o);
+  REQUIRE(kept.ok());
+  CHECK(kept.gave_way.empty());
+  CHECK(kept.diagnostics.points_skipped == clean.diagnostics.points_skipped);
+  CHECK(kept.diagnostics.per_loop[0].max_relative > 0.1);
+  // Validation.
+  o.stable_min_cos = 1.5;
+  CHECK(o.validate().find("stable_min_cos") != std::string::npos);
+  o.stable_min_cos = std::nan("");
+  CHECK(o.validate().find("stable_min_cos") != std::string::npos);
+}
+
 TEST_CASE("energy fit: a robust loss and custom directions also fit", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
   EnergyFitOptions o = EnergyFitOptions::from_json(

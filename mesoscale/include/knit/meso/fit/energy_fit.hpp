@@ -109,6 +109,14 @@ struct EnergyFitOptions {
   double weight_relative = 0.1;
   double weight_uniaxial = 30.0;
   double weight_paper = 3.0;
+  /// Where the cell gives way (choice, docs/database.md "Stable states"): along a fitted path,
+  /// a converged step whose stress increment dS makes with its strain increment de an angle
+  /// with cos(dS, de) < stable_min_cos marks the cell as having lost stability there (0:
+  /// negative second-order work dS . de < 0, Hill's criterion); that step and the rest of its
+  /// path are left out of the fit and of the fit-data diagnostics (the law is to be convex
+  /// where the cell is stable). Held-out paths are judged on every converged state. A value
+  /// below -1 keeps every state.
+  double stable_min_cos = 0.0;
 
   std::string validate() const;
   std::string to_json() const;
@@ -124,6 +132,9 @@ struct EnergyFitSummary {
   material::EnergyLawData law;
   material::EnergyFitDiagnostics diagnostics;
   int ceres_iterations = 0;
+  /// The fitted paths where the cell gave way (EnergyFitOptions::stable_min_cos), as
+  /// "/loop_k/raw/path_NN from step s"; those steps are left out of the fit.
+  std::vector<std::string> gave_way;
   bool ok() const { return status == FitStatus::kOk; }
 };
 
@@ -142,8 +153,11 @@ double uniaxial_axial_stress(const material::EnergyLawAt& at, int axis, double e
 
 /// Errors of a law against db's raw data: per loop length on the fit data, and on the
 /// held-out paths.
+/// States of fitted paths past the point where the cell gave way (cos(dS, de) below
+/// stable_min_cos, EnergyFitOptions) are left out, as in the fit.
 material::EnergyFitDiagnostics diagnose_energy_law(const material::EnergyLawData& law,
-                                                   const material::Database& db);
+                                                   const material::Database& db,
+                                                   double stable_min_cos = 0.0);
 
 /// Text summary (per l: RMS, max, relative; held-out) for the command line.
 std::string energy_fit_report(const EnergyFitSummary& s);
