@@ -1,6 +1,6 @@
-// Fit of the energy-based law with Ceres (see knit/meso/fit/energy_fit.hpp). Ceres is included
-// in the fit files only (design/style.md habit 6).
-
+// Fit of the energy-based law (see knit/meso/fit/energy_fit.hpp): the data, the options, the
+// ridge family (its nonnegative least squares solved exactly by fit_nnls.cpp) and the
+// diagnostics; the network family's Ceres L-BFGS fit is fit_network.cpp.
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>

@@ -166,6 +166,13 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int m
     }
     w = b - M * x;
   }
+  // A variable skipped above that still wants to enter means the method stalled.
+  const double tol =
+      64.0 * std::numeric_limits<double>::epsilon() * (mmax * x.cwiseAbs().maxCoeff() + bmax);
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (refused[i] && w(i) > tol)
+      return fail("stalled: coefficient " + std::to_string(i) +
+                  " would lower the objective but cannot enter the passive set");
   out.x = x;
   out.passive = static_cast<int>(P.size());
   out.kkt = kkt_violation(M, b, x);
