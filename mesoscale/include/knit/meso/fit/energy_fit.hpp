@@ -131,7 +131,7 @@ struct EnergyFitSummary {
   std::string reason;
   material::EnergyLawData law;
   material::EnergyFitDiagnostics diagnostics;
-  int ceres_iterations = 0;
+  int ceres_iterations = 0;  ///< network: Ceres L-BFGS iterations; ridge: active-set solves
   /// The fitted paths where the cell gave way (EnergyFitOptions::stable_min_cos), as
   /// "/loop_k/raw/path_NN from step s"; those steps are left out of the fit.
   std::vector<std::string> gave_way;
