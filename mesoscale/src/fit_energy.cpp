@@ -1,7 +1,6 @@
 // Fit of the energy-based law (see knit/meso/fit/energy_fit.hpp): the data, the options, the
 // ridge family (its nonnegative least squares solved exactly by fit_nnls.cpp) and the
 // diagnostics; the network family's Ceres L-BFGS fit is fit_network.cpp.
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -484,16 +483,19 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
     // A tiny ridge keeps M definite where no datum and no penalty reaches a coefficient.
     const double ridge = 1e-12 * std::max(M.diagonal().maxCoeff(), 1e-300) + 1e-14 / (sK * sK);
     M.diagonal().array() += ridge;
-    const Eigen::LLT<Eigen::MatrixXd> llt(M);
-    if (llt.info() != Eigen::Success) {
+    // With the ridge, a finite M is positive definite (the active-set solve checks each passive
+    // block's factor as it goes); no full factorization is needed here.
+    if (!M.allFinite() || !rhs.allFinite()) {
       out.status = FitStatus::kSolverFailed;
-      out.reason = "the normal matrix is not positive definite (non-finite data?)";
+      out.reason = "the normal matrix is not finite (non-finite data?)";
       return out;
     }
     // The exact minimizer over x >= 0 (active set, knit/meso/fit/nnls.hpp), in the unknowns
-    // y = x / sK, which are O(1). Until session 14 Ceres' bounded trust region solved this
-    // and stopped short of the optimum (KKT violation 5 % of |b|).
-    const NnlsResult qp = nnls_normal((sK * sK) * M, sK * rhs);
+    // y = x / sK, which are O(1): M and rhs scaled in place. Until session 14 Ceres' bounded
+    // trust region solved this and stopped short of the optimum (KKT violation 5 % of |b|).
+    M *= sK * sK;
+    rhs *= sK;
+    const NnlsResult qp = nnls_normal(M, rhs);
     out.ceres_iterations += qp.iterations;
     if (!qp.converged || !(qp.kkt <= 1e-8)) {
       out.status = FitStatus::kSolverFailed;

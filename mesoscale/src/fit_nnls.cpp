@@ -142,16 +142,14 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int m
       // Step to the first bound met; the variables that reach it leave the passive set.
       x += alpha * (s - x);
       x(block) = 0.0;
-      std::vector<int> keep;
-      for (int i : P) {
-        if (x(i) <= 0.0) {
-          x(i) = 0.0;
-          passive[i] = 0;
-        } else {
-          keep.push_back(i);
-        }
-      }
-      P.swap(keep);
+      P.erase(std::remove_if(P.begin(), P.end(),
+                             [&](int i) {
+                               if (x(i) > 0.0) return false;
+                               x(i) = 0.0;
+                               passive[i] = 0;
+                               return true;
+                             }),
+              P.end());
       if (P.empty()) break;
       if (!factor.refactor(P))
         return fail("the passive-set matrix is not positive definite (is M?)");

@@ -2,6 +2,7 @@
 // (knit/meso/fit/nnls.hpp): its KKT conditions, hand-solved cases, and the exact optimum that
 // Ceres' bounded trust region missed.
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <catch2/catch.hpp>
 #include <random>
 
