@@ -22,6 +22,27 @@ inline void add_outer(Eigen::Matrix3d& C, double c, const Eigen::Vector3d& a) {
   C(2, 2) += c * a(2) * a(2);
 }
 
+/// The first layer's activations h, h', h'' at e (the reverse-mode gradients start here).
+inline void first_layer(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                        double* h, double* dh, double* ddh) {
+  const double *a0 = th + sh.a0(), *b0 = th + sh.b0();
+  for (int i = 0; i < sh.h1; ++i) {
+    const double* a = a0 + 3 * i;
+    network_unit_activation(sh.stiffening1(i), a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i],
+                            h[i], dh[i], ddh[i]);
+  }
+}
+
+/// The second layer's pre-activation z_j = sum_i V_ji h_i + a1_j . e + b1_j.
+inline double second_layer_input(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                                 const double* h, int j) {
+  const double* a = th + sh.a1() + 3 * j;
+  const double* v = th + sh.V() + j * sh.h1;
+  double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + th[sh.b1() + j];
+  for (int i = 0; i < sh.h1; ++i) z += v[i] * h[i];
+  return z;
+}
+
 }  // namespace
 
 std::string NetworkShape::validate() const {
@@ -29,6 +50,11 @@ std::string NetworkShape::validate() const {
     return "hidden layer sizes must be in 1.." + std::to_string(kMaxUnits);
   if (stiff1 < 0 || stiff1 > h1 || stiff2 < 0 || stiff2 > h2)
     return "the stiffening units (stiff1, stiff2) must be in 0..h1 and 0..h2";
+  if (outer != 0 && outer != 1) return "outer must be 0 (none) or 1 (exponential)";
+  if (outer == 1 && !(std::isfinite(outer_scale) && outer_scale > 0.0))
+    return "outer_scale must be finite and positive";
+  if (outer == 1 && !(std::isfinite(outer_cap) && std::abs(outer_cap) <= 600.0))
+    return "outer_cap must be finite, |outer_cap| <= 600";
   return {};
 }
 
@@ -86,6 +112,62 @@ NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const
   return r;
 }
 
+NetworkResponse network_compose_outer(const NetworkShape& sh, const NetworkResponse& n,
+                                      bool with_C) {
+  if (sh.outer == 0) return n;
+  double g, dg, ddg;
+  network_outer(n.W, sh.outer_cap, g, dg, ddg);
+  NetworkResponse r;
+  r.W = sh.outer_scale * g;
+  r.S = (sh.outer_scale * dg) * n.S;
+  if (with_C) {
+    r.C = (sh.outer_scale * dg) * n.C + (sh.outer_scale * ddg) * (n.S * n.S.transpose());
+    r.C(1, 0) = r.C(0, 1);
+    r.C(2, 0) = r.C(0, 2);
+    r.C(2, 1) = r.C(1, 2);
+  }
+  return r;
+}
+
+void network_value_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                            double scale, double* grad) {
+  // N = sum_j w_j u_j + sum_i w1_i h_i + 1/2 e^T L L^T e:
+  //   dN/dw_j = u_j, dN/dw1_i = h_i, dN/dz_j = w_j u'_j (-> b1_j, a1_j e, V_ji h_i),
+  //   dN/dy_i = kappa_i h'_i (-> b0_i, a0_i e), dN/dL = e (L^T e)^T.
+  std::array<double, kMaxUnits> h, dh, ddh, kappa;
+  const double *w1 = th + sh.w1(), *V = th + sh.V(), *w = th + sh.w(), *L = th + sh.L();
+  const int H1 = sh.h1, H2 = sh.h2;
+  first_layer(sh, th, e, h.data(), dh.data(), ddh.data());
+  for (int i = 0; i < H1; ++i) {
+    kappa[i] = w1[i];
+    grad[sh.w1() + i] += scale * h[i];
+  }
+  for (int j = 0; j < H2; ++j) {
+    const double* v = V + j * H1;
+    double u, du, ddu;
+    network_unit_activation(sh.stiffening2(j), second_layer_input(sh, th, e, h.data(), j), u, du,
+                            ddu);
+    grad[sh.w() + j] += scale * u;
+    const double dz = scale * w[j] * du;
+    grad[sh.b1() + j] += dz;
+    for (int c = 0; c < 3; ++c) grad[sh.a1() + 3 * j + c] += dz * e(c);
+    double* gv = grad + sh.V() + j * H1;
+    for (int i = 0; i < H1; ++i) {
+      gv[i] += dz * h[i];
+      kappa[i] += w[j] * du * v[i];
+    }
+  }
+  for (int i = 0; i < H1; ++i) {
+    const double dy = scale * kappa[i] * dh[i];
+    grad[sh.b0() + i] += dy;
+    for (int c = 0; c < 3; ++c) grad[sh.a0() + 3 * i + c] += dy * e(c);
+  }
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Lm(L);
+  const Eigen::Vector3d Le = Lm.transpose() * e;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) grad[sh.L() + 3 * r + c] += scale * e(r) * Le(c);
+}
+
 void network_stress_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
                              const Eigen::Vector3d& g, double* grad) {
   // F = g . S. With alpha_i = a0_i . g, beta_j = a1_j . g, gamma_j = grad z_j . g:
@@ -93,13 +175,12 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
   // zeta_j = dF/dz_j = w_j u''_j gamma_j, omega_j = dF/dgamma_j = w_j u'_j,
   // eta_i = dF/dy_i = h'_i sum_j zeta_j V_ji + h''_i kappa_i alpha_i.
   std::array<double, kMaxUnits> h, dh, ddh, alpha, kappa, back;
-  const double *a0 = th + sh.a0(), *b0 = th + sh.b0(), *w1 = th + sh.w1(), *V = th + sh.V(),
-               *a1 = th + sh.a1(), *b1 = th + sh.b1(), *w = th + sh.w(), *L = th + sh.L();
+  const double *a0 = th + sh.a0(), *w1 = th + sh.w1(), *V = th + sh.V(), *a1 = th + sh.a1(),
+               *w = th + sh.w(), *L = th + sh.L();
   const int H1 = sh.h1, H2 = sh.h2;
+  first_layer(sh, th, e, h.data(), dh.data(), ddh.data());
   for (int i = 0; i < H1; ++i) {
     const double* a = a0 + 3 * i;
-    network_unit_activation(sh.stiffening1(i), a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i],
-                            h[i], dh[i], ddh[i]);
     alpha[i] = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
     kappa[i] = w1[i];
     back[i] = 0.0;
@@ -108,14 +189,11 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
   for (int j = 0; j < H2; ++j) {
     const double* a = a1 + 3 * j;
     const double* v = V + j * H1;
-    double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b1[j];
     double gamma = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
-    for (int i = 0; i < H1; ++i) {
-      z += v[i] * h[i];
-      gamma += v[i] * dh[i] * alpha[i];
-    }
+    for (int i = 0; i < H1; ++i) gamma += v[i] * dh[i] * alpha[i];
     double u, du, ddu;
-    network_unit_activation(sh.stiffening2(j), z, u, du, ddu);
+    network_unit_activation(sh.stiffening2(j), second_layer_input(sh, th, e, h.data(), j), u, du,
+                            ddu);
     const double zeta = w[j] * ddu * gamma, omega = w[j] * du;
     grad[sh.w() + j] += du * gamma;
     grad[sh.b1() + j] += zeta;
@@ -249,10 +327,14 @@ NetworkResponse pass_impl(const NetworkShape& shape, const double* q, const Eige
 NetworkResponse NetworkLawAt::pass(const Eigen::Vector3d& e) const {
   // The default shape and the sizes the docs measure get compiled sizes; any other the general
   // path (the same code, Eigen::Dynamic).
+  // The outer function (if any) is applied to each pass: the mirror average and the affine
+  // normalization act on G = c g(N).
   const double* q = packed_.data();
-  if (shape_.h1 == 12 && shape_.h2 == 6) return pass_impl<12, 6>(shape_, q, Q_, e);
-  if (shape_.h1 == 16 && shape_.h2 == 8) return pass_impl<16, 8>(shape_, q, Q_, e);
-  return pass_impl<Eigen::Dynamic, Eigen::Dynamic>(shape_, q, Q_, e);
+  if (shape_.h1 == 12 && shape_.h2 == 6)
+    return network_compose_outer(shape_, pass_impl<12, 6>(shape_, q, Q_, e));
+  if (shape_.h1 == 16 && shape_.h2 == 8)
+    return network_compose_outer(shape_, pass_impl<16, 8>(shape_, q, Q_, e));
+  return network_compose_outer(shape_, pass_impl<Eigen::Dynamic, Eigen::Dynamic>(shape_, q, Q_, e));
 }
 
 NetworkResponse NetworkLawAt::evaluate(const Eigen::Vector3d& e) const {

@@ -40,6 +40,16 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
     g.set_attribute(".", "h2", sh.h2);
     g.set_attribute(".", "stiff1", sh.stiff1);
     g.set_attribute(".", "stiff2", sh.stiff2);
+    // The outer function (session 15): "none", or "exp" with W built from G = outer_scale g(N).
+    g.set_attribute(".", "outer", sh.outer == 1 ? "exp" : "none");
+    if (sh.outer == 1) {
+      g.set_attribute(".", "outer_scale", sh.outer_scale);
+      g.set_attribute(".", "outer_cap", sh.outer_cap);
+      g.set_attribute(".", "outer_law",
+                      "N replaced by G = outer_scale g(N) in W, g(n) = exp(n) for n <= outer_cap, "
+                      "exp(outer_cap) (1 + d + d^2 / 2) beyond, d = n - outer_cap; outer_scale "
+                      "MPa, N dimensionless");
+    }
     g.write("l_knots", law.network.l_knots);
     g.set_attribute("l_knots", "units", "mm (theta piecewise linear in l between these)");
     g.write("theta", RowMatrixX(law.network.theta));
@@ -145,6 +155,19 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
         law.network.shape.stiff1 = root.attribute_int(g, "stiff1");
       if (root.has_attribute(g, "stiff2"))
         law.network.shape.stiff2 = root.attribute_int(g, "stiff2");
+      // Optional (written since session 15): the outer function; none in older databases.
+      if (root.has_attribute(g, "outer")) {
+        const std::string outer = root.attribute_string(g, "outer");
+        if (outer != "none" && outer != "exp")
+          throw InputError(
+              file, g,
+              "attribute outer is \"" + outer + "\"; this build reads \"none\" and \"exp\"");
+        law.network.shape.outer = outer == "exp" ? 1 : 0;
+        if (law.network.shape.outer == 1) {
+          law.network.shape.outer_scale = root.attribute_double(g, "outer_scale");
+          law.network.shape.outer_cap = root.attribute_double(g, "outer_cap");
+        }
+      }
       law.network.l_knots = root.read_doubles(g + "/l_knots");
       law.network.theta = root.read_matrix(g + "/theta");
     } else {

@@ -208,6 +208,7 @@ std::string EnergyFitOptions::validate() const {
     return "hidden1 and hidden2 must be in 1..64";
   if (stiff1 < 0 || stiff1 > hidden1 || stiff2 < 0 || stiff2 > hidden2)
     return "stiff1 and stiff2 must be in 0..hidden1 and 0..hidden2";
+  if (outer != "none" && outer != "exp") return "outer must be \"none\" or \"exp\"";
   if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
   if (seed < 0) return "seed must be >= 0";
   if (network_iterations < 1 || network_iterations > 1000000)
@@ -245,6 +246,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"hidden2", hidden2},
                       {"stiff1", stiff1},
                       {"stiff2", stiff2},
+                      {"outer", outer},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
                       {"network_iterations", network_iterations},
@@ -294,6 +296,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "hidden2",
                                 "stiff1",
                                 "stiff2",
+                                "outer",
                                 "l_coupling",
                                 "seed",
                                 "network_iterations",
@@ -342,6 +345,11 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
     if (!j["family"].is_string())
       throw InputError(file, pointer + "/family", "must be \"ridge\" or \"network\"");
     o.family = j["family"].get<std::string>();
+  }
+  if (j.contains("outer")) {
+    if (!j["outer"].is_string())
+      throw InputError(file, pointer + "/outer", "must be \"none\" or \"exp\"");
+    o.outer = j["outer"].get<std::string>();
   }
   if (j.contains("loss")) {
     const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
@@ -671,6 +679,8 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     os << "  energy law (input-convex network, hidden layers " << sh.h1 << " and " << sh.h2;
     if (sh.stiff1 > 0 || sh.stiff2 > 0)
       os << " (stiffening units " << sh.stiff1 << " and " << sh.stiff2 << ")";
+    if (sh.outer == 1)
+      os << " (outer exp, scale " << sh.outer_scale << " MPa, cap " << sh.outer_cap << ")";
     os << ", " << s.law.network.l_knots.size() << " loop-length knots";
   } else {
     os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()

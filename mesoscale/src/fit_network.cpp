@@ -73,23 +73,40 @@ class NetworkObjective : public ceres::FirstOrderFunction {
 
   bool Evaluate(const double* phi, double* cost, double* grad) const override {
     const int P = sh_.size();
+    const bool outer = sh_.outer != 0;
     to_theta(phi, theta_.data());
     std::fill(gtheta_.begin(), gtheta_.end(), 0.0);
     double f = 0.0;
-    std::vector<Eigen::Vector3d> S0(static_cast<std::size_t>(n_)), G0(static_cast<std::size_t>(n_));
+    // Per knot at e = 0: N0, S_N0 and (outer) g'(N0), g''(N0); S0 the normalization's stress.
+    std::vector<Eigen::Vector3d> S0(static_cast<std::size_t>(n_)), G0(static_cast<std::size_t>(n_)),
+        SN0(static_cast<std::size_t>(n_));
+    std::vector<double> dg0(static_cast<std::size_t>(n_), 1.0), ddg0(static_cast<std::size_t>(n_));
     for (int j = 0; j < n_; ++j) {
+      const auto J = static_cast<std::size_t>(j);
       const material::NetworkResponse r0 =
           material::network_evaluate(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(), false);
-      S0[static_cast<std::size_t>(j)] = Eigen::Vector3d(r0.S(0), r0.S(1), 0.0);
-      G0[static_cast<std::size_t>(j)].setZero();
+      SN0[J] = r0.S;
+      if (outer) {
+        double g;
+        material::network_outer(r0.W, sh_.outer_cap, g, dg0[J], ddg0[J]);
+      }
+      S0[J] = dg0[J] * Eigen::Vector3d(r0.S(0), r0.S(1), 0.0);
+      G0[J].setZero();
     }
     for (std::size_t p = 0; p < x_.size(); ++p) {
       const int j = knot_[p];
       const double* th = theta_.data() + j * P;
       const Eigen::Vector3d& x = x_[p];
       const Eigen::Vector3d mx(x(0), x(1), -x(2));
-      const Eigen::Vector3d sa = material::network_evaluate(sh_, th, x, false).S;
-      const Eigen::Vector3d sb = material::network_evaluate(sh_, th, mx, false).S;
+      const material::NetworkResponse ra = material::network_evaluate(sh_, th, x, false);
+      const material::NetworkResponse rb = material::network_evaluate(sh_, th, mx, false);
+      // The outer function's slopes (1 and 0 without it): S_G = g'(N) S_N.
+      double ga = 0.0, dga = 1.0, ddga = 0.0, dgb = 1.0, ddgb = 0.0;
+      if (outer) {
+        material::network_outer(ra.W, sh_.outer_cap, ga, dga, ddga);
+        material::network_outer(rb.W, sh_.outer_cap, ga, dgb, ddgb);
+      }
+      const Eigen::Vector3d sa = dga * ra.S, sb = dgb * rb.S;
       const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
                                 S0[static_cast<std::size_t>(j)] - t_[p];
       f += scale_ * w_[p] * s.squaredNorm();
@@ -105,15 +122,26 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         }
       if (!grad) continue;
       const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s + gt_tube;  // d f / d S_W
+      const Eigen::Vector3d mg(g(0), g(1), -g(2));
       double* gt = gtheta_.data() + j * P;
-      material::network_stress_gradient(sh_, th, x, 0.5 * g, gt);
-      material::network_stress_gradient(sh_, th, mx, 0.5 * Eigen::Vector3d(g(0), g(1), -g(2)), gt);
+      // d(g . g'(N) S_N) = g'(N) d(g . S_N) + g''(N) (g . S_N) dN.
+      material::network_stress_gradient(sh_, th, x, 0.5 * dga * g, gt);
+      material::network_stress_gradient(sh_, th, mx, 0.5 * dgb * mg, gt);
+      if (outer) {
+        material::network_value_gradient(sh_, th, x, 0.5 * ddga * g.dot(ra.S), gt);
+        material::network_value_gradient(sh_, th, mx, 0.5 * ddgb * mg.dot(rb.S), gt);
+      }
       G0[static_cast<std::size_t>(j)] -= Eigen::Vector3d(g(0), g(1), 0.0);
     }
     if (grad) {
-      for (int j = 0; j < n_; ++j)
+      for (int j = 0; j < n_; ++j) {
+        const auto J = static_cast<std::size_t>(j);
         material::network_stress_gradient(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(),
-                                          G0[static_cast<std::size_t>(j)], gtheta_.data() + j * P);
+                                          dg0[J] * G0[J], gtheta_.data() + j * P);
+        if (outer)
+          material::network_value_gradient(sh_, theta_.data() + j * P, Eigen::Vector3d::Zero(),
+                                           ddg0[J] * G0[J].dot(SN0[J]), gtheta_.data() + j * P);
+      }
       for (int j = 0; j < n_; ++j)
         for (int k = 0; k < P; ++k) {
           const int i = j * P + k;
@@ -163,6 +191,14 @@ std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
   for (int k = 0; k < sh.h2; ++k) at(sh.b1() + k) = 0.5 * n01(rng);
   for (int k = 0; k < sh.h2; ++k) at(sh.w() + k) = 0.55 + 0.1 * n01(rng);
   for (int k = 0; k < 9; ++k) at(sh.L() + k) = (k % 4 == 0) ? 0.3 : 0.0;
+  // With the exponential outer function the output weights start 16 times smaller (phi / 4),
+  // so that N starts of order 1 on the data and exp(N) does not overflow (N of the draw above
+  // reaches 10-20, and L-BFGS then stops at its first steps).
+  if (sh.outer != 0) {
+    for (int k = 0; k < sh.h1; ++k) at(sh.w1() + k) *= 0.25;
+    for (int k = 0; k < sh.h2; ++k) at(sh.w() + k) *= 0.25;
+    for (int k = 0; k < 9; ++k) at(sh.L() + k) *= 0.25;
+  }
   return phi;
 }
 
@@ -176,6 +212,7 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   sh.h2 = o.hidden2;
   sh.stiff1 = o.stiff1;
   sh.stiff2 = o.stiff2;
+  sh.outer = o.outer == "exp" ? 1 : 0;
   if (const std::string why = sh.validate(); !why.empty()) return "invalid options: " + why;
   const int n = static_cast<int>(loop_lengths.size()), P = sh.size();
   std::vector<Eigen::Vector3d> x, t;
@@ -249,13 +286,28 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost))
     return "Ceres (L-BFGS): " + summary.message;
 
-  // theta in scaled variables -> mm / MPa: N(e) = sS sE N^(e / sE).
+  // theta in scaled variables -> mm / MPa: N(e) = sS sE N^(e / sE) without an outer function;
+  // with it G(e) = sS sE g(N^(e / sE)), so N's output weights keep their values, outer_scale =
+  // sS sE, and the cap is set one unit above the largest N over the fit data (the stored law
+  // equals the fitted one there; beyond, g continues quadratically).
   std::vector<double> theta(phi.size());
   objective->to_theta(phi.data(), theta.data());
+  if (sh.outer != 0) {
+    double n_max = -1e300;
+    for (std::size_t p = 0; p < pts.size(); ++p) {
+      const double* th = theta.data() + static_cast<int>(pts[p].loop) * P;
+      const Eigen::Vector3d xp = pts[p].e / sE, mp(xp(0), xp(1), -xp(2));
+      n_max = std::max({n_max, material::network_evaluate(sh, th, xp, false).W,
+                        material::network_evaluate(sh, th, mp, false).W});
+    }
+    sh.outer_scale = sS * sE;
+    sh.outer_cap = std::min(n_max + 1.0, sh.outer_cap);
+  }
   law.network.shape = sh;
   law.network.l_knots = loop_lengths;
   law.network.theta.resize(n, P);
-  const double wscale = sS * sE, lscale = std::sqrt(sS / sE);
+  const double wscale = sh.outer != 0 ? 1.0 : sS * sE;
+  const double lscale = sh.outer != 0 ? 1.0 / sE : std::sqrt(sS / sE);
   for (int j = 0; j < n; ++j)
     for (int k = 0; k < P; ++k) {
       double v = theta[static_cast<std::size_t>(j * P + k)];

@@ -113,6 +113,17 @@ class NetworkLaw:
         L = t[o:o + 9].reshape(3, 3)
         self.Q = L @ L.T
         self.floor = float(g.attrs["floor"])
+        # The outer function (session 15, NetworkShape::outer): N replaced by c g(N),
+        # g = exp up to the cap, its C2 quadratic continuation beyond.
+        outer = g.attrs.get("outer", "none")
+        outer = outer.decode() if isinstance(outer, bytes) else str(outer)
+        if outer not in ("none", "exp"):
+            raise ValueError(f"/energy_law: attribute outer is {outer!r}; "
+                             "this script reads 'none' and 'exp'")
+        self.outer = outer == "exp"
+        if self.outer:
+            self.c = float(g.attrs["outer_scale"])
+            self.cap = float(g.attrs["outer_cap"])
         W0, S0 = self._raw(np.zeros((1, 3)))
         self.W0, self.S0 = W0[0], np.array([S0[0, 0], S0[0, 1], 0.0])
 
@@ -122,6 +133,11 @@ class NetworkLaw:
         W = u @ self.w + h @ self.w1 + 0.5 * np.einsum("...i,ij,...j->...", e, self.Q, e)
         kappa = self.w1 + (du * self.w) @ self.V
         S = (kappa * dh) @ self.A0 + (du * self.w) @ self.A1 + e @ self.Q
+        if self.outer:
+            d = np.maximum(W - self.cap, 0.0)
+            ec = np.exp(np.minimum(W, self.cap))
+            g, dg = ec * (1.0 + d + 0.5 * d * d), ec * (1.0 + d)
+            return self.c * g, (self.c * dg)[..., None] * S
         return W, S
 
     def eval(self, e):

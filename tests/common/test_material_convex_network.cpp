@@ -3,6 +3,7 @@
 // nonnegative weights, the fit's reverse-mode gradient against finite differences, the
 // mirror-averaged law, and validation (its l-derivative: test_material_energy_law.cpp).
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -163,27 +164,137 @@ TEST_CASE("convex network: the packed evaluation equals the reference network", 
   }
 }
 
-TEST_CASE("convex network: the fit's reverse-mode gradient equals finite differences", "[unit]") {
-  const NetworkShape sh = shape_with(5, 3, GENERATE(0, 1, 2, 3));
+namespace {
+/// A reverse-mode gradient against central differences over theta: at 20 random strains e and
+/// weights g, grad_of(th, e, g, grad) adds d f / d theta of f = value_of(th, e, g).
+template <class Grad, class Value>
+void check_theta_gradient(const NetworkShape& sh, unsigned seed, Grad grad_of, Value value_of) {
   INFO("stiffening units " << sh.stiff1 << " and " << sh.stiff2);
   std::vector<double> th = random_theta(sh, 9);
-  std::mt19937 gen(4);
+  std::mt19937 gen(seed);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (int trial = 0; trial < 20; ++trial) {
     const Eigen::Vector3d e(u(gen), u(gen), u(gen)), g(u(gen), u(gen), u(gen));
     std::vector<double> grad(th.size(), 0.0);
-    network_stress_gradient(sh, th.data(), e, g, grad.data());
+    grad_of(th.data(), e, g, grad.data());
     for (std::size_t k = 0; k < th.size(); ++k) {
       const double h = 1e-6, keep = th[k];
       th[k] = keep + h;
-      const double fp = g.dot(network_evaluate(sh, th.data(), e, false).S);
+      const double fp = value_of(th.data(), e, g);
       th[k] = keep - h;
-      const double fm = g.dot(network_evaluate(sh, th.data(), e, false).S);
+      const double fm = value_of(th.data(), e, g);
       th[k] = keep;
       INFO("trial " << trial << ", parameter " << k);
       REQUIRE(std::abs((fp - fm) / (2 * h) - grad[k]) <= 1e-6 * (1 + std::abs(grad[k])));
     }
   }
+}
+}  // namespace
+
+TEST_CASE("convex network: the fit's reverse-mode gradient equals finite differences", "[unit]") {
+  // network_stress_gradient: f = g . S_N.
+  const NetworkShape sh = shape_with(5, 3, GENERATE(0, 1, 2, 3));
+  check_theta_gradient(
+      sh, 4,
+      [&](const double* th, const Eigen::Vector3d& e, const Eigen::Vector3d& g, double* grad) {
+        network_stress_gradient(sh, th, e, g, grad);
+      },
+      [&](const double* th, const Eigen::Vector3d& e, const Eigen::Vector3d& g) {
+        return g.dot(network_evaluate(sh, th, e, false).S);
+      });
+}
+
+TEST_CASE("convex network: the value's reverse-mode gradient equals finite differences", "[unit]") {
+  // network_value_gradient (the exponential outer function's fit needs dN/dtheta): f = g_0 N.
+  const NetworkShape sh = shape_with(5, 3, GENERATE(0, 1, 2, 3));
+  check_theta_gradient(
+      sh, 5,
+      [&](const double* th, const Eigen::Vector3d& e, const Eigen::Vector3d& g, double* grad) {
+        network_value_gradient(sh, th, e, g(0), grad);
+      },
+      [&](const double* th, const Eigen::Vector3d& e, const Eigen::Vector3d& g) {
+        return g(0) * network_evaluate(sh, th, e, false).W;
+      });
+}
+
+TEST_CASE("convex network: the exponential outer function keeps S = dW, C = dS, convexity",
+          "[unit]") {
+  // G = c g(N), g = exp up to the cap and its quadratic continuation beyond: g is C2 at the cap;
+  // the packed law (mirror-averaged, normalized G) against the reference written out, S and C
+  // of the law against finite differences of W and S, C positive semidefinite, on strains on
+  // both sides of the cap (the cap is set to the median N of the samples).
+  NetworkShape sh = shape_with(7, 5, GENERATE(0, 1, 3));
+  INFO("stiffening units " << sh.stiff1 << " and " << sh.stiff2);
+  std::vector<double> th = random_theta(sh, 21);
+  // Output weights scaled down so that exp(N) stays moderate on the samples.
+  for (int k = sh.w1(); k < sh.V(); ++k) th[static_cast<std::size_t>(k)] *= 0.1;
+  for (int k = sh.w(); k < sh.size(); ++k) th[static_cast<std::size_t>(k)] *= 0.1;
+  std::mt19937 gen(14);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::vector<Eigen::Vector3d> es;
+  std::vector<double> ns;
+  for (int k = 0; k < 400; ++k) {
+    es.emplace_back(u(gen), u(gen), u(gen));
+    ns.push_back(network_evaluate(sh, th.data(), es.back(), false).W);
+  }
+  std::vector<double> sorted = ns;
+  std::nth_element(sorted.begin(), sorted.begin() + 200, sorted.end());
+  sh.outer = 1;
+  sh.outer_scale = 2.5;
+  sh.outer_cap = sorted[200];
+  // g is C2 at the cap.
+  double gl, dgl, ddgl, gr, dgr, ddgr;
+  network_outer(sh.outer_cap - 1e-12, sh.outer_cap, gl, dgl, ddgl);
+  network_outer(sh.outer_cap + 1e-12, sh.outer_cap, gr, dgr, ddgr);
+  CHECK(std::abs(gl - gr) < 1e-10 * gr);
+  CHECK(std::abs(dgl - dgr) < 1e-10 * gr);
+  CHECK(std::abs(ddgl - ddgr) < 1e-10 * gr);
+  const NetworkLawAt law(sh, th);
+  const NetworkResponse z =
+      network_compose_outer(sh, network_evaluate(sh, th.data(), Eigen::Vector3d::Zero()));
+  const Eigen::Vector3d S0(z.S(0), z.S(1), 0.0);
+  const Eigen::Matrix3d M = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
+  const NetworkResponse r0 = law.evaluate(Eigen::Vector3d::Zero());
+  CHECK(std::abs(r0.W) <= 1e-14 * std::abs(z.W));
+  CHECK(r0.S.norm() <= 1e-14 * (1 + z.S.norm()));
+  int beyond = 0;
+  double worst_S = 0.0, worst_C = 0.0, min_eig = 1e300;
+  for (std::size_t k = 0; k < es.size(); ++k) {
+    const Eigen::Vector3d& e = es[k];
+    if (ns[k] > sh.outer_cap) ++beyond;
+    const NetworkResponse a = network_compose_outer(sh, network_evaluate(sh, th.data(), e)),
+                          b = network_compose_outer(sh, network_evaluate(sh, th.data(), M * e));
+    const double W = 0.5 * (a.W + b.W) - z.W - S0.dot(e);
+    const Eigen::Vector3d S = 0.5 * (a.S + M * b.S) - S0;
+    const Eigen::Matrix3d C = 0.5 * (a.C + M * b.C * M);
+    const NetworkResponse r = law.evaluate(e);
+    INFO("e = " << e.transpose());
+    REQUIRE(std::abs(r.W - W) <= 1e-12 * (1 + std::abs(W) + std::abs(z.W)));
+    REQUIRE((r.S - S).norm() <= 1e-12 * (1 + S.norm() + z.S.norm()));
+    REQUIRE((r.C - C).norm() <= 1e-12 * (1 + C.norm()));
+    REQUIRE(r.C == r.C.transpose());
+    min_eig =
+        std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0) /
+                              (1 + r.C.norm()));
+    const double h = 1e-6;
+    Eigen::Matrix3d Cfd;
+    Eigen::Vector3d Sfd;
+    for (int j = 0; j < 3; ++j) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d(j) = h;
+      const NetworkResponse p = law.evaluate(e + d), m = law.evaluate(e - d);
+      Sfd(j) = (p.W - m.W) / (2 * h);
+      Cfd.col(j) = (p.S - m.S) / (2 * h);
+    }
+    worst_S = std::max(worst_S, (Sfd - r.S).norm() / (1 + r.S.norm()));
+    worst_C = std::max(worst_C, (Cfd - r.C).norm() / (1 + r.C.norm()));
+  }
+  INFO("beyond the cap " << beyond << " of " << es.size() << "; FD(S) " << worst_S << ", FD(C) "
+                         << worst_C << ", min eig / (1 + |C|) " << min_eig);
+  CHECK(beyond > 100);  // both pieces of g are exercised
+  CHECK(worst_S < 1e-7);
+  CHECK(worst_C < 1e-6);
+  CHECK(min_eig >= -1e-12);
 }
 
 TEST_CASE("convex network: the law is stress-free at 0, even in E12, convex", "[unit]") {
@@ -228,6 +339,19 @@ TEST_CASE("convex network: validation refuses bad data", "[unit]") {
   refuses([&](EnergyLawData& d) { d.network.shape.stiff2 = d.network.shape.h2 + 1; },
           "stiffening units");
   refuses([&](EnergyLawData& d) { d.network.shape.stiff1 = -1; }, "stiffening units");
+  refuses([&](EnergyLawData& d) { d.network.shape.outer = 2; }, "outer must be");
+  refuses(
+      [&](EnergyLawData& d) {
+        d.network.shape.outer = 1;
+        d.network.shape.outer_scale = 0.0;
+      },
+      "outer_scale");
+  refuses(
+      [&](EnergyLawData& d) {
+        d.network.shape.outer = 1;
+        d.network.shape.outer_cap = std::nan("");
+      },
+      "outer_cap");
   // Negative entries where no sign is required are fine (biases, first-layer weights, L).
   EnergyLawData ok = good;
   ok.network.theta(0, sh.b0()) = -3.0;

@@ -181,10 +181,14 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   db.energy_law = testing::make_test_network_law();
   db.energy_law->network.shape.stiff1 = 1;  // stiffening units (session 11) round-trip too
   db.energy_law->network.shape.stiff2 = 2;
+  db.energy_law->network.shape.outer = 1;  // and the exponential outer function (session 15)
+  db.energy_law->network.shape.outer_scale = 0.3;
+  db.energy_law->network.shape.outer_cap = 1.7;
   write_database(file, db);
   {
     const auto f = knit::io::H5File::open_read(file);
     CHECK(f.attribute_string("/energy_law", "family") == "network");
+    CHECK(f.attribute_string("/energy_law", "outer") == "exp");
     CHECK_FALSE(f.exists("/energy_law/coefficients"));  // no ridge datasets beside it
   }
   const Database back = read_database(file, false);
@@ -195,6 +199,9 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   CHECK(b.network.shape.h2 == a.network.shape.h2);
   CHECK(b.network.shape.stiff1 == 1);
   CHECK(b.network.shape.stiff2 == 2);
+  CHECK(b.network.shape.outer == 1);
+  CHECK(b.network.shape.outer_scale == 0.3);
+  CHECK(b.network.shape.outer_cap == 1.7);
   CHECK(b.network.l_knots == a.network.l_knots);
   CHECK(b.network.theta == a.network.theta);
   CHECK(b.floor == a.floor);
@@ -219,7 +226,22 @@ TEST_CASE("database v3: a network law written before the stiffening units still 
   REQUIRE(back.energy_law);
   CHECK(back.energy_law->network.shape.stiff1 == 0);
   CHECK(back.energy_law->network.shape.stiff2 == 0);
+  CHECK(back.energy_law->network.shape.outer == 0);  // nor an outer function (session 15)
   CHECK(back.energy_law->network.theta == db.energy_law->network.theta);
+}
+
+TEST_CASE("database v3: an unknown outer function is refused with its HDF5 path", "[unit]") {
+  const auto file = tmp("network_bad_outer.h5");
+  Database db = db_with_law();
+  db.energy_law = testing::make_test_network_law();
+  write_database(file, db);
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    f.remove_attribute("/energy_law", "outer");
+    f.set_attribute("/energy_law", "outer", "log");
+  }
+  CHECK_THROWS_WITH(read_database(file, false),
+                    Catch::Contains("/energy_law") && Catch::Contains("outer is \"log\""));
 }
 
 TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit]") {

@@ -519,6 +519,59 @@ def near_visited_failures(tmp):
     return out
 
 
+def outer_exp_failures(tmp):
+    """scripts/figures/energy_law.py's NetworkLaw with the exponential outer function (session
+    15) on a hand-made law whose network is its quadratic part alone, N = 1/2 e^T L L^T e: then
+    W = c g(N) - c g(0) + floor/2 |e|^2 is Fung's law in closed form, g = exp below the cap and
+    exp(cap) (1 + d + d^2 / 2) beyond (both pieces sampled); S against central differences of W;
+    an unknown outer function is refused."""
+    import h5py
+    from energy_law import load_law
+    out = []
+    db = os.path.join(tmp, "outer.h5")
+    c, cap, floor = 1.7, 0.03, 0.02
+    L = np.array([[1.2, 0.0, 0.0], [0.3, 0.9, 0.0], [0.0, 0.0, 0.8]])
+    theta = np.zeros((1, 20))
+    theta[0, 11:] = L.ravel()
+    with h5py.File(db, "w") as f:
+        law = f.create_group("energy_law")
+        law.attrs["family"] = "network"
+        law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, floor
+        law.attrs["outer"], law.attrs["outer_scale"], law.attrs["outer_cap"] = "exp", c, cap
+        law["l_knots"] = [5.0]
+        law["theta"] = theta
+    Q = L @ L.T
+    e = np.array([[0.05, -0.02, 0.03], [0.2, 0.1, -0.15], [-0.25, 0.3, 0.2], [0.0, 0.0, 0.0]])
+
+    def g(n):
+        d = np.maximum(n - cap, 0.0)
+        return np.exp(np.minimum(n, cap)) * (1.0 + d + 0.5 * d * d)
+    n = 0.5 * np.einsum("ki,ij,kj->k", e, Q, e)
+    want = c * (g(n) - 1.0) + 0.5 * floor * np.sum(e * e, axis=1)
+    with h5py.File(db, "r") as f:
+        law = load_law(f["energy_law"], 5.0)
+        W, S = law.eval(e)
+        h = 1e-6
+        Sfd = np.stack([(law.eval(e + h * np.eye(3)[j])[0] - law.eval(e - h * np.eye(3)[j])[0])
+                        / (2 * h) for j in range(3)], axis=-1)
+    if not (n[1:3] > cap).all() or not (n[0] < cap):
+        out.append(f"outer exp: the samples do not straddle the cap: N = {n}")
+    if np.abs(W - want).max() > 1e-12:
+        out.append(f"outer exp: W {W} instead of Fung's {want}")
+    if np.abs(S - Sfd).max() > 1e-7 * (1 + np.abs(S).max()):
+        out.append(f"outer exp: S {S.tolist()} is not dW/de {Sfd.tolist()}")
+    with h5py.File(db, "a") as f:
+        f["energy_law"].attrs["outer"] = "log"
+    with h5py.File(db, "r") as f:
+        try:
+            load_law(f["energy_law"], 5.0)
+            out.append("outer exp: an unknown outer function 'log' was read")
+        except ValueError as err:
+            if "outer" not in str(err):
+                out.append(f"outer exp: the refusal does not name the attribute: {err}")
+    return out
+
+
 def main():
     failures = []
     tmp = tempfile.mkdtemp(prefix="knit_report_test_")
@@ -607,6 +660,7 @@ def main():
         # -- the material law's checks (issue 11): each one made to fail ------------------------
         failures.extend(law_check_failures(tmp))
         failures.extend(near_visited_failures(tmp))
+        failures.extend(outer_exp_failures(tmp))
         failures.extend(held_out_reference_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])

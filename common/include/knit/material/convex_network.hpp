@@ -33,6 +33,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,14 @@ struct NetworkShape {
   /// stiffening activation rho (0 = none: the law of sessions 6-10). The layout of theta does
   /// not depend on them.
   int stiff1 = 0, stiff2 = 0;
+  /// The outer function (option `outer`, session 15): 0 = none, W built from N itself (the
+  /// law of sessions 6-14); 1 = exponential, W built from G(e) = outer_scale * g(N(e)) with
+  /// g(n) = exp(n) up to n = outer_cap and its C2 quadratic continuation beyond,
+  /// exp(cap) (1 + d + d^2 / 2), d = n - cap (convex and increasing: G is convex, Fung's
+  /// exponential form with a convex network in place of his quadratic). Not part of theta.
+  int outer = 0;
+  double outer_scale = 1.0;  ///< MPa (c of G = c g(N)); N dimensionless then
+  double outer_cap = 30.0;   ///< n beyond which g continues quadratically (no overflow)
   bool stiffening1(int i) const { return i >= h1 - stiff1; }
   bool stiffening2(int j) const { return j >= h2 - stiff2; }
   int a0() const { return 0; }                 ///< h1 x 3, row-major (a0_i)
@@ -126,6 +135,28 @@ struct NetworkResponse {
 /// with_C = false skips C (the fit needs S only).
 NetworkResponse network_evaluate(const NetworkShape& shape, const double* theta,
                                  const Eigen::Vector3d& e, bool with_C = true);
+
+/// g, g', g'' of the exponential outer function at n (see NetworkShape::outer).
+inline void network_outer(double n, double cap, double& g, double& dg, double& ddg) {
+  if (n <= cap) {
+    g = dg = ddg = std::exp(n);
+  } else {
+    const double ec = std::exp(cap), d = n - cap;
+    g = ec * (1.0 + d + 0.5 * d * d);
+    dg = ec * (1.0 + d);
+    ddg = ec;
+  }
+}
+
+/// The raw network composed with the shape's outer function: G(e) = outer_scale g(N(e)),
+/// dG/de = c g' S_N, d2G/de2 = c (g' C_N + g'' S_N S_N^T); N itself when shape.outer == 0.
+NetworkResponse network_compose_outer(const NetworkShape& shape, const NetworkResponse& n,
+                                      bool with_C = true);
+
+/// Reverse mode: grad += scale * dN(e; theta)/d theta (the value's gradient; the exponential
+/// outer function's fit needs it).
+void network_value_gradient(const NetworkShape& shape, const double* theta,
+                            const Eigen::Vector3d& e, double scale, double* grad);
 
 /// Reverse mode: grad += d(g . S_N(e; theta))/d theta (the fit's gradient, by hand; checked
 /// against finite differences in tests/test_material_convex_network.cpp).

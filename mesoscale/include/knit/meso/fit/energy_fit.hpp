@@ -58,6 +58,9 @@ struct EnergyFitOptions {
   /// Network family: how many of each layer's units use the stiffening activation rho
   /// (knit/material/convex_network.hpp; the last ones of the layer). 0: none.
   int stiff1 = 0, stiff2 = 0;
+  /// Network family: the outer function (knit/material/convex_network.hpp, NetworkShape::outer):
+  /// "none" (W from N itself) or "exp" (W from exp(N), Fung's form; session 15).
+  std::string outer = "none";
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
