@@ -16,8 +16,11 @@
 // (prior_points > 0) the sums also run over its states (target t = 0, no tube: m_p = 0), and
 // both n and sum w count them (the tube fits with the prior in docs/database.md were measured
 // so).
-// S_W the stress of the mirror-averaged, normalized law (S(0) = 0). The gradient is exact
-// (network_stress_gradient, reverse mode by hand, checked against finite differences in
+// S_W the stress of the mirror-averaged, normalized law (S(0) = 0). With the exponential outer
+// function (option outer "exp", session 15) the law is built from exp(N) instead of N:
+// S_W = 1/2 (g'(N(x)) S_N(x) + M g'(N(Mx)) S_N(Mx)) - g'(N(0)) S_N0, and the gradient adds
+// g''(N) (g . S_N) dN/dtheta (network_value_gradient) to g'(N) d(g . S_N)/dtheta. The gradient is
+// exact (network_stress_gradient, reverse mode by hand, checked against finite differences in
 // tests/common/test_material_convex_network.cpp); each objective evaluation costs about three
 // network passes per point. The initial phi is drawn from a seeded normal distribution (same for
 // every knot, so the knots start coupled), with positive first-layer biases so that the smoothed
@@ -293,7 +296,11 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   std::vector<double> theta(phi.size());
   objective->to_theta(phi.data(), theta.data());
   if (sh.outer != 0) {
-    double n_max = -1e300;
+    double n_max = -1e300;  // over the fit data and e = 0 (the normalization's point)
+    for (int j = 0; j < n; ++j)
+      n_max = std::max(
+          n_max,
+          material::network_evaluate(sh, theta.data() + j * P, Eigen::Vector3d::Zero(), false).W);
     for (std::size_t p = 0; p < pts.size(); ++p) {
       const double* th = theta.data() + static_cast<int>(pts[p].loop) * P;
       const Eigen::Vector3d xp = pts[p].e / sE, mp(xp(0), xp(1), -xp(2));
