@@ -542,10 +542,13 @@ struct JsonSchema::Impl {
       return;
     }
     // 3. The branch whose first error lies deepest (ties: fewer errors, then the first branch).
+    // An unknown key counts at the key's own depth: an object with a misspelt key, against
+    // "false or an object", is reported as the unknown key, not as "must be false".
+    auto depth_of = [](const Err& e) { return pointer_depth(e.at.empty() ? e.pointer : e.at); };
     std::size_t best = 0;
     for (std::size_t i = 1; i < results.size(); ++i) {
-      const std::size_t di = pointer_depth(results[i].front().pointer);
-      const std::size_t db = pointer_depth(results[best].front().pointer);
+      const std::size_t di = depth_of(results[i].front());
+      const std::size_t db = depth_of(results[best].front());
       if (di > db || (di == db && results[i].size() < results[best].size())) best = i;
     }
     out.insert(out.end(), results[best].begin(), results[best].end());

@@ -194,6 +194,17 @@ TEST_CASE("schema validator: oneOf/anyOf report the relevant branch, if/then/els
   CHECK(first_error(with("/load", {{"force", 2}})).empty());
   CHECK(first_error(with("/load", {{"displacement", {{"u", -1}}}})) ==
         "/load/displacement/u: must be >= 0, got -1");
+  // "false or an object" (the sweep input's energy_fit): a misspelt key of the object is
+  // reported as the unknown key (at its own depth), not as "must be false" (session 15).
+  const knit::io::JsonSchema false_or_object(
+      json::parse(R"({"oneOf": [{"const": false}, {"type": "object", "additionalProperties":
+                     false, "properties": {"tube": {"type": "number"}}}]})"),
+      "t");
+  const auto misspelt = false_or_object.errors(json::parse(R"({"tubee": 1})"));
+  REQUIRE(misspelt.size() == 1);
+  CHECK_THAT(misspelt[0].message, Catch::Contains("unknown key \"tubee\""));
+  CHECK(false_or_object.errors(json(true)).size() == 1);
+  CHECK(false_or_object.errors(json(false)).empty());
   // oneOf matching twice.
   json both =
       knit::io::JsonSchema(json::parse(R"({"oneOf": [{"type": "number"}, {"minimum": 0}]})"), "t")
