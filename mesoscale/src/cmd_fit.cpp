@@ -32,8 +32,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
                      "paper-law fit options (JSON file; defaults otherwise)");
       sub.add_option(
           "--energy-options", o->energy_options,
-          "energy-law fit options (JSON file; defaults otherwise: the input-convex network family, "
-          "docs/database.md; {\"family\": \"ridge\"} for the ridge-spline law)");
+          "energy-law fit options (JSON file; defaults otherwise: the input-convex network family "
+          "without a tube or outer function, docs/database.md; the default sweep's law is the "
+          "energy_fit object of cases/sweep/default.json, {\"outer\": \"exp\", \"tube\": "
+          "0.045, ...}; {\"family\": \"ridge\"} for the ridge-spline law)");
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       return [o]() -> int {
         using namespace knit::meso::fit;
