@@ -195,8 +195,8 @@ std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
   for (int k = 0; k < sh.h2; ++k) at(sh.w() + k) = 0.55 + 0.1 * n01(rng);
   for (int k = 0; k < 9; ++k) at(sh.L() + k) = (k % 4 == 0) ? 0.3 : 0.0;
   // With the exponential outer function the output weights start 16 times smaller (phi / 4),
-  // so that N starts of order 1 on the data and exp(N) does not overflow (N of the draw above
-  // reaches 10-20, and L-BFGS then stops at its first steps).
+  // so that exp(N) starts near the data's scale: from the draw above, with seed 2, L-BFGS
+  // stopped after 3 iterations on the default database (docs/database.md).
   if (sh.outer != 0) {
     for (int k = 0; k < sh.h1; ++k) at(sh.w1() + k) *= 0.25;
     for (int k = 0; k < sh.h2; ++k) at(sh.w() + k) *= 0.25;
