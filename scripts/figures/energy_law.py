@@ -118,7 +118,7 @@ class NetworkLaw:
         outer = g.attrs.get("outer", "none")
         outer = outer.decode() if isinstance(outer, bytes) else str(outer)
         if outer not in ("none", "exp"):
-            raise ValueError(f"/energy_law: attribute outer is {outer!r}; "
+            raise ValueError(f"{g.file.filename}: {g.name}: attribute outer is {outer!r}; "
                              "this script reads 'none' and 'exp'")
         self.outer = outer == "exp"
         if self.outer:
