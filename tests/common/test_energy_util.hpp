@@ -3,11 +3,29 @@
 #pragma once
 
 #include <random>
+#include <utility>
 
 #include "knit/material/energy_law.hpp"
 #include "knit/spline/knot_vector.hpp"
 
 namespace knit::material::testing {
+
+/// S = dW/de and C = dS/de of a response `eval(e)` (any type with W, S, C) against central
+/// differences of W and S at e with step h: {|S_fd - S| / (1 + |S|), |C_fd - C| / (1 + |C|)}.
+template <class Eval>
+std::pair<double, double> fd_errors(const Eval& eval, const Eigen::Vector3d& e, double h) {
+  const auto r = eval(e);
+  Eigen::Matrix3d Cfd;
+  Eigen::Vector3d Sfd;
+  for (int j = 0; j < 3; ++j) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    d(j) = h;
+    const auto p = eval(e + d), m = eval(e - d);
+    Sfd(j) = (p.W - m.W) / (2 * h);
+    Cfd.col(j) = (p.S - m.S) / (2 * h);
+  }
+  return {(Sfd - r.S).norm() / (1.0 + r.S.norm()), (Cfd - r.C).norm() / (1.0 + r.C.norm())};
+}
 
 inline EnergyLawData make_test_energy_law(unsigned seed = 7, double floor = 0.02) {
   EnergyLawData d;

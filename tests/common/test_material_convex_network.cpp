@@ -114,18 +114,10 @@ TEST_CASE("convex network: S and C of the raw network equal finite differences",
     min_eig =
         std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0));
     CHECK(network_evaluate(sh, th.data(), e, false).S == r.S);
-    Eigen::Matrix3d Cfd;
-    Eigen::Vector3d Sfd;
-    for (int j = 0; j < 3; ++j) {
-      Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      d(j) = h;
-      const NetworkResponse p = network_evaluate(sh, th.data(), e + d),
-                            m = network_evaluate(sh, th.data(), e - d);
-      Sfd(j) = (p.W - m.W) / (2 * h);
-      Cfd.col(j) = (p.S - m.S) / (2 * h);
-    }
-    worst_S = std::max(worst_S, (Sfd - r.S).norm() / (1 + r.S.norm()));
-    worst_C = std::max(worst_C, (Cfd - r.C).norm() / (1 + r.C.norm()));
+    const auto [fd_S, fd_C] = testing::fd_errors(
+        [&](const Eigen::Vector3d& x) { return network_evaluate(sh, th.data(), x); }, e, h);
+    worst_S = std::max(worst_S, fd_S);
+    worst_C = std::max(worst_C, fd_C);
   }
   INFO("FD(S) " << worst_S << ", FD(C) " << worst_C << ", min eig " << min_eig);
   CHECK(worst_S < 1e-7);
@@ -276,18 +268,10 @@ TEST_CASE("convex network: the exponential outer function keeps S = dW, C = dS, 
     min_eig =
         std::min(min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0) /
                               (1 + r.C.norm()));
-    const double h = 1e-6;
-    Eigen::Matrix3d Cfd;
-    Eigen::Vector3d Sfd;
-    for (int j = 0; j < 3; ++j) {
-      Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      d(j) = h;
-      const NetworkResponse p = law.evaluate(e + d), m = law.evaluate(e - d);
-      Sfd(j) = (p.W - m.W) / (2 * h);
-      Cfd.col(j) = (p.S - m.S) / (2 * h);
-    }
-    worst_S = std::max(worst_S, (Sfd - r.S).norm() / (1 + r.S.norm()));
-    worst_C = std::max(worst_C, (Cfd - r.C).norm() / (1 + r.C.norm()));
+    const auto [fd_S, fd_C] =
+        testing::fd_errors([&](const Eigen::Vector3d& x) { return law.evaluate(x); }, e, 1e-6);
+    worst_S = std::max(worst_S, fd_S);
+    worst_C = std::max(worst_C, fd_C);
   }
   INFO("beyond the cap " << beyond << " of " << es.size() << "; FD(S) " << worst_S << ", FD(C) "
                          << worst_C << ", min eig / (1 + |C|) " << min_eig);

@@ -212,16 +212,26 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   CHECK(ea.C == eb.C);
 }
 
-TEST_CASE("database v3: a network law written before the stiffening units still loads", "[unit]") {
-  const auto file = tmp("network_no_stiff.h5");
+namespace {
+/// A database with the test network law written to tmp(name), then `edit` applied to the file
+/// (an older or a damaged writer). Returns the database as written.
+template <class Edit>
+Database write_network_db_then(const std::string& file, Edit edit) {
   Database db = db_with_law();
   db.energy_law = testing::make_test_network_law();
   write_database(file, db);
-  {
-    auto f = knit::io::H5File::open_rw(file);
+  auto f = knit::io::H5File::open_rw(file);
+  edit(f);
+  return db;
+}
+}  // namespace
+
+TEST_CASE("database v3: a network law written before the stiffening units still loads", "[unit]") {
+  const auto file = tmp("network_no_stiff.h5");
+  const Database db = write_network_db_then(file, [](knit::io::H5File& f) {
     f.remove_attribute("/energy_law", "stiff1");
     f.remove_attribute("/energy_law", "stiff2");
-  }
+  });
   const Database back = read_database(file, false);
   REQUIRE(back.energy_law);
   CHECK(back.energy_law->network.shape.stiff1 == 0);
@@ -232,14 +242,10 @@ TEST_CASE("database v3: a network law written before the stiffening units still 
 
 TEST_CASE("database v3: an unknown outer function is refused with its HDF5 path", "[unit]") {
   const auto file = tmp("network_bad_outer.h5");
-  Database db = db_with_law();
-  db.energy_law = testing::make_test_network_law();
-  write_database(file, db);
-  {
-    auto f = knit::io::H5File::open_rw(file);
+  write_network_db_then(file, [](knit::io::H5File& f) {
     f.remove_attribute("/energy_law", "outer");
     f.set_attribute("/energy_law", "outer", "log");
-  }
+  });
   CHECK_THROWS_WITH(read_database(file, false),
                     Catch::Contains("/energy_law") && Catch::Contains("outer is \"log\""));
 }

@@ -118,17 +118,10 @@ TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[uni
           const double lmin = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues()(0);
           min_eig = std::min(min_eig, lmin);
           // C = central FD of S; S = central FD of W.
-          Eigen::Matrix3d Cfd;
-          Eigen::Vector3d Sfd;
-          for (int j = 0; j < 3; ++j) {
-            Eigen::Vector3d d = Eigen::Vector3d::Zero();
-            d(j) = h;
-            const EnergyResponse p = at.evaluate(e + d), m = at.evaluate(e - d);
-            Cfd.col(j) = (p.S - m.S) / (2 * h);
-            Sfd(j) = (p.W - m.W) / (2 * h);
-          }
-          worst_fd_C = std::max(worst_fd_C, (Cfd - r.C).norm() / (1.0 + r.C.norm()));
-          worst_fd_S = std::max(worst_fd_S, (Sfd - r.S).norm() / (1.0 + r.S.norm()));
+          const auto [fd_S, fd_C] =
+              testing::fd_errors([&](const Eigen::Vector3d& x) { return at.evaluate(x); }, e, h);
+          worst_fd_C = std::max(worst_fd_C, fd_C);
+          worst_fd_S = std::max(worst_fd_S, fd_S);
           // Continuity: |S(e1) - S(e)| <= L |e1 - e| with L = 1.5 max |C|_2 over the ends and
           // the midpoint of the 1-degree step (mean-value theorem, 50 % margin for the
           // variation of C between the three samples). A jump of S breaks it.
