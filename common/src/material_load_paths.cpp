@@ -136,12 +136,48 @@ Eigen::Vector3d fill_point(int i) {
   return u;
 }
 
+Eigen::Vector3d half_sphere_direction(int k, int n) {
+  if (n < 1 || k < 0 || k >= n)
+    throw std::invalid_argument("half_sphere_direction: need 0 <= k < n");
+  constexpr double kPi = 3.14159265358979323846;
+  constexpr double kPhi = 1.61803398874989484820;
+  const double z = (k + 0.5) / n;
+  const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double az = 2.0 * kPi * static_cast<double>(k) / (kPhi * kPhi);
+  return {rho * std::cos(az), rho * std::sin(az), z};
+}
+
+Eigen::Vector3d box_ray_end(const StrainBox& b, const Eigen::Vector3d& d, double min_J) {
+  // Box-normalized strain u: E_i = u_i * (the box's extent on u_i's side of 0).
+  const auto to_strain = [&](const Eigen::Vector3d& u) {
+    return Eigen::Vector3d(u(0) * (u(0) >= 0 ? b.E11_max : -b.E11_min),
+                           u(1) * (u(1) >= 0 ? b.E22_max : -b.E22_min), u(2) * b.E12_max);
+  };
+  const double m = d.cwiseAbs().maxCoeff();
+  if (!(m > 0.0)) throw std::invalid_argument("box_ray_end: zero direction");
+  const auto J2 = [](const Eigen::Vector3d& E) {
+    return (1.0 + 2.0 * E(0)) * (1.0 + 2.0 * E(1)) - 4.0 * E(2) * E(2);
+  };
+  const double target = min_J * min_J;
+  const Eigen::Vector3d end = to_strain(d / m);  // on the cube's surface
+  if (J2(end) >= target) return end;
+  // J^2 = 1 > target at s = 0: bisect s in [0, 1] for the first crossing J^2 = target (J^2 is
+  // quadratic in s on each side's linear map, so bisection from the start finds it).
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 80; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (J2(to_strain(mid * d / m)) >= target ? lo : hi) = mid;
+  }
+  return to_strain(lo * d / m);
+}
+
 std::vector<LoadPath> coverage_load_paths(const CoverageOptions& o) {
   if (o.directions < 0 || o.biaxial_steps < 1 || o.uniaxial_steps < 1 || o.gradient_steps < 1 ||
-      o.fill_count < 0 || o.fill_steps < 1 || !(o.fill_min_J >= 0.0 && o.fill_min_J < 1.0))
+      o.fill_count < 0 || o.fill_steps < 1 || o.rays < 0 || o.ray_steps < 1 ||
+      !(o.fill_min_J >= 0.0 && o.fill_min_J < 1.0))
     throw std::invalid_argument(
-        "coverage paths: directions >= 0, fill_count >= 0, steps >= 1 and 0 <= fill_min_J < 1 "
-        "required");
+        "coverage paths: directions, fill_count and rays >= 0, steps >= 1 and 0 <= fill_min_J "
+        "< 1 required");
   const StrainBox& b = o.box;
   if (!(b.E11_min < 0 && b.E11_max > 0 && b.E22_min < 0 && b.E22_max > 0 && b.E12_max > 0))
     throw std::invalid_argument("coverage paths: the box must contain E = 0 in its interior");
@@ -180,9 +216,27 @@ std::vector<LoadPath> coverage_load_paths(const CoverageOptions& o) {
     p.set = "coverage";
     paths.push_back(p);
   }
+  if (o.gradient_swapped)
+    for (const Eigen::Vector2d& e : o.stretch) {
+      LoadPath p;
+      p.kind = PathKind::kGradient;
+      p.H << e(1), 0.0, std::sin(o.gamma), e(0);
+      p.steps = o.gradient_steps;
+      p.set = "coverage";
+      paths.push_back(p);
+    }
   const auto fill =
       paths_to_points(b, o.fill_count, o.fill_steps, "coverage", o.fill_min_J, fill_point);
   paths.insert(paths.end(), fill.begin(), fill.end());
+  for (int k = 0; k < o.rays; ++k) {
+    const Eigen::Vector3d E = box_ray_end(b, half_sphere_direction(k, o.rays), o.fill_min_J);
+    LoadPath p;
+    p.kind = PathKind::kGradient;
+    p.H = upper_gradient_for(E(0), E(1), E(2)) - Eigen::Matrix2d::Identity();
+    p.steps = o.ray_steps;
+    p.set = "coverage";
+    paths.push_back(p);
+  }
   return paths;
 }
 

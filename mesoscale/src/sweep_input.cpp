@@ -66,6 +66,9 @@ material::CoverageOptions read_coverage(const nlohmann::json& c, const material:
   o.fill_count = c.value("fill_count", o.fill_count);
   o.fill_steps = c.value("fill_steps", o.fill_steps);
   o.fill_min_J = c.value("fill_min_J", o.fill_min_J);
+  o.rays = c.value("rays", o.rays);
+  o.ray_steps = c.value("ray_steps", o.ray_steps);
+  o.gradient_swapped = c.value("gradient_swapped", o.gradient_swapped);
   if (c.contains("gamma_deg")) o.gamma = c.at("gamma_deg").get<double>() * kPi / 180.0;
   if (c.contains("stretch")) {
     o.stretch.clear();

@@ -130,6 +130,95 @@ TEST_CASE("load paths: quasi-random fill paths cover the box apart from the held
   CHECK_THROWS_AS(coverage_load_paths(o), std::invalid_argument);
 }
 
+TEST_CASE("load paths: rays of the strain box end on its surface or at the area floor", "[unit]") {
+  // The Fibonacci half-sphere: unit vectors, heights (k + 1/2) / n, mean height 1/2 (the
+  // centroid of a uniform lattice on the half-sphere), no two directions alike.
+  const int n = 24;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d d = half_sphere_direction(k, n);
+    CHECK(d.norm() == Approx(1.0).epsilon(1e-14));
+    CHECK(d(2) == Approx((k + 0.5) / n).epsilon(1e-14));
+    mean += d / n;
+    for (int j = 0; j < k; ++j) CHECK((d - half_sphere_direction(j, n)).norm() > 0.2);
+  }
+  CHECK(mean(2) == Approx(0.5).epsilon(1e-14));
+  CHECK(std::abs(mean(0)) < 0.05);
+  CHECK(std::abs(mean(1)) < 0.05);
+  CHECK_THROWS_AS(half_sphere_direction(n, n), std::invalid_argument);
+
+  CoverageOptions o;
+  o.rays = n;
+  const auto cov = coverage_load_paths(o);
+  REQUIRE(cov.size() == 2 + 16 + 7 + static_cast<std::size_t>(n));
+  const StrainBox& b = o.box;
+  int on_surface = 0, at_floor = 0;
+  for (int k = 0; k < n; ++k) {
+    const LoadPath& p = cov[2 + 16 + 7 + k];
+    CHECK(p.set == "coverage");
+    CHECK(p.kind == PathKind::kGradient);
+    CHECK(p.steps == 8);
+    const Eigen::Matrix2d F = deformation_gradient(p, 1.0);
+    const Eigen::Matrix2d E = green_lagrange(F);
+    // Inside the box up to round-off (ends on its faces are computed, not copied).
+    StrainBox wide = b;
+    wide.E11_min -= 1e-12, wide.E11_max += 1e-12, wide.E22_min -= 1e-12, wide.E22_max += 1e-12;
+    wide.E12_max += 1e-12;
+    CHECK(wide.contains(E(0, 0), E(1, 1), E(0, 1)));
+    CHECK(E(0, 1) > 0.0);
+    const double J = F.determinant();
+    CHECK(J >= o.fill_min_J * (1.0 - 1e-12));
+    // The end lies on the ray: E is a positive multiple of the box-normalized direction.
+    const Eigen::Vector3d d = half_sphere_direction(k, n);
+    const Eigen::Vector3d u(E(0, 0) / (d(0) >= 0 ? b.E11_max : -b.E11_min),
+                            E(1, 1) / (d(1) >= 0 ? b.E22_max : -b.E22_min), E(0, 1) / b.E12_max);
+    CHECK((u / u.norm() - d).norm() < 1e-12);
+    // Either on the box's surface (the cube [-1, 1]^3 in u) or shortened to J = fill_min_J.
+    const bool surface = std::abs(u.cwiseAbs().maxCoeff() - 1.0) < 1e-12;
+    const bool floor = std::abs(J - o.fill_min_J) < 1e-9;
+    CHECK(surface != floor);
+    on_surface += surface;
+    at_floor += floor;
+  }
+  // The box holds both: most rays reach its faces, the compressed and sheared ones lock first.
+  CHECK(on_surface >= n / 2);
+  CHECK(at_floor >= 3);
+  o.ray_steps = 0;
+  CHECK_THROWS_AS(coverage_load_paths(o), std::invalid_argument);
+}
+
+TEST_CASE("load paths: the swapped shear-with-stretch paths are the course/wale mirror images",
+          "[unit]") {
+  CoverageOptions o;
+  const auto plain = coverage_load_paths(o);
+  o.gradient_swapped = true;
+  const auto both = coverage_load_paths(o);
+  const std::size_t first = 2 + 16, n = o.stretch.size();
+  REQUIRE(both.size() == plain.size() + n);
+  bool wale_compressed_sheared = false, before = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const LoadPath& p = both[first + k];
+    const LoadPath& q = both[first + n + k];
+    CHECK(q.kind == PathKind::kGradient);
+    CHECK(q.set == "coverage");
+    CHECK(q.steps == p.steps);
+    for (double t : {0.5, 1.0}) {
+      const Eigen::Matrix2d E = green_lagrange(deformation_gradient(p, t));
+      const Eigen::Matrix2d Eq = green_lagrange(deformation_gradient(q, t));
+      // E' = P E P with P the axis swap: E11 and E22 exchanged, E12 kept.
+      CHECK(Eq(0, 0) == Approx(E(1, 1)).margin(1e-14));
+      CHECK(Eq(1, 1) == Approx(E(0, 0)).margin(1e-14));
+      CHECK(Eq(0, 1) == Approx(E(0, 1)).margin(1e-14));
+      before = before || (E(1, 1) < -0.05 && E(0, 1) > 0.25);
+      wale_compressed_sheared = wale_compressed_sheared || (Eq(1, 1) < -0.05 && Eq(0, 1) > 0.25);
+    }
+  }
+  // The upper-triangular shear adds F12^2 / 2 to E22: only the mirror images reach shear with
+  // the wale compressed.
+  CHECK_FALSE(before);
+  CHECK(wale_compressed_sheared);
+}
+
 namespace {
 fs::path tmp(const std::string& name) {
   const fs::path d = fs::path(KNIT_BINARY_DIR) / "test_tmp";

@@ -67,6 +67,15 @@ struct StrainBox {
 ///     J = det F is below `fill_min_J` (0.5) are skipped: there the cell locks up (one fill
 ///     state at J = 0.19 reached S = 114 MPa, 5x the stress range of every other state, just
 ///     before its path diverged); the held-out states all have J >= 0.56.
+///   * `rays` gradient paths of `ray_steps` steps along rays of the whole 3-D box (issue 11,
+///     docs/database.md "Rays of the strain box"): the ray directions are the `rays` points
+///     of a Fibonacci lattice on the half-sphere E12 > 0 in box-normalized strain (each axis
+///     scaled by the box's extent on that side of 0, so the box is the cube [-1, 1]^3), each
+///     ray from E = 0 out to the box's surface; a ray whose end has J = det F < `fill_min_J`
+///     is shortened to J = fill_min_J. The full circle of biaxial directions above is the
+///     E12 = 0 section of this sphere; the rays add every mix of stretch, compression and
+///     shear out to the box's faces, edges and corners (the fill paths sample the interior).
+///     The law is even in E12, so one half-sphere suffices.
 struct CoverageOptions {
   StrainBox box;
   int directions = 16;  ///< biaxial directions on the full circle (22.5 deg)
@@ -77,6 +86,11 @@ struct CoverageOptions {
                                           {-0.12, 0.3}, {0.15, 0.2}, {-0.1, -0.1}};
   int fill_count = 0, fill_steps = 6;  ///< quasi-random fill paths (0 = none)
   double fill_min_J = 0.5;             ///< skip fill states with det F below this
+  int rays = 0, ray_steps = 8;         ///< rays of the 3-D box (0 = none)
+  /// Also the course/wale mirror image of every shear-with-stretch path: H' = P H P with P the
+  /// axis swap, [[e2, 0], [sin g, e1]] (lower triangular, so the shear's F12^2 / 2 goes to E11
+  /// instead of E22, and shear with E22 compressed is reached).
+  bool gradient_swapped = false;
 };
 std::vector<LoadPath> coverage_load_paths(const CoverageOptions& opt);
 
@@ -90,6 +104,17 @@ std::vector<LoadPath> holdout_load_paths(const StrainBox& box, int count, int st
 /// The end deformation gradient of an upper-triangular F with E(F) = E (see above); throws
 /// std::invalid_argument where none exists.
 Eigen::Matrix2d upper_gradient_for(double E11, double E22, double E12);
+
+/// Direction k (0 <= k < n) of a Fibonacci lattice on the half-sphere d(2) > 0 (unit vector):
+/// d(2) = (k + 1/2) / n, azimuth 2 pi k / phi^2 with phi the golden ratio (the points spread
+/// evenly in area; Gonzalez 2010, "Measurement of areas on a sphere using Fibonacci and
+/// latitude-longitude lattices").
+Eigen::Vector3d half_sphere_direction(int k, int n);
+
+/// The end strain (E11, E22, E12) of the ray from 0 along `d` in box-normalized strain
+/// (see CoverageOptions::rays) out to the surface of `box`, shortened along the ray to
+/// J = det F = min_J where the surface lies beyond it (J^2 = (1 + 2 E11)(1 + 2 E22) - 4 E12^2).
+Eigen::Vector3d box_ray_end(const StrainBox& box, const Eigen::Vector3d& d, double min_J);
 
 /// Point i (i >= 1) of the Halton sequence in base b (radical inverse), in [0, 1).
 double halton(int i, int base);
