@@ -34,8 +34,8 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
         "W(e; l) = 1/2 (N(e) + N(M e)) - N(0) - S_N0 . e + floor/2 |e|^2, M = diag(1, "
         "1, -1); N(e) = sum_j w_j sigma(z_j) + sum_i w1_i sigma(y_i) + 1/2 e^T L L^T "
         "e, y = A0 e + b0, z = V sigma(y) + A1 e + b1 (rho = max(0, x)^3 / 6 instead of "
-        "sigma on the last stiff1 and stiff2 units); V, w, w1 >= 0; theta(l) "
-        "piecewise linear between l_knots (knit/material/convex_network.hpp)");
+        "sigma on the last stiff1 and stiff2 units); V, w, w1 >= 0; between l_knots "
+        "as attribute l_interpolation says (knit/material/convex_network.hpp)");
     g.set_attribute(".", "h1", sh.h1);
     g.set_attribute(".", "h2", sh.h2);
     g.set_attribute(".", "stiff1", sh.stiff1);
@@ -50,8 +50,15 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
                       "exp(outer_cap) (1 + d + d^2 / 2) beyond, d = n - outer_cap; outer_scale "
                       "MPa, N dimensionless");
     }
+    // Between the knots (session 16): "parameters" (theta piecewise linear, one network) or
+    // "energy" (W piecewise linear: the convex combination of the two knots' laws).
+    const bool energy = law.network.l_interpolation == LInterpolation::kEnergy;
+    g.set_attribute(".", "l_interpolation", energy ? "energy" : "parameters");
     g.write("l_knots", law.network.l_knots);
-    g.set_attribute("l_knots", "units", "mm (theta piecewise linear in l between these)");
+    g.set_attribute("l_knots", "units",
+                    energy ? "mm (W piecewise linear in l between these: W = (1 - t) W_j + t "
+                             "W_j+1, each W_j the network at theta row j)"
+                           : "mm (theta piecewise linear in l between these)");
     g.write("theta", RowMatrixX(law.network.theta));
     g.set_attribute(
         "theta", "layout",
@@ -167,6 +174,16 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
           law.network.shape.outer_scale = root.attribute_double(g, "outer_scale");
           law.network.shape.outer_cap = root.attribute_double(g, "outer_cap");
         }
+      }
+      // Optional (written since session 16): the interpolation in l; parameters before.
+      if (root.has_attribute(g, "l_interpolation")) {
+        const std::string li = root.attribute_string(g, "l_interpolation");
+        if (li != "parameters" && li != "energy")
+          throw InputError(file, g,
+                           "attribute l_interpolation is \"" + li +
+                               "\"; this build reads \"parameters\" and \"energy\"");
+        law.network.l_interpolation =
+            li == "energy" ? LInterpolation::kEnergy : LInterpolation::kParameters;
       }
       law.network.l_knots = root.read_doubles(g + "/l_knots");
       law.network.theta = root.read_matrix(g + "/theta");

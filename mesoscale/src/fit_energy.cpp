@@ -209,6 +209,8 @@ std::string EnergyFitOptions::validate() const {
   if (stiff1 < 0 || stiff1 > hidden1 || stiff2 < 0 || stiff2 > hidden2)
     return "stiff1 and stiff2 must be in 0..hidden1 and 0..hidden2";
   if (outer != "none" && outer != "exp") return "outer must be \"none\" or \"exp\"";
+  if (l_interpolation != "parameters" && l_interpolation != "energy")
+    return "l_interpolation must be \"parameters\" or \"energy\"";
   if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
   if (seed < 0) return "seed must be >= 0";
   if (network_iterations < 1 || network_iterations > 1000000)
@@ -247,6 +249,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"stiff1", stiff1},
                       {"stiff2", stiff2},
                       {"outer", outer},
+                      {"l_interpolation", l_interpolation},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
                       {"network_iterations", network_iterations},
@@ -297,6 +300,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "stiff1",
                                 "stiff2",
                                 "outer",
+                                "l_interpolation",
                                 "l_coupling",
                                 "seed",
                                 "network_iterations",
@@ -350,6 +354,11 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
     if (!j["outer"].is_string())
       throw InputError(file, pointer + "/outer", "must be \"none\" or \"exp\"");
     o.outer = j["outer"].get<std::string>();
+  }
+  if (j.contains("l_interpolation")) {
+    if (!j["l_interpolation"].is_string())
+      throw InputError(file, pointer + "/l_interpolation", "must be \"parameters\" or \"energy\"");
+    o.l_interpolation = j["l_interpolation"].get<std::string>();
   }
   if (j.contains("loss")) {
     const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";

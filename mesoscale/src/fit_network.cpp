@@ -312,6 +312,9 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   }
   law.network.shape = sh;
   law.network.l_knots = loop_lengths;
+  law.network.l_interpolation = o.l_interpolation == "energy"
+                                    ? material::LInterpolation::kEnergy
+                                    : material::LInterpolation::kParameters;
   law.network.theta.resize(n, P);
   const double wscale = sh.outer != 0 ? 1.0 : sS * sE;
   const double lscale = sh.outer != 0 ? 1.0 / sE : std::sqrt(sS / sE);

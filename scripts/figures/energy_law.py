@@ -96,12 +96,16 @@ def _layer(x, stiff):
 class NetworkLaw:
     """The network family of /energy_law (attribute family = "network"), re-evaluated."""
 
-    def __init__(self, g, l):
+    def __init__(self, g, l, row=None):
+        """The network at theta(l) (piecewise linear in l), or at theta row `row`."""
         h1, h2 = int(g.attrs["h1"]), int(g.attrs["h2"])
         self.stiff1 = int(g.attrs.get("stiff1", 0))
         self.stiff2 = int(g.attrs.get("stiff2", 0))
         knots, theta = np.array(g["l_knots"]), np.array(g["theta"])
-        t = np.array([np.interp(l, knots, theta[:, k]) for k in range(theta.shape[1])])
+        if row is not None:
+            t = theta[row].copy()
+        else:
+            t = np.array([np.interp(l, knots, theta[:, k]) for k in range(theta.shape[1])])
         o = 0
         self.A0 = t[o:o + 3 * h1].reshape(h1, 3); o += 3 * h1
         self.b0 = t[o:o + h1]; o += h1
@@ -150,11 +154,43 @@ class NetworkLaw:
         return W, S
 
 
+class BlendedLaw:
+    """W(e; l) = (1 - t) W_j(e) + t W_j+1(e) between two knots' laws (attribute
+    l_interpolation = "energy", session 16; knit/material/convex_network.hpp LInterpolation)."""
+
+    def __init__(self, a, b, t):
+        self.a, self.b, self.t = a, b, t
+        self.floor = a.floor
+
+    def eval(self, e):
+        Wa, Sa = self.a.eval(e)
+        Wb, Sb = self.b.eval(e)
+        return (1.0 - self.t) * Wa + self.t * Wb, (1.0 - self.t) * Sa + self.t * Sb
+
+
 def load_law(g, l):
     """The stored law of /energy_law at loop length l, either family."""
     fam = g.attrs.get("family", "ridge")
     fam = fam.decode() if isinstance(fam, bytes) else str(fam)
-    return NetworkLaw(g, l) if fam == "network" else Law(g, l)
+    if fam != "network":
+        return Law(g, l)
+    li = g.attrs.get("l_interpolation", "parameters")
+    li = li.decode() if isinstance(li, bytes) else str(li)
+    if li not in ("parameters", "energy"):
+        raise ValueError(f"{g.file.filename}: {g.name}: attribute l_interpolation is {li!r}; "
+                         "this script reads 'parameters' and 'energy'")
+    if li == "parameters":
+        return NetworkLaw(g, l)
+    knots = np.array(g["l_knots"])
+    if len(knots) == 1 or l <= knots[0]:
+        return NetworkLaw(g, l, row=0)
+    if l >= knots[-1]:
+        return NetworkLaw(g, l, row=len(knots) - 1)
+    j = int(np.searchsorted(knots, l, side="right")) - 1
+    t = (l - knots[j]) / (knots[j + 1] - knots[j])
+    if t == 0.0:
+        return NetworkLaw(g, l, row=j)
+    return BlendedLaw(NetworkLaw(g, l, row=j), NetworkLaw(g, l, row=j + 1), t)
 
 
 def main():

@@ -112,27 +112,39 @@ TEST_CASE("bench: energy-law evaluations per second", "[.bench]") {
   // the ridge law (default directions: 24 ridges, cubic f'', 8 spans) and the network law of
   // the default fit (hidden layers 12 and 6; mirror-averaged: two network passes). With
   // KNIT_BENCH_DATABASE=FILE also the law stored in that material database, at its middle
-  // loop length (a fitted law: its units are curved where the data put them).
-  for (const bool network : {false, true}) {
-    const EnergyLaw law(network ? testing::make_test_network_law(7, 0.02, 12, 6)
-                                : testing::make_test_energy_law());
+  // loop length (a fitted law: its units are curved where the data put them) and between its
+  // two middle knots (with l_interpolation "energy" there: two laws, four network passes).
+  for (const int kind : {0, 1, 2}) {
+    EnergyLawData d = kind == 0 ? testing::make_test_energy_law()
+                                : testing::make_test_network_law(7, 0.02, 12, 6);
+    if (kind == 2) d.network.l_interpolation = LInterpolation::kEnergy;
+    const EnergyLaw law(d);
     double sink = 0.0;
-    const double rate = energy_law_rate(law, 5.3, sink);
+    const double rate = energy_law_rate(law, 5.3, sink);  // between the knots 4.5 and 5.5
     std::printf(
         "energy-law evaluation (%s): %.3g per second per core (W, S, C; target >= 2e6) [sink %g]\n",
-        network ? "network 12/6" : "ridge", rate, sink);
+        kind == 0   ? "ridge"
+        : kind == 1 ? "network 12/6, theta interpolated in l"
+                    : "network 12/6, W interpolated in l, between knots",
+        rate, sink);
     CHECK(rate > 0);
   }
   if (const char* file = std::getenv("KNIT_BENCH_DATABASE")) {
     const Database db = read_database(file, false);
     const EnergyLaw law(require_energy_law(db, file));
-    const double l = 0.5 * (db.entries.front().loop_length + db.entries.back().loop_length);
-    double sink = 0.0;
-    const double rate = energy_law_rate(law, l, sink);
-    std::printf(
-        "energy-law evaluation (%s, l = %g mm): %.3g per second per core (W, S, C; target >= "
-        "2e6) [sink %g]\n",
-        file, l, rate, sink);
-    CHECK(rate > 0);
+    const std::size_t n = db.entries.size(), m = n / 2;
+    const double l_mid = 0.5 * (db.entries.front().loop_length + db.entries.back().loop_length);
+    const double l_between =
+        n > 1 ? 0.5 * (db.entries[m == 0 ? 0 : m - 1].loop_length + db.entries[m].loop_length)
+              : l_mid;
+    for (const double l : {l_mid, l_between}) {
+      double sink = 0.0;
+      const double rate = energy_law_rate(law, l, sink);
+      std::printf(
+          "energy-law evaluation (%s, l = %g mm): %.3g per second per core (W, S, C; target >= "
+          "2e6) [sink %g]\n",
+          file, l, rate, sink);
+      CHECK(rate > 0);
+    }
   }
 }

@@ -184,11 +184,14 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   db.energy_law->network.shape.outer = 1;  // and the exponential outer function (session 15)
   db.energy_law->network.shape.outer_scale = 0.3;
   db.energy_law->network.shape.outer_cap = 1.7;
+  // and the interpolation in l (session 16)
+  db.energy_law->network.l_interpolation = LInterpolation::kEnergy;
   write_database(file, db);
   {
     const auto f = knit::io::H5File::open_read(file);
     CHECK(f.attribute_string("/energy_law", "family") == "network");
     CHECK(f.attribute_string("/energy_law", "outer") == "exp");
+    CHECK(f.attribute_string("/energy_law", "l_interpolation") == "energy");
     CHECK_FALSE(f.exists("/energy_law/coefficients"));  // no ridge datasets beside it
   }
   const Database back = read_database(file, false);
@@ -202,6 +205,7 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   CHECK(b.network.shape.outer == 1);
   CHECK(b.network.shape.outer_scale == 0.3);
   CHECK(b.network.shape.outer_cap == 1.7);
+  CHECK(b.network.l_interpolation == LInterpolation::kEnergy);
   CHECK(b.network.l_knots == a.network.l_knots);
   CHECK(b.network.theta == a.network.theta);
   CHECK(b.floor == a.floor);
@@ -238,6 +242,26 @@ TEST_CASE("database v3: a network law written before the stiffening units still 
   CHECK(back.energy_law->network.shape.stiff2 == 0);
   CHECK(back.energy_law->network.shape.outer == 0);  // nor an outer function (session 15)
   CHECK(back.energy_law->network.theta == db.energy_law->network.theta);
+}
+
+TEST_CASE("database v3: a network law without l_interpolation interpolates theta", "[unit]") {
+  // Written before session 16: theta piecewise linear in l, as it was fitted and checked.
+  const auto file = tmp("network_no_l_interpolation.h5");
+  write_network_db_then(file, [](knit::io::H5File& f) {
+    REQUIRE(f.attribute_string("/energy_law", "l_interpolation") == "parameters");
+    f.remove_attribute("/energy_law", "l_interpolation");
+  });
+  const Database back = read_database(file, false);
+  REQUIRE(back.energy_law);
+  CHECK(back.energy_law->network.l_interpolation == LInterpolation::kParameters);
+  const auto bad = tmp("network_bad_l_interpolation.h5");
+  write_network_db_then(bad, [](knit::io::H5File& f) {
+    f.remove_attribute("/energy_law", "l_interpolation");
+    f.set_attribute("/energy_law", "l_interpolation", "spline");
+  });
+  CHECK_THROWS_WITH(
+      read_database(bad, false),
+      Catch::Contains("/energy_law") && Catch::Contains("l_interpolation is \"spline\""));
 }
 
 TEST_CASE("database v3: an unknown outer function is refused with its HDF5 path", "[unit]") {

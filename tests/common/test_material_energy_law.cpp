@@ -86,11 +86,22 @@ const std::vector<double> kRadii = {0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4,
 
 }  // namespace
 
+namespace {
+/// 0: the ridge family; 1: the network, theta piecewise linear in l; 2: the network, W
+/// piecewise linear in l (LInterpolation::kEnergy).
+EnergyLawData law_of_kind(int kind) {
+  if (kind == 0) return testing::make_test_energy_law();
+  EnergyLawData d = testing::make_test_network_law();
+  if (kind == 2) d.network.l_interpolation = LInterpolation::kEnergy;
+  return d;
+}
+}  // namespace
+
 TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[unit]") {
-  // Both families: the ridge-spline sum and the input-convex network.
-  const bool network = GENERATE(false, true);
-  const EnergyLawData data =
-      network ? testing::make_test_network_law() : testing::make_test_energy_law();
+  // Both families (the network with either interpolation in l).
+  const int kind = GENERATE(0, 1, 2);
+  const bool network = kind > 0;
+  const EnergyLawData data = law_of_kind(kind);
   const EnergyLaw law(data);
   // The test law's ridge coefficients reach about 2 MPa on 24 directions: |C| <~ 50 MPa. FD
   // steps: central differences with h = 1e-6 have truncation h^2 |S'''| and round-off
@@ -140,7 +151,8 @@ TEST_CASE("energy law: polar-grid checks at every loop length and midway", "[uni
         }
     }
     INFO((network ? "network" : "ridge")
-         << " law, l = " << l << ", " << count << " strains: FD(C) " << worst_fd_C << ", FD(S) "
+         << " law (kind " << kind << ")"
+         << ", l = " << l << ", " << count << " strains: FD(C) " << worst_fd_C << ", FD(S) "
          << worst_fd_S << ", Lipschitz ratio " << worst_lipschitz << ", min eig " << min_eig);
     CHECK(worst_fd_C < tol_fd);
     CHECK(worst_fd_S < tol_fd);
@@ -174,10 +186,9 @@ TEST_CASE("energy law: W is even in E12 (orthotropy in the course/wale frame)", 
 }
 
 TEST_CASE("energy law: dS/dl equals the finite difference in l", "[unit]") {
-  // Both families; the l values lie inside the network's knot spans (theta is piecewise
-  // linear in l there).
-  const bool network = GENERATE(false, true);
-  const EnergyLaw law(network ? testing::make_test_network_law() : testing::make_test_energy_law());
+  // Both families (the network with either interpolation); the l values lie inside the
+  // network's knot spans (theta, or W, is piecewise linear in l there).
+  const EnergyLaw law(law_of_kind(GENERATE(0, 1, 2)));
   std::mt19937 gen(5);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   const double h = 1e-6;
@@ -191,6 +202,55 @@ TEST_CASE("energy law: dS/dl equals the finite difference in l", "[unit]") {
     }
   }
   CHECK_THROWS_AS(law.at(5.0).dS_dl(Eigen::Vector3d::Zero()), std::logic_error);
+}
+
+TEST_CASE("energy law: the energy interpolation is each knot's law, and their mean between",
+          "[unit]") {
+  // W(e; l) = (1 - t) W_j(e) + t W_j+1(e) (LInterpolation::kEnergy): at a knot the law of
+  // that knot's theta row; between knots the convex combination (so W, S, C and dS/dl of
+  // that span follow from the two knots' laws); clamped outside; continuous across a knot.
+  EnergyLawData d = testing::make_test_network_law();
+  d.network.l_interpolation = LInterpolation::kEnergy;
+  const EnergyLaw law(d);
+  EnergyLawData p = d;
+  p.network.l_interpolation = LInterpolation::kParameters;
+  const EnergyLaw by_theta(p);
+  const auto knot = [&](int j, const Eigen::Vector3d& e) {
+    NetworkResponse r = NetworkLawAt(d.network.shape, d.network.theta_row(j)).evaluate(e);
+    r.W += 0.5 * d.floor * e.squaredNorm();
+    r.S += d.floor * e;
+    r.C += d.floor * Eigen::Matrix3d::Identity();
+    return r;
+  };
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  double theta_vs_energy = 0.0;
+  for (int k = 0; k < 300; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    const NetworkResponse a = knot(0, e), b = knot(1, e), c = knot(2, e);
+    // At the knots (and clamped beyond them): the knot's own law, to the last bit.
+    for (auto [l, r] : {std::pair{4.5, a}, std::pair{5.5, b}, std::pair{6.5, c}, std::pair{4.0, a},
+                        std::pair{7.0, c}}) {
+      const EnergyResponse x = law.at(l).evaluate(e);
+      REQUIRE(x.W == r.W);
+      REQUIRE(x.S == r.S);
+      REQUIRE(x.C == r.C);
+    }
+    // Between: the convex combination, t = 0.3 in [4.5, 5.5] and t = 0.75 in [5.5, 6.5].
+    const EnergyResponse m = law.at(4.8).evaluate(e), n = law.at(6.25).evaluate(e);
+    const double tm = (4.8 - 4.5) / 1.0, tn = (6.25 - 5.5) / 1.0;
+    REQUIRE(m.W == Approx((1 - tm) * a.W + tm * b.W).epsilon(1e-13));
+    REQUIRE((m.S - ((1 - tm) * a.S + tm * b.S)).norm() <= 1e-13 * (1 + m.S.norm()));
+    REQUIRE((m.C - ((1 - tm) * a.C + tm * b.C)).norm() <= 1e-13 * (1 + m.C.norm()));
+    REQUIRE((n.S - ((1 - tn) * b.S + tn * c.S)).norm() <= 1e-13 * (1 + n.S.norm()));
+    // dS/dl in a span: the difference of the knots' stresses over the span's length.
+    REQUIRE((law.at(4.8, true).dS_dl(e) - (b.S - a.S)).norm() <= 1e-12 * (1 + b.S.norm()));
+    // Continuous across the knot 5.5 (both sides within 1e-9 mm).
+    REQUIRE((law.at(5.5 - 1e-9).evaluate(e).S - b.S).norm() <= 1e-7 * (1 + b.S.norm()));
+    // The interpolation is not the parameters' one: the mode is read, not ignored.
+    theta_vs_energy = std::max(theta_vs_energy, (by_theta.at(4.8).evaluate(e).S - m.S).norm());
+  }
+  CHECK(theta_vs_energy > 1e-3);
 }
 
 TEST_CASE("energy law: validation refuses bad data", "[unit]") {

@@ -306,6 +306,14 @@ TEST_CASE("energy fit: the exponential outer function is fitted, stored and keep
     CHECK(p.rms_relative < 0.035);
     CHECK(p.max_relative < 0.15);
   }
+  // The interpolation in l (session 16): parameters by default. The fit sees the knots only,
+  // so the other interpolation gives the same parameters, to the last bit.
+  CHECK(s.law.network.l_interpolation == knit::material::LInterpolation::kParameters);
+  o.l_interpolation = "energy";
+  const EnergyFitSummary t = fit_energy_law(db, o);
+  REQUIRE(t.ok());
+  CHECK(t.law.network.l_interpolation == knit::material::LInterpolation::kEnergy);
+  CHECK(t.law.network.theta == s.law.network.theta);
 }
 
 TEST_CASE("energy fit: states where the cell gives way are left out of the fit", "[unit]") {
@@ -448,6 +456,12 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("outer must be"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"outer": 1})", "f.json"),
                       Catch::Contains("f.json: /outer"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"l_interpolation": "spline"})", "f.json"),
+                      Catch::Contains("l_interpolation must be"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"l_interpolation": 0})", "f.json"),
+                      Catch::Contains("f.json: /l_interpolation"));
+    CHECK(EnergyFitOptions::from_json(R"({"l_interpolation": "parameters"})", "f.json")
+              .l_interpolation == "parameters");
     // Range before narrowing: 2^32 + 12 was read as 12 (the same check as the eq. 17 fit's).
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 4294967308})", "f.json"),
                       Catch::Contains("/hidden1") && Catch::Contains("32-bit"));

@@ -519,6 +519,23 @@ def near_visited_failures(tmp):
     return out
 
 
+def unknown_value_failures(db, attr, value, label):
+    """Sets /energy_law's attribute `attr` of the file `db` to an unknown `value`: the Python
+    evaluator must refuse it, naming the attribute and /energy_law."""
+    import h5py
+    from energy_law import load_law
+    with h5py.File(db, "a") as f:
+        f["energy_law"].attrs[attr] = value
+    with h5py.File(db, "r") as f:
+        try:
+            load_law(f["energy_law"], 5.3)
+        except ValueError as err:
+            if attr not in str(err) or "/energy_law" not in str(err):
+                return [f"{label}: the refusal does not name the attribute: {err}"]
+            return []
+    return [f"{label}: an unknown {attr} {value!r} was read"]
+
+
 def outer_exp_failures(tmp):
     """scripts/figures/energy_law.py's NetworkLaw with the exponential outer function (session
     15) on a hand-made law whose network is its quadratic part alone, N = 1/2 e^T L L^T e: then
@@ -560,16 +577,54 @@ def outer_exp_failures(tmp):
         out.append(f"outer exp: W {W} instead of Fung's {want}")
     if np.abs(S - Sfd).max() > 1e-7 * (1 + np.abs(S).max()):
         out.append(f"outer exp: S {S.tolist()} is not dW/de {Sfd.tolist()}")
-    with h5py.File(db, "a") as f:
-        f["energy_law"].attrs["outer"] = "log"
-    with h5py.File(db, "r") as f:
-        try:
-            load_law(f["energy_law"], 5.0)
-            out.append("outer exp: an unknown outer function 'log' was read")
-        except ValueError as err:
-            if "outer" not in str(err):
-                out.append(f"outer exp: the refusal does not name the attribute: {err}")
-    return out
+    return out + unknown_value_failures(db, "outer", "log", "outer exp")
+
+
+def l_interpolation_failures(tmp):
+    """scripts/figures/energy_law.py's interpolation in l (attribute l_interpolation, session
+    16) on a hand-made law of two knots whose networks are their quadratic parts alone,
+    N_j = 1/2 e^T L_j L_j^T e: "energy" gives W = (1 - t) N_a + t N_b + floor/2 |e|^2 between
+    them, "parameters" (and a file without the attribute) the quadratic of the interpolated L,
+    at a knot both give that knot's law; an unknown value is refused."""
+    import h5py
+    from energy_law import load_law
+    out = []
+    db = os.path.join(tmp, "l_interpolation.h5")
+    floor = 0.02
+    La = np.array([[1.2, 0.0, 0.0], [0.3, 0.9, 0.0], [0.0, 0.0, 0.8]])
+    Lb = np.array([[0.5, 0.0, 0.0], [-0.4, 1.5, 0.0], [0.2, 0.0, 0.3]])
+    theta = np.zeros((2, 20))
+    theta[0, 11:], theta[1, 11:] = La.ravel(), Lb.ravel()
+    e = np.array([[0.05, -0.02, 0.03], [0.2, 0.1, -0.15], [-0.25, 0.3, 0.2]])
+
+    def quad(L):  # the mirror average 1/2 (N(e) + N(M e)), M = diag(1, 1, -1), plus the floor
+        m = e * np.array([1.0, 1.0, -1.0])
+        Q = L @ L.T
+        return (0.25 * (np.einsum("ki,ij,kj->k", e, Q, e) + np.einsum("ki,ij,kj->k", m, Q, m))
+                + 0.5 * floor * np.sum(e * e, axis=1))
+
+    t = 0.3
+    want = {"energy": (1 - t) * quad(La) + t * quad(Lb),
+            "parameters": quad((1 - t) * La + t * Lb), None: quad((1 - t) * La + t * Lb)}
+    for mode, w in want.items():
+        with h5py.File(db, "w") as f:
+            law = f.create_group("energy_law")
+            law.attrs["family"] = "network"
+            law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, floor
+            if mode is not None:
+                law.attrs["l_interpolation"] = mode
+            law["l_knots"] = [5.0, 6.0]
+            law["theta"] = theta
+        with h5py.File(db, "r") as f:
+            W = load_law(f["energy_law"], 5.0 + t).eval(e)[0]
+            Wk = load_law(f["energy_law"], 6.0).eval(e)[0]
+        if np.abs(W - w).max() > 1e-12:
+            out.append(f"l_interpolation {mode}: W {W} at t = 0.3, want {w}")
+        if np.abs(Wk - quad(Lb)).max() > 1e-12:
+            out.append(f"l_interpolation {mode}: W {Wk} at the knot 6.0, want {quad(Lb)}")
+    if np.abs(want["energy"] - want["parameters"]).max() < 1e-3:
+        out.append("l_interpolation: the two modes agree on this law; the check cannot tell them")
+    return out + unknown_value_failures(db, "l_interpolation", "spline", "l_interpolation")
 
 
 def main():
@@ -661,6 +716,7 @@ def main():
         failures.extend(law_check_failures(tmp))
         failures.extend(near_visited_failures(tmp))
         failures.extend(outer_exp_failures(tmp))
+        failures.extend(l_interpolation_failures(tmp))
         failures.extend(held_out_reference_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])

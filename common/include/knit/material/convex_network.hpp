@@ -189,11 +189,37 @@ class NetworkLawAt {
   Eigen::Vector3d S0_ = Eigen::Vector3d::Zero();
 };
 
+/// How the law goes from one loop-length knot to the next (choice, docs/database.md
+/// "Interpolation in l"; attribute `l_interpolation` of /energy_law).
+enum class LInterpolation {
+  /// theta(l) piecewise linear, one network at theta(l) (sessions 6-15; a database without
+  /// the attribute). Between knots the network is not the mean of its neighbours: measured
+  /// 1-2 % of the stress range worse there than at the knots.
+  kParameters = 0,
+  /// W(e; l) = (1 - t) W_j(e) + t W_j+1(e), t = (l - l_j) / (l_j+1 - l_j): each knot's law
+  /// itself, and between knots their convex combination (convex, eig(C) >= floor, W, S, C
+  /// continuous in l; two network evaluations between knots, one at a knot). Since session 16.
+  kEnergy = 1,
+};
+
+/// The span that holds l: knot j and t in [0, 1) with l = (1 - t) l_j + t l_j+1; at or beyond
+/// the last knot j = n - 1, t = 0; at or before the first j = 0, t = 0 (clamped). `inside`:
+/// l_1 < l < l_n, where d/dl is that of the span [l_j, l_j+1) (as theta_at's derivative).
+struct KnotSpan {
+  Eigen::Index j = 0;
+  double t = 0.0;
+  bool inside = false;
+};
+
 /// The network family over l: knots and one theta per knot.
 struct NetworkLawData {
   NetworkShape shape;
   std::vector<double> l_knots;  ///< strictly increasing, mm (the fitted loop lengths)
   Eigen::MatrixXd theta;        ///< row j: theta at l_knots[j] (shape.size() columns)
+  LInterpolation l_interpolation = LInterpolation::kParameters;
+  KnotSpan span(double l) const;
+  /// Row j of theta.
+  std::vector<double> theta_row(Eigen::Index j) const;
   /// Empty if valid (sizes, finite, V, w, w1 >= 0, knots increasing), else the reason.
   std::string validate() const;
   /// theta(l), piecewise linear in l between knots, clamped outside; derivative = 1: dtheta/dl

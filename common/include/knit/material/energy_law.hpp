@@ -132,6 +132,12 @@ class EnergyLawAt {
   NetworkLawAt net_;
   NetworkLawAt net_lo_, net_hi_;  ///< theta(l) -/+ h dtheta/dl, for dS_dl (network family)
   double net_h_ = 0.0;
+  /// LInterpolation::kEnergy: net_ is knot j's law, net_next_ knot j+1's, W = (1 - t) W_j +
+  /// t W_j+1 with t = blend_ (0: net_ alone); dS/dl = (S_j+1 - S_j) / dl_span_.
+  bool energy_blend_ = false;
+  NetworkLawAt net_next_;
+  double blend_ = 0.0, dl_span_ = 0.0;
+  bool has_next_ = false;
 };
 
 /// The family over l: validated data and the l-basis.

@@ -61,6 +61,12 @@ struct EnergyFitOptions {
   /// Network family: the outer function (knit/material/convex_network.hpp, NetworkShape::outer):
   /// "none" (W from N itself) or "exp" (W from exp(N), Fung's form; session 15).
   std::string outer = "none";
+  /// Network family: the law between the fitted loop lengths (knit/material/convex_network.hpp
+  /// LInterpolation; docs/database.md "Interpolation in l"): "parameters" (theta piecewise
+  /// linear, one network; the default) or "energy" (W piecewise linear in l: closer to the cell
+  /// between the loop lengths, half the evaluation rate there). The fit itself sees the knots
+  /// only, so both give the same law there.
+  std::string l_interpolation = "parameters";
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
