@@ -68,8 +68,8 @@ struct StrainBox {
 ///     state at J = 0.19 reached S = 114 MPa, 5x the stress range of every other state, just
 ///     before its path diverged); the held-out states all have J >= 0.56.
 ///   * `rays` gradient paths of `ray_steps` steps along rays of the whole 3-D box (issue 11,
-///     docs/database.md "Rays of the strain box"): the ray directions are the `rays` points
-///     of a Fibonacci lattice on the half-sphere E12 > 0 in box-normalized strain (each axis
+///     docs/database.md "The compressed-and-sheared corner"): the ray directions are the `rays`
+///     points of a Fibonacci lattice on the half-sphere E12 > 0 in box-normalized strain (each axis
 ///     scaled by the box's extent on that side of 0, so the box is the cube [-1, 1]^3), each
 ///     ray from E = 0 out to the box's surface; a ray whose end has J = det F < `fill_min_J`
 ///     is shortened to J = fill_min_J. The full circle of biaxial directions above is the
