@@ -306,13 +306,13 @@ TEST_CASE("energy fit: the exponential outer function is fitted, stored and keep
     CHECK(p.rms_relative < 0.035);
     CHECK(p.max_relative < 0.15);
   }
-  // The interpolation in l (session 16): parameters by default. The fit sees the knots only,
-  // so the other interpolation gives the same parameters, to the last bit.
-  CHECK(s.law.network.l_interpolation == knit::material::LInterpolation::kParameters);
-  o.l_interpolation = "energy";
+  // The interpolation in l (session 16): energy by default. The fit sees the knots only, so
+  // the other interpolation gives the same parameters, to the last bit.
+  CHECK(s.law.network.l_interpolation == knit::material::LInterpolation::kEnergy);
+  o.l_interpolation = "parameters";
   const EnergyFitSummary t = fit_energy_law(db, o);
   REQUIRE(t.ok());
-  CHECK(t.law.network.l_interpolation == knit::material::LInterpolation::kEnergy);
+  CHECK(t.law.network.l_interpolation == knit::material::LInterpolation::kParameters);
   CHECK(t.law.network.theta == s.law.network.theta);
 }
 
