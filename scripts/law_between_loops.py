@@ -63,18 +63,13 @@ def sweep_input(stored, loop_lengths):
 
 def laws_at(g, l):
     """(stored law, the other interpolation's law or None, the stored mode) at loop length l."""
-    from energy_law import BlendedLaw, NetworkLaw, load_law
+    from energy_law import load_law, network_law, stored_l_interpolation
     stored = load_law(g, l)
     if _text(g.attrs.get("family", "ridge")) != "network":
         return stored, None, "ridge"
-    mode = _text(g.attrs.get("l_interpolation", "parameters"))
-    if mode == "energy":
-        return stored, NetworkLaw(g, l), mode
-    knots = np.array(g["l_knots"])
-    j = int(np.clip(np.searchsorted(knots, l, side="right") - 1, 0, len(knots) - 2))
-    t = float(np.clip((l - knots[j]) / (knots[j + 1] - knots[j]), 0.0, 1.0))
-    other = BlendedLaw(NetworkLaw(g, l, row=j), NetworkLaw(g, l, row=j + 1), t)
-    return stored, other, mode
+    mode = stored_l_interpolation(g)
+    other = {"energy": "parameters", "parameters": "energy"}[mode]
+    return stored, network_law(g, l, other), mode
 
 
 def compare(db, runs, which="all"):

@@ -168,18 +168,30 @@ class BlendedLaw:
         return (1.0 - self.t) * Wa + self.t * Wb, (1.0 - self.t) * Sa + self.t * Sb
 
 
+def stored_l_interpolation(g):
+    """The network law's attribute l_interpolation ("parameters" when absent); refuses any
+    other value with the file and the HDF5 path."""
+    li = g.attrs.get("l_interpolation", "parameters")
+    li = li.decode() if isinstance(li, bytes) else str(li)
+    if li not in ("parameters", "energy"):
+        raise ValueError(f"{g.file.filename}: {g.name}: attribute l_interpolation is {li!r}; "
+                         "this script reads 'parameters' and 'energy'")
+    return li
+
+
 def load_law(g, l):
     """The stored law of /energy_law at loop length l, either family."""
     fam = g.attrs.get("family", "ridge")
     fam = fam.decode() if isinstance(fam, bytes) else str(fam)
     if fam != "network":
         return Law(g, l)
-    li = g.attrs.get("l_interpolation", "parameters")
-    li = li.decode() if isinstance(li, bytes) else str(li)
-    if li not in ("parameters", "energy"):
-        raise ValueError(f"{g.file.filename}: {g.name}: attribute l_interpolation is {li!r}; "
-                         "this script reads 'parameters' and 'energy'")
-    if li == "parameters":
+    return network_law(g, l, stored_l_interpolation(g))
+
+
+def network_law(g, l, mode):
+    """The network law of /energy_law at loop length l with the interpolation `mode`
+    ("parameters" or "energy"), whatever the file says."""
+    if mode == "parameters":
         return NetworkLaw(g, l)
     knots = np.array(g["l_knots"])
     if len(knots) == 1 or l <= knots[0]:
