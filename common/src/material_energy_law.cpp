@@ -135,22 +135,26 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
   const EnergyLaw law(d);
   if (d.family == EnergyFamily::kNetwork) {
     network_ = true;
+    with_l_derivative_ = with_l_derivative;
     if (d.network.l_interpolation == LInterpolation::kEnergy) {
       // W(e; l) = (1 - t) W_j + t W_j+1 (docs/database.md "Interpolation in l").
       energy_blend_ = true;
       const KnotSpan s = d.network.span(l);
-      net_ = NetworkLawAt(d.network.shape, d.network.theta_row(s.j));
-      blend_ = s.t;
+      const std::vector<double> theta_j = d.network.theta_row(s.j);
+      net_ = NetworkLawAt(d.network.shape, theta_j);
+      lanes_ = NetworkLanesAt(d.network.shape, theta_j);
       if (s.inside && (s.t > 0.0 || with_l_derivative)) {
-        net_next_ = NetworkLawAt(d.network.shape, d.network.theta_row(s.j + 1));
+        const std::vector<double> theta_next = d.network.theta_row(s.j + 1);
+        net_next_ = NetworkLawAt(d.network.shape, theta_next);
+        if (s.t > 0.0) lanes_ = NetworkLanesAt(d.network.shape, theta_j, theta_next, s.t);
         has_next_ = true;
         dl_span_ = d.network.l_knots[static_cast<std::size_t>(s.j + 1)] -
                    d.network.l_knots[static_cast<std::size_t>(s.j)];
       }
-      if (with_l_derivative) net_h_ = 1.0;  // marks "built with the l-derivative"
       return;
     }
     net_ = NetworkLawAt(d.network.shape, d.network.theta_at(l));
+    lanes_ = NetworkLanesAt(d.network.shape, net_.theta());
     if (with_l_derivative) {
       // dS/dl = (dS/dtheta) dtheta/dl by central differences along dtheta/dl (theta(l) is
       // piecewise linear, so this is the derivative of the span that holds l).
@@ -216,14 +220,7 @@ void EnergyLawAt::accumulate(const Eigen::Vector3d& e, EnergyResponse& r) const 
 }
 
 EnergyResponse EnergyLawAt::evaluate_network(const Eigen::Vector3d& e) const {
-  NetworkResponse n = net_.evaluate(e);
-  if (blend_ > 0.0) {
-    const NetworkResponse m = net_next_.evaluate(e);
-    const double a = 1.0 - blend_;
-    n.W = a * n.W + blend_ * m.W;
-    n.S = a * n.S + blend_ * m.S;
-    n.C = a * n.C + blend_ * m.C;
-  }
+  const NetworkResponse n = lanes_.evaluate(e);
   EnergyResponse r;
   r.W = n.W + 0.5 * floor_ * e.squaredNorm();
   r.S = n.S + floor_ * e;
@@ -262,7 +259,7 @@ EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
 
 Eigen::Vector3d EnergyLawAt::dS_dl(const Eigen::Vector3d& e) const {
   if (network_) {
-    if (!(net_h_ > 0.0)) throw std::logic_error("EnergyLawAt: built without the l-derivative");
+    if (!with_l_derivative_) throw std::logic_error("EnergyLawAt: built without the l-derivative");
     if (energy_blend_)  // dW/dl = (W_j+1 - W_j) / dl in the span; 0 outside the knots
       return has_next_ ? Eigen::Vector3d((net_next_.evaluate(e).S - net_.evaluate(e).S) / dl_span_)
                        : Eigen::Vector3d::Zero();

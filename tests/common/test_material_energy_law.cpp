@@ -207,8 +207,11 @@ TEST_CASE("energy law: dS/dl equals the finite difference in l", "[unit]") {
 TEST_CASE("energy law: the energy interpolation is each knot's law, and their mean between",
           "[unit]") {
   // W(e; l) = (1 - t) W_j(e) + t W_j+1(e) (LInterpolation::kEnergy): at a knot the law of
-  // that knot's theta row; between knots the convex combination (so W, S, C and dS/dl of
-  // that span follow from the two knots' laws); clamped outside; continuous across a knot.
+  // that knot's theta row (to the last bit: the evaluator at a knot is the two-lane one of that
+  // row, NetworkLanesAt, itself equal to NetworkLawAt to round-off in
+  // test_material_network_lanes.cpp); between knots the convex combination (so W, S, C and
+  // dS/dl of that span follow from the two knots' laws); clamped outside; continuous across a
+  // knot.
   EnergyLawData d = testing::make_test_network_law();
   d.network.l_interpolation = LInterpolation::kEnergy;
   const EnergyLaw law(d);
@@ -216,7 +219,7 @@ TEST_CASE("energy law: the energy interpolation is each knot's law, and their me
   p.network.l_interpolation = LInterpolation::kParameters;
   const EnergyLaw by_theta(p);
   const auto knot = [&](int j, const Eigen::Vector3d& e) {
-    NetworkResponse r = NetworkLawAt(d.network.shape, d.network.theta_row(j)).evaluate(e);
+    NetworkResponse r = NetworkLanesAt(d.network.shape, d.network.theta_row(j)).evaluate(e);
     r.W += 0.5 * d.floor * e.squaredNorm();
     r.S += d.floor * e;
     r.C += d.floor * Eigen::Matrix3d::Identity();

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "knit/material/convex_network.hpp"
+#include "knit/material/network_lanes.hpp"
 #include "knit/material/ridge_spline.hpp"
 #include "knit/spline/bspline_basis.hpp"
 
@@ -129,14 +130,19 @@ class EnergyLawAt {
   std::vector<double> poly_, dpoly_;
   Eigen::Vector3d box_min_, box_max_;
   bool network_ = false;
+  /// What evaluate() calls: every network pass of the law at l in one sweep (two lanes at a
+  /// knot or with theta interpolated, four between knots with l_interpolation "energy").
+  NetworkLanesAt lanes_;
+  /// dS_dl of the network family (one pass per knot law, not the hot path):
+  bool with_l_derivative_ = false;
   NetworkLawAt net_;
   NetworkLawAt net_lo_, net_hi_;  ///< theta(l) -/+ h dtheta/dl, for dS_dl (network family)
   double net_h_ = 0.0;
-  /// LInterpolation::kEnergy: net_ is knot j's law, net_next_ knot j+1's, W = (1 - t) W_j +
-  /// t W_j+1 with t = blend_ (0: net_ alone); dS/dl = (S_j+1 - S_j) / dl_span_.
+  /// LInterpolation::kEnergy: net_ is knot j's law, net_next_ knot j+1's (W = (1 - t) W_j +
+  /// t W_j+1 in lanes_); dS/dl = (S_j+1 - S_j) / dl_span_.
   bool energy_blend_ = false;
   NetworkLawAt net_next_;
-  double blend_ = 0.0, dl_span_ = 0.0;
+  double dl_span_ = 0.0;
   bool has_next_ = false;
 };
 

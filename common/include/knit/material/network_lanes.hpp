@@ -1,0 +1,54 @@
+// The evaluator of the network law that the macroscale calls (session 17): all the network
+// passes of one evaluation in one sweep of the units.
+//
+// The law at a loop length is a weighted sum of network energies G_k = outer(N_k) over lanes k
+// (knit/material/convex_network.hpp):
+//   at a knot, or with theta interpolated in l:  W = 1/2 G(e; theta) + 1/2 G(M e; theta)
+//   between two knots, l_interpolation "energy":  W = (1 - t) [1/2 G(e; theta_j) + ...]
+//                                                   + t [1/2 G(e; theta_j+1) + ...]
+// minus the affine normalization W(0), S(0). The mirrored pass needs no mirrored input: the
+// network at theta with the E12 column of A0 and A1 and the third row of L negated is
+// N(M e; theta) as a function of e, with its gradient M S_N(M e) and Hessian M C_N(M e) M. So
+// every lane takes the same e, and the K lanes (2 or 4) are K networks side by side: one
+// first layer of K h1 units, one second layer of K h2 units (V block diagonal), each loop over
+// all of them at once. The arithmetic is that of NetworkLawAt::evaluate (the reference, tested
+// equal to round-off); what is saved is the per-pass overhead and the serial dependence of one
+// small pass on the next (the lanes are independent, so their work interleaves).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "knit/material/convex_network.hpp"
+
+namespace knit::material {
+
+class NetworkLanesAt {
+ public:
+  NetworkLanesAt() = default;
+  /// W at one theta: 1/2 (G(e) + G(M e)) - W0 - S0 . e (two lanes).
+  NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta);
+  /// W = (1 - t) W(theta_a) + t W(theta_b), each normalized as above (four lanes); t in [0, 1].
+  NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
+                 const std::vector<double>& theta_b, double t);
+  /// W, S, C at e (material frame, e finite). Allocation-free.
+  NetworkResponse evaluate(const Eigen::Vector3d& e) const;
+  int lanes() const { return K_; }
+
+ private:
+  void build(const NetworkShape& shape, const std::vector<const std::vector<double>*>& thetas,
+             const std::vector<double>& lane_weight);
+
+  NetworkShape shape_;
+  int K_ = 0;
+  /// Packed, each array K h1 (first layer) or K h2 (second layer) long, lane-major (lane k's
+  /// units at k h + i): c0, c1, c2, b0, w1, p00, p01, p02, p11, p12, p22 (products of the
+  /// columns of A0); then V (K blocks h2 x h1, row-major); then a10, a11, a12, b1, w.
+  std::vector<double> packed_;
+  /// Per lane: weight omega_k and Q = L L^T (upper triangle: 00, 01, 02, 11, 12, 22).
+  std::vector<double> omega_, Q_;
+  double W0_ = 0.0;
+  Eigen::Vector3d S0_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace knit::material

@@ -1,0 +1,254 @@
+// All network passes of one law evaluation in one sweep (see knit/material/network_lanes.hpp).
+#include <algorithm>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+#include <stdexcept>
+
+#include "knit/material/network_lanes.hpp"
+
+namespace knit::material {
+
+namespace {
+
+constexpr int kMaxUnitsPerLane = 64;  // NetworkShape::validate's bound
+constexpr int kMaxLanes = 4;
+
+/// The activation on the n units of a lane; rho on its last `stiff`. The sigma units two at a
+/// time, branch-free (SSE2, part of every x86-64): x clamped to [-1, 1] gives the cubic piece's
+/// s, s', s'' (their values at -1 and 1 are those of the linear pieces), and max(x - 1, 0)
+/// adds the linear part beyond 1. The same function as network_activation_impl to round-off
+/// (tested); in the lane layout this is 5 % faster than per-unit branches (measured, session 17).
+inline void activate_lane(const double* x, double* s, double* ds, double* dds, int n, int stiff) {
+  int i = 0;
+#ifdef __SSE2__
+  const __m128d one = _mm_set1_pd(1.0), mone = _mm_set1_pd(-1.0), zero = _mm_setzero_pd();
+  const __m128d c34 = _mm_set1_pd(0.75), half = _mm_set1_pd(0.5), c12 = _mm_set1_pd(1.0 / 12.0),
+                c3 = _mm_set1_pd(1.0 / 3.0), c316 = _mm_set1_pd(3.0 / 16.0);
+  for (; i + 2 <= n - stiff; i += 2) {
+    const __m128d xv = _mm_loadu_pd(x + i);
+    const __m128d xc = _mm_min_pd(_mm_max_pd(xv, mone), one), x2 = _mm_mul_pd(xc, xc);
+    // s = 3/4 (x^2 / 2 - x^4 / 12) + x / 2 + 3/16 on [-1, 1], + max(x - 1, 0) beyond
+    const __m128d poly =
+        _mm_mul_pd(c34, _mm_sub_pd(_mm_mul_pd(half, x2), _mm_mul_pd(_mm_mul_pd(x2, x2), c12)));
+    _mm_storeu_pd(s + i, _mm_add_pd(_mm_add_pd(poly, _mm_add_pd(_mm_mul_pd(half, xc), c316)),
+                                    _mm_max_pd(_mm_sub_pd(xv, one), zero)));
+    _mm_storeu_pd(
+        ds + i,
+        _mm_add_pd(_mm_mul_pd(c34, _mm_sub_pd(xc, _mm_mul_pd(_mm_mul_pd(x2, xc), c3))), half));
+    _mm_storeu_pd(dds + i, _mm_mul_pd(c34, _mm_sub_pd(one, x2)));
+  }
+#endif
+  for (; i < n - stiff; ++i) network_activation_impl<true>(x[i], s[i], ds[i], dds[i]);
+  for (; i < n; ++i) network_stiffening_activation(x[i], s[i], ds[i], dds[i]);
+}
+
+/// The lanes' weighted sum of outer(N_k) and its derivatives, before normalization. H1c, H2c,
+/// Kc > 0: sizes fixed at compile time (Eigen unrolls the lane products); 0: the shape's.
+template <int H1c, int H2c, int Kc>
+NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, const double* omega,
+                          const double* Q, const Eigen::Vector3d& e) {
+  constexpr int D1 = H1c > 0 ? H1c : Eigen::Dynamic, D2 = H2c > 0 ? H2c : Eigen::Dynamic;
+  constexpr int M1 = (H1c > 0 ? H1c : kMaxUnitsPerLane) * (Kc > 0 ? Kc : kMaxLanes);
+  constexpr int M2 = (H2c > 0 ? H2c : kMaxUnitsPerLane) * (Kc > 0 ? Kc : kMaxLanes);
+  using Seg1 = Eigen::Map<const Eigen::Array<double, D1, 1>>;
+  using Seg2 = Eigen::Map<const Eigen::Array<double, D2, 1>>;
+  using Vec1 = Eigen::Map<const Eigen::Matrix<double, D1, 1>>;
+  using Vec2 = Eigen::Map<const Eigen::Matrix<double, D2, 1>>;
+  using Blk = Eigen::Map<const Eigen::Matrix<double, D2, D1, Eigen::RowMajor>>;
+  const int H1 = H1c > 0 ? H1c : sh.h1, H2 = H2c > 0 ? H2c : sh.h2;
+  const int K = Kc > 0 ? Kc : k_lanes;
+  const int N1 = K * H1, N2 = K * H2;
+  const double *c0 = q, *c1 = q + N1, *c2 = q + 2 * N1, *b0 = q + 3 * N1, *w1 = q + 4 * N1;
+  const double* p = q + 5 * N1;  // p00, p01, p02, p11, p12, p22
+  const double* V = q + 11 * N1;
+  const double* a1 = V + N2 * H1;  // a10, a11, a12, b1, w
+  const double *b1 = a1 + 3 * N2, *w = a1 + 4 * N2;
+  const double e0 = e(0), e1 = e(1), e2 = e(2);
+
+  // First layer, all lanes.
+  double y[M1], h[M1], dh[M1], ddh[M1];
+  for (int i = 0; i < N1; ++i) y[i] = c0[i] * e0 + c1[i] * e1 + c2[i] * e2 + b0[i];
+  for (int k = 0; k < K; ++k)
+    activate_lane(y + k * H1, h + k * H1, dh + k * H1, ddh + k * H1, H1, sh.stiff1);
+  // Second layer: z = V_k h_k + A1 e + b1.
+  double z[M2], u[M2], du[M2], ddu[M2], wd[M2];
+  for (int j = 0; j < N2; ++j) z[j] = a1[j] * e0 + a1[N2 + j] * e1 + a1[2 * N2 + j] * e2 + b1[j];
+  for (int k = 0; k < K; ++k) {
+    Eigen::Map<Eigen::Matrix<double, D2, 1>> zk(z + k * H2, H2);
+    zk.noalias() += Blk(V + k * H2 * H1, H2, H1).lazyProduct(Vec1(h + k * H1, H1));
+  }
+  for (int k = 0; k < K; ++k)
+    activate_lane(z + k * H2, u + k * H2, du + k * H2, ddu + k * H2, H2, sh.stiff2);
+  for (int j = 0; j < N2; ++j) wd[j] = w[j] * du[j];
+  // kappa = w1 + V_k^T (w du)_k, and its products with h', h''.
+  double kd[M1], kdd[M1];
+  for (int k = 0; k < K; ++k) {
+    Eigen::Map<Eigen::Matrix<double, D1, 1>> kk(kd + k * H1, H1);
+    kk.noalias() = Blk(V + k * H2 * H1, H2, H1).transpose().lazyProduct(Vec2(wd + k * H2, H2));
+  }
+  for (int i = 0; i < N1; ++i) {
+    const double kappa = kd[i] + w1[i];
+    kd[i] = kappa * dh[i];
+    kdd[i] = kappa * ddh[i];
+  }
+
+  NetworkResponse r;
+  for (int k = 0; k < K; ++k) {
+    const int o1 = k * H1, o2 = k * H2;
+    const Seg1 kdk(kd + o1, H1), kddk(kdd + o1, H1);
+    const double* Qk = Q + 6 * k;
+    // N_k, S_N, C_N (upper triangle) of lane k.
+    double Wn =
+        (Seg1(w1 + o1, H1) * Seg1(h + o1, H1)).sum() + (Seg2(w + o2, H2) * Seg2(u + o2, H2)).sum();
+    const Seg2 wdk(wd + o2, H2);
+    Eigen::Vector3d S((kdk * Seg1(c0 + o1, H1)).sum() + (wdk * Seg2(a1 + o2, H2)).sum(),
+                      (kdk * Seg1(c1 + o1, H1)).sum() + (wdk * Seg2(a1 + N2 + o2, H2)).sum(),
+                      (kdk * Seg1(c2 + o1, H1)).sum() + (wdk * Seg2(a1 + 2 * N2 + o2, H2)).sum());
+    double C[6];
+    for (int m = 0; m < 6; ++m) C[m] = (kddk * Seg1(p + m * N1 + o1, H1)).sum() + Qk[m];
+    // Second-layer curvature: w_j u''_j grad z_j grad z_j^T for the curved units only.
+    for (int j = 0; j < H2; ++j) {
+      const double cj = w[o2 + j] * ddu[o2 + j];
+      if (cj == 0.0) continue;
+      const double* v = V + (o2 + j) * H1;
+      double g0 = a1[o2 + j], g1 = a1[N2 + o2 + j], g2 = a1[2 * N2 + o2 + j];
+      for (int i = 0; i < H1; ++i) {
+        const double vd = v[i] * dh[o1 + i];
+        g0 += vd * c0[o1 + i];
+        g1 += vd * c1[o1 + i];
+        g2 += vd * c2[o1 + i];
+      }
+      const double x0 = cj * g0, x1 = cj * g1;
+      C[0] += x0 * g0;
+      C[1] += x0 * g1;
+      C[2] += x0 * g2;
+      C[3] += x1 * g1;
+      C[4] += x1 * g2;
+      C[5] += cj * g2 * g2;
+    }
+    // 1/2 e^T Q e.
+    const double Qe0 = Qk[0] * e0 + Qk[1] * e1 + Qk[2] * e2;
+    const double Qe1 = Qk[1] * e0 + Qk[3] * e1 + Qk[4] * e2;
+    const double Qe2 = Qk[2] * e0 + Qk[4] * e1 + Qk[5] * e2;
+    Wn += 0.5 * (e0 * Qe0 + e1 * Qe1 + e2 * Qe2);
+    S += Eigen::Vector3d(Qe0, Qe1, Qe2);
+    // The outer function (G = c g(N): S_G = c g' S_N, C_G = c (g' C_N + g'' S_N S_N^T)).
+    double gW = Wn, gS = 1.0, gC = 0.0;
+    if (sh.outer == 1) {
+      double g, dg, ddg;
+      network_outer(Wn, sh.outer_cap, g, dg, ddg);
+      gW = sh.outer_scale * g;
+      gS = sh.outer_scale * dg;
+      gC = sh.outer_scale * ddg;
+    }
+    const double ok = omega[k], s1 = ok * gS, s2 = ok * gC;
+    r.W += ok * gW;
+    r.S += s1 * S;
+    r.C(0, 0) += s1 * C[0] + s2 * S(0) * S(0);
+    r.C(0, 1) += s1 * C[1] + s2 * S(0) * S(1);
+    r.C(0, 2) += s1 * C[2] + s2 * S(0) * S(2);
+    r.C(1, 1) += s1 * C[3] + s2 * S(1) * S(1);
+    r.C(1, 2) += s1 * C[4] + s2 * S(1) * S(2);
+    r.C(2, 2) += s1 * C[5] + s2 * S(2) * S(2);
+  }
+  r.C(1, 0) = r.C(0, 1);
+  r.C(2, 0) = r.C(0, 2);
+  r.C(2, 1) = r.C(1, 2);
+  return r;
+}
+
+}  // namespace
+
+NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta) {
+  build(shape, {&theta, &theta}, {0.5, 0.5});
+}
+
+NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
+                               const std::vector<double>& theta_b, double t) {
+  const double a = 0.5 * (1.0 - t), b = 0.5 * t;
+  build(shape, {&theta_a, &theta_a, &theta_b, &theta_b}, {a, a, b, b});
+}
+
+void NetworkLanesAt::build(const NetworkShape& shape,
+                           const std::vector<const std::vector<double>*>& thetas,
+                           const std::vector<double>& lane_weight) {
+  if (const std::string why = shape.validate(); !why.empty())
+    throw std::invalid_argument("NetworkLanesAt: " + why);
+  shape_ = shape;
+  K_ = static_cast<int>(thetas.size());
+  const int H1 = shape.h1, H2 = shape.h2, N1 = K_ * H1, N2 = K_ * H2;
+  packed_.assign(static_cast<std::size_t>(11 * N1 + N2 * H1 + 5 * N2), 0.0);
+  omega_ = lane_weight;
+  Q_.assign(static_cast<std::size_t>(6 * K_), 0.0);
+  double* q = packed_.data();
+  double* V = q + 11 * N1;
+  double* a1 = V + N2 * H1;
+  for (int k = 0; k < K_; ++k) {
+    if (static_cast<int>(thetas[static_cast<std::size_t>(k)]->size()) != shape.size())
+      throw std::invalid_argument("NetworkLanesAt: theta must have shape.size() entries");
+    const double* th = thetas[static_cast<std::size_t>(k)]->data();
+    // Odd lanes are the mirror images: the E12 column of A0 and A1 and the third row of L
+    // negated, so that the lane's network at e is N(M e).
+    const double m = k % 2 == 1 ? -1.0 : 1.0;
+    for (int i = 0; i < H1; ++i) {
+      const double* a = th + shape.a0() + 3 * i;
+      const int o = k * H1 + i;
+      const double a2 = m * a[2];
+      q[o] = a[0];
+      q[N1 + o] = a[1];
+      q[2 * N1 + o] = a2;
+      q[3 * N1 + o] = th[shape.b0() + i];
+      q[4 * N1 + o] = th[shape.w1() + i];
+      q[5 * N1 + o] = a[0] * a[0];
+      q[6 * N1 + o] = a[0] * a[1];
+      q[7 * N1 + o] = a[0] * a2;
+      q[8 * N1 + o] = a[1] * a[1];
+      q[9 * N1 + o] = a[1] * a2;
+      q[10 * N1 + o] = a2 * a2;
+    }
+    std::copy(th + shape.V(), th + shape.V() + H2 * H1, V + k * H2 * H1);
+    for (int j = 0; j < H2; ++j) {
+      const double* a = th + shape.a1() + 3 * j;
+      const int o = k * H2 + j;
+      a1[o] = a[0];
+      a1[N2 + o] = a[1];
+      a1[2 * N2 + o] = m * a[2];
+      a1[3 * N2 + o] = th[shape.b1() + j];
+      a1[4 * N2 + o] = th[shape.w() + j];
+    }
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> L =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(th + shape.L());
+    L.row(2) *= m;
+    const Eigen::Matrix3d Qk = L * L.transpose();
+    double* Qp = Q_.data() + 6 * k;
+    Qp[0] = Qk(0, 0);
+    Qp[1] = Qk(0, 1);
+    Qp[2] = Qk(0, 2);
+    Qp[3] = Qk(1, 1);
+    Qp[4] = Qk(1, 2);
+    Qp[5] = Qk(2, 2);
+  }
+  W0_ = 0.0;
+  S0_.setZero();
+  const NetworkResponse n0 = evaluate(Eigen::Vector3d::Zero());
+  W0_ = n0.W;
+  S0_ = n0.S;  // mirror-symmetric lanes: S0(2) = 0 up to round-off
+  S0_(2) = 0.0;
+}
+
+NetworkResponse NetworkLanesAt::evaluate(const Eigen::Vector3d& e) const {
+  const double *q = packed_.data(), *om = omega_.data(), *Q = Q_.data();
+  NetworkResponse r;
+  if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 2)
+    r = lanes_sum<12, 6, 2>(shape_, K_, q, om, Q, e);
+  else if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 4)
+    r = lanes_sum<12, 6, 4>(shape_, K_, q, om, Q, e);
+  else
+    r = lanes_sum<0, 0, 0>(shape_, K_, q, om, Q, e);
+  r.W -= W0_ + S0_.dot(e);
+  r.S -= S0_;
+  return r;
+}
+
+}  // namespace knit::material
