@@ -1,5 +1,6 @@
 // All network passes of one law evaluation in one sweep (see knit/material/network_lanes.hpp).
 #include <algorithm>
+#include <cstring>
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
@@ -41,6 +42,18 @@ inline void activate_lane(const double* x, double* s, double* ds, double* dds, i
 #endif
   for (; i < n - stiff; ++i) network_activation_impl<true>(x[i], s[i], ds[i], dds[i]);
   for (; i < n; ++i) network_stiffening_activation(x[i], s[i], ds[i], dds[i]);
+}
+
+/// The upper triangle (00, 01, 02, 11, 12, 22) of C += c g g^T, for doubles or lane vectors.
+template <class T>
+[[gnu::always_inline]] inline void add_outer_upper(T* C, T c, T g0, T g1, T g2) {
+  const T x0 = c * g0, x1 = c * g1;
+  C[0] += x0 * g0;
+  C[1] += x0 * g1;
+  C[2] += x0 * g2;
+  C[3] += x1 * g1;
+  C[4] += x1 * g2;
+  C[5] += c * g2 * g2;
 }
 
 /// The lanes' weighted sum of outer(N_k) and its derivatives, before normalization. H1c, H2c,
@@ -119,13 +132,7 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
         g1 += vd * c1[o1 + i];
         g2 += vd * c2[o1 + i];
       }
-      const double x0 = cj * g0, x1 = cj * g1;
-      C[0] += x0 * g0;
-      C[1] += x0 * g1;
-      C[2] += x0 * g2;
-      C[3] += x1 * g1;
-      C[4] += x1 * g2;
-      C[5] += cj * g2 * g2;
+      add_outer_upper(C, cj, g0, g1, g2);
     }
     // 1/2 e^T Q e.
     const double Qe0 = Qk[0] * e0 + Qk[1] * e1 + Qk[2] * e2;
@@ -158,21 +165,167 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
   return r;
 }
 
+// ---- The four-wide kernel (session 17): unit-major, the 4 lanes of a unit in one 256-bit
+// vector, so every step is vertical (no horizontal sums). GCC's vector extension, compiled for
+// AVX2 only (target attribute on the entry point; without AVX GCC splits the vectors into SSE2
+// halves and it ran at half the portable code's rate, so a processor without AVX2 takes
+// lanes_sum). No contraction (-std=c++20 keeps -ffp-contract=off): the portable code's IEEE
+// operations in another order, equal to round-off (tested).
+// -Wpsabi (GCC's note that a 256-bit vector passed by value without AVX changes the ABI) is
+// silenced for the rest of this translation unit (and its unity group; the note is issued at
+// its end): every function that takes or returns v4 is always_inline into the AVX2 entry point.
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef double v4 __attribute__((vector_size(32)));
+
+template <class VT>
+[[gnu::always_inline]] inline VT ldv(const double* p) {
+  VT r;
+  std::memcpy(&r, p, sizeof r);
+  return r;
+}
+template <class VT>
+[[gnu::always_inline]] inline VT splatv(double x) {
+  VT r;
+  for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l) r[l] = x;
+  return r;
+}
+
+template <class v4, int H1c, int H2c>
+[[gnu::always_inline]] inline void lanes4_body(int h1, int h2, int stiff1, int stiff2,
+                                               const double* q, const double* e, double* out) {
+  const int H1 = H1c > 0 ? H1c : h1, H2 = H2c > 0 ? H2c : h2;
+  constexpr int L = sizeof(v4) / sizeof(double);
+  const auto ld4 = [](const double* p) __attribute__((always_inline)) {
+    return ldv<v4>(p);
+  };
+  const auto splat4 = [](double x) __attribute__((always_inline)) {
+    return splatv<v4>(x);
+  };
+  const double* F1 = q;                 // [f][i][lane], f: c0 c1 c2 b0 w1 p00 p01 p02 p11 p12 p22
+  const double* Vp = q + 11 * H1 * L;   // [j][i][lane]
+  const double* F2 = Vp + H2 * H1 * L;  // [f][j][lane], f: a10 a11 a12 b1 w
+  const double* Qp = F2 + 5 * H2 * L;   // [m][lane]
+  const auto f1 = [&](int f, int i) __attribute__((always_inline)) {
+    return ld4(F1 + (f * H1 + i) * L);
+  };
+  const auto f2 = [&](int f, int j) __attribute__((always_inline)) {
+    return ld4(F2 + (f * H2 + j) * L);
+  };
+  const auto vv = [&](int j, int i) __attribute__((always_inline)) {
+    return ld4(Vp + (j * H1 + i) * L);
+  };
+  const v4 E0 = splat4(e[0]), E1 = splat4(e[1]), E2 = splat4(e[2]);
+  const v4 one = splat4(1.0), mone = splat4(-1.0), zero = splat4(0.0);
+  const auto act = [&](v4 x, bool stiff, v4& s, v4& ds, v4& dds) __attribute__((always_inline)) {
+    if (!stiff) {
+      v4 xc = x < mone ? mone : x;
+      xc = xc > one ? one : xc;
+      const v4 x2 = xc * xc;
+      s = 0.75 * (0.5 * x2 - x2 * x2 * (1.0 / 12.0)) + 0.5 * xc + 3.0 / 16.0 +
+          (x > one ? x - one : zero);
+      ds = 0.75 * (xc - x2 * xc * (1.0 / 3.0)) + 0.5;
+      dds = 0.75 * (one - x2);
+    } else {
+      const v4 xp = x > zero ? x : zero;
+      dds = xp;
+      ds = 0.5 * xp * xp;
+      s = ds * xp / 3.0;
+    }
+  };
+  v4 h[kMaxUnitsPerLane], dh[kMaxUnitsPerLane], ddh[kMaxUnitsPerLane];
+  for (int i = 0; i < H1; ++i)
+    act(f1(0, i) * E0 + f1(1, i) * E1 + f1(2, i) * E2 + f1(3, i), i >= H1 - stiff1, h[i], dh[i],
+        ddh[i]);
+  v4 u[kMaxUnitsPerLane], du[kMaxUnitsPerLane], ddu[kMaxUnitsPerLane], wd[kMaxUnitsPerLane];
+  v4 W = zero, S0 = zero, S1 = zero, S2 = zero;
+  for (int j = 0; j < H2; ++j) {
+    v4 z = zero;
+    for (int i = 0; i < H1; ++i) z += vv(j, i) * h[i];
+    z += f2(0, j) * E0 + f2(1, j) * E1 + f2(2, j) * E2 + f2(3, j);
+    act(z, j >= H2 - stiff2, u[j], du[j], ddu[j]);
+    const v4 wj = f2(4, j);
+    wd[j] = wj * du[j];
+    W += wj * u[j];
+    S0 += wd[j] * f2(0, j);
+    S1 += wd[j] * f2(1, j);
+    S2 += wd[j] * f2(2, j);
+  }
+  v4 C[6] = {zero, zero, zero, zero, zero, zero};
+  for (int i = 0; i < H1; ++i) {
+    v4 kappa = f1(4, i);
+    for (int j = 0; j < H2; ++j) kappa += vv(j, i) * wd[j];
+    const v4 kd = kappa * dh[i], kdd = kappa * ddh[i];
+    W += f1(4, i) * h[i];
+    S0 += kd * f1(0, i);
+    S1 += kd * f1(1, i);
+    S2 += kd * f1(2, i);
+    for (int m = 0; m < 6; ++m) C[m] += kdd * f1(5 + m, i);
+  }
+  // Second-layer curvature, for the units curved in some lane (c_j = 0 in the others).
+  for (int j = 0; j < H2; ++j) {
+    const v4 cj = f2(4, j) * ddu[j];
+    bool flat = true;
+    for (int l = 0; l < L; ++l) flat = flat && cj[l] == 0.0;
+    if (flat) continue;
+    v4 g0 = f2(0, j), g1 = f2(1, j), g2 = f2(2, j);
+    for (int i = 0; i < H1; ++i) {
+      const v4 vd = vv(j, i) * dh[i];
+      g0 += vd * f1(0, i);
+      g1 += vd * f1(1, i);
+      g2 += vd * f1(2, i);
+    }
+    add_outer_upper(C, cj, g0, g1, g2);
+  }
+  // 1/2 e^T Q e.
+  v4 Qm[6];
+  for (int m = 0; m < 6; ++m) Qm[m] = ld4(Qp + L * m);
+  const v4 Qe0 = Qm[0] * E0 + Qm[1] * E1 + Qm[2] * E2;
+  const v4 Qe1 = Qm[1] * E0 + Qm[3] * E1 + Qm[4] * E2;
+  const v4 Qe2 = Qm[2] * E0 + Qm[4] * E1 + Qm[5] * E2;
+  W += 0.5 * (E0 * Qe0 + E1 * Qe1 + E2 * Qe2);
+  const v4 res[10] = {W,
+                      S0 + Qe0,
+                      S1 + Qe1,
+                      S2 + Qe2,
+                      C[0] + Qm[0],
+                      C[1] + Qm[1],
+                      C[2] + Qm[2],
+                      C[3] + Qm[3],
+                      C[4] + Qm[4],
+                      C[5] + Qm[5]};
+  for (int m = 0; m < 10; ++m) std::memcpy(out + L * m, &res[m], sizeof(v4));
+}
+
+/// The kernel's entry points: 12 / 6 units (the default) with compiled sizes, any other shape
+/// with the shape's; AVX2 where the processor has it (chosen once, at the first call).
+template <int H1c, int H2c>
+__attribute__((target("avx2"))) void lanes4_avx2(int h1, int h2, int stiff1, int stiff2,
+                                                 const double* q, const double* e, double* out) {
+  lanes4_body<v4, H1c, H2c>(h1, h2, stiff1, stiff2, q, e, out);
+}
+
+/// The four-lane AVX2 kernel for this shape, or nullptr where the processor has no AVX2.
+NetworkLanesAt::WideKernel wide_kernel(int h1, int h2) {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (!avx2) return nullptr;
+  return h1 == 12 && h2 == 6 ? lanes4_avx2<12, 6> : lanes4_avx2<0, 0>;
+}
+
 }  // namespace
 
 NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta) {
-  build(shape, {&theta, &theta}, {0.5, 0.5});
+  build(shape, {&theta, &theta}, {0.5, 0.5}, LanesKernel::kPortable);
 }
 
 NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
-                               const std::vector<double>& theta_b, double t) {
+                               const std::vector<double>& theta_b, double t, LanesKernel kernel) {
   const double a = 0.5 * (1.0 - t), b = 0.5 * t;
-  build(shape, {&theta_a, &theta_a, &theta_b, &theta_b}, {a, a, b, b});
+  build(shape, {&theta_a, &theta_a, &theta_b, &theta_b}, {a, a, b, b}, kernel);
 }
 
 void NetworkLanesAt::build(const NetworkShape& shape,
                            const std::vector<const std::vector<double>*>& thetas,
-                           const std::vector<double>& lane_weight) {
+                           const std::vector<double>& lane_weight, LanesKernel kernel) {
   if (const std::string why = shape.validate(); !why.empty())
     throw std::invalid_argument("NetworkLanesAt: " + why);
   shape_ = shape;
@@ -229,6 +382,33 @@ void NetworkLanesAt::build(const NetworkShape& shape,
     Qp[4] = Qk(1, 2);
     Qp[5] = Qk(2, 2);
   }
+  // The four-wide kernel's layout (four lanes only, where the processor has AVX2).
+  wide_ = K_ == 4 && kernel == LanesKernel::kAuto ? wide_kernel(H1, H2) : nullptr;
+  packed4_.clear();
+  if (!wide_) {
+    W0_ = 0.0;
+    S0_.setZero();
+    const NetworkResponse n0 = evaluate(Eigen::Vector3d::Zero());
+    W0_ = n0.W;
+    S0_ = n0.S;
+    S0_(2) = 0.0;
+    return;
+  }
+  const int L = K_;
+  packed4_.assign(static_cast<std::size_t>(L * (11 * H1 + H2 * H1 + 5 * H2 + 6)), 0.0);
+  double* F1 = packed4_.data();
+  double* V4 = F1 + 11 * H1 * L;
+  double* F2 = V4 + H2 * H1 * L;
+  double* Q4 = F2 + 5 * H2 * L;
+  for (int k = 0; k < L; ++k) {
+    for (int f = 0; f < 11; ++f)
+      for (int i = 0; i < H1; ++i) F1[(f * H1 + i) * L + k] = q[f * N1 + k * H1 + i];
+    for (int j = 0; j < H2; ++j)
+      for (int i = 0; i < H1; ++i) V4[(j * H1 + i) * L + k] = V[(k * H2 + j) * H1 + i];
+    for (int f = 0; f < 5; ++f)
+      for (int j = 0; j < H2; ++j) F2[(f * H2 + j) * L + k] = a1[f * N2 + k * H2 + j];
+    for (int m = 0; m < 6; ++m) Q4[m * L + k] = Q_[static_cast<std::size_t>(6 * k + m)];
+  }
   W0_ = 0.0;
   S0_.setZero();
   const NetworkResponse n0 = evaluate(Eigen::Vector3d::Zero());
@@ -240,7 +420,34 @@ void NetworkLanesAt::build(const NetworkShape& shape,
 NetworkResponse NetworkLanesAt::evaluate(const Eigen::Vector3d& e) const {
   const double *q = packed_.data(), *om = omega_.data(), *Q = Q_.data();
   NetworkResponse r;
-  if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 2)
+  if (wide_) {
+    double ls[40];  // per quantity m (N, S_N, C_N upper triangle) the 4 lanes at 4 m + k
+    wide_(shape_.h1, shape_.h2, shape_.stiff1, shape_.stiff2, packed4_.data(), e.data(), ls);
+    for (int k = 0; k < K_; ++k) {
+      const double Wn = ls[4 * 0 + k];
+      const Eigen::Vector3d S(ls[4 * 1 + k], ls[4 * 2 + k], ls[4 * 3 + k]);
+      double gW = Wn, gS = 1.0, gC = 0.0;
+      if (shape_.outer == 1) {
+        double g, dg, ddg;
+        network_outer(Wn, shape_.outer_cap, g, dg, ddg);
+        gW = shape_.outer_scale * g;
+        gS = shape_.outer_scale * dg;
+        gC = shape_.outer_scale * ddg;
+      }
+      const double ok = omega_[static_cast<std::size_t>(k)], s1 = ok * gS, s2 = ok * gC;
+      r.W += ok * gW;
+      r.S += s1 * S;
+      r.C(0, 0) += s1 * ls[4 * 4 + k] + s2 * S(0) * S(0);
+      r.C(0, 1) += s1 * ls[4 * 5 + k] + s2 * S(0) * S(1);
+      r.C(0, 2) += s1 * ls[4 * 6 + k] + s2 * S(0) * S(2);
+      r.C(1, 1) += s1 * ls[4 * 7 + k] + s2 * S(1) * S(1);
+      r.C(1, 2) += s1 * ls[4 * 8 + k] + s2 * S(1) * S(2);
+      r.C(2, 2) += s1 * ls[4 * 9 + k] + s2 * S(2) * S(2);
+    }
+    r.C(1, 0) = r.C(0, 1);
+    r.C(2, 0) = r.C(0, 2);
+    r.C(2, 1) = r.C(1, 2);
+  } else if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 2)
     r = lanes_sum<12, 6, 2>(shape_, K_, q, om, Q, e);
   else if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 4)
     r = lanes_sum<12, 6, 4>(shape_, K_, q, om, Q, e);

@@ -1,8 +1,9 @@
 // The lane evaluator of the network law (knit/material/network_lanes.hpp) against the
 // reference pass by pass (NetworkLawAt, itself tested against the formula written out in
 // test_material_convex_network.cpp): two lanes = the mirror-averaged law at one theta, four
-// lanes = the convex combination of two knots' laws; on the compiled sizes (12 / 6) and the
-// general path (9 / 5, 16 / 8), with stiffening units and the exponential outer function.
+// lanes = the convex combination of two knots' laws (both kernels: AVX2 and portable); on the
+// compiled sizes (12 / 6) and the general path (9 / 5, 16 / 8), with stiffening units and the
+// exponential outer function.
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -59,8 +60,12 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
   const NetworkLanesAt two(sh, ta);
   CHECK(two.lanes() == 2);
   const double t = GENERATE(0.0, 0.3, 1.0);
-  const NetworkLanesAt four(sh, ta, tb, t);
+  // Both four-lane kernels: the AVX2 one (where the processor has it) and the portable one.
+  const LanesKernel kernel = GENERATE(LanesKernel::kAuto, LanesKernel::kPortable);
+  const NetworkLanesAt four(sh, ta, tb, t, kernel);
   CHECK(four.lanes() == 4);
+  CHECK(four.wide() == (kernel == LanesKernel::kAuto && __builtin_cpu_supports("avx2")));
+  CHECK_FALSE(two.wide());
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> u(-0.7, 0.7);
   int beyond_cap = 0;
@@ -81,7 +86,8 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
 
 TEST_CASE("network lanes: stress-free at 0 and even in E12", "[unit]") {
   const NetworkShape sh = lanes_shape(12, 6, 0, 0, true);
-  const NetworkLanesAt law(sh, lanes_theta(sh, 41), lanes_theta(sh, 42), 0.6);
+  const NetworkLanesAt law(sh, lanes_theta(sh, 41), lanes_theta(sh, 42), 0.6,
+                           GENERATE(LanesKernel::kAuto, LanesKernel::kPortable));
   const NetworkResponse r0 = law.evaluate(Eigen::Vector3d::Zero());
   CHECK(std::abs(r0.W) <= 1e-14);
   CHECK(r0.S.norm() <= 1e-14);

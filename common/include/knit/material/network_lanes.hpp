@@ -13,7 +13,8 @@
 // first layer of K h1 units, one second layer of K h2 units (V block diagonal), each loop over
 // all of them at once. The arithmetic is that of NetworkLawAt::evaluate (the reference, tested
 // equal to round-off); what is saved is the per-pass overhead and the serial dependence of one
-// small pass on the next (the lanes are independent, so their work interleaves).
+// small pass on the next (the lanes are independent, so their work interleaves). Four lanes
+// take an AVX2 kernel where the processor has it (LanesKernel below; docs/database.md).
 #pragma once
 
 #include <Eigen/Core>
@@ -23,21 +24,32 @@
 
 namespace knit::material {
 
+/// Which code evaluates four lanes: kAuto = the AVX2 kernel where the processor has AVX2 (one
+/// 256-bit vector holds a unit's four lanes; +45 % on the default law between knots, session
+/// 17), else the portable one (Eigen, SSE2); kPortable = always the portable one (tests).
+/// Two lanes always take the portable one (faster there than the four-wide kernel).
+enum class LanesKernel { kAuto, kPortable };
+
 class NetworkLanesAt {
  public:
+  /// The AVX2 kernel's signature (common/src/material_network_lanes.cpp).
+  using WideKernel = void (*)(int, int, int, int, const double*, const double*, double*);
   NetworkLanesAt() = default;
   /// W at one theta: 1/2 (G(e) + G(M e)) - W0 - S0 . e (two lanes).
   NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta);
   /// W = (1 - t) W(theta_a) + t W(theta_b), each normalized as above (four lanes); t in [0, 1].
   NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
-                 const std::vector<double>& theta_b, double t);
+                 const std::vector<double>& theta_b, double t,
+                 LanesKernel kernel = LanesKernel::kAuto);
   /// W, S, C at e (material frame, e finite). Allocation-free.
   NetworkResponse evaluate(const Eigen::Vector3d& e) const;
   int lanes() const { return K_; }
+  /// True if evaluate() runs the AVX2 kernel.
+  bool wide() const { return wide_ != nullptr; }
 
  private:
   void build(const NetworkShape& shape, const std::vector<const std::vector<double>*>& thetas,
-             const std::vector<double>& lane_weight);
+             const std::vector<double>& lane_weight, LanesKernel kernel);
 
   NetworkShape shape_;
   int K_ = 0;
@@ -47,6 +59,10 @@ class NetworkLanesAt {
   std::vector<double> packed_;
   /// Per lane: weight omega_k and Q = L L^T (upper triangle: 00, 01, 02, 11, 12, 22).
   std::vector<double> omega_, Q_;
+  /// The same, unit-major for the four-wide kernel: [field][unit][lane], 4 lanes (a two-lane
+  /// law fills lanes 2 and 3 with copies of 0 and 1 at weight 0).
+  std::vector<double> packed4_;
+  WideKernel wide_ = nullptr;
   double W0_ = 0.0;
   Eigen::Vector3d S0_ = Eigen::Vector3d::Zero();
 };
