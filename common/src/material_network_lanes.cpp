@@ -56,6 +56,30 @@ template <class T>
   C[5] += c * g2 * g2;
 }
 
+/// r += omega G_k, G_k = outer(N_k) of one lane from its N, S_N and C_N (upper triangle 00, 01,
+/// 02, 11, 12, 22): G = c g(N), S_G = c g' S_N, C_G = c (g' C_N + g'' S_N S_N^T) (the identity
+/// without an outer function). Upper triangle of r.C only.
+inline void add_lane(const NetworkShape& sh, double omega, double Wn, const Eigen::Vector3d& S,
+                     const double* C, NetworkResponse& r) {
+  double gW = Wn, gS = 1.0, gC = 0.0;
+  if (sh.outer == 1) {
+    double g, dg, ddg;
+    network_outer(Wn, sh.outer_cap, g, dg, ddg);
+    gW = sh.outer_scale * g;
+    gS = sh.outer_scale * dg;
+    gC = sh.outer_scale * ddg;
+  }
+  const double s1 = omega * gS, s2 = omega * gC;
+  r.W += omega * gW;
+  r.S += s1 * S;
+  r.C(0, 0) += s1 * C[0] + s2 * S(0) * S(0);
+  r.C(0, 1) += s1 * C[1] + s2 * S(0) * S(1);
+  r.C(0, 2) += s1 * C[2] + s2 * S(0) * S(2);
+  r.C(1, 1) += s1 * C[3] + s2 * S(1) * S(1);
+  r.C(1, 2) += s1 * C[4] + s2 * S(1) * S(2);
+  r.C(2, 2) += s1 * C[5] + s2 * S(2) * S(2);
+}
+
 /// The lanes' weighted sum of outer(N_k) and its derivatives, before normalization. H1c, H2c,
 /// Kc > 0: sizes fixed at compile time (Eigen unrolls the lane products); 0: the shape's.
 template <int H1c, int H2c, int Kc>
@@ -140,24 +164,7 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
     const double Qe2 = Qk[2] * e0 + Qk[4] * e1 + Qk[5] * e2;
     Wn += 0.5 * (e0 * Qe0 + e1 * Qe1 + e2 * Qe2);
     S += Eigen::Vector3d(Qe0, Qe1, Qe2);
-    // The outer function (G = c g(N): S_G = c g' S_N, C_G = c (g' C_N + g'' S_N S_N^T)).
-    double gW = Wn, gS = 1.0, gC = 0.0;
-    if (sh.outer == 1) {
-      double g, dg, ddg;
-      network_outer(Wn, sh.outer_cap, g, dg, ddg);
-      gW = sh.outer_scale * g;
-      gS = sh.outer_scale * dg;
-      gC = sh.outer_scale * ddg;
-    }
-    const double ok = omega[k], s1 = ok * gS, s2 = ok * gC;
-    r.W += ok * gW;
-    r.S += s1 * S;
-    r.C(0, 0) += s1 * C[0] + s2 * S(0) * S(0);
-    r.C(0, 1) += s1 * C[1] + s2 * S(0) * S(1);
-    r.C(0, 2) += s1 * C[2] + s2 * S(0) * S(2);
-    r.C(1, 1) += s1 * C[3] + s2 * S(1) * S(1);
-    r.C(1, 2) += s1 * C[4] + s2 * S(1) * S(2);
-    r.C(2, 2) += s1 * C[5] + s2 * S(2) * S(2);
+    add_lane(sh, omega[k], Wn, S, C, r);
   }
   r.C(1, 0) = r.C(0, 1);
   r.C(2, 0) = r.C(0, 2);
@@ -424,25 +431,9 @@ NetworkResponse NetworkLanesAt::evaluate(const Eigen::Vector3d& e) const {
     double ls[40];  // per quantity m (N, S_N, C_N upper triangle) the 4 lanes at 4 m + k
     wide_(shape_.h1, shape_.h2, shape_.stiff1, shape_.stiff2, packed4_.data(), e.data(), ls);
     for (int k = 0; k < K_; ++k) {
-      const double Wn = ls[4 * 0 + k];
-      const Eigen::Vector3d S(ls[4 * 1 + k], ls[4 * 2 + k], ls[4 * 3 + k]);
-      double gW = Wn, gS = 1.0, gC = 0.0;
-      if (shape_.outer == 1) {
-        double g, dg, ddg;
-        network_outer(Wn, shape_.outer_cap, g, dg, ddg);
-        gW = shape_.outer_scale * g;
-        gS = shape_.outer_scale * dg;
-        gC = shape_.outer_scale * ddg;
-      }
-      const double ok = omega_[static_cast<std::size_t>(k)], s1 = ok * gS, s2 = ok * gC;
-      r.W += ok * gW;
-      r.S += s1 * S;
-      r.C(0, 0) += s1 * ls[4 * 4 + k] + s2 * S(0) * S(0);
-      r.C(0, 1) += s1 * ls[4 * 5 + k] + s2 * S(0) * S(1);
-      r.C(0, 2) += s1 * ls[4 * 6 + k] + s2 * S(0) * S(2);
-      r.C(1, 1) += s1 * ls[4 * 7 + k] + s2 * S(1) * S(1);
-      r.C(1, 2) += s1 * ls[4 * 8 + k] + s2 * S(1) * S(2);
-      r.C(2, 2) += s1 * ls[4 * 9 + k] + s2 * S(2) * S(2);
+      const double C[6] = {ls[16 + k], ls[20 + k], ls[24 + k], ls[28 + k], ls[32 + k], ls[36 + k]};
+      add_lane(shape_, omega_[static_cast<std::size_t>(k)], ls[k],
+               Eigen::Vector3d(ls[4 + k], ls[8 + k], ls[12 + k]), C, r);
     }
     r.C(1, 0) = r.C(0, 1);
     r.C(2, 0) = r.C(0, 2);
