@@ -8,9 +8,14 @@ out/results/<case>/results.h5, scripts/pipeline.mk), and prints per case and ove
 visited box (min/max of E11 = E_course, E22 = E_wale, |E12|), the 1/99 % quantiles and the
 fraction of samples inside the database box (docs/unit-cell.md, "Strain box").
 
-    /usr/bin/python3 scripts/strain_box.py out/results
-    /usr/bin/python3 scripts/strain_box.py out/results --box -0.35 0.45 -0.30 0.55 0.40
+    /usr/bin/python3 scripts/strain_box.py out/results --database out/database.h5
+    /usr/bin/python3 scripts/strain_box.py out/results --box -0.35 0.60 -0.30 0.55 0.40
+
+The box is the one the database was swept with (`--database`: load_paths.box of the sweep input
+stored in /sweep's attribute input_json), or `--box`; without either, the API's built-in
+StrainBox (E11 up to 0.45, not the default sweep's 0.60), and the first line says so.
 """
+import json
 import argparse
 import glob
 import os
@@ -38,6 +43,35 @@ def read_case(path):
     return np.vstack(rows) if rows else np.zeros((0, 3))
 
 
+class BadInput(Exception):
+    """Bad input: printed with the file and the path inside it, exit code 2."""
+
+
+def database_box(path):
+    """(E11_min, E11_max, E22_min, E22_max, E12_max) of the sweep input stored in a database;
+    a clear error naming the file and the HDF5 path or JSON key where it is missing."""
+    try:
+        f = h5py.File(path, "r")
+    except OSError as e:
+        raise BadInput("%s: not a readable HDF5 file (%s)" % (path, e))
+    with f:
+        if "sweep" not in f or "input_json" not in f["sweep"].attrs:
+            raise BadInput("%s: /sweep: attribute input_json missing (not a swept database?);"
+                             " give the box with --box" % path)
+        text = f["sweep"].attrs["input_json"]
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    try:
+        b = json.loads(text)["load_paths"]["box"]
+        box = (b["E11"][0], b["E11"][1], b["E22"][0], b["E22"][1], b["E12_max"])
+        box = tuple(float(v) for v in box)
+    except (KeyError, IndexError, TypeError, ValueError) as e:
+        raise BadInput("%s: /sweep input_json: /load_paths/box missing or malformed (%s); give "
+                         "the box with --box" % (path, e))
+    if not all(np.isfinite(box)) or not (box[0] < box[1] and box[2] < box[3] and box[4] > 0):
+        raise BadInput("%s: /sweep input_json: /load_paths/box is not a box: %s" % (path, box))
+    return box
+
+
 def inside(E, box):
     e11lo, e11hi, e22lo, e22hi, e12 = box
     return ((E[:, 0] >= e11lo) & (E[:, 0] <= e11hi) & (E[:, 1] >= e22lo) & (E[:, 1] <= e22hi) &
@@ -56,14 +90,26 @@ def line(name, E, box):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("results", help="directory searched recursively for results.h5")
-    ap.add_argument("--box", nargs=5, type=float, default=DEFAULT_BOX,
-                    metavar=("E11_MIN", "E11_MAX", "E22_MIN", "E22_MAX", "E12_MAX"))
+    src = ap.add_mutually_exclusive_group()
+    src.add_argument("--database", help="material database (.h5): use the box it was swept with")
+    src.add_argument("--box", nargs=5, type=float,
+                     metavar=("E11_MIN", "E11_MAX", "E22_MIN", "E22_MAX", "E12_MAX"))
     a = ap.parse_args()
+    origin = "given"
+    if a.database:
+        try:
+            a.box, origin = database_box(a.database), "of " + a.database
+        except BadInput as e:
+            print("error: %s" % e, file=sys.stderr)
+            return 2
+    elif a.box is None:
+        a.box, origin = DEFAULT_BOX, "the API's built-in default (no --database or --box)"
     files = sorted(glob.glob(os.path.join(a.results, "**", "results.h5"), recursive=True))
     if not files:
         print("no results.h5 under %s" % a.results, file=sys.stderr)
         return 2
-    print("database box: E11 [%+.2f, %+.2f], E22 [%+.2f, %+.2f], |E12| <= %.2f" % tuple(a.box))
+    print("box (%s): E11 [%+.2f, %+.2f], E22 [%+.2f, %+.2f], |E12| <= %.2f" %
+          ((origin,) + tuple(a.box)))
     allE = []
     for p in files:
         E = read_case(p)
