@@ -23,6 +23,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
     [](CLI::App& sub) {
       struct FitCli {
         std::string db, out, options, energy_options, law = "both";
+        int threads = 0;
       };
       auto o = std::make_shared<FitCli>();
       sub.add_option("database", o->db, "material database (.h5)")->required();
@@ -37,6 +38,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
           "energy_fit object of cases/sweep/default.json, {\"outer\": \"exp\", \"tube\": "
           "0.045, ...}; {\"family\": \"ridge\"} for the ridge-spline law)");
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
+      sub.add_option("--threads", o->threads,
+                     "threads of the energy-law fit (default 0: all cores, at most one per loop "
+                     "length; the law is the same for every count)")
+          ->check(CLI::Range(0, 4096));
       return [o]() -> int {
         using namespace knit::meso::fit;
         const std::string target = o->out.empty() ? o->db : o->out;
@@ -58,10 +63,11 @@ static knit::cli::SubcommandRegistrar reg_fit(
             if (!f.ok()) rc = knit::kExitFailure;
         }
         if (energy) {
-          const EnergyFitOptions eo =
-              o->energy_options.empty() ? EnergyFitOptions{}
-                                        : EnergyFitOptions::from_json(
-                                              read_text_file(o->energy_options), o->energy_options);
+          EnergyFitOptions eo = o->energy_options.empty()
+                                    ? EnergyFitOptions{}
+                                    : EnergyFitOptions::from_json(read_text_file(o->energy_options),
+                                                                  o->energy_options);
+          eo.threads = o->threads;
           const auto s = fit_energy_database(db, eo);
           std::cout << energy_fit_report(s);
           if (s.status == FitStatus::kRefused)

@@ -194,6 +194,7 @@ std::string EnergyFitOptions::validate() const {
   if (!(loss_scale > 0.0)) return "loss_scale must be positive";
   if (loss_rounds < 1 || loss_rounds > 50) return "loss_rounds must be in 1..50";
   if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (threads < 0) return "threads must be >= 0 (0: all cores)";
   if (!(weight_relative >= 0.0 && weight_relative <= 100.0))
     return "weight_relative must be in [0, 100] (0: absolute errors)";
   if (!(weight_uniaxial > 0.0 && weight_uniaxial <= 1e3))

@@ -25,11 +25,18 @@
 // network passes per point. The initial phi is drawn from a seeded normal distribution (same for
 // every knot, so the knots start coupled), with positive first-layer biases so that the smoothed
 // ReLUs start in their curved or linear part.
+//
+// Threads (EnergyFitOptions::threads, session 18): each loop length's points go to one thread,
+// in their order, and write only that knot's gradient block; the objective's terms are stored
+// per point and summed afterwards in the serial order. So every thread count gives the same
+// floating-point operations in the same order: the fitted law is the same to the last bit.
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include "fit_energy_data.hpp"
 #include "knit/material/convex_network.hpp"
@@ -45,7 +52,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
   NetworkObjective(NetworkShape shape, int knots, std::vector<Eigen::Vector3d> x,
                    std::vector<Eigen::Vector3d> t, std::vector<double> w, std::vector<int> knot,
                    double coupling, std::vector<double> tube, std::vector<double> tube_scale,
-                   double tube_weight)
+                   double tube_weight, int threads)
       : sh_(shape),
         n_(knots),
         x_(std::move(x)),
@@ -57,10 +64,15 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         tube_scale_(std::move(tube_scale)),
         tube_weight_(tube_weight / (3.0 * static_cast<double>(x_.size()))),
         theta_(static_cast<std::size_t>(knots * shape.size())),
-        gtheta_(theta_.size()) {
+        gtheta_(theta_.size()),
+        terms_(4 * x_.size()),
+        points_of_knot_(static_cast<std::size_t>(knots)),
+        threads_(std::max(1, std::min(threads, knots))) {
     double sum = 0.0;
     for (double v : w_) sum += v;
     scale_ = 1.0 / (3.0 * sum);
+    for (std::size_t p = 0; p < x_.size(); ++p)
+      points_of_knot_[static_cast<std::size_t>(knot_[p])].push_back(p);
   }
   int NumParameters() const override { return n_ * sh_.size(); }
 
@@ -96,46 +108,65 @@ class NetworkObjective : public ceres::FirstOrderFunction {
       S0[J] = dg0[J] * Eigen::Vector3d(r0.S(0), r0.S(1), 0.0);
       G0[J].setZero();
     }
-    for (std::size_t p = 0; p < x_.size(); ++p) {
-      const int j = knot_[p];
+    // One knot's points, in their order (see the file comment): terms_ gets each point's
+    // addends to f (0 where a term is absent: f + 0 = f exactly), gtheta_ and G0 that knot's
+    // blocks only.
+    const auto knot_terms = [&](int j) {
       const double* th = theta_.data() + j * P;
-      const Eigen::Vector3d& x = x_[p];
-      const Eigen::Vector3d mx(x(0), x(1), -x(2));
-      const material::NetworkResponse ra = material::network_evaluate(sh_, th, x, false);
-      const material::NetworkResponse rb = material::network_evaluate(sh_, th, mx, false);
-      // The outer function's slopes (1 and 0 without it): S_G = g'(N) S_N.
-      double ga = 0.0, dga = 1.0, ddga = 0.0, dgb = 1.0, ddgb = 0.0;
-      if (outer) {
-        material::network_outer(ra.W, sh_.outer_cap, ga, dga, ddga);
-        material::network_outer(rb.W, sh_.outer_cap, ga, dgb, ddgb);
-      }
-      const Eigen::Vector3d sa = dga * ra.S, sb = dgb * rb.S;
-      const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
-                                S0[static_cast<std::size_t>(j)] - t_[p];
-      f += scale_ * w_[p] * s.squaredNorm();
-      // The tube: each component's excess over tau_p, squared (C1), unweighted.
-      Eigen::Vector3d gt_tube = Eigen::Vector3d::Zero();
-      if (tube_weight_ > 0.0)
-        for (int c = 0; c < 3; ++c) {
-          const double ex = std::abs(s(c)) - tube_[p];
-          if (ex <= 0.0) continue;
-          const double tw = tube_weight_ * tube_scale_[p];
-          f += tw * ex * ex;
-          gt_tube(c) = 2.0 * tw * ex * (s(c) < 0.0 ? -1.0 : 1.0);
+      for (std::size_t p : points_of_knot_[static_cast<std::size_t>(j)]) {
+        double* term = terms_.data() + 4 * p;
+        const Eigen::Vector3d& x = x_[p];
+        const Eigen::Vector3d mx(x(0), x(1), -x(2));
+        const material::NetworkResponse ra = material::network_evaluate(sh_, th, x, false);
+        const material::NetworkResponse rb = material::network_evaluate(sh_, th, mx, false);
+        // The outer function's slopes (1 and 0 without it): S_G = g'(N) S_N.
+        double ga = 0.0, dga = 1.0, ddga = 0.0, dgb = 1.0, ddgb = 0.0;
+        if (outer) {
+          material::network_outer(ra.W, sh_.outer_cap, ga, dga, ddga);
+          material::network_outer(rb.W, sh_.outer_cap, ga, dgb, ddgb);
         }
-      if (!grad) continue;
-      const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s + gt_tube;  // d f / d S_W
-      const Eigen::Vector3d mg(g(0), g(1), -g(2));
-      double* gt = gtheta_.data() + j * P;
-      // d(g . g'(N) S_N) = g'(N) d(g . S_N) + g''(N) (g . S_N) dN.
-      material::network_stress_gradient(sh_, th, x, 0.5 * dga * g, gt);
-      material::network_stress_gradient(sh_, th, mx, 0.5 * dgb * mg, gt);
-      if (outer) {
-        material::network_value_gradient(sh_, th, x, 0.5 * ddga * g.dot(ra.S), gt);
-        material::network_value_gradient(sh_, th, mx, 0.5 * ddgb * mg.dot(rb.S), gt);
+        const Eigen::Vector3d sa = dga * ra.S, sb = dgb * rb.S;
+        const Eigen::Vector3d s = 0.5 * (sa + Eigen::Vector3d(sb(0), sb(1), -sb(2))) -
+                                  S0[static_cast<std::size_t>(j)] - t_[p];
+        term[0] = scale_ * w_[p] * s.squaredNorm();
+        // The tube: each component's excess over tau_p, squared (C1), unweighted.
+        Eigen::Vector3d gt_tube = Eigen::Vector3d::Zero();
+        for (int c = 0; c < 3; ++c) term[1 + c] = 0.0;
+        if (tube_weight_ > 0.0)
+          for (int c = 0; c < 3; ++c) {
+            const double ex = std::abs(s(c)) - tube_[p];
+            if (ex <= 0.0) continue;
+            const double tw = tube_weight_ * tube_scale_[p];
+            term[1 + c] = tw * ex * ex;
+            gt_tube(c) = 2.0 * tw * ex * (s(c) < 0.0 ? -1.0 : 1.0);
+          }
+        if (!grad) continue;
+        const Eigen::Vector3d g = (2.0 * scale_ * w_[p]) * s + gt_tube;  // d f / d S_W
+        const Eigen::Vector3d mg(g(0), g(1), -g(2));
+        double* gt = gtheta_.data() + j * P;
+        // d(g . g'(N) S_N) = g'(N) d(g . S_N) + g''(N) (g . S_N) dN.
+        material::network_stress_gradient(sh_, th, x, 0.5 * dga * g, gt);
+        material::network_stress_gradient(sh_, th, mx, 0.5 * dgb * mg, gt);
+        if (outer) {
+          material::network_value_gradient(sh_, th, x, 0.5 * ddga * g.dot(ra.S), gt);
+          material::network_value_gradient(sh_, th, mx, 0.5 * ddgb * mg.dot(rb.S), gt);
+        }
+        G0[static_cast<std::size_t>(j)] -= Eigen::Vector3d(g(0), g(1), 0.0);
       }
-      G0[static_cast<std::size_t>(j)] -= Eigen::Vector3d(g(0), g(1), 0.0);
+    };
+    if (threads_ == 1) {
+      for (int j = 0; j < n_; ++j) knot_terms(j);
+    } else {
+      std::atomic<int> next{0};
+      const auto work = [&] {
+        for (int j = next++; j < n_; j = next++) knot_terms(j);
+      };
+      std::vector<std::thread> pool;
+      for (int t = 1; t < threads_; ++t) pool.emplace_back(work);
+      work();
+      for (std::thread& t : pool) t.join();
     }
+    for (double v : terms_) f += v;  // the serial order: point by point, term by term
     if (grad) {
       for (int j = 0; j < n_; ++j) {
         const auto J = static_cast<std::size_t>(j);
@@ -178,6 +209,9 @@ class NetworkObjective : public ceres::FirstOrderFunction {
   double tube_weight_;
   double scale_ = 1.0;
   mutable std::vector<double> theta_, gtheta_;
+  mutable std::vector<double> terms_;                     // 4 addends to f per point
+  std::vector<std::vector<std::size_t>> points_of_knot_;  // each knot's points, in order
+  int threads_;
 };
 
 /// Initial phi of one knot (see the file comment).
@@ -271,9 +305,11 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   std::vector<double> phi(static_cast<std::size_t>(n * P));
   for (int j = 0; j < n; ++j) std::copy(phi0.begin(), phi0.end(), phi.begin() + j * P);
 
-  auto* objective = new NetworkObjective(sh, n, std::move(x), std::move(t), std::move(w),
-                                         std::move(knot), o.l_coupling, std::move(tube_of_point),
-                                         std::move(tube_scale), o.tube > 0.0 ? o.tube_weight : 0.0);
+  auto* objective = new NetworkObjective(
+      sh, n, std::move(x), std::move(t), std::move(w), std::move(knot), o.l_coupling,
+      std::move(tube_of_point), std::move(tube_scale), o.tube > 0.0 ? o.tube_weight : 0.0,
+      o.threads > 0 ? o.threads
+                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   ceres::GradientProblem problem(objective);  // takes ownership
   ceres::GradientProblemSolver::Options so;
   so.line_search_direction_type = ceres::LBFGS;

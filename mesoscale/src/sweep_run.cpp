@@ -296,7 +296,11 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   material::Database db = assemble_database(in, rep.results);
   const auto tf = std::chrono::steady_clock::now();
   if (in.fit) rep.fits = fit_sweep_database(db, in.fit_options, rep.threads);
-  if (in.fit && in.energy_fit) rep.energy_fit = fit::fit_energy_database(db, in.energy_fit_options);
+  if (in.fit && in.energy_fit) {
+    fit::EnergyFitOptions eo = in.energy_fit_options;
+    eo.threads = rep.threads;  // the cases' threads are idle by now
+    rep.energy_fit = fit::fit_energy_database(db, eo);
+  }
   rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
   rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_sweep_database(opt.output, db, in, rep.results, rep);

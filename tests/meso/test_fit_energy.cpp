@@ -148,6 +148,30 @@ TEST_CASE("energy fit: the network fit gives the same law from the same seed", "
   CHECK(fit_network(db, 100, 2).law.network.theta != s.law.network.theta);
 }
 
+TEST_CASE("energy fit: the network fit gives the same law for every thread count", "[unit]") {
+  // Each knot's points go to one thread, in order, and the objective's terms are summed in the
+  // serial order (mesoscale/src/fit_network.cpp), so the threads change no floating-point
+  // operation: the law is the same to the last bit. Three knots, so that two threads get
+  // unequal shares; the outer function and a tube, so that every term of the objective is there.
+  const Database db = synthetic_coverage_db({4.5, 5.5, 6.5}, 6);
+  EnergyFitOptions o = small_network(4, 3, 150);
+  o.outer = "exp";
+  o.tube = 0.01;
+  o.threads = 1;
+  const EnergyFitSummary one = fit_energy_law(db, o);
+  REQUIRE(one.ok());
+  for (int threads : {2, 3, 0}) {
+    INFO("threads " << threads);
+    o.threads = threads;
+    const EnergyFitSummary many = fit_energy_law(db, o);
+    REQUIRE(many.ok());
+    CHECK(many.law.network.theta == one.law.network.theta);
+    CHECK(many.ceres_iterations == one.ceres_iterations);
+  }
+  o.threads = -1;
+  CHECK(o.validate() == "threads must be >= 0 (0: all cores)");
+}
+
 TEST_CASE("energy fit: the monotonicity bound of the data", "[unit]") {
   // The gradient of a convex quadratic is monotone: no convex law need miss anything.
   Eigen::Matrix3d C;

@@ -128,6 +128,10 @@ struct EnergyFitOptions {
   /// where the cell is stable). Held-out paths are judged on every converged state. A value
   /// below -1 keeps every state.
   double stable_min_cos = 0.0;
+  /// Network family: worker threads of the fit (0: all cores; at most one per loop length).
+  /// Not a property of the law: every count gives the same law to the last bit
+  /// (mesoscale/src/fit_network.cpp), so it is not in to_json() / from_json().
+  int threads = 0;
 
   std::string validate() const;
   std::string to_json() const;
