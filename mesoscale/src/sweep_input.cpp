@@ -146,6 +146,12 @@ std::string SweepInput::job_definition() const {
   j["retry"] = {{"max_retries", retry.max_retries},
                 {"step_factor", retry.step_factor},
                 {"max_retries_coverage", retry.max_retries_extra}};
+  // Only when set, so that the job definitions (and checkpoints) of sweeps without it stay as
+  // they were.
+  if (retry.substeps_paper != 1 || retry.substeps_coverage != 1 || retry.substeps_holdout != 1)
+    j["substeps"] = {{"paper", retry.substeps_paper},
+                     {"coverage", retry.substeps_coverage},
+                     {"holdout", retry.substeps_holdout}};
   return j.dump();  // keys sorted (std::map): canonical
 }
 
@@ -222,6 +228,20 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     in.retry.step_factor = j.at("retry").value("step_factor", in.retry.step_factor);
     in.retry.max_retries_extra =
         j.at("retry").value("max_retries_coverage", in.retry.max_retries_extra);
+  }
+  if (j.contains("substeps")) {
+    const auto& s = j.at("substeps");
+    const auto get = [&](const char* key, int& v) {
+      if (!s.contains(key)) return;
+      const auto& x = s.at(key);
+      if (!x.is_number_integer() || x.get<int>() < 1 || x.get<int>() > 16)
+        throw InputError(file, std::string("/substeps/") + key,
+                         "must be an integer from 1 to 16 (cell solves per recorded step)");
+      v = x.get<int>();
+    };
+    get("paper", in.retry.substeps_paper);
+    get("coverage", in.retry.substeps_coverage);
+    get("holdout", in.retry.substeps_holdout);
   }
   if (j.contains("fit")) {
     const auto& f = j.at("fit");

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -88,7 +89,7 @@ JobResult run_job(const Job& job, const RetryPolicy& retry, const PathRunner& ru
   best.index = job.index;
   best.raw = subsample(RawPath{}, job.load_path, 1);
   int best_steps = -1;
-  int m = 1;
+  int m = std::max(1, retry.substeps_for(job.load_path));
   const int max_retries = retry.retries_for(job.load_path);
   for (int a = 0; a <= max_retries; ++a, m *= retry.step_factor) {
     material::LoadPath lp = job.load_path;

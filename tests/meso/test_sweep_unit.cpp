@@ -271,6 +271,62 @@ TEST_CASE("sweep job: non-convergence retried with smaller steps and the recorde
   CHECK(none.raw.status[0] == kStepFailed);
 }
 
+TEST_CASE("sweep job: substeps refine the first attempt per path set, the recorded steps stay",
+          "[unit]") {
+  // "substeps" (session 18): each recorded step is reached through that many cell solves on
+  // the first attempt; the database keeps the path's own steps (every m-th solve).
+  const auto in0 = synthetic_input(6);
+  const Job j = make_jobs(in0)[0];  // a paper path
+  REQUIRE(j.load_path.set == "paper");
+  const JobResult plain = run_job(j, in0.retry, synthetic_runner());
+  std::vector<int> seen;
+  const PathRunner counting = [&seen](double l, const LoadPath& p) {
+    seen.push_back(p.steps);
+    return synthetic_runner()(l, p);
+  };
+  SweepInput in = in0;
+  in.retry.substeps_paper = 3;
+  in.retry.substeps_coverage = 5;
+  const JobResult fine = run_job(j, in.retry, counting);
+  REQUIRE(seen == std::vector<int>{18});
+  CHECK(fine.status == JobStatus::kConverged);
+  CHECK(fine.attempts == 1);
+  CHECK(fine.step_factor == 3);
+  CHECK(fine.raw.status.size() == 6);
+  CHECK((fine.raw.F - plain.raw.F).cwiseAbs().maxCoeff() < 1e-14);
+  CHECK((fine.raw.S - plain.raw.S).cwiseAbs().maxCoeff() < 1e-12);
+  // Another set: its own count.
+  Job c = j;
+  c.load_path.set = "coverage";
+  seen.clear();
+  run_job(c, in.retry, counting);
+  CHECK(seen == std::vector<int>{30});
+  c.load_path.set = "holdout";
+  seen.clear();
+  run_job(c, in.retry, counting);
+  CHECK(seen == std::vector<int>{6});
+  // The input: parsed per set, bounds named by JSON pointer, and part of the job definition
+  // only when set (older checkpoints keep their identity).
+  const std::string base = knit_test::synthetic_sweep_json(6);
+  REQUIRE(base.back() == '}');
+  const auto with = [&](const std::string& extra) {
+    return base.substr(0, base.size() - 1) + ", " + extra + "}";
+  };
+  const SweepInput parsed = parse_sweep_input(with(R"("substeps": {"holdout": 4})"), "s.json");
+  CHECK(parsed.retry.substeps_holdout == 4);
+  CHECK(parsed.retry.substeps_paper == 1);
+  CHECK(parsed.retry.substeps_coverage == 1);
+  CHECK(parsed.job_definition() != in0.job_definition());
+  CHECK(parse_sweep_input(with(R"("substeps": {"holdout": 1})"), "s.json").job_definition() ==
+        in0.job_definition());
+  try {
+    parse_sweep_input(with(R"("substeps": {"coverage": 0})"), "s.json");
+    FAIL("substeps 0 accepted");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/substeps/coverage");
+  }
+}
+
 TEST_CASE(
     "sweep: any number of threads gives the same database and failed cases are kept and "
     "reported but not fitted",
