@@ -9,7 +9,7 @@ namespace knit::material {
 
 namespace {
 
-constexpr int kMaxUnits = 64;  // per layer: the evaluation keeps its work arrays on the stack
+constexpr int kMaxUnits = NetworkForward::kMaxUnits;  // per layer: work arrays on the stack
 
 /// Upper triangle of C += c a a^T.
 inline void add_outer(Eigen::Matrix3d& C, double c, const Eigen::Vector3d& a) {
@@ -58,27 +58,37 @@ std::string NetworkShape::validate() const {
   return {};
 }
 
+void network_forward(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                     NetworkForward& f) {
+  first_layer(sh, th, e, f.h.data(), f.dh.data(), f.ddh.data());
+  for (int j = 0; j < sh.h2; ++j)
+    network_unit_activation(sh.stiffening2(j), second_layer_input(sh, th, e, f.h.data(), j), f.u[j],
+                            f.du[j], f.ddu[j]);
+}
+
 NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
                                  bool with_C) {
-  std::array<double, kMaxUnits> h, dh, ddh, kappa;
-  const double *a0 = th + sh.a0(), *b0 = th + sh.b0(), *w1 = th + sh.w1(), *V = th + sh.V(),
-               *a1 = th + sh.a1(), *b1 = th + sh.b1(), *w = th + sh.w(), *L = th + sh.L();
+  NetworkForward f;
+  network_forward(sh, th, e, f);
+  return network_evaluate(sh, th, e, f, with_C);
+}
+
+NetworkResponse network_evaluate(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                                 const NetworkForward& f, bool with_C) {
+  std::array<double, kMaxUnits> kappa;
+  const double *a0 = th + sh.a0(), *w1 = th + sh.w1(), *V = th + sh.V(), *a1 = th + sh.a1(),
+               *w = th + sh.w(), *L = th + sh.L();
+  const double *h = f.h.data(), *dh = f.dh.data(), *ddh = f.ddh.data();
   const int H1 = sh.h1, H2 = sh.h2;
   NetworkResponse r;
   for (int i = 0; i < H1; ++i) {
-    const double* a = a0 + 3 * i;
-    network_unit_activation(sh.stiffening1(i), a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b0[i],
-                            h[i], dh[i], ddh[i]);
     r.W += w1[i] * h[i];
     kappa[i] = w1[i];
   }
   for (int j = 0; j < H2; ++j) {
     const double* a = a1 + 3 * j;
     const double* v = V + j * H1;
-    double z = a[0] * e(0) + a[1] * e(1) + a[2] * e(2) + b1[j];
-    for (int i = 0; i < H1; ++i) z += v[i] * h[i];
-    double u, du, ddu;
-    network_unit_activation(sh.stiffening2(j), z, u, du, ddu);
+    const double u = f.u[j], du = f.du[j], ddu = f.ddu[j];
     r.W += w[j] * u;
     const double wdu = w[j] * du;
     for (int i = 0; i < H1; ++i) kappa[i] += wdu * v[i];
@@ -131,22 +141,27 @@ NetworkResponse network_compose_outer(const NetworkShape& sh, const NetworkRespo
 
 void network_value_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
                             double scale, double* grad) {
+  NetworkForward f;
+  network_forward(sh, th, e, f);
+  network_value_gradient(sh, th, e, f, scale, grad);
+}
+
+void network_value_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                            const NetworkForward& f, double scale, double* grad) {
   // N = sum_j w_j u_j + sum_i w1_i h_i + 1/2 e^T L L^T e:
   //   dN/dw_j = u_j, dN/dw1_i = h_i, dN/dz_j = w_j u'_j (-> b1_j, a1_j e, V_ji h_i),
   //   dN/dy_i = kappa_i h'_i (-> b0_i, a0_i e), dN/dL = e (L^T e)^T.
-  std::array<double, kMaxUnits> h, dh, ddh, kappa;
+  std::array<double, kMaxUnits> kappa;
   const double *w1 = th + sh.w1(), *V = th + sh.V(), *w = th + sh.w(), *L = th + sh.L();
+  const double *h = f.h.data(), *dh = f.dh.data();
   const int H1 = sh.h1, H2 = sh.h2;
-  first_layer(sh, th, e, h.data(), dh.data(), ddh.data());
   for (int i = 0; i < H1; ++i) {
     kappa[i] = w1[i];
     grad[sh.w1() + i] += scale * h[i];
   }
   for (int j = 0; j < H2; ++j) {
     const double* v = V + j * H1;
-    double u, du, ddu;
-    network_unit_activation(sh.stiffening2(j), second_layer_input(sh, th, e, h.data(), j), u, du,
-                            ddu);
+    const double u = f.u[j], du = f.du[j];
     grad[sh.w() + j] += scale * u;
     const double dz = scale * w[j] * du;
     grad[sh.b1() + j] += dz;
@@ -170,15 +185,22 @@ void network_value_gradient(const NetworkShape& sh, const double* th, const Eige
 
 void network_stress_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
                              const Eigen::Vector3d& g, double* grad) {
+  NetworkForward f;
+  network_forward(sh, th, e, f);
+  network_stress_gradient(sh, th, e, f, g, grad);
+}
+
+void network_stress_gradient(const NetworkShape& sh, const double* th, const Eigen::Vector3d& e,
+                             const NetworkForward& f, const Eigen::Vector3d& g, double* grad) {
   // F = g . S. With alpha_i = a0_i . g, beta_j = a1_j . g, gamma_j = grad z_j . g:
   //   F = sum_i w1_i h'_i alpha_i + sum_j w_j u'_j gamma_j + g^T L L^T e,
   // zeta_j = dF/dz_j = w_j u''_j gamma_j, omega_j = dF/dgamma_j = w_j u'_j,
   // eta_i = dF/dy_i = h'_i sum_j zeta_j V_ji + h''_i kappa_i alpha_i.
-  std::array<double, kMaxUnits> h, dh, ddh, alpha, kappa, back;
+  std::array<double, kMaxUnits> alpha, kappa, back;
   const double *a0 = th + sh.a0(), *w1 = th + sh.w1(), *V = th + sh.V(), *a1 = th + sh.a1(),
                *w = th + sh.w(), *L = th + sh.L();
+  const double *h = f.h.data(), *dh = f.dh.data(), *ddh = f.ddh.data();
   const int H1 = sh.h1, H2 = sh.h2;
-  first_layer(sh, th, e, h.data(), dh.data(), ddh.data());
   for (int i = 0; i < H1; ++i) {
     const double* a = a0 + 3 * i;
     alpha[i] = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
@@ -191,9 +213,7 @@ void network_stress_gradient(const NetworkShape& sh, const double* th, const Eig
     const double* v = V + j * H1;
     double gamma = a[0] * g(0) + a[1] * g(1) + a[2] * g(2);
     for (int i = 0; i < H1; ++i) gamma += v[i] * dh[i] * alpha[i];
-    double u, du, ddu;
-    network_unit_activation(sh.stiffening2(j), second_layer_input(sh, th, e, h.data(), j), u, du,
-                            ddu);
+    const double du = f.du[j], ddu = f.ddu[j];
     const double zeta = w[j] * ddu * gamma, omega = w[j] * du;
     grad[sh.w() + j] += du * gamma;
     grad[sh.b1() + j] += zeta;

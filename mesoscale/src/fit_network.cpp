@@ -113,12 +113,15 @@ class NetworkObjective : public ceres::FirstOrderFunction {
     // blocks only.
     const auto knot_terms = [&](int j) {
       const double* th = theta_.data() + j * P;
+      material::NetworkForward fa, fb;  // each pass's activations, once per point
       for (std::size_t p : points_of_knot_[static_cast<std::size_t>(j)]) {
         double* term = terms_.data() + 4 * p;
         const Eigen::Vector3d& x = x_[p];
         const Eigen::Vector3d mx(x(0), x(1), -x(2));
-        const material::NetworkResponse ra = material::network_evaluate(sh_, th, x, false);
-        const material::NetworkResponse rb = material::network_evaluate(sh_, th, mx, false);
+        material::network_forward(sh_, th, x, fa);
+        material::network_forward(sh_, th, mx, fb);
+        const material::NetworkResponse ra = material::network_evaluate(sh_, th, x, fa, false);
+        const material::NetworkResponse rb = material::network_evaluate(sh_, th, mx, fb, false);
         // The outer function's slopes (1 and 0 without it): S_G = g'(N) S_N.
         double ga = 0.0, dga = 1.0, ddga = 0.0, dgb = 1.0, ddgb = 0.0;
         if (outer) {
@@ -145,11 +148,11 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         const Eigen::Vector3d mg(g(0), g(1), -g(2));
         double* gt = gtheta_.data() + j * P;
         // d(g . g'(N) S_N) = g'(N) d(g . S_N) + g''(N) (g . S_N) dN.
-        material::network_stress_gradient(sh_, th, x, 0.5 * dga * g, gt);
-        material::network_stress_gradient(sh_, th, mx, 0.5 * dgb * mg, gt);
+        material::network_stress_gradient(sh_, th, x, fa, 0.5 * dga * g, gt);
+        material::network_stress_gradient(sh_, th, mx, fb, 0.5 * dgb * mg, gt);
         if (outer) {
-          material::network_value_gradient(sh_, th, x, 0.5 * ddga * g.dot(ra.S), gt);
-          material::network_value_gradient(sh_, th, mx, 0.5 * ddgb * mg.dot(rb.S), gt);
+          material::network_value_gradient(sh_, th, x, fa, 0.5 * ddga * g.dot(ra.S), gt);
+          material::network_value_gradient(sh_, th, mx, fb, 0.5 * ddgb * mg.dot(rb.S), gt);
         }
         G0[static_cast<std::size_t>(j)] -= Eigen::Vector3d(g(0), g(1), 0.0);
       }

@@ -33,6 +33,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -136,6 +137,22 @@ struct NetworkResponse {
 NetworkResponse network_evaluate(const NetworkShape& shape, const double* theta,
                                  const Eigen::Vector3d& e, bool with_C = true);
 
+/// One network pass's unit activations at e and their first two derivatives (network_forward),
+/// so that the fit computes them once per point for the value, the stress and both reverse-mode
+/// gradients below (session 18); every function given one computes exactly what it computes
+/// without it, to the last bit.
+struct NetworkForward {
+  static constexpr int kMaxUnits = 64;       ///< per layer
+  std::array<double, kMaxUnits> h, dh, ddh;  ///< first layer
+  std::array<double, kMaxUnits> u, du, ddu;  ///< second layer
+};
+void network_forward(const NetworkShape& shape, const double* theta, const Eigen::Vector3d& e,
+                     NetworkForward& f);
+/// network_evaluate from the pass f = network_forward(shape, theta, e).
+NetworkResponse network_evaluate(const NetworkShape& shape, const double* theta,
+                                 const Eigen::Vector3d& e, const NetworkForward& f,
+                                 bool with_C = true);
+
 /// g, g', g'' of the exponential outer function at n (see NetworkShape::outer).
 inline void network_outer(double n, double cap, double& g, double& dg, double& ddg) {
   if (n <= cap) {
@@ -157,11 +174,19 @@ NetworkResponse network_compose_outer(const NetworkShape& shape, const NetworkRe
 /// outer function's fit needs it).
 void network_value_gradient(const NetworkShape& shape, const double* theta,
                             const Eigen::Vector3d& e, double scale, double* grad);
+/// The same from the pass f = network_forward(shape, theta, e).
+void network_value_gradient(const NetworkShape& shape, const double* theta,
+                            const Eigen::Vector3d& e, const NetworkForward& f, double scale,
+                            double* grad);
 
 /// Reverse mode: grad += d(g . S_N(e; theta))/d theta (the fit's gradient, by hand; checked
 /// against finite differences in tests/test_material_convex_network.cpp).
 void network_stress_gradient(const NetworkShape& shape, const double* theta,
                              const Eigen::Vector3d& e, const Eigen::Vector3d& g, double* grad);
+/// The same from the pass f = network_forward(shape, theta, e).
+void network_stress_gradient(const NetworkShape& shape, const double* theta,
+                             const Eigen::Vector3d& e, const NetworkForward& f,
+                             const Eigen::Vector3d& g, double* grad);
 
 /// The mirror-averaged, normalized law at one theta (see above), floor excluded. Holds theta
 /// re-laid out for vectorized evaluation (first-layer weights by column, their pairwise
