@@ -36,6 +36,7 @@
 #include <atomic>
 #include <cmath>
 #include <random>
+#include <system_error>
 #include <thread>
 
 #include "fit_energy_data.hpp"
@@ -165,7 +166,12 @@ class NetworkObjective : public ceres::FirstOrderFunction {
         for (int j = next++; j < n_; j = next++) knot_terms(j);
       };
       std::vector<std::thread> pool;
-      for (int t = 1; t < threads_; ++t) pool.emplace_back(work);
+      try {
+        for (int t = 1; t < threads_; ++t) pool.emplace_back(work);
+      } catch (const std::system_error&) {
+        // No more threads to be had: the ones started (and this one) do all the knots, with
+        // the same result (see the file comment).
+      }
       work();
       for (std::thread& t : pool) t.join();
     }
