@@ -25,3 +25,33 @@ def stress_range(paths):
     component over its fit data (every path but the held-out ones)."""
     s = np.concatenate([p[2] for p in paths if p[0] != "holdout"])
     return max(s[:, c].max() - s[:, c].min() for c in range(3))
+
+
+def stored_sweep_input(db, path):
+    """The sweep input stored in an open database (/sweep attribute input_json), as a dict;
+    exits with an error naming the file and the HDF5 path when it is missing."""
+    import json
+    if "sweep" not in db or "input_json" not in db["sweep"].attrs:
+        raise SystemExit("error: %s: /sweep has no attribute input_json (not a sweep's "
+                         "database)" % path)
+    v = db["sweep"].attrs["input_json"]
+    return json.loads(v.decode() if isinstance(v, bytes) else str(v))
+
+
+def run_sweep(knit_meso, sweep, work, name, threads, what):
+    """Writes `sweep` (a dict) to WORK/NAME.json (WORK: a new kept temporary directory when
+    None), runs `knit-meso sweep` on it into WORK/NAME.h5 and returns that path; `what` says
+    what is run, in the line printed before."""
+    import json
+    import os
+    import subprocess
+    import tempfile
+    work = work or tempfile.mkdtemp(prefix=name + "_")
+    os.makedirs(work, exist_ok=True)
+    inp, out = os.path.join(work, name + ".json"), os.path.join(work, name + ".h5")
+    with open(inp, "w") as fh:
+        json.dump(sweep, fh, indent=1)
+    print("running %s: %s sweep %s -o %s" % (what, knit_meso, inp, out), flush=True)
+    subprocess.run([knit_meso, "sweep", inp, "-o", out, "--threads", str(threads), "--force",
+                    "--plain", "--no-progress"], check=True)
+    return out

@@ -29,17 +29,14 @@ and how many of those the law meets within 5 %. numpy and h5py only: run with
 /usr/bin/python3 (tests/report/test_cell_uniqueness.py).
 """
 import argparse
-import json
 import os
-import subprocess
 import sys
-import tempfile
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from cell_paths import stress_range  # noqa: E402
+from cell_paths import run_sweep, stored_sweep_input, stress_range  # noqa: E402
 
 
 def _text(v):
@@ -182,24 +179,14 @@ def main(argv=None):
     if not os.path.isfile(a.db):
         raise SystemExit("error: %s: no such file" % a.db)
     db = h5py.File(a.db, "r")
-    if "sweep" not in db or "input_json" not in db["sweep"].attrs:
-        raise SystemExit("error: %s: /sweep has no attribute input_json (not a sweep's "
-                         "database)" % a.db)
-    stored = json.loads(_text(db["sweep"].attrs["input_json"]))
+    stored = stored_sweep_input(db, a.db)
     paths = selected_paths(db, a.set)
     if not paths:
         raise SystemExit("error: %s: no gradient or biaxial path of set %r in /loop_0/raw" %
                          (a.db, a.set))
     extra, counts = twin_extras(paths, a.steps_factor)
-    work = a.work or tempfile.mkdtemp(prefix="cell_uniqueness_")
-    os.makedirs(work, exist_ok=True)
-    inp, out = os.path.join(work, "twins.json"), os.path.join(work, "twins.h5")
-    with open(inp, "w") as fh:
-        json.dump(sweep_input(stored, extra), fh, indent=1)
-    print("running %d twin paths x %d loop lengths: %s sweep %s -o %s" %
-          (len(extra), len(stored["loop_lengths"]), a.knit_meso, inp, out), flush=True)
-    subprocess.run([a.knit_meso, "sweep", inp, "-o", out, "--threads", str(a.threads),
-                    "--force", "--plain", "--no-progress"], check=True)
+    out = run_sweep(a.knit_meso, sweep_input(stored, extra), a.work, "twins", a.threads,
+                    "%d twin paths x %d loop lengths" % (len(extra), len(stored["loop_lengths"])))
     law_of = (lambda l: load_law(db["energy_law"], l)) if "energy_law" in db else None
     rows, summary = compare(db, h5py.File(out, "r"), paths, counts, law_of, a.tol)
     print("%6s %-9s %-24s %8s  %s" % ("l mm", "path", "end (E11, E22, 2E12)", "spread",

@@ -22,17 +22,14 @@ writes nothing into DB.h5. --between reuses such a run instead. numpy and h5py o
 (tests/report/test_law_between_loops.py).
 """
 import argparse
-import json
 import os
-import subprocess
 import sys
-import tempfile
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from cell_paths import load_paths, stress_range  # noqa: E402
+from cell_paths import load_paths, run_sweep, stored_sweep_input, stress_range  # noqa: E402
 
 THRESHOLD = 0.05
 
@@ -121,21 +118,11 @@ def main(argv=None):
         raise SystemExit("error: --set must be all, paper, coverage or holdout")
     out = a.between
     if out is None:
-        if "sweep" not in db or "input_json" not in db["sweep"].attrs:
-            raise SystemExit("error: %s: /sweep has no attribute input_json (not a sweep's "
-                             "database)" % a.db)
-        stored = json.loads(_text(db["sweep"].attrs["input_json"]))
+        stored = stored_sweep_input(db, a.db)
         knots = [float(x) for x in np.array(db["loop_lengths"])]
-        work = a.work or tempfile.mkdtemp(prefix="law_between_loops_")
-        os.makedirs(work, exist_ok=True)
-        inp, out = os.path.join(work, "between.json"), os.path.join(work, "between.h5")
-        with open(inp, "w") as fh:
-            json.dump(sweep_input(stored, between_points(knots, a.per_span)), fh, indent=1)
-        print("running the database's paths at %s mm: %s sweep %s -o %s" %
-              (", ".join("%g" % x for x in between_points(knots, a.per_span)), a.knit_meso, inp,
-               out), flush=True)
-        subprocess.run([a.knit_meso, "sweep", inp, "-o", out, "--threads", str(a.threads),
-                        "--force", "--plain", "--no-progress"], check=True)
+        ls = between_points(knots, a.per_span)
+        out = run_sweep(a.knit_meso, sweep_input(stored, ls), a.work, "between", a.threads,
+                        "the database's paths at %s mm" % ", ".join("%g" % x for x in ls))
     if not os.path.isfile(out):
         raise SystemExit("error: %s: no such file" % out)
     rows = compare(db, h5py.File(out, "r"), a.set)

@@ -197,16 +197,16 @@ template <class VT>
   return r;
 }
 
-template <class v4, int H1c, int H2c>
+template <class VT, int H1c, int H2c>
 [[gnu::always_inline]] inline void lanes4_body(int h1, int h2, int stiff1, int stiff2,
                                                const double* q, const double* e, double* out) {
   const int H1 = H1c > 0 ? H1c : h1, H2 = H2c > 0 ? H2c : h2;
-  constexpr int L = sizeof(v4) / sizeof(double);
+  constexpr int L = sizeof(VT) / sizeof(double);
   const auto ld4 = [](const double* p) __attribute__((always_inline)) {
-    return ldv<v4>(p);
+    return ldv<VT>(p);
   };
   const auto splat4 = [](double x) __attribute__((always_inline)) {
-    return splatv<v4>(x);
+    return splatv<VT>(x);
   };
   const double* F1 = q;                 // [f][i][lane], f: c0 c1 c2 b0 w1 p00 p01 p02 p11 p12 p22
   const double* Vp = q + 11 * H1 * L;   // [j][i][lane]
@@ -221,47 +221,47 @@ template <class v4, int H1c, int H2c>
   const auto vv = [&](int j, int i) __attribute__((always_inline)) {
     return ld4(Vp + (j * H1 + i) * L);
   };
-  const v4 E0 = splat4(e[0]), E1 = splat4(e[1]), E2 = splat4(e[2]);
-  const v4 one = splat4(1.0), mone = splat4(-1.0), zero = splat4(0.0);
-  const auto act = [&](v4 x, bool stiff, v4& s, v4& ds, v4& dds) __attribute__((always_inline)) {
+  const VT E0 = splat4(e[0]), E1 = splat4(e[1]), E2 = splat4(e[2]);
+  const VT one = splat4(1.0), mone = splat4(-1.0), zero = splat4(0.0);
+  const auto act = [&](VT x, bool stiff, VT& s, VT& ds, VT& dds) __attribute__((always_inline)) {
     if (!stiff) {
-      v4 xc = x < mone ? mone : x;
+      VT xc = x < mone ? mone : x;
       xc = xc > one ? one : xc;
-      const v4 x2 = xc * xc;
+      const VT x2 = xc * xc;
       s = 0.75 * (0.5 * x2 - x2 * x2 * (1.0 / 12.0)) + 0.5 * xc + 3.0 / 16.0 +
           (x > one ? x - one : zero);
       ds = 0.75 * (xc - x2 * xc * (1.0 / 3.0)) + 0.5;
       dds = 0.75 * (one - x2);
     } else {
-      const v4 xp = x > zero ? x : zero;
+      const VT xp = x > zero ? x : zero;
       dds = xp;
       ds = 0.5 * xp * xp;
       s = ds * xp / 3.0;
     }
   };
-  v4 h[kMaxUnitsPerLane], dh[kMaxUnitsPerLane], ddh[kMaxUnitsPerLane];
+  VT h[kMaxUnitsPerLane], dh[kMaxUnitsPerLane], ddh[kMaxUnitsPerLane];
   for (int i = 0; i < H1; ++i)
     act(f1(0, i) * E0 + f1(1, i) * E1 + f1(2, i) * E2 + f1(3, i), i >= H1 - stiff1, h[i], dh[i],
         ddh[i]);
-  v4 u[kMaxUnitsPerLane], du[kMaxUnitsPerLane], ddu[kMaxUnitsPerLane], wd[kMaxUnitsPerLane];
-  v4 W = zero, S0 = zero, S1 = zero, S2 = zero;
+  VT u[kMaxUnitsPerLane], du[kMaxUnitsPerLane], ddu[kMaxUnitsPerLane], wd[kMaxUnitsPerLane];
+  VT W = zero, S0 = zero, S1 = zero, S2 = zero;
   for (int j = 0; j < H2; ++j) {
-    v4 z = zero;
+    VT z = zero;
     for (int i = 0; i < H1; ++i) z += vv(j, i) * h[i];
     z += f2(0, j) * E0 + f2(1, j) * E1 + f2(2, j) * E2 + f2(3, j);
     act(z, j >= H2 - stiff2, u[j], du[j], ddu[j]);
-    const v4 wj = f2(4, j);
+    const VT wj = f2(4, j);
     wd[j] = wj * du[j];
     W += wj * u[j];
     S0 += wd[j] * f2(0, j);
     S1 += wd[j] * f2(1, j);
     S2 += wd[j] * f2(2, j);
   }
-  v4 C[6] = {zero, zero, zero, zero, zero, zero};
+  VT C[6] = {zero, zero, zero, zero, zero, zero};
   for (int i = 0; i < H1; ++i) {
-    v4 kappa = f1(4, i);
+    VT kappa = f1(4, i);
     for (int j = 0; j < H2; ++j) kappa += vv(j, i) * wd[j];
-    const v4 kd = kappa * dh[i], kdd = kappa * ddh[i];
+    const VT kd = kappa * dh[i], kdd = kappa * ddh[i];
     W += f1(4, i) * h[i];
     S0 += kd * f1(0, i);
     S1 += kd * f1(1, i);
@@ -270,13 +270,13 @@ template <class v4, int H1c, int H2c>
   }
   // Second-layer curvature, for the units curved in some lane (c_j = 0 in the others).
   for (int j = 0; j < H2; ++j) {
-    const v4 cj = f2(4, j) * ddu[j];
+    const VT cj = f2(4, j) * ddu[j];
     bool flat = true;
     for (int l = 0; l < L; ++l) flat = flat && cj[l] == 0.0;
     if (flat) continue;
-    v4 g0 = f2(0, j), g1 = f2(1, j), g2 = f2(2, j);
+    VT g0 = f2(0, j), g1 = f2(1, j), g2 = f2(2, j);
     for (int i = 0; i < H1; ++i) {
-      const v4 vd = vv(j, i) * dh[i];
+      const VT vd = vv(j, i) * dh[i];
       g0 += vd * f1(0, i);
       g1 += vd * f1(1, i);
       g2 += vd * f1(2, i);
@@ -284,13 +284,13 @@ template <class v4, int H1c, int H2c>
     add_outer_upper(C, cj, g0, g1, g2);
   }
   // 1/2 e^T Q e.
-  v4 Qm[6];
+  VT Qm[6];
   for (int m = 0; m < 6; ++m) Qm[m] = ld4(Qp + L * m);
-  const v4 Qe0 = Qm[0] * E0 + Qm[1] * E1 + Qm[2] * E2;
-  const v4 Qe1 = Qm[1] * E0 + Qm[3] * E1 + Qm[4] * E2;
-  const v4 Qe2 = Qm[2] * E0 + Qm[4] * E1 + Qm[5] * E2;
+  const VT Qe0 = Qm[0] * E0 + Qm[1] * E1 + Qm[2] * E2;
+  const VT Qe1 = Qm[1] * E0 + Qm[3] * E1 + Qm[4] * E2;
+  const VT Qe2 = Qm[2] * E0 + Qm[4] * E1 + Qm[5] * E2;
   W += 0.5 * (E0 * Qe0 + E1 * Qe1 + E2 * Qe2);
-  const v4 res[10] = {W,
+  const VT res[10] = {W,
                       S0 + Qe0,
                       S1 + Qe1,
                       S2 + Qe2,
@@ -300,7 +300,7 @@ template <class v4, int H1c, int H2c>
                       C[3] + Qm[3],
                       C[4] + Qm[4],
                       C[5] + Qm[5]};
-  for (int m = 0; m < 10; ++m) std::memcpy(out + L * m, &res[m], sizeof(v4));
+  for (int m = 0; m < 10; ++m) std::memcpy(out + L * m, &res[m], sizeof(VT));
 }
 
 /// The kernel's entry points: 12 / 6 units (the default) with compiled sizes, any other shape
