@@ -15,7 +15,6 @@ The box is the one the database was swept with (`--database`: load_paths.box of 
 stored in /sweep's attribute input_json), or `--box`; without either, the API's built-in
 StrainBox (E11 up to 0.45, not the default sweep's 0.60), and the first line says so.
 """
-import json
 import argparse
 import glob
 import os
@@ -23,6 +22,9 @@ import sys
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cell_paths import stored_sweep_input  # noqa: E402
 
 # The default box of knit/material/load_paths.hpp (StrainBox): E11, E22 ranges and |E12| bound.
 DEFAULT_BOX = (-0.35, 0.45, -0.30, 0.55, 0.40)
@@ -55,18 +57,19 @@ def database_box(path):
     except OSError as e:
         raise BadInput("%s: not a readable HDF5 file (%s)" % (path, e))
     with f:
-        if "sweep" not in f or "input_json" not in f["sweep"].attrs:
-            raise BadInput("%s: /sweep: attribute input_json missing (not a swept database?);"
-                             " give the box with --box" % path)
-        text = f["sweep"].attrs["input_json"]
-    text = text.decode() if isinstance(text, bytes) else str(text)
+        try:
+            stored = stored_sweep_input(f, path)
+        except SystemExit as e:
+            raise BadInput("%s; give the box with --box" % str(e).replace("error: ", "", 1))
+        except ValueError as e:
+            raise BadInput("%s: /sweep input_json: not JSON (%s)" % (path, e))
     try:
-        b = json.loads(text)["load_paths"]["box"]
+        b = stored["load_paths"]["box"]
         box = (b["E11"][0], b["E11"][1], b["E22"][0], b["E22"][1], b["E12_max"])
         box = tuple(float(v) for v in box)
     except (KeyError, IndexError, TypeError, ValueError) as e:
         raise BadInput("%s: /sweep input_json: /load_paths/box missing or malformed (%s); give "
-                         "the box with --box" % (path, e))
+                       "the box with --box" % (path, e))
     if not all(np.isfinite(box)) or not (box[0] < box[1] and box[2] < box[3] and box[4] > 0):
         raise BadInput("%s: /sweep input_json: /load_paths/box is not a box: %s" % (path, box))
     return box

@@ -392,29 +392,22 @@ void NetworkLanesAt::build(const NetworkShape& shape,
   // The four-wide kernel's layout (four lanes only, where the processor has AVX2).
   wide_ = K_ == 4 && kernel == LanesKernel::kAuto ? wide_kernel(H1, H2) : nullptr;
   packed4_.clear();
-  if (!wide_) {
-    W0_ = 0.0;
-    S0_.setZero();
-    const NetworkResponse n0 = evaluate(Eigen::Vector3d::Zero());
-    W0_ = n0.W;
-    S0_ = n0.S;
-    S0_(2) = 0.0;
-    return;
-  }
-  const int L = K_;
-  packed4_.assign(static_cast<std::size_t>(L * (11 * H1 + H2 * H1 + 5 * H2 + 6)), 0.0);
-  double* F1 = packed4_.data();
-  double* V4 = F1 + 11 * H1 * L;
-  double* F2 = V4 + H2 * H1 * L;
-  double* Q4 = F2 + 5 * H2 * L;
-  for (int k = 0; k < L; ++k) {
-    for (int f = 0; f < 11; ++f)
-      for (int i = 0; i < H1; ++i) F1[(f * H1 + i) * L + k] = q[f * N1 + k * H1 + i];
-    for (int j = 0; j < H2; ++j)
-      for (int i = 0; i < H1; ++i) V4[(j * H1 + i) * L + k] = V[(k * H2 + j) * H1 + i];
-    for (int f = 0; f < 5; ++f)
-      for (int j = 0; j < H2; ++j) F2[(f * H2 + j) * L + k] = a1[f * N2 + k * H2 + j];
-    for (int m = 0; m < 6; ++m) Q4[m * L + k] = Q_[static_cast<std::size_t>(6 * k + m)];
+  if (wide_) {
+    const int L = K_;
+    packed4_.assign(static_cast<std::size_t>(L * (11 * H1 + H2 * H1 + 5 * H2 + 6)), 0.0);
+    double* F1 = packed4_.data();
+    double* V4 = F1 + 11 * H1 * L;
+    double* F2 = V4 + H2 * H1 * L;
+    double* Q4 = F2 + 5 * H2 * L;
+    for (int k = 0; k < L; ++k) {
+      for (int f = 0; f < 11; ++f)
+        for (int i = 0; i < H1; ++i) F1[(f * H1 + i) * L + k] = q[f * N1 + k * H1 + i];
+      for (int j = 0; j < H2; ++j)
+        for (int i = 0; i < H1; ++i) V4[(j * H1 + i) * L + k] = V[(k * H2 + j) * H1 + i];
+      for (int f = 0; f < 5; ++f)
+        for (int j = 0; j < H2; ++j) F2[(f * H2 + j) * L + k] = a1[f * N2 + k * H2 + j];
+      for (int m = 0; m < 6; ++m) Q4[m * L + k] = Q_[static_cast<std::size_t>(6 * k + m)];
+    }
   }
   W0_ = 0.0;
   S0_.setZero();

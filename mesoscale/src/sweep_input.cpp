@@ -229,19 +229,11 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     in.retry.max_retries_extra =
         j.at("retry").value("max_retries_coverage", in.retry.max_retries_extra);
   }
-  if (j.contains("substeps")) {
+  if (j.contains("substeps")) {  // bounds: the schema's (1 to 16)
     const auto& s = j.at("substeps");
-    const auto get = [&](const char* key, int& v) {
-      if (!s.contains(key)) return;
-      const auto& x = s.at(key);
-      if (!x.is_number_integer() || x.get<int>() < 1 || x.get<int>() > 16)
-        throw InputError(file, std::string("/substeps/") + key,
-                         "must be an integer from 1 to 16 (cell solves per recorded step)");
-      v = x.get<int>();
-    };
-    get("paper", in.retry.substeps_paper);
-    get("coverage", in.retry.substeps_coverage);
-    get("holdout", in.retry.substeps_holdout);
+    in.retry.substeps_paper = s.value("paper", in.retry.substeps_paper);
+    in.retry.substeps_coverage = s.value("coverage", in.retry.substeps_coverage);
+    in.retry.substeps_holdout = s.value("holdout", in.retry.substeps_holdout);
   }
   if (j.contains("fit")) {
     const auto& f = j.at("fit");

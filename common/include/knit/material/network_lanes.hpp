@@ -59,8 +59,8 @@ class NetworkLanesAt {
   std::vector<double> packed_;
   /// Per lane: weight omega_k and Q = L L^T (upper triangle: 00, 01, 02, 11, 12, 22).
   std::vector<double> omega_, Q_;
-  /// The same, unit-major for the four-wide kernel: [field][unit][lane], 4 lanes (a two-lane
-  /// law fills lanes 2 and 3 with copies of 0 and 1 at weight 0).
+  /// The same, unit-major for the four-wide kernel: [field][unit][lane], 4 lanes (empty when
+  /// the portable code evaluates).
   std::vector<double> packed4_;
   WideKernel wide_ = nullptr;
   double W0_ = 0.0;
