@@ -188,10 +188,14 @@ std::string EnergyFitOptions::validate() const {
   if (l_degree < 0 || l_degree > 5) return "l_degree must be in 0..5";
   if (l_control_points < 1 || l_control_points > 50) return "l_control_points must be in 1..50";
   if (!(s_margin >= 0.0 && s_margin <= 10.0)) return "s_margin must be in [0, 10]";
-  if (!std::isfinite(floor)) return "floor must be finite";
+  // Upper bounds where larger values overflow the objective (floor 1e308: "Initial cost and
+  // jacobian evaluation failed"); the default laws' floors are 0.17-0.19 MPa, their stress
+  // ranges 20-33 MPa.
+  if (!(std::isfinite(floor) && floor <= 1e3))
+    return "floor must be <= 1000 MPa (< 0: floor_relative times the data's secant stiffness)";
   if (!(floor_relative >= 0.0 && floor_relative < 1.0)) return "floor_relative must be in [0, 1)";
-  if (!(smoothing >= 0.0 && std::isfinite(smoothing))) return "smoothing must be >= 0";
-  if (!(loss_scale > 0.0)) return "loss_scale must be positive";
+  if (!(smoothing >= 0.0 && smoothing <= 1e3)) return "smoothing must be in [0, 1000]";
+  if (!(loss_scale > 0.0 && loss_scale <= 1e3)) return "loss_scale must be in (0, 1000]";
   if (loss_rounds < 1 || loss_rounds > 50) return "loss_rounds must be in 1..50";
   if (max_iterations < 1) return "max_iterations must be >= 1";
   if (threads < 0) return "threads must be >= 0 (0: all cores)";
@@ -714,12 +718,21 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     for (const auto& g : s.gave_way) os << " " << g << (&g == &s.gave_way.back() ? "" : ",");
     os << "\n";
   }
+  // A direction without a uniaxial path (NaN) says so instead of printing "nan".
+  const auto ratio = [](double r) {
+    std::ostringstream t;
+    if (std::isfinite(r))
+      t << r;
+    else
+      t << "no path";
+    return t.str();
+  };
   for (const auto& p : d.per_loop)
     if (p.uniaxial_end_ratio.array().isFinite().any())
       os << "    l = " << p.loop_length
          << " mm, uniaxial stress (lateral stress of the law zero): law / cell axial stress at the "
             "end, course "
-         << p.uniaxial_end_ratio(0) << ", wale " << p.uniaxial_end_ratio(1)
+         << ratio(p.uniaxial_end_ratio(0)) << ", wale " << ratio(p.uniaxial_end_ratio(1))
          << "; largest |law / cell - 1| where the cell's stress is >= 10 % of its path's largest: "
          << 100 * p.uniaxial_max_relative << " %\n";
   if (d.holdout_points > 0)

@@ -135,9 +135,13 @@ std::string FitOptions::validate() const {
   if (degree1 > 9 || degree2 > 9 || shear_degree > 9) return "degrees must be <= 9";
   if (n_ctrl1 < degree1 + 1 || n_ctrl2 < degree2 + 1 || shear_n_ctrl < shear_degree + 1)
     return "the number of control points must be at least degree + 1";
-  if (!(smoothing >= 0.0)) return "smoothing must be >= 0";
-  if (!(loss_scale > 0.0)) return "loss_scale must be positive";
-  if (!(foot_point_penalty >= 0.0)) return "foot_point_penalty must be >= 0";
+  // Upper bounds: beyond them the weights overflow (smoothing 1e308 made the residuals
+  // infinite and Ceres failed with a message that named no option); they are 1e10 times the
+  // defaults or more, far past any value that changes the fit.
+  if (!(smoothing >= 0.0 && smoothing <= 1e3)) return "smoothing must be in [0, 1000]";
+  if (!(loss_scale > 0.0 && loss_scale <= 1e3)) return "loss_scale must be in (0, 1000]";
+  if (!(foot_point_penalty >= 0.0 && foot_point_penalty <= 1e3))
+    return "foot_point_penalty must be in [0, 1000]";
   if (max_iterations < 1) return "max_iterations must be >= 1";
   return {};
 }

@@ -172,6 +172,22 @@ TEST_CASE("energy fit: the network fit gives the same law for every thread count
   CHECK(o.validate() == "threads must be >= 0 (0: all cores)");
 }
 
+TEST_CASE("energy fit: a floor or weights large enough to overflow are refused", "[unit]") {
+  // floor 1e308 ended in "Initial cost and jacobian evaluation failed", naming no option.
+  EnergyFitOptions o;
+  CHECK(o.validate().empty());
+  o.floor = 1e308;
+  CHECK(o.validate().find("floor must be <= 1000 MPa") == 0);
+  o.floor = 1e3;
+  CHECK(o.validate().empty());
+  o.floor = -1.0;
+  o.smoothing = 1e308;
+  CHECK(o.validate() == "smoothing must be in [0, 1000]");
+  o.smoothing = 1e-9;
+  o.loss_scale = 1e308;
+  CHECK(o.validate() == "loss_scale must be in (0, 1000]");
+}
+
 TEST_CASE("energy fit: the monotonicity bound of the data", "[unit]") {
   // The gradient of a convex quadratic is monotone: no convex law need miss anything.
   Eigen::Matrix3d C;
@@ -433,6 +449,12 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
     CHECK(dg.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
     CHECK(dg.per_loop[1].uniaxial_max_relative == Approx(1.0 - 1.0 / scale).margin(1e-6));
     CHECK(std::isnan(dg.per_loop[1].uniaxial_end_ratio(0)));
+    // The report says so for the course (no course-wise path here) instead of "nan".
+    EnergyFitSummary with = s;
+    with.diagnostics = dg;
+    const std::string report = energy_fit_report(with);
+    CHECK(report.find("course no path, wale ") != std::string::npos);
+    CHECK(report.find("nan") == std::string::npos);
   }
 }
 

@@ -238,3 +238,21 @@ TEST_CASE("fit: the initial_stiffness option is read, written and checked", "[un
   CHECK_THROWS_WITH(FitOptions::from_json(R"({"initial_stiffness": "zero"})", "o.json"),
                     Catch::Contains("o.json") && Catch::Contains("/initial_stiffness"));
 }
+
+TEST_CASE("fit: weights large enough to overflow are refused with the option's name", "[unit]") {
+  // smoothing 1e308 made the residuals infinite: Ceres failed without naming an option, and
+  // foot_point_penalty 1e308 ended the foot-point solves in invalid steps with exit code 0.
+  FitOptions o;
+  CHECK(o.validate().empty());
+  o.smoothing = 1e308;
+  CHECK(o.validate() == "smoothing must be in [0, 1000]");
+  o.smoothing = 1e3;
+  CHECK(o.validate().empty());
+  o.foot_point_penalty = 1e308;
+  CHECK(o.validate() == "foot_point_penalty must be in [0, 1000]");
+  o.foot_point_penalty = 1e-4;
+  o.loss_scale = 1e308;
+  CHECK(o.validate() == "loss_scale must be in (0, 1000]");
+  CHECK_THROWS_WITH(FitOptions::from_json(R"({"smoothing": 1e308})", "o.json"),
+                    Catch::Contains("o.json") && Catch::Contains("smoothing must be in"));
+}

@@ -327,6 +327,36 @@ TEST_CASE("sweep job: substeps refine the first attempt per path set, the record
   }
 }
 
+TEST_CASE("sweep input: fit options large enough to overflow are refused by JSON pointer",
+          "[unit]") {
+  // Found by feeding each option 1e308: the paper fit's smoothing then failed inside Ceres and
+  // the energy fit's floor at its first evaluation, neither naming the option.
+  const std::string base = knit_test::synthetic_sweep_json(6);
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    const auto at = base.find(from);
+    REQUIRE(at != std::string::npos);
+    return std::string(base).replace(at, from.size(), to);
+  };
+  CHECK_NOTHROW(parse_sweep_input(base, "s.json"));
+  const std::pair<std::string, std::string> cases[] = {
+      {R"("smoothing": 1e-6)", R"("smoothing": 1e308)"},
+      {R"("smoothing": 1e-6)", R"("smoothing": 1e-6, "foot_point_penalty": 1e308)"},
+      {R"("network_iterations": 100)", R"("network_iterations": 100, "floor": 1e308)"},
+      {R"("network_iterations": 100)", R"("network_iterations": 100, "smoothing": 1e308)"}};
+  const char* pointers[] = {"/fit/smoothing", "/fit/foot_point_penalty", "/energy_fit/floor",
+                            "/energy_fit/smoothing"};
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    INFO(pointers[i]);
+    try {
+      parse_sweep_input(replaced(cases[i].first, cases[i].second), "s.json");
+      FAIL("accepted");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == pointers[i]);
+      CHECK(std::string(e.what()).find("must be <= 1000") != std::string::npos);
+    }
+  }
+}
+
 TEST_CASE(
     "sweep: any number of threads gives the same database and failed cases are kept and "
     "reported but not fitted",
