@@ -101,7 +101,10 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
                   jobs[i].load_path.steps, r.attempts, r.message.c_str());
     }
   }
-  std::printf("wrote %s\n", output.c_str());
+  if (rep.wrote_database)
+    std::printf("wrote %s\n", output.c_str());
+  else
+    std::printf("database NOT written: %s\n", rep.not_written.c_str());
   std::fflush(stdout);
 }
 

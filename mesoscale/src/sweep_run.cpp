@@ -293,6 +293,17 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
 
   // ---- assemble, fit, write (rank 0) -----------------------------------------------------
   for (const Job& j : jobs) rep.results.push_back(finished.at(j.index));
+  // Nothing converged (every loop length too short for the cell's geometry, say): a database
+  // without a single state would replace whatever the output holds. Leave it as it was.
+  if (std::none_of(rep.results.begin(), rep.results.end(),
+                   [](const JobResult& r) { return r.converged_steps() > 0; })) {
+    rep.not_written =
+        "no case converged a single step; " + opt.output.string() + " is left as it was";
+    rep.seconds_total =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!opt.keep_parts) store->remove();
+    return rep;
+  }
   material::Database db = assemble_database(in, rep.results);
   const auto tf = std::chrono::steady_clock::now();
   if (in.fit) rep.fits = fit_sweep_database(db, in.fit_options, rep.threads);

@@ -587,3 +587,27 @@ TEST_CASE("sweep: an infeasible fit is refused from the input, before any case r
   CHECK_NOTHROW(run_sweep(nofit, quiet(dir / "nofit.h5"), counting));
   CHECK(calls == 1);
 }
+
+TEST_CASE("sweep: a sweep in which no case converged leaves the output as it was", "[unit]") {
+  // Found with a loop length of 1 mm (too short for the cell's geometry): every case failed,
+  // and the sweep replaced the database already at the output by one without a state.
+  const auto dir = knit_test::scratch("sweep_unit_nothing");
+  const auto out = dir / "db.h5";
+  {
+    std::ofstream f(out);
+    f << "an earlier database";
+  }
+  const SweepReport r =
+      run_sweep(synthetic_input(), quiet(out), [](double, const LoadPath&) -> PathOutcome {
+        throw std::runtime_error("cell geometry: could not match the loop length");
+      });
+  CHECK_FALSE(r.wrote_database);
+  CHECK(r.not_written.find("no case converged a single step") != std::string::npos);
+  CHECK_FALSE(r.ok());
+  CHECK(r.failed_cases() == static_cast<int>(r.results.size()));
+  std::ifstream f(out);
+  std::stringstream text;
+  text << f.rdbuf();
+  CHECK(text.str() == "an earlier database");
+  CHECK_FALSE(std::filesystem::exists(out.string() + ".parts"));
+}

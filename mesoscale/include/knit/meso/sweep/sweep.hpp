@@ -46,13 +46,16 @@ struct SweepReport {
   double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
   int threads = 1, ranks = 1;
   bool wrote_database = false;  ///< false on ranks other than 0
+  /// Why rank 0 did not write the database (empty: it did, or another rank): a sweep in which
+  /// no case converged a single step stores nothing, and the output is left as it was.
+  std::string not_written;
   /// Cases that fail the sweep: a paper path that did not converge to its end, or a runner
   /// error on any path. Coverage and held-out paths may stop early where the cell jams or
   /// buckles (issue 11): they are kept with their step status, counted by stopped_cases().
   int failed_cases() const;
   int stopped_cases() const;
   bool fits_ok() const;
-  bool ok() const { return failed_cases() == 0 && fits_ok(); }
+  bool ok() const { return failed_cases() == 0 && fits_ok() && not_written.empty(); }
 };
 
 /// True if this result makes the sweep fail (see SweepReport::failed_cases).
