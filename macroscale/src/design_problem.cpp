@@ -139,6 +139,21 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
                      "the case names no applied displacement (output.applied_displacement)");
   o.at_strain = numbers(j.at("at_strain"), file, p + "/at_strain");
   if (o.at_strain.empty()) throw InputError(file, p + "/at_strain", "needs at least one strain");
+  // The design solves the case at the load factors lambda = eps L / Delta_1 of these strains,
+  // and the case's loading ends at lambda = 1: a strain of the other sign, 0 or beyond the
+  // case's end is refused here, by pointer (123456789 ran to a load of 1e48 N and exit code 0;
+  // 0 and -1 failed in the solve, naming no field).
+  const double end = c.output.applied->value / c.output.applied->gauge_length;
+  for (std::size_t k = 0; k < o.at_strain.size(); ++k) {
+    const double lambda = o.at_strain[k] / end;
+    if (!(std::isfinite(lambda) && lambda > 0.0 && lambda <= 1.0 + 1e-12))
+      throw InputError(file, p + "/at_strain/" + std::to_string(k),
+                       "must lie between 0 (excluded) and " + fmt(end) +
+                           ", the case's applied strain at its end (output.applied_displacement: " +
+                           fmt(c.output.applied->value) + " mm over the gauge length " +
+                           fmt(c.output.applied->gauge_length) + " mm), got " +
+                           fmt(o.at_strain[k]));
+  }
   const bool targets = o.kind != DesignObjective::Kind::kStrainVariance &&
                        o.kind != DesignObjective::Kind::kReactionLinearity;
   if (o.kind == DesignObjective::Kind::kReactionLinearity) {

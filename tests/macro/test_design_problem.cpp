@@ -125,6 +125,20 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
                             "target": [1]}])"),
          "/objectives/0/target");
+  // Strains outside the case's loading (it ends at 4 mm / 20 mm = 0.2): 123456789 ran to a
+  // load of 1e48 N with exit code 0, and 0 failed in the solve naming no field.
+  expect("beyond_end.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.25],
+                            "target": [1, 2]}])"),
+         "/objectives/0/at_strain/1");
+  expect("zero_strain.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0],
+                            "target": [1]}])"),
+         "/objectives/0/at_strain/0");
+  expect("huge_target.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                            "target": [1e308]}])"),
+         "/objectives/0/target/0");
   expect("tied_twice.json",
          design(R"([{"field": "stitch_value", "indices": [0], "lower": 4.5, "upper": 6.5},
                     {"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}])",
