@@ -265,6 +265,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
             const auto h = f.attribute_doubles(p, "H");
             if (h.size() != 4) throw InputError(fname, p, "attribute H must have 4 values");
             r.path.H << h[0], h[1], h[2], h[3];
+            if (!r.path.H.allFinite()) throw InputError(fname, p, "attribute H must be finite");
           }
           r.path.set = f.has_attribute(p, "set") ? f.attribute_string(p, "set") : "paper";
           if (!is_valid_path_set(r.path.set))
@@ -276,6 +277,8 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           const auto t = f.attribute_doubles(p, "target");
           if (t.size() != 2) throw InputError(fname, p, "attribute target must have 2 values");
           r.path.target = {t[0], t[1]};
+          if (!r.path.target.allFinite())
+            throw InputError(fname, p, "attribute target must be finite");
           r.path.steps = f.attribute_int(p, "steps");
           for (const char* d : {"F", "P", "E", "S", "status"}) require_dataset(p + "/" + d);
           r.F = f.read_matrix(p + "/F");
@@ -289,6 +292,24 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
             throw InputError(fname, p,
                              "F, P must be steps x 4 and E, S steps x 3 with steps = " +
                                  std::to_string(n) + " (the length of status)");
+          // A converged step is data: its numbers must be finite (found by writing NaN into F:
+          // `knit-meso fit` copied it into the refitted database with exit code 0).
+          for (Eigen::Index s = 0; s < n; ++s) {
+            const int st = r.status[static_cast<std::size_t>(s)];
+            if (st < 0 || st > 2)
+              throw InputError(fname, p + "/status",
+                               "step " + std::to_string(s + 1) + ": status " + std::to_string(st) +
+                                   " (0 converged, 1 did not converge, 2 not reached)");
+            if (st != 0) continue;
+            for (const auto& [d, m] : {std::pair<const char*, const RowMatrixX*>{"F", &r.F},
+                                       {"P", &r.P},
+                                       {"E", &r.E},
+                                       {"S", &r.S}})
+              if (!m->row(s).allFinite())
+                throw InputError(fname, p + "/" + d,
+                                 "step " + std::to_string(s + 1) +
+                                     " is marked converged (status 0) but is not finite");
+          }
           e.raw.push_back(std::move(r));
         }
       }

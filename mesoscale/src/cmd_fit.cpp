@@ -74,6 +74,14 @@ static knit::cli::SubcommandRegistrar reg_fit(
             throw knit::InputError(o->db, "", "energy law refused: " + s.reason);
           if (!s.ok()) rc = knit::kExitFailure;
         }
+        // A fit that failed writes nothing: the database would otherwise carry the laws that
+        // were fitted beside the old law of the one that failed (or none), and replacing the
+        // input would lose its consistent state (found with a stress of 1e308 MPa in the raw
+        // data). The target is left as it was.
+        if (rc != knit::kExitOk) {
+          std::cout << "database NOT written: a fit failed; " << target << " is left as it was\n";
+          return rc;
+        }
         db.provenance = knit::material::current_provenance();
         knit::material::write_database(target, db);
         return rc;

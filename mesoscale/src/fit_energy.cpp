@@ -164,6 +164,23 @@ EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int 
     return out;
   }
   out.diagnostics = diagnose_energy_law(out.law, db, o.stable_min_cos);
+  // A law whose errors against its own data are not finite is not a result (found with one
+  // stress of 1e308 MPa in the raw data: the fit "succeeded" with a floor of 1.6e306 MPa and an
+  // rms of inf, exit code 0).
+  for (const auto& p : out.diagnostics.per_loop)
+    if (!(p.rms.allFinite() && p.max.allFinite() && std::isfinite(p.max_relative) &&
+          std::isfinite(p.rms_relative) && std::isfinite(p.stress_range))) {
+      std::ostringstream m;
+      m << "the law's errors against the data are not finite (at l = " << p.loop_length
+        << " mm: rms " << p.rms.transpose() << " MPa); the data's stress ranges:";
+      for (const auto& q : out.diagnostics.per_loop)
+        m << " " << q.stress_range << " MPa at " << q.loop_length << " mm"
+          << (&q == &out.diagnostics.per_loop.back() ? "" : ",");
+      m << " (are the raw stresses in MPa?)";
+      out.status = FitStatus::kSolverFailed;
+      out.reason = m.str();
+      return out;
+    }
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();
   return out;
@@ -505,18 +522,20 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
     // A tiny ridge keeps M definite where no datum and no penalty reaches a coefficient.
     const double ridge = 1e-12 * std::max(M.diagonal().maxCoeff(), 1e-300) + 1e-14 / (sK * sK);
     M.diagonal().array() += ridge;
-    // With the ridge, a finite M is positive definite (the active-set solve checks each passive
-    // block's factor as it goes); no full factorization is needed here.
-    if (!M.allFinite() || !rhs.allFinite()) {
-      out.status = FitStatus::kSolverFailed;
-      out.reason = "the normal matrix is not finite (non-finite data?)";
-      return out;
-    }
     // The exact minimizer over x >= 0 (active set, knit/meso/fit/nnls.hpp), in the unknowns
     // y = x / sK, which are O(1): M and rhs scaled in place. Until session 14 Ceres' bounded
     // trust region solved this and stopped short of the optimum (KKT violation 5 % of |b|).
     M *= sK * sK;
     rhs *= sK;
+    // With the ridge, a finite M is positive definite (the active-set solve checks each passive
+    // block's factor as it goes); no full factorization is needed here. Checked after the
+    // scaling: a stress of 1e308 MPa left M finite and overflowed it there, and nnls_normal
+    // threw out of the fit.
+    if (!M.allFinite() || !rhs.allFinite()) {
+      out.status = FitStatus::kSolverFailed;
+      out.reason = "the normal matrix is not finite (non-finite or overflowing data?)";
+      return out;
+    }
     const NnlsResult qp = nnls_normal(M, rhs);
     out.ceres_iterations += qp.iterations;
     if (!qp.converged || !(qp.kkt <= 1e-8)) {

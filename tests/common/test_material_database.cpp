@@ -1,6 +1,7 @@
 // Material database file: round trip, atomic write, and the errors for bad files.
 #include <catch2/catch.hpp>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -133,6 +134,32 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
       f.write("/loop_0/fit/knots_1", std::vector<double>{0, 0, 1});
     }
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("/loop_0/fit: response surface"));
+  }
+  SECTION("non-finite or unknown raw data") {
+    // A converged step is data: NaN in it is refused with its dataset and step (NaN in F was
+    // copied into a refitted database with exit code 0), and so are a status other than 0, 1,
+    // 2 and a non-finite path definition. A NaN in a step that did not converge is no data.
+    const auto expect = [&](auto&& change, const std::string& what) {
+      auto db = small_db();
+      change(db.entries[1].raw[2]);
+      const auto f = tmp("nonfinite.h5");
+      write_database(f, db);
+      CHECK_THROWS_WITH(read_database(f), Catch::Contains(what));
+    };
+    expect([](RawPath& r) { r.F(1, 2) = std::nan(""); },
+           "/loop_1/raw/path_02/F: step 2 is marked converged (status 0) but is not finite");
+    expect([](RawPath& r) { r.S(3, 0) = INFINITY; },
+           "/loop_1/raw/path_02/S: step 4 is marked converged");
+    expect([](RawPath& r) { r.status[1] = 9; },
+           "/loop_1/raw/path_02/status: step 2: status 9 (0 converged, 1 did not converge, 2 "
+           "not reached)");
+    expect([](RawPath& r) { r.path.target(1) = std::nan(""); },
+           "/loop_1/raw/path_02: attribute target must be finite");
+    auto db = small_db();
+    db.entries[1].raw[2].P(2, 0) = std::nan("");  // step 3 did not converge (status 1)
+    const auto f = tmp("nonfinite_unconverged.h5");
+    write_database(f, db);
+    CHECK_NOTHROW(read_database(f));
   }
   SECTION("unfitted database used by the macroscale") {
     auto db = small_db();

@@ -467,6 +467,21 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     CHECK_THAT(s.reason,
                Catch::Contains("/loop_1/raw/path_03: step 3") && Catch::Contains("not finite"));
   }
+  SECTION("data so large that the law's errors overflow") {
+    // One stress of 1e308 MPa: the fit once "succeeded" with a floor of 1.6e306 MPa and an rms
+    // error of inf. A law whose errors against its own data are not finite is no result.
+    Database db = synthetic_coverage_db({4.5, 6.5}, 4);
+    db.entries[1].raw[3].S(2, 1) = 1e308;
+    EnergyFitOptions ridge;
+    ridge.family = "ridge";
+    const auto s = fit_energy_law(db, ridge);
+    CHECK_FALSE(s.ok());
+    CHECK_THAT(s.reason, Catch::Contains("the normal matrix is not finite"));
+    const auto n = fit_energy_law(db, small_network(4, 3, 50));
+    CHECK_FALSE(n.ok());
+    CHECK_THAT(n.reason, Catch::Contains("the law's errors against the data are not finite") &&
+                             Catch::Contains("1e+308 MPa at 6.5 mm"));
+  }
   SECTION("a loop length without usable data") {
     Database db = synthetic_coverage_db({4.5, 6.5}, 4);
     for (auto& r : db.entries[0].raw) std::fill(r.status.begin(), r.status.end(), 1);
