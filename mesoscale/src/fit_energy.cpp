@@ -181,6 +181,16 @@ EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int 
       out.reason = m.str();
       return out;
     }
+  const auto& d = out.diagnostics;
+  if (!(d.holdout_rms.allFinite() && d.holdout_max.allFinite() &&
+        std::isfinite(d.holdout_max_relative))) {
+    std::ostringstream m;
+    m << "the law's errors against the held-out data are not finite (rms "
+      << d.holdout_rms.transpose() << " MPa): a held-out state's stress overflows";
+    out.status = FitStatus::kSolverFailed;
+    out.reason = m.str();
+    return out;
+  }
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();
   return out;

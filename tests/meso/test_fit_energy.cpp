@@ -481,6 +481,17 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     CHECK_FALSE(n.ok());
     CHECK_THAT(n.reason, Catch::Contains("the law's errors against the data are not finite") &&
                              Catch::Contains("1e+308 MPa at 6.5 mm"));
+    // The same in a held-out state: the fit is fine, its held-out errors are not.
+    Database h = synthetic_coverage_db({4.5, 6.5}, 4);
+    const auto held =
+        std::find_if(h.entries[1].raw.begin(), h.entries[1].raw.end(),
+                     [](const material::RawPath& r) { return r.path.set == "holdout"; });
+    REQUIRE(held != h.entries[1].raw.end());
+    held->S(0, 0) = 1e308;  // held-out paths are single states
+    const auto hs = fit_energy_law(h, ridge);
+    CHECK_FALSE(hs.ok());
+    CHECK_THAT(hs.reason, Catch::Contains("the law's errors against the held-out data are not "
+                                          "finite"));
   }
   SECTION("a loop length without usable data") {
     Database db = synthetic_coverage_db({4.5, 6.5}, 4);
