@@ -164,32 +164,33 @@ EnergyFitSummary& finish_fit(const Database& db, const EnergyFitOptions& o, int 
     return out;
   }
   out.diagnostics = diagnose_energy_law(out.law, db, o.stable_min_cos);
-  // A law whose errors against its own data are not finite is not a result (found with one
-  // stress of 1e308 MPa in the raw data: the fit "succeeded" with a floor of 1.6e306 MPa and an
-  // rms of inf, exit code 0).
-  for (const auto& p : out.diagnostics.per_loop)
+  // A law whose errors against its own data (or the held-out data) are not finite is not a
+  // result (found with one stress of 1e308 MPa in the raw data: the fit "succeeded" with a
+  // floor of 1.6e306 MPa and an rms of inf, exit code 0).
+  const auto failed = [&out](const std::ostringstream& m) -> EnergyFitSummary& {
+    out.status = FitStatus::kSolverFailed;
+    out.reason = m.str();
+    return out;
+  };
+  const auto& d = out.diagnostics;
+  for (const auto& p : d.per_loop)
     if (!(p.rms.allFinite() && p.max.allFinite() && std::isfinite(p.max_relative) &&
           std::isfinite(p.rms_relative) && std::isfinite(p.stress_range))) {
       std::ostringstream m;
       m << "the law's errors against the data are not finite (at l = " << p.loop_length
         << " mm: rms " << p.rms.transpose() << " MPa); the data's stress ranges:";
-      for (const auto& q : out.diagnostics.per_loop)
+      for (const auto& q : d.per_loop)
         m << " " << q.stress_range << " MPa at " << q.loop_length << " mm"
-          << (&q == &out.diagnostics.per_loop.back() ? "" : ",");
+          << (&q == &d.per_loop.back() ? "" : ",");
       m << " (are the raw stresses in MPa?)";
-      out.status = FitStatus::kSolverFailed;
-      out.reason = m.str();
-      return out;
+      return failed(m);
     }
-  const auto& d = out.diagnostics;
   if (!(d.holdout_rms.allFinite() && d.holdout_max.allFinite() &&
         std::isfinite(d.holdout_max_relative))) {
     std::ostringstream m;
     m << "the law's errors against the held-out data are not finite (rms "
       << d.holdout_rms.transpose() << " MPa): a held-out state's stress overflows";
-    out.status = FitStatus::kSolverFailed;
-    out.reason = m.str();
-    return out;
+    return failed(m);
   }
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();

@@ -17,11 +17,16 @@ int run(const std::string& args) {
   const int rc = std::system(cmd.c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
+
+/// The tests' scratch directory (created).
+fs::path scratch_dir() {
+  const fs::path dir = scratch_dir();
+  return dir;
+}
 }  // namespace
 
 TEST_CASE("knit-meso synth --no-fit, then fit, refits from the raw data", "[unit]") {
-  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_synth.h5";
   REQUIRE(run("synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
   auto raw = knit::material::read_database(db);
@@ -44,8 +49,7 @@ TEST_CASE("knit-meso synth --no-fit, then fit, refits from the raw data", "[unit
 
 TEST_CASE("knit-meso synth writes the energy law; fit --law energy adds it to a v1 file",
           "[unit]") {
-  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_synth_energy.h5";
   REQUIRE(run("synth --steps 8 --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
   const auto a = knit::material::read_database(db, false);
@@ -75,8 +79,7 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   // One stress of 1e308 MPa in the raw data: the energy fit fails (its normal matrix
   // overflows), and the database, refitted in place, was still written. A raw-only file and
   // the ridge family keep the test fast (the network fit took 45 s under the sanitizers).
-  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
-  fs::create_directories(dir);
+  const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_fit_fails.h5";
   REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
   const fs::path ridge = dir / "cli_fit_fails_ridge.json";
