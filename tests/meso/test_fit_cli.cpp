@@ -20,7 +20,8 @@ int run(const std::string& args) {
 
 /// The tests' scratch directory (created).
 fs::path scratch_dir() {
-  const fs::path dir = scratch_dir();
+  const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
+  fs::create_directories(dir);
   return dir;
 }
 }  // namespace
