@@ -90,7 +90,12 @@ def main():
             "the sweep input keeps the database's cell and paths")
     c(stored["loop_lengths"] == [4.5, 6.5], "the stored input is not modified")
 
-    tmp = tempfile.mkdtemp(prefix="law_between_loops_test_")
+    with tempfile.TemporaryDirectory(prefix="law_between_loops_test_") as tmp:
+        return file_checks(c, tmp)
+
+
+def file_checks(c, tmp):
+    """The checks on files (a database and cell runs in `tmp`, removed afterwards)."""
     db, runs = os.path.join(tmp, "db.h5"), os.path.join(tmp, "runs.h5")
     write_db(db)
     write_runs(runs, db)
