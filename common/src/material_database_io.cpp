@@ -258,8 +258,17 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           } catch (const std::invalid_argument& ex) {
             throw InputError(fname, p, std::string("attribute kind: ") + ex.what());
           }
-          // axis, H and set came with issue 11; older files have biaxial/shear paths of the
-          // paper's set only.
+          // axis, H and set came with issue 11 (format 2); older files have biaxial/shear paths
+          // of the paper's set only. From format 2 on they are always written: a missing one is
+          // a damaged file, not an old one (a deleted set read as "paper" put coverage paths
+          // into the eq. 17 fan and held-out paths into the fit).
+          if (db.format_version >= 2)
+            for (const char* a : {"axis", "H", "set"})
+              if (!f.has_attribute(p, a))
+                throw InputError(fname, p,
+                                 std::string("attribute ") + a + " is missing (format " +
+                                     std::to_string(db.format_version) +
+                                     " writes axis, H and set on every path)");
           if (f.has_attribute(p, "axis")) r.path.axis = f.attribute_int(p, "axis");
           if (f.has_attribute(p, "H")) {
             const auto h = f.attribute_doubles(p, "H");

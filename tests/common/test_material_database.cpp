@@ -161,6 +161,26 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     write_database(f, db);
     CHECK_NOTHROW(read_database(f));
   }
+  SECTION("a path attribute of format 2 missing") {
+    // Deleting /loop_k/raw/path_q's set read it as "paper": a coverage path joined the eq. 17
+    // fan and a held-out path the fit, silently. From format 2 on it is a damaged file.
+    for (const char* a : {"set", "H", "axis"}) {
+      const auto bad = tmp("noset.h5");
+      fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        f.remove_attribute("/loop_1/raw/path_03", a);
+      }
+      CHECK_THROWS_WITH(read_database(bad),
+                        Catch::Contains(std::string("/loop_1/raw/path_03: attribute ") + a +
+                                        " is missing (format 3 writes axis, H and set"));
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        f.set_attribute(".", "format_version", 1);
+      }
+      CHECK_NOTHROW(read_database(bad));  // a version-1 file never had them
+    }
+  }
   SECTION("unfitted database used by the macroscale") {
     auto db = small_db();
     db.entries[1].surface.reset();
