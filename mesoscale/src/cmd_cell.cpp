@@ -62,7 +62,16 @@ int run(const Options& o) {
   if (!(go.gamma_over_w >= 0 && go.gamma_over_w <= 1))
     throw knit::InputError("", "--gamma-over-w", "must be in [0, 1]");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
-  const CellGeometry g = make_cell_geometry(o.loop_length, go);
+  const CellGeometry g = [&] {
+    try {
+      return make_cell_geometry(o.loop_length, go);
+    } catch (const std::runtime_error& e) {  // a loop too short for w and d
+      throw knit::InputError("", "--loop-length",
+                             "no cell geometry for " + std::to_string(o.loop_length) +
+                                 " mm with yarn diameter " + std::to_string(go.d) +
+                                 " mm: " + e.what());
+    }
+  }();
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
 
   std::vector<Polyline> lines;

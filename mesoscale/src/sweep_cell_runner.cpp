@@ -4,8 +4,10 @@
 // it at F* = I and then follows the path step by step from the last converged state; it is
 // deterministic and shares nothing with concurrent calls.
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
 #include "knit/meso/homog/uniaxial.hpp"
@@ -25,6 +27,21 @@ homog::CellOptions cell_options(const SweepInput& in) {
 
 PathRunner cell_runner(const SweepInput& in) {
   const homog::CellOptions co = cell_options(in);
+  // Every loop length's cell is built once before any case runs: one the geometry cannot be
+  // made for (a loop too short for its wale width and yarn diameter) is an input error. Found
+  // with a loop length of 1 mm: every case of it failed with the same geometry error, and the
+  // database was written with a loop length that holds no state.
+  for (std::size_t k = 0; k < in.loop_lengths.size(); ++k) {
+    const double l = in.loop_lengths[k];
+    try {
+      const homog::PeriodicCell cell(l, co);
+    } catch (const std::exception& e) {
+      std::ostringstream m;
+      m << "the unit cell of loop length " << l << " mm (yarn diameter " << co.section.d
+        << " mm) cannot be built: " << e.what();
+      throw InputError(in.file, io::json_pointer_append("/loop_lengths", k), m.str());
+    }
+  }
   return [co](double l, const material::LoadPath& path) {
     const int n = path.steps;
     PathOutcome out;

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "knit/core/errors.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
 #include "knit/meso/homog/uniaxial.hpp"
 #include "knit/meso/sweep/sweep.hpp"
@@ -112,4 +113,21 @@ TEST_CASE("sweep cell runner: uniaxial and gradient paths record F, E, S consist
     CHECK(grad.raw.E(k, 2) == Approx(E(0, 1)).epsilon(1e-12));
   }
   CHECK(grad.raw.S(2, 2) > 0);  // positive shear
+}
+
+TEST_CASE("sweep cell runner: a loop length the cell cannot be built for is an input error",
+          "[unit]") {
+  // Before: every case of a 1 mm loop failed with the same geometry error, one by one, and the
+  // database was written with a loop length holding no state. Now the runner refuses the input
+  // before any case runs, naming the loop length's JSON pointer.
+  sweep::SweepInput in = sweep::parse_sweep_input(
+      R"({"loop_lengths": [4.5, 5.0, 5.5, 6.0, 6.5], "cell": {"analysis": {"elements": 16}}})",
+      "short.json");
+  CHECK_NOTHROW(sweep::cell_runner(in));  // the paper's range builds
+  in.loop_lengths = {4.5, 1.0};
+  CHECK_THROWS_AS(sweep::cell_runner(in), knit::InputError);
+  CHECK_THROWS_WITH(sweep::cell_runner(in),
+                    Catch::Contains("short.json: /loop_lengths/1: the unit cell of loop length 1 "
+                                    "mm (yarn diameter") &&
+                        Catch::Contains("could not match the loop length"));
 }
