@@ -14,6 +14,7 @@
 #include <cstring>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
 
 namespace fs = std::filesystem;
 
@@ -94,6 +95,13 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
     } else {
       if (fs::is_directory(st)) refuse("is a directory; give the name of the file to write");
       if (!fs::is_regular_file(st)) refuse("exists and is not a regular file");
+      // The files written with kFile are HDF5 databases: an existing non-empty file that is
+      // not HDF5 is somebody else's (found: `knit-meso sweep IN -o notes.txt` replaced a text
+      // file by a database).
+      if (!fs::is_empty(target, ec) && !ec && !is_hdf5_file(target))
+        refuse(
+            "exists and is not an HDF5 file (knitscale writes HDF5 databases): it is not ours "
+            "to replace; give another name, or remove it first");
     }
     if (::access(parent.c_str(), W_OK | X_OK) != 0)
       refuse("cannot be replaced: directory " + parent.string() + " is not writable");

@@ -227,7 +227,13 @@ TEST_CASE("check_output_target refuses what a run must not or cannot write", "[u
   CHECK(why(d / "ours/", dirk).empty());
   CHECK(why(d / "empty", dirk).empty());
   CHECK(why(d / "new" / "deeper" / "out", dirk).empty());  // parents are created
-  CHECK(why(d / "file", filek).empty());                   // a file output replaces a file
+  // A database output replaces an earlier HDF5 file or an empty file, never any other file
+  // (`knit-meso sweep IN -o notes.txt` replaced a text file by a database).
+  CHECK_THAT(why(d / "file", filek), Catch::Contains("exists and is not an HDF5 file"));
+  { knit::io::H5File::create(d / "earlier.h5").close(); }
+  CHECK(why(d / "earlier.h5", filek).empty());
+  std::ofstream(d / "touched.h5").close();
+  CHECK(why(d / "touched.h5", filek).empty());
   CHECK(why(d / "new.h5", filek).empty());
   if (::geteuid() != 0) {  // root writes everywhere
     fs::create_directories(d / "ro");

@@ -30,7 +30,9 @@ enum class OutputKind { kDirectory, kFile };
 ///  * a symbolic link (dangling or not: the rename would replace the link, not its target);
 ///  * kDirectory: an existing non-directory; the current directory or one of its ancestors; a
 ///    non-empty directory that is not a knitscale output (no marker file);
-///  * kFile: an existing directory (or other non-regular file);
+///  * kFile (an HDF5 file: the database outputs): an existing directory (or other non-regular
+///    file); an existing non-empty file that is not HDF5 (not ours to replace; an existing HDF5
+///    file is taken for an earlier database and replaced);
 ///  * a target whose nearest existing ancestor is not a writable directory (missing parents
 ///    are created by the writer, so "a/b/out" needs "a" — or the first existing one — writable).
 void check_output_target(const std::filesystem::path& target, OutputKind kind,
