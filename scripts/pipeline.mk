@@ -294,7 +294,12 @@ $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scri
 
 report: $(OUT)/report.md
 
+# Only an output directory of the pipeline's: the checkout's out/, or one holding the marker
+# that scripts/run.sh writes (another directory's figures/ or logs/ are not ours to delete).
 clean:
+	@if [ "$(OUT)" != "$(ROOT)/out" ] && [ ! -f "$(OUT)/.knitscale-output" ]; then \
+	  echo "clean: $(OUT) holds no .knitscale-output file: not a pipeline output, nothing removed" >&2; \
+	  exit 2; fi
 	rm -rf $(OUT)/database.h5 $(OUT)/database.source $(OUT)/database.time $(OUT)/cases \
 	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/knitmap $(OUT)/design \
 	  $(OUT)/report.md

@@ -6,7 +6,24 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/setup.sh"
 # Only the executables the pipeline runs; the test executables are built by scripts/test.sh.
 out="${KNIT_OUT:-$root/out}"
+# A KNIT_OUT of the user's is written only if it is new, empty or an earlier run's output (the
+# marker file .knitscale-output, written below): the pipeline writes figures/, results/, logs/
+# ... into it and `make clean` removes them, so another directory's files are not ours to
+# replace. The default out/ of the checkout is the pipeline's own.
+marker="$out/.knitscale-output"
+if [ -n "${KNIT_OUT:-}" ]; then
+  if [ -e "$out" ] && [ ! -d "$out" ]; then
+    echo "run: KNIT_OUT=$out exists and is not a directory" >&2
+    exit 2
+  fi
+  if [ -d "$out" ] && [ -n "$(ls -A "$out")" ] && [ ! -f "$marker" ]; then
+    echo "run: KNIT_OUT=$out is a non-empty directory that is not a knitscale output (no" \
+      ".knitscale-output file): its files are not ours to replace; give a new or empty directory" >&2
+    exit 2
+  fi
+fi
 mkdir -p "$out"
+[ -f "$marker" ] || echo "knitscale output: the reproduction pipeline (scripts/run.sh)" > "$marker"
 if [ -f "$root/scripts/pipeline.mk" ]; then
   pipeline=(make -f "$root/scripts/pipeline.mk" ROOT="$root" BUILD="$root/build" OUT="$out")
   # knit-meso first; then the material database (the mesoscale sweep, the pipeline's longest
