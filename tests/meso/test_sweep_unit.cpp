@@ -55,7 +55,8 @@ SweepOptions quiet(const std::filesystem::path& out) {
 
 }  // namespace
 
-TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
+TEST_CASE("sweep input: the default, dense, wale-compressed-rays and reduced case files",
+          "[unit]") {
   const auto d = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/default.json");
   CHECK(d.loop_lengths == std::vector<double>{4.5, 5.0, 5.5, 6.0, 6.5});
   // The paper's 13 paths, then 2 uniaxial + 16 biaxial + 7 gradient coverage paths and 12
@@ -98,6 +99,32 @@ TEST_CASE("sweep input: the default and reduced case files", "[unit]") {
   for (const auto& p : dense.paths)
     fill += p.set == "coverage" && p.kind == knit::material::PathKind::kGradient && p.steps == 6;
   CHECK(fill == 48);
+  // The variant with rays into the shear-with-wale-compressed octant: the default plus 6
+  // explicit paths, which are exactly the rays of `rays: 24` (default box, 8 steps, J >= 0.5)
+  // whose end lies in E11 >= 0, E22 < 0, as its description says.
+  const auto wcr =
+      load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/wale_compressed_rays.json");
+  REQUIRE(wcr.paths.size() == d.paths.size() + 6);
+  knit::material::CoverageOptions co;
+  co.box.E11_min = -0.35;
+  co.box.E11_max = 0.60;
+  co.biaxial_steps = co.gradient_steps = 8;
+  const std::size_t without = knit::material::coverage_load_paths(co).size();
+  co.rays = 24;
+  const auto all = knit::material::coverage_load_paths(co);
+  std::vector<Eigen::Matrix2d> octant;
+  for (std::size_t k = without; k < all.size(); ++k) {
+    const Eigen::Matrix2d E =
+        knit::material::green_lagrange(knit::material::deformation_gradient(all[k], 1.0));
+    if (E(0, 0) >= 0 && E(1, 1) < 0) octant.push_back(all[k].H);
+  }
+  REQUIRE(octant.size() == 6);
+  for (std::size_t k = 0; k < 6; ++k) {
+    const auto& p = wcr.paths[d.paths.size() + k];
+    CHECK(p.set == "coverage");
+    CHECK(p.steps == 8);
+    CHECK((p.H - octant[k]).cwiseAbs().maxCoeff() < 1e-11);
+  }
   const auto r = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/reduced.json");
   CHECK(r.loop_lengths.size() == 1);
   CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12, -1, -1, -1, -1});
