@@ -222,6 +222,17 @@ def near_visited_text(db_path, res_dir):
     return (text or "Where the runs go: no run wrote material-frame strains.") + "\n"
 
 
+def small_strain_text(db_path):
+    """The law over the cell at small strains (scripts/law_small_strain.py; information beside
+    the checks, not judged)."""
+    try:
+        import law_small_strain
+        text = law_small_strain.summary(law_small_strain.small_strain_ratios(db_path))
+    except (OSError, KeyError, ValueError) as e:
+        text = f"Small strains: not computed ({e})."
+    return (text or "Small strains: the database has no energy law.") + "\n"
+
+
 class Data:
     """The pipeline's results, loaded on demand: curves and fields by case name."""
 
@@ -529,6 +540,7 @@ class Report:
                 L.append(f"| {md(statement)} | {md(threshold)} | {md(measured)} | {verdict(ok)} |")
             L.append("")
             L.append(near_visited_text(db_path, os.path.join(self.out, "results")))
+            L.append(small_strain_text(db_path))
         L.append("## Statements of the paper against our numbers\n")
         L.append("Each check is a function of the loaded results (scripts/report_checks.py; "
                  "thresholds and their reasons in docs/reproduction.md). Curves are compared at "

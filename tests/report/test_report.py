@@ -25,6 +25,7 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
 import report  # noqa: E402
 import report_checks as rc  # noqa: E402
+from fixtures import linear_network_law, raw_path  # noqa: E402  (tests/report/fixtures.py)
 
 L = 50.0
 N = 11  # output grid n_u = n_v
@@ -481,17 +482,10 @@ def near_visited_failures(tmp):
         g["E_course"], g["E_wale"], g["E_course_wale"] = [0.1, 0.3], [0.0, 0.3], [0.0, -0.05]
     with h5py.File(db, "w") as f:
         f["loop_lengths"] = [5.0]
-        law = f.create_group("energy_law")
-        law.attrs["family"] = "network"
-        law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, 0.0
-        law["l_knots"] = [5.0]
-        law["theta"] = np.zeros((1, 20))
+        linear_network_law(f, 0.0)
 
         def path(name, set_, E, S):
-            g = f.create_group(f"loop_0/raw/{name}")
-            g["E"], g["S"] = np.array(E, float), np.array(S, float)
-            g["status"] = np.zeros(len(E), dtype=int)
-            g.attrs["set"] = set_
+            raw_path(f, name, set_, E, S)
         # Stored E is tensor shear. Range of the fit data: S11 from 0.5 to 10 -> 9.5 MPa.
         path("fit", "coverage", [[0.1, 0.0, 0.0], [0.6, 0.0, 0.0], [0.3, 0.3, 0.049]],
              [[0.5, 0.0, 0.0], [10.0, 0.0, 0.0], [0.5, 0.76, 0.0]])

@@ -1,0 +1,23 @@
+"""Hand-made database pieces shared by the report scripts' tests (h5py, numpy)."""
+import numpy as np
+
+
+def linear_network_law(f, floor, loop_length=5.0):
+    """/energy_law of an open file: a network law with one unit per layer and all parameters 0
+    at one loop length, so S = floor (E11, E22, 2 E12) exactly (floor 0: S = 0)."""
+    law = f.create_group("energy_law")
+    law.attrs["family"] = "network"
+    law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, float(floor)
+    law["l_knots"] = [loop_length]
+    law["theta"] = np.zeros((1, 20))
+    return law
+
+
+def raw_path(f, name, set_, E, S, loop=0):
+    """A converged /loop_<loop>/raw/<name> of an open file (E with tensor E12, as the sweep
+    writes it)."""
+    g = f.create_group(f"loop_{loop}/raw/{name}")
+    g["E"], g["S"] = np.array(E, float), np.array(S, float)
+    g["status"] = np.zeros(len(E), dtype=np.int32)
+    g.attrs["set"], g.attrs["kind"], g.attrs["axis"] = set_, "gradient", 0
+    return g
