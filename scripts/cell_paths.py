@@ -3,6 +3,21 @@ scripts (fit_bounds.py, path_consistency.py): numpy and h5py only."""
 import numpy as np
 
 
+def path_set(f, g):
+    """The set ("paper", "coverage", "holdout") of the raw path group `g` of the open database
+    `f`: its attribute set. A format-1 file has none (its paths are the paper's); from format 2
+    on a missing one is a damaged file, refused with its HDF5 path (as knit-meso's reader does:
+    read as "paper", a coverage path would join the fan and a held-out path the fit data)."""
+    s = g.attrs.get("set")
+    if s is None:
+        version = int(f.attrs.get("format_version", 1))
+        if version >= 2:
+            raise ValueError("%s: %s: attribute set is missing (format %d writes it on every "
+                             "path)" % (f.filename, g.name, version))
+        return "paper"
+    return s.decode() if isinstance(s, bytes) else str(s)
+
+
 def load_paths(f, loop):
     """[(set, e (n x 3, e3 = 2 E12), S (n x 3), kind, axis)] of the converged steps of
     /loop_<loop>/raw, in the order of the path names."""
@@ -12,10 +27,9 @@ def load_paths(f, loop):
         ok = g[name]["status"][:] == 0
         e = g[name]["E"][:][ok].copy()
         e[:, 2] *= 2.0
-        s = g[name].attrs.get("set", "paper")
         kind = g[name].attrs.get("kind", "biaxial")
         kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-        out.append((s.decode() if isinstance(s, bytes) else str(s), e, g[name]["S"][:][ok], kind,
+        out.append((path_set(f, g[name]), e, g[name]["S"][:][ok], kind,
                     int(g[name].attrs.get("axis", 0))))
     return out
 

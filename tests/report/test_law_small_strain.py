@@ -66,6 +66,22 @@ def main():
                              text=True)
         c(out.returncode != 0 and "--small must be" in out.stderr,
           "--small 0 refused: %s" % out.stderr.strip()[-200:])
+        # A path without its set attribute: read as "paper" in a format-1 file (which never has
+        # one), refused with its HDF5 path from format 2 on (scripts/cell_paths.py, path_set).
+        with h5py.File(db, "a") as f:
+            del f["loop_0/raw/held"].attrs["set"]
+            f.attrs["format_version"] = 1
+        rows = lss.small_strain_ratios(db)
+        c(rows and rows[0]["n"] == 4,
+          "format 1: the path without a set is read as a paper path (4 small states): %s" % rows)
+        with h5py.File(db, "a") as f:
+            f.attrs["format_version"] = 3
+        try:
+            lss.small_strain_ratios(db)
+            c(False, "format 3: a path without a set is refused")
+        except ValueError as e:
+            c("/loop_0/raw/held: attribute set is missing" in str(e),
+              "format 3: a path without a set is refused with its HDF5 path: %s" % e)
         write_db(db, law=False)
         c(lss.small_strain_ratios(db) == [], "no energy law: no rows")
         out = subprocess.run([sys.executable, SCRIPT, db], capture_output=True, text=True)
