@@ -3,6 +3,12 @@ scripts (fit_bounds.py, path_consistency.py): numpy and h5py only."""
 import numpy as np
 
 
+def attr_text(v):
+    """An HDF5 string attribute as str (h5py gives bytes or str, depending on how it was
+    written)."""
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
 def path_set(f, g):
     """The set ("paper", "coverage", "holdout") of the raw path group `g` of the open database
     `f`: its attribute set. A format-1 file has none (its paths are the paper's); from format 2
@@ -15,7 +21,7 @@ def path_set(f, g):
             raise ValueError("%s: %s: attribute set is missing (format %d writes it on every "
                              "path)" % (f.filename, g.name, version))
         return "paper"
-    return s.decode() if isinstance(s, bytes) else str(s)
+    return attr_text(s)
 
 
 def load_paths(f, loop):
@@ -27,8 +33,7 @@ def load_paths(f, loop):
         ok = g[name]["status"][:] == 0
         e = g[name]["E"][:][ok].copy()
         e[:, 2] *= 2.0
-        kind = g[name].attrs.get("kind", "biaxial")
-        kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+        kind = attr_text(g[name].attrs.get("kind", "biaxial"))
         out.append((path_set(f, g[name]), e, g[name]["S"][:][ok], kind,
                     int(g[name].attrs.get("axis", 0))))
     return out

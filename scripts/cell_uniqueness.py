@@ -47,11 +47,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from cell_paths import path_set, run_sweep, stored_sweep_input, stress_range  # noqa: E402
-
-
-def _text(v):
-    return v.decode() if isinstance(v, bytes) else str(v)
+from cell_paths import attr_text, path_set, run_sweep, stored_sweep_input, stress_range  # noqa: E402
 
 
 def sym_sqrt2(C):
@@ -85,7 +81,7 @@ def selected_paths(f, which):
     out = []
     for name in sorted(g, key=lambda n: int(n.split("_")[-1])):
         a = g[name].attrs
-        kind, s = _text(a.get("kind", "biaxial")), path_set(f, g[name])
+        kind, s = attr_text(a.get("kind", "biaxial")), path_set(f, g[name])
         if which != "all" and s != which:
             continue
         if kind == "gradient":

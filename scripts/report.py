@@ -211,26 +211,29 @@ def held_out_reference_text(db_path):
             f"reference): {ref[0]} of {ref[1]} (largest {100 * ref[2]:.1f} %)")
 
 
+def beside_text(title, sentence, empty):
+    """A sentence printed beside the law's checks, not judged: sentence() (a script's summary),
+    "TITLE: not computed (why)." when it fails on the files, "TITLE: EMPTY." when it is empty."""
+    try:
+        text = sentence()
+    except (OSError, KeyError, ValueError) as e:
+        text = f"{title}: not computed ({e})."
+    return (text or f"{title}: {empty}.") + "\n"
+
+
 def near_visited_text(db_path, res_dir):
     """The law's errors at the cell states near the strains the runs visit
-    (scripts/law_near_visited.py; information beside the checks, not judged)."""
-    try:
-        import law_near_visited
-        text = law_near_visited.summary(law_near_visited.near_errors(db_path, res_dir))
-    except (OSError, KeyError, ValueError) as e:
-        text = f"Where the runs go: not computed ({e})."
-    return (text or "Where the runs go: no run wrote material-frame strains.") + "\n"
+    (scripts/law_near_visited.py)."""
+    import law_near_visited as m
+    return beside_text("Where the runs go", lambda: m.summary(m.near_errors(db_path, res_dir)),
+                       "no run wrote material-frame strains")
 
 
 def small_strain_text(db_path):
-    """The law over the cell at small strains (scripts/law_small_strain.py; information beside
-    the checks, not judged)."""
-    try:
-        import law_small_strain
-        text = law_small_strain.summary(law_small_strain.small_strain_ratios(db_path))
-    except (OSError, KeyError, ValueError) as e:
-        text = f"Small strains: not computed ({e})."
-    return (text or "Small strains: the database has no energy law.") + "\n"
+    """The law over the cell at small strains (scripts/law_small_strain.py)."""
+    import law_small_strain as m
+    return beside_text("Small strains", lambda: m.summary(m.small_strain_ratios(db_path)),
+                       "the database has no energy law")
 
 
 class Data:
