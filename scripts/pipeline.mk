@@ -50,6 +50,28 @@ CASES := $(sort $(basename $(notdir $(wildcard $(CASEDIR)/*.json))))
 STATUS := $(CASES:%=$(RES)/%.status)
 st = $(addprefix $(RES)/,$(addsuffix .status,$(1)))
 
+# An OUT other than the checkout's out/ is written only if it is new, empty or an earlier run's
+# output (the marker .knitscale-output, as scripts/run.sh; docs/reproduction.md): the targets
+# below write figures/, results/, logs/ ... into it, so another directory's files are not ours
+# to replace. Checked when the makefile is read, for every goal but clean (which has its own).
+ifneq ($(filter-out clean,$(or $(MAKECMDGOALS),all)),)
+OUT_STATE := $(shell d='$(OUT)'; \
+  if [ -e "$$d" ] && [ ! -d "$$d" ]; then echo notdir; \
+  elif [ "$$d" != '$(ROOT)/out' ] && [ -d "$$d" ] && [ -n "$$(ls -A "$$d")" ] \
+       && [ ! -f "$$d/.knitscale-output" ]; then echo foreign; \
+  else mkdir -p "$$d" && { [ -f "$$d/.knitscale-output" ] || echo "knitscale output: the \
+reproduction pipeline (scripts/pipeline.mk)" > "$$d/.knitscale-output"; } && echo ours; fi)
+ifeq ($(OUT_STATE),notdir)
+$(error OUT=$(OUT) exists and is not a directory)
+endif
+ifeq ($(OUT_STATE),foreign)
+$(error OUT=$(OUT) is a non-empty directory that is not a knitscale output (no .knitscale-output file): its files are not ours to replace; give a new or empty directory)
+endif
+ifneq ($(OUT_STATE),ours)
+$(error OUT=$(OUT): cannot create the directory or its .knitscale-output marker)
+endif
+endif
+
 .PHONY: all database cases figures report clean meso
 .DELETE_ON_ERROR:
 

@@ -22,6 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from cell_paths import path_set  # noqa: E402  (scripts/cell_paths.py)
 from surfaces import basis, database_figure_args, pick_loop  # noqa: E402
 
 
@@ -222,7 +224,12 @@ def main():
             st = np.array(p["status"])
             E, S = np.array(p["E"]), np.array(p["S"])
             sel = (st == 0) & (np.abs(E[:, 2]) < 0.02)
-            target = held if p.attrs.get("set", "paper") == "holdout" else pts
+            # A missing set is refused from format 2 on (it read as "paper": a held-out state
+            # drawn as fit data).
+            try:
+                target = held if path_set(f, p) == "holdout" else pts
+            except ValueError as err:
+                sys.exit(str(err))
             for i in np.nonzero(sel)[0]:
                 target.append((E[i, 0], E[i, 1], S[i, 0], S[i, 1]))
     pts, held = np.array(pts).reshape(-1, 4), np.array(held).reshape(-1, 4)

@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""scripts/figures/energy_law.py (Fig. 6e, the energy law beside the cell's data) on a
+hand-made database of one loop length whose law is S = 2 e (fixtures.py):
+
+* it draws (exit 0, a PNG) from a format-3 database whose paths carry their set;
+* a path without its set attribute in a format-3 file is refused, exit non-zero, naming the
+  file and the HDF5 path (it used to be read as "paper": a held-out state drawn as fit data);
+* a format-1 file (which never had the attribute) still draws.
+Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+from fixtures import linear_network_law, raw_path  # tests/report/fixtures.py
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, "scripts", "figures", "energy_law.py")
+
+
+def write_db(path, version, drop_set=False):
+    with h5py.File(path, "w") as f:
+        f.attrs["format_version"] = version
+        f["loop_lengths"] = [5.0]
+        law = linear_network_law(f, 2.0)
+        law["box_min"], law["box_max"] = [-0.3, -0.3, -0.4], [0.6, 0.55, 0.4]
+        raw_path(f, "fit", "coverage", [[0.1, 0, 0], [0.2, 0, 0]], [[0.2, 0, 0], [0.4, 0, 0]])
+        held = raw_path(f, "held", "holdout", [[0, 0.1, 0]], [[0, 0.2, 0]])
+        if drop_set:
+            del held.attrs["set"]
+
+
+def draw(db, png):
+    return subprocess.run([sys.executable, SCRIPT, "--database", db, "--loop-length", "5",
+                           "--out", png], capture_output=True, text=True)
+
+
+def main():
+    c = Checklist()
+    with tempfile.TemporaryDirectory(prefix="energy_law_figure_test_") as tmp:
+        db, png = os.path.join(tmp, "db.h5"), os.path.join(tmp, "fig.png")
+        write_db(db, 3)
+        r = draw(db, png)
+        c(r.returncode == 0 and os.path.getsize(png) > 0,
+          "format 3 with every set: drawn (exit %d, %s)" % (r.returncode, r.stderr.strip()[-300:]))
+        os.remove(png)
+        write_db(db, 3, drop_set=True)
+        r = draw(db, png)
+        c(r.returncode != 0 and not os.path.exists(png),
+          "format 3, /loop_0/raw/held without set: refused, nothing drawn (exit %d)" % r.returncode)
+        c("db.h5" in r.stderr and "/loop_0/raw/held: attribute set is missing" in r.stderr,
+          "the message names the file and the HDF5 path: %s" % r.stderr.strip()[-300:])
+        write_db(db, 1, drop_set=True)
+        r = draw(db, png)
+        c(r.returncode == 0 and os.path.exists(png),
+          "format 1 without set (its paths are the paper's): drawn (exit %d, %s)"
+          % (r.returncode, r.stderr.strip()[-300:]))
+    return c.exit_code()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
