@@ -38,13 +38,17 @@ struct Reader {
     if ((strict_lo ? !(d > lo) : !(d >= lo)) || !(d <= hi)) {
       std::ostringstream m;
       m << "must be " << (strict_lo ? "> " : ">= ") << lo;
-      if (hi < 1e299) m << " and <= " << hi;
+      if (hi < 1e299)
+        m << " and <= " << hi;
+      else
+        m << " and finite (below 1e300)";
       m << ", got " << d;
       fail(p, m.str());
     }
     v = d;
   }
-  void integer(const json& j, const std::string& ptr, const char* key, int& v, int lo) const {
+  void integer(const json& j, const std::string& ptr, const char* key, int& v, int lo,
+               int hi) const {
     if (!j.contains(key)) return;
     const json& x = j[key];
     const std::string p = ptr + "/" + key;
@@ -54,7 +58,7 @@ struct Reader {
                             ? 1ll << 62
                             : x.get<long long>();
     if (i < lo) fail(p, "must be >= " + std::to_string(lo) + ", got " + std::to_string(i));
-    if (i > std::numeric_limits<int>::max()) fail(p, "must be at most 2147483647, got " + x.dump());
+    if (i > hi) fail(p, "must be <= " + std::to_string(hi) + ", got " + x.dump());
     v = static_cast<int>(i);
   }
 };
@@ -100,10 +104,10 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/yarn/nu", section.nu, -1, 0.5, true, true},
       {"/yarn/d", section.d, 0, inf, true, false},
       {"/loop/gamma_over_w", geometry.gamma_over_w, 0, 1, false, false},
-      {"/analysis/elements", double(elements), 4, inf, false, false},
-      {"/analysis/degree", double(degree), 2, inf, false, false},
-      {"/analysis/slave_points_per_element", double(contact.slave_points_per_element), 1, inf,
-       false, false},
+      {"/analysis/elements", double(elements), 4, kMaxElements, false, false},
+      {"/analysis/degree", double(degree), 2, kMaxDegree, false, false},
+      {"/analysis/slave_points_per_element", double(contact.slave_points_per_element), 1,
+       kMaxSlavePoints, false, false},
       {"/contact/penalty", p.k_N, 0, inf, true, false},
       {"/contact/allowance", p.g0, 0, inf, false, false},
       {"/contact/delta", p.delta, 0, inf, true, false},
@@ -114,9 +118,9 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/contact/margin", contact.margin, 0, inf, false, false},
       {"/contact/self_exclusion", contact.self_exclusion, 0, 1, true, false},
       {"/solver/tolerance", newton.tol, 0, 1, true, false},
-      {"/solver/max_iterations", double(newton.max_iterations), 1, inf, false, false},
-      {"/solver/equilibration_steps", double(equilibration_steps), 1, inf, false, false},
-      {"/solver/max_cutbacks", double(max_cutbacks), 0, inf, false, false},
+      {"/solver/max_iterations", double(newton.max_iterations), 1, kMaxIterations, false, false},
+      {"/solver/equilibration_steps", double(equilibration_steps), 1, kMaxIterations, false, false},
+      {"/solver/max_cutbacks", double(max_cutbacks), 0, kMaxCutbacks, false, false},
   });
 }
 
@@ -150,9 +154,10 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
   if (j.contains("analysis")) {
     const json& a = j["analysis"];
     R.object(a, "/analysis", {"elements", "degree", "slave_points_per_element"});
-    R.integer(a, "/analysis", "elements", o.elements, 4);
-    R.integer(a, "/analysis", "degree", o.degree, 2);
-    R.integer(a, "/analysis", "slave_points_per_element", o.contact.slave_points_per_element, 1);
+    R.integer(a, "/analysis", "elements", o.elements, 4, CellOptions::kMaxElements);
+    R.integer(a, "/analysis", "degree", o.degree, 2, CellOptions::kMaxDegree);
+    R.integer(a, "/analysis", "slave_points_per_element", o.contact.slave_points_per_element, 1,
+              CellOptions::kMaxSlavePoints);
   }
   if (j.contains("contact")) {
     const json& c = j["contact"];
@@ -180,9 +185,11 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     const json& s = j["solver"];
     R.object(s, "/solver", {"tolerance", "max_iterations", "equilibration_steps", "max_cutbacks"});
     R.num(s, "/solver", "tolerance", o.newton.tol, 0, 1, true);
-    R.integer(s, "/solver", "max_iterations", o.newton.max_iterations, 1);
-    R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1);
-    R.integer(s, "/solver", "max_cutbacks", o.max_cutbacks, 0);
+    R.integer(s, "/solver", "max_iterations", o.newton.max_iterations, 1,
+              CellOptions::kMaxIterations);
+    R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1,
+              CellOptions::kMaxIterations);
+    R.integer(s, "/solver", "max_cutbacks", o.max_cutbacks, 0, CellOptions::kMaxCutbacks);
   }
   if (const auto bad = o.validate()) R.fail(bad->pointer, bad->message);
   return o;

@@ -208,7 +208,13 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     std::string source = file, prefix = "/cell";
     if (c.is_string()) {
       const auto path = io::resolve_input_path(file, c.get<std::string>());
-      c = io::read_json_file(path);
+      try {
+        c = io::read_json_file(path);
+      } catch (const InputError& e) {
+        // Said "x: file not found" without the sweep input and the field that named it.
+        throw InputError(file, "/cell",
+                         "the cell parameter file cannot be read: " + std::string(e.what()));
+      }
       in.cell_file = source = path.string();
       prefix.clear();
     }

@@ -79,3 +79,58 @@ TEST_CASE("cell options: validate() names the field of a value out of range or n
   o.contact.penalty.delta = 0;
   CHECK_THROWS_AS(knit::meso::homog::PeriodicCell(4.5, o), std::invalid_argument);
 }
+
+// Session 21 (fuzzing the sweep input): elements or degree 123456789 ended in std::bad_alloc
+// reported as a geometry failure of the loop length, slave_points_per_element 123456789 ran for
+// minutes. Every integer field now has an upper bound, in the schema, the reader and validate().
+TEST_CASE("cell config: the integer fields have upper bounds, named by pointer", "[unit]") {
+  struct Bound {
+    const char* section;
+    const char* key;
+    int max;
+  };
+  const Bound bounds[] = {{"analysis", "elements", CellOptions::kMaxElements},
+                          {"analysis", "degree", CellOptions::kMaxDegree},
+                          {"analysis", "slave_points_per_element", CellOptions::kMaxSlavePoints},
+                          {"solver", "max_iterations", CellOptions::kMaxIterations},
+                          {"solver", "equilibration_steps", CellOptions::kMaxIterations},
+                          {"solver", "max_cutbacks", CellOptions::kMaxCutbacks}};
+  for (const Bound& b : bounds) {
+    const std::string ptr = std::string("/") + b.section + "/" + b.key;
+    auto text = [&](long long v) {
+      return std::string("{\"") + b.section + "\": {\"" + b.key + "\": " + std::to_string(v) + "}}";
+    };
+    INFO(ptr);
+    CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_max.json", text(b.max))));
+    std::string pointer = "<no error>";
+    try {
+      read_cell_options(write_tmp("cell_cfg_max.json", text(b.max + 1)));
+    } catch (const knit::InputError& e) {
+      pointer = e.pointer();
+    }
+    CHECK(pointer == ptr);
+    try {
+      read_cell_options(write_tmp("cell_cfg_max.json", text(123456789)));
+      pointer = "<no error>";
+    } catch (const knit::InputError& e) {
+      pointer = e.pointer();
+    }
+    CHECK(pointer == ptr);
+  }
+  CellOptions o;
+  o.elements = CellOptions::kMaxElements + 1;
+  REQUIRE(o.validate().has_value());
+  CHECK(o.validate()->pointer == "/analysis/elements");
+  o = {};
+  o.max_cutbacks = CellOptions::kMaxCutbacks + 1;
+  REQUIRE(o.validate().has_value());
+  CHECK(o.validate()->pointer == "/solver/max_cutbacks");
+  // A real number beyond the reader's 1e300 said "must be > 0, got 1e+308".
+  try {
+    read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e308}})"));
+    FAIL("E = 1e308 accepted");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/yarn/E");
+    CHECK(std::string(e.what()).find("finite (below 1e300)") != std::string::npos);
+  }
+}

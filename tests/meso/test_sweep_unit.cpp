@@ -189,6 +189,17 @@ TEST_CASE("sweep input: cell parameters inline or from a file relative to the sw
     CHECK(e.file() == (dir / "bad.json").string());
     CHECK(e.pointer() == "/contact/mu");
   }
+  // A cell file that is not there (or not JSON): the sweep input and /cell are named beside it
+  // (session 21; it said "missing.json: file not found" alone).
+  knit_test::write_text(dir / "s3.json", R"({"loop_lengths": [4.5], "cell": "missing.json"})");
+  try {
+    load_sweep_input(dir / "s3.json");
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == (dir / "s3.json").string());
+    CHECK(e.pointer() == "/cell");
+    CHECK(std::string(e.what()).find("missing.json: file not found") != std::string::npos);
+  }
 }
 
 TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {

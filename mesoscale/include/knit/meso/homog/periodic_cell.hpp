@@ -70,6 +70,15 @@ struct CellOptions {
   int equilibration_steps = 4;
   int max_cutbacks = 6;
 
+  /// Upper bounds of the integer fields (schemas/cell.schema.json "maximum"; session 21: a
+  /// value of 123456789 ended in std::bad_alloc or ran for minutes). Far above what the
+  /// convergence studies use (docs/unit-cell.md: elements 16-128, degree 3-5).
+  static constexpr int kMaxElements = 1024;
+  static constexpr int kMaxDegree = 8;
+  static constexpr int kMaxSlavePoints = 16;
+  static constexpr int kMaxIterations = 1000;  ///< max_iterations and equilibration_steps
+  static constexpr int kMaxCutbacks = 30;      ///< 2^-30 of a step
+
   /// Checks every field for finiteness and against the range of schemas/cell.schema.json
   /// (implemented beside the JSON reader, homog_cell_config.cpp); the first bad field, or
   /// nothing. The reader, the command line and PeriodicCell use it, so no value is ever
