@@ -169,7 +169,7 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_option("-o,--output,--out", o->out, "output directory");
       auto* ne =
           sub.add_option("--elements", o->elements_arg, "analysis-curve elements (default 32)")
-              ->check(knit::cli::integer(4, 100000));
+              ->check(knit::cli::integer(4, knit::meso::homog::CellOptions::kMaxElements));
       auto* kn = sub.add_option("--penalty", o->k_N_arg, "normal penalty stiffness k_N (MPa)")
                      ->check(number(0, inf, Ends::kOpenLow));
       auto* g0 = sub.add_option("--allowance", o->g0_arg, "penetration allowance g0 (mm)")
