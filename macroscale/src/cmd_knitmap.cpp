@@ -34,7 +34,9 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_option("--output,-o", o->output, "output directory");
       sub.add_option("--angle-tolerance", o->angle_tolerance,
                      "largest deviation of the course direction from its mean (deg)")
-          ->check(CLI::PositiveNumber);
+          // A finite angle in (0, 180]: CLI::PositiveNumber let "nan" through, which passed
+          // every patch (session 21).
+          ->check(knit::cli::number(0, 180, knit::cli::Ends::kOpenLow));
       return [o]() -> int {
         const auto in = knit::macro::load_knitmap_input(o->case_file);
         knit::macro::KnitMapOptions opt;

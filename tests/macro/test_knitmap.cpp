@@ -283,4 +283,15 @@ TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothin
   }
   CHECK(run_knitmap(file + " --output " + (kDir / "nocells_out").string()) == 2);
   CHECK(!fs::exists(kDir / "nocells_out"));
+  // --angle-tolerance must be a finite angle in (0, 180] deg: "nan" passed every patch
+  // (session 21, found by fuzzing the flags).
+  const std::string ok = write_case("tol.json", case_text(knit_material(db, "5.0"), 10, 10));
+  for (const char* bad : {"nan", "inf", "0", "-1", "181", "x"}) {
+    INFO(bad);
+    CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance " +
+                      bad) == 2);
+    CHECK(!fs::exists(kDir / "tol_out"));
+  }
+  CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance 180") ==
+        0);
 }
