@@ -1,6 +1,34 @@
 """The unit cell's raw load paths in a material database (/loop_<k>/raw), for the analysis
 scripts (fit_bounds.py, path_consistency.py): numpy and h5py only."""
+import argparse
+import math
+import os
+
 import numpy as np
+
+
+def open_database(path, prog):
+    """The HDF5 file at `path`, opened for reading, or SystemExit naming it: missing, or not an
+    HDF5 file (the scripts ended in an OSError traceback there before session 21)."""
+    import h5py
+    if not os.path.isfile(path):
+        raise SystemExit(f"{prog}: {path}: no such file")
+    try:
+        return h5py.File(path, "r")
+    except OSError as err:
+        raise SystemExit(f"{prog}: {path}: not a readable HDF5 file ({err})")
+
+
+def positive_number(text):
+    """An argparse type: a finite number > 0. With type=float, "nan" passed every check and
+    every comparison with it was false (path_consistency.py --radius nan: "0 pairs", exit 0)."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}")
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
+    return v
 
 
 def attr_text(v):

@@ -47,7 +47,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from cell_paths import attr_text, path_set, run_sweep, stored_sweep_input, stress_range  # noqa: E402
+from cell_paths import (attr_text, open_database, path_set, positive_number,  # noqa: E402
+                        run_sweep, stored_sweep_input, stress_range)
 
 
 def sym_sqrt2(C):
@@ -234,7 +235,7 @@ def main(argv=None):
     ap.add_argument("--steps-factor", default="2,3,4", help="twins' steps / the path's, a "
                     "comma-separated list (default 2,3,4; each factor adds a twin of every "
                     "kind)")
-    ap.add_argument("--tol", type=float, default=0.05, help="spread that counts as one state "
+    ap.add_argument("--tol", type=positive_number, default=0.05, help="spread that counts as one state "
                     "(fraction of the stress range; default 0.05, the issue's criterion)")
     ap.add_argument("--work", help="directory for the twins' sweep input and database "
                     "(default: a new temporary directory, kept)")
@@ -244,9 +245,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     import h5py
     from energy_law import load_law
-    if not os.path.isfile(a.db):
-        raise SystemExit("error: %s: no such file" % a.db)
-    db = h5py.File(a.db, "r")
+    db = open_database(a.db, "error")
     stored = stored_sweep_input(db, a.db)
     paths = selected_paths(db, a.set)
     if not paths:

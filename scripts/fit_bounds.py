@@ -225,6 +225,10 @@ def main():
     except OSError as err:
         print("fit_bounds.py: %s: %s" % (a.database, err), file=sys.stderr)
         return 2
+    if "loop_lengths" not in f:
+        print("fit_bounds.py: %s: /loop_lengths: dataset missing (not a material database)"
+              % a.database, file=sys.stderr)
+        return 2
     count = len(f["loop_lengths"])
     loops = a.loops if a.loops is not None else sorted({0, count - 1})
     for loop in loops:

@@ -29,7 +29,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from cell_paths import load_paths, run_sweep, stored_sweep_input, stress_range  # noqa: E402
+from cell_paths import (load_paths, open_database, run_sweep,  # noqa: E402
+                        stored_sweep_input, stress_range)
 
 THRESHOLD = 0.05
 
@@ -109,9 +110,7 @@ def main(argv=None):
                     "(written by an earlier run of this script) instead of running the cell")
     a = ap.parse_args(argv)
     import h5py
-    if not os.path.isfile(a.db):
-        raise SystemExit("error: %s: no such file" % a.db)
-    db = h5py.File(a.db, "r")
+    db = open_database(a.db, "error")
     if "energy_law" not in db:
         raise SystemExit("error: %s: /energy_law: group missing (no energy law to check)" % a.db)
     if a.set not in ("all", "paper", "coverage", "holdout"):

@@ -27,7 +27,7 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, stress_range  # noqa: E402
+from cell_paths import load_paths, open_database, positive_number, stress_range  # noqa: E402
 from energy_law import load_law  # noqa: E402
 from strain_box import read_case  # noqa: E402
 
@@ -129,13 +129,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("database", help="material database (HDF5) with /energy_law")
     ap.add_argument("results", help="directory searched recursively for results.h5")
-    ap.add_argument("--radius", type=float, default=RADIUS,
+    ap.add_argument("--radius", type=positive_number, default=RADIUS,
                     help=f"distance to a visited state, tensor strain (default {RADIUS})")
     a = ap.parse_args()
-    if not a.radius > 0:
-        sys.exit(f"law_near_visited: --radius must be > 0 (got {a.radius})")
-    if not os.path.isfile(a.database):
-        sys.exit(f"law_near_visited: {a.database}: no such file")
+    open_database(a.database, "law_near_visited").close()
     rows = near_errors(a.database, a.results, a.radius)
     if not rows:
         sys.exit(f"law_near_visited: nothing to compare ({a.database}: no /energy_law, or no "

@@ -26,7 +26,7 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, stress_range  # noqa: E402
+from cell_paths import load_paths, open_database, positive_number, stress_range  # noqa: E402
 from energy_law import load_law  # noqa: E402
 
 SMALL = 0.05  # the largest |E11|, |E22|, |E12| (tensor shear) of a small-strain state
@@ -88,13 +88,10 @@ def summary(rows, small=SMALL):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("database", help="material database (HDF5) with /energy_law")
-    ap.add_argument("--small", type=float, default=SMALL,
+    ap.add_argument("--small", type=positive_number, default=SMALL,
                     help=f"largest strain component of a small-strain state (default {SMALL})")
     a = ap.parse_args()
-    if not (a.small > 0 and np.isfinite(a.small)):
-        sys.exit(f"law_small_strain: --small must be a finite number > 0 (got {a.small})")
-    if not os.path.isfile(a.database):
-        sys.exit(f"law_small_strain: {a.database}: no such file")
+    open_database(a.database, "law_small_strain").close()
     rows = small_strain_ratios(a.database, a.small)
     if not rows:
         sys.exit(f"law_small_strain: {a.database}: no /energy_law")

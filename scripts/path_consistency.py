@@ -31,7 +31,7 @@ try:
 except ImportError:
     sys.exit("path_consistency.py: needs python3-h5py (run it with /usr/bin/python3)")
 
-from cell_paths import load_paths, stress_range  # scripts/cell_paths.py
+from cell_paths import load_paths, positive_number, stress_range  # scripts/cell_paths.py
 
 
 def read_loop(f, loop):
@@ -59,7 +59,7 @@ def pairs(E, S, pid, rng, radius):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("database")
-    ap.add_argument("--radius", type=float, default=0.01)
+    ap.add_argument("--radius", type=positive_number, default=0.01)
     ap.add_argument("--self-check", action="store_true")
     a = ap.parse_args()
     try:

@@ -64,8 +64,20 @@ def main():
           % (out.stdout + out.stderr)[-300:])
         out = subprocess.run([sys.executable, SCRIPT, db, "--small", "0"], capture_output=True,
                              text=True)
-        c(out.returncode != 0 and "--small must be" in out.stderr,
+        c(out.returncode != 0 and "--small: must be a finite number > 0" in out.stderr,
           "--small 0 refused: %s" % out.stderr.strip()[-200:])
+        out = subprocess.run([sys.executable, SCRIPT, db, "--small", "nan"], capture_output=True,
+                             text=True)
+        c(out.returncode != 0 and "--small: must be a finite number > 0" in out.stderr,
+          "--small nan refused: %s" % out.stderr.strip()[-200:])
+        # A file that is not HDF5: named, no traceback (scripts/cell_paths.py, open_database).
+        notdb = os.path.join(tmp, "notes.h5")
+        with open(notdb, "w") as fh:
+            fh.write("not hdf5")
+        out = subprocess.run([sys.executable, SCRIPT, notdb], capture_output=True, text=True)
+        c(out.returncode != 0 and "notes.h5: not a readable HDF5 file" in out.stderr
+          and "Traceback" not in out.stderr, "a non-HDF5 file refused by name: %s"
+          % out.stderr.strip()[-300:])
         # A path without its set attribute: read as "paper" in a format-1 file (which never has
         # one), refused with its HDF5 path from format 2 on (scripts/cell_paths.py, path_set).
         with h5py.File(db, "a") as f:

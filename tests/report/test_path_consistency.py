@@ -73,6 +73,11 @@ def main():
             f.write("not hdf5")
         rc, out = run(bad)
         check(rc == 2 and "not.h5" in out, "a file that is not a database: exit 2, named", out)
+        # "nan" passed type=float and every comparison with it failed: "0 pairs", exit 0.
+        for radius in ("nan", "0", "-1", "inf"):
+            rc, out = run(same, "--radius", radius)
+            check(rc == 2 and "--radius: must be a finite number > 0" in out,
+                  "--radius %s refused (exit %d)" % (radius, rc), out)
     return check.exit_code()
 
 
