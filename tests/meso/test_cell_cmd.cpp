@@ -138,7 +138,9 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"path --loop-length 4.5 --uniaxial 2 0.1", "--uniaxial", "AXIS must be 0 (course) or 1"},
       {"path --loop-length 4.5 --uniaxial 1 0.1 --shear 5", "--uniaxial", "excludes"},
       {"path --loop-length 4.5 --shear 5 --steps 0", "--steps", "[1, 100000]"},
-      {"path --loop-length 4.5 --shear 5 --elements 2", "--elements", "[4, 100000]"},
+      {"path --loop-length 4.5 --shear 5 --elements 2", "--elements", "[4, 1024]"},
+      // The cell's bound (CellOptions::kMaxElements, session 21), named as the flag.
+      {"path --loop-length 4.5 --shear 5 --elements 2000", "--elements", "[4, 1024]"},
       {"path --loop-length 4.5 --shear 5 --allowance -0.1", "--allowance", ">= 0"},
       {"path --loop-length 4.5 --shear 5 --stick 0", "--stick", "> 0"},
       {"path --loop-length 4.5 --shear 5 --delta 1e999", "--delta", "> 0"},
