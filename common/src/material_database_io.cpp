@@ -81,6 +81,9 @@ std::string strip_file(const std::string& msg, const std::string& file) {
 }  // namespace
 
 void write_database(const std::filesystem::path& file, const Database& db) {
+  if (const auto bad = first_nonfinite_step(db))
+    throw std::runtime_error(file.string() + ": database not written: " + *bad +
+                             " is marked converged (status 0) but is not finite");
   io::AtomicFile out(file);
   {
     H5File f = H5File::create(out.temp_path());
@@ -384,6 +387,24 @@ const EnergyLawData& require_energy_law(const Database& db, const std::string& f
 
 std::string raw_path_location(std::size_t k, std::size_t q) {
   return loop_group(k) + "/raw/" + path_group(q);
+}
+
+std::optional<std::string> first_nonfinite_step(const Database& db) {
+  for (std::size_t k = 0; k < db.entries.size(); ++k)
+    for (std::size_t q = 0; q < db.entries[k].raw.size(); ++q) {
+      const RawPath& r = db.entries[k].raw[q];
+      for (std::size_t s = 0; s < r.status.size(); ++s) {
+        if (r.status[s] != 0) continue;
+        const auto i = static_cast<Eigen::Index>(s);
+        for (const auto& [d, m] : {std::pair<const char*, const RowMatrixX*>{"F", &r.F},
+                                   {"P", &r.P},
+                                   {"E", &r.E},
+                                   {"S", &r.S}})
+          if (i < m->rows() && !m->row(i).allFinite())
+            return raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1);
+      }
+    }
+  return std::nullopt;
 }
 
 }  // namespace knit::material

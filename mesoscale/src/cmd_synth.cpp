@@ -63,6 +63,13 @@ static knit::cli::SubcommandRegistrar reg_synth(
           for (const auto& p : synthetic_coverage_paths(std::max(4, o->steps / 2)))
             so.paths.push_back(p);
         auto db = synthetic_database(so);
+        // The stand-in's stiffness k = (4.5 / l)^2 overflows for a tiny l: its stresses were
+        // written as inf and NaN with exit 0 (session 21, --loop-lengths 1e-300).
+        if (const auto bad = knit::material::first_nonfinite_step(db))
+          throw knit::InputError("", "--loop-lengths",
+                                 "the stand-in law's stress is not finite (" + *bad +
+                                     "): its stiffness (4.5 / l)^2 MPa overflows; give loop "
+                                     "lengths of a knit (a few mm)");
         int rc = knit::kExitOk;
         if (!o->no_fit) {
           const FitOptions fo =

@@ -104,3 +104,14 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   CHECK(run("fit " + db.string() + energy + " -o " + out.string()) == 1);
   CHECK_FALSE(fs::exists(out));
 }
+
+// Session 21: the stand-in's stiffness (4.5 / l)^2 overflows for l = 1e-300, and `synth
+// --no-fit` wrote inf and NaN stresses with exit 0. Now refused (exit 2), nothing written.
+TEST_CASE("knit-meso synth: loop lengths whose stresses are not finite are refused", "[unit]") {
+  const fs::path db = scratch_dir() / "cli_synth_tiny.h5";
+  fs::remove(db);
+  CHECK(run("synth --no-fit --no-coverage --loop-lengths 1e-300 --out " + db.string()) == 2);
+  CHECK(!fs::exists(db));
+  CHECK(run("synth --no-fit --no-coverage --loop-lengths 1e-300,4.5 --out " + db.string()) == 2);
+  CHECK(!fs::exists(db));
+}

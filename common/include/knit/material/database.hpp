@@ -150,10 +150,17 @@ const EnergyLawData& require_energy_law(const Database& db, const std::string& f
 /// HDF5 path of raw path q of loop length k ("/loop_k/raw/path_qq"), for messages.
 std::string raw_path_location(std::size_t k, std::size_t q);
 
+/// The first converged step (status 0) of db's raw data with a non-finite F, P, E or S, as
+/// "/loop_k/raw/path_qq/S: step s", or nothing. The reader refuses such a file; the writer
+/// refuses to write one (session 21: `knit-meso synth --loop-lengths 1e-300` wrote inf and NaN
+/// stresses with exit 0).
+std::optional<std::string> first_nonfinite_step(const Database& db);
+
 /// Provenance of this build, now.
 Provenance current_provenance();
 
-/// Writes atomically (temporary file next to `file`, then rename). Throws std::runtime_error.
+/// Writes atomically (temporary file next to `file`, then rename). Throws std::runtime_error,
+/// and writes nothing, when a converged step is not finite (first_nonfinite_step).
 void write_database(const std::filesystem::path& file, const Database& db);
 
 /// Reads and validates. Throws knit::InputError(file, hdf5_path, what) on a bad file.
