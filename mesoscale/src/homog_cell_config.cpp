@@ -99,6 +99,15 @@ std::optional<CellOptionError> CellOptions::validate() const {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const auto& p = contact.penalty;
   const auto& f = contact.friction;
+  // Two fields together (session 21, found by fuzzing: an allowance of 123456789 mm ran with
+  // exit 0): an allowance of a whole yarn diameter lets two yarns pass through each other
+  // without force, so the cell has no contact at all.
+  if (std::isfinite(p.g0) && std::isfinite(section.d) && section.d > 0 && p.g0 >= section.d) {
+    std::ostringstream m;
+    m << "must be smaller than the yarn diameter /yarn/d = " << section.d << " mm, got " << p.g0
+      << " (an allowance of a whole diameter lets yarns pass through each other without force)";
+    return CellOptionError{"/contact/allowance", m.str()};
+  }
   return check_ranges({
       {"/yarn/E", section.E, 0, inf, true, false},
       {"/yarn/nu", section.nu, -1, 0.5, true, true},

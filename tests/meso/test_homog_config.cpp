@@ -125,6 +125,19 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
   o.max_cutbacks = CellOptions::kMaxCutbacks + 1;
   REQUIRE(o.validate().has_value());
   CHECK(o.validate()->pointer == "/solver/max_cutbacks");
+  // An allowance of a whole yarn diameter (or 123456789 mm, which ran with exit 0) leaves the
+  // cell without contact.
+  std::string allowance_pointer;
+  try {
+    read_cell_options(
+        write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.3}, "contact": {"allowance": 0.3}})"));
+  } catch (const knit::InputError& e) {
+    allowance_pointer = e.pointer();
+    CHECK(std::string(e.what()).find("smaller than the yarn diameter") != std::string::npos);
+  }
+  CHECK(allowance_pointer == "/contact/allowance");
+  CHECK_NOTHROW(read_cell_options(
+      write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.3}, "contact": {"allowance": 0.29}})")));
   // A real number beyond the reader's 1e300 said "must be > 0, got 1e+308".
   try {
     read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e308}})"));
