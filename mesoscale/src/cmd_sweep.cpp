@@ -10,8 +10,13 @@
 //   knit-meso sweep cases/sweep/default.json --output db.h5
 //   knit-meso sweep cases/sweep/reduced.json --output reduced.h5 --threads 2
 //   mpirun -np 4 knit-meso sweep cases/sweep/default.json --output db.h5
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -108,6 +113,30 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
   std::fflush(stdout);
 }
 
+// Ctrl-C (SIGINT) says what is kept and how to go on, then ends the process as the signal
+// would (session 21: it printed nothing). Async-signal-safe: the message is composed before,
+// the handler only write()s it and re-raises with the default action.
+char g_interrupt_message[4096];
+std::size_t g_interrupt_length = 0;
+
+extern "C" void on_interrupt(int sig) {
+  if (g_interrupt_length > 0) {
+    const ssize_t ignored = ::write(STDERR_FILENO, g_interrupt_message, g_interrupt_length);
+    (void)ignored;
+  }
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+void explain_interrupt(const Cli& c) {
+  const std::string m = "\nknit-meso sweep: interrupted; the cases finished so far are kept in " +
+                        c.output + ".parts: continue with `knit-meso sweep " + c.input +
+                        " --output " + c.output + " --resume`\n";
+  g_interrupt_length = std::min(m.size(), sizeof g_interrupt_message);
+  std::memcpy(g_interrupt_message, m.data(), g_interrupt_length);
+  std::signal(SIGINT, on_interrupt);
+}
+
 int run(const Cli& c) {
   using namespace knit::meso::sweep;
   MpiSession mpi;
@@ -128,6 +157,7 @@ int run(const Cli& c) {
     o.tty = c.plain ? 0 : -1;
     o.log = mpi.rank() == 0 ? stdout : nullptr;
     const PathRunner runner = make_runner(in);
+    if (mpi.rank() == 0) explain_interrupt(c);
     const SweepReport rep = run_sweep(in, o, runner, &mpi);
     if (mpi.rank() != 0) return knit::kExitOk;
     print_summary(in, rep, c.output);

@@ -42,6 +42,34 @@ int count_job_files(const fs::path& dir) {
   return n;
 }
 
+/// Starts `knit-meso sweep IN --output DB --threads 2` with 150 ms per case and returns its
+/// pid: stdout to /dev/null, stderr to `err` (/dev/null if empty), and
+/// KNIT_SWEEP_TEST_COUNT_FILE = count_file unless it is empty.
+pid_t spawn_slow_sweep(const fs::path& in, const fs::path& db, const fs::path& err,
+                       const std::string& count_file) {
+  const pid_t pid = fork();
+  if (pid != 0) return pid;
+  setenv("KNIT_SWEEP_TEST_DELAY_MS", "150", 1);
+  if (!count_file.empty()) setenv("KNIT_SWEEP_TEST_COUNT_FILE", count_file.c_str(), 1);
+  const std::string i = in.string(), o = db.string();
+  const int null_fd = ::open("/dev/null", O_WRONLY);
+  const int err_fd =
+      err.empty() ? null_fd : ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  dup2(null_fd, 1);
+  dup2(err_fd, 2);
+  execl(kExe.c_str(), kExe.c_str(), "sweep", i.c_str(), "--output", o.c_str(), "--threads", "2",
+        "--no-progress", static_cast<char*>(nullptr));
+  _exit(127);
+}
+
+/// Waits (at most 60 s) until `parts` holds at least n checkpointed jobs.
+void wait_for_jobs(const fs::path& parts, int n) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (count_job_files(parts) < n &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
+
 }  // namespace
 
 TEST_CASE("knit-meso sweep: bad input exits with 2 and names the JSON pointer", "[case]") {
@@ -63,24 +91,10 @@ TEST_CASE(
   const auto dir = knit_test::scratch("sweep_cli_kill");
   knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
   const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", count = dir / "count.txt";
-  const pid_t pid = fork();
+  const pid_t pid = spawn_slow_sweep(dir / "s.json", db, "", count.string());
   REQUIRE(pid >= 0);
-  if (pid == 0) {
-    setenv("KNIT_SWEEP_TEST_DELAY_MS", "150", 1);
-    setenv("KNIT_SWEEP_TEST_COUNT_FILE", count.c_str(), 1);
-    const std::string in = (dir / "s.json").string(), out = db.string();
-    const int fd = ::open("/dev/null", 1);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    execl(kExe.c_str(), kExe.c_str(), "sweep", in.c_str(), "--output", out.c_str(), "--threads",
-          "2", static_cast<char*>(nullptr));
-    _exit(127);
-  }
   // Wait until some (not all) cases are checkpointed, then SIGKILL.
-  const auto t0 = std::chrono::steady_clock::now();
-  while (count_job_files(parts) < 7 &&
-         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  wait_for_jobs(parts, 7);
   kill(pid, SIGKILL);
   int st = 0;
   waitpid(pid, &st, 0);
@@ -108,6 +122,30 @@ TEST_CASE(
                 (dir / "full.h5").string() + " --threads 1 > /dev/null 2>&1") == 0);
   CHECK(knit_test::database_difference(knit::material::read_database(db),
                                        knit::material::read_database(dir / "full.h5")) == 0.0);
+}
+
+// Session 21: Ctrl-C printed nothing. Now the sweep says what is kept and how to go on, and
+// still ends as SIGINT does (the checkpoints stay for --resume).
+TEST_CASE("knit-meso sweep: Ctrl-C says how to resume and ends by the signal", "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_sigint");
+  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
+  const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
+  const pid_t pid = spawn_slow_sweep(dir / "s.json", db, err, "");
+  REQUIRE(pid >= 0);
+  wait_for_jobs(parts, 3);
+  kill(pid, SIGINT);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  CHECK(WIFSIGNALED(st));
+  CHECK((WIFSIGNALED(st) && WTERMSIG(st) == SIGINT));
+  std::ifstream in(err);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(text);
+  CHECK(text.find("interrupted; the cases finished so far are kept in " + parts.string()) !=
+        std::string::npos);
+  CHECK(text.find("--output " + db.string() + " --resume") != std::string::npos);
+  CHECK(count_job_files(parts) >= 3);
+  CHECK_FALSE(fs::exists(db));
 }
 
 TEST_CASE("knit-meso sweep: mpirun with 2 ranks gives the serial database", "[case]") {
