@@ -58,7 +58,8 @@ bool is_knitscale_output(const fs::path& dir) {
          fs::is_regular_file(fs::symlink_status(dir / kOutputMarker, ec));
 }
 
-void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option) {
+void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option,
+                         std::string_view hdf5_format) {
   const std::string opt(option);
   const fs::path target = without_trailing_slash(target_in);
   auto refuse = [&](const std::string& why) { throw InputError(target_in.string(), opt, why); };
@@ -102,6 +103,22 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
         refuse(
             "exists and is not an HDF5 file (knitscale writes HDF5 databases): it is not ours "
             "to replace; give another name, or remove it first");
+      // An HDF5 file of somebody else's (a results file, another program's data) is not an
+      // earlier database either: ours carry their format in the root attribute "format".
+      if (!hdf5_format.empty() && !fs::is_empty(target, ec) && !ec) {
+        std::string format;
+        try {
+          const H5File f = H5File::open_read(target);
+          if (f.has_attribute(".", "format")) format = f.attribute_string(".", "format");
+        } catch (const std::exception&) {
+          format.clear();
+        }
+        if (format != hdf5_format)
+          refuse("exists and is an HDF5 file that is not a " + std::string(hdf5_format) +
+                 " (root attribute format " +
+                 (format.empty() ? std::string("missing") : "\"" + format + "\"") +
+                 "): it is not ours to replace; give another name, or remove it first");
+      }
     }
     if (::access(parent.c_str(), W_OK | X_OK) != 0)
       refuse("cannot be replaced: directory " + parent.string() + " is not writable");

@@ -12,6 +12,7 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
@@ -45,8 +46,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
       return [o]() -> int {
         using namespace knit::meso::fit;
         const std::string target = o->out.empty() ? o->db : o->out;
+        // In place, the reader below judges the input; --out must be new or a database.
         knit::io::check_output_target(target, knit::io::OutputKind::kFile,
-                                      o->out.empty() ? "database" : "--out");
+                                      o->out.empty() ? "database" : "--out",
+                                      o->out.empty() ? "" : knit::material::kDatabaseFormatName);
         const knit::io::OutputLock lock(target);
         auto db = knit::material::read_database(o->db, true);
         const bool paper = o->law != "energy", energy = o->law != "paper";

@@ -24,6 +24,7 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/material/database.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
 // A named namespace per command: the cmd_*.cpp files share one unity translation unit
@@ -146,7 +147,8 @@ int run(const Cli& c) {
       throw knit::InputError("", "--force", "cannot be combined with --resume");
     if (c.threads < 0) throw knit::InputError("", "--threads", "must be >= 0");
     // Before any case runs (the lock is taken by run_sweep, on rank 0).
-    knit::io::check_output_target(c.output, knit::io::OutputKind::kFile, "--output");
+    knit::io::check_output_target(c.output, knit::io::OutputKind::kFile, "--output",
+                                  knit::material::kDatabaseFormatName);
     SweepOptions o;
     o.output = c.output;
     o.resume = c.resume;

@@ -17,6 +17,7 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
@@ -50,7 +51,8 @@ static knit::cli::SubcommandRegistrar reg_synth(
                    "only the 13 paper paths (no coverage or held-out paths)");
       return [o]() -> int {
         using namespace knit::meso::fit;
-        knit::io::check_output_target(o->out, knit::io::OutputKind::kFile, "--out");
+        knit::io::check_output_target(o->out, knit::io::OutputKind::kFile, "--out",
+                                      knit::material::kDatabaseFormatName);
         const knit::io::OutputLock lock(o->out);
         SyntheticOptions so;
         so.loop_lengths = o->loop_lengths;

@@ -235,6 +235,33 @@ TEST_CASE("check_output_target refuses what a run must not or cannot write", "[u
   std::ofstream(d / "touched.h5").close();
   CHECK(why(d / "touched.h5", filek).empty());
   CHECK(why(d / "new.h5", filek).empty());
+  // With the format of what is written given (the database outputs, session 21), an HDF5 file
+  // is replaced only if it carries that format in its root attribute "format": somebody
+  // else's HDF5 file (a results file, another program's data) was replaced by a database.
+  auto why_format = [](const fs::path& t) -> std::string {
+    try {
+      knit::io::check_output_target(t, OutputKind::kFile, "--out", "test-db-format");
+    } catch (const knit::InputError& e) {
+      return e.message();
+    }
+    return "";
+  };
+  CHECK_THAT(why_format(d / "earlier.h5"),
+             Catch::Contains("not a test-db-format (root attribute format missing)"));
+  {
+    auto f = knit::io::H5File::create(d / "other.h5");
+    f.set_attribute(".", "format", "other-format");
+  }
+  CHECK_THAT(why_format(d / "other.h5"),
+             Catch::Contains("(root attribute format \"other-format\")"));
+  {
+    auto f = knit::io::H5File::create(d / "ours.h5");
+    f.set_attribute(".", "format", "test-db-format");
+  }
+  CHECK(why_format(d / "ours.h5").empty());
+  CHECK(why_format(d / "touched.h5").empty());  // an empty file
+  CHECK(why_format(d / "new.h5").empty());
+  CHECK_THAT(why_format(d / "file"), Catch::Contains("exists and is not an HDF5 file"));
   if (::geteuid() != 0) {  // root writes everywhere
     fs::create_directories(d / "ro");
     fs::permissions(d / "ro", fs::perms::owner_read | fs::perms::owner_exec);

@@ -31,12 +31,14 @@ enum class OutputKind { kDirectory, kFile };
 ///  * kDirectory: an existing non-directory; the current directory or one of its ancestors; a
 ///    non-empty directory that is not a knitscale output (no marker file);
 ///  * kFile (an HDF5 file: the database outputs): an existing directory (or other non-regular
-///    file); an existing non-empty file that is not HDF5 (not ours to replace; an existing HDF5
-///    file is taken for an earlier database and replaced);
+///    file); an existing non-empty file that is not HDF5 (not ours to replace); with
+///    `hdf5_format` given, an existing HDF5 file whose root attribute "format" is not
+///    `hdf5_format` (session 21: somebody else's HDF5 file was taken for an earlier database
+///    and replaced);
 ///  * a target whose nearest existing ancestor is not a writable directory (missing parents
 ///    are created by the writer, so "a/b/out" needs "a" — or the first existing one — writable).
 void check_output_target(const std::filesystem::path& target, OutputKind kind,
-                         std::string_view option = "--output");
+                         std::string_view option = "--output", std::string_view hdf5_format = {});
 
 /// An exclusive lock on an output, held for the lifetime of the object: flock(2) on
 /// "<target>.lock" beside the target, which holds "knitscale lock pid <pid>". Another process
