@@ -413,6 +413,13 @@ TEST_CASE(
   const auto d1 = knit::material::read_database(dir / "one.h5");
   const auto d3 = knit::material::read_database(dir / "three.h5");
   CHECK(knit_test::database_difference(d1, d3) == 0.0);
+  CHECK(r3.threads == 3);
+  // No more workers than cases (session 21: --threads 4096 started 4096 threads for 7 cases).
+  auto o_many = quiet(dir / "many.h5");
+  o_many.threads = 4096;
+  const SweepReport r_many = run_sweep(in, o_many, synthetic_runner());
+  CHECK(r_many.threads == 26);
+  CHECK(knit_test::database_difference(d1, knit::material::read_database(dir / "many.h5")) == 0.0);
   REQUIRE(d1.entries.size() == 2);
   CHECK(d1.entries[0].surface.has_value());
   CHECK(d1.generator.find("synthetic") != std::string::npos);
