@@ -17,13 +17,12 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
-import h5py  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from cell_paths import path_set  # noqa: E402  (scripts/cell_paths.py)
+from cell_paths import open_database, path_set  # noqa: E402  (scripts/cell_paths.py)
 from surfaces import basis, database_figure_args, pick_loop  # noqa: E402
 
 
@@ -209,7 +208,7 @@ def network_law(g, l, mode):
 
 def main():
     a = database_figure_args()
-    with h5py.File(a.database, "r") as f:
+    with open_database(a.database, "energy_law.py") as f:
         if "energy_law" not in f:
             sys.exit(f"{a.database}: /energy_law: group missing (run `knit-meso fit "
                      f"{a.database} --law energy`)")

@@ -12,7 +12,6 @@ in the paper's figures); the reference outline is dashed. Design fields are draw
 reference surface with arrows along the knitting (course) direction Q(alpha) e1.
 """
 import argparse
-import math
 import os
 import sys
 

@@ -11,13 +11,16 @@ Usage: surfaces.py --database DB.h5 --loop-length 6.5 --out fig06.png
 """
 import argparse
 import os
+import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
-import h5py  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from cell_paths import open_database  # noqa: E402  (scripts/cell_paths.py)
 
 
 def basis(p, U, x):
@@ -61,7 +64,8 @@ def database_figure_args():
 
 def main():
     a = database_figure_args()
-    with h5py.File(a.database, "r") as f:
+    # A missing or non-HDF5 file: named, no traceback (session 21).
+    with open_database(a.database, "surfaces.py") as f:
         k, l = pick_loop(f, a.loop_length)
         g = f[f"loop_{k}"]
         gen = f.attrs.get("generator", b"?")

@@ -5,6 +5,8 @@ hand-made database of one loop length whose law is S = 2 e (fixtures.py):
 * it draws (exit 0, a PNG) from a format-3 database whose paths carry their set;
 * a path without its set attribute in a format-3 file is refused, exit non-zero, naming the
   file and the HDF5 path (it used to be read as "paper": a held-out state drawn as fit data);
+* a file that is missing or not HDF5 is refused by name, without a traceback (also by
+  scripts/figures/surfaces.py, Fig. 6);
 * a format-1 file (which never had the attribute) still draws.
 Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
 """
@@ -54,6 +56,19 @@ def main():
           "format 3, /loop_0/raw/held without set: refused, nothing drawn (exit %d)" % r.returncode)
         c("db.h5" in r.stderr and "/loop_0/raw/held: attribute set is missing" in r.stderr,
           "the message names the file and the HDF5 path: %s" % r.stderr.strip()[-300:])
+        # A file that is not HDF5 (and one that is not there): named, no traceback, for this
+        # figure and Fig. 6 (scripts/figures/surfaces.py), which share the command line.
+        notdb = os.path.join(tmp, "notes.h5")
+        with open(notdb, "w") as fh:
+            fh.write("not hdf5")
+        for script in (SCRIPT, os.path.join(ROOT, "scripts", "figures", "surfaces.py")):
+            for path, what in ((notdb, "notes.h5: not a readable HDF5 file"),
+                               (os.path.join(tmp, "missing.h5"), "missing.h5: no such file")):
+                r = subprocess.run([sys.executable, script, "--database", path, "--out", png],
+                                   capture_output=True, text=True)
+                c(r.returncode != 0 and what in r.stderr and "Traceback" not in r.stderr,
+                  "%s, %s: refused by name (exit %d): %s" % (os.path.basename(script), what,
+                                                            r.returncode, r.stderr.strip()[-200:]))
         write_db(db, 1, drop_set=True)
         r = draw(db, png)
         c(r.returncode == 0 and os.path.exists(png),
