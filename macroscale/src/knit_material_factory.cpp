@@ -95,14 +95,30 @@ Basis2 read_basis(const nlohmann::json& j, const std::string& p, const CaseConte
   return b;
 }
 
+// A knitting angle (rad) within one turn either way: a larger one is the same direction as one
+// inside, and 1e308 rad is no direction at all (session 21: accepted with exit 0, its cosine
+// rounding noise).
+void check_angle(double a, const std::string& p, const CaseContext& ctx, bool deg) {
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  if (!(std::abs(a) <= kTurn)) {
+    std::ostringstream m;
+    m << "a knitting angle must lie in " << (deg ? "[-360, 360] deg" : "[-2 pi, 2 pi] rad")
+      << ", got " << (deg ? a * 180.0 / std::numbers::pi : a)
+      << " (a larger angle is the same course direction as one inside)";
+    throw InputError(ctx.file, p, m.str());
+  }
+}
+
 spline::SplineSurface read_field(const nlohmann::json& j, const std::string& p,
                                  const CaseContext& ctx, bool angle) {
   const auto& pu = ctx.patch->basis_u();
   const auto& pv = ctx.patch->basis_v();
   double scale = 1.0;
-  if (j.is_number())
+  if (j.is_number()) {
+    if (angle) check_angle(j.get<double>(), p, ctx, false);
     return make_scalar_field(
         ScalarFieldSpec::constant(j.get<double>(), pu.lo(), pu.hi(), pv.lo(), pv.hi()));
+  }
   if (!j.is_object()) throw InputError(ctx.file, p, "must be a number or a spline field object");
   if (angle && j.contains("align_with")) {
     check_keys(j, p, ctx, {"align_with", "degrees", "knots_u", "knots_v", "description"});
@@ -136,6 +152,9 @@ spline::SplineSurface read_field(const nlohmann::json& j, const std::string& p,
   s.knots_v = b.V;
   s.values = number_array(j.at("values"), p + "/values", ctx);
   for (double& x : s.values) x *= scale;
+  if (angle)
+    for (std::size_t i = 0; i < s.values.size(); ++i)
+      check_angle(s.values[i], p + "/values/" + std::to_string(i), ctx, scale != 1.0);
   try {
     return make_scalar_field(s);
   } catch (const std::exception& e) {

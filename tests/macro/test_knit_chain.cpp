@@ -166,6 +166,20 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
           head +
           R"("stitch_value": 5, "knitting_angle": {"align_with": [0, 0, 1], "degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1]}})"),
       Catch::Contains("/material/knitting_angle/align_with: "));
+  // Knitting angles within one turn either way (session 21: 1e308 rad ran with exit 0).
+  CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": 1e308})"),
+                    Catch::Contains("/material/knitting_angle: a knitting angle must lie in "
+                                    "[-2 pi, 2 pi] rad, got 1e+308"));
+  CHECK_THROWS_WITH(
+      load(
+          head +
+          R"("stitch_value": 5, "knitting_angle": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [350, 400], "unit": "deg"}})"),
+      Catch::Contains("/material/knitting_angle/values/1: a knitting angle must lie in "
+                      "[-360, 360] deg, got 400"));
+  CHECK_NOTHROW(load(
+      head +
+      R"("stitch_value": 5, "knitting_angle": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [-360, 360], "unit": "deg"}})"));
+  CHECK_NOTHROW(load(head + R"("stitch_value": 5, "knitting_angle": -6.28})"));
   CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "colour": 1})"),
                     Catch::Contains("/material/colour: unknown key"));
   CHECK_THROWS_WITH(
