@@ -19,6 +19,11 @@ namespace knit::macro {
 
 namespace {
 
+/// Upper bounds of the solver's tolerances (schemas/case.schema.json "maximum"): relative to the
+/// load, and in N.
+constexpr double kMaxRelativeTolerance = 1e-2;
+constexpr double kMaxAbsoluteTolerance = 1e-3;
+
 using nlohmann::json;
 
 class Reader {
@@ -317,9 +322,20 @@ void read_solver(const Reader& r, const json& root, Case& c) {
           "line_search", "line_search_first", "threads", "thickness_integration", "description"});
   SolverOptions& o = c.solver;
   if (s.contains("steps")) o.steps = r.integer(s.at("steps"), "/solver/steps", 1, 100000);
-  if (s.contains("tolerance")) o.tolerance = r.positive(s.at("tolerance"), "/solver/tolerance");
-  if (s.contains("absolute_tolerance"))
+  // Upper bounds (session 21, found by fuzzing: a tolerance of 1e308 accepted every first
+  // iterate, 0 Newton iterations, and the run ended with exit 0).
+  if (s.contains("tolerance")) {
+    o.tolerance = r.positive(s.at("tolerance"), "/solver/tolerance");
+    if (o.tolerance > kMaxRelativeTolerance)
+      r.fail("/solver/tolerance",
+             "must be at most 0.01 (relative to the load), got " + s.at("tolerance").dump());
+  }
+  if (s.contains("absolute_tolerance")) {
     o.absolute_tolerance = r.positive(s.at("absolute_tolerance"), "/solver/absolute_tolerance");
+    if (o.absolute_tolerance > kMaxAbsoluteTolerance)
+      r.fail("/solver/absolute_tolerance",
+             "must be at most 0.001 N, got " + s.at("absolute_tolerance").dump());
+  }
   if (s.contains("max_iterations"))
     o.max_iterations = r.integer(s.at("max_iterations"), "/solver/max_iterations", 1, 1000);
   if (s.contains("max_cutbacks"))

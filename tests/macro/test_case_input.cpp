@@ -121,6 +121,15 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     j["solver"]["stepz"] = 3;
     CHECK(error_of(j).rfind("bad.json: /solver/stepz: unknown key", 0) == 0);
   }
+  // Tolerances that accept every first iterate (session 21: 1e308 ran with exit 0).
+  for (const char* key : {"tolerance", "absolute_tolerance"}) {
+    INFO(key);
+    json j = base;
+    j["solver"][key] = 1e308;
+    CHECK(error_of(j).rfind(std::string("bad.json: /solver/") + key + ": ", 0) == 0);
+    j["solver"][key] = 1e-3;
+    CHECK(error_of(j).empty());
+  }
   {
     json j = base;
     j["material"]["type"] = "rubber";
