@@ -126,7 +126,7 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/contact/stick_penalty", f.k_T, 0, inf, true, false},
       {"/contact/margin", contact.margin, 0, inf, false, false},
       {"/contact/self_exclusion", contact.self_exclusion, 0, 1, true, false},
-      {"/solver/tolerance", newton.tol, 0, 1, true, false},
+      {"/solver/tolerance", newton.tol, 0, 0.01, true, false},  // 1 accepted the first iterate
       {"/solver/max_iterations", double(newton.max_iterations), 1, kMaxIterations, false, false},
       {"/solver/equilibration_steps", double(equilibration_steps), 1, kMaxIterations, false, false},
       {"/solver/max_cutbacks", double(max_cutbacks), 0, kMaxCutbacks, false, false},
@@ -193,7 +193,7 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
   if (j.contains("solver")) {
     const json& s = j["solver"];
     R.object(s, "/solver", {"tolerance", "max_iterations", "equilibration_steps", "max_cutbacks"});
-    R.num(s, "/solver", "tolerance", o.newton.tol, 0, 1, true);
+    R.num(s, "/solver", "tolerance", o.newton.tol, 0, 0.01, true);
     R.integer(s, "/solver", "max_iterations", o.newton.max_iterations, 1,
               CellOptions::kMaxIterations);
     R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1,

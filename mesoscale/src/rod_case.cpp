@@ -244,8 +244,14 @@ RodCase load_rod_case(const std::filesystem::path& path) {
     if (js.contains("count")) c.path.steps = R.integer(js["count"], "/steps/count", 1);
     if (js.contains("max_cutbacks"))
       c.path.max_cutbacks = R.integer(js["max_cutbacks"], "/steps/max_cutbacks", 0);
-    if (js.contains("tolerance"))
+    if (js.contains("tolerance")) {
       c.path.newton.tol = R.positive(js["tolerance"], "/steps/tolerance");
+      // 1e308 accepted every first iterate: 0 Newton iterations, an undeformed rod and exit 0
+      // (session 21).
+      if (c.path.newton.tol > 1e-2)
+        R.fail("/steps/tolerance",
+               "must be at most 0.01 (a dimensionless residual), got " + js["tolerance"].dump());
+    }
     if (js.contains("max_iterations"))
       c.path.newton.max_iterations = R.integer(js["max_iterations"], "/steps/max_iterations", 1);
     if (js.contains("min_increment"))

@@ -46,6 +46,9 @@ TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
   // 4294967300 narrowed to 4 and was accepted (issue 14): ranges are checked before narrowing.
   CHECK(pointer_of(R"({"analysis": {"elements": 4294967300}})") == "/analysis/elements");
   CHECK(pointer_of(R"({"yarn": {"nu": 0.7}})") == "/yarn/nu");
+  // A residual tolerance of 1 accepted the first iterate (session 21): at most 0.01.
+  CHECK(pointer_of(R"({"solver": {"tolerance": 0.5}})") == "/solver/tolerance");
+  CHECK(pointer_of(R"({"solver": {"tolerance": 0.01}})") == "<no error>");
   CHECK(pointer_of(R"({"bogus": 1})") == "");
   CHECK(pointer_of(R"({not json)") == "");
 }

@@ -117,6 +117,9 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
       {R"({"rods": []})", "/rods"},
       {R"({"section": {"d": -1}, "rods": [)" + good_rod + "]}", "/section/d"},
       {R"({"rods": [)" + good_rod + R"(], "steps": {"count": 0}})", "/steps/count"},
+      // 1e308 accepted every first iterate: an undeformed rod with exit 0 (session 21).
+      {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 1e308}})", "/steps/tolerance"},
+      {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 0.5}})", "/steps/tolerance"},
       {R"({"rods": [{"name": "b", "curve": {"type": "spiral"}, "start": {}, "end": {}}]})",
        "/rods/0/curve/type"},
       {R"({"rods": [)" + good_rod +
