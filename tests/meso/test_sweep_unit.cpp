@@ -180,26 +180,28 @@ TEST_CASE("sweep input: cell parameters inline or from a file relative to the sw
       R"({"loop_lengths": [4.5], "cell": {"analysis": {"elements": 20}, "contact": {"mu": 0.2}}})",
       "b.json");
   CHECK(a.job_definition() == b.job_definition());  // the content counts, not where it is
+  // The error of loading a sweep input (the test fails if there is none).
+  auto error_of = [](const std::filesystem::path& input) {
+    try {
+      load_sweep_input(input);
+    } catch (const knit::InputError& e) {
+      return e;
+    }
+    FAIL("no error: " << input);
+    return knit::InputError("", "", "");
+  };
   knit_test::write_text(dir / "bad.json", R"({"contact": {"mu": -1}})");
   knit_test::write_text(dir / "s2.json", R"({"loop_lengths": [4.5], "cell": "bad.json"})");
-  try {
-    load_sweep_input(dir / "s2.json");
-    FAIL("no error");
-  } catch (const knit::InputError& e) {
-    CHECK(e.file() == (dir / "bad.json").string());
-    CHECK(e.pointer() == "/contact/mu");
-  }
+  const knit::InputError bad = error_of(dir / "s2.json");
+  CHECK(bad.file() == (dir / "bad.json").string());
+  CHECK(bad.pointer() == "/contact/mu");
   // A cell file that is not there (or not JSON): the sweep input and /cell are named beside it
   // (session 21; it said "missing.json: file not found" alone).
   knit_test::write_text(dir / "s3.json", R"({"loop_lengths": [4.5], "cell": "missing.json"})");
-  try {
-    load_sweep_input(dir / "s3.json");
-    FAIL("no error");
-  } catch (const knit::InputError& e) {
-    CHECK(e.file() == (dir / "s3.json").string());
-    CHECK(e.pointer() == "/cell");
-    CHECK(std::string(e.what()).find("missing.json: file not found") != std::string::npos);
-  }
+  const knit::InputError missing = error_of(dir / "s3.json");
+  CHECK(missing.file() == (dir / "s3.json").string());
+  CHECK(missing.pointer() == "/cell");
+  CHECK(std::string(missing.what()).find("missing.json: file not found") != std::string::npos);
 }
 
 TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {
