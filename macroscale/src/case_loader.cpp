@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/input_file.hpp"
@@ -23,6 +24,33 @@ namespace {
 /// load, and in N.
 constexpr double kMaxRelativeTolerance = 1e-2;
 constexpr double kMaxAbsoluteTolerance = 1e-3;
+
+/// Bounds of lengths relative to the patch's size D, the diagonal of its control net's bounding
+/// box (the surface lies inside that box). A thickness below 1e-4 D makes every internal force
+/// vanish against the solver's absolute tolerance (t = 1e-300 "converged" every step with 0
+/// iterations and left the free control points where the predictor put them); a shell thicker
+/// than its own size is no shell. A gauge length is a distance between jaws on the patch: below
+/// 0.01 D or above 10 D the printed strain (displacement / gauge length) says nothing (1e308 gave
+/// strain 0 at every step).
+constexpr double kMinThicknessPerSize = 1e-4;
+constexpr double kMaxThicknessPerSize = 1.0;
+constexpr double kMinGaugePerSize = 1e-2;
+constexpr double kMaxGaugePerSize = 10.0;
+
+/// The diagonal of the control net's bounding box, mm.
+double patch_size(const spline::SplineSurface& s) {
+  const Eigen::MatrixXd& P = s.control_points();
+  return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+}
+
+/// "[lo, hi] mm (a and b times the patch's size D = ... mm)"
+std::string relative_range(double lo, double hi, double size) {
+  std::ostringstream o;
+  o << "[" << lo * size << ", " << hi * size << "] mm (" << lo << " to " << hi
+    << " times the patch's size D = " << size
+    << " mm, the diagonal of its control net's bounding box)";
+  return o.str();
+}
 
 using nlohmann::json;
 
@@ -177,6 +205,12 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
   }
   c.thickness = r.positive(g.at("thickness"), "/geometry/thickness");
   c.input_surface = spline::SplineSurface(bu, bv, P, w);
+  const double size = patch_size(c.input_surface);
+  if (!(c.thickness >= kMinThicknessPerSize * size && c.thickness <= kMaxThicknessPerSize * size))
+    r.fail("/geometry/thickness",
+           "the thickness must lie in " +
+               relative_range(kMinThicknessPerSize, kMaxThicknessPerSize, size) + ", got " +
+               g.at("thickness").dump());
   c.surface = c.input_surface;
   if (root.contains("refinement")) {
     const json& rf = root.at("refinement");
@@ -432,6 +466,12 @@ void read_output(const Reader& r, const json& root, Case& c) {
       ad.corner = r.corner(a.at("corner"), ptr + "/corner");
     ad.component = r.component(a.at("component"), ptr + "/component");
     ad.gauge_length = r.positive(a.at("gauge_length"), ptr + "/gauge_length");
+    const double size = patch_size(c.input_surface);
+    if (!(ad.gauge_length >= kMinGaugePerSize * size && ad.gauge_length <= kMaxGaugePerSize * size))
+      r.fail(ptr + "/gauge_length",
+             "the gauge length (the distance between the jaws) must lie in " +
+                 relative_range(kMinGaugePerSize, kMaxGaugePerSize, size) + ", got " +
+                 a.at("gauge_length").dump());
     bool found = false;
     for (const BoundaryCondition& bc : c.bcs) {
       const bool same =

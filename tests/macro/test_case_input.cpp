@@ -130,6 +130,35 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     j["solver"][key] = 1e-3;
     CHECK(error_of(j).empty());
   }
+  // Lengths relative to the patch's size D = 70.71 mm (session 22: a thickness of 1e-300
+  // "converged" every step with 0 iterations, a gauge length of 1e308 printed strain 0; exit 0).
+  for (const double t : {1e-300, 1e-6, 7e-3, 71.0, 1e300}) {
+    INFO(t);
+    json j = base;
+    j["geometry"]["thickness"] = t;
+    CHECK(error_of(j).rfind("bad.json: /geometry/thickness: the thickness must lie in "
+                            "[0.00707107, 70.7107] mm",
+                            0) == 0);
+  }
+  for (const double t : {7.1e-3, 70.7}) {
+    json j = base;
+    j["geometry"]["thickness"] = t;
+    CHECK(error_of(j).empty());
+  }
+  for (const double g : {1e-300, 0.7, 708.0, 1e308}) {
+    INFO(g);
+    json j = base;
+    j["output"]["applied_displacement"]["gauge_length"] = g;
+    CHECK(error_of(j).rfind("bad.json: /output/applied_displacement/gauge_length: the gauge "
+                            "length (the distance between the jaws) must lie in [0.707107, "
+                            "707.107] mm",
+                            0) == 0);
+  }
+  for (const double g : {0.71, 707.0}) {
+    json j = base;
+    j["output"]["applied_displacement"]["gauge_length"] = g;
+    CHECK(error_of(j).empty());
+  }
   {
     json j = base;
     j["material"]["type"] = "rubber";
