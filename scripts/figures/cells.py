@@ -7,8 +7,8 @@ Usage: cells.py --out fig05.png DIR_4.5 DIR_6.5
 """
 import argparse
 import base64
-import json
 import os
+import sys
 import xml.etree.ElementTree as ET
 
 import matplotlib
@@ -16,6 +16,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main, read_json  # noqa: E402
 
 
 _VTK_TYPES = {"Float64": np.float64, "Float32": np.float32, "Int64": np.int64, "Int32": np.int32,
@@ -53,8 +55,7 @@ def main():
     fig, axs = plt.subplots(1, len(a.dirs), figsize=(5 * len(a.dirs), 5))
     axs = np.atleast_1d(axs)
     for ax, d in zip(axs, a.dirs):
-        with open(os.path.join(d, "cell.json")) as f:
-            info = json.load(f)
+        info = read_json(os.path.join(d, "cell.json"))
         polys, image = read_vtp(os.path.join(d, "cell.vtp"))
         for P, im in zip(polys, image):
             ax.plot(P[:, 0], P[:, 1], color="0.75" if im else "C1", lw=2.5 if im == 0 else 1.5,
@@ -76,4 +77,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

@@ -12,8 +12,8 @@ DIR/design.png unless --out is given. The pipeline calls it (make -f scripts/pip
 designs); the C++ command never needs python.
 """
 import argparse
-import json
 import os
+import sys
 
 import matplotlib
 
@@ -26,6 +26,8 @@ try:
 except ImportError:  # the section panel is then left out
     h5py = None
 from scipy.interpolate import BSpline  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main, read_json  # noqa: E402
 
 
 def read_history(path):
@@ -66,8 +68,7 @@ def main():
     ap.add_argument("--section", default="", help="strain field along v = 0.5 of the final run (E11, E22, E12)")
     a = ap.parse_args()
     h = read_history(os.path.join(a.dir, "history.csv"))
-    with open(os.path.join(a.dir, "case.json")) as f:
-        case = json.load(f)
+    case = read_json(os.path.join(a.dir, "case.json"))
     fields = [(k, case["material"].get(k)) for k in ("stitch_value", "knitting_angle")]
     fields = [(k, field_grid(s)) for k, s in fields if field_grid(s) is not None]
     run = os.path.join(a.dir, "run")
@@ -140,4 +141,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

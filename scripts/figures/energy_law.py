@@ -22,6 +22,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from figure_inputs import guarded_main  # noqa: E402
 from cell_paths import open_database, path_set  # noqa: E402  (scripts/cell_paths.py)
 from surfaces import basis, database_figure_args, pick_loop  # noqa: E402
 
@@ -263,4 +264,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

@@ -10,12 +10,15 @@ C++ command never needs python.
 """
 import argparse
 import os
+import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main  # noqa: E402
 
 
 def read_map(path):
@@ -72,4 +75,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main  # noqa: E402
 from results import Result  # noqa: E402
 
 LABELS = {
@@ -204,4 +205,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

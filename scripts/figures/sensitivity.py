@@ -24,6 +24,9 @@ result: the measured number. One row per (parameter, value, observable).
 import argparse
 import math
 import os
+import sys
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main  # noqa: E402
 
 FIGURE = "sensitivity.png"
 COLUMNS = ["parameter", "value", "observable", "result"]
@@ -143,4 +146,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

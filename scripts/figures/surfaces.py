@@ -21,6 +21,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from cell_paths import open_database  # noqa: E402  (scripts/cell_paths.py)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_inputs import guarded_main  # noqa: E402
 
 
 def basis(p, U, x):
@@ -128,4 +130,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guarded_main(main)

@@ -1,0 +1,44 @@
+"""The figure scripts' error boundary: a damaged or missing input ends the script with one line
+that names the file (or the command line's inputs), exit code 1, instead of a traceback.
+
+Session 22: `knitmap.py DIR`, `design.py DIR` and `cells.py DIR...` on a directory without their
+files, or with a damaged case.json or history.csv, ended in a FileNotFoundError or
+JSONDecodeError traceback. Used as `guarded_main(main)` under `if __name__ == "__main__"`; the
+pipeline's batches (batch.py) run the scripts as __main__ too, so the line lands in the
+figure's log and the PNG becomes the placeholder as before.
+"""
+import json
+import os
+import sys
+
+
+def guarded_main(main):
+    prog = os.path.basename(sys.argv[0])
+    try:
+        main()
+    except json.JSONDecodeError as err:
+        # json names the position only: the file comes from read_json below when the script
+        # reads through it, else the message shows the command line.
+        where = getattr(err, "knit_path", None) or "a JSON input (" + _command_line() + ")"
+        raise SystemExit(f"{prog}: {where}: not valid JSON "
+                         f"(line {err.lineno}, column {err.colno}: {err.msg})")
+    except OSError as err:
+        where = err.filename if err.filename else "an input (" + _command_line() + ")"
+        raise SystemExit(f"{prog}: {where}: {err.strerror or err}")
+    except (ValueError, KeyError, IndexError, TypeError) as err:
+        raise SystemExit(f"{prog}: an input is damaged or not a knitscale output "
+                         f"({type(err).__name__}: {err}; the command line: {_command_line()})")
+
+
+def read_json(path):
+    """json.load of `path`; a parse error keeps the path for guarded_main's message."""
+    with open(path) as f:
+        try:
+            return json.load(f)
+        except json.JSONDecodeError as err:
+            err.knit_path = path
+            raise
+
+
+def _command_line():
+    return " ".join(sys.argv[1:]) or "no arguments"

@@ -1,0 +1,60 @@
+#!/usr/bin/python3
+"""The figure scripts a user runs on a directory (scripts/figures/knitmap.py, design.py,
+cells.py, sensitivity.py) refuse a missing or damaged input with one line naming the file and a
+non-zero exit, without a Python traceback (scripts/figures/figure_inputs.py; session 22: they
+ended in FileNotFoundError and JSONDecodeError tracebacks), and draw nothing.
+Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FIG = os.path.join(ROOT, "scripts", "figures")
+
+
+def run(script, *args):
+    return subprocess.run([sys.executable, os.path.join(FIG, script)] + list(args),
+                          capture_output=True, text=True, env=dict(os.environ, MPLBACKEND="Agg"))
+
+
+def main():
+    c = Checklist()
+    with tempfile.TemporaryDirectory(prefix="figure_inputs_test_") as tmp:
+        missing = os.path.join(tmp, "missing")
+        damaged = os.path.join(tmp, "damaged")
+        os.makedirs(damaged)
+        with open(os.path.join(damaged, "history.csv"), "w") as f:
+            f.write("iteration,J\n0,1\n1,0.5\n")
+        for name in ("case.json", "cell.json"):
+            with open(os.path.join(damaged, name), "w") as f:
+                f.write("{\n")
+        png = os.path.join(tmp, "x.png")
+        table = os.path.join(tmp, "table.csv")
+        with open(table, "w") as f:
+            f.write("p,v\n")
+        jobs = [
+            (("knitmap.py", missing, "--out", png), os.path.join(missing, "knitmap.csv")),
+            (("design.py", missing, "--out", png), os.path.join(missing, "history.csv")),
+            (("design.py", damaged, "--out", png),
+             os.path.join(damaged, "case.json") + ": not valid JSON (line 2"),
+            (("cells.py", "--out", png, missing), os.path.join(missing, "cell.json")),
+            (("cells.py", "--out", png, damaged),
+             os.path.join(damaged, "cell.json") + ": not valid JSON (line 2"),
+            (("sensitivity.py", "--out", png, table), table + ":1: header must be"),
+        ]
+        for args, expect in jobs:
+            r = run(*args)
+            what = " ".join(os.path.relpath(a, tmp) if a.startswith(tmp) else a for a in args)
+            c(r.returncode != 0 and not os.path.exists(png),
+              f"{what}: refused (exit {r.returncode}), nothing drawn", r.stderr[-500:])
+            c(expect in r.stderr and "Traceback" not in r.stderr,
+              f"{what}: one line naming the file, no traceback", r.stderr[-500:])
+    return c.exit_code()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
