@@ -119,6 +119,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "units", "mm, N, MPa");
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
+  if (!material_warning_.empty()) h5.set_attribute(".", "material_warning", material_warning_);
   h5.write_strings("case_json", {case_.text});
   // The CSV columns.
   const int n = static_cast<int>(rows_.size());
@@ -182,6 +183,7 @@ void ResultsWriter::finish(const RunReport& report) {
   if (report.status != RunStatus::kCompleted)
     csv.add_comment("run stopped early: " + report.message);
   if (!material_failure_.empty()) csv.add_comment(material_failure_);
+  if (!material_warning_.empty()) csv.add_comment(material_warning_);
   for (const StepRow& r : rows_) {
     std::vector<io::CsvCell> row = {r.step, r.lambda};
     if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
@@ -196,6 +198,7 @@ void ResultsWriter::finish(const RunReport& report) {
   std::ostringstream sum;
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n";
   if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
+  if (!material_warning_.empty()) sum << material_warning_ << "\n";
   sum << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
   if (!report.message.empty()) sum << "message: " << report.message << "\n";

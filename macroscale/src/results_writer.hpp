@@ -33,6 +33,8 @@ class ResultsWriter {
   /// The run's verdict on the material (run.hpp, material_failure_message()); empty if the
   /// material never failed. Written to summary.txt and load_strain.csv.
   void set_material_failure(std::string m) { material_failure_ = std::move(m); }
+  /// Material::warning(): a comment in the CSV, a line in summary.txt, an HDF5 attribute.
+  void set_material_warning(std::string m) { material_warning_ = std::move(m); }
 
  private:
   struct Fields {
@@ -54,6 +56,7 @@ class ResultsWriter {
   std::vector<Fields> steps_;  ///< kept for the HDF5 file
   std::string material_report_;
   std::string material_failure_;
+  std::string material_warning_;
 };
 
 }  // namespace knit::macro

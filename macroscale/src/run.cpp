@@ -168,10 +168,14 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   if (opt.progress && !failure.empty()) *opt.progress << failure << std::endl;
   const std::string material_report = c.material->report();
   if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
+  res.material_warning = c.material->warning();
+  if (opt.warnings && !res.material_warning.empty())
+    *opt.warnings << res.material_warning << std::endl;
   if (opt.progress && res.report.first_unstable_step > 0)
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
   if (writer) {
     writer->set_material_report(material_report);
+    writer->set_material_warning(res.material_warning);
     writer->set_material_failure(failure);
     // A stopped run still writes its last converged state.
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&

@@ -98,6 +98,7 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   CHECK_THAT(rep, Catch::Contains("1 extrapolated") &&
                       Catch::Contains("visited material-frame strain box: E11 [-0.2, 0.6]"));
   CHECK_THAT(rep, !Catch::Contains("at converged states"));  // no audit yet
+  CHECK(m.warning().empty());                                // trial iterates alone never warn
   // The converged-state audit counts only what is evaluated between begin and end.
   REQUIRE(m.begin_converged_audit());
   m.evaluate({0.7, 0.0, 0.0}, p);  // extrapolated
@@ -106,6 +107,18 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   m.evaluate({0.8, 0.0, 0.0}, p);  // after the audit: counted in the totals only
   CHECK(m.energy_stats().outside_box == 3);
   CHECK_THAT(m.report(), Catch::Contains("at converged states: 1 of 2 evaluations extrapolated"));
+  // More than 2 % of the converged states' evaluations outside the box: a warning (session 22:
+  // a stretch of 10 times the specimen "completed" with 100 % outside and no warning).
+  CHECK_THAT(m.warning(), Catch::StartsWith("warning: 50 % of the material evaluations at "
+                                            "converged states lie outside the database's data"));
+  REQUIRE(m.begin_converged_audit());
+  for (int k = 0; k < 48; ++k) m.evaluate({0.1, 0.1, 0.0}, p);
+  m.end_converged_audit();
+  CHECK(m.warning().empty());  // 1 of 50: 2 %, not more
+  REQUIRE(m.begin_converged_audit());
+  m.evaluate({0.9, 0.0, 0.0}, p);
+  m.end_converged_audit();
+  CHECK_THAT(m.warning(), Catch::StartsWith("warning: 3.92 % "));  // 2 of 51
   CHECK(m.failed_evaluations() == 0);
   const auto bad = m.evaluate({NAN, 0.0, 0.0}, p);
   CHECK(m.failed_evaluations() == 1);

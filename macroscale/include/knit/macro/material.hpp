@@ -83,6 +83,11 @@ class Material {
   /// residual once more at each converged step inside the audit (run.cpp).
   virtual bool begin_converged_audit() const { return false; }
   virtual void end_converged_audit() const {}
+
+  /// A warning for the end of a run when the converged states lie largely where the material
+  /// has no data (e.g. the knit law's extension beyond its database's strain box): the run
+  /// still completes, the warning goes to stderr and summary.txt. Empty by default.
+  virtual std::string warning() const { return {}; }
 };
 
 }  // namespace knit::macro

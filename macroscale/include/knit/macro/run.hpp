@@ -81,6 +81,8 @@ struct RunResult {
   RunReport report;
   /// Material::failed_evaluations() at the end of the run; > 0 means not trustworthy.
   long failed_material_evaluations = 0;
+  /// Material::warning() at the end of the run (empty: none).
+  std::string material_warning;
   /// Plain success: every step converged and the material never failed.
   bool succeeded() const {
     return report.status == RunStatus::kCompleted && failed_material_evaluations == 0;
