@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +24,14 @@ static_assert(std::is_same_v<hid_t, std::int64_t>,
               "hid_t is expected to be int64_t (HDF5 >= 1.10)");
 
 namespace {
+
+/// "cannot write dataset" plus the system's reason when the write set errno (HDF5's file
+/// driver writes with write(2)): a full file system said only "cannot write dataset" before
+/// session 22, now "... (No space left on device)". Callers clear errno before the write.
+std::string write_failure(const std::string& what) {
+  const int e = errno;
+  return e != 0 ? what + " (" + std::strerror(e) + ")" : what;
+}
 
 // ---- library shutdown ------------------------------------------------------------------------
 // After a failed H5Fclose (disk full during the final flush) the file stays half-closed inside
@@ -444,8 +453,9 @@ static void write_numeric(hid_t loc, const std::string& name, std::span<const T>
                          H5P_DEFAULT));
   if (!ds.valid()) fail("cannot create dataset (file opened read-only?)");
   if (data.empty()) return;
+  errno = 0;
   if (H5Dwrite(ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
-    fail("cannot write dataset");
+    fail(write_failure("cannot write dataset"));
   if (opts.checksum && !fletcher32)
     write_digest(ds.get(), fnv1a(data.data(), data.size_bytes()), fail);
 }
@@ -479,8 +489,9 @@ void H5Group::write_strings(const std::string& path, const std::vector<std::stri
   std::vector<const char*> ptrs;
   ptrs.reserve(v.size());
   for (const auto& s : v) ptrs.push_back(s.c_str());
+  errno = 0;
   if (H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) < 0)
-    fail(path, "cannot write dataset");
+    fail(path, write_failure("cannot write dataset"));
   // Fletcher32 on a string dataset would cover only the references to the heap: a digest.
   write_digest(ds.get(), strings_digest(v), H5GroupAccess::fail(*this, path));
 }

@@ -85,7 +85,8 @@ void write_database(const std::filesystem::path& file, const Database& db) {
     throw std::runtime_error(file.string() + ": database not written: " + *bad +
                              " is marked converged (status 0) but is not finite");
   io::AtomicFile out(file);
-  {
+  const bool existed = std::filesystem::exists(file);
+  try {
     H5File f = H5File::create(out.temp_path());
     f.set_attribute(".", "format", kDatabaseFormatName);
     f.set_attribute(".", "format_version", kDatabaseFormatVersion);  // always the current format
@@ -195,8 +196,24 @@ void write_database(const std::filesystem::path& file, const Database& db) {
     }
     if (db.energy_law) detail::write_energy_law(f, *db.energy_law, db.energy_diagnostics);
     f.close();
+  } catch (const std::exception& e) {
+    throw database_not_written(file, existed, out.temp_path(), e);
   }
   out.commit();
+}
+
+std::runtime_error database_not_written(const std::filesystem::path& target, bool existed,
+                                        const std::filesystem::path& temp,
+                                        const std::exception& e) {
+  // The writer's messages name the temporary file, which AtomicFile removes: name the target
+  // and say what became of it (session 22: a full file system named only the temporary).
+  std::string why = strip_file(e.what(), temp.string());
+  for (const char* inner : {"database not written (no file was created): ",
+                            "database not written (the earlier file is left as it was): "})
+    if (why.rfind(inner, 0) == 0) why = why.substr(std::string(inner).size());
+  return std::runtime_error(
+      target.string() + ": database not written (" +
+      (existed ? "the earlier file is left as it was" : "no file was created") + "): " + why);
 }
 
 Database read_database(const std::filesystem::path& file, bool with_raw) {

@@ -171,6 +171,13 @@ int run(const Cli& c) {
       std::fprintf(stderr, "knit-meso sweep (rank %d): %s\n", mpi.rank(), e.what());
       mpi.abort(knit::kExitFailure);
     }
+    // Cases already finished (a full file system at the database write, say) are not lost:
+    // say where they are and how to go on (session 22).
+    std::error_code ec;
+    if (std::filesystem::is_directory(c.output + ".parts", ec))
+      throw std::runtime_error(std::string(e.what()) + "; the cases finished so far are kept in " +
+                               c.output + ".parts: continue with `knit-meso sweep " + c.input +
+                               " --output " + c.output + " --resume` once the cause is fixed");
     throw;
   }
 }

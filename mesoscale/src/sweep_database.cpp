@@ -122,8 +122,9 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
   // it), gets the report, and is fsynced and renamed onto `output` by commit().
   io::AtomicFile out(output);
   const fs::path tmp = out.temp_path();
-  material::write_database(tmp, db);
-  {
+  const bool existed = fs::exists(output);
+  try {
+    material::write_database(tmp, db);
     io::H5File f = io::H5File::open_rw(tmp);
     io::H5Group g = f.create_group("/sweep/report");
     const auto nl = static_cast<Eigen::Index>(in.loop_lengths.size());
@@ -177,6 +178,8 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
       fit_status.push_back(fs_.ok() ? "ok" : "not fitted: " + fs_.reason);
     if (!fit_status.empty()) g.write_strings("fit_status", fit_status);
     f.close();
+  } catch (const std::exception& e) {
+    throw material::database_not_written(output, existed, tmp, e);
   }
   out.commit();
 }

@@ -1,7 +1,10 @@
 // Material database file: round trip, atomic write, and the errors for bad files.
+#include <sys/resource.h>
+
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -105,6 +108,46 @@ TEST_CASE("database: a converged step that is not finite is not written", "[unit
   }
   CHECK(fs::file_size(file) == before);  // the earlier database is left as it was
   CHECK(read_database(file).entries[1].raw[3].S.allFinite());
+}
+
+// Session 22: a write that fails (a full file system) named only the temporary file, which is
+// removed. A file-size limit (SIGXFSZ ignored: write(2) fails with EFBIG as it fails with ENOSPC
+// on a full disk) stands in for the full disk, in this test's own process.
+TEST_CASE("database: a write that fails names the target and leaves the earlier file", "[unit]") {
+  const auto file = tmp("full.h5"), fresh = tmp("full_fresh.h5");
+  fs::remove(fresh);
+  const Database db = small_db();
+  write_database(file, db);
+  const auto before = fs::file_size(file);
+  std::signal(SIGXFSZ, SIG_IGN);
+  rlimit saved{};
+  REQUIRE(getrlimit(RLIMIT_FSIZE, &saved) == 0);
+  rlimit small = saved;
+  small.rlim_cur = 16 * 1024;
+  REQUIRE(setrlimit(RLIMIT_FSIZE, &small) == 0);
+  std::string earlier, none;
+  try {
+    write_database(file, db);
+  } catch (const std::runtime_error& e) {
+    earlier = e.what();
+  }
+  try {
+    write_database(fresh, db);
+  } catch (const std::runtime_error& e) {
+    none = e.what();
+  }
+  REQUIRE(setrlimit(RLIMIT_FSIZE, &saved) == 0);
+  INFO(earlier << "\n" << none);
+  CHECK(earlier.rfind(file.string() + ": database not written (the earlier file is left as it "
+                                      "was): ",
+                      0) == 0);
+  CHECK(none.rfind(fresh.string() + ": database not written (no file was created): ", 0) == 0);
+  CHECK(earlier.find(".tmp-") == std::string::npos);
+  CHECK(fs::file_size(file) == before);
+  CHECK(read_database(file).entries.size() == 2);
+  CHECK_FALSE(fs::exists(fresh));
+  for (const auto& e : fs::directory_iterator(file.parent_path()))
+    CHECK(e.path().filename().string().find("full.h5.tmp-") == std::string::npos);
 }
 
 TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {

@@ -240,6 +240,35 @@ TEST_CASE("knit-macro run: bad input exits with 2 and writes no output directory
   fs::remove_all(d);
 }
 
+// Session 22: a full file system during a run named the partial directory, which is removed
+// with the failed run. A file-size limit (ulimit -f, SIGXFSZ ignored: write(2) fails as on a
+// full disk) stands in for the full disk.
+TEST_CASE(
+    "knit-macro run: outputs that cannot be written leave the earlier outputs and name "
+    "the target",
+    "[unit]") {
+  const fs::path d = temp_dir("full");
+  std::ofstream(d / "case.json") << read_json("tensile_svk.json").dump(2);
+  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
+  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const std::string csv = slurp(d / "out" / "load_strain.csv");
+  // 64 KiB per file: a VTU of the 41 x 41 grid (~300 KiB) does not fit.
+  const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 64; " + std::string(KNIT_BIN_DIR) +
+                          "/knit-macro run " + args + " > " + (d / "log.txt").string() + " 2>&1\"";
+  const int st = std::system(cmd.c_str());
+  CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 1));
+  const std::string log = slurp(d / "log.txt");
+  INFO(log);
+  CHECK(log.find("error: " + (d / "out").string() +
+                 ": outputs not written (the earlier outputs are left as they were): vtk/") !=
+        std::string::npos);
+  CHECK(log.find("partial") == std::string::npos);
+  CHECK(slurp(d / "out" / "load_strain.csv") == csv);
+  for (const auto& e : fs::directory_iterator(d))
+    CHECK(e.path().filename().string().find("partial") == std::string::npos);
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
   // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <thread>
 
+#include "../output_test_util.hpp"
 #include "knit/meso/sweep/mpi.hpp"
 #include "test_sweep_util.hpp"
 
@@ -173,4 +174,39 @@ TEST_CASE("knit-meso sweep: mpirun with 2 ranks gives the serial database", "[ca
   CHECK(text.find("2 ranks") != std::string::npos);
   CHECK(knit_test::database_difference(knit::material::read_database(dir / "serial.h5"),
                                        knit::material::read_database(dir / "mpi.h5")) <= 1e-12);
+}
+
+// Session 22: a full file system at the database write named only the temporary file, and said
+// nothing of the checkpoints. A file-size limit (ulimit -f, SIGXFSZ ignored: write(2) fails
+// with EFBIG as it fails with ENOSPC on a full disk) stands in for the full disk.
+TEST_CASE(
+    "knit-meso sweep: a database that cannot be written keeps the earlier file and the "
+    "checkpoints, and says how to resume",
+    "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_full");
+  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
+  const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
+  const std::string sweep = kExe + " sweep " + (dir / "s.json").string() + " --output " +
+                            db.string() + " --no-progress > /dev/null";
+  REQUIRE(shell(sweep + " 2>&1") == 0);
+  const std::string before = knit_test::read_text(db);
+  // 100 KiB per file: every checkpoint fits (< 4 KiB), the database (~600 KiB) does not.
+  CHECK(shell("bash -c \"trap '' XFSZ; ulimit -f 100; " + sweep + " 2> " + err.string() + "\"") ==
+        1);
+  const std::string text = knit_test::read_text(err);
+  INFO(text);
+  CHECK(text.rfind("error: " + db.string() +
+                       ": database not written (the earlier file is left as it was): ",
+                   0) == 0);
+  CHECK(text.find(".tmp-") == std::string::npos);  // the temporary, gone, is not named
+  CHECK(text.find("the cases finished so far are kept in " + parts.string() +
+                  ": continue with `knit-meso sweep " + (dir / "s.json").string() + " --output " +
+                  db.string() + " --resume`") != std::string::npos);
+  CHECK(knit_test::read_text(db) == before);
+  CHECK(count_job_files(parts) == 26);
+  for (const auto& e : fs::directory_iterator(dir))
+    CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  // Once the cause is gone, --resume writes the database from the checkpoints.
+  CHECK(shell(sweep + " --resume 2>&1") == 0);
+  CHECK_FALSE(fs::exists(parts));
 }

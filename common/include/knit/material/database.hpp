@@ -163,6 +163,13 @@ Provenance current_provenance();
 /// and writes nothing, when a converged step is not finite (first_nonfinite_step).
 void write_database(const std::filesystem::path& file, const Database& db);
 
+/// The error of a database write into the temporary `temp` of `target` that failed with `e`
+/// (a full file system, say): "TARGET: database not written (the earlier file is left as it
+/// was | no file was created): REASON", REASON without the temporary's name (gone by then) or
+/// an inner "database not written" of a nested write. `existed`: whether `target` existed.
+std::runtime_error database_not_written(const std::filesystem::path& target, bool existed,
+                                        const std::filesystem::path& temp, const std::exception& e);
+
 /// Reads and validates. Throws knit::InputError(file, hdf5_path, what) on a bad file.
 /// raw = false skips the raw path data (faster for the macroscale).
 Database read_database(const std::filesystem::path& file, bool raw = true);
