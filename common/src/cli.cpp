@@ -12,6 +12,7 @@
 
 #include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 
 namespace knit::cli {
 
@@ -106,7 +107,9 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    // An output directory abandoned by the failure is named as itself, not as its partial
+    // directory (gone by now), with what became of it (knit/io/atomic.hpp).
+    std::cerr << "error: " << io::explain_unwritten_outputs(e.what()) << "\n";
     return kExitFailure;
   }
   return kExitFailure;

@@ -286,3 +286,29 @@ void AtomicDirectory::commit() {
 }
 
 }  // namespace knit::io
+
+namespace knit::io {
+
+std::string explain_unwritten_outputs(const std::string& message) {
+  const std::string token = ".partial-" + std::to_string(::getpid());
+  const std::size_t at = message.find(token);
+  if (at == std::string::npos) return message;
+  // The directory's path runs back to the start of the message or to the blank before it.
+  const std::size_t blank = message.rfind(' ', at);
+  const std::size_t start = blank == std::string::npos ? 0 : blank + 1;
+  const std::string target = message.substr(start, at - start);
+  if (target.empty()) return message;
+  // REASON: the message with every partial directory of this process named as its target,
+  // files of the outer one relative to it ("DIR.partial-1/run.partial-1/x" -> "run/x").
+  std::string why = message.substr(0, start) + message.substr(at + token.size());
+  if (why.size() > start && why[start] == '/') why.erase(start, 1);
+  for (std::size_t k = why.find(token); k != std::string::npos; k = why.find(token, k))
+    why.erase(k, token.size());
+  std::error_code ec;
+  const bool earlier = fs::exists(target, ec);
+  return target + ": outputs not written (" +
+         (earlier ? "the earlier outputs are left as they were" : "nothing was written") +
+         "): " + why;
+}
+
+}  // namespace knit::io

@@ -209,18 +209,6 @@ void ResultsWriter::finish(const RunReport& report) {
   dir_.commit();  // DIR.partial-<pid> -> DIR
 }
 
-std::runtime_error ResultsWriter::not_written(const std::exception& e, bool existed) const {
-  // Files inside the partial directory are named relative to DIR.
-  std::string why = e.what();
-  const std::string partial = dir_.path().string() + "/", target = dir_.target().string();
-  for (std::size_t at = why.find(partial); at != std::string::npos; at = why.find(partial, at))
-    why.erase(at, partial.size());
-  return std::runtime_error(
-      target + ": outputs not written (" +
-      (existed ? "the earlier outputs are left as they were" : "nothing was written") +
-      "): " + why);
-}
-
 std::uint64_t estimate_output_bytes(const Case& c) {
   const auto samples = static_cast<std::uint64_t>(c.output.grid_u) * c.output.grid_v;
   const auto cells = static_cast<std::uint64_t>(std::max(0, c.output.grid_u - 1)) *

@@ -35,11 +35,6 @@ class ResultsWriter {
   void set_material_failure(std::string m) { material_failure_ = std::move(m); }
   /// Material::warning(): a comment in the CSV, a line in summary.txt, an HDF5 attribute.
   void set_material_warning(std::string m) { material_warning_ = std::move(m); }
-  /// The error of a write that failed with `e` before finish() committed (a full file system,
-  /// say): "DIR: outputs not written (the earlier outputs are left as they were | nothing was
-  /// written): REASON", files of the partial directory (removed with this object) named
-  /// relative to DIR in REASON. `existed`: whether DIR existed before the run.
-  std::runtime_error not_written(const std::exception& e, bool existed) const;
 
  private:
   struct Fields {

@@ -106,7 +106,6 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   Problem p = setup_problem(c);
   const ShellModel& m = *p.model;
   std::unique_ptr<ResultsWriter> writer;
-  const bool existed = !opt.output_dir.empty() && std::filesystem::exists(opt.output_dir);
   if (!opt.output_dir.empty()) writer = std::make_unique<ResultsWriter>(c, m, opt.output_dir);
   RunResult res;
   std::vector<std::vector<int>> corner_sets;  // the control points of each corner reaction
@@ -116,82 +115,73 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   int outputs = 0;
   Eigen::VectorXd last_written;
   ShellModel::Evaluation audit;
-  try {
-    res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
-      // Where the converged state lies in the material's data (one residual pass per step).
-      if (c.material->begin_converged_audit()) {
-        m.evaluate(s.u, false, audit);
-        c.material->end_converged_audit();
-      }
-      StepRow row;
-      row.step = s.step;
-      row.lambda = s.lambda;
-      if (c.output.applied) {
-        row.applied = s.lambda * c.output.applied->value;
-        row.strain = row.applied / c.output.applied->gauge_length;
-      }
-      for (size_t k = 0; k < c.output.reactions.size(); ++k) {
-        const ReactionOutput& r = c.output.reactions[k];
-        double f = 0.0;
-        if (r.at_edge)
-          f = edge_reaction(m, s.fint, r.edge, r.component, r.rows);
-        else
-          for (int a : corner_sets[k]) f += s.fint(3 * a + r.component);
-        row.reactions.push_back(f);
-      }
-      for (const OutputPoint& op : c.output.points)
-        row.points.push_back(m.displacement(s.u, op.at));
-      row.iterations = s.iterations;
-      row.residual = s.residual;
-      row.seconds = s.seconds;
-      row.negative_pivots = s.negative_pivots;
-      res.rows.push_back(row);
-      res.u = s.u;
-      if (opt.progress) {
-        char line[240];
-        int len =
-            std::snprintf(line, sizeof line,
-                          "step %4d  load factor %.6f  iterations %2d  residual %.3e  time %.3f s",
-                          s.step, s.lambda, s.iterations, s.residual, s.seconds);
-        if (s.negative_pivots > 0 && len > 0 && len < int(sizeof line))
-          std::snprintf(line + len, sizeof line - len, "  UNSTABLE: %d negative pivots",
-                        s.negative_pivots);
-        *opt.progress << line << std::endl;
-      }
-      if (writer) {
-        writer->add_row(row);
-        if (++outputs % c.output.every == 0 || s.lambda >= 1.0 - 1e-12)
-          writer->add_step(s.step, s.lambda, s.u);
-        else
-          last_written = s.u;
-      }
-    });
-    res.failed_material_evaluations = c.material->failed_evaluations();
-    const std::string failure =
-        material_failure_message(res.report, res.failed_material_evaluations);
-    if (opt.progress && !failure.empty()) *opt.progress << failure << std::endl;
-    const std::string material_report = c.material->report();
-    if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
-    res.material_warning = c.material->warning();
-    if (opt.warnings && !res.material_warning.empty())
-      *opt.warnings << res.material_warning << std::endl;
-    if (opt.progress && res.report.first_unstable_step > 0)
-      *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
-    if (writer) {
-      writer->set_material_report(material_report);
-      writer->set_material_warning(res.material_warning);
-      writer->set_material_failure(failure);
-      // A stopped run still writes its last converged state.
-      if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
-          outputs % c.output.every != 0)
-        writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
-      writer->finish(res.report);
+  res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
+    // Where the converged state lies in the material's data (one residual pass per step).
+    if (c.material->begin_converged_audit()) {
+      m.evaluate(s.u, false, audit);
+      c.material->end_converged_audit();
     }
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    if (!writer) throw;
-    throw writer->not_written(e, existed);  // e.g. a full file system (session 22)
+    StepRow row;
+    row.step = s.step;
+    row.lambda = s.lambda;
+    if (c.output.applied) {
+      row.applied = s.lambda * c.output.applied->value;
+      row.strain = row.applied / c.output.applied->gauge_length;
+    }
+    for (size_t k = 0; k < c.output.reactions.size(); ++k) {
+      const ReactionOutput& r = c.output.reactions[k];
+      double f = 0.0;
+      if (r.at_edge)
+        f = edge_reaction(m, s.fint, r.edge, r.component, r.rows);
+      else
+        for (int a : corner_sets[k]) f += s.fint(3 * a + r.component);
+      row.reactions.push_back(f);
+    }
+    for (const OutputPoint& op : c.output.points) row.points.push_back(m.displacement(s.u, op.at));
+    row.iterations = s.iterations;
+    row.residual = s.residual;
+    row.seconds = s.seconds;
+    row.negative_pivots = s.negative_pivots;
+    res.rows.push_back(row);
+    res.u = s.u;
+    if (opt.progress) {
+      char line[240];
+      int len =
+          std::snprintf(line, sizeof line,
+                        "step %4d  load factor %.6f  iterations %2d  residual %.3e  time %.3f s",
+                        s.step, s.lambda, s.iterations, s.residual, s.seconds);
+      if (s.negative_pivots > 0 && len > 0 && len < int(sizeof line))
+        std::snprintf(line + len, sizeof line - len, "  UNSTABLE: %d negative pivots",
+                      s.negative_pivots);
+      *opt.progress << line << std::endl;
+    }
+    if (writer) {
+      writer->add_row(row);
+      if (++outputs % c.output.every == 0 || s.lambda >= 1.0 - 1e-12)
+        writer->add_step(s.step, s.lambda, s.u);
+      else
+        last_written = s.u;
+    }
+  });
+  res.failed_material_evaluations = c.material->failed_evaluations();
+  const std::string failure = material_failure_message(res.report, res.failed_material_evaluations);
+  if (opt.progress && !failure.empty()) *opt.progress << failure << std::endl;
+  const std::string material_report = c.material->report();
+  if (opt.progress && !material_report.empty()) *opt.progress << material_report << std::endl;
+  res.material_warning = c.material->warning();
+  if (opt.warnings && !res.material_warning.empty())
+    *opt.warnings << res.material_warning << std::endl;
+  if (opt.progress && res.report.first_unstable_step > 0)
+    *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
+  if (writer) {
+    writer->set_material_report(material_report);
+    writer->set_material_warning(res.material_warning);
+    writer->set_material_failure(failure);
+    // A stopped run still writes its last converged state.
+    if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
+        outputs % c.output.every != 0)
+      writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
+    writer->finish(res.report);
   }
   return res;
 }

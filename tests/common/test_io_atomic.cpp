@@ -142,6 +142,31 @@ TEST_CASE("AtomicDirectory leaves an existing output intact until commit", "[uni
   }
 }
 
+// Session 22: a full file system said "DIR.partial-123/vtk/step_0005.vtu: write failed (disk
+// full?)", naming a directory removed with the failure. The programs' error printer now says it
+// of DIR (knit::cli::run_main).
+TEST_CASE("an error that abandoned an output directory is said of the directory",
+          "[unit][io][atomic]") {
+  using knit::io::explain_unwritten_outputs;
+  const fs::path base = scratch("unwritten");
+  const std::string pid = std::to_string(::getpid());
+  const std::string fresh = (base / "fresh").string(), old = (base / "old").string();
+  fs::create_directories(old);
+  CHECK(explain_unwritten_outputs(fresh + ".partial-" + pid + "/vtk/s.vtu: write failed") ==
+        fresh + ": outputs not written (nothing was written): vtk/s.vtu: write failed");
+  CHECK(explain_unwritten_outputs(old + ".partial-" + pid + "/run.partial-" + pid +
+                                  "/a.csv: write failed") ==
+        old +
+            ": outputs not written (the earlier outputs are left as they were): run/a.csv: "
+            "write failed");
+  CHECK(explain_unwritten_outputs("cannot write " + old + ".partial-" + pid + "/x") ==
+        old + ": outputs not written (the earlier outputs are left as they were): cannot write x");
+  // Not ours to explain: another process's partial directory, or none.
+  const std::string other = fresh + ".partial-" + std::to_string(::getpid() + 1) + "/x: failed";
+  CHECK(explain_unwritten_outputs(other) == other);
+  CHECK(explain_unwritten_outputs("db.h5: cannot write dataset") == "db.h5: cannot write dataset");
+}
+
 TEST_CASE("CsvWriter writes a header, %.10g numbers and quoted text", "[unit][io][csv]") {
   const fs::path file = scratch("curve.csv");
   knit::io::CsvWriter csv(file, {"step", "u_mm", "F_N", "status"});

@@ -61,6 +61,15 @@ class AtomicFile {
 /// Writes `content` to `target` atomically.
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
 
+/// The message of an error that abandoned an output directory of this process (an
+/// AtomicDirectory, removed by then with its "DIR.partial-<pid>"), said of DIR: "DIR: outputs not
+/// written (the earlier outputs are left as they were | nothing was written): REASON", files of
+/// the partial directory named relative to DIR in REASON (a full file system said only
+/// "DIR.partial-123/vtk/step_0005.vtu: write failed (disk full?)", naming a directory that no
+/// longer exists). Any other message is returned unchanged. The programs' error printer
+/// (knit::cli::run_main) passes every failure through it.
+std::string explain_unwritten_outputs(const std::string& message);
+
 /// An output directory built as "<DIR>.partial-<pid>" and put in place on commit(). An existing
 /// DIR stays untouched until the new one is complete. Only a directory knitscale wrote (it holds
 /// the marker file kOutputMarker, written into every output directory) or an empty one is ever
