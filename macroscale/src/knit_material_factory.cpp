@@ -215,6 +215,22 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
                        db.string() + ": /loop_" + std::to_string(k) + "/fit: " + e.what());
     }
   }
+  {
+    // A homogenized fabric spans many stitches: a patch smaller than one loop of the database
+    // is a case in other units (a 50 mm patch written in metres ran with exit 0, session 22).
+    const Eigen::MatrixXd& P = ctx.patch->control_points();
+    const double size = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+    const double l_max = energy ? energy->data().l_max : family->max();
+    if (!(size >= l_max)) {
+      std::ostringstream os;
+      os << "the patch (size " << size
+         << " mm, the diagonal of its control net's bounding box) is smaller than one loop of "
+            "the database ("
+         << l_max << " mm, " << db.string()
+         << "): a knit case is in mm, N, MPa, and a homogenized fabric spans many stitches";
+      throw InputError(ctx.file, "/geometry/control_points", os.str());
+    }
+  }
   const auto l = read_field(m.at("stitch_value"), p + "/stitch_value", ctx, false);
   const auto a = m.contains("knitting_angle")
                      ? read_field(m.at("knitting_angle"), p + "/knitting_angle", ctx, true)

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "../common/test_energy_util.hpp"
@@ -175,4 +176,34 @@ TEST_CASE("knit material: the case key /material/law", "[unit]") {
                         Catch::Contains("knit-meso fit " + v1 + " --law energy"));
   CHECK_THROWS_WITH(parse_case(square_case(material(with, "neo")), "c.json"),
                     Catch::Contains("c.json: /material/law"));
+}
+
+// Session 22: a knit case in other units ran with exit 0 (the database is in mm, N, MPa).
+TEST_CASE("knit material: a case in other units is refused", "[unit]") {
+  const std::string db = db_file("units.h5", true, kDatabaseFormatVersion);
+  const std::string material =
+      R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": 5})";
+  const std::string mm = square_case(material);
+  CHECK_NOTHROW(parse_case(mm, "c.json"));
+  // Declared: "units" other than "mm, N, MPa".
+  nlohmann::json j = nlohmann::json::parse(mm);
+  j["units"] = "mm, N, MPa";
+  CHECK_NOTHROW(parse_case(j.dump(), "c.json"));
+  j["units"] = "m, N, Pa";
+  CHECK_THROWS_WITH(parse_case(j.dump(), "c.json"),
+                    Catch::StartsWith("c.json: /units: a knit case is in \"mm, N, MPa\""));
+  // Not declared: the 50 mm patch written in metres is smaller than one loop (6.5 mm).
+  j.erase("units");
+  for (auto& p : j["geometry"]["control_points"])
+    p = {p[0].get<double>() * 1e-3, p[1].get<double>() * 1e-3, 0.0};
+  j["geometry"]["thickness"] = 0.76e-3;
+  CHECK_THROWS_WITH(
+      parse_case(j.dump(), "c.json"),
+      Catch::StartsWith("c.json: /geometry/control_points: the patch (size 0.0707107 mm") &&
+          Catch::Contains("smaller than one loop of the database (6.5 mm"));
+  // Other materials take any consistent units.
+  j["material"] = {
+      {"type", "saint_venant_kirchhoff"}, {"youngs_modulus", 1.0}, {"poisson_ratio", 0.3}};
+  j["units"] = "m, N, Pa";
+  CHECK_NOTHROW(parse_case(j.dump(), "c.json"));
 }
