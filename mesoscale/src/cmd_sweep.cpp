@@ -114,8 +114,9 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
   std::fflush(stdout);
 }
 
-// Ctrl-C (SIGINT) says what is kept and how to go on, then ends the process as the signal
-// would (session 21: it printed nothing). Async-signal-safe: the message is composed before,
+// Ctrl-C (SIGINT), and SIGTERM and SIGHUP (a job scheduler's stop, a closed terminal; session
+// 22), say what is kept and how to go on, then end the process as the signal would (session
+// 21: it printed nothing). Async-signal-safe: the message is composed before,
 // the handler only write()s it and re-raises with the default action.
 char g_interrupt_message[4096];
 std::size_t g_interrupt_length = 0;
@@ -135,7 +136,7 @@ void explain_interrupt(const Cli& c) {
                         " --output " + c.output + " --resume`\n";
   g_interrupt_length = std::min(m.size(), sizeof g_interrupt_message);
   std::memcpy(g_interrupt_message, m.data(), g_interrupt_length);
-  std::signal(SIGINT, on_interrupt);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_interrupt);
 }
 
 int run(const Cli& c) {

@@ -126,27 +126,30 @@ TEST_CASE(
 }
 
 // Session 21: Ctrl-C printed nothing. Now the sweep says what is kept and how to go on, and
-// still ends as SIGINT does (the checkpoints stay for --resume).
-TEST_CASE("knit-meso sweep: Ctrl-C says how to resume and ends by the signal", "[case]") {
-  const auto dir = knit_test::scratch("sweep_cli_sigint");
-  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
-  const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
-  const pid_t pid = spawn_slow_sweep(dir / "s.json", db, err, "");
-  REQUIRE(pid >= 0);
-  wait_for_jobs(parts, 3);
-  kill(pid, SIGINT);
-  int st = 0;
-  waitpid(pid, &st, 0);
-  CHECK(WIFSIGNALED(st));
-  CHECK((WIFSIGNALED(st) && WTERMSIG(st) == SIGINT));
-  std::ifstream in(err);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  INFO(text);
-  CHECK(text.find("interrupted; the cases finished so far are kept in " + parts.string()) !=
-        std::string::npos);
-  CHECK(text.find("--output " + db.string() + " --resume") != std::string::npos);
-  CHECK(count_job_files(parts) >= 3);
-  CHECK_FALSE(fs::exists(db));
+// still ends as the signal does (the checkpoints stay for --resume); session 22: SIGTERM and
+// SIGHUP too (a job scheduler's stop, a closed terminal).
+TEST_CASE("knit-meso sweep: Ctrl-C or SIGTERM or SIGHUP says how to resume and ends by the signal",
+          "[case]") {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    INFO("signal " << sig);
+    const auto dir = knit_test::scratch("sweep_cli_signal_" + std::to_string(sig));
+    knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
+    const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
+    const pid_t pid = spawn_slow_sweep(dir / "s.json", db, err, "");
+    REQUIRE(pid >= 0);
+    wait_for_jobs(parts, 3);
+    kill(pid, sig);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    CHECK((WIFSIGNALED(st) && WTERMSIG(st) == sig));
+    const std::string text = knit_test::read_text(err);
+    INFO(text);
+    CHECK(text.find("interrupted; the cases finished so far are kept in " + parts.string()) !=
+          std::string::npos);
+    CHECK(text.find("--output " + db.string() + " --resume") != std::string::npos);
+    CHECK(count_job_files(parts) >= 3);
+    CHECK_FALSE(fs::exists(db));
+  }
 }
 
 TEST_CASE("knit-meso sweep: mpirun with 2 ranks gives the serial database", "[case]") {
