@@ -44,8 +44,14 @@ spline::SplineSurface make_scalar_field(const ScalarFieldSpec& spec) {
 
 spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, int degree_u,
                                         std::vector<double> knots_u, int degree_v,
-                                        std::vector<double> knots_v, const Eigen::Vector3d& v) {
+                                        std::vector<double> knots_v, const Eigen::Vector3d& v_in) {
   if (geometry.dim() != 3) throw std::invalid_argument("align: the geometry must be 3-D");
+  // A direction: only its sense counts (session 22: (1e-300, 0, 0) was taken for a vector
+  // normal to the surface, (0, 0, 0) too, with that message).
+  const double v_norm = v_in.stableNorm();
+  if (!(v_norm > 0.0 && std::isfinite(v_norm)))
+    throw std::invalid_argument("align: the vector v must be finite and not zero");
+  const Eigen::Vector3d v = v_in / v_norm;
   const spline::BSplineBasis bu(degree_u, std::move(knots_u)), bv(degree_v, std::move(knots_v));
   const auto gu = bu.greville(), gv = bv.greville();
   const int nu = bu.size(), nv = bv.size();
@@ -58,7 +64,7 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
       const Eigen::Vector3d a3 = a1.cross(a2).normalized();
       const Eigen::Vector3d e1 = a1.normalized();
       const Eigen::Vector3d vt = v - v.dot(a3) * a3;
-      if (vt.norm() < 1e-12 * std::max(1.0, v.norm()))
+      if (vt.norm() < 1e-12)
         throw std::invalid_argument(
             "align: the vector v is normal to the surface at a Greville point");
       double ang = std::atan2(e1.cross(vt).dot(a3), e1.dot(vt));

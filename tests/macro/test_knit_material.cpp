@@ -138,6 +138,19 @@ TEST_CASE("knit material: alpha aligned with a vector at the Greville points", "
       align_alpha_field(geo, 2, {0, 0, 0, 0.5, 1, 1, 1}, 1, {0, 0, 1, 1}, Eigen::Vector3d(1, 0, 0));
   for (double u : {0.0, 0.3, 1.0})
     for (double v : {0.0, 0.7}) CHECK(alpha.eval(u, v)(0) == Approx(-beta).margin(1e-12));
+  // v is a direction: its length does not count (session 22: 1e-300 x was refused as normal to
+  // the surface), a zero or non-finite v is named as such, a normal v as normal.
+  auto align = [&](const Eigen::Vector3d& v) {
+    return align_alpha_field(geo, 2, {0, 0, 0, 0.5, 1, 1, 1}, 1, {0, 0, 1, 1}, v);
+  };
+  for (const double scale : {1e-300, 1e300})
+    CHECK(align(scale * Eigen::Vector3d(1, 0, 0)).eval(0.3, 0.7)(0) == Approx(-beta).margin(1e-12));
+  CHECK_THROWS_WITH(align(Eigen::Vector3d::Zero()),
+                    "align: the vector v must be finite and not zero");
+  CHECK_THROWS_WITH(align(Eigen::Vector3d(INFINITY, 0, 0)),
+                    "align: the vector v must be finite and not zero");
+  CHECK_THROWS_WITH(align(Eigen::Vector3d(0, 0, 2)),
+                    "align: the vector v is normal to the surface at a Greville point");
 }
 
 TEST_CASE("knit material: failed inversions are its failed evaluations", "[unit]") {
