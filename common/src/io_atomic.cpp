@@ -285,10 +285,6 @@ void AtomicDirectory::commit() {
   fsync_path(parent_or_dot(target_), true);
 }
 
-}  // namespace knit::io
-
-namespace knit::io {
-
 std::string explain_unwritten_outputs(const std::string& message) {
   const std::string token = ".partial-" + std::to_string(::getpid());
   const std::size_t at = message.find(token);

@@ -37,12 +37,6 @@ constexpr double kMaxThicknessPerSize = 1.0;
 constexpr double kMinGaugePerSize = 1e-2;
 constexpr double kMaxGaugePerSize = 10.0;
 
-/// The diagonal of the control net's bounding box, mm.
-double patch_size(const spline::SplineSurface& s) {
-  const Eigen::MatrixXd& P = s.control_points();
-  return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
-}
-
 /// "[lo, hi] mm (a and b times the patch's size D = ... mm)"
 std::string relative_range(double lo, double hi, double size) {
   std::ostringstream o;

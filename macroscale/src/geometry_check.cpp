@@ -40,9 +40,14 @@ std::string where(const Eigen::Vector2d& t, const std::vector<double>& su,
 
 }  // namespace
 
+double patch_size(const spline::SplineSurface& s) {
+  const Eigen::MatrixXd& P = s.control_points();
+  return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+}
+
 std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& s) {
   const Eigen::MatrixXd& P = s.control_points();
-  double scale = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+  double scale = patch_size(s);
   if (!(scale > 0)) scale = 1.0;
   const std::vector<double> su = sample_abscissae(s.basis_u().knots(), s.basis_u().degree());
   const std::vector<double> sv = sample_abscissae(s.basis_v().knots(), s.basis_v().degree());

@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/macro/geometry_check.hpp"
 #include "knit/macro/knit_material.hpp"
 #include "knit/macro/material_factory.hpp"
 #include "knit/material/database.hpp"
@@ -218,8 +219,7 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   {
     // A homogenized fabric spans many stitches: a patch smaller than one loop of the database
     // is a case in other units (a 50 mm patch written in metres ran with exit 0, session 22).
-    const Eigen::MatrixXd& P = ctx.patch->control_points();
-    const double size = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+    const double size = patch_size(*ctx.patch);
     const double l_max = energy ? energy->data().l_max : family->max();
     if (!(size >= l_max)) {
       std::ostringstream os;

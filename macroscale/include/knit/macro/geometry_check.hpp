@@ -26,6 +26,11 @@ struct GeometryDefect {
   std::string message;  ///< one line: what and where ("... at the corner (0, 1)")
 };
 
+/// The patch's size: the diagonal of its control net's bounding box (the surface lies inside
+/// it), mm. The scale of the defect tolerances here and of the case's length bounds
+/// (thickness, gauge length, a knit patch against one loop).
+double patch_size(const spline::SplineSurface& surface);
+
 /// The first defect of the reference surface, or nothing.
 std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& surface);
 
