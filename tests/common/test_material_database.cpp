@@ -1,5 +1,7 @@
 // Material database file: round trip, atomic write, and the errors for bad files.
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -112,31 +114,43 @@ TEST_CASE("database: a converged step that is not finite is not written", "[unit
 
 // Session 22: a write that fails (a full file system) named only the temporary file, which is
 // removed. A file-size limit (SIGXFSZ ignored: write(2) fails with EFBIG as it fails with ENOSPC
-// on a full disk) stands in for the full disk, in this test's own process.
+// on a full disk) stands in for the full disk, in a child process: HDF5 keeps a file whose
+// close failed half-open, by design left to the OS at exit (docs/io.md), which LeakSanitizer
+// would report here. The child writes the two messages to a file and leaves with _exit.
 TEST_CASE("database: a write that fails names the target and leaves the earlier file", "[unit]") {
-  const auto file = tmp("full.h5"), fresh = tmp("full_fresh.h5");
+  const auto file = tmp("full.h5"), fresh = tmp("full_fresh.h5"), log = tmp("full_messages.txt");
   fs::remove(fresh);
+  fs::remove(log);
   const Database db = small_db();
   write_database(file, db);
   const auto before = fs::file_size(file);
-  std::signal(SIGXFSZ, SIG_IGN);
-  rlimit saved{};
-  REQUIRE(getrlimit(RLIMIT_FSIZE, &saved) == 0);
-  rlimit small = saved;
-  small.rlim_cur = 16 * 1024;
-  REQUIRE(setrlimit(RLIMIT_FSIZE, &small) == 0);
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    std::string messages;
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit small{16 * 1024, 16 * 1024};
+    setrlimit(RLIMIT_FSIZE, &small);
+    for (const fs::path& target : {file, fresh}) {
+      try {
+        write_database(target, db);
+        messages += "written\n";
+      } catch (const std::runtime_error& e) {
+        messages += std::string(e.what()) + "\n";
+      }
+    }
+    small = {1 << 20, 1 << 20};
+    setrlimit(RLIMIT_FSIZE, &small);
+    std::ofstream(log) << messages;
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  REQUIRE((WIFEXITED(status) && WEXITSTATUS(status) == 0));
+  std::ifstream in(log);
   std::string earlier, none;
-  try {
-    write_database(file, db);
-  } catch (const std::runtime_error& e) {
-    earlier = e.what();
-  }
-  try {
-    write_database(fresh, db);
-  } catch (const std::runtime_error& e) {
-    none = e.what();
-  }
-  REQUIRE(setrlimit(RLIMIT_FSIZE, &saved) == 0);
+  std::getline(in, earlier);
+  std::getline(in, none);
   INFO(earlier << "\n" << none);
   CHECK(earlier.rfind(file.string() + ": database not written (the earlier file is left as it "
                                       "was): ",
