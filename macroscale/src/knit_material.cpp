@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -158,10 +159,19 @@ MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const Respo
                                            const Eigen::Vector2d& theta) const {
   MaterialResponse out;
   evaluations_.fetch_add(1, std::memory_order_relaxed);
+  // The converged-state audit (see Material): beyond the data are the kinds 0-3 (beyond the
+  // last load step, outside the fan, the linear initial law in biaxial compression, beyond the
+  // shear data); a failed inversion is a failure, counted apart.
+  auto audit = [this](int flags) {
+    if (!audit_.load(std::memory_order_relaxed)) return;
+    audit_evaluations_.fetch_add(1, std::memory_order_relaxed);
+    if (flags & 0b1111) audit_outside_.fetch_add(1, std::memory_order_relaxed);
+  };
   if (alpha == 0.0) {
     const auto ev = rs.evaluate(E);
     out.S = ev.S;
     out.C = ev.C;
+    audit(ev.flags);
     if (ev.flags) {
       for (int k = 0; k < 5; ++k)
         if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
@@ -174,6 +184,7 @@ MaterialResponse KnitMaterial::evaluate_at(const Eigen::Vector3d& E, const Respo
   const auto ev = rs.evaluate(Ehat);
   out.S = TSinv * ev.S;
   out.C = TSinv * ev.C * TE;
+  audit(ev.flags);
   if (ev.flags) {
     for (int k = 0; k < 5; ++k)
       if (ev.flags & (1 << k)) counts_[k].fetch_add(1, std::memory_order_relaxed);
@@ -233,6 +244,24 @@ void KnitMaterial::reset_stats() {
   where_.clear();
 }
 
+std::string KnitMaterial::warning() const {
+  const long n = audit_evaluations_.load();
+  if (n == 0) return {};
+  const double share = static_cast<double>(audit_outside_.load()) / static_cast<double>(n);
+  if (!(share > kExtrapolatedWarning)) return {};
+  std::ostringstream os;
+  os << std::setprecision(3) << "warning: " << 100.0 * share
+     << " % of the material evaluations at converged states lie outside the database's data ("
+     << (energy_ ? "its strain box, in the material report"
+                 : "beyond the fan of load paths, the last load step or the shear data, or in "
+                   "biaxial compression")
+     << "; more than " << 100.0 * kExtrapolatedWarning << " %): there the results come from "
+     << (energy_ ? "the law's convex extension"
+                 : "the response surfaces' extension (eq. 17) and the linear initial law")
+     << ", not from cell runs (docs/database.md)";
+  return os.str();
+}
+
 std::string KnitMaterial::report() const {
   if (energy_) return energy_report();
   const Stats s = stats();
@@ -250,6 +279,11 @@ std::string KnitMaterial::report() const {
   os << "; extrapolated:";
   for (int k = 0; k < 5; ++k)
     if (s.count[k]) os << "\n  " << s.count[k] << " x " << names[k];
+  if (const long n = audit_evaluations_.load(); n > 0) {
+    const long k = audit_outside_.load();
+    os << "\n  at converged states: " << k << " of " << n << " evaluations extrapolated ("
+       << std::setprecision(4) << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)";
+  }
   os << "\n  first locations (theta1, theta2; material strains E_course, E_wale, 2E_cw):";
   for (const auto& w : s.first)
     os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();

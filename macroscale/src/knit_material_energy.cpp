@@ -126,21 +126,6 @@ KnitMaterial::EnergyStats KnitMaterial::energy_stats() const {
   return s;
 }
 
-std::string KnitMaterial::warning() const {
-  const long n = audit_evaluations_.load();
-  if (!energy_ || n == 0) return {};
-  const double share = static_cast<double>(audit_outside_.load()) / static_cast<double>(n);
-  if (!(share > kExtrapolatedWarning)) return {};
-  std::ostringstream os;
-  os << std::setprecision(3) << "warning: " << 100.0 * share
-     << " % of the material evaluations at converged states lie outside the database's data "
-        "(strain box in the material report; more than "
-     << 100.0 * kExtrapolatedWarning
-     << " %): there the results come from the law's convex extension, not from cell runs "
-        "(docs/database.md)";
-  return os.str();
-}
-
 std::string KnitMaterial::energy_report() const {
   const EnergyStats s = energy_stats();
   const auto& box = energy_->data();

@@ -168,3 +168,25 @@ TEST_CASE("knit material: failed inversions are its failed evaluations", "[unit]
   CHECK(m.failed_evaluations() == 1);
   CHECK(m.failed_evaluations() == m.stats().count[4]);
 }
+
+// Session 22: the paper's law (eq. 17) is audited at converged states too, and warns as the
+// energy law does when more than 2 % of those evaluations lie beyond its data.
+TEST_CASE("knit material: the paper law's converged states are audited and warned about",
+          "[unit]") {
+  KnitMaterial m = graded(0.0);
+  REQUIRE(m.law() == "paper");
+  REQUIRE(m.begin_converged_audit());
+  m.evaluate(Eigen::Vector3d(0.1, 0.1, 0.0), at(0.3, 0.6));    // inside the fan
+  m.evaluate(Eigen::Vector3d(-0.3, -0.3, 0.0), at(0.3, 0.6));  // biaxial compression
+  m.end_converged_audit();
+  m.evaluate(Eigen::Vector3d(-0.3, -0.3, 0.0), at(0.3, 0.6));  // not audited
+  CHECK_THAT(m.report(), Catch::Contains("at converged states: 1 of 2 evaluations extrapolated"));
+  CHECK_THAT(m.warning(), Catch::StartsWith("warning: 50 % of the material evaluations") &&
+                              Catch::Contains("the response surfaces' extension (eq. 17)"));
+  m.reset_stats();
+  CHECK(m.warning().empty());
+  REQUIRE(m.begin_converged_audit());
+  for (int k = 0; k < 60; ++k) m.evaluate(Eigen::Vector3d(0.1, 0.1, 0.0), at(0.3, 0.6));
+  m.end_converged_audit();
+  CHECK(m.warning().empty());
+}

@@ -102,16 +102,17 @@ class KnitMaterial : public Material {
   std::vector<std::pair<std::string, double>> output_fields(
       const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const override;
   std::string report() const override;
-  /// Energy law only: counts the evaluations between begin and end apart (see Material).
+  /// Counts the evaluations between begin and end apart (see Material): the energy law those
+  /// outside its data strain box, the paper's law those its response surfaces extrapolate.
   bool begin_converged_audit() const override {
-    if (!energy_) return false;
     audit_.store(true);
     return true;
   }
   void end_converged_audit() const override { audit_.store(false); }
-  /// Energy law: a warning when more than kExtrapolatedWarning of the evaluations at converged
-  /// states lie outside the database's strain box (the law's convex extension, not cell data;
-  /// the issue-11 acceptance allows the paper cases 2 %). A prescribed stretch of 10 times the
+  /// A warning when more than kExtrapolatedWarning of the evaluations at converged states lie
+  /// outside the database's data (the energy law's convex extension beyond its strain box, or
+  /// the paper law's extension of eq. 17 beyond its fan; the issue-11 acceptance allows the
+  /// paper cases 2 %). A prescribed stretch of 10 times the
   /// specimen's length ran to "completed" with 100 % of them outside and no word of it but the
   /// figure inside the material report.
   std::string warning() const override;
