@@ -10,6 +10,7 @@ figure's log and the PNG becomes the placeholder as before.
 import json
 import os
 import sys
+import traceback
 
 
 def guarded_main(main):
@@ -26,8 +27,12 @@ def guarded_main(main):
         where = err.filename if err.filename else "an input (" + _command_line() + ")"
         raise SystemExit(f"{prog}: {where}: {err.strerror or err}")
     except (ValueError, KeyError, IndexError, TypeError) as err:
+        # Where it was raised, so that a defect of the script itself is not hidden behind the
+        # input: the innermost frame's file and line.
+        tb = traceback.extract_tb(err.__traceback__)[-1]
         raise SystemExit(f"{prog}: an input is damaged or not a knitscale output "
-                         f"({type(err).__name__}: {err}; the command line: {_command_line()})")
+                         f"({type(err).__name__}: {err}; raised at {os.path.basename(tb.filename)}:"
+                         f"{tb.lineno}; the command line: {_command_line()})")
 
 
 def read_json(path):
