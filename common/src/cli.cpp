@@ -87,9 +87,16 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
   app.set_version_flag("--version",
                        program + " " + project_version() + " (git " + git_revision() + ")");
   app.require_subcommand(1);
+  // The exit codes, at the foot of every --help (session 22: they were only in the docs).
+  const std::string exit_codes =
+      "\nExit codes: 0 done (warnings, if any, on stderr); 1 the computation failed or its "
+      "outputs could not be written (the message says what is kept); 2 bad command line or input "
+      "(the message names the file and the field). Units: mm, N, MPa.";
+  app.footer(exit_codes);
   std::vector<std::pair<CLI::App*, Runner>> subs;
   for (auto& e : registry()) {
     CLI::App* sub = app.add_subcommand(e.name, e.description);
+    sub->footer(exit_codes);
     subs.emplace_back(sub, e.setup(*sub));
   }
   try {

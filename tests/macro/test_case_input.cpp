@@ -269,6 +269,23 @@ TEST_CASE(
   fs::remove_all(d);
 }
 
+// Session 22: the exit codes were in the docs only; every --help now ends with them.
+TEST_CASE("knit-macro --help and run --help state the exit codes and units", "[unit]") {
+  const fs::path d = temp_dir("help");
+  for (const std::string cmd : {"", " run"}) {
+    INFO("knit-macro" << cmd << " --help");
+    const std::string line = std::string(KNIT_BIN_DIR) + "/knit-macro" + cmd + " --help > " +
+                             (d / "help.txt").string() + " 2>&1";
+    const int st = std::system(line.c_str());
+    CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));
+    const std::string help = slurp(d / "help.txt");
+    CHECK(help.find("Exit codes: 0 done") != std::string::npos);
+    CHECK(help.find("2 bad command line or input") != std::string::npos);
+    CHECK(help.find("Units: mm, N, MPa.") != std::string::npos);
+  }
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
   // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with
