@@ -508,12 +508,12 @@ Case parse_case(const std::string& text, const std::string& file) {
   ctx.pointer = "/material";
   ctx.patch = &c.surface;
   c.material = make_material(root.at("material"), ctx);
-  // The knit material's database is in mm, N, MPa: a case that declares other units would run
-  // with its numbers read as those (session 22). Other materials take any consistent units.
-  if (c.material->name() == "knit" && root.contains("units") &&
-      root.at("units").get<std::string>() != "mm, N, MPa")
-    r.fail("/units", "a knit case is in \"mm, N, MPa\" (its material database's units), got " +
-                         root.at("units").dump());
+  // A material with data in fixed units (the knit database: mm, N, MPa): a case declaring other
+  // units would run with its numbers read as those (session 22).
+  if (const std::string units = c.material->required_units();
+      !units.empty() && root.contains("units") && root.at("units").get<std::string>() != units)
+    r.fail("/units", "a " + c.material->name() + " case is in \"" + units +
+                         "\" (its material database's units), got " + root.at("units").dump());
   read_bcs(r, root, c);
   read_loads(r, root, c);
   read_solver(r, root, c);

@@ -71,6 +71,20 @@ void wait_for_jobs(const fs::path& parts, int n) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
 }
 
+/// A scratch directory holding the synthetic sweep input s.json, and the paths of its
+/// database db.h5 and checkpoints db.h5.parts there.
+struct SweepScratch {
+  fs::path dir, db, parts;
+};
+SweepScratch sweep_scratch(const std::string& name) {
+  SweepScratch s;
+  s.dir = knit_test::scratch(name);
+  s.db = s.dir / "db.h5";
+  s.parts = s.dir / "db.h5.parts";
+  knit_test::write_text(s.dir / "s.json", knit_test::synthetic_sweep_json());
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("knit-meso sweep: bad input exits with 2 and names the JSON pointer", "[case]") {
@@ -79,8 +93,7 @@ TEST_CASE("knit-meso sweep: bad input exits with 2 and names the JSON pointer", 
   const std::string log = (dir / "log.txt").string();
   CHECK(shell(kExe + " sweep " + (dir / "bad.json").string() + " --output " +
               (dir / "x.h5").string() + " > " + log + " 2>&1") == 2);
-  std::ifstream in(log);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = knit_test::read_text(log);
   CHECK(text.find("/loop_lengths/1") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "x.h5"));
 }
@@ -89,9 +102,8 @@ TEST_CASE(
     "knit-meso sweep: killed midway then resumed recomputes nothing and equals an "
     "uninterrupted run",
     "[case]") {
-  const auto dir = knit_test::scratch("sweep_cli_kill");
-  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
-  const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", count = dir / "count.txt";
+  const SweepScratch s = sweep_scratch("sweep_cli_kill");
+  const fs::path &dir = s.dir, &db = s.db, &parts = s.parts, count = dir / "count.txt";
   const pid_t pid = spawn_slow_sweep(dir / "s.json", db, "", count.string());
   REQUIRE(pid >= 0);
   // Wait until some (not all) cases are checkpointed, then SIGKILL.
@@ -132,9 +144,8 @@ TEST_CASE("knit-meso sweep: Ctrl-C or SIGTERM or SIGHUP says how to resume and e
           "[case]") {
   for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
     INFO("signal " << sig);
-    const auto dir = knit_test::scratch("sweep_cli_signal_" + std::to_string(sig));
-    knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
-    const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
+    const SweepScratch s = sweep_scratch("sweep_cli_signal_" + std::to_string(sig));
+    const fs::path &dir = s.dir, &db = s.db, &parts = s.parts, err = dir / "stderr.txt";
     const pid_t pid = spawn_slow_sweep(dir / "s.json", db, err, "");
     REQUIRE(pid >= 0);
     wait_for_jobs(parts, 3);
@@ -170,8 +181,7 @@ TEST_CASE("knit-meso sweep: mpirun with 2 ranks gives the serial database", "[ca
   const int rc =
       shell("mpirun --allow-run-as-root --oversubscribe -np 2 " + kExe + " sweep " + in +
             " --output " + (dir / "mpi.h5").string() + " --threads 1 > " + log + " 2>&1");
-  std::ifstream l(log);
-  const std::string text((std::istreambuf_iterator<char>(l)), std::istreambuf_iterator<char>());
+  const std::string text = knit_test::read_text(log);
   INFO(text);
   REQUIRE(rc == 0);
   CHECK(text.find("2 ranks") != std::string::npos);
@@ -186,9 +196,8 @@ TEST_CASE(
     "knit-meso sweep: a database that cannot be written keeps the earlier file and the "
     "checkpoints, and says how to resume",
     "[case]") {
-  const auto dir = knit_test::scratch("sweep_cli_full");
-  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
-  const fs::path db = dir / "db.h5", parts = dir / "db.h5.parts", err = dir / "stderr.txt";
+  const SweepScratch s = sweep_scratch("sweep_cli_full");
+  const fs::path &dir = s.dir, &db = s.db, &parts = s.parts, err = dir / "stderr.txt";
   const std::string sweep = kExe + " sweep " + (dir / "s.json").string() + " --output " +
                             db.string() + " --no-progress > /dev/null";
   REQUIRE(shell(sweep + " 2>&1") == 0);

@@ -116,6 +116,8 @@ class KnitMaterial : public Material {
   /// specimen's length ran to "completed" with 100 % of them outside and no word of it but the
   /// figure inside the material report.
   std::string warning() const override;
+  /// The database's units.
+  std::string required_units() const override { return "mm, N, MPa"; }
   static constexpr double kExtrapolatedWarning = 0.02;
 
   double stitch_value(const Eigen::Vector2d& theta) const;

@@ -88,6 +88,10 @@ class Material {
   /// has no data (e.g. the knit law's extension beyond its database's strain box): the run
   /// still completes, the warning goes to stderr and summary.txt. Empty by default.
   virtual std::string warning() const { return {}; }
+
+  /// The units a case with this material must be in (its data's, e.g. "mm, N, MPa"), or
+  /// empty: any consistent units (the case's `units` is then informational).
+  virtual std::string required_units() const { return {}; }
 };
 
 }  // namespace knit::macro
