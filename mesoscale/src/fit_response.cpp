@@ -130,20 +130,41 @@ bool in_paper_fit(const RawPath& r) {
          (r.path.kind == material::PathKind::kBiaxial || r.path.kind == material::PathKind::kShear);
 }
 
-std::string FitOptions::validate() const {
-  if (degree1 < 1 || degree2 < 1 || shear_degree < 1) return "degrees must be >= 1";
-  if (degree1 > 9 || degree2 > 9 || shear_degree > 9) return "degrees must be <= 9";
-  if (n_ctrl1 < degree1 + 1 || n_ctrl2 < degree2 + 1 || shear_n_ctrl < shear_degree + 1)
-    return "the number of control points must be at least degree + 1";
-  // Upper bounds: beyond them the weights overflow (smoothing 1e308 made the residuals
-  // infinite and Ceres failed with a message that named no option); they are 1e10 times the
-  // defaults or more, far past any value that changes the fit.
-  if (!(smoothing >= 0.0 && smoothing <= 1e3)) return "smoothing must be in [0, 1000]";
-  if (!(loss_scale > 0.0 && loss_scale <= 1e3)) return "loss_scale must be in (0, 1000]";
+std::optional<FitOptions::Invalid> FitOptions::invalid() const {
+  const auto range = [](const char* key, int v, int lo, int hi,
+                        const char* note = "") -> std::optional<Invalid> {
+    if (v >= lo && v <= hi) return std::nullopt;
+    return Invalid{std::string("/") + key, "must be in " + std::to_string(lo) + ".." +
+                                               std::to_string(hi) + note + ", got " +
+                                               std::to_string(v)};
+  };
+  // Upper bounds, the same as the sweep schema's /fit: degree 9; 60 control points per
+  // direction (the fan has 12 paths and 20 steps, so the default 11 already spans it; 40 take
+  // 9 s, 60 take 90 s, and 123456789 ran for minutes before they were bounded); 100,000
+  // iterations (the default 100).
+  const char* at_least = " (at least degree + 1)";
+  for (const auto& bad :
+       {range("degree_1", degree1, 1, 9), range("degree_2", degree2, 1, 9),
+        range("shear_degree", shear_degree, 1, 9),
+        range("control_points_1", n_ctrl1, degree1 + 1, kMaxControlPoints, at_least),
+        range("control_points_2", n_ctrl2, degree2 + 1, kMaxControlPoints, at_least),
+        range("shear_control_points", shear_n_ctrl, shear_degree + 1, kMaxControlPoints, at_least),
+        range("max_iterations", max_iterations, 1, 100000)})
+    if (bad) return bad;
+  // Upper bounds where the weights overflow (smoothing 1e308 made the residuals infinite and
+  // Ceres failed with a message that named no option); they are 1e10 times the defaults or
+  // more, far past any value that changes the fit.
+  if (!(smoothing >= 0.0 && smoothing <= 1e3)) return Invalid{"/smoothing", "must be in [0, 1000]"};
+  if (!(loss_scale > 0.0 && loss_scale <= 1e3))
+    return Invalid{"/loss_scale", "must be in (0, 1000]"};
   if (!(foot_point_penalty >= 0.0 && foot_point_penalty <= 1e3))
-    return "foot_point_penalty must be in [0, 1000]";
-  if (max_iterations < 1) return "max_iterations must be >= 1";
-  return {};
+    return Invalid{"/foot_point_penalty", "must be in [0, 1000]"};
+  return std::nullopt;
+}
+
+std::string FitOptions::validate() const {
+  const auto bad = invalid();
+  return bad ? bad->pointer.substr(1) + " " + bad->message : std::string();
 }
 
 std::string FitOptions::to_json() const {
@@ -222,7 +243,7 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
     else
       throw InputError(file, "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
   }
-  if (const std::string why = o.validate(); !why.empty()) throw InputError(file, "", why);
+  if (const auto bad = o.invalid()) throw InputError(file, bad->pointer, bad->message);
   return o;
 }
 

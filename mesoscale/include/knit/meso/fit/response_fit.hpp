@@ -42,6 +42,7 @@
 // more, no shear path, and a fitted E-surface that cannot be inverted.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,14 @@ struct FitOptions {
   int max_iterations = 100;
   InitialStiffness initial_stiffness = InitialStiffness::kFirstStep;
 
-  /// Empty if valid, else the reason.
+  /// Control points per direction at most (and at least degree + 1).
+  static constexpr int kMaxControlPoints = 60;
+  /// An option out of its range: its JSON pointer in the options file and what is wrong.
+  struct Invalid {
+    std::string pointer, message;
+  };
+  std::optional<Invalid> invalid() const;
+  /// Empty if valid, else the reason ("degree_1 must be in 1..9, got 0").
   std::string validate() const;
   std::string to_json() const;
   /// Parses the options JSON (the same keys as to_json()); throws knit::InputError.
