@@ -225,7 +225,8 @@ std::string EnergyFitOptions::validate() const {
   if (!(smoothing >= 0.0 && smoothing <= 1e3)) return "smoothing must be in [0, 1000]";
   if (!(loss_scale > 0.0 && loss_scale <= 1e3)) return "loss_scale must be in (0, 1000]";
   if (loss_rounds < 1 || loss_rounds > 50) return "loss_rounds must be in 1..50";
-  if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (max_iterations < 1 || max_iterations > 100000)  // the sweep schema's bound
+    return "max_iterations must be in 1..100000";
   if (threads < 0) return "threads must be >= 0 (0: all cores)";
   if (!(weight_relative >= 0.0 && weight_relative <= 100.0))
     return "weight_relative must be in [0, 100] (0: absolute errors)";

@@ -518,6 +518,9 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("family must be"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube": 2})", "f.json"),
                       Catch::Contains("tube must be in [0, 1]"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"max_iterations": 100001})", "f.json"),
+                      Catch::Contains("max_iterations must be in 1..100000"));
+    CHECK(EnergyFitOptions::from_json(R"({"max_iterations": 100000})").max_iterations == 100000);
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube_weight": -1})", "f.json"),
                       Catch::Contains("tube_weight"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 0})", "f.json"),
