@@ -54,6 +54,7 @@ knit::cli::SubcommandRegistrar reg(
             std::cerr << knit::macro::material_failure_message(r.report,
                                                                r.failed_material_evaluations)
                       << "; ";
+          if (!r.output_failure.empty()) std::cerr << r.output_failure << "; ";
           std::cerr << "outputs in " << ro.output_dir.string() << "\n";
           return knit::kExitFailure;
         }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -86,6 +87,7 @@ ResultsWriter::Fields ResultsWriter::sample(int step, double lambda,
 void ResultsWriter::add_step(int step, double lambda, const Eigen::VectorXd& u) {
   if (!case_.output.vtk && !case_.output.hdf5) return;
   Fields f = sample(step, lambda, u);
+  check_finite(f);
   if (case_.output.vtk) {  // `output.vtk: false`: no VTU files, no PVD
     char name[64];
     std::snprintf(name, sizeof name, "step_%04d.vtu", step);
@@ -94,6 +96,36 @@ void ResultsWriter::add_step(int step, double lambda, const Eigen::VectorXd& u) 
     pvd_.write();  // valid after every step
   }
   if (case_.output.hdf5) steps_.push_back(std::move(f));
+}
+
+void ResultsWriter::check_finite(const Fields& f) {
+  const int gu = case_.output.grid_u, gv = case_.output.grid_v;
+  for (int k = 0; k < gu * gv; ++k) {
+    const auto name_of_bad = [&]() -> std::string {
+      if (!f.x.row(k).allFinite()) return "x";
+      if (!f.u.row(k).allFinite()) return "displacement";
+      for (Eigen::Index c = 0; c < f.values.cols(); ++c)
+        if (!std::isfinite(f.values(k, c))) return f.names[static_cast<size_t>(c)];
+      return {};
+    };
+    const std::string bad = name_of_bad();
+    if (bad.empty()) continue;
+    if (nonfinite_output_.empty()) {
+      std::ostringstream o;
+      o << "output field " << bad << " is not finite at step " << f.step << ", (theta1, theta2) = ("
+        << fmt(double(k % gu) / (gu - 1)) << ", " << fmt(double(k / gu) / (gv - 1))
+        << ") of the output grid";
+      nonfinite_output_ = o.str();
+    }
+    ++nonfinite_values_;
+  }
+}
+
+std::string ResultsWriter::output_failure() const {
+  if (nonfinite_output_.empty()) return {};
+  return nonfinite_output_ + " (" + std::to_string(nonfinite_values_) +
+         " non-finite sample(s) in all): the material gave a non-finite number at a strain that "
+         "no quadrature point reached; the results are not trustworthy";
 }
 
 void ResultsWriter::write_vtu(const fs::path& file, const Fields& f) const {
@@ -120,6 +152,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
   if (!material_warning_.empty()) h5.set_attribute(".", "material_warning", material_warning_);
+  if (!nonfinite_output_.empty()) h5.set_attribute(".", "output_failure", output_failure());
   h5.write_strings("case_json", {case_.text});
   // The CSV columns.
   const int n = static_cast<int>(rows_.size());
@@ -184,6 +217,7 @@ void ResultsWriter::finish(const RunReport& report) {
     csv.add_comment("run stopped early: " + report.message);
   if (!material_failure_.empty()) csv.add_comment(material_failure_);
   if (!material_warning_.empty()) csv.add_comment(material_warning_);
+  if (!nonfinite_output_.empty()) csv.add_comment(output_failure());
   for (const StepRow& r : rows_) {
     std::vector<io::CsvCell> row = {r.step, r.lambda};
     if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
@@ -199,6 +233,7 @@ void ResultsWriter::finish(const RunReport& report) {
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n";
   if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
   if (!material_warning_.empty()) sum << material_warning_ << "\n";
+  if (!nonfinite_output_.empty()) sum << "output failure: " << output_failure() << "\n";
   sum << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";
   if (!report.message.empty()) sum << "message: " << report.message << "\n";

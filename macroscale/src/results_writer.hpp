@@ -35,6 +35,11 @@ class ResultsWriter {
   void set_material_failure(std::string m) { material_failure_ = std::move(m); }
   /// Material::warning(): a comment in the CSV, a line in summary.txt, an HDF5 attribute.
   void set_material_warning(std::string m) { material_warning_ = std::move(m); }
+  /// Empty, or where the sampled output fields first held a non-finite number (the first
+  /// field, step and point, and how many values in all): the quadrature points, which Newton
+  /// checks, may never reach a strain where the material's stress overflows, the output grid
+  /// can. Written to summary.txt, load_strain.csv and results.h5; the run then fails.
+  std::string output_failure() const;
 
  private:
   struct Fields {
@@ -45,6 +50,7 @@ class ResultsWriter {
     Eigen::MatrixXd values;          ///< n x names.size()
   };
   Fields sample(int step, double lambda, const Eigen::VectorXd& u) const;
+  void check_finite(const Fields& f);
   void write_vtu(const std::filesystem::path& file, const Fields& f) const;
   void write_hdf5(const std::filesystem::path& file, const RunReport& report) const;
 
@@ -57,6 +63,8 @@ class ResultsWriter {
   std::string material_report_;
   std::string material_failure_;
   std::string material_warning_;
+  std::string nonfinite_output_;
+  long nonfinite_values_ = 0;
 };
 
 }  // namespace knit::macro

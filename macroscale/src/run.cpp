@@ -182,6 +182,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
         outputs % c.output.every != 0)
       writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
     writer->finish(res.report);
+    res.output_failure = writer->output_failure();
   }
   return res;
 }

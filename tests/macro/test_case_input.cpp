@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -487,6 +488,49 @@ TEST_CASE("a run with failed material evaluations does not report plain success"
   REQUIRE(fs::exists(d / "out" / "summary.txt"));  // outputs kept
   CHECK(slurp(d / "out" / "summary.txt").find(msg) != std::string::npos);
   CHECK(slurp(d / "out" / "load_strain.csv").find(msg) != std::string::npos);
+  fs::remove_all(d);
+}
+
+namespace {
+// A linear material whose stress is not finite where only the output grid evaluates it (the
+// samples of the written fields, MaterialPoint::point_id < 0): stands in for a law whose stress
+// overflows at a strain the quadrature points never reach (a paper-law database with a shear
+// control value of 1e308 did so at the patch's corners, found by fuzzing the database).
+class OverflowAtSamplesMaterial : public Material {
+ public:
+  std::string name() const override { return "overflow at the samples"; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& where) const override {
+    MaterialResponse r = svk_.evaluate(E, where);
+    if (where.point_id < 0 && where.theta(0) == 1.0)
+      r.S(2) = std::numeric_limits<double>::infinity();
+    return r;
+  }
+
+ private:
+  SaintVenantKirchhoff svk_{1.0, 0.0};
+};
+}  // namespace
+
+TEST_CASE("a non-finite number in the written fields makes the run fail, saying where", "[unit]") {
+  const fs::path d = temp_dir("overflow");
+  json j = strip_case(0.01);
+  j["solver"] = {{"steps", 2}};
+  Case c = parse_case(j.dump(), "overflow.json");
+  c.material = std::make_shared<OverflowAtSamplesMaterial>();
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  const RunResult r = run_case(c, ro);
+  CHECK(r.report.status == RunStatus::kCompleted);  // Newton never saw it...
+  CHECK(r.failed_material_evaluations == 0);
+  CHECK_FALSE(r.succeeded());  // ...but the outputs hold it: knit-macro exits 1
+  CHECK_THAT(r.output_failure, Catch::StartsWith("output field n12 is not finite at step 1, "
+                                                 "(theta1, theta2) = (1, 0) of the output grid"));
+  REQUIRE(fs::exists(d / "out" / "summary.txt"));  // outputs kept, the failure in each of them
+  CHECK(slurp(d / "out" / "summary.txt").find("output failure: " + r.output_failure) !=
+        std::string::npos);
+  CHECK(slurp(d / "out" / "load_strain.csv").find(r.output_failure) != std::string::npos);
+  CHECK(knit::io::H5File::open_read(d / "out" / "results.h5")
+            .attribute_string(".", "output_failure") == r.output_failure);
   fs::remove_all(d);
 }
 

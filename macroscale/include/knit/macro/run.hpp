@@ -83,9 +83,14 @@ struct RunResult {
   long failed_material_evaluations = 0;
   /// Material::warning() at the end of the run (empty: none).
   std::string material_warning;
-  /// Plain success: every step converged and the material never failed.
+  /// Empty, or where the written output fields held a non-finite number (results_writer.hpp:
+  /// the output grid reached a strain where the material's stress is not finite).
+  std::string output_failure;
+  /// Plain success: every step converged, the material never failed and every output value is
+  /// finite.
   bool succeeded() const {
-    return report.status == RunStatus::kCompleted && failed_material_evaluations == 0;
+    return report.status == RunStatus::kCompleted && failed_material_evaluations == 0 &&
+           output_failure.empty();
   }
   std::vector<StepRow> rows;
   Eigen::VectorXd u;  ///< displacement of the last converged step
