@@ -1,6 +1,7 @@
 // The energy-based response surface (see knit/material/energy_law.hpp).
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "knit/material/energy_law.hpp"
@@ -74,8 +75,20 @@ void validate(const EnergyLawData& d) {
     fail("data strain box must be finite with min <= max");
   if (d.family == EnergyFamily::kNetwork) {
     if (const std::string why = d.network.validate(); !why.empty()) fail("network: " + why);
+    // The knots are the loop lengths whose networks were fitted, so they run from l_min to
+    // l_max exactly: a last knot of 1e308 (or a first of 1e-300) "covered" the range and
+    // stretched the interpolation between its neighbours over it, silently.
+    const double tol = 1e-9 * d.l_max;
     if (d.network.l_knots.front() > d.l_min || d.network.l_knots.back() < d.l_max)
       fail("network: loop-length knots must cover [l_min, l_max]");
+    if (d.network.l_knots.front() < d.l_min - tol || d.network.l_knots.back() > d.l_max + tol) {
+      std::ostringstream o;
+      o << "network: loop-length knots must run from l_min to l_max (the loop lengths of the "
+           "fitted networks), got "
+        << d.network.l_knots.front() << " ... " << d.network.l_knots.back() << " mm for ["
+        << d.l_min << ", " << d.l_max << "] mm";
+      fail(o.str());
+    }
     return;
   }
   const Eigen::Index K = d.directions.d.rows();

@@ -317,6 +317,9 @@ TEST_CASE("convex network: validation refuses bad data", "[unit]") {
   refuses([&](EnergyLawData& d) { d.network.theta(0, 0) = std::nan(""); }, "finite");
   refuses([&](EnergyLawData& d) { d.network.l_knots = {4.5, 4.5, 6.5}; }, "strictly increasing");
   refuses([&](EnergyLawData& d) { d.network.l_knots = {4.6, 5.5, 6.5}; }, "cover");
+  // Knots beyond the range (found by fuzzing a database: they "covered" it).
+  refuses([&](EnergyLawData& d) { d.network.l_knots = {4.5, 5.5, 1e308}; }, "run from l_min");
+  refuses([&](EnergyLawData& d) { d.network.l_knots = {1e-300, 5.5, 6.5}; }, "run from l_min");
   refuses([&](EnergyLawData& d) { d.network.theta.conservativeResize(3, sh.size() - 1); },
           "theta must be");
   refuses([&](EnergyLawData& d) { d.network.shape.h1 = 0; }, "hidden layer sizes");

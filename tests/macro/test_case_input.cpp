@@ -469,17 +469,22 @@ class FailingMaterial : public Material {
  private:
   SaintVenantKirchhoff svk_{1.0, 0.0};
 };
+
+// The two-step strip case run with `material` into d / "out".
+RunResult run_strip_with(std::shared_ptr<Material> material, const fs::path& d) {
+  json j = strip_case(0.01);
+  j["solver"] = {{"steps", 2}};
+  Case c = parse_case(j.dump(), (d.filename().string() + ".json"));
+  c.material = std::move(material);
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  return run_case(c, ro);
+}
 }  // namespace
 
 TEST_CASE("a run with failed material evaluations does not report plain success", "[unit]") {
   const fs::path d = temp_dir("failing");
-  json j = strip_case(0.01);
-  j["solver"] = {{"steps", 2}};
-  Case c = parse_case(j.dump(), "failing.json");
-  c.material = std::make_shared<FailingMaterial>();
-  RunOptions ro;
-  ro.output_dir = d / "out";
-  const RunResult r = run_case(c, ro);
+  const RunResult r = run_strip_with(std::make_shared<FailingMaterial>(), d);
   CHECK(r.report.status == RunStatus::kCompleted);  // every step converged...
   CHECK(r.failed_material_evaluations == 22000);
   CHECK_FALSE(r.succeeded());  // ...but the run is not a plain success (knit-macro: exit 1)
@@ -513,13 +518,7 @@ class OverflowAtSamplesMaterial : public Material {
 
 TEST_CASE("a non-finite number in the written fields makes the run fail, saying where", "[unit]") {
   const fs::path d = temp_dir("overflow");
-  json j = strip_case(0.01);
-  j["solver"] = {{"steps", 2}};
-  Case c = parse_case(j.dump(), "overflow.json");
-  c.material = std::make_shared<OverflowAtSamplesMaterial>();
-  RunOptions ro;
-  ro.output_dir = d / "out";
-  const RunResult r = run_case(c, ro);
+  const RunResult r = run_strip_with(std::make_shared<OverflowAtSamplesMaterial>(), d);
   CHECK(r.report.status == RunStatus::kCompleted);  // Newton never saw it...
   CHECK(r.failed_material_evaluations == 0);
   CHECK_FALSE(r.succeeded());  // ...but the outputs hold it: knit-macro exits 1
