@@ -101,6 +101,17 @@ Section read_section(const Reader& R, const json& j, const std::string& ptr, Sec
   if (j.contains("nu")) s.nu = R.number(j["nu"], ptr + "/nu", -1.0, 0.5, true, true);
   if (j.contains("d")) s.d = R.positive(j["d"], ptr + "/d");
   if (j.contains("shear_factor")) s.kappa = R.positive(j["shear_factor"], ptr + "/shear_factor");
+  // The stiffnesses must be finite and positive: d = 1e308 made E A infinite, every residual
+  // then scaled to 0, and the rod "converged" undeformed with 0 Newton iterations and exit 0;
+  // d = 1e-300 made E I vanish (found by fuzzing the rod cases).
+  const Eigen::Vector3d cg = s.C_Gamma(), ck = s.C_K();
+  if (!(cg.allFinite() && ck.allFinite() && (cg.array() > 0.0).all() && (ck.array() > 0.0).all())) {
+    std::ostringstream o;
+    o << "the section's stiffnesses must be finite and positive, got E A = " << cg(2)
+      << " N, E I = " << ck(0) << " N mm^2, G J = " << ck(2) << " N mm^2 (E = " << s.E
+      << " MPa, d = " << s.d << " mm)";
+    R.fail(ptr, o.str());
+  }
   return s;
 }
 

@@ -120,6 +120,13 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
       // 1e308 accepted every first iterate: an undeformed rod with exit 0 (session 21).
       {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 1e308}})", "/steps/tolerance"},
       {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 0.5}})", "/steps/tolerance"},
+      // d = 1e308: E A = inf, every residual scaled to 0, the rod "converged" undeformed with
+      // exit 0; d = 1e-300: E I = 0 (session 23). The section names itself.
+      {R"({"section": {"d": 1e308}, "rods": [)" + good_rod + "]}", "/section"},
+      {R"({"section": {"d": 1e-300}, "rods": [)" + good_rod + "]}", "/section"},
+      {R"({"rods": [)" + good_rod.substr(0, good_rod.size() - 1) +
+           R"(, "section": {"E": 1e308, "d": 1e200}}]})",
+       "/rods/0/section"},
       {R"({"rods": [{"name": "b", "curve": {"type": "spiral"}, "start": {}, "end": {}}]})",
        "/rods/0/curve/type"},
       {R"({"rods": [)" + good_rod +
