@@ -111,11 +111,8 @@ knit::cli::SubcommandRegistrar reg(
         for (std::size_t k = 0; k < d.variables.size(); ++k)
           sum << "variable " << header[4 + k] << ": " << d.variables[k].initial << " -> " << r.x[k]
               << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "]\n";
-        sum << "final run: "
-            << (run.succeeded() ? "completed"
-                                : knit::macro::material_failure_message(
-                                      run.report, run.failed_material_evaluations))
-            << "\n";
+        const std::string run_failure = knit::macro::run_failure_message(run);
+        sum << "final run: " << (run.succeeded() ? "completed" : run_failure) << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());
         out.commit();
         for (const auto& h : r.history)
@@ -124,6 +121,13 @@ knit::cli::SubcommandRegistrar reg(
         if (r.status == DesignStatus::kIterationLimit || r.status == DesignStatus::kFailed) {
           std::cerr << "knit-macro design: " << o->file << ": " << to_string(r.status)
                     << (r.message.empty() ? "" : ": " + r.message) << "\n";
+          return knit::kExitFailure;
+        }
+        // The design's result is its final run: one that stopped, whose material failed or whose
+        // outputs are not finite is no result (before: exit 0 with the reason in summary.txt).
+        if (!run.succeeded()) {
+          std::cerr << "knit-macro design: " << o->file << ": the final run of the design did not "
+                    << "succeed: " << run_failure << "; outputs in " << dir.string() << "\n";
           return knit::kExitFailure;
         }
         return knit::kExitOk;

@@ -47,15 +47,8 @@ knit::cli::SubcommandRegistrar reg(
         ro.warnings = &std::cerr;
         const auto r = knit::macro::run_case(c, ro);
         if (!r.succeeded()) {
-          std::cerr << "knit-macro: " << o->case_file << ": ";
-          if (r.report.status != knit::macro::RunStatus::kCompleted)
-            std::cerr << r.report.message << "; ";
-          if (r.failed_material_evaluations > 0)
-            std::cerr << knit::macro::material_failure_message(r.report,
-                                                               r.failed_material_evaluations)
-                      << "; ";
-          if (!r.output_failure.empty()) std::cerr << r.output_failure << "; ";
-          std::cerr << "outputs in " << ro.output_dir.string() << "\n";
+          std::cerr << "knit-macro: " << o->case_file << ": " << knit::macro::run_failure_message(r)
+                    << "; outputs in " << ro.output_dir.string() << "\n";
           return knit::kExitFailure;
         }
         std::cout << "wrote " << ro.output_dir.string() << "\n";

@@ -101,6 +101,19 @@ std::string material_failure_message(const RunReport& report, long n) {
          "; results are not trustworthy";
 }
 
+std::string run_failure_message(const RunResult& r) {
+  std::string m;
+  const auto add = [&m](const std::string& part) {
+    if (part.empty()) return;
+    m += (m.empty() ? "" : "; ") + part;
+  };
+  if (r.report.status != RunStatus::kCompleted) add(r.report.message);
+  add(material_failure_message(r.report, r.failed_material_evaluations));
+  add(r.output_failure);
+  if (m.empty() && !r.succeeded()) m = "the run did not complete";
+  return m;
+}
+
 RunResult run_case(const Case& c, const RunOptions& opt) {
   if (!opt.output_dir.empty()) check_output_size(c, opt);  // before any work or file
   Problem p = setup_problem(c);

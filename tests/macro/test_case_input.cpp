@@ -490,6 +490,7 @@ TEST_CASE("a run with failed material evaluations does not report plain success"
   CHECK_FALSE(r.succeeded());  // ...but the run is not a plain success (knit-macro: exit 1)
   const std::string msg = material_failure_message(r.report, r.failed_material_evaluations);
   CHECK(msg == "completed with 22000 failed material evaluations; results are not trustworthy");
+  CHECK(run_failure_message(r) == msg);            // what knit-macro run and design print
   REQUIRE(fs::exists(d / "out" / "summary.txt"));  // outputs kept
   CHECK(slurp(d / "out" / "summary.txt").find(msg) != std::string::npos);
   CHECK(slurp(d / "out" / "load_strain.csv").find(msg) != std::string::npos);
@@ -530,7 +531,27 @@ TEST_CASE("a non-finite number in the written fields makes the run fail, saying 
   CHECK(slurp(d / "out" / "load_strain.csv").find(r.output_failure) != std::string::npos);
   CHECK(knit::io::H5File::open_read(d / "out" / "results.h5")
             .attribute_string(".", "output_failure") == r.output_failure);
+  CHECK(run_failure_message(r) == r.output_failure);  // what knit-macro run and design print
   fs::remove_all(d);
+}
+
+TEST_CASE("why a run is not a plain success: every reason, joined", "[unit]") {
+  RunResult r;
+  r.report.status = RunStatus::kCompleted;
+  CHECK(r.succeeded());
+  CHECK(run_failure_message(r).empty());
+  r.report.status = RunStatus::kNotConverged;
+  r.report.message = "step 3 did not converge";
+  r.failed_material_evaluations = 2;
+  r.output_failure = "output field n12 is not finite";
+  CHECK_FALSE(r.succeeded());
+  CHECK(run_failure_message(r) ==
+        "step 3 did not converge; stopped with 2 failed material evaluations; results are not "
+        "trustworthy; output field n12 is not finite");
+  r.report.message.clear();
+  r.failed_material_evaluations = 0;
+  r.output_failure.clear();
+  CHECK(run_failure_message(r) == "the run did not complete");  // never empty on a failure
 }
 
 TEST_CASE("a folded database surface is refused at load, naming the database and HDF5 group",

@@ -102,4 +102,8 @@ RunResult run_case(const Case& c, const RunOptions& options);
 /// "stopped ..." for a run that did not complete); empty if n == 0.
 std::string material_failure_message(const RunReport& report, long n);
 
+/// Why a run is not a plain success (RunResult::succeeded()): the stop message, the material's
+/// failures and the output failure, joined by "; "; empty if it succeeded.
+std::string run_failure_message(const RunResult& r);
+
 }  // namespace knit::macro
