@@ -78,6 +78,15 @@ CLI::Validator integer(long long lo, long long hi) {
       "INTEGER " + range);
 }
 
+CLI::Validator non_empty() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return text.empty() ? "must not be empty (leave the option out to take its default)"
+                            : std::string();
+      },
+      "");
+}
+
 SubcommandRegistrar::SubcommandRegistrar(std::string name, std::string description, Setup setup) {
   registry().push_back({std::move(name), std::move(description), std::move(setup)});
 }
@@ -98,6 +107,11 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
     CLI::App* sub = app.add_subcommand(e.name, e.description);
     sub->footer(exit_codes);
     subs.emplace_back(sub, e.setup(*sub));
+    // An option given with an empty value is refused (exit 2) instead of being taken as not
+    // given: `-o ""` (an unset shell variable) fell back to the default output, and for
+    // `knit-meso fit` that default is to replace the input database (session 24).
+    for (CLI::Option* opt : sub->get_options())
+      if (opt->get_type_size_max() != 0) opt->check(non_empty());
   }
   try {
     app.parse(argc, argv);

@@ -242,6 +242,11 @@ std::uint64_t parse_size(std::string_view text, std::string_view option) {
   else if (!unit.empty())
     return bad();
   if (end == s.c_str() || !std::isfinite(v) || v < 0 || v * f > 1.8e19) return bad();
+  // A positive size below one byte (0.5, 1e-300) would round to 0, which means "no cap": the
+  // opposite of what was asked (session 24).
+  if (v > 0 && v * f < 1)
+    throw InputError("", std::string(option),
+                     "\"" + s + "\" is below one byte (0 means no cap; give a size such as 500M)");
   return static_cast<std::uint64_t>(v * f);
 }
 

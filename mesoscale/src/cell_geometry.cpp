@@ -105,7 +105,9 @@ double solve_h(double l, double h0, double rtol, Build&& build, int* iters) {
     h2 = h3 > 0 ? h3 : 0.5 * h1;
     L2 = build(h2) - l;
   }
-  if (std::abs(L2) > 1e3 * rtol * l)
+  // Written so that a NaN residual (a yarn diameter of 1e308 mm overflows the shape) fails too:
+  // before, it passed this test and the cell was written with a measured length of NaN, exit 0.
+  if (!(std::abs(L2) <= 1e3 * rtol * l))
     throw std::runtime_error("cell geometry: could not match the loop length (residual " +
                              std::to_string(L2) + " mm); is the loop too short for w and d?");
   if (iters) *iters = it;

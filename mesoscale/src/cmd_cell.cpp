@@ -15,6 +15,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -66,10 +67,10 @@ int run(const Options& o) {
     try {
       return make_cell_geometry(o.loop_length, go);
     } catch (const std::runtime_error& e) {  // a loop too short for w and d
-      throw knit::InputError("", "--loop-length",
-                             "no cell geometry for " + std::to_string(o.loop_length) +
-                                 " mm with yarn diameter " + std::to_string(go.d) +
-                                 " mm: " + e.what());
+      std::ostringstream msg;                // (std::to_string printed 1e308 with 309 digits)
+      msg << "no cell geometry for " << o.loop_length << " mm with yarn diameter " << go.d
+          << " mm: " << e.what();
+      throw knit::InputError("", "--loop-length", msg.str());
     }
   }();
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");

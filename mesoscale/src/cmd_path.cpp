@@ -22,6 +22,8 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -110,8 +112,21 @@ int run(const Options& o) {
     if (!(std::abs(o.shear) < 80))
       throw knit::InputError("", "--shear", "|gamma| must be < 80 deg");
   }
+  // A loop too short for its yarn is bad input (exit 2, as in `knit-meso cell`), not a failed
+  // computation: before, exit 1 with a message that named no option.
+  const auto cell_ptr = [&] {
+    try {
+      return std::make_unique<PeriodicCell>(o.loop_length, co);
+    } catch (const std::runtime_error& e) {
+      if (std::string(e.what()).rfind("cell geometry:", 0) != 0) throw;
+      std::ostringstream msg;
+      msg << "no cell geometry for " << o.loop_length << " mm with yarn diameter " << co.section.d
+          << " mm: " << e.what();
+      throw knit::InputError("", "--loop-length", msg.str());
+    }
+  }();
+  PeriodicCell& cell = *cell_ptr;
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
-  PeriodicCell cell(o.loop_length, co);
   std::string csv = csv_header();
   std::vector<std::pair<double, std::string>> pvd;
   const PathResult res = run_path(cell, p, [&](int k, const StepResult& r) {
@@ -137,7 +152,11 @@ int run(const Options& o) {
       "equilibration %.3f s -> %s/path.csv\n",
       res.message.c_str(), n, res.seconds, n > 0 ? res.seconds / n : 0.0,
       n > 0 ? double(res.iterations) / n : 0.0, res.equilibration_seconds, o.out.c_str());
-  return res.completed ? knit::kExitOk : knit::kExitFailure;
+  if (res.completed) return knit::kExitOk;
+  // Said on stderr too, as the other commands do (before: on stdout only, stderr empty).
+  std::fprintf(stderr, "knit-meso path: %s; the %d converged step(s) are kept in %s\n",
+               res.message.c_str(), n, o.out.c_str());
+  return knit::kExitFailure;
 }
 
 knit::cli::SubcommandRegistrar reg(

@@ -44,9 +44,12 @@ static knit::cli::SubcommandRegistrar reg_synth(
           ->check(knit::cli::number(0, 50, knit::cli::Ends::kOpenLow));
       sub.add_option("--steps", o->steps, "load steps per path")
           ->check(knit::cli::integer(4, 1000));
-      sub.add_option("--fit-options", o->fit_options, "fit options (JSON file)");
-      sub.add_option("--energy-options", o->energy_options, "energy-law fit options (JSON file)");
-      sub.add_flag("--no-fit", o->no_fit, "store the raw data only");
+      auto* fo = sub.add_option("--fit-options", o->fit_options, "fit options (JSON file)");
+      auto* eo = sub.add_option("--energy-options", o->energy_options,
+                                "energy-law fit options (JSON file)");
+      // Options of a fit that --no-fit skips were ignored unread, even a missing file (session
+      // 24): now the parser refuses the combination.
+      sub.add_flag("--no-fit", o->no_fit, "store the raw data only")->excludes(fo)->excludes(eo);
       sub.add_flag("--no-coverage", o->no_coverage,
                    "only the 13 paper paths (no coverage or held-out paths)");
       return [o]() -> int {

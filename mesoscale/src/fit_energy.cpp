@@ -10,6 +10,7 @@
 #include "fit_energy_data.hpp"
 #include "fit_options_json.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/nnls.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -303,12 +304,9 @@ std::string EnergyFitOptions::to_json() const {
 
 EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std::string& file,
                                              const std::string& pointer) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(file, pointer, std::string("not valid JSON: ") + e.what());
-  }
+  // The common parser (line and column of a syntax error, a depth limit, numbers beyond a
+  // double and duplicate keys refused) as for every other JSON input.
+  const nlohmann::json j = knit::io::parse_json(text, file);
   if (!j.is_object()) throw InputError(file, pointer, "energy-fit options must be a JSON object");
   EnergyFitOptions o;
   static const char* known[] = {"s_degree",

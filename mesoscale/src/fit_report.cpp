@@ -1,8 +1,7 @@
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 #include "knit/meso/fit/report.hpp"
 
 namespace knit::meso::fit {
@@ -38,11 +37,9 @@ std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& 
 }
 
 std::string read_text_file(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw knit::InputError(file, "", "cannot open");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  // The defensive reader of every other input (session 24: an ifstream here read /dev/zero
+  // until memory ran out and blocked for ever on a FIFO).
+  return knit::io::read_input_file(file);
 }
 
 }  // namespace knit::meso::fit

@@ -13,6 +13,7 @@
 
 #include "fit_options_json.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/spline/knot_vector.hpp"
 #include "knit/spline/surface.hpp"
@@ -185,12 +186,9 @@ std::string FitOptions::to_json() const {
 }
 
 FitOptions FitOptions::from_json(const std::string& text, const std::string& file) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(file, "", std::string("not valid JSON: ") + e.what());
-  }
+  // The common parser (line and column of a syntax error, a depth limit, numbers beyond a
+  // double and duplicate keys refused) as for every other JSON input.
+  const nlohmann::json j = knit::io::parse_json(text, file);
   if (!j.is_object()) throw InputError(file, "", "fit options must be a JSON object");
   FitOptions o;
   auto get_int = [&](const char* k, int& v) { read_int_option(j, k, file, "", v); };

@@ -398,6 +398,10 @@ TEST_CASE("Output sizes: parsed from the command line, printed in decimal units"
   CHECK(knit::io::parse_size("500M", "--max") == 500'000'000u);
   CHECK(knit::io::parse_size("10k", "--max") == 10'000u);
   CHECK(knit::io::parse_size("123", "--max") == 123u);
+  // Session 24: a positive size below one byte rounded to 0, which means "no cap".
+  CHECK(knit::io::parse_size("0.5k", "--max") == 500u);
+  CHECK_THROWS_AS(knit::io::parse_size("1e-300", "--max"), knit::InputError);
+  CHECK_THROWS_AS(knit::io::parse_size("0.5", "--max"), knit::InputError);
   CHECK(knit::io::parse_size("0", "--max") == 0u);
   for (const char* bad : {"", "G", "-1", "nan", "1Q", "1e30"})
     CHECK_THROWS_WITH(knit::io::parse_size(bad, "--max"), Catch::Contains("--max"));

@@ -287,6 +287,23 @@ TEST_CASE("knit-macro --help and run --help state the exit codes and units", "[u
   fs::remove_all(d);
 }
 
+// Session 24 (fuzzing the command line): `-o ''` ran into the default output directory (the
+// case's name), and --max-output-size 1e-300 rounded to 0 bytes, which means "no cap".
+TEST_CASE("knit-macro run: an empty option value and a size below one byte are refused", "[unit]") {
+  const fs::path d = temp_dir("empty_option");
+  std::ofstream(d / "strip.json") << strip_case(0.1).dump(2);
+  const fs::path cwd = fs::current_path();
+  fs::current_path(d);  // where the default output directory "strip" would go
+  CHECK(run_exe("strip.json -o ''", d / "log.txt") == 2);
+  CHECK(slurp(d / "log.txt").find("--output: must not be empty") != std::string::npos);
+  CHECK(run_exe("strip.json -o out --max-output-size 1e-300", d / "log.txt") == 2);
+  CHECK(slurp(d / "log.txt").find("below one byte") != std::string::npos);
+  fs::current_path(cwd);
+  CHECK_FALSE(fs::exists(d / "strip"));
+  CHECK_FALSE(fs::exists(d / "out"));
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
   // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with

@@ -145,6 +145,12 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"path --loop-length 4.5 --shear 5 --stick 0", "--stick", "> 0"},
       {"path --loop-length 4.5 --shear 5 --delta 1e999", "--delta", "> 0"},
       {"sweep nothing.json --threads -3", "--threads", "[0, 4096]"},
+      // Session 24: a NaN residual of the loop-length match passed its test (the cell was
+      // written with a measured length of NaN, exit 0); a loop too short for its yarn was exit
+      // 1 in `path`, naming no option; an empty value was taken as the option left out.
+      {"cell --loop-length 5 --diameter 1e308", "--loop-length", "could not match"},
+      {"path --loop-length 2.5 --shear 5", "--loop-length", "no cell geometry for 2.5 mm"},
+      {"cell --loop-length 4.5 --config ''", "--config", "must not be empty"},
   };
   for (const Bad& b : bad) {
     INFO(b.args);
@@ -193,4 +199,28 @@ TEST_CASE("knit-meso cell --config reads the cell parameter file", "[unit]") {
   CHECK(log.find("bad.json: /contact/penalty") != std::string::npos);
   CHECK_FALSE(fs::exists(dir + "/c"));
   fs::remove_all(dir);
+}
+
+// Session 24: a path that stops early said so on stdout only; stderr was empty (exit 1).
+TEST_CASE("knit-meso path: a step that does not converge is reported on stderr", "[unit]") {
+  const std::string out = std::string(KNIT_BINARY_DIR) + "/test_cell_cmd_diverges";
+  fs::remove_all(out);
+  const std::string err = out + "_stderr.txt";
+  // A stick penalty of 1e308 MPa: the first step converges, the second diverges.
+  const std::string cmd = "timeout 60 " + std::string(KNIT_BIN_DIR) +
+                          "/knit-meso path --loop-length 5 --biaxial 0.05 0.05 --steps 2 "
+                          "--no-vtp --stick 1e308 --out " +
+                          out + " > /dev/null 2> " + err;
+  const int rc = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(rc));
+  CHECK(WEXITSTATUS(rc) == 1);
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  INFO(ss.str());
+  CHECK(ss.str().find("knit-meso path: step 2 did not converge") != std::string::npos);
+  CHECK(ss.str().find("kept in " + out) != std::string::npos);
+  CHECK(fs::exists(fs::path(out) / "path.csv"));  // the converged step is kept
+  fs::remove_all(out);
+  fs::remove(err);
 }

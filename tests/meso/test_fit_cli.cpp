@@ -115,3 +115,31 @@ TEST_CASE("knit-meso synth: loop lengths whose stresses are not finite are refus
   CHECK(run("synth --no-fit --no-coverage --loop-lengths 1e-300,4.5 --out " + db.string()) == 2);
   CHECK(!fs::exists(db));
 }
+
+// Session 24 (fuzzing the command lines): `-o ""` was taken as "no --out", so the fit replaced
+// the input database; options files were read with an ifstream (/dev/zero until memory ran
+// out, a FIFO for ever); --no-fit ignored the fit's options files unread, even missing ones.
+TEST_CASE("knit-meso fit and synth: empty values, devices and unused options are refused",
+          "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_empty_out.h5";
+  REQUIRE(run("synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  const auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string before = bytes(db);
+  CHECK(run("fit " + db.string() + " --law paper -o ''") == 2);
+  CHECK(bytes(db) == before);  // not refitted in place
+  CHECK(run("fit " + db.string() + " --law paper --options /dev/zero -o " +
+            (dir / "cli_zero.h5").string()) == 2);
+  CHECK_FALSE(fs::exists(dir / "cli_zero.h5"));
+  CHECK(bytes(db) == before);
+  const fs::path out = dir / "cli_no_fit.h5";
+  fs::remove(out);
+  CHECK(run("synth --no-fit --fit-options " + (dir / "missing.json").string() + " --out " +
+            out.string()) == 2);
+  CHECK(run("synth --no-fit --energy-options " + (dir / "missing.json").string() + " --out " +
+            out.string()) == 2);
+  CHECK_FALSE(fs::exists(out));
+}

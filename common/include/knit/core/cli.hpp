@@ -41,6 +41,8 @@ CLI::Validator number(double lo, double hi, Ends ends = Ends::kClosed);
 
 /// A validator for an integer option: an integer within [lo, hi].
 CLI::Validator integer(long long lo, long long hi);
+/// Refuses an empty value; run_main puts it on every option that takes a value.
+CLI::Validator non_empty();
 
 /// The text "[lo, hi]" / "(lo, hi]" / "> lo" ... of a range, for messages and help.
 std::string describe_range(double lo, double hi, Ends ends);

@@ -17,7 +17,8 @@ void print_fit_summaries(std::ostream& os, const material::Database& db,
 /// only (the coverage and held-out paths are the energy law's), and stores it in db.
 std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& options);
 
-/// The whole file as text; throws knit::InputError if it cannot be opened.
+/// The whole file as text (knit::io::read_input_file: a regular file of at most 64 MiB); throws
+/// knit::InputError if it cannot be read.
 std::string read_text_file(const std::string& file);
 
 }  // namespace knit::meso::fit
