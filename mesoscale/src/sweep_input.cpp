@@ -3,11 +3,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/meso/sweep/input.hpp"
 
@@ -16,14 +15,6 @@ namespace knit::meso::sweep {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "", "cannot read file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// Appends generated or explicit paths (not in the shared default set: path id -1).
 void append(SweepInput& in, const std::vector<material::LoadPath>& paths) {
@@ -264,7 +255,9 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
 }
 
 SweepInput load_sweep_input(const std::filesystem::path& file) {
-  return parse_sweep_input(read_text(file), file.string());
+  // The defensive reader of every input (session 24: an ifstream here read /dev/zero until
+  // memory ran out and waited on a FIFO for ever).
+  return parse_sweep_input(knit::io::read_input_file(file), file.string());
 }
 
 }  // namespace knit::meso::sweep

@@ -126,6 +126,8 @@ TEST_CASE("sweep input: the default, dense, wale-compressed-rays and reduced cas
     CHECK((p.H - octant[k]).cwiseAbs().maxCoeff() < 1e-11);
   }
   const auto r = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/reduced.json");
+  // Session 24: the sweep input was read with an ifstream, /dev/zero until memory ran out.
+  CHECK_THROWS_WITH(load_sweep_input("/dev/zero"), Catch::Contains("not a regular file"));
   CHECK(r.loop_lengths.size() == 1);
   CHECK(r.path_ids == std::vector<int>{0, 4, 7, 11, 12, -1, -1, -1, -1});
   CHECK(r.paths[4].kind == knit::material::PathKind::kShear);
