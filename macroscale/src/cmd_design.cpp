@@ -118,19 +118,11 @@ knit::cli::SubcommandRegistrar reg(
         for (const auto& h : r.history)
           std::cout << "iteration " << h.iteration << ": J = " << h.J << "\n";
         std::cout << sum.str() << "wrote " << dir.string() << "\n";
-        if (r.status == DesignStatus::kIterationLimit || r.status == DesignStatus::kFailed) {
-          std::cerr << "knit-macro design: " << o->file << ": " << to_string(r.status)
-                    << (r.message.empty() ? "" : ": " + r.message) << "\n";
-          return knit::kExitFailure;
-        }
-        // The design's result is its final run: one that stopped, whose material failed or whose
-        // outputs are not finite is no result (before: exit 0 with the reason in summary.txt).
-        if (!run.succeeded()) {
-          std::cerr << "knit-macro design: " << o->file << ": the final run of the design did not "
-                    << "succeed: " << run_failure << "; outputs in " << dir.string() << "\n";
-          return knit::kExitFailure;
-        }
-        return knit::kExitOk;
+        const auto verdict = knit::macro::design_verdict(r, run);
+        if (verdict.exit_code != knit::kExitOk)
+          std::cerr << "knit-macro design: " << o->file << ": " << verdict.reason << "; outputs in "
+                    << dir.string() << "\n";
+        return verdict.exit_code;
       };
     });
 

@@ -4,9 +4,20 @@
 #include <chrono>
 #include <cmath>
 
+#include "knit/core/errors.hpp"
 #include "knit/macro/design_problem.hpp"
+#include "knit/macro/run.hpp"
 
 namespace knit::macro {
+
+DesignVerdict design_verdict(const DesignResult& r, const RunResult& final_run) {
+  if (r.status == DesignStatus::kIterationLimit || r.status == DesignStatus::kFailed)
+    return {kExitFailure, to_string(r.status) + (r.message.empty() ? "" : ": " + r.message)};
+  if (!final_run.succeeded())
+    return {kExitFailure,
+            "the final run of the design did not succeed: " + run_failure_message(final_run)};
+  return {kExitOk, {}};
+}
 
 std::string to_string(DesignStatus s) {
   switch (s) {

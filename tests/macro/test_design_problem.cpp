@@ -9,6 +9,7 @@
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/design_problem.hpp"
+#include "knit/macro/run.hpp"
 #include "knit_test_database.hpp"
 
 using namespace knit::macro;
@@ -222,4 +223,42 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
     CHECK(l.history.size() < r.history.size());
     CHECK(l.history.back().J <= l.history.front().J);
   }
+}
+
+// Session 23 made a final run that is not a plain success end `knit-macro design` with exit 1;
+// session 24 moved that decision out of the command so that it is tested.
+TEST_CASE("design: the exit code is the optimizer's status and the final run's", "[unit]") {
+  DesignResult r;
+  RunResult run;
+  run.report.status = RunStatus::kCompleted;
+  for (DesignStatus s : {DesignStatus::kConverged, DesignStatus::kInfeasible}) {
+    r.status = s;
+    const DesignVerdict v = design_verdict(r, run);
+    CHECK(v.exit_code == knit::kExitOk);
+    CHECK(v.reason.empty());
+  }
+  r.status = DesignStatus::kConverged;
+  run.output_failure = "output field n12 is not finite at step 20";
+  DesignVerdict v = design_verdict(r, run);
+  CHECK(v.exit_code == knit::kExitFailure);
+  CHECK(v.reason == "the final run of the design did not succeed: " + run.output_failure);
+  run.output_failure.clear();
+  run.failed_material_evaluations = 3;
+  CHECK(design_verdict(r, run).exit_code == knit::kExitFailure);
+  run.failed_material_evaluations = 0;
+  run.report.status = RunStatus::kNotConverged;
+  run.report.message = "step 7 did not converge";
+  r.status = DesignStatus::kInfeasible;
+  v = design_verdict(r, run);
+  CHECK(v.exit_code == knit::kExitFailure);
+  CHECK(v.reason.find("step 7 did not converge") != std::string::npos);
+  run.report.status = RunStatus::kCompleted;
+  r.status = DesignStatus::kIterationLimit;
+  r.message = "30 iterations";
+  v = design_verdict(r, run);
+  CHECK(v.exit_code == knit::kExitFailure);
+  CHECK(v.reason == "iteration limit: 30 iterations");
+  r.status = DesignStatus::kFailed;
+  r.message.clear();
+  CHECK(design_verdict(r, run).reason == "failed");
 }

@@ -152,6 +152,18 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
 void classify_result(const DesignProblem& d, const OptimizeOptions& options, bool converged,
                      DesignResult& r);
 
+struct RunResult;  // knit/macro/run.hpp
+/// What `knit-macro design` ends with, once its outputs are written: exit code 0 and no reason
+/// for a converged design or an infeasible target whose final run (the best design, run to the
+/// case's full load) is a plain success; 1 and the reason for an iteration limit or a failed
+/// optimization, and for a final run that stopped, whose material failed or whose outputs are
+/// not finite (the design's result is its final run; session 23, before: exit 0).
+struct DesignVerdict {
+  int exit_code = 0;
+  std::string reason;  ///< empty for exit code 0
+};
+DesignVerdict design_verdict(const DesignResult& r, const RunResult& final_run);
+
 }  // namespace knit::macro
 
 namespace knit::macro {
