@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/input_file.hpp"
@@ -38,10 +39,21 @@ material::StrainBox read_box(const nlohmann::json& lp, const std::string& file) 
     b.E22_max = j.at("E22").at(1).get<double>();
   }
   b.E12_max = j.value("E12_max", b.E12_max);
-  if (!(b.E11_min < 0 && b.E11_max > 0))
-    throw InputError(file, "/load_paths/box/E11", "must be [min < 0, max > 0]");
-  if (!(b.E22_min < 0 && b.E22_max > 0))
-    throw InputError(file, "/load_paths/box/E22", "must be [min < 0, max > 0]");
+  // Each side at least kMinBoxExtent from 0 (session 23's note: a box of 1e-300 ran, its
+  // coverage paths all at zero strain and the law fitted on the paper's paths alone).
+  const double m = material::StrainBox::kMinExtent;
+  std::ostringstream range;
+  range << "must be [min <= -" << m << ", max >= " << m << "] (the box spans the strains the "
+        << "cases visit; docs/unit-cell.md, \"Strain box\")";
+  if (!(b.E11_min <= -m && b.E11_max >= m))
+    throw InputError(file, "/load_paths/box/E11", range.str());
+  if (!(b.E22_min <= -m && b.E22_max >= m))
+    throw InputError(file, "/load_paths/box/E22", range.str());
+  if (!(b.E12_max >= m)) {
+    std::ostringstream e12;
+    e12 << "must be >= " << m;
+    throw InputError(file, "/load_paths/box/E12_max", e12.str());
+  }
   return b;
 }
 

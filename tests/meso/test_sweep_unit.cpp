@@ -168,6 +168,16 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
         "/cell/contact/mu");
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "cell": 3})") == "/cell");
   CHECK(pointer_of(R"({"steps": 4})") == "");  // required loop_lengths: the document itself
+  // Session 24: a box of 1e-300 ran, its coverage paths all at zero strain.
+  auto box = [](const std::string& b) {
+    return R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", "box": )" + b +
+           R"(, "coverage": true}})";
+  };
+  CHECK(pointer_of(box(R"({"E11": [-1e-300, 1e-300]})")) == "/load_paths/box/E11");
+  CHECK(pointer_of(box(R"({"E22": [-0.3, 0.0009]})")) == "/load_paths/box/E22");
+  CHECK(pointer_of(box(R"({"E12_max": 1e-300})")) == "/load_paths/box/E12_max");
+  CHECK(pointer_of(box(R"({"E11": [-0.001, 0.001], "E22": [-0.001, 0.001], "E12_max": 0.001})")) ==
+        "<no error>");
 }
 
 TEST_CASE("sweep input: cell parameters inline or from a file relative to the sweep file",

@@ -48,6 +48,9 @@ struct StrainBox {
   double E11_min = -0.35, E11_max = 0.45;
   double E22_min = -0.30, E22_max = 0.55;
   double E12_max = 0.40;  ///< |E12| <= E12_max
+  /// Smallest extent of each side from 0 that a sweep input may give (0.1 % strain): below it
+  /// the coverage paths carry stresses at the level of the cell's round-off.
+  static constexpr double kMinExtent = 1e-3;
   bool contains(double E11, double E22, double E12) const;
 };
 
