@@ -5,11 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 
+#include "knit/core/errors.hpp"
 #include "knit/spline/refine.hpp"
 
 namespace knit::macro {
@@ -66,9 +68,19 @@ MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
 
 std::uint64_t memory_limit_bytes() {
   if (const char* env = std::getenv("KNIT_MAX_MEMORY_MB")) {
+    // A value that is set but not understood is an error, not the machine's memory in silence
+    // (session 24: "4G", "-1" and "1e308" were ignored; above 2^44 MiB the shift wrapped).
+    constexpr unsigned long long kMaxMb = 1ull << 40;
+    const std::string text(env);
+    errno = 0;
     char* end = nullptr;
     const unsigned long long mb = std::strtoull(env, &end, 10);
-    if (end != env && *end == '\0' && mb > 0) return static_cast<std::uint64_t>(mb) << 20;
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || *end != '\0' ||
+        errno == ERANGE || mb < 1 || mb > kMaxMb)
+      throw InputError("KNIT_MAX_MEMORY_MB", "",
+                       "the environment variable must be a whole number of MiB in [1, " +
+                           std::to_string(kMaxMb) + "], got \"" + text + "\"");
+    return static_cast<std::uint64_t>(mb) << 20;
   }
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
   if (pages <= 0 || page <= 0) return ~std::uint64_t{0};

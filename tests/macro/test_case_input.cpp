@@ -675,6 +675,17 @@ TEST_CASE("a refinement that cannot fit in memory is refused at load with the es
   CHECK_THAT(e, Catch::StartsWith("bad.json: /refinement: 271 x 271 control points of degree "
                                   "(15, 15) need about ") &&
                     Catch::Contains("quadrature data") && Catch::Contains("KNIT_MAX_MEMORY_MB"));
+  // Session 24: a KNIT_MAX_MEMORY_MB that is not a whole number of MiB was ignored in silence.
+  for (const char* bad : {"4G", "-1", "0", "1e308", "", "99999999999999999999"}) {
+    INFO("KNIT_MAX_MEMORY_MB=" << bad);
+    ::setenv("KNIT_MAX_MEMORY_MB", bad, 1);
+    CHECK_THROWS_WITH(memory_limit_bytes(), Catch::StartsWith("KNIT_MAX_MEMORY_MB: the "
+                                                              "environment variable must be"));
+  }
+  ::setenv("KNIT_MAX_MEMORY_MB", "4096", 1);
+  CHECK(memory_limit_bytes() == (4096ull << 20));
+  ::unsetenv("KNIT_MAX_MEMORY_MB");
+  CHECK(memory_limit_bytes() > 0);
   // The estimate itself: 1 element of degree 5 is small; 16 x 16 of degree 15 is not.
   const Case small = parse_case(read_json("tensile_svk.json").dump(), "t.json");
   CHECK(estimate_shell_memory(small.surface).total() < (64ull << 20));

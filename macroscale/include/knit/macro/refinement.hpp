@@ -33,8 +33,9 @@ struct MemoryEstimate {
 std::string format_bytes(std::uint64_t bytes);
 MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s);
 
-/// The memory a run may use: KNIT_MAX_MEMORY_MB from the environment if set (a positive
-/// integer), else the machine's physical memory.
+/// The memory a run may use: KNIT_MAX_MEMORY_MB from the environment if set (a whole number of
+/// MiB in [1, 2^40]; anything else throws knit::InputError naming the variable), else the
+/// machine's physical memory.
 std::uint64_t memory_limit_bytes();
 
 }  // namespace knit::macro
