@@ -76,10 +76,10 @@ TEST_CASE("the unrolled cubic and quartic kernels equal the general one bit for 
 }
 
 TEST_CASE("a quadratic NURBS quarter circle is exact", "[unit][spline]") {
-  Eigen::MatrixXd P(3, 2);
-  P << 1, 0, 1, 1, 0, 1;
-  Eigen::VectorXd w(3);
-  w << 1, std::sqrt(0.5), 1;
+  // Initializer lists, not the comma initializer: with that, GCC 12 -O2 warned
+  // -Wmaybe-uninitialized inside Eigen's DenseStorage here (a false positive).
+  const Eigen::MatrixXd P{{1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}};
+  const Eigen::VectorXd w{{1.0, std::sqrt(0.5), 1.0}};
   SplineCurve c(BSplineBasis(2, {0, 0, 0, 1, 1, 1}), P, w);
   for (int i = 0; i <= 100; ++i) {
     const Eigen::MatrixXd d = c.derivatives(i / 100.0, 2);
