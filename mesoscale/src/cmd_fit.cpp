@@ -42,7 +42,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
       sub.add_option("--threads", o->threads,
                      "threads of the energy-law fit (default 0: all cores, at most one per loop "
                      "length; the law is the same for every count)")
-          ->check(CLI::Range(0, 4096));
+          ->check(knit::cli::integer(0, 4096));  // as sweep's: CLI::Range took 0x10 and 1e3
       return [o]() -> int {
         using namespace knit::meso::fit;
         const std::string target = o->out.empty() ? o->db : o->out;

@@ -130,6 +130,9 @@ TEST_CASE("knit-meso fit and synth: empty values, devices and unused options are
   };
   const std::string before = bytes(db);
   CHECK(run("fit " + db.string() + " --law paper -o ''") == 2);
+  // --threads as the sweep's (knit::cli::integer): CLI::Range read 0x10 as 16 threads.
+  for (const char* threads : {"0x10", "1e3", "-1", "4097"})
+    CHECK(run("fit " + db.string() + " --law paper --threads " + threads) == 2);
   CHECK(bytes(db) == before);  // not refitted in place
   CHECK(run("fit " + db.string() + " --law paper --options /dev/zero -o " +
             (dir / "cli_zero.h5").string()) == 2);
