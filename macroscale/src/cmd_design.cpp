@@ -21,6 +21,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/run.hpp"
 
@@ -58,6 +59,12 @@ knit::cli::SubcommandRegistrar reg(
           std::cout << "objective " << ob.name << ": weight " << ob.weight << ", "
                     << ob.at_strain.size() << " applied strain(s)\n";
         std::cout << "smoothness weight: " << d.smoothness << "\n";
+        const std::filesystem::path dir = o->output.empty() ? std::filesystem::path(o->file).stem()
+                                                            : std::filesystem::path(o->output);
+        // The output target is checked before the optimization, and by --check (session 24:
+        // it was checked only when the results were written, after minutes of optimizing).
+        knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
+                                      o->output.empty() ? "output directory" : "--output");
         if (o->check) return knit::kExitOk;
         const auto r = knit::macro::optimize_design(d);
         using knit::macro::DesignStatus;
@@ -66,8 +73,6 @@ knit::cli::SubcommandRegistrar reg(
           std::cout << "status: failed\n";
           return knit::kExitFailure;
         }
-        const std::filesystem::path dir = o->output.empty() ? std::filesystem::path(o->file).stem()
-                                                            : std::filesystem::path(o->output);
         knit::io::AtomicDirectory out(dir);
         std::vector<std::string> header = {"iteration", "J", "gradient_norm", "seconds"};
         for (std::size_t k = 0; k < d.variables.size(); ++k)

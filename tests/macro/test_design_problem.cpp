@@ -87,6 +87,30 @@ TEST_CASE("design file: a valid file loads", "[unit]") {
   CHECK(run_design(kDir / "ok.json") == 0);
 }
 
+// Session 24: the output target was checked only when the results were written, after the
+// whole optimization; now before it, and by --check.
+TEST_CASE("design: an output directory that is not ours is refused before any work", "[unit]") {
+  write_case();
+  write(kDir / "ok.json", design(kVars, kObjs));
+  const fs::path user = kDir / "user_dir";
+  write(user / "notes.txt", "not a knitscale output");
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
+                          (kDir / "ok.json").string() + " -o " + user.string() + " > " +
+                          (kDir / "out_target.log").string() + " 2>&1";
+  for (const std::string check : {" --check", ""}) {
+    INFO("knit-macro design" << check);
+    const std::string line = cmd.substr(0, cmd.find(" -o ")) + check + cmd.substr(cmd.find(" -o "));
+    const int st = std::system(line.c_str());
+    CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 2));
+    std::ifstream in(kDir / "out_target.log");
+    const std::string log((std::istreambuf_iterator<char>(in)), {});
+    CHECK(log.find("not a knitscale output") != std::string::npos);
+    CHECK(log.find("iteration") == std::string::npos);  // no optimization reported
+  }
+  CHECK(fs::exists(user / "notes.txt"));
+  fs::remove_all(user);
+}
+
 TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]") {
   write_case();
   auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr) {
