@@ -73,9 +73,8 @@ std::uint64_t memory_limit_bytes() {
     constexpr unsigned long long kMaxMb = 1ull << 40;
     const std::string text(env);
     errno = 0;
-    char* end = nullptr;
-    const unsigned long long mb = std::strtoull(env, &end, 10);
-    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || *end != '\0' ||
+    const unsigned long long mb = std::strtoull(env, nullptr, 10);
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
         errno == ERANGE || mb < 1 || mb > kMaxMb)
       throw InputError("KNIT_MAX_MEMORY_MB", "",
                        "the environment variable must be a whole number of MiB in [1, " +

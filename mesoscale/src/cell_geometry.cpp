@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -108,8 +109,8 @@ double solve_h(double l, double h0, double rtol, Build&& build, int* iters) {
   // Written so that a NaN residual (a yarn diameter of 1e308 mm overflows the shape) fails too:
   // before, it passed this test and the cell was written with a measured length of NaN, exit 0.
   if (!(std::abs(L2) <= 1e3 * rtol * l))
-    throw std::runtime_error("cell geometry: could not match the loop length (residual " +
-                             std::to_string(L2) + " mm); is the loop too short for w and d?");
+    throw GeometryError("cell geometry: could not match the loop length (residual " +
+                        std::to_string(L2) + " mm); is the loop too short for w and d?");
   if (iters) *iters = it;
   return h2;
 }
@@ -286,6 +287,13 @@ Clearance minimum_clearance(const LoopShape& sh, double c) {
   }
   best.clearance = best.min_distance - sh.d;
   return best;
+}
+
+std::string loop_length_message(double loop_length, double d, const GeometryError& e) {
+  std::ostringstream msg;  // (std::to_string printed 1e308 with 309 digits)
+  msg << "no cell geometry for " << loop_length << " mm with yarn diameter " << d
+      << " mm: " << e.what();
+  return msg.str();
 }
 
 }  // namespace knit::meso::cell

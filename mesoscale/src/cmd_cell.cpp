@@ -15,7 +15,6 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -66,11 +65,8 @@ int run(const Options& o) {
   const CellGeometry g = [&] {
     try {
       return make_cell_geometry(o.loop_length, go);
-    } catch (const std::runtime_error& e) {  // a loop too short for w and d
-      std::ostringstream msg;                // (std::to_string printed 1e308 with 309 digits)
-      msg << "no cell geometry for " << o.loop_length << " mm with yarn diameter " << go.d
-          << " mm: " << e.what();
-      throw knit::InputError("", "--loop-length", msg.str());
+    } catch (const GeometryError& e) {  // a loop too short for w and d
+      throw knit::InputError("", "--loop-length", loop_length_message(o.loop_length, go.d, e));
     }
   }();
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");

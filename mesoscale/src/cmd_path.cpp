@@ -22,12 +22,11 @@
 #include <memory>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
-#include <string>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
+#include "knit/meso/cell/geometry.hpp"
 #include "knit/meso/cell/output.hpp"
 #include "knit/meso/homog/cell_config.hpp"
 #include "knit/meso/homog/path.hpp"
@@ -117,12 +116,9 @@ int run(const Options& o) {
   const auto cell_ptr = [&] {
     try {
       return std::make_unique<PeriodicCell>(o.loop_length, co);
-    } catch (const std::runtime_error& e) {
-      if (std::string(e.what()).rfind("cell geometry:", 0) != 0) throw;
-      std::ostringstream msg;
-      msg << "no cell geometry for " << o.loop_length << " mm with yarn diameter " << co.section.d
-          << " mm: " << e.what();
-      throw knit::InputError("", "--loop-length", msg.str());
+    } catch (const knit::meso::cell::GeometryError& e) {
+      throw knit::InputError("", "--loop-length",
+                             knit::meso::cell::loop_length_message(o.loop_length, co.section.d, e));
     }
   }();
   PeriodicCell& cell = *cell_ptr;

@@ -18,6 +18,12 @@ int run(const std::string& args) {
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
+/// The whole file, byte for byte.
+std::string bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 /// The tests' scratch directory (created).
 fs::path scratch_dir() {
   const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
@@ -91,10 +97,6 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
     S(2, 1) = 1e308;
     f.write("/loop_1/raw/path_03/S", S);
   }
-  const auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
   const std::string before = bytes(db);
   const std::string energy = " --law energy --energy-options " + ridge.string();
   CHECK(run("fit " + db.string() + energy) == 1);
@@ -124,10 +126,6 @@ TEST_CASE("knit-meso fit and synth: empty values, devices and unused options are
   const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_empty_out.h5";
   REQUIRE(run("synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
-  const auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
   const std::string before = bytes(db);
   CHECK(run("fit " + db.string() + " --law paper -o ''") == 2);
   // --threads as the sweep's (knit::cli::integer): CLI::Range read 0x10 as 16 threads.

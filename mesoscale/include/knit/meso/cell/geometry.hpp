@@ -24,6 +24,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "knit/spline/curve.hpp"
@@ -72,8 +74,20 @@ struct CellGeometry {
   int h_iterations = 0;
 };
 
-/// Builds the cell for loop length l. Throws std::invalid_argument on bad options.
+/// The loop-length match failed: the loop is too short for w and d, or an absurd diameter
+/// made the residual NaN. The commands turn it into an input error (loop_length_message).
+class GeometryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Builds the cell for loop length l. Throws std::invalid_argument on bad options and
+/// GeometryError when no loop of that length exists.
 CellGeometry make_cell_geometry(double loop_length, const GeometryOptions& opt = {});
+
+/// "no cell geometry for 2.5 mm with yarn diameter 0.38 mm: <why>": the message of the
+/// --loop-length error of `knit-meso cell` and `knit-meso path`.
+std::string loop_length_message(double loop_length, double d, const GeometryError& e);
 
 /// Arc length of a spline curve (Gauss-Legendre, `npts` points per knot span).
 double spline_length(const spline::SplineCurve& curve, int npts = 12);
