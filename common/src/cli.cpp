@@ -113,24 +113,33 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
     for (CLI::Option* opt : sub->get_options())
       if (opt->get_type_size_max() != 0) opt->check(non_empty());
   }
+  // Every message names the program it comes from (session 25: a bad option printed CLI11's
+  // bare "The following argument was not expected: --force", and an input error "error: ...":
+  // in a pipeline's log or under make -j the lines of several programs interleave).
+  // "knit-meso fit" when the subcommand was reached, else "knit-meso".
+  const auto who = [&] {
+    for (const auto& s : subs)
+      if (s.first->parsed()) return program + " " + s.first->get_name();
+    return program;
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    std::cerr << who() << ": " << CLI::FailureMessage::simple(&app, e);
     return kExitBadInput;
   }
   try {
     for (auto& [sub, run] : subs)
       if (sub->parsed()) return run();
   } catch (const InputError& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << who() << ": error: " << e.what() << "\n";
     return kExitBadInput;
   } catch (const std::exception& e) {
     // An output directory abandoned by the failure is named as itself, not as its partial
     // directory (gone by now), with what became of it (knit/io/atomic.hpp).
-    std::cerr << "error: " << io::explain_unwritten_outputs(e.what()) << "\n";
+    std::cerr << who() << ": error: " << io::explain_unwritten_outputs(e.what()) << "\n";
     return kExitFailure;
   }
   return kExitFailure;

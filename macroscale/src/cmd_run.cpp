@@ -47,8 +47,9 @@ knit::cli::SubcommandRegistrar reg(
         ro.warnings = &std::cerr;
         const auto r = knit::macro::run_case(c, ro);
         if (!r.succeeded()) {
-          std::cerr << "knit-macro: " << o->case_file << ": " << knit::macro::run_failure_message(r)
-                    << "; outputs in " << ro.output_dir.string() << "\n";
+          std::cerr << "knit-macro run: " << o->case_file << ": "
+                    << knit::macro::run_failure_message(r) << "; outputs in "
+                    << ro.output_dir.string() << "\n";
           return knit::kExitFailure;
         }
         std::cout << "wrote " << ro.output_dir.string() << "\n";

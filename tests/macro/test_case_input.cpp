@@ -304,6 +304,28 @@ TEST_CASE("knit-macro run: an empty option value and a size below one byte are r
   fs::remove_all(d);
 }
 
+// Session 25: CLI11's messages ("The following argument was not expected: --force") and ours
+// ("error: ...") did not say which program wrote them; in a pipeline's log several interleave.
+TEST_CASE("knit-macro: every error line starts with the program and its subcommand", "[unit]") {
+  const fs::path d = temp_dir("who");
+  std::ofstream(d / "strip.json") << strip_case(0.1).dump(2);
+  const auto first_line = [&](const std::string& cmd) {
+    const int st = std::system((std::string(KNIT_BIN_DIR) + "/knit-macro" + cmd + " > " +
+                                (d / "log.txt").string() + " 2>&1")
+                                   .c_str());
+    CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 2));
+    const std::string log = slurp(d / "log.txt");
+    return log.substr(0, log.find('\n'));
+  };
+  // A parse error of the subcommand, one of the program, and an input error of the run.
+  CHECK(first_line(" run " + (d / "strip.json").string() + " --no-such-flag") ==
+        "knit-macro run: The following argument was not expected: --no-such-flag");
+  CHECK(first_line("") == "knit-macro: A subcommand is required");
+  CHECK(first_line(" run " + (d / "missing.json").string()) ==
+        "knit-macro run: error: " + (d / "missing.json").string() + ": file not found");
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged steps", "[unit]") {
   // A St. Venant-Kirchhoff strip under a compressive dead load: the axial force per unit width
   // and thickness cannot exceed E / (3 sqrt 3) = 0.19245 E (stretch 1/sqrt 3), so with

@@ -207,7 +207,7 @@ TEST_CASE(
         1);
   const std::string text = knit_test::read_text(err);
   INFO(text);
-  CHECK(text.rfind("error: " + db.string() +
+  CHECK(text.rfind("knit-meso sweep: error: " + db.string() +
                        ": database not written (the earlier file is left as it was): ",
                    0) == 0);
   CHECK(text.find(".tmp-") == std::string::npos);  // the temporary, gone, is not named
