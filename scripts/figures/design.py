@@ -104,13 +104,17 @@ def main():
         ax.set_xlabel("theta1 (u)")
         ax.set_ylabel("theta2 (v)")
         ax.set_title(f"designed {name}")
-        if C.shape[1] > 1:  # the profile along u at mid-height, on the same axes' scale
+        if C.shape[1] > 1:  # the profile along u at mid-height, in an inset with its own axis
+            # (until session 25 it was drawn over the map in the map's coordinates, where it
+            # read as a line of the domain at theta2 ~ 0.2)
             prof = F[F.shape[0] // 2]
-            lo, hi = prof.min(), prof.max()
-            flo, fhi = F.min(), F.max()  # scaled like the colours (a constant profile is flat)
-            span = fhi - flo if fhi - flo > 1e-9 * max(1.0, abs(fhi)) else np.inf
-            ax.plot(u, 0.05 + 0.3 * (prof - flo) / span, "w-", lw=1.5)
-            ax.text(0.02, 0.37, f"profile at v = 0.5: {lo:.3g}..{hi:.3g}", color="w", fontsize=7)
+            ins = ax.inset_axes([0.08, 0.06, 0.5, 0.28])
+            ins.plot(u, prof, "k-", lw=1.2)
+            ins.set_facecolor((1, 1, 1, 0.85))
+            ins.set_title(f"along v = 0.5: {prof.min():.3g} ... {prof.max():.3g} {unit}",
+                          fontsize=6, pad=2)
+            ins.tick_params(labelsize=5, pad=1, length=2)
+            ins.margins(x=0)
     k = 1 + len(fields)
     if curve is not None:
         ax = axes[0][k]
@@ -130,7 +134,7 @@ def main():
         ax.plot(u, E, "-")
         ax.set_xlabel("theta1 (u) at v = 0.5")
         ax.set_ylabel(a.section)
-        ax.set_title(f"final run: {a.section} along the section (std {np.std(E):.2g})")
+        ax.set_title(f"final run: {a.section} along the section\n(std {np.std(E):.2g})", fontsize=10)
         ax.grid(True, alpha=0.3)
     if a.title:
         fig.suptitle(a.title)
