@@ -27,10 +27,23 @@ namespace {
 
 /// "cannot write dataset" plus the system's reason when the write set errno (HDF5's file
 /// driver writes with write(2)): a full file system said only "cannot write dataset" before
-/// session 22, now "... (No space left on device)". Callers clear errno before the write.
+/// session 22, now "... (No space left on device)". Callers clear errno before the write (since
+/// session 25 also before creating an attribute, which can make the file grow).
 std::string write_failure(const std::string& what) {
   const int e = errno;
   return e != 0 ? what + " (" + std::strerror(e) + ")" : what;
+}
+
+/// A failed create: the system's reason when HDF5 left one in errno (a file that could not
+/// grow: "File too large" under a size limit, "No space left on device"), else the likely
+/// causes. Session 25: every create failure guessed "(file opened read-only?)", also when
+/// `ulimit -f` had stopped the file from growing.
+std::string create_failure(const std::string& what) {
+  const int e = errno;
+  return e != 0 ? what + " (" + std::strerror(e) + ")"
+                : what +
+                      " (the file is read-only, or could not grow: disk full or a file size "
+                      "limit?)";
 }
 
 // ---- library shutdown ------------------------------------------------------------------------
@@ -370,8 +383,9 @@ H5Group H5Group::create_group(const std::string& path) {
     return open_group(path);
   }
   H5Handle lcpl = intermediate_lcpl();
+  errno = 0;
   H5Handle g(H5Gcreate2(id_.get(), h5name(path).c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT));
-  if (!g.valid()) fail(path, "cannot create group (file opened read-only?)");
+  if (!g.valid()) fail(path, create_failure("cannot create group"));
   return H5Group(std::move(g), file_, full(path));
 }
 
@@ -449,9 +463,10 @@ static void write_numeric(hid_t loc, const std::string& name, std::span<const T>
   }
   if (H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(loc, name.c_str(), H5P_DEFAULT);
   H5Handle lcpl = intermediate_lcpl();
+  errno = 0;
   H5Handle ds(H5Dcreate2(loc, name.c_str(), native_type<T>(), space.get(), lcpl.get(), dcpl.get(),
                          H5P_DEFAULT));
-  if (!ds.valid()) fail("cannot create dataset (file opened read-only?)");
+  if (!ds.valid()) fail(create_failure("cannot create dataset"));
   if (data.empty()) return;
   errno = 0;
   if (H5Dwrite(ds.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
@@ -482,9 +497,10 @@ void H5Group::write_strings(const std::string& path, const std::vector<std::stri
   if (H5Lexists(id_.get(), name.c_str(), H5P_DEFAULT) > 0)
     H5Ldelete(id_.get(), name.c_str(), H5P_DEFAULT);
   H5Handle lcpl = intermediate_lcpl();
+  errno = 0;
   H5Handle ds(H5Dcreate2(id_.get(), name.c_str(), type.get(), space.get(), lcpl.get(), H5P_DEFAULT,
                          H5P_DEFAULT));
-  if (!ds.valid()) fail(path, "cannot create dataset (file opened read-only?)");
+  if (!ds.valid()) fail(path, create_failure("cannot create dataset"));
   if (v.empty()) return;
   std::vector<const char*> ptrs;
   ptrs.reserve(v.size());
@@ -644,11 +660,14 @@ void H5Group::set_attribute(const std::string& obj_path, const std::string& name
   drop_attribute(id_.get(), obj, name);
   H5Handle type = utf8_vlen_string_type();
   H5Handle space(H5Screate(H5S_SCALAR));
+  errno = 0;
   H5Handle a(H5Acreate_by_name(id_.get(), obj.c_str(), name.c_str(), type.get(), space.get(),
                                H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!a.valid()) fail(obj_path, "cannot create attribute " + name);
+  if (!a.valid()) fail(obj_path, write_failure("cannot create attribute " + name));
   const char* p = value.c_str();
-  if (H5Awrite(a.get(), type.get(), &p) < 0) fail(obj_path, "cannot write attribute " + name);
+  errno = 0;
+  if (H5Awrite(a.get(), type.get(), &p) < 0)
+    fail(obj_path, write_failure("cannot write attribute " + name));
 }
 
 template <class T>
@@ -657,11 +676,13 @@ static void set_numeric_attribute(hid_t loc, const std::string& obj, const std::
   drop_attribute(loc, obj, name);
   const hsize_t dim = n;
   H5Handle space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &dim, nullptr));
+  errno = 0;
   H5Handle a(H5Acreate_by_name(loc, obj.c_str(), name.c_str(), native_type<T>(), space.get(),
                                H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!a.valid()) fail("cannot create attribute " + name);
+  if (!a.valid()) fail(write_failure("cannot create attribute " + name));
+  errno = 0;
   if (n > 0 && H5Awrite(a.get(), native_type<T>(), data) < 0)
-    fail("cannot write attribute " + name);
+    fail(write_failure("cannot write attribute " + name));
 }
 
 void H5Group::set_attribute(const std::string& obj_path, const std::string& name, double value) {

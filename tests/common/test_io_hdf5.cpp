@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <regex>
 #include <string>
 
@@ -394,6 +395,49 @@ TEST_CASE("HDF5: disk full while flushing gives a clean error and a clean exit",
   CHECK(WIFEXITED(status));
   CHECK((WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status)) == 3);
   CHECK_FALSE(fs::exists(file));
+}
+
+TEST_CASE("HDF5: a create that meets a file size limit names the system's reason",
+          "[unit][io][hdf5]") {
+  // Session 25: HDF5 makes room in its metadata cache by writing, so a create can be what
+  // meets a full disk or `ulimit -f`; every create failure said "(file opened read-only?)",
+  // a wrong guess without the system's reason. No raw data is written (groups, then empty
+  // datasets), so what meets the limit is a create.
+  for (const bool datasets : {false, true}) {
+    const fs::path file = scratch("grow.h5"), msg = scratch("grow.txt");
+    const pid_t pid = fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+      std::signal(SIGXFSZ, SIG_IGN);
+      std::ofstream out(msg);  // opened before the limit
+      rlimit r{64 * 1024, 64 * 1024};
+      setrlimit(RLIMIT_FSIZE, &r);
+      std::string what = "no error";
+      try {
+        auto f = knit::io::H5File::create(file);
+        for (int k = 0; k < 20000; ++k) {
+          const std::string g = "/g" + std::to_string(k);
+          if (datasets)
+            f.write(g + "/d", std::vector<double>{});
+          else
+            f.create_group(g);
+        }
+      } catch (const std::runtime_error& e) {
+        what = e.what();
+      }
+      out << what << std::flush;
+      std::_Exit(0);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    REQUIRE(WIFEXITED(status));
+    std::ifstream in(msg);
+    const std::string what((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    INFO(what);
+    CHECK(what.find(datasets ? ": cannot create dataset" : ": cannot create group") !=
+          std::string::npos);
+    CHECK(what.find("(File too large)") != std::string::npos);
+  }
 }
 
 TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",
