@@ -386,7 +386,10 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    throw InputError(fname, where == "/" ? "" : where, strip_file(e.what(), fname));
+    // The HDF5 layer names its own object ("FILE: /loop_0: attribute wale_width missing"):
+    // that path is kept, not prefixed with `where` again (session 25: "/loop_0: /loop_0: ...").
+    const std::string why = strip_file(e.what(), fname);
+    throw InputError(fname, where == "/" || why.rfind('/', 0) == 0 ? "" : where, why);
   }
 }
 

@@ -256,7 +256,8 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
   } catch (const std::exception& e) {
     std::string m = e.what();
     if (m.rfind(file + ": ", 0) == 0) m = m.substr(file.size() + 2);
-    throw InputError(file, where, m);
+    // The HDF5 layer names its own object: keep its path, not `where` again (session 25).
+    throw InputError(file, m.rfind('/', 0) == 0 ? "" : where, m);
   }
 }
 

@@ -207,6 +207,13 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     }
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("/loop_1/fit/shear: group missing"));
   }
+  SECTION("missing attribute: its object's path once") {
+    // Session 25: "bad.h5: /loop_0: /loop_0: attribute wale_width missing".
+    const auto bad = tmp("noattr.h5");
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    knit::io::H5File::open_rw(bad).remove_attribute("/loop_0", "wale_width");
+    CHECK_THROWS_WITH(read_database(bad), bad.string() + ": /loop_0: attribute wale_width missing");
+  }
   SECTION("bad surface data") {
     const auto bad = tmp("badsurf.h5");
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);

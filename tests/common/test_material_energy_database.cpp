@@ -164,6 +164,12 @@ TEST_CASE("database v2: bad /energy_law content is refused with its HDF5 path", 
     CHECK_THROWS_WITH(read_database(bad),
                       Catch::Contains("energy_bad.h5: /energy_law/s_range: dataset missing"));
   }
+  SECTION("missing attribute: its object's path once") {
+    // Session 25: "energy_bad.h5: /energy_law: /energy_law: attribute floor missing".
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    knit::io::H5File::open_rw(bad).remove_attribute("/energy_law", "floor");
+    CHECK_THROWS_WITH(read_database(bad), bad.string() + ": /energy_law: attribute floor missing");
+  }
   SECTION("range that does not cover the loop lengths") {
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
     {
