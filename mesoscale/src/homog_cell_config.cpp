@@ -29,17 +29,18 @@ struct Reader {
   }
   // Reads j[key] into v if present; checks lo < v (strict) or lo <= v and v <= hi.
   void num(const json& j, const std::string& ptr, const char* key, double& v, double lo, double hi,
-           bool strict_lo) const {
+           bool strict_lo, bool strict_hi = false) const {
     if (!j.contains(key)) return;
     const json& x = j[key];
     const std::string p = ptr + "/" + key;
     if (!x.is_number()) fail(p, "must be a number");
     const double d = x.get<double>();
-    if ((strict_lo ? !(d > lo) : !(d >= lo)) || !(d <= hi)) {
+    if ((strict_lo ? !(d > lo) : !(d >= lo)) || (strict_hi ? !(d < hi) : !(d <= hi))) {
       std::ostringstream m;
+      m.precision(12);  // 0.49999995 printed as 0.5 beside "<= 0.5" (session 25)
       m << "must be " << (strict_lo ? "> " : ">= ") << lo;
       if (hi < 1e299)
-        m << " and <= " << hi;
+        m << (strict_hi ? " and < " : " and <= ") << hi;
       else
         m << " and finite (below 1e300)";
       m << ", got " << d;
@@ -152,7 +153,9 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     const json& y = j["yarn"];
     R.object(y, "/yarn", {"E", "nu", "d"});
     R.num(y, "/yarn", "E", o.section.E, 0, inf, true);
-    R.num(y, "/yarn", "nu", o.section.nu, -1, 0.4999999, true);
+    // (-1, 0.5) as schemas/cell.schema.json says (the bound was 0.4999999, which refused
+    // 0.49999995 that the schema allows; session 25).
+    R.num(y, "/yarn", "nu", o.section.nu, -1, 0.5, true, true);
     R.num(y, "/yarn", "d", o.section.d, 0, inf, true);
   }
   if (j.contains("loop")) {

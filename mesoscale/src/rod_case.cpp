@@ -72,8 +72,12 @@ struct Reader {
     if (!j.is_number_integer())
       fail(ptr, "must be an integer, got " + (j.is_number() ? j.dump() : kind(j)));
     const long long v = j.get<long long>();
-    if (v < lo || v > 1000000)
-      fail(ptr, "must be an integer >= " + std::to_string(lo) + ", got " + j.dump());
+    // The upper bound is part of the message (session 25: 1000001 was refused as "must be an
+    // integer >= 1"); schemas/rod.schema.json states it too.
+    constexpr long long kMax = 1000000;
+    if (v < lo || v > kMax)
+      fail(ptr, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(kMax) +
+                    "], got " + j.dump());
     return static_cast<int>(v);
   }
   std::string string(const json& j, const std::string& ptr,

@@ -176,7 +176,10 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
 
   const nlohmann::json lp = j.value("load_paths", nlohmann::json{{"preset", "default"}});
   if (lp.is_object()) {
-    const double e_max = lp.value("e_max", 0.35), e_min = lp.value("e_min", -0.15);
+    // Absent keys take the defaults of material::default_load_paths (one place: until session
+    // 25 this read 0.35 for e_max where the header, the schema and the docs say 0.40).
+    const double e_max = lp.value("e_max", material::kDefaultFanEMax);
+    const double e_min = lp.value("e_min", material::kDefaultFanEMin);
     const double g_max = lp.value("gamma_max_deg", 40.0) * kPi / 180.0;
     if (!(e_min < e_max)) throw InputError(file, "/load_paths/e_min", "must be smaller than e_max");
     const auto all = material::default_load_paths(steps, e_max, e_min, g_max);

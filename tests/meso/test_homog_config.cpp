@@ -46,6 +46,10 @@ TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
   // 4294967300 narrowed to 4 and was accepted (issue 14): ranges are checked before narrowing.
   CHECK(pointer_of(R"({"analysis": {"elements": 4294967300}})") == "/analysis/elements");
   CHECK(pointer_of(R"({"yarn": {"nu": 0.7}})") == "/yarn/nu");
+  // The reader's bound is the schema's, nu < 0.5 (session 25: 0.49999995 was refused as
+  // "must be > -1 and <= 0.5, got 0.5").
+  CHECK(pointer_of(R"({"yarn": {"nu": 0.49999995}})") == "<no error>");
+  CHECK(pointer_of(R"({"yarn": {"nu": 0.5}})") == "/yarn/nu");
   // A residual tolerance of 1 accepted the first iterate (session 21): at most 0.01.
   CHECK(pointer_of(R"({"solver": {"tolerance": 0.5}})") == "/solver/tolerance");
   CHECK(pointer_of(R"({"solver": {"tolerance": 0.01}})") == "<no error>");

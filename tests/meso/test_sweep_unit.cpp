@@ -180,6 +180,21 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
         "<no error>");
 }
 
+// Session 25: an input without e_max ran the fan to 0.35 while the schema, the header of
+// default_load_paths and docs/database.md say 0.40.
+TEST_CASE("sweep input: the preset's fan without e_max and e_min is the documented default",
+          "[unit]") {
+  const auto in = parse_sweep_input(
+      R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", "select": [0, 6]}})",
+      "s.json");
+  const auto fan = knit::material::default_load_paths(20);
+  REQUIRE(in.paths.size() == 2);
+  CHECK(in.paths[0].target.isApprox(fan[0].target));
+  CHECK(in.paths[1].target.isApprox(fan[6].target));
+  CHECK(in.paths[0].target(0) == Approx(0.40));
+  CHECK(in.paths[0].target(1) == Approx(-0.15));
+}
+
 TEST_CASE("sweep input: cell parameters inline or from a file relative to the sweep file",
           "[unit]") {
   const auto dir = knit_test::scratch("sweep_unit_cellfile");

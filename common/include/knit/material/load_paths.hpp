@@ -128,8 +128,14 @@ double halton(int i, int base);
 /// sequences", 2018).
 Eigen::Vector3d fill_point(int i);
 
+/// The paper's fan: the largest and the smallest end strain of the biaxial paths (the sweep
+/// input's `load_paths/e_max` and `e_min` when absent).
+inline constexpr double kDefaultFanEMax = 0.40;
+inline constexpr double kDefaultFanEMin = -0.15;
+
 /// The 13 default paths (12 biaxial + 1 shear), `steps` increments each.
-std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = 0.40, double e_min = -0.15,
+std::vector<LoadPath> default_load_paths(int steps = 20, double e_max = kDefaultFanEMax,
+                                         double e_min = kDefaultFanEMin,
                                          double gamma_max = 0.6981317007977318 /*40 deg*/);
 
 /// Macroscopic deformation gradient F* (2x2) of path `path` at step fraction t in [0, 1].
