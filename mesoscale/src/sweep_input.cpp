@@ -177,7 +177,7 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
   const nlohmann::json lp = j.value("load_paths", nlohmann::json{{"preset", "default"}});
   if (lp.is_object()) {
     // Absent keys take the defaults of material::default_load_paths (one place: until session
-    // 25 this read 0.35 for e_max where the header, the schema and the docs say 0.40).
+    // 25 this read 0.35 for e_max where the header and docs/database.md say 0.40).
     const double e_max = lp.value("e_max", material::kDefaultFanEMax);
     const double e_min = lp.value("e_min", material::kDefaultFanEMin);
     const double g_max = lp.value("gamma_max_deg", 40.0) * kPi / 180.0;

@@ -180,7 +180,7 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
         "<no error>");
 }
 
-// Session 25: an input without e_max ran the fan to 0.35 while the schema, the header of
+// Session 25: an input without e_max ran the fan to 0.35 while the header of
 // default_load_paths and docs/database.md say 0.40.
 TEST_CASE("sweep input: the preset's fan without e_max and e_min is the documented default",
           "[unit]") {
