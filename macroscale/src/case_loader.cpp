@@ -484,10 +484,36 @@ void read_output(const Reader& r, const json& root, Case& c) {
 
 }  // namespace
 
+namespace {
+Case parse_case_json(const json& root, const std::string& text, const std::string& file);
+}  // namespace
+
 Case parse_case(const std::string& text, const std::string& file) {
-  Reader r(file);
   // Parse errors name the line and column; duplicate keys are errors (knit/io).
   const json root = io::parse_json(text, file);
+  try {
+    return parse_case_json(root, text, file);
+  } catch (const InputError& e) {
+    // The line of the field, as the schema-driven readers give it (session 25: a case file's
+    // errors named the pointer only). For an error inside another file (the database) it is
+    // the line of the case-file field that names that file.
+    // A document on one line (a generated case) gains nothing from "(line 1)".
+    const auto newline = text.find('\n');
+    const bool one_line = newline == std::string::npos ||
+                          text.find_first_not_of(" \t\r\n", newline) == std::string::npos;
+    if (e.file() != file || e.pointer().empty() || one_line ||
+        e.message().find("(line ") != std::string::npos)
+      throw;
+    const auto lines = io::json_pointer_lines(text);
+    const auto it = lines.find(e.pointer());
+    if (it == lines.end()) throw;
+    throw InputError(file, e.pointer(), e.message() + " (line " + std::to_string(it->second) + ")");
+  }
+}
+
+namespace {
+Case parse_case_json(const json& root, const std::string& text, const std::string& file) {
+  Reader r(file);
   r.keys(root, "",
          {"$schema", "description", "units", "geometry", "refinement", "material",
           "boundary_conditions", "loads", "solver", "output"},
@@ -526,6 +552,7 @@ Case parse_case(const std::string& text, const std::string& file) {
   io::JsonSchema::embedded("case").validate(root, file);
   return c;
 }
+}  // namespace
 
 Case load_case(const std::string& path) {
   // Regular files only, at most io::kMaxJsonInputBytes (a FIFO blocked, /dev/zero never ended).
