@@ -2,6 +2,7 @@
 #include "knit/io/json_input.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -164,6 +165,34 @@ struct LineScanner {
   }
 };
 }  // namespace
+
+std::string closest_key(const std::string& key, const std::vector<std::string>& known) {
+  // Levenshtein distance, case-insensitive, two rows.
+  const auto distance = [](const std::string& a, const std::string& b) {
+    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      cur[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                          std::tolower(static_cast<unsigned char>(b[j - 1]));
+        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (same ? 0 : 1)});
+      }
+      std::swap(prev, cur);
+    }
+    return prev[b.size()];
+  };
+  std::string best;
+  std::size_t best_d = std::max<std::size_t>(1, std::min<std::size_t>(2, key.size() / 3));
+  for (const auto& k : known) {
+    const std::size_t d = distance(key, k);
+    if (d <= best_d && (best.empty() || d < best_d)) {
+      best = k;
+      best_d = d;
+    }
+  }
+  return best;
+}
 
 std::map<std::string, int> json_pointer_lines(std::string_view text) {
   LineScanner s;

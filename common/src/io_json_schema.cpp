@@ -431,35 +431,12 @@ struct JsonSchema::Impl {
     }
   }
 
-  /// Levenshtein distance (for "did you mean").
-  static std::size_t edit_distance(const std::string& a, const std::string& b) {
-    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-      cur[0] = i;
-      for (std::size_t j = 1; j <= b.size(); ++j)
-        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1,
-                           prev[j - 1] + (std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                                                  std::tolower(static_cast<unsigned char>(b[j - 1]))
-                                              ? 0
-                                              : 1)});
-      std::swap(prev, cur);
-    }
-    return prev[b.size()];
-  }
-
   /// " (did you mean "x"?)" for a close known key, else " (allowed: ...)" for short lists.
   static std::string allowed_keys(const json* props, const std::string& key) {
     if (props) {
-      std::string best;
-      std::size_t best_d = std::max<std::size_t>(1, std::min<std::size_t>(2, key.size() / 3));
-      for (auto it = props->begin(); it != props->end(); ++it) {
-        const std::size_t d = edit_distance(key, it.key());
-        if (d <= best_d && (best.empty() || d < best_d)) {
-          best = it.key();
-          best_d = d;
-        }
-      }
+      std::vector<std::string> known;
+      for (auto it = props->begin(); it != props->end(); ++it) known.push_back(it.key());
+      const std::string best = closest_key(key, known);
       if (!best.empty()) return " (did you mean \"" + best + "\"?)";
     }
     if (!props || props->empty() || props->size() > 16) return "";

@@ -74,7 +74,11 @@ class Reader {
                        [&](const char* k) { return it.key() == k; })) {
         std::string list;
         for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
-        fail(ptr + "/" + it.key(), "unknown key (allowed here: " + list + ")");
+        // A close key is suggested as the schema reader does (session 25).
+        const std::string best = io::closest_key(it.key(), {allowed.begin(), allowed.end()});
+        fail(ptr + "/" + it.key(), "unknown key (" +
+                                       (best.empty() ? "" : "did you mean \"" + best + "\"? ") +
+                                       "allowed here: " + list + ")");
       }
     }
     for (const char* k : required)

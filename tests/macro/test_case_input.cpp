@@ -152,6 +152,19 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     json j = base;
     j["solver"]["stepz"] = 3;
     CHECK(error_of(j).rfind("bad.json: /solver/stepz: unknown key", 0) == 0);
+    // A close key is suggested, as the schema-driven readers do (session 25).
+    CHECK(error_of(j).rfind("bad.json: /solver/stepz: unknown key (did you mean \"steps\"? ", 0) ==
+          0);
+    j = base;
+    j["geometry"]["thicknes"] = j["geometry"]["thickness"];
+    j["geometry"].erase("thickness");
+    CHECK(error_of(j).rfind(
+              "bad.json: /geometry/thicknes: unknown key (did you mean \"thickness\"? allowed "
+              "here: ",
+              0) == 0);
+    j = base;
+    j["solver"]["zzzzzz"] = 3;  // nothing close: the list only
+    CHECK(error_of(j).rfind("bad.json: /solver/zzzzzz: unknown key (allowed here: ", 0) == 0);
   }
   // Tolerances that accept every first iterate (session 21: 1e308 ran with exit 0).
   for (const char* key : {"tolerance", "absolute_tolerance"}) {

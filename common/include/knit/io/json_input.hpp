@@ -110,6 +110,11 @@ class JsonSchema {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The known key closest to a misspelt `key` (Levenshtein distance, case-insensitive, at most
+/// max(1, min(2, |key| / 3))), or "" when none is that close: the "did you mean" of the schema
+/// reader and of the hand-written readers (the case loader).
+std::string closest_key(const std::string& key, const std::vector<std::string>& known);
+
 /// Line (1-based) where each value starts in JSON text, by JSON pointer ("" = the root). For
 /// object members, the line of the key. The text must be valid JSON.
 std::map<std::string, int> json_pointer_lines(std::string_view text);
