@@ -194,11 +194,36 @@ std::string closest_key(const std::string& key, const std::vector<std::string>& 
   return best;
 }
 
+std::string unknown_key_note(const std::string& key, const std::vector<std::string>& known) {
+  const std::string best = closest_key(key, known);
+  std::string list;
+  if (!known.empty() && known.size() <= kMaxListedKeys)
+    for (const auto& k : known) list += (list.empty() ? "\"" : ", \"") + k + "\"";
+  if (best.empty() && list.empty()) return "";
+  std::string note = " (";
+  if (!best.empty()) note += "did you mean \"" + best + "\"?";
+  if (!list.empty()) note += (best.empty() ? "allowed: " : " allowed: ") + list;
+  return note + ")";
+}
+
 std::map<std::string, int> json_pointer_lines(std::string_view text) {
   LineScanner s;
   s.t = text;
   s.value("");
   return std::move(s.lines);
+}
+
+std::string with_line(std::string_view text, const std::vector<std::string>& pointers,
+                      std::string message) {
+  const auto newline = text.find('\n');
+  const bool one_line = newline == std::string_view::npos ||
+                        text.find_first_not_of(" \t\r\n", newline) == std::string_view::npos;
+  if (one_line || message.find("(line ") != std::string::npos) return message;
+  const auto lines = json_pointer_lines(text);
+  for (const auto& p : pointers)
+    if (auto it = lines.find(p); it != lines.end())
+      return message + " (line " + std::to_string(it->second) + ")";
+  return message;
 }
 
 namespace {
@@ -371,12 +396,7 @@ nlohmann::json load_and_validate(const std::filesystem::path& path, const JsonSc
   const auto errs = schema.errors(j);
   if (!errs.empty()) {
     const auto& e = errs.front();
-    const auto lines = json_pointer_lines(text);
-    auto it = lines.find(e.at);
-    if (it == lines.end()) it = lines.find(e.pointer);
-    std::string msg = e.message;
-    if (it != lines.end()) msg += " (line " + std::to_string(it->second) + ")";
-    throw knit::InputError(path.string(), e.pointer, msg);
+    throw knit::InputError(path.string(), e.pointer, with_line(text, {e.at, e.pointer}, e.message));
   }
   return j;
 }

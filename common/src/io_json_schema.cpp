@@ -431,22 +431,12 @@ struct JsonSchema::Impl {
     }
   }
 
-  /// " (did you mean "x"?)" for a close known key, else " (allowed: ...)" for short lists.
+  /// The common note (io::unknown_key_note): a close known key, the allowed ones when few.
   static std::string allowed_keys(const json* props, const std::string& key) {
-    if (props) {
-      std::vector<std::string> known;
+    std::vector<std::string> known;
+    if (props)
       for (auto it = props->begin(); it != props->end(); ++it) known.push_back(it.key());
-      const std::string best = closest_key(key, known);
-      if (!best.empty()) return " (did you mean \"" + best + "\"?)";
-    }
-    if (!props || props->empty() || props->size() > 16) return "";
-    std::string s = " (allowed: ";
-    bool first = true;
-    for (auto it = props->begin(); it != props->end(); ++it) {
-      s += (first ? "\"" : ", \"") + it.key() + "\"";
-      first = false;
-    }
-    return s + ")";
+    return unknown_key_note(key, known);
   }
 
   // Follows $ref chains at the top of a schema (to look at a branch's own keywords).

@@ -71,15 +71,9 @@ class Reader {
     object(j, ptr);
     for (auto it = j.begin(); it != j.end(); ++it) {
       if (std::none_of(allowed.begin(), allowed.end(),
-                       [&](const char* k) { return it.key() == k; })) {
-        std::string list;
-        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
-        // A close key is suggested as the schema reader does (session 25).
-        const std::string best = io::closest_key(it.key(), {allowed.begin(), allowed.end()});
-        fail(ptr + "/" + it.key(), "unknown key (" +
-                                       (best.empty() ? "" : "did you mean \"" + best + "\"? ") +
-                                       "allowed here: " + list + ")");
-      }
+                       [&](const char* k) { return it.key() == k; }))
+        fail(ptr + "/" + it.key(),
+             "unknown key" + io::unknown_key_note(it.key(), {allowed.begin(), allowed.end()}));
     }
     for (const char* k : required)
       if (!j.contains(k)) fail(ptr, std::string("missing required key \"") + k + "\"");
@@ -499,19 +493,12 @@ Case parse_case(const std::string& text, const std::string& file) {
     return parse_case_json(root, text, file);
   } catch (const InputError& e) {
     // The line of the field, as the schema-driven readers give it (session 25: a case file's
-    // errors named the pointer only). For an error inside another file (the database) it is
-    // the line of the case-file field that names that file.
-    // A document on one line (a generated case) gains nothing from "(line 1)".
-    const auto newline = text.find('\n');
-    const bool one_line = newline == std::string::npos ||
-                          text.find_first_not_of(" \t\r\n", newline) == std::string::npos;
-    if (e.file() != file || e.pointer().empty() || one_line ||
-        e.message().find("(line ") != std::string::npos)
-      throw;
-    const auto lines = io::json_pointer_lines(text);
-    const auto it = lines.find(e.pointer());
-    if (it == lines.end()) throw;
-    throw InputError(file, e.pointer(), e.message() + " (line " + std::to_string(it->second) + ")");
+    // errors named the pointer only). An error inside another file (the database) keeps its
+    // own location.
+    if (e.file() != file || e.pointer().empty()) throw;
+    std::string msg = io::with_line(text, {e.pointer()}, e.message());
+    if (msg == e.message()) throw;
+    throw InputError(file, e.pointer(), std::move(msg));
   }
 }
 

@@ -273,13 +273,12 @@ DesignProblem load_design(const std::string& path) {
   d.file = path;
   const json root = io::read_json_file(path);
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
+  const std::vector<std::string> top_keys = {"$schema",    "description", "case",     "variables",
+                                             "objectives", "smoothness",  "optimizer"};
   for (auto it = root.begin(); it != root.end(); ++it)
-    if (std::string k = it.key(); k != "$schema" && k != "description" && k != "case" &&
-                                  k != "variables" && k != "objectives" && k != "smoothness" &&
-                                  k != "optimizer")
-      throw InputError(path, io::json_pointer_append("", k),
-                       "unknown key (allowed: $schema, description, case, variables, objectives, "
-                       "smoothness, optimizer)");
+    if (std::find(top_keys.begin(), top_keys.end(), it.key()) == top_keys.end())
+      throw InputError(path, io::json_pointer_append("", it.key()),
+                       "unknown key" + io::unknown_key_note(it.key(), top_keys));
   if (!root.contains("case") || !root.at("case").is_string())
     throw InputError(path, "/case", "needs the case file (a string, relative to this file)");
   d.case_file = io::resolve_input_path(path, root.at("case").get<std::string>()).string();

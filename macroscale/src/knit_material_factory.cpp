@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/knit_material.hpp"
 #include "knit/macro/material_factory.hpp"
@@ -47,11 +48,9 @@ std::vector<double> number_array(const nlohmann::json& j, const std::string& p,
 void check_keys(const nlohmann::json& j, const std::string& p, const CaseContext& ctx,
                 const std::vector<std::string>& allowed) {
   for (auto it = j.begin(); it != j.end(); ++it)
-    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw InputError(ctx.file, p + "/" + it.key(), "unknown key (allowed: " + list + ")");
-    }
+    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
+      throw InputError(ctx.file, p + "/" + it.key(),
+                       "unknown key" + io::unknown_key_note(it.key(), allowed));
 }
 
 struct Basis2 {

@@ -1,8 +1,12 @@
 #include "knit/macro/material_factory.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/macro/knit_material.hpp"
 #include "knit/macro/svk_material.hpp"
 
@@ -37,13 +41,13 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
   const std::string type = m.at("type").get<std::string>();
   if (type == "knit") return make_knit_material(m, ctx);
   if (type == "saint_venant_kirchhoff") {
+    const std::vector<std::string> allowed = {"type", "youngs_modulus", "poisson_ratio",
+                                              "description"};
     for (auto it = m.begin(); it != m.end(); ++it)
-      if (it.key() != "type" && it.key() != "youngs_modulus" && it.key() != "poisson_ratio" &&
-          it.key() != "description")
-        throw InputError(
-            ctx.file, ctx.pointer + "/" + it.key(),
-            "unknown key for a saint_venant_kirchhoff material (allowed: type, youngs_modulus, "
-            "poisson_ratio, description)");
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
+        throw InputError(ctx.file, ctx.pointer + "/" + it.key(),
+                         "unknown key for a saint_venant_kirchhoff material" +
+                             io::unknown_key_note(it.key(), allowed));
     const double E = positive_number(m, "youngs_modulus", ctx);
     if (!m.contains("poisson_ratio"))
       throw InputError(ctx.file, ctx.pointer, "missing required key \"poisson_ratio\"");

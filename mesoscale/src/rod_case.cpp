@@ -44,11 +44,9 @@ struct Reader {
               std::set<std::string> required = {}) const {
     if (!j.is_object()) fail(ptr, "must be an object, got " + kind(j));
     for (const auto& [k, v] : j.items())
-      if (!allowed.count(k)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "\"" : ", \"") + a + "\"";
-        fail(ptr, "unknown key \"" + k + "\" (allowed: " + list + ")");
-      }
+      if (!allowed.count(k))
+        fail(ptr, "unknown key \"" + k + "\"" +
+                      io::unknown_key_note(k, {allowed.begin(), allowed.end()}));
     for (const auto& r : required)
       if (!j.contains(r)) fail(ptr, "missing required key \"" + r + "\"");
   }

@@ -80,6 +80,29 @@ TEST_CASE("read_json_file reports file, line and column", "[unit][io][json]") {
   CHECK(knit::io::read_json_file(scratch("ok.json", R"({"x": [1, 2.5]})"))["x"][1] == 2.5);
 }
 
+TEST_CASE("unknown_key_note and with_line: one wording and one line rule for every reader",
+          "[unit][io][json]") {
+  using knit::io::unknown_key_note;
+  using knit::io::with_line;
+  CHECK(unknown_key_note("nu", {}) == "");
+  CHECK(unknown_key_note("zzzz", {"E", "nu"}) == " (allowed: \"E\", \"nu\")");
+  CHECK(unknown_key_note("Nu", {"E", "nu"}) == " (did you mean \"nu\"? allowed: \"E\", \"nu\")");
+  // More than kMaxListedKeys: the suggestion alone, or nothing.
+  std::vector<std::string> many;
+  for (std::size_t i = 0; i <= knit::io::kMaxListedKeys; ++i)
+    many.push_back("key" + std::to_string(i));
+  CHECK(unknown_key_note("key3x", many) == " (did you mean \"key3\"?)");
+  CHECK(unknown_key_note("qqqqqqqq", many) == "");
+
+  const std::string text = "{\n  \"a\": 1,\n  \"b\": {\n    \"c\": 2\n  }\n}\n";
+  CHECK(with_line(text, {"/b/c"}, "bad") == "bad (line 4)");
+  CHECK(with_line(text, {"/x", "/b"}, "bad") == "bad (line 3)");  // the first pointer found
+  CHECK(with_line(text, {"/x"}, "bad") == "bad");
+  CHECK(with_line(text, {"/a"}, "bad (line 9)") == "bad (line 9)");          // names a line already
+  CHECK(with_line(R"({"a": 1, "b": {"c": 2}})", {"/b/c"}, "bad") == "bad");  // one line
+  CHECK(with_line("{\"a\": 1}\n\n", {"/a"}, "bad") == "bad");  // one line and blank ones
+}
+
 TEST_CASE("JSON pointers escape per RFC 6901", "[unit][io][json]") {
   CHECK(knit::io::json_pointer_escape("a/b~c") == "a~1b~0c");
   CHECK(knit::io::json_pointer_append("/x", "~/") == "/x/~0~1");
@@ -129,9 +152,10 @@ TEST_CASE("schema validator: objects, arrays, $ref", "[unit][io][json][schema]")
   CHECK(first_error(with("/material", {{"E", 800}, {"Young", 1}})) ==
         "/material: unknown key \"Young\" (allowed: \"E\", \"nu\")");
   CHECK(first_error(with("/geometry", {{"thickness", 1}, {"elemnts", 2}})) ==
-        "/geometry: unknown key \"elemnts\" (did you mean \"elements\"?)");
+        "/geometry: unknown key \"elemnts\" (did you mean \"elements\"? allowed: \"angle\", "
+        "\"elements\", \"fraction\", \"thickness\")");
   CHECK(first_error(with("/material", {{"E", 800}, {"Nu", 0.3}})) ==
-        "/material: unknown key \"Nu\" (did you mean \"nu\"?)");
+        "/material: unknown key \"Nu\" (did you mean \"nu\"? allowed: \"E\", \"nu\")");
   CHECK(first_error(with("/material", {{"E", 800}, {"nu", 0.5}})) ==
         "/material/nu: must be < 0.5, got 0.5");
   CHECK(first_error(with("/material", json::object())) == "/material: missing required key \"E\"");

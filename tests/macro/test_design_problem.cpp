@@ -177,6 +177,12 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
              R"(, "optimizer": "lbfgs"})",
          "/optimizer");
+  expect("misspelt_key.json",
+         R"({"case": "case.json", "variables": )" + kVars + R"(, "objective": )" + kObjs + "}",
+         "/objective");
+  CHECK_THROWS_WITH(load_design((kDir / "misspelt_key.json").string()),
+                    Catch::Contains("/objective: unknown key (did you mean \"objectives\"? "
+                                    "allowed: \"$schema\", "));
 }
 
 TEST_CASE("design objective: reaction terms and their gradient equal finite differences",

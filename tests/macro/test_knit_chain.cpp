@@ -182,6 +182,10 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
   CHECK_NOTHROW(load(head + R"("stitch_value": 5, "knitting_angle": -6.28})"));
   CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "colour": 1})"),
                     Catch::Contains("/material/colour: unknown key"));
+  // The material readers suggest a close key, as every reader does (io::unknown_key_note).
+  CHECK_THROWS_WITH(load(head + R"("stitch_valu": 5})"),
+                    Catch::Contains("/material/stitch_valu: unknown key (did you mean "
+                                    "\"stitch_value\"? allowed: "));
   CHECK_THROWS_WITH(
       load(R"({"type": "knit", "database": "/nonexistent/db.h5", "stitch_value": 5})"),
       Catch::Contains("bad.json: /material/database: /nonexistent/db.h5: file not found"));

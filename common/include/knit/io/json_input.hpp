@@ -115,6 +115,19 @@ class JsonSchema {
 /// reader and of the hand-written readers (the case loader).
 std::string closest_key(const std::string& key, const std::vector<std::string>& known);
 
+/// What follows "unknown key" in every reader's message, one wording for all of them (the
+/// schema reader, the case, material, design and rod readers): ` (did you mean "x"? allowed:
+/// "a", "b")`. The suggestion is closest_key's; the allowed keys are listed when there are at
+/// most kMaxListedKeys of them. "" when there is neither.
+inline constexpr std::size_t kMaxListedKeys = 16;
+std::string unknown_key_note(const std::string& key, const std::vector<std::string>& known);
+
+/// `message` + " (line N)", N the line of the first of `pointers` found in the JSON `text`
+/// (json_pointer_lines); `message` unchanged when none is found, when it already names a line,
+/// or when the document is on one line (a generated file gains nothing from "(line 1)").
+std::string with_line(std::string_view text, const std::vector<std::string>& pointers,
+                      std::string message);
+
 /// Line (1-based) where each value starts in JSON text, by JSON pointer ("" = the root). For
 /// object members, the line of the key. The text must be valid JSON.
 std::map<std::string, int> json_pointer_lines(std::string_view text);
