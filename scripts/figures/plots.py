@@ -42,7 +42,26 @@ LABELS = {
 }
 
 
-def label_of(name):
+def mesh_label(case):
+    """'p = P, h = H' from a case's refinement, plus the corner pad's radius when it has one
+    (a mesh study compares meshes, so its legend names them and their corner condition)."""
+    ref = case.get("refinement") or {}
+    p, el = ref.get("degree"), ref.get("elements")
+    if p is None or not el:
+        return None
+    h = el[0] if len(set(el)) == 1 else "x".join(str(e) for e in el)
+    radii = [bc.get("radius", 0) for bc in case.get("boundary_conditions", []) if "corner" in bc]
+    grip = ""
+    if radii:
+        grip = f" ({max(radii):g} mm pad)" if max(radii) > 0 else " (corner point)"
+    return f"p = {p}, h = {h}{grip}"
+
+
+def label_of(name, case=None, study=False):
+    if study and case:
+        lab = mesh_label(case)
+        if lab:
+            return lab
     if name in LABELS:
         return LABELS[name]
     if name.startswith(("conv", "mesh")):
@@ -71,12 +90,13 @@ def placeholder(out, title, message):
 def cmd_load(a):
     fig, ax = plt.subplots(figsize=(6, 4.2))
     drawn = 0
+    study = any(n.startswith(("conv", "mesh")) for n in a.cases)  # legend by mesh
     for name in a.cases:
         r = Result(a.results, name)
         if not r.ok or len(r.csv.get("strain", [])) == 0:
             continue
         eps, f = r.strain(), r.load()
-        lab = label_of(name) + ("" if r.completed else " (stopped early)")
+        lab = label_of(name, r.case, study) + ("" if r.completed else " (stopped early)")
         ax.plot(100 * eps, f, "-" if r.completed else "--", marker=".", ms=3, label=lab)
         drawn += 1
     if drawn == 0:

@@ -53,6 +53,23 @@ def main():
               f"{what}: refused (exit {r.returncode}), nothing drawn", r.stderr[-500:])
             c(expect in r.stderr and "Traceback" not in r.stderr,
               f"{what}: one line naming the file, no traceback", r.stderr[-500:])
+    # A mesh study's legend names each mesh and its corner condition (session 26: the h = 1
+    # curve of Sect. 3.2.1's study read "diagonal (load along the diagonal)").
+    sys.path.insert(0, FIG)
+    import plots  # noqa: E402
+    point = {"refinement": {"degree": 5, "elements": [1, 1]},
+             "boundary_conditions": [{"all": True, "fix": ["z"]}, {"corner": "u0v0", "fix": ["x"]}]}
+    pad = {"refinement": {"degree": 5, "elements": [4, 4]},
+           "boundary_conditions": [{"corner": "u1v1", "fix": ["x"], "radius": 5.0}]}
+    edges = {"refinement": {"degree": 3, "elements": [4, 2]},
+             "boundary_conditions": [{"edge": "v0", "fix": ["x"]}]}
+    for case, want in ((point, "p = 5, h = 1 (corner point)"), (pad, "p = 5, h = 4 (5 mm pad)"),
+                       (edges, "p = 3, h = 4x2"), ({}, None)):
+        got = plots.mesh_label(case)
+        c(got == want, f"mesh_label: {want!r}", repr(got))
+    c(plots.label_of("s321_bilinear_diagonal", point, study=True) == "p = 5, h = 1 (corner point)"
+      and plots.label_of("s321_bilinear_diagonal", point) == plots.LABELS["s321_bilinear_diagonal"],
+      "label_of: by mesh in a study only")
     return c.exit_code()
 
 
