@@ -6,10 +6,11 @@
 //   history.csv (iteration, J, gradient norm, seconds, the variables), summary.txt (status,
 //   objective terms before and after, evaluations, time), case.json (the best design; runs as
 //   is with `knit-macro run`) and run/ (that run's usual outputs).
-//   A status line "status: converged | infeasible target | iteration limit | failed".
-//   Exit codes: 0 converged or infeasible target (the best design inside the bounds is
-//   written; the status line says which), 1 iteration limit or a failed solve (the best design
-//   so far is written; nothing if the first solve fails), 2 bad input (nothing is written).
+//   A status line "status: converged | infeasible target | target not met | iteration limit |
+//   failed" (the two misses with a "message:" line saying why).
+//   Exit codes: 0 converged, infeasible target or target not met (the best design inside the
+//   bounds is written; the status line says which), 1 iteration limit or a failed solve (the best
+//   design so far is written; nothing if the first solve fails), 2 bad input (nothing is written).
 // Example:
 //   knit-macro design cases/design/uniform_load.json --output out/design/uniform_load
 #include <filesystem>

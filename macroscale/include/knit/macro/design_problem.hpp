@@ -114,9 +114,12 @@ namespace knit::macro {
 ///    double the next trial, rejected ones halve it.
 /// Both stop when a step changes no variable by more than `x_tolerance` times its interval,
 /// when an accepted step lowers J by less than `function_tolerance` times J, or after
-/// `max_iterations`. The result's status: kConverged, kIterationLimit,
-/// kInfeasible (converged with J above `feasible` x J0 and a variable on a bound: the target
-/// is out of reach inside the bounds; the best design is kept) or kFailed (a solve failed).
+/// `max_iterations`. The result's status: kConverged (J at most `feasible` x J0: the targets
+/// are met), kIterationLimit, kInfeasible (converged with J above `feasible` x J0 and a
+/// variable on a bound: the target is out of reach inside the bounds; the best design is
+/// kept), kTargetNotMet (the same inside the bounds: a local minimum, or a loose function
+/// tolerance; the best design is kept) or kFailed (a solve failed). The two misses say why in
+/// DesignResult::message.
 struct OptimizeOptions {
   int max_iterations = 30;
   double x_tolerance = 1e-6;
@@ -124,8 +127,8 @@ struct OptimizeOptions {
   /// J / J0 below which a converged design counts as meeting its targets.
   double feasible = 1e-6;
 };
-enum class DesignStatus { kConverged, kIterationLimit, kInfeasible, kFailed };
-/// "converged", "iteration limit", "infeasible target", "failed".
+enum class DesignStatus { kConverged, kIterationLimit, kInfeasible, kTargetNotMet, kFailed };
+/// "converged", "iteration limit", "infeasible target", "target not met", "failed".
 std::string to_string(DesignStatus s);
 struct DesignIteration {
   int iteration = 0;
