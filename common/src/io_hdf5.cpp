@@ -376,6 +376,17 @@ bool H5Group::is_dataset(const std::string& path) const {
   return exists(path) && object_type(id_.get(), h5name(path)) == H5O_TYPE_DATASET;
 }
 
+void H5Group::copy_from(const H5Group& from, const std::string& path) {
+  silence_hdf5();
+  if (!from.exists(path)) fail(path, "cannot copy from " + from.file_name() + ": missing there");
+  if (exists(path)) fail(path, "cannot copy: exists already");
+  H5Handle lcpl = intermediate_lcpl();
+  errno = 0;
+  if (H5Ocopy(from.id_.get(), h5name(path).c_str(), id_.get(), h5name(path).c_str(), H5P_DEFAULT,
+              lcpl.get()) < 0)
+    fail(path, create_failure("cannot copy from " + from.file_name()));
+}
+
 H5Group H5Group::create_group(const std::string& path) {
   silence_hdf5();
   if (exists(path)) {

@@ -1,5 +1,6 @@
 // HDF5 reading and writing of the material database (layout: schemas/database.layout.json,
 // docs/database.md). HDF5 is reached only through knit/io/hdf5.hpp.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -80,7 +81,8 @@ std::string strip_file(const std::string& msg, const std::string& file) {
 
 }  // namespace
 
-void write_database(const std::filesystem::path& file, const Database& db) {
+void write_database(const std::filesystem::path& file, const Database& db,
+                    const std::function<void(io::H5File&)>& extra) {
   if (const auto bad = first_nonfinite_step(db))
     throw std::runtime_error(file.string() + ": database not written: " + *bad +
                              " is marked converged (status 0) but is not finite");
@@ -195,11 +197,33 @@ void write_database(const std::filesystem::path& file, const Database& db) {
       }
     }
     if (db.energy_law) detail::write_energy_law(f, *db.energy_law, db.energy_diagnostics);
+    if (extra) extra(f);
     f.close();
   } catch (const std::exception& e) {
     throw database_not_written(file, existed, out.temp_path(), e);
   }
   out.commit();
+}
+
+std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File& to,
+                                              const std::string& refit_note) {
+  std::vector<std::string> copied;
+  for (const std::string& name : from.children("/")) {
+    const std::string path = "/" + name;
+    if (!to.exists(path)) {
+      to.copy_from(from, path);
+      copied.push_back(path);
+    } else if (path == "/sweep" && from.is_group(path) && to.is_group(path)) {
+      for (const std::string& child : from.children(path))
+        if (!to.exists(path + "/" + child)) {
+          to.copy_from(from, path + "/" + child);
+          copied.push_back(path + "/" + child);
+        }
+    }
+  }
+  if (std::find(copied.begin(), copied.end(), "/sweep/report") != copied.end())
+    to.set_attribute("/sweep/report", "refitted", refit_note);
+  return copied;
 }
 
 std::runtime_error database_not_written(const std::filesystem::path& target, bool existed,

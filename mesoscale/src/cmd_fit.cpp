@@ -11,6 +11,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/hdf5.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
@@ -86,7 +87,21 @@ static knit::cli::SubcommandRegistrar reg_fit(
           return rc;
         }
         db.provenance = knit::material::current_provenance();
-        knit::material::write_database(target, db);
+        // What the Database does not hold (the sweep's /sweep/report, groups a user added)
+        // comes along from the input, in the same atomic write.
+        std::vector<std::string> carried;
+        knit::material::write_database(target, db, [&](knit::io::H5File& f) {
+          const auto src = knit::io::H5File::open_read(o->db);
+          carried = knit::material::carry_over_unwritten(
+              src, f,
+              "the laws were refitted by knit-meso fit (" + db.provenance.created +
+                  "); fit_status and case_in_fit describe the sweep's own fit");
+        });
+        if (!carried.empty()) {
+          std::cout << "kept from " << o->db << ":";
+          for (const auto& c : carried) std::cout << " " << c;
+          std::cout << "\n";
+        }
         return rc;
       };
     });

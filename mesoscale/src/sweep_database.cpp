@@ -118,14 +118,10 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
                           const SweepInput& in, const std::vector<JobResult>& results,
                           const SweepReport& report) {
   if (output.has_parent_path()) fs::create_directories(output.parent_path());
-  // The database goes to a temporary next to `output` (write_database is itself atomic onto
-  // it), gets the report, and is fsynced and renamed onto `output` by commit().
-  io::AtomicFile out(output);
-  const fs::path tmp = out.temp_path();
-  const bool existed = fs::exists(output);
-  try {
-    material::write_database(tmp, db);
-    io::H5File f = io::H5File::open_rw(tmp);
+  // The database and its report in one temporary next to `output`, fsynced and renamed onto
+  // it (write_database; session 26: the database was written atomically onto a temporary of
+  // its own, whose nested temporary a kill left behind for good).
+  material::write_database(output, db, [&](io::H5File& f) {
     io::H5Group g = f.create_group("/sweep/report");
     const auto nl = static_cast<Eigen::Index>(in.loop_lengths.size());
     const auto np = static_cast<Eigen::Index>(in.paths.size());
@@ -177,11 +173,7 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
     for (const auto& fs_ : report.fits)
       fit_status.push_back(fs_.ok() ? "ok" : "not fitted: " + fs_.reason);
     if (!fit_status.empty()) g.write_strings("fit_status", fit_status);
-    f.close();
-  } catch (const std::exception& e) {
-    throw material::database_not_written(output, existed, tmp, e);
-  }
-  out.commit();
+  });
 }
 
 // ---- runners ----------------------------------------------------------------------------------

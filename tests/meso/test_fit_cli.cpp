@@ -54,6 +54,33 @@ TEST_CASE("knit-meso synth --no-fit, then fit, refits from the raw data", "[unit
   CHECK(run("fit " + (dir / "missing.h5").string()) == 2);
 }
 
+// Session 26: a refit rewrote the database from what a Database holds, so the sweep's
+// /sweep/report (its record of failed cases) and anything else in the file were gone, exit 0.
+TEST_CASE("knit-meso fit keeps what the database holds beyond the laws", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_synth_carry.h5";
+  REQUIRE(run("synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  {
+    auto f = knit::io::H5File::open_rw(db);
+    f.write("/sweep/report/case_status", std::vector<int>{0, 1, 2});
+    f.set_attribute("/sweep/report", "failed_cases", "1");
+    f.write("/notes/measured", std::vector<double>{1.5, 2.5});
+    f.close();
+  }
+  REQUIRE(run("fit " + db.string() + " --law paper") == 0);
+  {
+    const auto f = knit::io::H5File::open_read(db);
+    REQUIRE(f.is_dataset("/sweep/report/case_status"));
+    CHECK(f.read_ints("/sweep/report/case_status") == std::vector<int>{0, 1, 2});
+    CHECK(f.attribute_string("/sweep/report", "failed_cases") == "1");
+    CHECK(f.attribute_string("/sweep/report", "refitted").find("knit-meso fit") !=
+          std::string::npos);
+    CHECK(f.is_dataset("/notes/measured"));
+  }
+  const auto refit = knit::material::read_database(db);  // still a valid database
+  CHECK(refit.entries[0].surface);
+}
+
 TEST_CASE("knit-meso synth writes the energy law; fit --law energy adds it to a v1 file",
           "[unit]") {
   const fs::path dir = scratch_dir();

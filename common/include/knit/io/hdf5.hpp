@@ -120,6 +120,10 @@ class H5Group {
   H5Group open_group(const std::string& path) const;
   /// True if every component of the path exists (any object kind).
   bool exists(const std::string& path) const;
+  /// Copies the object at `path` of `from` (a group with everything under it, or a dataset,
+  /// with their attributes; H5Ocopy) to the same path here, creating missing parent groups.
+  /// The path must not exist here. Throws naming this file and the path.
+  void copy_from(const H5Group& from, const std::string& path);
   bool is_group(const std::string& path) const;
   bool is_dataset(const std::string& path) const;
   /// Names of the direct children (groups and datasets) of the group at path, sorted by name.

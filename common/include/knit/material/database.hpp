@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -25,6 +26,10 @@
 #include "knit/material/load_paths.hpp"
 #include "knit/material/loop_length_family.hpp"
 #include "knit/material/response_surface.hpp"
+
+namespace knit::io {
+class H5File;  // knit/io/hdf5.hpp
+}  // namespace knit::io
 
 namespace knit::material {
 
@@ -160,8 +165,21 @@ std::optional<std::string> first_nonfinite_step(const Database& db);
 Provenance current_provenance();
 
 /// Writes atomically (temporary file next to `file`, then rename). Throws std::runtime_error,
-/// and writes nothing, when a converged step is not finite (first_nonfinite_step).
-void write_database(const std::filesystem::path& file, const Database& db);
+/// and writes nothing, when a converged step is not finite (first_nonfinite_step). `extra`,
+/// when given, adds to the open file before it is closed and renamed (the sweep's
+/// /sweep/report; `knit-meso fit` copies the input's objects the Database does not hold), so
+/// one temporary and one rename make the whole file (session 26: the sweep wrote the database
+/// into its own temporary, a nested "..DB.h5.tmp-P-n.tmp-P-m" that a kill left for good).
+void write_database(const std::filesystem::path& file, const Database& db,
+                    const std::function<void(io::H5File&)>& extra = {});
+
+/// Copies into `to` (a database being written) every object of `from` (the database it was
+/// made from) at the root or directly under /sweep that `to` does not hold: what a Database
+/// does not carry, such as the sweep's /sweep/report and groups a user added. Marks a copied
+/// /sweep/report (attribute "refitted") as describing the sweep's own fit. Returns the copied
+/// paths. Session 26: `knit-meso fit` dropped /sweep/report, with exit 0.
+std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File& to,
+                                              const std::string& refit_note);
 
 /// The error of a database write into the temporary `temp` of `target` that failed with `e`
 /// (a full file system, say): "TARGET: database not written (the earlier file is left as it
