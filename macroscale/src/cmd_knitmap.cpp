@@ -49,6 +49,10 @@ knit::cli::SubcommandRegistrar reg(
                 : std::filesystem::path(o->output);
         knit::macro::write_knitmap(map, in, dir);
         std::cout << knit::macro::knitmap_summary(map) << "wrote " << dir.string() << "\n";
+        // Warnings on stderr as well, as the help's footer says (session 26: only on stdout
+        // and in summary.txt).
+        for (const auto& w : map.warnings)
+          std::cerr << "knit-macro knitmap: warning: " << o->case_file << ": " << w << "\n";
         return knit::kExitOk;
       };
     });

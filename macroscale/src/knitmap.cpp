@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -235,9 +236,17 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
   double t = t_min;
   double height = cells.course_height(l_at(s_mid, t_min + 1e-9 * (t_max - t_min)));
   bool nonconvex_warned = false;
+  // Course lines whose chord holds no stitch: at the start and the end of the patch (a taper
+  // narrower than one stitch) they are left out with a warning; between courses that hold
+  // stitches the fabric would fall apart into pieces, which no machine knits as one map
+  // (session 26: the first such line ended the map, and an hourglass's upper half was
+  // silently missing, exit 0).
+  int empty_start = 0, empty_pending = 0;
+  double first_gap = 0.0;
+  long empty_lines = 0;
   for (;;) {
     Row row;
-    bool done = false;
+    bool done = false, empty = false;
     for (int it = 0; it < 30; ++it) {
       const double tc = t + 0.5 * height;
       if (!(tc < t_max)) {
@@ -258,7 +267,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
       row.laid = lay(cr.front(), cr.back(), tc);
       row.course.t = tc - t_min;
       if (row.laid.l.empty()) {
-        done = true;
+        empty = true;
         break;
       }
       double sum = 0;
@@ -269,6 +278,27 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
       if (converged) break;
     }
     if (done) break;
+    if (empty) {
+      if (rows.empty()) {
+        ++empty_start;
+      } else if (empty_pending++ == 0) {
+        first_gap = t + 0.5 * height - t_min;
+      }
+      t += height;
+      if (++empty_lines > 1000000)
+        throw InputError(c.file, "/geometry", "more than 10^6 course lines hold no stitch");
+      continue;
+    }
+    if (empty_pending > 0) {
+      char where[96];
+      std::snprintf(where, sizeof where, "%.4g mm", first_gap);
+      throw InputError(c.file, "/geometry",
+                       "the patch is narrower than one stitch across " +
+                           std::to_string(empty_pending) + " course line(s) " + where +
+                           " into it (across the courses), between courses that hold stitches: "
+                           "the fabric would fall apart into pieces there; widen the patch or "
+                           "map the pieces as separate cases");
+    }
     row.course.height = height;
     row.course.stitches = static_cast<int>(row.laid.l.size());
     double wsum = 0;
@@ -288,6 +318,11 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
   }
   if (rows.empty())
     throw InputError(c.file, "/geometry", "the patch holds no course (smaller than one stitch)");
+  if (empty_start > 0 || empty_pending > 0)
+    map.warnings.push_back(std::to_string(empty_start) + " course line(s) at the start and " +
+                           std::to_string(empty_pending) +
+                           " at the end of the patch are narrower than one stitch and are "
+                           "left out (the patch tapers below one stitch width there)");
 
   // Round half up with a tolerance: a centred course of an even stitch count has r exactly at
   // a half integer, where round-off must not shift some courses by one needle.

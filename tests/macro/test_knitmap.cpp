@@ -237,6 +237,54 @@ TEST_CASE("knitmap: a linear grading and the command's outputs", "[case]") {
       CHECK(m.stitches[i].l > m.stitches[i - 1].l);
 }
 
+/// A patch of straight-sided rows (degree 1 across): row k spans x in [cx - hw_k, cx + hw_k]
+/// at y_k. Courses run along x (alpha 0).
+std::string tapered_case(const std::string& material, const std::vector<double>& y,
+                         const std::vector<double>& half_width, double cx = 25.0) {
+  std::ostringstream os;
+  os.precision(17);
+  os << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0)";
+  for (std::size_t k = 1; k + 1 < y.size(); ++k) os << ", " << double(k) / double(y.size() - 1);
+  os << R"(, 1, 1], "control_points": [)";
+  for (std::size_t k = 0; k < y.size(); ++k)
+    os << (k ? ", " : "") << "[" << cx - half_width[k] << ", " << y[k] << ", 0], ["
+       << cx + half_width[k] << ", " << y[k] << ", 0]";
+  os << R"(], "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [1, 1]}, "material": )"
+     << material << R"(,
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "v0", "fix": ["x", "y"]}],
+    "output": {"vtk": false, "hdf5": false}})";
+  return os.str();
+}
+
+// Session 26 (found by a helper's audit): the first course line whose chord held no stitch
+// ended the map, so an hourglass with a 0.1 mm waist lost its upper half with exit 0, and a V
+// whose tip is narrower than a stitch was refused as "holds no course".
+TEST_CASE("knitmap: a waist narrower than a stitch is refused; a narrow tip is left out",
+          "[case]") {
+  const std::string db = database();
+  const std::string m = knit_material(db, "5.0");
+  const std::string hourglass =
+      write_case("hourglass.json", tapered_case(m, {0, 25, 50}, {25, 0.05, 25}));
+  try {
+    const auto in = load_knitmap_input(hourglass);
+    (void)make_knitmap(in.c, in.cells);
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/geometry");
+    CHECK_THAT(e.what(), Catch::Contains("fall apart into pieces"));
+  }
+  fs::remove_all(kDir / "hourglass_out");
+  CHECK(run_knitmap(hourglass + " --output " + (kDir / "hourglass_out").string()) == 2);
+  CHECK(!fs::exists(kDir / "hourglass_out"));
+  // A V: 0.1 mm at the bottom, 50 mm at the top. The courses that hold stitches are all
+  // there: about H / c of them, the narrow start left out with a warning.
+  const KnitMap v = map_of("v.json", tapered_case(m, {0, 50}, {0.05, 25}));
+  CHECK(std::abs(double(v.courses.size()) - 50.0 / c_of(5.0)) <= 2.0);
+  REQUIRE(!v.warnings.empty());
+  CHECK_THAT(v.warnings.back(), Catch::Contains("left out"));
+}
+
 TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothing", "[case]") {
   const std::string db = database();
   auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr,
