@@ -130,6 +130,8 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
     std::cerr << who() << ": " << CLI::FailureMessage::simple(&app, e);
     return kExitBadInput;
   }
+  // The markers of this run's output directories name it (knit/io/output_target.hpp).
+  io::set_output_owner(who());
   try {
     for (auto& [sub, run] : subs)
       if (sub->parsed()) return run();

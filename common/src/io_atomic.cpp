@@ -211,7 +211,9 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   fs::create_directory(partial_, ec);
   if (ec) fail(partial_, "cannot create directory: " + ec.message());
   std::ofstream marker(partial_ / kOutputMarker, std::ios::binary);
-  marker << "knitscale output\n" << Provenance::current().to_json_string() << "\n";
+  // The first line names the writer (output_owner): only it replaces this output later.
+  marker << "knitscale output" << (output_owner().empty() ? "" : ": " + output_owner()) << "\n"
+         << Provenance::current().to_json_string() << "\n";
   if (!marker) fail(partial_ / kOutputMarker, "cannot write");
 }
 
@@ -258,10 +260,10 @@ void AtomicDirectory::commit() {
   } else {
     if (!fs::is_directory(fs::symlink_status(target_, ec)))
       fail(target_, "exists and is not a directory");
-    if (!is_knitscale_output(target_) && !fs::is_empty(target_, ec))
-      fail(target_, "is a non-empty directory that is not a knitscale output (no " +
-                        std::string(kOutputMarker) + "): left alone; the new output is in " +
-                        partial_.string());
+    if (!is_own_output(target_) && !fs::is_empty(target_, ec))
+      fail(target_, "became a non-empty directory that is not this program's output (its " +
+                        std::string(kOutputMarker) + " is missing or names another) while " +
+                        "the run went on: left alone; the new output is in " + partial_.string());
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
       remove_old_output(partial_);  // now holds the old contents
     } else {

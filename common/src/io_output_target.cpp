@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -58,6 +59,37 @@ bool is_knitscale_output(const fs::path& dir) {
          fs::is_regular_file(fs::symlink_status(dir / kOutputMarker, ec));
 }
 
+namespace {
+std::string& owner_storage() {
+  static std::string owner;
+  return owner;
+}
+}  // namespace
+
+void set_output_owner(std::string owner) {
+  owner_storage() = std::move(owner);
+}
+const std::string& output_owner() {
+  return owner_storage();
+}
+
+std::optional<std::string> output_marker_owner(const fs::path& dir) {
+  if (!is_knitscale_output(dir)) return std::nullopt;
+  std::ifstream in(dir / kOutputMarker, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  static const std::string tag = "knitscale output";
+  if (line == tag) return std::string();
+  if (line.rfind(tag + ": ", 0) == 0) return line.substr(tag.size() + 2);
+  return line;
+}
+
+bool is_own_output(const fs::path& dir) {
+  const auto owner = output_marker_owner(dir);
+  return owner && (owner->empty() || *owner == output_owner());
+}
+
 void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option,
                          std::string_view hdf5_format) {
   const std::string opt(option);
@@ -93,6 +125,11 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
         refuse(std::string("is a non-empty directory that is not a knitscale output (no ") +
                kOutputMarker +
                " file): its files are not ours to replace; give a new or empty directory");
+      if (!ec && !empty && !is_own_output(target))
+        refuse("is the output of " + *output_marker_owner(target) + " (its " + kOutputMarker +
+               " says so), not of " +
+               (output_owner().empty() ? std::string("this program") : output_owner()) +
+               ": not ours to replace; give another directory");
     } else {
       if (fs::is_directory(st)) refuse("is a directory; give the name of the file to write");
       if (!fs::is_regular_file(st)) refuse("exists and is not a regular file");

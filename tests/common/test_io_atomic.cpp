@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -363,6 +364,58 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(fs::exists(d / "out.partial-99999999x"));
   CHECK(fs::exists(d / ("out.partial-" + dead + "0")));
   CHECK(fs::exists(d / ("other.partial-" + dead)));
+}
+
+// Session 26 (found by a helper's audit): `knit-macro run case.json -o out` replaced the
+// reproduction pipeline's output directory -- its database, figures and report -- because
+// every marker was taken for the program's own. A marker now names its writer.
+TEST_CASE("AtomicDirectory replaces only outputs of its own program", "[unit][io][atomic]") {
+  struct OwnerGuard {
+    explicit OwnerGuard(const std::string& o) { knit::io::set_output_owner(o); }
+    ~OwnerGuard() { knit::io::set_output_owner(""); }
+  };
+  const fs::path d = scratch("owner");
+  const fs::path pipeline = d / "out";
+  fs::create_directories(pipeline / "figures");
+  std::ofstream(pipeline / knit::io::kOutputMarker)
+      << "knitscale output: the reproduction pipeline (scripts/pipeline.mk)\n";
+  std::ofstream(pipeline / "database.h5") << "db";
+  std::ofstream(pipeline / "figures" / "fig.png") << "png";
+  CHECK(knit::io::output_marker_owner(pipeline) ==
+        std::optional<std::string>("the reproduction pipeline (scripts/pipeline.mk)"));
+  {
+    OwnerGuard g("knit-macro run");
+    CHECK_FALSE(knit::io::is_own_output(pipeline));
+    CHECK_THROWS_WITH(knit::io::check_output_target(pipeline, knit::io::OutputKind::kDirectory),
+                      Catch::Contains("is the output of the reproduction pipeline "
+                                      "(scripts/pipeline.mk) (its .knitscale-output says so), "
+                                      "not of knit-macro run"));
+    CHECK_THROWS_AS(knit::io::AtomicDirectory(pipeline), knit::InputError);
+    CHECK(slurp(pipeline / "database.h5") == "db");
+    CHECK(fs::exists(pipeline / "figures" / "fig.png"));
+
+    // Its own output: written with its name in the marker, and replaced by it again.
+    const fs::path run = d / "run";
+    for (int k = 0; k < 2; ++k) {
+      knit::io::AtomicDirectory a(run);
+      std::ofstream(a.path() / "x.txt") << k;
+      a.commit();
+    }
+    CHECK_THAT(slurp(run / knit::io::kOutputMarker),
+               Catch::StartsWith("knitscale output: knit-macro run\n"));
+    CHECK(slurp(run / "x.txt") == "1");
+    // Another program's output is refused, a marker naming no owner (before session 26) is not.
+    OwnerGuard other("knit-meso cell");
+    CHECK_THROWS_WITH(knit::io::AtomicDirectory(run),
+                      Catch::Contains("is the output of knit-macro run"));
+    CHECK(slurp(run / "x.txt") == "1");
+    std::ofstream(run / knit::io::kOutputMarker) << "knitscale output\n{}\n";
+    CHECK(knit::io::output_marker_owner(run) == std::optional<std::string>(""));
+    knit::io::AtomicDirectory a(run);
+    a.commit();
+    CHECK_FALSE(fs::exists(run / "x.txt"));
+  }
+  CHECK(knit::io::output_marker_owner(d) == std::nullopt);  // no marker
 }
 
 TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its target",

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,23 @@ inline constexpr const char* kOutputMarker = ".knitscale-output";
 /// True if `dir` is a directory holding the marker file.
 bool is_knitscale_output(const std::filesystem::path& dir);
 
+/// Who writes this process's output directories, as its markers say: "knit-macro run",
+/// "knit-meso cell", ... (knit::cli::run_main sets it from the program and the subcommand).
+/// Empty (the default: a library caller, a test) writes markers that name no owner.
+void set_output_owner(std::string owner);
+const std::string& output_owner();
+
+/// The owner `dir`'s marker names: the first line "knitscale output: OWNER" gives OWNER, a
+/// plain "knitscale output" (markers before session 26, library callers) gives "", any other
+/// first line gives that line; nothing without a marker.
+std::optional<std::string> output_marker_owner(const std::filesystem::path& dir);
+
+/// True if this process may replace the directory `dir`: it holds the marker, and the marker
+/// names no owner or this process's (output_owner()). Session 26: `knit-macro run -o out`
+/// replaced the reproduction pipeline's whole output directory -- its database, figures and
+/// report -- because any marker was taken for the program's own.
+bool is_own_output(const std::filesystem::path& dir);
+
 enum class OutputKind { kDirectory, kFile };
 
 /// Refuses, before any work, an output target the run could not (or must not) write. Throws
@@ -29,7 +47,8 @@ enum class OutputKind { kDirectory, kFile };
 ///  * an empty name, ".", "..", "/" or any path ending in "." or "..";
 ///  * a symbolic link (dangling or not: the rename would replace the link, not its target);
 ///  * kDirectory: an existing non-directory; the current directory or one of its ancestors; a
-///    non-empty directory that is not a knitscale output (no marker file);
+///    non-empty directory that is not a knitscale output (no marker file), or the output of
+///    another program (is_own_output);
 ///  * kFile (an HDF5 file: the database outputs): an existing directory (or other non-regular
 ///    file); an existing non-empty file that is not HDF5 (not ours to replace); with
 ///    `hdf5_format` given, an existing HDF5 file whose root attribute "format" is not
