@@ -2,6 +2,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
@@ -31,6 +32,47 @@ std::string slurp(const fs::path& p) {
   ss << in.rdbuf();
   return ss.str();
 }
+
+/// A file the store writes: manifest.json, job_NNNNN.txt, or an atomic temporary of either
+/// (".NAME.tmp-<pid>-<n>").
+bool is_store_file(std::string name) {
+  if (name.size() > 1 && name[0] == '.') {
+    const std::size_t tmp = name.find(".tmp-");
+    if (tmp == std::string::npos) return false;
+    name = name.substr(1, tmp - 1);
+  }
+  if (name == kManifest) return true;
+  if (name.size() != 13 || name.rfind("job_", 0) != 0 || name.substr(9) != ".txt") return false;
+  for (std::size_t i = 4; i < 9; ++i)
+    if (name[i] < '0' || name[i] > '9') return false;
+  return true;
+}
+
+/// Why `dir` is not a checkpoint directory of ours, or "" if it is: a directory holding only
+/// the store's files, whose manifest (when readable) is a knit-sweep-parts manifest. A damaged
+/// manifest beside our job files is still ours (--force may discard it).
+std::string not_ours(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec)))
+    return "exists and is not a directory of sweep checkpoints";
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (!is_store_file(name) || !fs::is_regular_file(it->symlink_status(ec)))
+      return "holds \"" + name + "\", which the sweep does not write";
+  }
+  if (ec) return "cannot be read: " + ec.message();
+  if (fs::exists(dir / kManifest, ec)) {
+    try {
+      const auto m = nlohmann::json::parse(slurp(dir / kManifest));
+      if (!m.is_object() || m.value("format", std::string()) != "knit-sweep-parts")
+        return "has a manifest.json that is not a sweep's (format is not \"knit-sweep-parts\")";
+    } catch (const std::exception&) {
+      // damaged: judged by its neighbours (all ours)
+    }
+  }
+  return "";
+}
 }  // namespace
 
 fs::path CheckpointStore::parts_dir(const fs::path& database) {
@@ -43,7 +85,15 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                                  int job_count, bool resume, bool force)
     : dir_(parts_dir(database)) {
   const std::string fp = fingerprint(job_definition);
-  if (fs::exists(dir_)) {
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(dir_, ec))) {
+    // Session 26 (found by a helper's audit): --force deleted a directory of that name with
+    // the user's files in it (or a plain file), with exit 0.
+    if (const std::string why = not_ours(dir_); !why.empty())
+      throw InputError(dir_.string(), "",
+                       why +
+                           ": not ours to continue or discard; rename or remove it, or give "
+                           "the database another --output");
     if (!resume && !force)
       throw InputError(dir_.string(), "",
                        "checkpoints of an unfinished sweep exist: continue it with --resume, or "
@@ -53,7 +103,9 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
       try {
         have = nlohmann::json::parse(slurp(dir_ / kManifest)).at("fingerprint").get<std::string>();
       } catch (const std::exception&) {
-        have = "";
+        throw InputError((dir_ / kManifest).string(), "",
+                         "--resume: the checkpoints' manifest is missing or damaged, so they "
+                         "cannot be matched to this sweep input; use --force to discard them");
       }
       if (have != fp)
         throw InputError(dir_.string(), "",
@@ -62,7 +114,9 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                          "to discard them");
       return;
     }
-    fs::remove_all(dir_);
+    remove();
+    if (fs::exists(fs::symlink_status(dir_, ec)))
+      throw InputError(dir_.string(), "", "--force: cannot discard the checkpoints");
   }
   fs::create_directories(dir_);
   const nlohmann::json m = {{"format", "knit-sweep-parts"},
@@ -125,8 +179,16 @@ void CheckpointStore::store(const JobResult& r) const {
 }
 
 void CheckpointStore::remove() const {
+  // Only the store's own files, then the directory if that emptied it: a file somebody put
+  // there meanwhile stays, with the directory.
   std::error_code ec;
-  fs::remove_all(dir_, ec);
+  std::vector<fs::path> ours;
+  for (auto it = fs::directory_iterator(dir_, ec); !ec && it != fs::directory_iterator();
+       it.increment(ec))
+    if (is_store_file(it->path().filename().string()) && it->is_regular_file(ec))
+      ours.push_back(it->path());
+  for (const auto& p : ours) fs::remove(p, ec);
+  fs::remove(dir_, ec);  // fails (and keeps it) unless empty
 }
 
 }  // namespace knit::meso::sweep

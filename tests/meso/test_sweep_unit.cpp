@@ -523,6 +523,60 @@ TEST_CASE("sweep: resume recomputes only the missing cases and gives the same da
   CHECK_FALSE(std::filesystem::exists(CheckpointStore::parts_dir(out)));
 }
 
+// Session 26 (found by a helper's audit): --force deleted a DB.h5.parts that the sweep had not
+// written -- a directory with the user's files, or a plain file -- with exit 0; and a damaged
+// manifest was reported as "a different sweep input".
+TEST_CASE("sweep: --force discards only checkpoints the sweep wrote", "[unit]") {
+  namespace fs = std::filesystem;
+  const auto dir = knit_test::scratch("sweep_unit_parts");
+  const auto in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  const int n = static_cast<int>(jobs.size());
+  const auto out = dir / "db.h5";
+  const fs::path parts = CheckpointStore::parts_dir(out);
+  // A directory of the user's, and a plain file, of that name: refused, kept.
+  fs::create_directories(parts / "sub");
+  std::ofstream(parts / "mine.txt") << "mine";
+  std::ofstream(parts / "sub" / "deep.txt") << "deep";
+  for (bool resume : {false, true}) {
+    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, resume, !resume),
+                      Catch::Contains("which the sweep does not write"));
+  }
+  CHECK(fs::exists(parts / "mine.txt"));
+  CHECK(fs::exists(parts / "sub" / "deep.txt"));
+  fs::remove_all(parts);
+  std::ofstream(parts) << "a file";
+  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, true),
+                    Catch::Contains("not a directory of sweep checkpoints"));
+  CHECK(fs::is_regular_file(parts));
+  fs::remove(parts);
+  // Somebody else's manifest.json: not ours either.
+  fs::create_directories(parts);
+  std::ofstream(parts / "manifest.json") << R"({"format": "other-tool"})";
+  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, true),
+                    Catch::Contains("not a sweep's"));
+  fs::remove_all(parts);
+  // Ours: discarded by --force, file by file.
+  {
+    CheckpointStore store(out, in.job_definition(), n, false, false);
+    store.store(run_job(jobs[0], in.retry, synthetic_runner()));
+  }
+  // A damaged manifest beside our records: --resume says so, --force discards them.
+  std::ofstream(parts / "manifest.json") << "{";
+  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, true, false),
+                    Catch::Contains("manifest is missing or damaged"));
+  {
+    CheckpointStore store(out, in.job_definition(), n, false, true);
+    CHECK_FALSE(fs::exists(parts / "job_00000.txt"));
+    CHECK(fs::exists(parts / "manifest.json"));
+    // A file put into the directory meanwhile stays, with the directory.
+    std::ofstream(parts / "notes.txt") << "notes";
+    store.remove();
+    CHECK(fs::exists(parts / "notes.txt"));
+    CHECK_FALSE(fs::exists(parts / "manifest.json"));
+  }
+}
+
 TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consistently", "[unit]") {
   const auto dir = knit_test::scratch("sweep_unit_residual");
   const Eigen::Vector3d S0(0.15, 0.07, 0.01);
