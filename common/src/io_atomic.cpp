@@ -11,6 +11,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 #include "knit/io/provenance.hpp"
 
@@ -170,6 +171,21 @@ fs::path prepare_target(fs::path target, std::string_view option) {
   return target;
 }
 
+/// Removes an output directory of ours with its marker last, so that a kill part-way leaves a
+/// marked directory, which the next run's clean-up recognizes and removes (session 26: the
+/// marker went in directory order, 1st or 2nd, and a kill then left "DIR.partial-<pid>"
+/// without it, which nothing ever removed).
+void remove_marked_tree(const fs::path& dir) {
+  std::error_code ec;
+  std::vector<fs::path> entries;
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
+       it.increment(ec))
+    if (it->path().filename() != kOutputMarker) entries.push_back(it->path());
+  for (const auto& e : entries) fs::remove_all(e, ec);
+  fs::remove(dir / kOutputMarker, ec);
+  fs::remove(dir, ec);
+}
+
 /// Removes "<target>.partial-<pid>" and "<target>.old-<pid>" left by killed runs: only those
 /// whose pid is dead (or ours: an earlier run with a recycled pid) and which hold the marker.
 void remove_stale_siblings(const fs::path& target) {
@@ -181,10 +197,8 @@ void remove_stale_siblings(const fs::path& target) {
     for (const char* tag : {".partial-", ".old-"}) {
       const long pid = pid_in_name(f, name + tag, false);
       if (pid < 0) continue;
-      if ((pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path())) {
-        std::error_code rm;
-        fs::remove_all(it->path(), rm);
-      }
+      if ((pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path()))
+        remove_marked_tree(it->path());
     }
   }
 }
@@ -192,7 +206,10 @@ void remove_stale_siblings(const fs::path& target) {
 /// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
 void remove_old_output(const fs::path& old) {
   std::error_code ec;
-  if (is_knitscale_output(old) || fs::is_empty(old, ec)) fs::remove_all(old, ec);
+  if (is_knitscale_output(old))
+    remove_marked_tree(old);
+  else if (fs::is_empty(old, ec))
+    fs::remove(old, ec);
 }
 
 }  // namespace
@@ -231,7 +248,7 @@ AtomicDirectory::~AtomicDirectory() {
   if (!active_ || committed_) return;
   std::error_code ec;
   if (on_abandon_ == OnAbandon::Remove) {
-    fs::remove_all(partial_, ec);
+    remove_marked_tree(partial_);
   } else {
     std::ofstream(partial_ / "INCOMPLETE")
         << "This directory is the incomplete output for " << target_.string()
@@ -260,10 +277,24 @@ void AtomicDirectory::commit() {
   } else {
     if (!fs::is_directory(fs::symlink_status(target_, ec)))
       fail(target_, "exists and is not a directory");
-    if (!is_own_output(target_) && !fs::is_empty(target_, ec))
+    if (!is_own_output(target_) && !fs::is_empty(target_, ec)) {
+      // Keep the new output beside it under a name of its own (the clean-up of partial
+      // directories would remove it; session 26: the message named it, and it was gone).
+      fs::path kept = target_;
+      kept += ".new-";
+      kept += std::to_string(::getpid());
+      std::string where = partial_.string();
+      if (!fs::exists(fs::symlink_status(kept, ec)) &&
+          ::rename(partial_.c_str(), kept.c_str()) == 0) {
+        where = kept.string();
+        active_ = false;  // nothing left to remove
+      } else {
+        on_abandon_ = OnAbandon::Keep;
+      }
       fail(target_, "became a non-empty directory that is not this program's output (its " +
                         std::string(kOutputMarker) + " is missing or names another) while " +
-                        "the run went on: left alone; the new output is in " + partial_.string());
+                        "the run went on: left alone; the new output is kept in " + where);
+    }
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
       remove_old_output(partial_);  // now holds the old contents
     } else {

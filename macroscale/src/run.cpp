@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <ostream>
 
 #include "knit/core/errors.hpp"
@@ -119,6 +120,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   Problem p = setup_problem(c);
   const ShellModel& m = *p.model;
   std::unique_ptr<ResultsWriter> writer;
+  std::error_code ec;
+  const bool had_output = !opt.output_dir.empty() && std::filesystem::exists(opt.output_dir, ec);
   if (!opt.output_dir.empty()) writer = std::make_unique<ResultsWriter>(c, m, opt.output_dir);
   RunResult res;
   std::vector<std::vector<int>> corner_sets;  // the control points of each corner reaction
@@ -186,6 +189,14 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     *opt.warnings << res.material_warning << std::endl;
   if (opt.progress && res.report.first_unstable_step > 0)
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
+  // A run in which no load step converged does not replace an earlier output of the same
+  // directory with its empty one (session 26, found by a helper's audit: a rerun that failed
+  // at the first step cost the earlier results); into a new directory it writes its summary.
+  if (writer && res.report.converged_steps == 0 && had_output) {
+    writer.reset();  // the partial directory goes; the earlier output stays
+    res.output_failure = "no load step converged: nothing written; the earlier outputs in " +
+                         opt.output_dir.string() + " are left as they were";
+  }
   if (writer) {
     writer->set_material_report(material_report);
     writer->set_material_warning(res.material_warning);

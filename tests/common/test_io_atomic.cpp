@@ -418,6 +418,35 @@ TEST_CASE("AtomicDirectory replaces only outputs of its own program", "[unit][io
   CHECK(knit::io::output_marker_owner(d) == std::nullopt);  // no marker
 }
 
+// Session 26 (found by a helper's audit): when a foreign directory appeared at the target
+// during a run, the refusal said "the new output is in DIR.partial-<pid>", which the
+// destructor then deleted.
+TEST_CASE("AtomicDirectory keeps the new output when a foreign directory took its place",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("taken");
+  const fs::path target = d / "out";
+  std::string kept;
+  {
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "result.txt") << "new";
+    fs::create_directories(target);
+    std::ofstream(target / "theirs.txt") << "theirs";  // somebody else's, meanwhile
+    try {
+      a.commit();
+      FAIL("no error");
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      const std::size_t at = m.find("the new output is kept in ");
+      REQUIRE(at != std::string::npos);
+      kept = m.substr(at + std::string("the new output is kept in ").size());
+    }
+  }
+  CHECK(kept == (d / ("out.new-" + std::to_string(::getpid()))).string());
+  CHECK(slurp(fs::path(kept) / "result.txt") == "new");
+  CHECK(slurp(target / "theirs.txt") == "theirs");
+  CHECK_FALSE(fs::exists(target / knit::io::kOutputMarker));
+}
+
 TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its target",
           "[unit][io][atomic]") {
   const fs::path d = scratch("stale_tmp");

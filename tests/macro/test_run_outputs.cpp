@@ -73,6 +73,42 @@ TEST_CASE("knit-macro run never deletes files it did not write", "[unit][outputs
   fs::remove_all(d);
 }
 
+// Session 26 (found by a helper's audit): the reproduction pipeline's output directory (marked
+// by scripts/pipeline.mk) was replaced by a run's; a rerun in which no step converged replaced
+// the earlier results with its empty output.
+TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a failed rerun",
+          "[unit][outputs]") {
+  const fs::path d = scratch("owner");
+  const std::string c = small_case(d);
+  fs::create_directories(d / "pipeline" / "figures");
+  std::ofstream(d / "pipeline" / ".knitscale-output")
+      << "knitscale output: the reproduction pipeline (scripts/pipeline.mk)\n";
+  std::ofstream(d / "pipeline" / "figures" / "f.png") << "png";
+  auto r = macro(c + " --output " + (d / "pipeline").string());
+  CHECK(r.rc == 2);
+  CHECK(knit_test::contains(r.output, "is the output of the reproduction pipeline"));
+  CHECK(fs::exists(d / "pipeline" / "figures" / "f.png"));
+
+  REQUIRE(macro(c + " --output " + (d / "out").string()).rc == 0);
+  std::ifstream good_in(d / "out" / "load_strain.csv");
+  const std::string good((std::istreambuf_iterator<char>(good_in)), {});
+  json j = json::parse(std::ifstream(c));
+  j["solver"]["max_iterations"] = 1;  // no step can converge
+  j["solver"]["tolerance"] = 1e-30;
+  j["solver"]["max_cutbacks"] = 1;
+  std::ofstream(d / "fail.json") << j.dump(2);
+  r = macro((d / "fail.json").string() + " --output " + (d / "out").string());
+  CHECK(r.rc == 1);
+  CHECK(knit_test::contains(r.output, "no load step converged: nothing written"));
+  std::ifstream again_in(d / "out" / "load_strain.csv");
+  CHECK(std::string((std::istreambuf_iterator<char>(again_in)), {}) == good);
+  // Into a new directory the failed run still writes its summary.
+  r = macro((d / "fail.json").string() + " --output " + (d / "new").string());
+  CHECK(r.rc == 1);
+  CHECK(fs::exists(d / "new" / "summary.txt"));
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run refuses an output it cannot write before the run", "[unit][outputs]") {
   const fs::path d = scratch("targets");
   const std::string c = small_case(d);
