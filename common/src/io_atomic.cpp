@@ -191,6 +191,19 @@ void remove_marked_tree(const fs::path& dir) {
 void remove_stale_siblings(const fs::path& target) {
   const std::string name = target.filename().string();
   std::error_code ec;
+  // A run killed between the two renames of a replacement without RENAME_EXCHANGE left no
+  // DIR and the earlier output in DIR.old-<pid>: put it back first (session 26: the clean-up
+  // deleted it, before a run that could still fail).
+  if (!fs::exists(fs::symlink_status(target, ec))) {
+    for (auto it = fs::directory_iterator(parent_or_dot(target), ec);
+         !ec && it != fs::directory_iterator(); it.increment(ec)) {
+      const long pid = pid_in_name(it->path().filename().string(), name + ".old-", false);
+      if (pid >= 0 && (pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path()) &&
+          ::rename(it->path().c_str(), target.c_str()) == 0)
+        break;
+    }
+    ec.clear();
+  }
   for (auto it = fs::directory_iterator(parent_or_dot(target), ec);
        !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const std::string f = it->path().filename().string();

@@ -364,6 +364,17 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(fs::exists(d / "out.partial-99999999x"));
   CHECK(fs::exists(d / ("out.partial-" + dead + "0")));
   CHECK(fs::exists(d / ("other.partial-" + dead)));
+  // Killed between the two renames of a replacement without RENAME_EXCHANGE: no DIR, the
+  // earlier output in DIR.old-<pid>. The next run puts it back, and a run that then fails
+  // leaves it there (session 26: the clean-up deleted it).
+  fs::remove_all(target);
+  make("out.old-" + dead, true);
+  {
+    knit::io::AtomicDirectory a(target);  // abandoned: no commit
+    CHECK(slurp(target / "x") == "x");
+  }
+  CHECK(slurp(target / "x") == "x");
+  CHECK_FALSE(fs::exists(d / ("out.old-" + dead)));
 }
 
 // Session 26 (found by a helper's audit): `knit-macro run case.json -o out` replaced the
