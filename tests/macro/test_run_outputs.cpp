@@ -109,6 +109,22 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
   fs::remove_all(d);
 }
 
+// Session 26: an interrupted run ended silently (the sweep said what it kept; run, design and
+// fit did not).
+TEST_CASE("knit-macro run: an interrupt says what became of the outputs", "[unit][outputs]") {
+  const fs::path d = scratch("interrupt");
+  const std::string c = small_case(d, 5, 100000);  // runs far longer than the 1 s below
+  const auto r =
+      knit_test::run_command("timeout --preserve-status -s INT 1 " + std::string(KNIT_BIN_DIR) +
+                             "/knit-macro run " + c + " --output " + (d / "out").string());
+  CHECK(r.rc == 130);  // 128 + SIGINT: ended by the signal
+  CHECK(knit_test::contains(r.output,
+                            "knit-macro run: interrupted; outputs not yet complete "
+                            "are not written, earlier outputs stay as they were"));
+  CHECK_FALSE(fs::exists(d / "out"));
+  fs::remove_all(d);
+}
+
 TEST_CASE("knit-macro run refuses an output it cannot write before the run", "[unit][outputs]") {
   const fs::path d = scratch("targets");
   const std::string c = small_case(d);
