@@ -181,7 +181,11 @@ void remove_marked_tree(const fs::path& dir) {
   for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
        it.increment(ec))
     if (it->path().filename() != kOutputMarker) entries.push_back(it->path());
-  for (const auto& e : entries) fs::remove_all(e, ec);
+  if (ec) return;  // not listed: keep it marked for a later clean-up
+  for (const auto& e : entries) {
+    fs::remove_all(e, ec);
+    if (ec) return;  // something stays: so does the marker
+  }
   fs::remove(dir / kOutputMarker, ec);
   fs::remove(dir, ec);
 }
@@ -229,9 +233,10 @@ void remove_old_output(const fs::path& old) {
 
 AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::string_view option)
     : target_(prepare_target(std::move(target), option)), lock_(target_), on_abandon_(on_abandon) {
-  // Under the lock: nobody else writes this target now; check again what it holds.
-  check_output_target(target_, OutputKind::kDirectory, option);
+  // Under the lock: nobody else writes this target now. Clean up after killed runs (which may
+  // put an earlier output back in place), then check again what the target holds.
   remove_stale_siblings(target_);
+  check_output_target(target_, OutputKind::kDirectory, option);
   partial_ = target_;
   partial_ += ".partial-";
   partial_ += std::to_string(::getpid());
@@ -293,17 +298,19 @@ void AtomicDirectory::commit() {
     if (!is_own_output(target_) && !fs::is_empty(target_, ec)) {
       // Keep the new output beside it under a name of its own (the clean-up of partial
       // directories would remove it; session 26: the message named it, and it was gone).
-      fs::path kept = target_;
-      kept += ".new-";
-      kept += std::to_string(::getpid());
-      std::string where = partial_.string();
-      if (!fs::exists(fs::symlink_status(kept, ec)) &&
-          ::rename(partial_.c_str(), kept.c_str()) == 0) {
-        where = kept.string();
-        active_ = false;  // nothing left to remove
-      } else {
-        on_abandon_ = OnAbandon::Keep;
+      std::string where;
+      for (int k = 0; k < 100 && where.empty(); ++k) {
+        fs::path kept = target_;
+        kept += ".new-" + std::to_string(::getpid()) + (k ? "-" + std::to_string(k) : "");
+        if (!fs::exists(fs::symlink_status(kept, ec)) &&
+            ::rename(partial_.c_str(), kept.c_str()) == 0)
+          where = kept.string();
       }
+      if (where.empty()) {  // kept as the partial directory, complete, without INCOMPLETE
+        where = partial_.string() + " (rename it: the next run into " + target_.string() +
+                " removes it)";
+      }
+      active_ = false;  // nothing to remove or mark
       fail(target_, "became a non-empty directory that is not this program's output (its " +
                         std::string(kOutputMarker) + " is missing or names another) while " +
                         "the run went on: left alone; the new output is kept in " + where);

@@ -48,8 +48,8 @@ knit::cli::SubcommandRegistrar reg(
         const auto r = knit::macro::run_case(c, ro);
         if (!r.succeeded()) {
           std::cerr << "knit-macro run: " << o->case_file << ": "
-                    << knit::macro::run_failure_message(r) << "; outputs in "
-                    << ro.output_dir.string() << "\n";
+                    << knit::macro::run_failure_message(r)
+                    << (r.wrote_outputs ? "; outputs in " + ro.output_dir.string() : "") << "\n";
           return knit::kExitFailure;
         }
         std::cout << "wrote " << ro.output_dir.string() << "\n";

@@ -50,21 +50,31 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, bool co
     const double tol = 1e-6 * (v.upper - v.lower);
     on_bound = on_bound || r.x[i] <= v.lower + tol || r.x[i] >= v.upper - tol;
   }
-  if (!(r.J > opt.feasible * r.J0)) {
+  // The objectives' share of J: the smoothness penalty (the last term when it is on) is a
+  // regularization, not a target, and keeps J > 0 at a design that meets every target.
+  auto objectives_only = [&](const std::vector<std::pair<std::string, double>>& terms, double J) {
+    if (d.smoothness <= 0.0 || terms.size() != d.objectives.size() + 1) return J;
+    return std::max(0.0, J - terms.back().second);
+  };
+  const double Jo = objectives_only(r.terms, r.J), J0o = objectives_only(r.terms0, r.J0);
+  if (!(Jo > opt.feasible * J0o)) {
     r.status = DesignStatus::kConverged;
     return;
   }
-  // Stopped with J above `feasible` x J0: the objectives are not met. On a bound the bounds
+  // Stopped with the objectives above `feasible` x their start: not met. On a bound the bounds
   // keep them out of reach; inside, the optimizer stopped at a local minimum (or a loose
   // function tolerance stopped it early). Session 26: that case said "converged" (design
   // example (a)'s stale target, docs/design.md).
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "J = %.6g is %.3g x J0 (above the %.0e that counts as met)", r.J,
-                r.J0 > 0 ? r.J / r.J0 : 0.0, opt.feasible);
+  char buf[240];
+  std::snprintf(buf, sizeof buf,
+                "the objectives' J = %.6g is %.3g x their start (above the %.0e that counts as "
+                "met%s)",
+                Jo, J0o > 0 ? Jo / J0o : 0.0, opt.feasible,
+                Jo != r.J ? "; the smoothness penalty left out" : "");
   r.status = on_bound ? DesignStatus::kInfeasible : DesignStatus::kTargetNotMet;
   char tol[64];
   std::snprintf(tol, sizeof tol, "%g", opt.function_tolerance);
-  r.message = std::string(buf) +
+  r.message = (r.message.empty() ? "" : r.message + "; ") + std::string(buf) +
               (on_bound ? ", with a variable on a bound: the targets lie outside the bounds"
                         : std::string(", inside the bounds: a local minimum of J, or a stop by "
                                       "the function tolerance (") +

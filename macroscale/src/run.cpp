@@ -120,9 +120,12 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   Problem p = setup_problem(c);
   const ShellModel& m = *p.model;
   std::unique_ptr<ResultsWriter> writer;
-  std::error_code ec;
-  const bool had_output = !opt.output_dir.empty() && std::filesystem::exists(opt.output_dir, ec);
   if (!opt.output_dir.empty()) writer = std::make_unique<ResultsWriter>(c, m, opt.output_dir);
+  // After the writer took the output (and put back an earlier one a killed run had moved
+  // aside): is there an earlier output a run without a converged step must not replace?
+  std::error_code ec;
+  const bool had_output = writer && std::filesystem::is_directory(opt.output_dir, ec) &&
+                          !std::filesystem::is_empty(opt.output_dir, ec);
   RunResult res;
   std::vector<std::vector<int>> corner_sets;  // the control points of each corner reaction
   for (const ReactionOutput& r : c.output.reactions)
@@ -206,6 +209,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
         outputs % c.output.every != 0)
       writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
     writer->finish(res.report);
+    res.wrote_outputs = true;
     res.output_failure = writer->output_failure();
   }
   return res;

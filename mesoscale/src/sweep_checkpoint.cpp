@@ -42,8 +42,11 @@ bool is_store_file(std::string name) {
     name = name.substr(1, tmp - 1);
   }
   if (name == kManifest) return true;
-  if (name.size() != 13 || name.rfind("job_", 0) != 0 || name.substr(9) != ".txt") return false;
-  for (std::size_t i = 4; i < 9; ++i)
+  // job_%05d.txt: at least 5 digits (index 100000 has 6)
+  if (name.size() < 13 || name.rfind("job_", 0) != 0 ||
+      name.compare(name.size() - 4, 4, ".txt") != 0)
+    return false;
+  for (std::size_t i = 4; i + 4 < name.size(); ++i)
     if (name[i] < '0' || name[i] > '9') return false;
   return true;
 }

@@ -50,10 +50,14 @@ def mesh_label(case):
     if p is None or not el:
         return None
     h = el[0] if len(set(el)) == 1 else "x".join(str(e) for e in el)
-    radii = [bc.get("radius", 0) for bc in case.get("boundary_conditions", []) if "corner" in bc]
+    radii = [bc.get("radius") or 0 for bc in case.get("boundary_conditions", []) if "corner" in bc]
     grip = ""
-    if radii:
-        grip = f" ({max(radii):g} mm pad)" if max(radii) > 0 else " (corner point)"
+    if radii and all(r > 0 for r in radii) and len(set(radii)) == 1:
+        grip = f" ({radii[0]:g} mm pad)"
+    elif radii and not any(r > 0 for r in radii):
+        grip = " (corner point)"
+    elif radii:
+        grip = " (corner pads " + ", ".join(f"{r:g}" for r in radii) + " mm)"
     return f"p = {p}, h = {h}{grip}"
 
 

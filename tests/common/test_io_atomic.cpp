@@ -422,9 +422,20 @@ TEST_CASE("AtomicDirectory replaces only outputs of its own program", "[unit][io
     CHECK(slurp(run / "x.txt") == "1");
     std::ofstream(run / knit::io::kOutputMarker) << "knitscale output\n{}\n";
     CHECK(knit::io::output_marker_owner(run) == std::optional<std::string>(""));
-    knit::io::AtomicDirectory a(run);
-    a.commit();
+    {
+      knit::io::AtomicDirectory a(run);
+      a.commit();
+    }
     CHECK_FALSE(fs::exists(run / "x.txt"));
+    // An earlier output of another program put back from DIR.old-<dead pid> is checked like
+    // any other: refused at once, not after the run (review of session 26).
+    const fs::path moved = d / "run2.old-999999999";
+    fs::create_directories(moved);
+    std::ofstream(moved / knit::io::kOutputMarker) << "knitscale output: knit-macro design\n";
+    std::ofstream(moved / "y.txt") << "y";
+    CHECK_THROWS_WITH(knit::io::AtomicDirectory(d / "run2"),
+                      Catch::Contains("is the output of knit-macro design"));
+    CHECK(slurp(d / "run2" / "y.txt") == "y");
   }
   CHECK(knit::io::output_marker_owner(d) == std::nullopt);  // no marker
 }

@@ -270,6 +270,33 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
   }
 }
 
+// The smoothness penalty is a regularization: a design that meets its targets with J > 0 from
+// the penalty alone is "converged" (review of session 26).
+TEST_CASE("design status: the smoothness penalty does not count against the targets", "[unit]") {
+  DesignProblem d;
+  d.variables.resize(1);
+  d.variables[0].lower = 4.5;
+  d.variables[0].upper = 6.5;
+  d.objectives.resize(1);
+  d.smoothness = 0.1;
+  OptimizeOptions opt;
+  DesignResult r;
+  r.x = {5.5};
+  r.terms0 = {{"load", 10.0}, {"smoothness", 1.0}};
+  r.J0 = 11.0;
+  r.terms = {{"load", 0.0}, {"smoothness", 0.5}};
+  r.J = 0.5;
+  classify_result(d, opt, true, r);
+  CHECK(r.status == DesignStatus::kConverged);
+  r.terms = {{"load", 1.0}, {"smoothness", 0.5}};
+  r.J = 1.5;
+  r.message = "no descent step found";
+  classify_result(d, opt, true, r);
+  CHECK(r.status == DesignStatus::kTargetNotMet);
+  CHECK_THAT(r.message, Catch::StartsWith("no descent step found; the objectives' J = 1 is 0.1 x"));
+  CHECK_THAT(r.message, Catch::Contains("the smoothness penalty left out"));
+}
+
 // Session 23 made a final run that is not a plain success end `knit-macro design` with exit 1;
 // session 24 moved that decision out of the command so that it is tested.
 TEST_CASE("design: the exit code is the optimizer's status and the final run's", "[unit]") {

@@ -102,10 +102,21 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
   CHECK(knit_test::contains(r.output, "no load step converged: nothing written"));
   std::ifstream again_in(d / "out" / "load_strain.csv");
   CHECK(std::string((std::istreambuf_iterator<char>(again_in)), {}) == good);
-  // Into a new directory the failed run still writes its summary.
-  r = macro((d / "fail.json").string() + " --output " + (d / "new").string());
+  CHECK_FALSE(knit_test::contains(r.output, "; outputs in"));
+  // An earlier output that a killed replacement had moved aside (no DIR, DIR.old-<dead pid>)
+  // is put back and kept by the failed rerun as well.
+  fs::rename(d / "out", d / "out.old-999999999");
+  r = macro((d / "fail.json").string() + " --output " + (d / "out").string());
   CHECK(r.rc == 1);
-  CHECK(fs::exists(d / "new" / "summary.txt"));
+  std::ifstream back_in(d / "out" / "load_strain.csv");
+  CHECK(std::string((std::istreambuf_iterator<char>(back_in)), {}) == good);
+  // Into a new, or an empty, directory the failed run still writes its summary.
+  fs::create_directories(d / "empty");
+  for (const char* dir : {"new", "empty"}) {
+    r = macro((d / "fail.json").string() + " --output " + (d / dir).string());
+    CHECK(r.rc == 1);
+    CHECK(fs::exists(d / dir / "summary.txt"));
+  }
   fs::remove_all(d);
 }
 

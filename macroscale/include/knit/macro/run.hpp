@@ -86,6 +86,9 @@ struct RunResult {
   /// Empty, or where the written output fields held a non-finite number (results_writer.hpp:
   /// the output grid reached a strain where the material's stress is not finite).
   std::string output_failure;
+  /// False when the run wrote no output directory (none asked for, or a run without a
+  /// converged step that left an earlier output in place).
+  bool wrote_outputs = false;
   /// Plain success: every step converged, the material never failed and every output value is
   /// finite.
   bool succeeded() const {
