@@ -98,9 +98,9 @@ SubcommandRegistrar::SubcommandRegistrar(std::string name, std::string descripti
 
 namespace {
 // The line an interrupted run prints (SIGINT, SIGTERM, SIGHUP) before it ends by the signal:
-// prepared beforehand, written by an async-signal-safe handler (session 26: run, design, fit
-// ended silently; the sweep installs its own handler, which names its checkpoints).
-char g_interrupt_line[256];
+// prepared beforehand, written by an async-signal-safe handler (the sweep's since session 21;
+// every program's since session 26: run, design and fit ended silently).
+char g_interrupt_line[4096];
 std::size_t g_interrupt_length = 0;
 
 void on_cli_interrupt(int sig) {
@@ -111,16 +111,16 @@ void on_cli_interrupt(int sig) {
   std::signal(sig, SIG_DFL);
   std::raise(sig);
 }
+}  // namespace
 
-void say_when_interrupted(const std::string& who) {
-  const std::string m = "\n" + who +
-                        ": interrupted; outputs not yet complete are not written, earlier "
-                        "outputs stay as they were\n";
-  g_interrupt_length = std::min(m.size(), sizeof g_interrupt_line);
-  std::memcpy(g_interrupt_line, m.data(), g_interrupt_length);
+void on_interrupt_say(const std::string& line) {
+  const std::string m = "\n" + line + "\n";
+  g_interrupt_length = 0;  // no half-copied line if a signal comes now
+  const std::size_t n = std::min(m.size(), sizeof g_interrupt_line);
+  std::memcpy(g_interrupt_line, m.data(), n);
+  g_interrupt_length = n;
   for (const int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_cli_interrupt);
 }
-}  // namespace
 
 int run_main(int argc, char** argv, const std::string& program, const std::string& description) {
   CLI::App app{description, program};
@@ -163,7 +163,9 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
   }
   // The markers of this run's output directories name it (knit/io/output_target.hpp).
   io::set_output_owner(who());
-  say_when_interrupted(who());
+  on_interrupt_say(who() +
+                   ": interrupted; outputs not yet complete are not written, earlier outputs "
+                   "stay as they were");
   try {
     for (auto& [sub, run] : subs)
       if (sub->parsed()) return run();

@@ -14,7 +14,6 @@
 
 #include <algorithm>
 #include <array>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -116,27 +115,13 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
 
 // Ctrl-C (SIGINT), and SIGTERM and SIGHUP (a job scheduler's stop, a closed terminal; session
 // 22), say what is kept and how to go on, then end the process as the signal would (session
-// 21: it printed nothing). Async-signal-safe: the message is composed before,
-// the handler only write()s it and re-raises with the default action.
-char g_interrupt_message[4096];
-std::size_t g_interrupt_length = 0;
-
-extern "C" void on_interrupt(int sig) {
-  if (g_interrupt_length > 0) {
-    const ssize_t ignored = ::write(STDERR_FILENO, g_interrupt_message, g_interrupt_length);
-    (void)ignored;
-  }
-  std::signal(sig, SIG_DFL);
-  std::raise(sig);
-}
-
+// 21: it printed nothing). knit::cli::on_interrupt_say holds the async-signal-safe handler.
 void explain_interrupt(const Cli& c) {
-  const std::string m = "\nknit-meso sweep: interrupted; the cases finished so far are kept in " +
-                        c.output + ".parts: continue with `knit-meso sweep " + c.input +
-                        " --output " + c.output + " --resume`\n";
-  g_interrupt_length = std::min(m.size(), sizeof g_interrupt_message);
-  std::memcpy(g_interrupt_message, m.data(), g_interrupt_length);
-  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_interrupt);
+  knit::cli::on_interrupt_say(
+      "knit-meso sweep: interrupted; the cases finished so far are kept "
+      "in " +
+      c.output + ".parts: continue with `knit-meso sweep " + c.input + " --output " + c.output +
+      " --resume`");
 }
 
 int run(const Cli& c) {

@@ -50,4 +50,11 @@ std::string describe_range(double lo, double hi, Ends ends);
 /// Builds the app from the registered subcommands, parses, runs; returns the exit code.
 int run_main(int argc, char** argv, const std::string& program, const std::string& description);
 
+/// The line printed on stderr when SIGINT, SIGTERM or SIGHUP ends the process (it then ends
+/// as the signal would). run_main sets a general one before the subcommand runs ("<program>
+/// <subcommand>: interrupted; ..."); a subcommand that knows more (the sweep: its checkpoints
+/// and the --resume command) replaces it. Async-signal-safe: the line is copied (up to 4 kB)
+/// here, and the handler only write()s it.
+void on_interrupt_say(const std::string& line);
+
 }  // namespace knit::cli
