@@ -206,6 +206,16 @@ std::string unknown_key_note(const std::string& key, const std::vector<std::stri
   return note + ")";
 }
 
+std::optional<UnknownKey> find_unknown_key(const nlohmann::json& j, const std::string& pointer,
+                                           const std::vector<std::string>& allowed) {
+  if (!j.is_object()) return std::nullopt;
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
+      return UnknownKey{it.key(), json_pointer_append(pointer, it.key()),
+                        unknown_key_note(it.key(), allowed)};
+  return std::nullopt;
+}
+
 std::map<std::string, int> json_pointer_lines(std::string_view text) {
   LineScanner s;
   s.t = text;

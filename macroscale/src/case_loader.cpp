@@ -69,12 +69,8 @@ class Reader {
   void keys(const json& j, const std::string& ptr, std::initializer_list<const char*> allowed,
             std::initializer_list<const char*> required = {}) const {
     object(j, ptr);
-    for (auto it = j.begin(); it != j.end(); ++it) {
-      if (std::none_of(allowed.begin(), allowed.end(),
-                       [&](const char* k) { return it.key() == k; }))
-        fail(ptr + "/" + it.key(),
-             "unknown key" + io::unknown_key_note(it.key(), {allowed.begin(), allowed.end()}));
-    }
+    if (auto u = io::find_unknown_key(j, ptr, {allowed.begin(), allowed.end()}))
+      fail(u->pointer, "unknown key" + u->note);
     for (const char* k : required)
       if (!j.contains(k)) fail(ptr, std::string("missing required key \"") + k + "\"");
   }

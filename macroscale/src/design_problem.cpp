@@ -275,10 +275,8 @@ DesignProblem load_design(const std::string& path) {
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
   const std::vector<std::string> top_keys = {"$schema",    "description", "case",     "variables",
                                              "objectives", "smoothness",  "optimizer"};
-  for (auto it = root.begin(); it != root.end(); ++it)
-    if (std::find(top_keys.begin(), top_keys.end(), it.key()) == top_keys.end())
-      throw InputError(path, io::json_pointer_append("", it.key()),
-                       "unknown key" + io::unknown_key_note(it.key(), top_keys));
+  if (auto u = io::find_unknown_key(root, "", top_keys))
+    throw InputError(path, u->pointer, "unknown key" + u->note);
   if (!root.contains("case") || !root.at("case").is_string())
     throw InputError(path, "/case", "needs the case file (a string, relative to this file)");
   d.case_file = io::resolve_input_path(path, root.at("case").get<std::string>()).string();

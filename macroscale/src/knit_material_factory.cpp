@@ -47,10 +47,8 @@ std::vector<double> number_array(const nlohmann::json& j, const std::string& p,
 
 void check_keys(const nlohmann::json& j, const std::string& p, const CaseContext& ctx,
                 const std::vector<std::string>& allowed) {
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
-      throw InputError(ctx.file, p + "/" + it.key(),
-                       "unknown key" + io::unknown_key_note(it.key(), allowed));
+  if (auto u = io::find_unknown_key(j, p, allowed))
+    throw InputError(ctx.file, u->pointer, "unknown key" + u->note);
 }
 
 struct Basis2 {

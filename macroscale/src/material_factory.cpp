@@ -43,11 +43,9 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
   if (type == "saint_venant_kirchhoff") {
     const std::vector<std::string> allowed = {"type", "youngs_modulus", "poisson_ratio",
                                               "description"};
-    for (auto it = m.begin(); it != m.end(); ++it)
-      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
-        throw InputError(ctx.file, ctx.pointer + "/" + it.key(),
-                         "unknown key for a saint_venant_kirchhoff material" +
-                             io::unknown_key_note(it.key(), allowed));
+    if (auto u = io::find_unknown_key(m, ctx.pointer, allowed))
+      throw InputError(ctx.file, u->pointer,
+                       "unknown key for a saint_venant_kirchhoff material" + u->note);
     const double E = positive_number(m, "youngs_modulus", ctx);
     if (!m.contains("poisson_ratio"))
       throw InputError(ctx.file, ctx.pointer, "missing required key \"poisson_ratio\"");

@@ -342,10 +342,8 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "tube_uniaxial_weight",
                                 "prior_points",
                                 "prior_weight"};
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (std::find_if(std::begin(known), std::end(known),
-                     [&](const char* k) { return it.key() == k; }) == std::end(known))
-      throw InputError(file, pointer + "/" + it.key(), "unknown energy-fit option");
+  if (auto u = io::find_unknown_key(j, pointer, {std::begin(known), std::end(known)}))
+    throw InputError(file, u->pointer, "unknown energy-fit option" + u->note);
   auto get_int = [&](const char* k, int& v) { read_int_option(j, k, file, pointer, v); };
   auto get_double = [&](const char* k, double& v) { read_double_option(j, k, file, pointer, v); };
 

@@ -201,10 +201,8 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
                                 "loss_scale",         "optimize_foot_points",
                                 "foot_point_penalty", "max_iterations",
                                 "initial_stiffness"};
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (std::find_if(std::begin(known), std::end(known),
-                     [&](const char* k) { return it.key() == k; }) == std::end(known))
-      throw InputError(file, "/" + it.key(), "unknown fit option");
+  if (auto u = io::find_unknown_key(j, "", {std::begin(known), std::end(known)}))
+    throw InputError(file, u->pointer, "unknown fit option" + u->note);
   get_int("degree_1", o.degree1);
   get_int("degree_2", o.degree2);
   get_int("control_points_1", o.n_ctrl1);

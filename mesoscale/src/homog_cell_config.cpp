@@ -24,8 +24,8 @@ struct Reader {
   }
   void object(const json& j, const std::string& ptr, const std::set<std::string>& allowed) const {
     if (!j.is_object()) fail(ptr, "must be an object");
-    for (const auto& [k, v] : j.items())
-      if (!allowed.count(k)) fail(ptr + "/" + k, "unknown field");
+    if (auto u = io::find_unknown_key(j, ptr, {allowed.begin(), allowed.end()}))
+      fail(ptr, "unknown key \"" + u->key + "\"" + u->note);
   }
   // Reads j[key] into v if present; checks lo < v (strict) or lo <= v and v <= hi.
   void num(const json& j, const std::string& ptr, const char* key, double& v, double lo, double hi,

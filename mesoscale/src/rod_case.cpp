@@ -43,10 +43,8 @@ struct Reader {
   void object(const json& j, const std::string& ptr, std::set<std::string> allowed,
               std::set<std::string> required = {}) const {
     if (!j.is_object()) fail(ptr, "must be an object, got " + kind(j));
-    for (const auto& [k, v] : j.items())
-      if (!allowed.count(k))
-        fail(ptr, "unknown key \"" + k + "\"" +
-                      io::unknown_key_note(k, {allowed.begin(), allowed.end()}));
+    if (auto u = io::find_unknown_key(j, ptr, {allowed.begin(), allowed.end()}))
+      fail(ptr, "unknown key \"" + u->key + "\"" + u->note);
     for (const auto& r : required)
       if (!j.contains(r)) fail(ptr, "missing required key \"" + r + "\"");
   }

@@ -80,6 +80,23 @@ TEST_CASE("read_json_file reports file, line and column", "[unit][io][json]") {
   CHECK(knit::io::read_json_file(scratch("ok.json", R"({"x": [1, 2.5]})"))["x"][1] == 2.5);
 }
 
+TEST_CASE("find_unknown_key: the first unknown member and its escaped pointer",
+          "[unit][io][json]") {
+  using knit::io::find_unknown_key;
+  const nlohmann::json j = nlohmann::json::parse(R"({"E": 1, "x/y~z": 2, "nu": 3})");
+  CHECK_FALSE(find_unknown_key(j, "/material", {"E", "nu", "x/y~z"}).has_value());
+  CHECK_FALSE(find_unknown_key(nlohmann::json::array(), "/material", {}).has_value());
+  const auto u = find_unknown_key(j, "/material", {"E", "nu"});
+  REQUIRE(u.has_value());
+  CHECK(u->key == "x/y~z");
+  CHECK(u->pointer == "/material/x~1y~0z");  // RFC 6901: '~' -> "~0", '/' -> "~1"
+  CHECK(u->note == " (allowed: \"E\", \"nu\")");
+  const auto v = find_unknown_key(nlohmann::json::parse(R"({"Nu": 3})"), "", {"E", "nu"});
+  REQUIRE(v.has_value());
+  CHECK(v->pointer == "/Nu");
+  CHECK(v->note == " (did you mean \"nu\"? allowed: \"E\", \"nu\")");
+}
+
 TEST_CASE("unknown_key_note and with_line: one wording and one line rule for every reader",
           "[unit][io][json]") {
   using knit::io::unknown_key_note;

@@ -107,6 +107,25 @@ TEST_CASE("bad case input of several lines also names the line", "[unit]") {
         "v1) (line " +
             std::to_string(line_of("\"u2\"")) + ")");
   CHECK(message(j.dump()).find("(line") == std::string::npos);
+  // An unknown key holding '/' or '~' is named by its escaped pointer (RFC 6901), so its line
+  // is found too (session 27: "/material/x/y: unknown key", no line).
+  j = read_json("tensile_svk.json");
+  j["material"]["x/y~z"] = 1;
+  const std::string odd = j.dump(2);
+  const auto odd_at = odd.find("\"x/y~z\"");
+  REQUIRE(odd_at != std::string::npos);
+  CHECK(message(odd).rfind("bad.json: /material/x~1y~0z: unknown key for a saint_venant_kirchhoff "
+                           "material (allowed: ",
+                           0) == 0);
+  CHECK(
+      message(odd).find(
+          "(line " +
+          std::to_string(1 + std::count(odd.begin(),
+                                        odd.begin() + static_cast<std::ptrdiff_t>(odd_at), '\n')) +
+          ")") != std::string::npos);
+  j = read_json("tensile_svk.json");
+  j["solver"]["a/b"] = 1;
+  CHECK(message(j.dump()).rfind("bad.json: /solver/a~1b: unknown key (allowed: ", 0) == 0);
 }
 
 TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {

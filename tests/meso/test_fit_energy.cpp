@@ -544,6 +544,8 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("/degree_1") && Catch::Contains("32-bit"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"smooth": 1})", "f.json"),
                       Catch::Contains("/smooth: unknown energy-fit option"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"seeed": 1})", "f.json"),
+                      Catch::Contains("/seeed: unknown energy-fit option (did you mean \"seed\"?"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"directions": [[1, 0]]})", "f.json"),
                       Catch::Contains("/directions/0"));
     EnergyFitOptions o;

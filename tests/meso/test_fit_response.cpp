@@ -103,7 +103,10 @@ TEST_CASE("fit: data that cannot determine the surface are refused with the reas
     CHECK_THROWS_WITH(FitOptions::from_json("{\"loss\": \"l1\"}", "opts.json"),
                       Catch::Contains("opts.json: /loss: must be"));
     CHECK_THROWS_WITH(FitOptions::from_json("{\"smoth\": 1}", "opts.json"),
-                      Catch::Contains("/smoth: unknown fit option"));
+                      Catch::Contains("/smoth: unknown fit option (allowed: \"degree_1\", "));
+    // A key holding '/' is named by its escaped pointer (session 27: "/a/b").
+    CHECK_THROWS_WITH(FitOptions::from_json("{\"a/b\": 1}", "opts.json"),
+                      Catch::Contains("opts.json: /a~1b: unknown fit option"));
   }
   SECTION("every integer option is bounded and named by its pointer") {
     // control_points_1 = 123456789 ran for minutes (60 take 90 s); the bounds are the sweep

@@ -34,6 +34,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -121,6 +122,22 @@ std::string closest_key(const std::string& key, const std::vector<std::string>& 
 /// most kMaxListedKeys of them. "" when there is neither.
 inline constexpr std::size_t kMaxListedKeys = 16;
 std::string unknown_key_note(const std::string& key, const std::vector<std::string>& known);
+
+/// The first member of the object `j` whose key is not in `allowed`, as the hand-written
+/// readers report it (the case, material, design, rod and cell readers and the fit options):
+/// the key, its JSON pointer under `pointer`, escaped as RFC 6901 says ("a/b" -> "a~1b", so
+/// the pointer names the member and its line can be found), and unknown_key_note. nullopt
+/// when every key is allowed (or `j` is not an object). One loop for every reader (session 27:
+/// four readers appended the raw key, "/material/x/y" for the key "x/y"). The case, material,
+/// design and fit-option readers name the member's pointer; the rod and cell readers word it
+/// as their schemas do (the object's pointer, the key quoted).
+struct UnknownKey {
+  std::string key;
+  std::string pointer;
+  std::string note;
+};
+std::optional<UnknownKey> find_unknown_key(const nlohmann::json& j, const std::string& pointer,
+                                           const std::vector<std::string>& allowed);
 
 /// `message` + " (line N)", N the line of the first of `pointers` found in the JSON `text`
 /// (json_pointer_lines); `message` unchanged when none is found, when it already names a line,
