@@ -2,19 +2,21 @@
 #include "knit/macro/geometry_check.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <vector>
 
+#include "knit/spline/knot_vector.hpp"
 #include "knit/spline/quadrature.hpp"
 
 namespace knit::macro {
 
 namespace {
 
-/// Span ends and the p + 1 Gauss points of every non-empty knot span, increasing.
-std::vector<double> sample_abscissae(const std::vector<double>& U, int p) {
-  const spline::QuadratureRule g = spline::gauss_legendre(p + 1);
+/// Span ends and the max(p + 1, n) Gauss points of every non-empty knot span, increasing.
+std::vector<double> sample_abscissae(const std::vector<double>& U, int p, int n) {
+  const spline::QuadratureRule g = spline::gauss_legendre(std::max(p + 1, n));
   std::vector<double> s;
   for (std::size_t i = 0; i + 1 < U.size(); ++i) {
     const double a = U[i], b = U[i + 1];
@@ -45,12 +47,25 @@ double patch_size(const spline::SplineSurface& s) {
   return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
 }
 
-std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& s) {
+int dense_samples_per_span(const spline::SplineSurface& s) {
+  const auto spans = [](const std::vector<double>& U) {
+    return std::max<std::size_t>(1, spline::unique_knots(U).size() - 1);
+  };
+  const double cells = static_cast<double>(spans(s.basis_u().knots())) *
+                       static_cast<double>(spans(s.basis_v().knots()));
+  return static_cast<int>(std::clamp(std::floor(std::sqrt(kMaxDenseSamples / cells)), 1.0,
+                                     static_cast<double>(kDenseSamplesPerSpan)));
+}
+
+std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& s,
+                                                   int samples_per_span) {
   const Eigen::MatrixXd& P = s.control_points();
   double scale = patch_size(s);
   if (!(scale > 0)) scale = 1.0;
-  const std::vector<double> su = sample_abscissae(s.basis_u().knots(), s.basis_u().degree());
-  const std::vector<double> sv = sample_abscissae(s.basis_v().knots(), s.basis_v().degree());
+  const std::vector<double> su =
+      sample_abscissae(s.basis_u().knots(), s.basis_u().degree(), samples_per_span);
+  const std::vector<double> sv =
+      sample_abscissae(s.basis_v().knots(), s.basis_v().degree(), samples_per_span);
   const std::size_t nu = su.size();
   spline::SurfaceBasis sb;
   std::vector<Eigen::Vector3d> prev_row(nu);  // normals of the previous v row

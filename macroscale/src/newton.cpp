@@ -317,6 +317,10 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     report.message = s.str();
   };
 
+  // Whether anything loads the patch: forces, or prescribed displacements (a zero-load case
+  // converges at the undeformed state by right).
+  const bool loaded =
+      fext_norm > 0.0 || dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
   while (lambda < 1.0 - 1e-12) {
     const double next_nominal = std::min(1.0, h_nom * std::floor(lambda / h_nom + 1.0 + 1e-9));
     const double lam1 = std::min(lambda + h, next_nominal);
@@ -340,6 +344,20 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     if (!o.converged && !o.work_cap && step > 0) {  // retry without the predictor
       uf = ufree;
       o = newton(lam1, uf, search);
+    }
+    if (o.converged && step == 0 && o.iterations == 0 && loaded && ufree.size() > 0 &&
+        ufree.squaredNorm() == 0.0) {
+      std::ostringstream s;
+      s << "load step to lambda = " << lam1
+        << " converged at the undeformed state with no iteration: its out-of-balance force "
+        << o.residual << " N is already within the tolerance (tolerance " << opt.tolerance
+        << " x reference force + absolute_tolerance " << opt.absolute_tolerance
+        << " N), so the loads are too small for the solver to see them; lower "
+           "/solver/absolute_tolerance well below the load; 0 converged steps kept";
+      report.status = RunStatus::kNotConverged;
+      report.reason = StopReason::kLoadBelowTolerance;
+      report.message = s.str();
+      return report;
     }
     if (o.converged) {
       if (o.negative_pivots == -2 && K.symmetric()) {

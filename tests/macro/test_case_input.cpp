@@ -143,7 +143,8 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
   }
   {
     json j = base;
-    j["geometry"]["knots_u"] = {0, 0, 0.5, 1, 1};
+    j["geometry"]["degrees"] = {2, 1};  // a degree-1 interior knot is refused (not C^1)
+    j["geometry"]["knots_u"] = {0, 0, 0, 1, 1, 1};
     CHECK(error_of(j).rfind(
               "bad.json: /geometry/control_points: 4 control points, but the knot vectors", 0) ==
           0);
@@ -530,6 +531,15 @@ TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provena
   CHECK(json::parse(h5.read_strings("case_json").at(0)) == j);
   CHECK(h5.read_doubles("fields/step_0004/E22").size() == 35u);
   CHECK(h5.read_doubles("steps/reactions/jaw_force").size() == 4u);
+  // Every dataset states its unit; n and m say which stress measure they are (session 27).
+  CHECK(h5.attribute_string("steps/reactions/jaw_force", "units") == "N");
+  CHECK(h5.attribute_string("steps/strain", "units") == "1");
+  CHECK(h5.attribute_string("fields/step_0004/X", "units") == "mm");
+  CHECK(h5.attribute_string("fields/step_0004/kappa11", "units") == "1/mm");
+  CHECK(h5.attribute_string("fields/step_0004/n11", "units") == "N/mm");
+  CHECK(h5.attribute_string("fields/step_0004/m12", "units") == "N");
+  CHECK_THAT(h5.attribute_string("fields/step_0004/n11", "measure"),
+             Catch::StartsWith("2nd Piola-Kirchhoff stress resultant"));
   fs::remove_all(d);
 }
 
@@ -563,6 +573,63 @@ TEST_CASE("a folded (flipped) reference surface is refused at load", "[unit]") {
          e.find("folded geometry") != std::string::npos));
 }
 
+TEST_CASE("a fold between the quadrature points is refused at load", "[unit]") {
+  // Session 27: a one-span cubic whose x runs 0, 51, -1, 50 folds back over theta1 in about
+  // (0.451, 0.549), between the 6 Gauss points of the p = 5 analysis surface: it ran
+  // "completed" with exit 0. The input surface is now sampled densely as well.
+  json j = read_json("tensile_svk.json");
+  j["geometry"]["degrees"] = {3, 1};
+  j["geometry"]["knots_u"] = {0, 0, 0, 0, 1, 1, 1, 1};
+  j["geometry"]["control_points"] = {{0, 0, 0},  {51, 0, 0},  {-1, 0, 0},  {50, 0, 0},
+                                     {0, 50, 0}, {51, 50, 0}, {-1, 50, 0}, {50, 50, 0}};
+  const auto error_of = [](const json& c) {
+    try {
+      parse_case(c.dump(), "fold.json");
+    } catch (const knit::InputError& err) {
+      return std::string(err.what());
+    }
+    return std::string();
+  };
+  CHECK(error_of(j).rfind("fold.json: /geometry/control_points: folded geometry: ", 0) == 0);
+  j["geometry"]["control_points"] = {{0, 0, 0},  {17, 0, 0},  {33, 0, 0},  {50, 0, 0},
+                                     {0, 50, 0}, {17, 50, 0}, {33, 50, 0}, {50, 50, 0}};
+  CHECK(error_of(j).empty());  // the same patch unfolded
+}
+
+TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector", "[unit]") {
+  // Session 27: a C^0 knot acted as a hinge (a kinked plate deflected 36 % more, exit 0) and a
+  // C^-1 knot tore the patch (1e-13 N at 30 % strain, exit 0).
+  json j = read_json("tensile_svk.json");
+  const auto error_of = [](const json& c) {
+    try {
+      parse_case(c.dump(), "kink.json");
+    } catch (const knit::InputError& err) {
+      return std::string(err.what());
+    }
+    return std::string();
+  };
+  j["geometry"]["degrees"] = {2, 1};
+  j["geometry"]["knots_u"] = {0, 0, 0, 0.5, 0.5, 1, 1, 1};
+  json cp = json::array();
+  for (const double y : {0.0, 50.0})
+    for (const double x : {0.0, 12.5, 25.0, 37.5, 50.0}) cp.push_back({x, y, 0.0});
+  j["geometry"]["control_points"] = cp;
+  CHECK(error_of(j).rfind("kink.json: /geometry/knots_u: interior knot 0.5 has multiplicity 2 >= "
+                          "the degree 2: the surface is only C^0 there (a hinge)",
+                          0) == 0);
+  j["geometry"]["knots_u"] = {0, 0, 0, 0.25, 0.5, 1, 1, 1};  // C^1 everywhere: accepted
+  CHECK(error_of(j).empty());
+  j = read_json("tensile_svk.json");
+  j["geometry"]["knots_v"] = {0, 0, 0.5, 0.5, 1, 1};
+  cp = json::array();
+  for (const double y : {0.0, 25.0, 25.0, 50.0})
+    for (const double x : {0.0, 50.0}) cp.push_back({x, y, 0.0});
+  j["geometry"]["control_points"] = cp;
+  CHECK(error_of(j).rfind("kink.json: /geometry/knots_v: interior knot 0.5 has multiplicity 2 >= "
+                          "the degree 1: the surface is only C^-1 there (torn apart)",
+                          0) == 0);
+}
+
 namespace {
 // A linear material that claims failed evaluations (stands in for a knit law whose
 // response-surface inversions failed).
@@ -589,6 +656,30 @@ RunResult run_strip_with(std::shared_ptr<Material> material, const fs::path& d) 
   return run_case(c, ro);
 }
 }  // namespace
+
+TEST_CASE("a load within the solver's tolerance stops the run instead of reporting zeros",
+          "[unit]") {
+  // Session 27: an edge load of 1e-12 N/mm (1e-12 N in all) "converged" every step at the
+  // undeformed state with 0 iterations (absolute_tolerance 1e-10 N): zero displacements, exit 0.
+  const fs::path d = temp_dir("tiny_load");
+  const auto run_with = [&](double q, const std::string& name) {
+    json j = strip_case(q);
+    j["solver"] = {{"steps", 2}};
+    const Case c = parse_case(j.dump(), name + ".json");
+    RunOptions ro;
+    ro.output_dir = d / name;
+    return run_case(c, ro).report;
+  };
+  const RunReport tiny = run_with(1e-12, "tiny");
+  CHECK(tiny.status == RunStatus::kNotConverged);
+  CHECK(tiny.reason == StopReason::kLoadBelowTolerance);
+  CHECK(tiny.converged_steps == 0);
+  CHECK_THAT(tiny.message, Catch::Contains("lower /solver/absolute_tolerance"));
+  // No load at all converges at the undeformed state by right; a load the solver sees runs.
+  CHECK(run_with(0.0, "zero").status == RunStatus::kCompleted);
+  CHECK(run_with(1e-3, "small").status == RunStatus::kCompleted);
+  fs::remove_all(d);
+}
 
 TEST_CASE("a run with failed material evaluations does not report plain success", "[unit]") {
   const fs::path d = temp_dir("failing");

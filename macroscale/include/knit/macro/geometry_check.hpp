@@ -5,9 +5,14 @@
 // sampled and the boundary conditions act. A degenerate corner (two coincident control points)
 // has J = 0 only there, so checking the quadrature points alone lets it pass.
 //
-// Sample set (choice): per knot span in each direction the span ends and the p + 1 Gauss
-// points (the shell's quadrature); the tensor grid of these abscissae. J <= 1e-10 scale^2
-// (the tolerance of reference_point(), scale = diagonal of the control net's bounding box)
+// Sample set (choice): per knot span in each direction the span ends and max(p + 1, n) Gauss
+// points (n = 0: the shell's quadrature); the tensor grid of these abscissae. The case loader
+// checks the analysis surface with n = 0 and the input surface (the same geometry, before
+// refinement, usually a few spans) with dense_samples_per_span(), up to 24 points per span: a
+// fold narrower than the spacing of the shell's quadrature points passed before (session 27:
+// a one-span cubic folded over theta1 in (0.451, 0.549) ran "completed" with exit 0). Sampling
+// is not a proof: a fold narrower than about 1/24 of an input knot span still passes. J <= 1e-10
+// scale^2 (the tolerance of reference_point(), scale = diagonal of the control net's bounding box)
 // is degenerate; a normal that turns by more than 90 degrees between neighbouring samples
 // (A3 . A3' <= 0) is a fold.
 #pragma once
@@ -31,7 +36,15 @@ struct GeometryDefect {
 /// (thickness, gauge length, a knit patch against one loop).
 double patch_size(const spline::SplineSurface& surface);
 
-/// The first defect of the reference surface, or nothing.
-std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& surface);
+/// The first defect of the reference surface, or nothing; `samples_per_span` Gauss points per
+/// knot span and direction, at least p + 1.
+std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& surface,
+                                                   int samples_per_span = 0);
+
+/// Dense sampling of the input surface: kDenseSamplesPerSpan per span and direction, fewer when
+/// the patch has so many spans that the grid would pass kMaxDenseSamples points.
+inline constexpr int kDenseSamplesPerSpan = 24;
+inline constexpr double kMaxDenseSamples = 4.0e5;
+int dense_samples_per_span(const spline::SplineSurface& surface);
 
 }  // namespace knit::macro

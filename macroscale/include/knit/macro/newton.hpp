@@ -96,7 +96,11 @@ struct StepResult {
 enum class RunStatus { kCompleted, kNotConverged };
 
 /// Why a run stopped (kNone if it completed).
-enum class StopReason { kNone, kCutbacks, kIncrementFloor, kWorkCap };
+/// kLoadBelowTolerance: the first step "converged" at the undeformed state with no iteration
+/// although it is out of balance there (||r|| > 0): the loads lie within the tolerance, and
+/// every step would report the undeformed state (session 27: an edge load of 5e-11 N ran with
+/// exit 0 and zero displacements under the default absolute_tolerance of 1e-10 N).
+enum class StopReason { kNone, kCutbacks, kIncrementFloor, kWorkCap, kLoadBelowTolerance };
 
 /// Where the time of a run went (wall seconds), for benchmarks.
 struct SolverStats {
