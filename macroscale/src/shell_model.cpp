@@ -480,6 +480,23 @@ ShellSample ShellModel::sample(const Eigen::VectorXd& u, const Eigen::Vector2d& 
   return s;
 }
 
+std::pair<Eigen::Vector3d, Eigen::Vector3d> ShellModel::normals(
+    const Eigen::VectorXd& u, const Eigen::Vector2d& theta) const {
+  spline::SurfaceBasis sb;
+  surface_.basis(theta(0), theta(1), 1, sb);
+  Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = A1, a1 = A1, a2 = A1;
+  const Eigen::MatrixXd& P = surface_.control_points();
+  for (int l = 0; l < sb.index.size(); ++l) {
+    const int a = sb.index(l);
+    const Eigen::Vector3d X = P.row(a).transpose(), x = X + u.segment<3>(3 * a);
+    A1 += sb.R(1, l) * X, A2 += sb.R(2, l) * X;
+    a1 += sb.R(1, l) * x, a2 += sb.R(2, l) * x;
+  }
+  const Eigen::Vector3d N = A1.cross(A2), n = a1.cross(a2);
+  return {n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero(),
+          N.norm() > 0 ? Eigen::Vector3d(N.normalized()) : Eigen::Vector3d::Zero()};
+}
+
 Eigen::VectorXd ShellModel::point_force(const Eigen::Vector2d& theta,
                                         const Eigen::Vector3d& F) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());

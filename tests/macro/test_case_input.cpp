@@ -681,6 +681,47 @@ TEST_CASE("a load within the solver's tolerance stops the run instead of reporti
   fs::remove_all(d);
 }
 
+TEST_CASE("a converged state that folds over itself is not accepted", "[unit]") {
+  // Session 27: Green-Lagrange strains do not see an inverted configuration, and the s312
+  // patch compressed by 30 % ran "completed" (exit 0) with its corners turned inside out. The
+  // same with a St. Venant-Kirchhoff patch compressed by 80 % in plane: the run stops where the
+  // normal flips, and no written state is inverted.
+  json j = read_json("tensile_svk.json");
+  j["refinement"] = {{"degree", 3}, {"elements", {2, 2}}};
+  j["boundary_conditions"][1]["prescribe"] = {{"y", -40.0}};
+  j["boundary_conditions"].push_back({{"all", true}, {"fix", {"z"}}});
+  j["solver"]["steps"] = 10;
+  const fs::path d = temp_dir("fold_run");
+  const Case c = parse_case(j.dump(), "fold_run.json");
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  const RunReport r = run_case(c, ro).report;
+  CHECK(r.status == RunStatus::kNotConverged);
+  CHECK_THAT(r.message, Catch::Contains("the surface folds over itself"));
+  CHECK(r.converged_steps >= 5);  // up to about 80 % of the load it holds
+  // Every written state: the signed area of every cell of the output grid is positive.
+  auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+  int cells = 0, inverted = 0;
+  for (int s = 1; s <= r.converged_steps; ++s) {
+    char g[64];
+    std::snprintf(g, sizeof g, "fields/step_%04d/x", s);
+    const auto x = h5.read_matrix(g);  // grid points x 3, u index fastest
+    const int gu = c.output.grid_u, gv = c.output.grid_v;
+    REQUIRE(x.rows() == gu * gv);
+    const auto at = [&](int i, int k, int comp) { return x(i + gu * k, comp); };
+    for (int k = 0; k + 1 < gv; ++k)
+      for (int i = 0; i + 1 < gu; ++i) {
+        const double ax = at(i + 1, k, 0) - at(i, k, 0), ay = at(i + 1, k, 1) - at(i, k, 1);
+        const double bx = at(i, k + 1, 0) - at(i, k, 0), by = at(i, k + 1, 1) - at(i, k, 1);
+        ++cells;
+        if (!(ax * by - ay * bx > 0.0)) ++inverted;
+      }
+  }
+  CHECK(cells > 0);
+  CHECK(inverted == 0);
+  fs::remove_all(d);
+}
+
 TEST_CASE("a run with failed material evaluations does not report plain success", "[unit]") {
   const fs::path d = temp_dir("failing");
   const RunResult r = run_strip_with(std::make_shared<FailingMaterial>(), d);

@@ -87,6 +87,12 @@ class ShellModel {
   int num_dofs() const { return 3 * surface_.size(); }
   int num_elements() const { return static_cast<int>(elements_.size()); }
   int num_quadrature_points() const { return static_cast<int>(points_.size()); }
+  /// The current unit normal a3 = a1 x a2 / |a1 x a2| at theta for displacement u, and the
+  /// reference normal A3 there (zero vectors where the tangents are parallel).
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> normals(const Eigen::VectorXd& u,
+                                                      const Eigen::Vector2d& theta) const;
+  /// The reference configuration at quadrature point pid (its theta, frame e1, e2, e3 = A3).
+  const ReferencePoint& quadrature_point(int pid) const { return points_[pid].ref; }
   /// Control points of element e (the (pu+1)(pv+1) functions non-zero on it).
   const Eigen::VectorXi& element_control_points(int e) const { return elements_[e].cp; }
   /// Whether the element tangents use the sum-factorized kernel (a B-spline surface of degree
