@@ -2,6 +2,7 @@
 #include "knit/meso/cell/geometry.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -203,10 +204,21 @@ bool refine_crossing(const LoopShape& sh, const Eigen::Vector2d& t, double& s1, 
 
 }  // namespace
 
-std::vector<Crossing> crossings_with_next_course(const LoopShape& sh, double c) {
+std::optional<std::string> interlock_defect(const LoopShape& shape, double c) {
+  const std::size_t n = crossings_with_next_course(shape, c, 300).size();
+  if (n == static_cast<std::size_t>(kStitchCrossings)) return std::nullopt;
+  std::ostringstream m;
+  m << "the loop does not interlock with the next course like a single-jersey stitch: its "
+       "centreline crosses the next course's at "
+    << n << " points in projection, not " << kStitchCrossings
+    << " (the loop length is outside the range where the closed-form loop is a knit)";
+  return m.str();
+}
+
+std::vector<Crossing> crossings_with_next_course(const LoopShape& sh, double c, int samples) {
   // Self loop over s in [0,1); neighbours: the loop shifted by (i w, c) for i = -2..2, each over
   // its own s in [0,1). Segment-segment intersection of dense polylines, then Newton.
-  const int N = 1200;
+  const int N = std::max(8, samples);
   std::vector<Eigen::Vector2d> P(N + 1);
   for (int k = 0; k <= N; ++k) P[k] = sh.point(double(k) / N).head<2>();
   std::vector<Crossing> out;

@@ -64,7 +64,9 @@ int run(const Options& o) {
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");
   const CellGeometry g = [&] {
     try {
-      return make_cell_geometry(o.loop_length, go);
+      CellGeometry built = make_cell_geometry(o.loop_length, go);
+      if (const auto bad = interlock_defect(built.shape, built.dim.c)) throw GeometryError(*bad);
+      return built;
     } catch (const GeometryError& e) {  // a loop too short for w and d
       throw knit::InputError("", "--loop-length", loop_length_message(o.loop_length, go.d, e));
     }

@@ -87,6 +87,7 @@ PeriodicCell::PeriodicCell(double loop_length, const CellOptions& opt) : opt_(op
   opt_.contact.d = opt_.section.d;
   const cell::AnalysisCurve ac =
       cell::analysis_curve(dim_, opt_.elements, opt_.degree, opt_.geometry);
+  if (const auto bad = cell::interlock_defect(ac.shape, dim_.c)) throw cell::GeometryError(*bad);
   rod::RodSpec spec;
   spec.name = "loop";
   spec.basis = ac.curve.basis();

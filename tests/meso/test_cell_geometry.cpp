@@ -84,3 +84,23 @@ TEST_CASE("interlocking: crossing order with the next course and clearance", "[u
     CHECK(cl.min_distance < 0.38);
   }
 }
+
+TEST_CASE("a loop length whose loop does not interlock is not a knit", "[unit]") {
+  // Session 27: 3.0 and 20 mm ran with exit 0; the closed form crosses the next course nowhere
+  // there, and the cell had no wale strength (S22 = 0.0006 MPa at 50 %).
+  for (double l : {3.3, 4.5, 5.5, 6.5, 9.0}) {
+    INFO("l = " << l);
+    const auto g = make_cell_geometry(l);
+    CHECK_FALSE(interlock_defect(g.shape, g.dim.c).has_value());
+    // The coarse count agrees with the dense crossings.
+    CHECK(crossings_with_next_course(g.shape, g.dim.c, 300).size() ==
+          crossings_with_next_course(g.shape, g.dim.c).size());
+  }
+  for (double l : {3.0, 20.0}) {
+    INFO("l = " << l);
+    const auto g = make_cell_geometry(l);
+    const auto bad = interlock_defect(g.shape, g.dim.c);
+    REQUIRE(bad.has_value());
+    CHECK_THAT(*bad, Catch::Contains("crosses the next course's at 0 points in projection, not 4"));
+  }
+}

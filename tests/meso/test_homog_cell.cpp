@@ -196,3 +196,10 @@ TEST_CASE("a step that meets a limit point ends, not converged, instead of sub-s
   CHECK(failed_step == 7);
   CHECK(message.find("limit point") != std::string::npos);
 }
+
+TEST_CASE("a periodic cell is refused where its loop does not interlock", "[unit]") {
+  // Every entry (path, cell, the sweep's loop lengths) builds a PeriodicCell; one of 3 mm has
+  // no crossing with the next course (session 27: exit 0 with S22 = 0.0006 MPa at 50 %).
+  CHECK_THROWS_AS(PeriodicCell(3.0), knit::meso::cell::GeometryError);
+  CHECK_NOTHROW(PeriodicCell(4.5));
+}
