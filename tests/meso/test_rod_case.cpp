@@ -136,6 +136,12 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
           "control_points": [[0,0,0],[1,0,0],[2,0,0]]}, "start": {"position": "fixed", "rotation": "fixed",
           "force": [1,0,0]}, "end": {"position": "free", "rotation": "free"}}]})",
        "/rods/0/curve/knots"},
+      // A C^0 knot: collocation cannot hold the kink (session 27: "diverged", exit 1).
+      {R"({"rods": [{"name": "b", "curve": {"type": "bspline", "degree": 2,
+          "knots": [0,0,0,0.5,0.5,1,1,1], "control_points": [[0,0,0],[2.5,0,0],[5,0,0],[7.5,0,0],
+          [10,0,0]]}, "start": {"position": "fixed", "rotation": "fixed"},
+          "end": {"position": "free", "rotation": "free", "force": [0,0,1e-6]}}]})",
+       "/rods/0/curve/knots"},
       {R"({"rods": [)" + good_rod + R"(], "typo": 1})", ""},
       {R"({"rods": [ )", ""},
   };
