@@ -105,7 +105,7 @@ KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> fam
   for (int a = 0; a < L.rows(); ++a)
     if (!(L(a, 0) >= l_min() && L(a, 0) <= l_max())) {
       std::ostringstream os;
-      os << L(a, 0) << " mm is outside the database's " << l_min() << "-" << l_max() << " mm";
+      os << loop_length_outside(L(a, 0), l_min(), l_max());
       if (!source_.database.empty()) os << " (" << source_.database << ")";
       throw InputError(source_.file, source_.stitch_pointer + "/values/" + std::to_string(a),
                        os.str());
@@ -288,6 +288,19 @@ std::string KnitMaterial::report() const {
   for (const auto& w : s.first)
     os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();
   return os.str();
+}
+
+std::string loop_length_outside(double l, double lo, double hi) {
+  const auto text = [](double x, int digits) {
+    std::ostringstream o;
+    o.precision(digits);
+    o << x;
+    return o.str();
+  };
+  std::string v;
+  for (int digits = 15; digits <= 17; ++digits)
+    if (v = text(l, digits); v != text(lo, digits) && v != text(hi, digits)) break;
+  return v + " mm is outside the database's " + text(lo, 15) + "-" + text(hi, 15) + " mm";
 }
 
 }  // namespace knit::macro

@@ -244,8 +244,7 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
     const double hi = energy ? energy->data().l_max : family->max();
     if (!(v >= lo && v <= hi)) {
       std::ostringstream os;
-      os << v << " mm is outside the database's " << lo << "-" << hi << " mm (" << db.string()
-         << ")";
+      os << loop_length_outside(v, lo, hi) << " (" << db.string() << ")";
       throw InputError(ctx.file, p + "/stitch_value", os.str());
     }
   }

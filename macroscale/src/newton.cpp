@@ -79,7 +79,9 @@ EnergyLineSearch energy_line_search(const std::function<std::optional<double>(do
 
 std::string stability_summary(const RunReport& r) {
   std::ostringstream o;
-  if (r.max_negative_pivots < 0) {
+  if (r.converged_steps == 0) {
+    o << "not available (no converged step)";
+  } else if (r.max_negative_pivots < 0) {
     o << "not available (unsymmetric tangent, LU factorization)";
   } else if (r.first_unstable_step < 0) {
     o << "the tangent was positive definite at every converged step (0 negative pivots)";

@@ -172,6 +172,11 @@ TEST_CASE("LDLT inertia: a strip compressed past its limit point reports negativ
   CHECK(r.report.first_unstable_step == 9);
   CHECK(r.report.first_unstable_lambda == Approx(0.9));
   CHECK(stability_summary(r.report).find("unstable from step 9") != std::string::npos);
+  // Without a converged step there is nothing to say (session 27: "unsymmetric tangent, LU
+  // factorization" for symmetric laws too).
+  RunReport none;
+  none.converged_steps = 0;
+  CHECK(stability_summary(none) == "not available (no converged step)");
 }
 
 TEST_CASE("energy line search: the full step first, backtracking decreases Pi", "[unit]") {

@@ -202,4 +202,9 @@ class KnitMaterial : public Material {
 /// JSON pointers below ctx.pointer.
 std::unique_ptr<Material> make_knit_material(const nlohmann::json& material,
                                              const CaseContext& ctx);
+
+/// "<l> mm is outside the database's <lo>-<hi> mm": l with 15 digits, or 16-17 where 15 would
+/// print it as the bound itself (session 27: 6.500000000000001 read "6.5 mm is outside the
+/// database's 4.5-6.5 mm").
+std::string loop_length_outside(double l, double lo, double hi);
 }  // namespace knit::macro
