@@ -88,8 +88,11 @@ knit::cli::SubcommandRegistrar reg(
         csv.commit();
         const std::string case_text = knit::macro::design_case_text(d, r.x);
         knit::io::write_file_atomically(out / "case.json", case_text);
-        // The final run's usual outputs.
-        const auto best = knit::macro::parse_case(case_text, (out / "case.json").string());
+        // The final run's usual outputs. Its case is named by its final path, which exists once
+        // the directory is committed (out / "case.json" is in DIR.partial-<pid>: the run's
+        // provenance named a directory that no longer exists; session 27). Relative paths in
+        // the case resolve alike: both directories have the same parent.
+        const auto best = knit::macro::parse_case(case_text, (dir / "case.json").string());
         knit::macro::RunOptions ro;
         ro.output_dir = out / "run";
         const auto run = knit::macro::run_case(best, ro);

@@ -335,3 +335,25 @@ TEST_CASE("design: the exit code is the optimizer's status and the final run's",
   r.message.clear();
   CHECK(design_verdict(r, run).reason == "failed");
 }
+
+// Session 27: the final run's provenance (the CSV's first comment, results.h5's `input`) named
+// its case in DIR.partial-<pid>, a directory that no longer exists once the design is written.
+TEST_CASE("design: the final run names its case by the committed path", "[unit]") {
+  write_case();
+  write(kDir / "prov.json", R"({"case": "case.json", "variables": )" + kVars +
+                                R"(, "objectives": )" + kObjs +
+                                R"(, "optimizer": {"max_iterations": 1}})");
+  const fs::path out = kDir / "prov_out";
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
+                          (kDir / "prov.json").string() + " -o " + out.string() + " > " +
+                          (kDir / "prov.log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(st));
+  REQUIRE(fs::exists(out / "run" / "load_strain.csv"));
+  std::ifstream in(out / "run" / "load_strain.csv");
+  std::string first;
+  std::getline(in, first);
+  CHECK(first.rfind("# knit-macro results of " + (out / "case.json").string() + " (", 0) == 0);
+  CHECK(first.find(".partial-") == std::string::npos);
+  fs::remove_all(out);
+}
