@@ -149,7 +149,10 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
     g.write("case_converged_steps", conv);
     g.write("case_in_fit", in_fit);
     g.set_attribute("case_in_fit", "values",
-                    "1 = its converged steps entered the fit (non-converged steps never do)");
+                    "1 = its converged steps entered the paper's response-surface fit (eq. 17: "
+                    "the paper's paths only; non-converged steps never do). The energy law "
+                    "(/energy_law) fits the converged steps of every path whose set is not "
+                    "\"holdout\", up to where the cell gave way (/energy_law/diagnostics)");
     g.write("case_seconds", seconds);
     g.write_strings("case_messages", messages);
     g.write("residual_S", residual);
