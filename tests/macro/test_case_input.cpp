@@ -32,9 +32,9 @@ json read_json(const std::string& name) {
 }
 
 /// The error message of parsing (and setting up) a modified tensile case, or "" if it passed.
-std::string error_of(const json& j) {
+std::string error_of(const json& j, const std::string& file = "bad.json") {
   try {
-    const Case c = parse_case(j.dump(), "bad.json");
+    const Case c = parse_case(j.dump(), file);
     setup_problem(c);
   } catch (const knit::InputError& e) {
     return e.what();
@@ -582,14 +582,7 @@ TEST_CASE("a fold between the quadrature points is refused at load", "[unit]") {
   j["geometry"]["knots_u"] = {0, 0, 0, 0, 1, 1, 1, 1};
   j["geometry"]["control_points"] = {{0, 0, 0},  {51, 0, 0},  {-1, 0, 0},  {50, 0, 0},
                                      {0, 50, 0}, {51, 50, 0}, {-1, 50, 0}, {50, 50, 0}};
-  const auto error_of = [](const json& c) {
-    try {
-      parse_case(c.dump(), "fold.json");
-    } catch (const knit::InputError& err) {
-      return std::string(err.what());
-    }
-    return std::string();
-  };
+  const auto error_of = [](const json& c) { return ::error_of(c, "fold.json"); };
   CHECK(error_of(j).rfind("fold.json: /geometry/control_points: folded geometry: ", 0) == 0);
   j["geometry"]["control_points"] = {{0, 0, 0},  {17, 0, 0},  {33, 0, 0},  {50, 0, 0},
                                      {0, 50, 0}, {17, 50, 0}, {33, 50, 0}, {50, 50, 0}};
@@ -600,14 +593,7 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
   // Session 27: a C^0 knot acted as a hinge (a kinked plate deflected 36 % more, exit 0) and a
   // C^-1 knot tore the patch (1e-13 N at 30 % strain, exit 0).
   json j = read_json("tensile_svk.json");
-  const auto error_of = [](const json& c) {
-    try {
-      parse_case(c.dump(), "kink.json");
-    } catch (const knit::InputError& err) {
-      return std::string(err.what());
-    }
-    return std::string();
-  };
+  const auto error_of = [](const json& c) { return ::error_of(c, "kink.json"); };
   j["geometry"]["degrees"] = {2, 1};
   j["geometry"]["knots_u"] = {0, 0, 0, 0.5, 0.5, 1, 1, 1};
   json cp = json::array();
