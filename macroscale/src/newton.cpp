@@ -323,8 +323,8 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
 
   // Whether anything loads the patch: forces, or prescribed displacements (a zero-load case
   // converges at the undeformed state by right).
-  const bool loaded =
-      fext_norm > 0.0 || dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
+  const bool loaded = fext_red.norm() > 0.0 ||
+                      dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
   // The unit normal a3 at every quadrature point of the last converged state (the reference
   // normals A3 at first). A converged state whose normal turned by more than 90 degrees at a
   // point within one step is not accepted: the step is cut back, and a fold that persists
@@ -385,8 +385,8 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       uf = ufree;
       o = newton(lam1, uf, search);
     }
-    if (o.converged && step == 0 && o.iterations == 0 && loaded && ufree.size() > 0 &&
-        ufree.squaredNorm() == 0.0) {
+    if (o.converged && step == 0 && o.iterations == 0 && o.residual > 0.0 && loaded &&
+        ufree.size() > 0 && ufree.squaredNorm() == 0.0) {
       std::ostringstream s;
       s << "load step to lambda = " << lam1
         << " converged at the undeformed state with no iteration: its out-of-balance force "

@@ -664,6 +664,14 @@ TEST_CASE("a load within the solver's tolerance stops the run instead of reporti
   // No load at all converges at the undeformed state by right; a load the solver sees runs.
   CHECK(run_with(0.0, "zero").status == RunStatus::kCompleted);
   CHECK(run_with(1e-3, "small").status == RunStatus::kCompleted);
+  // A load that goes straight into the supports (on the fixed edge u0, x) deforms nothing:
+  // the undeformed state is the answer (review of session 27: it was refused).
+  json j = strip_case(0.0);
+  j["loads"] = json::array({{{"type", "edge"}, {"edge", "u0"}, {"force_per_length", {1.0, 0, 0}}}});
+  j["solver"] = {{"steps", 2}};
+  RunOptions ro;
+  ro.output_dir = d / "supports";
+  CHECK(run_case(parse_case(j.dump(), "supports.json"), ro).report.status == RunStatus::kCompleted);
   fs::remove_all(d);
 }
 
