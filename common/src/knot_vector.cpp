@@ -106,6 +106,22 @@ int knot_multiplicity(const std::vector<double>& U, double u) {
   return static_cast<int>(std::count(U.begin(), U.end(), u));
 }
 
+std::optional<KnotBreak> first_non_c1_knot(const std::vector<double>& U, int p) {
+  for (const double x : unique_knots(U)) {
+    if (x == U.front() || x == U.back()) continue;
+    if (const int m = knot_multiplicity(U, x); m >= p) return KnotBreak{x, m};
+  }
+  return std::nullopt;
+}
+
+std::string describe_knot_break(const KnotBreak& k, int p, const std::string& what) {
+  std::ostringstream os;
+  os.precision(12);
+  os << "interior knot " << k.value << " has multiplicity " << k.multiplicity << " >= the degree "
+     << p << ": the " << what << " is only C^" << p - k.multiplicity << " there";
+  return os.str();
+}
+
 std::vector<double> unique_knots(const std::vector<double>& U) {
   std::vector<double> b;
   for (double x : U)

@@ -159,22 +159,17 @@ spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const cha
   // and refinement keeps that continuity: C^0 acts as a hinge (session 27: a kinked plate
   // deflected 36 % more than the smooth one, exit 0), C^-1 tears the patch apart (a torn strip
   // carried 1e-13 N at 30 % strain, exit 0). The design fields may be C^-1; the geometry not.
-  for (const double x : spline::unique_knots(U)) {
-    if (x == U.front() || x == U.back()) continue;
-    const int m = spline::knot_multiplicity(U, x);
-    if (m >= p) {
-      std::ostringstream os;
-      os.precision(12);
-      os << "interior knot " << x << " has multiplicity " << m << " >= the degree " << p
-         << ": the surface is only C^" << p - m << " there (" << (m > p ? "torn apart" : "a hinge")
-         << "), and a Kirchhoff-Love shell needs C^1; ";
-      if (p == 1)
-        os << "a degree-1 geometry can have no interior knot: leave them out and subdivide "
-              "with \"refinement\", or raise the degree";
-      else
-        os << "give interior knots multiplicity <= " << p - 1;
-      r.fail(ptr, os.str());
-    }
+  if (const auto kink = spline::first_non_c1_knot(U, p)) {
+    std::ostringstream os;
+    os << spline::describe_knot_break(*kink, p, "surface") << " ("
+       << (kink->multiplicity > p ? "torn apart" : "a hinge")
+       << "), and a Kirchhoff-Love shell needs C^1; ";
+    if (p == 1)
+      os << "a degree-1 geometry can have no interior knot: leave them out and subdivide "
+            "with \"refinement\", or raise the degree";
+    else
+      os << "give interior knots multiplicity <= " << p - 1;
+    r.fail(ptr, os.str());
   }
   return spline::BSplineBasis(p, U);
 }

@@ -326,7 +326,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   const bool loaded = fext_red.norm() > 0.0 ||
                       dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
   // The unit normal a3 at every quadrature point of the last converged state (the reference
-  // normals A3 at first). A converged state whose normal turned by more than 90 degrees at a
+  // normals A3 at first). A converged state whose normal turned by 90 degrees or more at a
   // point within one step is not accepted: the step is cut back, and a fold that persists
   // stops the run. Green-Lagrange strains do not see a mirrored (inverted) configuration, so
   // Newton converges to one (session 27: the s312 patch compressed by 30 % inverted at its
@@ -345,7 +345,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   for (std::size_t k = 0; k < corners.size(); ++k)
     normals[nq + k] = model.normals(Eigen::VectorXd::Zero(model.num_dofs()), corners[k]).second;
   // The first check point whose normal at the converged u (quadrature points: from `trial`'s
-  // point states, evaluated there if they are not) turned by more than 90 degrees from
+  // point states, evaluated there if they are not) turned by 90 degrees or more from
   // `normals`, or -1; -2 if the configuration degenerated. Fills normals_now.
   auto flipped_point = [&](const Eigen::VectorXd& u) {
     if (!(trial.has_points && trial_u.size() > 0 && trial_u == u)) {
@@ -409,7 +409,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
           const Eigen::Vector2d t =
               q < nq ? model.quadrature_point(q).theta : corners[static_cast<std::size_t>(q - nq)];
           s << "the surface folds over itself: its normal at (theta1, theta2) = (" << t(0) << ", "
-            << t(1) << ") turned by more than 90 degrees within the step (an inverted or "
+            << t(1) << ") turned by 90 degrees or more within the step (an inverted or "
             << "folded configuration, which the strains do not see)";
         }
         o.why = s.str();

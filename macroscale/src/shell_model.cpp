@@ -482,7 +482,7 @@ ShellSample ShellModel::sample(const Eigen::VectorXd& u, const Eigen::Vector2d& 
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> ShellModel::normals(
     const Eigen::VectorXd& u, const Eigen::Vector2d& theta) const {
-  spline::SurfaceBasis sb;
+  thread_local spline::SurfaceBasis sb;  // kept: called per element corner and converged step
   surface_.basis(theta(0), theta(1), 1, sb);
   Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = A1, a1 = A1, a2 = A1;
   const Eigen::MatrixXd& P = surface_.control_points();

@@ -205,7 +205,7 @@ bool refine_crossing(const LoopShape& sh, const Eigen::Vector2d& t, double& s1, 
 }  // namespace
 
 std::optional<std::string> interlock_defect(const LoopShape& shape, double c) {
-  const std::size_t n = crossings_with_next_course(shape, c, 300).size();
+  const std::size_t n = crossings_with_next_course(shape, c, kInterlockChords).size();
   if (n == static_cast<std::size_t>(kStitchCrossings)) return std::nullopt;
   std::ostringstream m;
   m << "the loop does not interlock with the next course like a single-jersey stitch: its "

@@ -179,21 +179,16 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
   // m >= p the tangent (and so the rod's frame) jumps, and no collocation row holds the kink
   // (session 27: a straight line with a C^0 knot "diverged" under 1e-6 N, exit 1, and so did
   // the exact NURBS ring, whose quadrant knots are C^0). Refinement keeps the continuity.
-  for (const double x : spline::unique_knots(U)) {
-    if (x == U.front() || x == U.back()) continue;
-    if (const int m = spline::knot_multiplicity(U, x); m >= p) {
-      std::ostringstream os;
-      os.precision(12);
-      os << "interior knot " << x << " has multiplicity " << m << " >= the degree " << p
-         << ": the curve is only C^" << p - m
-         << " there, and collocation of the rod equations needs C^1; ";
-      if (p == 1)
-        os << "a degree-1 curve can have no interior knot: raise the degree";
-      else
-        os << "give interior knots multiplicity <= " << p - 1
-           << " (a NURBS circle with C^0 quadrant knots is not C^1: use a C^1 parametrization)";
-      R.fail(ptr + "/knots", os.str());
-    }
+  if (const auto kink = spline::first_non_c1_knot(U, p)) {
+    std::ostringstream os;
+    os << spline::describe_knot_break(*kink, p, "curve")
+       << ", and collocation of the rod equations needs C^1; ";
+    if (p == 1)
+      os << "a degree-1 curve can have no interior knot: raise the degree";
+    else
+      os << "give interior knots multiplicity <= " << p - 1
+         << " (a NURBS circle with C^0 quadrant knots is not C^1: use a C^1 parametrization)";
+    R.fail(ptr + "/knots", os.str());
   }
   RodSpec s;
   s.basis = spline::BSplineBasis(p, U);

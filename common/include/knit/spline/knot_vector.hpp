@@ -10,6 +10,7 @@
 //   span     index i with U[i] <= u < U[i+1] and p <= i <= n - 1 (clamped at the last knot)
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -62,6 +63,16 @@ int find_span(int n, int p, double u, const std::vector<double>& U);
 
 /// Multiplicity of the knot value u in U (exact comparison).
 int knot_multiplicity(const std::vector<double>& U, double u);
+
+/// The first interior knot of U (degree p) where the spline is not C^1 (multiplicity m >= p,
+/// continuity C^(p-m)), or nothing: the shell geometry and the rod centerline must be C^1.
+struct KnotBreak {
+  double value = 0.0;
+  int multiplicity = 0;
+};
+std::optional<KnotBreak> first_non_c1_knot(const std::vector<double>& U, int p);
+/// "interior knot 0.5 has multiplicity 2 >= the degree 2: the <what> is only C^0 there".
+std::string describe_knot_break(const KnotBreak& k, int p, const std::string& what);
 
 /// The distinct knot values of U (breakpoints), in increasing order.
 std::vector<double> unique_knots(const std::vector<double>& U);

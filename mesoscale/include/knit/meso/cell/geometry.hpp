@@ -132,6 +132,7 @@ std::vector<Crossing> crossings_with_next_course(const LoopShape& shape, double 
 /// of 300 chords (about 2 ms; every PeriodicCell is checked). Session 27: loop lengths of 3.0
 /// and 20 mm ran with exit 0, a cell without wale strength (S22 = 0.0006 MPa at 50 %).
 inline constexpr int kStitchCrossings = 4;
+inline constexpr int kInterlockChords = 300;  ///< polyline of the count (1200 for positions)
 std::optional<std::string> interlock_defect(const LoopShape& shape, double c);
 
 /// Minimum distance between the cell's centerline and its periodic images (i w, j c), |i|,|j| <= 1
