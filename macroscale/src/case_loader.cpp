@@ -232,6 +232,22 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
     const int ev = r.integer(el[1], "/refinement/elements/1", 1, 256);
     c.surface = refine_patch(c.input_surface, p, eu, ev);
   }
+  // The analysis basis must be C^1 everywhere, which degree 1 is not between elements (session
+  // 28: "refinement" to degree 1 put C^0 hinge lines inside the C^1 rule of the input knots),
+  // and the bending strains of eq. 12 need second derivatives, which vanish on degree-1 spans.
+  if (root.contains("refinement")) {
+    if (c.surface.basis_u().degree() < 2 || c.surface.basis_v().degree() < 2)
+      r.fail(
+          "/refinement/degree",
+          "the analysis degree must be >= 2 (a Kirchhoff-Love shell needs C^1 between "
+          "elements and second derivatives for its curvatures), got " +
+              std::to_string(std::min(c.surface.basis_u().degree(), c.surface.basis_v().degree())));
+  } else if (pu < 2 || pv < 2) {
+    r.fail(std::string("/geometry/degrees/") + (pu < 2 ? "0" : "1"),
+           "degree 1 cannot be analysed as a Kirchhoff-Love shell (its curvatures need second "
+           "derivatives and C^1 between elements); add \"refinement\": {\"degree\": 2 or more, "
+           "\"elements\": [n_u, n_v]} to elevate the analysis basis");
+  }
   // Refuse what cannot fit in memory now, not with std::bad_alloc at the start of the run.
   const MemoryEstimate mem = estimate_shell_memory(c.surface);
   const std::uint64_t limit = memory_limit_bytes();

@@ -614,6 +614,21 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
   CHECK(error_of(j).rfind("kink.json: /geometry/knots_v: interior knot 0.5 has multiplicity 2 >= "
                           "the degree 1: the surface is only C^-1 there (torn apart)",
                           0) == 0);
+  // Session 28: the analysis basis could still be degree 1 (hinge lines between its elements),
+  // through "refinement" to degree 1 or a degree-1 patch without refinement.
+  j = read_json("tensile_svk.json");
+  j["refinement"] = {{"degree", 1}, {"elements", {4, 4}}};
+  CHECK(error_of(j).rfind("kink.json: /refinement/degree: the analysis degree must be >= 2", 0) ==
+        0);
+  j.erase("refinement");
+  CHECK(error_of(j).rfind("kink.json: /geometry/degrees/0: degree 1 cannot be analysed", 0) == 0);
+  j["geometry"]["degrees"] = {2, 1};
+  j["geometry"]["knots_u"] = {0, 0, 0, 1, 1, 1};
+  j["geometry"]["control_points"] = {{0, 0, 0},  {25, 0, 0},  {50, 0, 0},
+                                     {0, 50, 0}, {25, 50, 0}, {50, 50, 0}};
+  CHECK(error_of(j).rfind("kink.json: /geometry/degrees/1: degree 1 cannot be analysed", 0) == 0);
+  j["refinement"] = read_json("tensile_svk.json")["refinement"];  // degree 5: accepted
+  CHECK(error_of(j).empty());
 }
 
 namespace {

@@ -138,8 +138,9 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
   const std::string db = test_database();
   auto load = [&](const std::string& material) {
     std::ostringstream cs;
-    cs << R"({"geometry": )" << square(0.0) << R"(, "material": )" << material << R"(,
-      "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
+    cs << R"({"geometry": )" << square(0.0) << R"(, "refinement": {"degree": 2, "elements": [1, 1]},
+      "material": )"
+       << material << R"(, "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
     return parse_case(cs.str(), "bad.json");
   };
   const std::string head = R"({"type": "knit", "database": ")" + db + "\", ";

@@ -134,7 +134,7 @@ std::string square_case(const std::string& material) {
   std::ostringstream cs;
   cs << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
     "control_points": [[0, 0, 0], [50, 0, 0], [0, 50, 0], [50, 50, 0]], "thickness": 0.76},
-    "material": )"
+    "refinement": {"degree": 2, "elements": [1, 1]}, "material": )"
      << material << R"(, "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
   return cs.str();
 }
