@@ -41,11 +41,24 @@ knit::cli::SubcommandRegistrar reg(
                                       o->outdir.empty() ? "output directory" : "--output");
         const rod::RodCase c =
             rod::load_rod_case(o->file);  // InputError -> exit 2, nothing written
-        const rod::PathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
+        const rod::CasePathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
         std::cout << "rod: " << rep.message << "; lambda = " << rep.lambda_reached << ", "
                   << rep.increments << " increments, " << rep.cutbacks << " cut-backs, "
                   << rep.total_iterations << " Newton iterations; outputs in " << out.string()
                   << "\n";
+        if (rep.resolution) {
+          const rod::ResolutionCheck& rc = *rep.resolution;
+          if (!rc.checked || rc.difference > rod::kResolutionTolerance)
+            std::cerr << "knit-meso rod: warning: " << rc.describe() << " (tolerance "
+                      << 100 * rod::kResolutionTolerance << " %)"
+                      << (rc.checked
+                              ? "; the mesh is too coarse for this case: raise the elements or the "
+                                "degree of the rods' curves (or their \"refine\")"
+                              : "")
+                      << "\n";
+          else
+            std::cout << "resolution: " << rc.describe() << "\n";
+        }
         return rep.completed ? knit::kExitOk : knit::kExitFailure;
       };
     });

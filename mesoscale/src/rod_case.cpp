@@ -14,6 +14,7 @@
 #include "knit/io/provenance.hpp"
 #include "knit/meso/rod/builders.hpp"
 #include "knit/meso/rod/output.hpp"
+#include "knit/meso/rod/resolution.hpp"
 #include "knit/spline/knot_vector.hpp"
 #include "knit/spline/refine.hpp"
 
@@ -142,6 +143,16 @@ EndCondition read_end(const Reader& R, const json& j, const std::string& ptr) {
   return c;
 }
 
+// The analysis basis needs degree >= 2 (session 28): on degree 1, one element has no interior
+// collocation point, so no balance equation at all (the elastica "completed" with the linear
+// tip deflection, 0.0007 mm for 6.7 mm), and four elements gave a singular Jacobian.
+constexpr int kMinAnalysisDegree = 2;
+std::string too_low(int p) {
+  return "the analysis degree must be >= 2 (on degree 1 the collocation has no interior point "
+         "per element and the balance equations are lost), got " +
+         std::to_string(p);
+}
+
 RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const Section& sec) {
   if (!j.is_object()) R.fail(ptr, "must be an object, got " + Reader::kind(j));
   if (!j.contains("type")) R.fail(ptr, "missing required key \"type\"");
@@ -154,6 +165,7 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
     const int p = R.integer(j["degree"], ptr + "/degree", 1);
     const int ne = R.integer(j["elements"], ptr + "/elements", 1);
     if (p > 12) R.fail(ptr + "/degree", "must be <= 12, got " + std::to_string(p));
+    if (p < kMinAnalysisDegree) R.fail(ptr + "/degree", too_low(p));
     return straight_rod(a, b, p, ne, sec);
   }
   R.object(j, ptr, {"type", "degree", "knots", "control_points", "weights", "refine"},
@@ -211,11 +223,14 @@ RodSpec read_curve(const Reader& R, const json& j, const std::string& ptr, const
     const int ne = R.integer(jr["elements"], ptr + "/refine/elements", 1);
     if (pr < p) R.fail(ptr + "/refine/degree", "must be >= the curve degree " + std::to_string(p));
     if (pr > 12) R.fail(ptr + "/refine/degree", "must be <= 12, got " + std::to_string(pr));
+    if (pr < kMinAnalysisDegree) R.fail(ptr + "/refine/degree", too_low(pr));
     const spline::SplineCurve fine =
         spline::refine(spline::SplineCurve(s.basis, s.r0, s.weights), pr, ne);
     s.basis = fine.basis();
     s.r0 = fine.control_points();
     s.weights = fine.rational() ? Eigen::VectorXd(fine.weights()) : Eigen::VectorXd();
+  } else if (p < kMinAnalysisDegree) {
+    R.fail(ptr + "/degree", too_low(p) + " (or add \"refine\" with a degree >= 2)");
   }
   return s;
 }
@@ -293,7 +308,12 @@ RodCase load_rod_case(const std::filesystem::path& path) {
   }
   if (j.contains("output")) {
     const json& jo = j["output"];
-    R.object(jo, "/output", {"points", "samples_per_element", "vtp"});
+    R.object(jo, "/output", {"points", "samples_per_element", "vtp", "check_resolution"});
+    if (jo.contains("check_resolution")) {
+      if (!jo["check_resolution"].is_boolean())
+        R.fail("/output/check_resolution", "must be a boolean");
+      c.check_resolution = jo["check_resolution"].get<bool>();
+    }
     if (jo.contains("samples_per_element"))
       c.samples_per_element =
           R.integer(jo["samples_per_element"], "/output/samples_per_element", 1);
@@ -324,7 +344,8 @@ RodCase load_rod_case(const std::filesystem::path& path) {
   return c;
 }
 
-PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, std::ostream* log) {
+CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,
+                            std::ostream* log) {
   const RodSystem& sys = c.system;
   const std::string provenance = io::Provenance::current(c.file).to_json_string();
   io::AtomicDirectory dir(outdir);  // OUT.partial-<pid>, renamed onto OUT by commit()
@@ -355,7 +376,8 @@ PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, s
   };
   Eigen::VectorXd x = sys.initial_state();
   record(0, c.path.lambda_start, x);
-  const PathReport rep =
+  CasePathReport rep;
+  static_cast<PathReport&>(rep) =
       solve_path(sys, x, c.path, [&](int step, double lambda, const Eigen::VectorXd& xs) {
         record(step, lambda, xs);
         if (log) *log << "step " << step << ": lambda = " << lambda << "\n";
@@ -370,9 +392,24 @@ PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir, s
       if (std::abs(st.lambda - rows[r].lambda) <= 1e-12 * std::max(1.0, std::abs(st.lambda))) ++r;
     }
   }
+  // Resolution check (knit/meso/rod/resolution.hpp): the same path on the bisected mesh.
+  if (rep.completed && c.check_resolution) {
+    std::vector<RodPoint> where;
+    for (const auto& p : c.points) where.push_back({p.rod, p.xi});
+    if (where.empty())
+      for (int k = 0; k < sys.num_rods(); ++k) {
+        const auto& b = sys.spec(k).basis;
+        where.push_back({k, b.lo()});
+        where.push_back({k, b.hi()});
+      }
+    rep.resolution = check_resolution(sys, x, rep.lambda_reached, c.path, where);
+  }
   io::CsvWriter csv(dir / "load_displacement.csv", header);
   csv.add_comment("provenance: " + provenance);
   csv.add_comment("displacements u = r - r0 [mm] of the named points; path: " + rep.message);
+  if (rep.resolution)
+    csv.add_comment("resolution: " + rep.resolution->describe() + " (tolerance " +
+                    std::to_string(static_cast<int>(100 * kResolutionTolerance)) + " %)");
   for (size_t r = 0; r < rows.size(); ++r) {
     std::vector<io::CsvCell> cells{rows[r].step, rows[r].lambda, iters[r]};
     for (double v : rows[r].u) cells.emplace_back(v);

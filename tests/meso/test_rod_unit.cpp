@@ -7,6 +7,7 @@
 
 #include "knit/meso/rod/builders.hpp"
 #include "knit/meso/rod/quaternion.hpp"
+#include "knit/meso/rod/resolution.hpp"
 #include "knit/meso/rod/rod_system.hpp"
 #include "knit/meso/rod/solver.hpp"
 
@@ -251,4 +252,28 @@ TEST_CASE("section: yarn defaults reproduce the values of design/notes.md", "[un
   CHECK(s.shear_factor() == Approx(6 * 1.3 / 8.8));
   CHECK(s.C_Gamma()(0) == Approx(800.0 / 2.6 * (6 * 1.3 / 8.8) * s.A()));
   CHECK(s.C_K()(2) == Approx(800.0 / 2.6 * s.J()));
+}
+
+// The resolution check's second mesh (session 28): every span halved, the same reference
+// centerline, loads and end conditions, and again a stress-free reference state.
+TEST_CASE("rod: the bisected system keeps the geometry and doubles the spans", "[unit]") {
+  RodSystem sys;
+  RodSpec s = helix_rod(3, 5);
+  s.end.force = Vector3d(0.0, 1e-4, 2e-4);
+  s.line_force = Vector3d(1e-5, 0.0, 0.0);
+  sys.add_rod(s);
+  const RodSystem fine = bisected(sys);
+  REQUIRE(fine.num_rods() == 1);
+  CHECK(fine.spec(0).basis.degree() == 3);
+  CHECK(fine.num_control_points(0) == 3 + 10);
+  CHECK(fine.spec(0).name == "helix");
+  CHECK((fine.spec(0).end.force - s.end.force).norm() == 0.0);
+  CHECK((fine.spec(0).line_force - s.line_force).norm() == 0.0);
+  // Gauss quadrature of |r0_xi| (not a polynomial) per span: twice the spans, a finer sum.
+  CHECK(fine.reference_length(0) == Approx(sys.reference_length(0)).epsilon(1e-8));
+  for (double xi : {0.0, 0.13, 0.5, 0.77, 1.0})
+    CHECK((fine.reference_position(0, xi) - sys.reference_position(0, xi)).norm() < 1e-12);
+  Eigen::VectorXd F;
+  fine.residual(fine.initial_state(), 0.0, F);
+  CHECK(F.cwiseProduct(fine.row_scales()).cwiseAbs().maxCoeff() < 1e-12);
 }

@@ -10,10 +10,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "knit/meso/rod/resolution.hpp"
 #include "knit/meso/rod/rod_system.hpp"
 #include "knit/meso/rod/solver.hpp"
 
@@ -33,6 +35,14 @@ struct RodCase {
   std::vector<NamedPoint> points;
   int samples_per_element = 8;
   bool write_vtp = true;
+  /// /output/check_resolution: solve again on the bisected mesh and compare (resolution.hpp)
+  bool check_resolution = true;
+};
+
+/// The path report plus the resolution check (absent when not run: disabled, or the path
+/// stopped early).
+struct CasePathReport : PathReport {
+  std::optional<ResolutionCheck> resolution;
 };
 
 /// Reads and checks a case file; throws knit::InputError(file, pointer, message).
@@ -41,7 +51,7 @@ RodCase load_rod_case(const std::filesystem::path& file);
 /// Solves the case along its load path and writes the outputs into outdir (atomically, also
 /// when the path stops early: then the outputs hold the converged steps). Progress lines go
 /// to `log` if given.
-PathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,
-                        std::ostream* log = nullptr);
+CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,
+                            std::ostream* log = nullptr);
 
 }  // namespace knit::meso::rod
