@@ -211,7 +211,8 @@ std::optional<std::string> interlock_defect(const LoopShape& shape, double c) {
   m << "the loop does not interlock with the next course like a single-jersey stitch: its "
        "centreline crosses the next course's at "
     << n << " points in projection, not " << kStitchCrossings
-    << " (the loop length is outside the range where the closed-form loop is a knit)";
+    << " (the loop shape, set by the loop length, gamma/w and the yarn diameter, is outside the "
+       "range where the closed-form loop is a knit)";
   return m.str();
 }
 

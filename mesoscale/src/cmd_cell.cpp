@@ -67,7 +67,7 @@ int run(const Options& o) {
       CellGeometry built = make_cell_geometry(o.loop_length, go);
       if (const auto bad = interlock_defect(built.shape, built.dim.c)) throw GeometryError(*bad);
       return built;
-    } catch (const GeometryError& e) {  // a loop too short for w and d
+    } catch (const GeometryError& e) {  // a loop that cannot be built or does not interlock
       throw knit::InputError("", "--loop-length", loop_length_message(o.loop_length, go.d, e));
     }
   }();

@@ -50,7 +50,7 @@ Chain ContactSet::chain(const Eigen::MatrixXd& Q, int course) const {
   return c;
 }
 
-std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) const {
+std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, double reach) const {
   const int n = basis_.size(), p = basis_.degree();
   const std::vector<double> br = spline::unique_knots(basis_.knots());
   const int ne = static_cast<int>(br.size()) - 1;
@@ -61,7 +61,7 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q) cons
     lo[e] = Q.middleRows(f, p + 1).colwise().minCoeff().transpose();
     hi[e] = Q.middleRows(f, p + 1).colwise().maxCoeff().transpose();
   }
-  const double inflate = opt_.d + opt_.margin;
+  const double inflate = reach;
   std::vector<Found> out;
   const int ns = static_cast<int>(xi_.size());
   (void)n;
@@ -106,7 +106,7 @@ const std::vector<ContactSet::Found>& ContactSet::found(const Eigen::MatrixXd& Q
       same_bits(c.Q.data(), Q.data(), Q.size()) && same_bits(c.a1.data(), a1_.data(), 3) &&
       same_bits(c.a2.data(), a2_.data(), 3))
     return c.found;
-  c.found = search(Q);
+  c.found = search(Q, opt_.d + opt_.margin);
   c.Q = Q;
   c.a1 = a1_;
   c.a2 = a2_;
@@ -150,6 +150,7 @@ Eigen::Vector2d* ContactSet::reference_for(const Found& f) {
 
 int ContactSet::capture_reference(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   reference_.assign(reference_.size(), {});
+  record_sides(sys, x);  // the first state the pass-through guard compares with
   if (opt_.reference != ContactOptions::Reference::kInitialOverlap) return 0;
   int n = 0;
   for (const Found& f : found(positions(sys, x)))
@@ -283,6 +284,37 @@ void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
       if (Eigen::Vector2d* ref = reference_for(f)) (*ref)(0) = f.pr.u;
   last_dissipation_ = D;
   dissipation_ += D;
+  record_sides(sys, x);
+}
+
+/// Slave point x_s and the master's material point of a watched pair in the state Q.
+Eigen::Vector3d ContactSet::separation(const Eigen::MatrixXd& Q, int point, int course, int k,
+                                       double u) const {
+  const int p = basis_.degree();
+  const Eigen::Vector3d xs = (Nc_.row(point) * Q.middleRows(first_[point], p + 1)).transpose();
+  return xs - eval_chain(chain(Q, course), u, k).x;
+}
+
+void ContactSet::record_sides(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  const Eigen::MatrixXd Q = positions(sys, x);
+  sides_.clear();
+  for (const Found& f : search(Q, kWatchRadius * opt_.d + opt_.margin)) {
+    const Eigen::Vector3d r = separation(Q, f.point, f.course, f.pr.k, f.pr.u);
+    if (!(r.norm() > 0)) continue;  // on the centerline: no side to keep
+    sides_.push_back({f.point, f.course, f.pr.k, f.pr.u, r.normalized()});
+  }
+}
+
+std::optional<ContactSet::PassThrough> ContactSet::pass_through(const rod::RodSystem& sys,
+                                                                const Eigen::VectorXd& x) const {
+  const Eigen::MatrixXd Q = positions(sys, x);
+  std::optional<PassThrough> worst;
+  for (const Side& s : sides_) {
+    const double side = separation(Q, s.point, s.course, s.k, s.u).dot(s.n);
+    if (side < 0 && (!worst || -side > worst->depth))
+      worst = PassThrough{s.point, s.course, xi_[s.point], s.u, -side};
+  }
+  return worst;
 }
 
 }  // namespace knit::meso::contact

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "knit/meso/rod/quaternion.hpp"
@@ -151,7 +152,31 @@ bool PeriodicCell::try_solve(const Matrix2d& F, StepResult& res) {
       rod::solve_newton(sys_, x, 1.0, {periodic_.get(), contact_.get()}, opt_.newton);
   res.iterations += nr.iterations;
   res.message = nr.message;
-  if (!nr.converged) {
+  bool accept = nr.converged;
+  if (accept) {
+    // A converged state whose yarns went through each other is not a solution (contact_set.hpp,
+    // pass-through guard): cut back, as for a failed increment.
+    std::ostringstream m;
+    m.precision(3);
+    if (const auto pt = contact_->pass_through(sys_, x)) {
+      m << "yarns passed through each other (slave point at xi = " << pt->xi << ", course "
+        << pt->course << ", " << pt->depth << " mm beyond the master's centerline)";
+    } else {
+      // Sunk into each other short of passing through: the same branch at a smaller depth
+      // (contact_set.hpp, kMaxOverlap).
+      double g = 0.0;
+      for (const auto& p : contact_->active_pairs(sys_, x)) g = std::min(g, p.gap);
+      if (g < -contact::ContactSet::kMaxOverlap * opt_.contact.d)
+        m << "yarns sank " << -g << " mm into each other, more than "
+          << contact::ContactSet::kMaxOverlap << " d";
+    }
+    if (!m.str().empty()) {
+      res.message = m.str();
+      ++res.pass_throughs;
+      accept = false;
+    }
+  }
+  if (!accept) {
     set_F(F_);
     contact_->reset_increment();
     return false;
@@ -183,9 +208,12 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
       // the same state "converges" for ever (session 12: course compression with shear, 4.5
       // mm, stuck at 0.94117191743... of a step). Below kMinSubstep of the step: not converged.
       if (inc < kMinSubstep) {
-        res.message = "sub-steps below " + std::to_string(kMinSubstep) +
-                      " of the step at load fraction " + std::to_string(lam) +
-                      " (a limit point: the cell does not pass this strain)";
+        // The last attempt's reason stays in the message (a Newton failure, or the
+        // pass-through guard's refusal).
+        res.message =
+            "sub-steps below " + std::to_string(kMinSubstep) + " of the step at load fraction " +
+            std::to_string(lam) +
+            " (a limit point: the cell does not pass this strain); last attempt: " + res.message;
         break;
       }
     }
@@ -194,6 +222,7 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
   h.converged = lam >= 1 - 1e-14;
   h.iterations = res.iterations;
   h.cutbacks = res.cutbacks;
+  h.pass_throughs = res.pass_throughs;
   h.message = res.message;
   h.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return h;

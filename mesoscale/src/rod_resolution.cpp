@@ -46,8 +46,8 @@ ResolutionCheck check_resolution(const RodSystem& sys, const Eigen::VectorXd& x,
   if (lambda_reached != path.lambda_end) {
     // Stop the check at the case's last converged load factor, keeping the nominal increment.
     const double nominal = (path.lambda_end - path.lambda_start) / path.steps;
-    path.steps = std::max(1, static_cast<int>(std::ceil(
-                                 (lambda_reached - path.lambda_start) / nominal - 1e-9)));
+    path.steps = std::max(
+        1, static_cast<int>(std::ceil((lambda_reached - path.lambda_start) / nominal - 1e-9)));
     path.lambda_end = lambda_reached;
   }
   if (lambda_reached == path.lambda_start) {
@@ -56,8 +56,9 @@ ResolutionCheck check_resolution(const RodSystem& sys, const Eigen::VectorXd& x,
   }
   const PathReport rep = solve_path(fine, xf, path);
   if (!rep.completed) {
-    rc.note = "the run on the bisected mesh stopped at lambda = " +
-              std::to_string(rep.lambda_reached) + " (" + rep.message + ")";
+    rc.note =
+        "the run on the bisected mesh stopped at lambda = " + std::to_string(rep.lambda_reached) +
+        " (" + rep.message + ")";
     return rc;
   }
   double diff = 0.0;

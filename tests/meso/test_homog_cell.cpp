@@ -201,5 +201,39 @@ TEST_CASE("a periodic cell is refused where its loop does not interlock", "[unit
   // Every entry (path, cell, the sweep's loop lengths) builds a PeriodicCell; one of 3 mm has
   // no crossing with the next course (session 27: exit 0 with S22 = 0.0006 MPa at 50 %).
   CHECK_THROWS_AS(PeriodicCell(3.0), knit::meso::cell::GeometryError);
+  CHECK_THROWS_WITH(PeriodicCell(3.0), Catch::Contains("does not interlock with the next course"));
   CHECK_NOTHROW(PeriodicCell(4.5));
+}
+
+// Session 28: the gap |x_s - x_m| - d has no sign, and one large step let the yarns of a 4.5 mm
+// cell slip through each other: course stretch F11 = 1.8 in one step gave S = (-1.2, -3.8) MPa,
+// compression under tension, for (8.7, 15.4) MPa in 40 steps, converged and exit 0. Wale
+// stretch F22 = 1.8 in one step converged with the yarns sunk 0.93 d into each other, S = (8.7,
+// 10.2) MPa for (17.8, 17.2). Both states are now refused and the step cut back
+// (contact_set.hpp, pass-through guard and kMaxOverlap).
+TEST_CASE("a step whose yarns pass through each other is cut back, not accepted", "[case]") {
+  for (const int axis : {0, 1}) {
+    INFO("stretch along " << (axis == 0 ? "the course" : "the wale"));
+    Eigen::Matrix2d F = Eigen::Matrix2d::Identity();
+    F(axis, axis) = 1.8;
+    PeriodicCell one(4.5, fast_options());
+    REQUIRE(one.equilibrate().converged);
+    const StepResult r1 = one.solve(F);
+    PeriodicCell many(4.5, fast_options());
+    REQUIRE(many.equilibrate().converged);
+    StepResult rn;
+    for (int k = 1; k <= 40; ++k) {
+      Eigen::Matrix2d Fk = Eigen::Matrix2d::Identity();
+      Fk(axis, axis) = 1.0 + 0.8 * k / 40.0;
+      rn = many.solve(Fk);
+      REQUIRE(rn.converged);
+      CHECK(rn.pass_throughs == 0);  // small steps: the guard does not fire
+    }
+    INFO(r1.message);
+    CHECK(r1.pass_throughs > 0);  // the full step went through and was cut back
+    CHECK(r1.converged);          // ... and its sub-steps reach F
+    // At the stresses of the small steps (friction's path dependence: a few %).
+    CHECK(r1.S(0, 0) == Approx(rn.S(0, 0)).epsilon(0.1));
+    CHECK(r1.S(1, 1) == Approx(rn.S(1, 1)).epsilon(0.1));
+  }
 }

@@ -43,6 +43,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "knit/meso/contact/law.hpp"
@@ -99,19 +100,58 @@ class ContactSet : public rod::ExternalContribution {
   int num_reference_pairs() const;
   /// Accepts the state x as converged: histories and dissipation are updated.
   void commit(const rod::RodSystem& sys, const Eigen::VectorXd& x);
-  /// Everything commit() changes (friction anchors, references, dissipation): trial solves
-  /// (the uniaxial path's lateral iteration) save and restore it.
+  /// Pass-through guard (session 28). The gap |x_s - x_m| - d has no sign, so a slave point
+  /// that crosses its master's centerline within one increment sees the pair open again on
+  /// the other side, and Newton converges to yarns that went through each other (4.5 mm, wale
+  /// stretch F22 = 1.8 in one step: S = (0.002, 0.004) MPa for (17.8, 17.2) in 40 steps, exit 0).
+  /// commit() records, for every pair within kWatchRadius diameters of each other, the side of
+  /// the master on which the slave point lies: n = (x_s - x_m(u)) / |x_s - x_m(u)| at the
+  /// master's material point (copy k, parameter u). A converged state in which
+  /// (x_s - x_m(u)) . n < 0 for one of them has the slave point on the other side of the same
+  /// material point: a pass-through. Sliding moves the slave along the master and turns n, so a
+  /// large step can be refused that is none; it is then cut back, and the smaller steps pass.
+  /// (A sliding-invariant side, the sign of r . (t_s x t_m) of crossing strands, was tried and
+  /// rejected: where the loop wraps around a leg, the slave points along the wrap cross the
+  /// tangent plane, and 4.5 mm shear to 50 degrees stopped at a limit point in 40 steps.)
+  /// Pairs farther apart at the last commit are not watched (a step that moves a yarn through
+  /// another from farther away is not caught).
+  static constexpr double kWatchRadius = 2.0;  ///< in yarn diameters (choice)
+  /// A converged state with a pair overlapping by more than kMaxOverlap d is refused as well
+  /// (choice): the centerlines are then within 0.2 d of each other, one small step from a
+  /// pass-through, with a penalty line load two orders above the yarn forces. 4.5 mm, wale
+  /// stretch F22 = 1.8 in one step converged there (overlap 0.93 d, S = (8.7, 10.2) MPa for
+  /// (17.8, 17.2) in 40 steps, whose deepest overlap is 0.66 d).
+  static constexpr double kMaxOverlap = 0.8;
+  struct Side {
+    int point = 0, course = 0, k = 0;
+    double u = 0;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();  ///< r/|r| at the commit
+  };
+  struct PassThrough {
+    int point = 0, course = 0;
+    double xi = 0, u = 0;  ///< slave parameter; master parameter (unrolled)
+    double depth = 0;      ///< -(x_s - x_m(u)) . n [mm], > 0: how far beyond the master
+  };
+  /// The deepest pass-through of the converged state x against the last commit, or nullopt.
+  std::optional<PassThrough> pass_through(const rod::RodSystem& sys,
+                                          const Eigen::VectorXd& x) const;
+  int num_watched_pairs() const { return static_cast<int>(sides_.size()); }
+
+  /// Everything commit() changes (friction anchors, references, dissipation, sides): trial
+  /// solves (the uniaxial path's lateral iteration) save and restore it.
   struct State {
     std::vector<std::vector<double>> history;
     std::vector<std::vector<Eigen::Vector2d>> reference;
     double dissipation = 0, last_dissipation = 0;
+    std::vector<Side> sides;
   };
-  State save() const { return {history_, reference_, dissipation_, last_dissipation_}; }
+  State save() const { return {history_, reference_, dissipation_, last_dissipation_, sides_}; }
   void restore(const State& s) {
     history_ = s.history;
     reference_ = s.reference;
     dissipation_ = s.dissipation;
     last_dissipation_ = s.last_dissipation;
+    sides_ = s.sides;
     reset_increment();
   }
   /// Drops the pending (in-increment) pairs, e.g. after a failed increment.
@@ -127,13 +167,19 @@ class ContactSet : public rod::ExternalContribution {
     int point, course;
     Projection pr;
   };
-  std::vector<Found> search(const Eigen::MatrixXd& Q) const;
+  /// Pairs within `reach` of each other (d + margin for the contact loads).
+  std::vector<Found> search(const Eigen::MatrixXd& Q, double reach) const;
   /// search(Q) at the current periods, remembered for the last (Q, a1, a2): a converged state
   /// is searched by the Newton's last residual, commit() (twice) and homogenization
   /// (active_pairs()); the search is a pure function of them, so the result is reused.
   const std::vector<Found>& found(const Eigen::MatrixXd& Q);
   Chain chain(const Eigen::MatrixXd& Q, int course) const;
   double anchor_for(const Found& f);
+  /// sides_ of the state x (see Side).
+  void record_sides(const rod::RodSystem& sys, const Eigen::VectorXd& x);
+  /// x_s - x_m(u) of slave point `point` and copy k of course `course` in the state Q.
+  Eigen::Vector3d separation(const Eigen::MatrixXd& Q, int point, int course, int k,
+                             double u) const;
   /// The reference (u_r, g_r) matched by f, or nullptr.
   Eigen::Vector2d* reference_for(const Found& f);
   Eigen::MatrixXd positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const;
@@ -155,6 +201,7 @@ class ContactSet : public rod::ExternalContribution {
   // reference_[slave*3 + course+1]: (u_r, g_r) of the stress-free reference pairs
   std::vector<std::vector<Eigen::Vector2d>> reference_;
   double dissipation_ = 0, last_dissipation_ = 0;
+  std::vector<Side> sides_;  // of the last committed state (pass-through guard)
   struct SearchCache {
     bool valid = false;
     Eigen::MatrixXd Q;

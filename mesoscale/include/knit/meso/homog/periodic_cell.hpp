@@ -103,6 +103,8 @@ struct StepResult {
   Eigen::Vector3d n1 = Eigen::Vector3d::Zero(), n2 = Eigen::Vector3d::Zero();
   int iterations = 0;  ///< Newton iterations (all increments of the step)
   int cutbacks = 0;
+  int pass_throughs = 0;  ///< of the cut-backs: converged increments whose yarns went through
+                          ///< (or sank kMaxOverlap d into) each other (contact_set.hpp)
   double seconds = 0;
   int active_contacts = 0;
   double min_gap = 0;
