@@ -213,11 +213,20 @@ std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(
     const Eigen::Vector2d& theta, const Eigen::Vector3d& E) const {
   const double alpha = knitting_angle(theta);
   const Eigen::Vector3d Ehat = mech::T_E(alpha) * E;
-  return {{"stitch_value", stitch_value(theta)},
+  const double l = stitch_value(theta);
+  // Where the mid-surface strain lies beyond the law's data (session 28: the report counted
+  // the quadrature points' evaluations, but the output grid's samples, which the figures show,
+  // were not marked): the energy law's strain box, or the response surface's extension kinds
+  // 0-3 (beyond the last step, outside the fan, linear compression, beyond the shear data).
+  const bool beyond =
+      !Ehat.allFinite() ||
+      (energy_ ? !energy_at(l)->inside_box(Ehat) : (surface_at(l)->evaluate(Ehat).flags & 0b1111));
+  return {{"stitch_value", l},
           {"knitting_angle", alpha},
           {"E_course", Ehat(0)},
           {"E_wale", Ehat(1)},
-          {"E_course_wale", 0.5 * Ehat(2)}};
+          {"E_course_wale", 0.5 * Ehat(2)},
+          {"beyond_law_data", beyond ? 1.0 : 0.0}};
 }
 
 KnitMaterial::Stats KnitMaterial::stats() const {

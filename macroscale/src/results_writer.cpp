@@ -67,6 +67,7 @@ std::string result_unit(const std::string& name) {
                                                               {"E_course", "1"},
                                                               {"E_wale", "1"},
                                                               {"E_course_wale", "1"},
+                                                              {"beyond_law_data", "1"},
                                                               {"step", "1"},
                                                               {"load_factor", "1"},
                                                               {"applied_displacement", "mm"},

@@ -160,6 +160,32 @@ std::string db_file(const std::string& name, bool energy, int version) {
 }
 }  // namespace
 
+// Session 28: the report counted the extrapolated evaluations at the quadrature points, but
+// the output grid's samples, which the figures show, carried no mark.
+TEST_CASE("knit material: the output field beyond_law_data marks samples beyond the data",
+          "[unit]") {
+  auto beyond = [](const KnitMaterial& m, const Eigen::Vector3d& E) {
+    for (const auto& [name, v] : m.output_fields({0.8, 0.5}, E))
+      if (name == "beyond_law_data") return v;
+    return -1.0;
+  };
+  for (const double alpha : {0.0, 0.6}) {
+    const KnitMaterial m = energy_material(alpha);
+    CHECK(beyond(m, {0.05, 0.05, 0.0}) == 0.0);
+    CHECK(beyond(m, {5.0, 0.0, 0.0}) == 1.0);  // far beyond the box in any frame
+    CHECK(beyond(m, {NAN, 0.0, 0.0}) == 1.0);
+  }
+  // The paper's response surfaces (law "paper"): beyond the last step of the fan.
+  const std::string db = db_file("beyond_v1.h5", false, 1);
+  const Case c = parse_case(
+      square_case(R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": 5.0})"),
+      "c.json");
+  const auto& paper = dynamic_cast<const KnitMaterial&>(*c.material);
+  REQUIRE(paper.law() == "paper");
+  CHECK(beyond(paper, {0.05, 0.05, 0.0}) == 0.0);
+  CHECK(beyond(paper, {5.0, 5.0, 0.0}) == 1.0);
+}
+
 TEST_CASE("knit material: the case key /material/law", "[unit]") {
   const std::string with = db_file("law_energy.h5", true, 2), v1 = db_file("law_v1.h5", false, 1);
   auto material = [](const std::string& db, const std::string& law) {
