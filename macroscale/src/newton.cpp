@@ -8,7 +8,7 @@
 #include <optional>
 #include <sstream>
 
-#include "knit/spline/knot_vector.hpp"
+#include "knit/macro/fold_guard.hpp"
 
 namespace knit::macro {
 
@@ -325,41 +325,18 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   // converges at the undeformed state by right).
   const bool loaded = fext_red.norm() > 0.0 ||
                       dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
-  // The unit normal a3 at every quadrature point of the last converged state (the reference
-  // normals A3 at first). A converged state whose normal turned by 90 degrees or more at a
-  // point within one step is not accepted: the step is cut back, and a fold that persists
-  // stops the run. Green-Lagrange strains do not see a mirrored (inverted) configuration, so
-  // Newton converges to one (session 27: the s312 patch compressed by 30 % inverted at its
-  // corners from step 18, 62 of 1,600 output cells with negative area, exit 0). A rotation by
-  // 90 degrees or more within one step at a point is also far beyond what the stepping resolves
-  // anywhere else; cutting the step back lets a genuine large rotation through.
-  // Besides the quadrature points, the element corners (the grid of the knot breakpoints): an
-  // inversion starts at the patch's corners, outside the quadrature points' reach.
-  const int nq = model.num_quadrature_points();
-  std::vector<Eigen::Vector2d> corners;
-  for (const double tv : spline::unique_knots(model.surface().basis_v().knots()))
-    for (const double tu : spline::unique_knots(model.surface().basis_u().knots()))
-      corners.emplace_back(tu, tv);
-  std::vector<Eigen::Vector3d> normals(nq + corners.size()), normals_now(normals.size());
-  for (int q = 0; q < nq; ++q) normals[q] = model.quadrature_point(q).e3;
-  for (std::size_t k = 0; k < corners.size(); ++k)
-    normals[nq + k] = model.normals(Eigen::VectorXd::Zero(model.num_dofs()), corners[k]).second;
-  // The first check point whose normal at the converged u (quadrature points: from `trial`'s
-  // point states, evaluated there if they are not) turned by 90 degrees or more from
-  // `normals`, or -1; -2 if the configuration degenerated. Fills normals_now.
+  // No converged state may fold over itself (fold_guard.hpp). The first check point whose
+  // normal at the converged u turned by 90 degrees or more, or -1; -2 if the configuration
+  // degenerated. The quadrature points' normals come from `trial`'s point states, evaluated
+  // there if they are not.
+  FoldGuard folds(model);
   auto flipped_point = [&](const Eigen::VectorXd& u) {
     if (!(trial.has_points && trial_u.size() > 0 && trial_u == u)) {
       trial_u = u;
       model.evaluate(trial_u, false, trial, /*keep_points=*/true);
       if (!trial.ok) return -2;
     }
-    for (int q = 0; q < nq; ++q)
-      normals_now[q] = Eigen::Map<const Eigen::Vector3d>(trial.points[q].a3);
-    for (std::size_t k = 0; k < corners.size(); ++k)
-      normals_now[nq + k] = model.normals(u, corners[k]).first;
-    for (std::size_t q = 0; q < normals.size(); ++q)
-      if (!(normals_now[q].dot(normals[q]) > 0.0)) return static_cast<int>(q);
-    return -1;
+    return folds.check(u, trial.points);
   };
   while (lambda < 1.0 - 1e-12) {
     const double next_nominal = std::min(1.0, h_nom * std::floor(lambda / h_nom + 1.0 + 1e-9));
@@ -402,21 +379,12 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     if (o.converged) {
       if (const int q = flipped_point(dofs.expand(uf, lam1)); q != -1) {
         o.converged = false;
-        std::ostringstream s;
-        if (q == -2) {
-          s << "the configuration degenerated (zero Jacobian or non-finite strains)";
-        } else {
-          const Eigen::Vector2d t =
-              q < nq ? model.quadrature_point(q).theta : corners[static_cast<std::size_t>(q - nq)];
-          s << "the surface folds over itself: its normal at (theta1, theta2) = (" << t(0) << ", "
-            << t(1) << ") turned by 90 degrees or more within the step (an inverted or "
-            << "folded configuration, which the strains do not see)";
-        }
-        o.why = s.str();
+        o.why = q == -2 ? "the configuration degenerated (zero Jacobian or non-finite strains)"
+                        : folds.describe(q);
       }
     }
     if (o.converged) {
-      normals.swap(normals_now);
+      folds.accept();
       if (o.negative_pivots == -2 && K.symmetric()) {
         // No factorization in this step (converged at once): the inertia at this state (its
         // tangent is assembled already when the step's first evaluation was here).

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "knit/macro/case.hpp"
+#include "knit/macro/fold_guard.hpp"
 #include "knit/macro/reduced_tangent.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
@@ -377,4 +378,44 @@ TEST_CASE("Newton: the round-off floor, by the correction or by a stalled residu
   CHECK_FALSE(at_round_off_floor(4.150e-8, ref, 2e-6, 4.150e-8, opt));
   // A stalled residual far above the tolerance is a failing step, not a floor.
   CHECK_FALSE(at_round_off_floor(1e-4, ref, 3e-8, 1e-4, opt));
+}
+
+// The fold guard (fold_guard.hpp; session 27's check, a class of its own since session 28): a
+// mirrored patch (x -> -x, which the Green-Lagrange strains do not see) has every normal
+// turned by 180 degrees; a rigid rotation by 60 degrees about x turns none by 90 or more.
+TEST_CASE("fold guard: a mirrored state is found, a rotation below 90 degrees passes", "[unit]") {
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  const ShellModel m(test::curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, true), 0.1, mat);
+  FoldGuard guard(m);
+  const Eigen::MatrixXd& P = m.surface().control_points();
+  auto displaced = [&](const Eigen::Matrix3d& Q) {
+    Eigen::VectorXd u(m.num_dofs());
+    for (int a = 0; a < P.rows(); ++a)
+      u.segment<3>(3 * a) = Q * P.row(a).transpose() - P.row(a).transpose();
+    return u;
+  };
+  auto check = [&](const Eigen::VectorXd& u) {
+    ShellModel::Evaluation ev;
+    m.evaluate(u, false, ev, /*keep_points=*/true);
+    REQUIRE(ev.ok);
+    return guard.check(u, ev.points);
+  };
+  CHECK(check(Eigen::VectorXd::Zero(m.num_dofs())) == -1);
+  const Eigen::Matrix3d rot60 =
+      Eigen::AngleAxisd(60.0 * std::acos(-1.0) / 180.0, Eigen::Vector3d::UnitX())
+          .toRotationMatrix();
+  CHECK(check(displaced(rot60)) == -1);
+  const Eigen::Matrix3d mirror = Eigen::Vector3d(-1.0, 1.0, 1.0).asDiagonal();
+  const int q = check(displaced(mirror));
+  CHECK(q == 0);  // the first check point already
+  CHECK_THAT(guard.describe(q), Catch::StartsWith("the surface folds over itself: its normal at "
+                                                  "(theta1, theta2) = ("));
+  // Accepted, the mirrored state is the new reference: mirrored again it passes, the original
+  // does not.
+  guard.accept();
+  CHECK(check(displaced(mirror)) == -1);
+  guard.accept();
+  CHECK(check(Eigen::VectorXd::Zero(m.num_dofs())) == 0);
+  // The element corners are checked too: their index follows the quadrature points'.
+  CHECK(guard.where(m.num_quadrature_points()).isApprox(Eigen::Vector2d(0.0, 0.0)));
 }
