@@ -185,8 +185,21 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
   if (file_.has_parent_path()) fs::create_directories(file_.parent_path(), ec);  // as the writer
   // A lock file unlinked by its releasing holder between our open() and flock() is not the lock
   // any more: retry on the new file (checked by comparing inodes).
-  for (int attempt = 0; attempt < 20; ++attempt) {
-    const int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  // An EMPTY lock file that this process did not create is either another knitscale process's,
+  // created a moment ago and not yet tagged (it tags it once it holds the flock), or someone
+  // else's empty file, which must not be taken over and unlinked on release (session 28: an
+  // empty "out.lock" of the user's was). So: create with O_EXCL to know whether it is ours, and
+  // an empty file that is not ours and not held is looked at again a few times, then refused.
+  constexpr int kEmptyRetries = 10;
+  int empty_seen = 0;
+  for (int attempt = 0; attempt < 20 + kEmptyRetries; ++attempt) {
+    bool created = true;
+    int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0 && errno == EEXIST) {
+      created = false;
+      fd = ::open(file_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
+      if (fd < 0 && errno == ENOENT) continue;  // released between the two opens: again
+    }
     if (fd < 0)
       throw InputError(
           out, "",
@@ -219,6 +232,16 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
     if (::fstat(fd, &a) != 0 || ::stat(file_.c_str(), &b) != 0 || a.st_ino != b.st_ino ||
         a.st_dev != b.st_dev) {
       ::close(fd);
+      continue;
+    }
+    if (!created && read_small(fd).empty()) {
+      ::close(fd);
+      if (++empty_seen > kEmptyRetries)
+        throw InputError(out, "",
+                         file_.string() +
+                             " exists, is empty and is not a knitscale lock file; rename or "
+                             "remove it, or choose another output");
+      ::usleep(20000);  // 20 ms: time for its creator to tag it
       continue;
     }
     const std::string me = kLockTag + std::to_string(::getpid()) + "\n";

@@ -320,6 +320,13 @@ TEST_CASE("OutputLock: one holder at a time, named in the refusal, stale locks t
   std::ofstream(d / "out.lock") << "someone's notes";
   CHECK_THROWS_WITH(knit::io::OutputLock(target), Catch::Contains("not a knitscale lock file"));
   CHECK(slurp(d / "out.lock") == "someone's notes");
+  // Nor an empty one (session 28: an empty file was taken over, and unlinked on release).
+  fs::remove(d / "out.lock");
+  std::ofstream(d / "out.lock").close();
+  CHECK_THROWS_WITH(knit::io::OutputLock(target),
+                    Catch::Contains("exists, is empty and is not a knitscale lock file"));
+  CHECK(fs::exists(d / "out.lock"));
+  CHECK(fs::file_size(d / "out.lock") == 0);
 }
 
 TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our stale partials",
