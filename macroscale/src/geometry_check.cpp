@@ -106,3 +106,24 @@ std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& 
 }
 
 }  // namespace knit::macro
+
+namespace knit::macro {
+
+double reference_area(const spline::SplineSurface& surface, int points_per_span) {
+  const auto qu = spline::gauss_legendre_on_spans(
+      points_per_span > 0 ? points_per_span : surface.basis_u().degree() + 1,
+      surface.basis_u().knots());
+  const auto qv = spline::gauss_legendre_on_spans(
+      points_per_span > 0 ? points_per_span : surface.basis_v().degree() + 1,
+      surface.basis_v().knots());
+  double area = 0.0;
+  for (std::size_t j = 0; j < qv.points.size(); ++j)
+    for (std::size_t i = 0; i < qu.points.size(); ++i) {
+      const Eigen::MatrixXd d = surface.derivatives(qu.points[i], qv.points[j], 1);
+      const Eigen::Vector3d a1 = d.row(1).transpose(), a2 = d.row(2).transpose();
+      area += qu.weights[i] * qv.weights[j] * a1.cross(a2).norm();
+    }
+  return area;
+}
+
+}  // namespace knit::macro

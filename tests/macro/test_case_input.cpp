@@ -15,6 +15,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
+#include "knit/macro/geometry_check.hpp"
 #include "knit/macro/refinement.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
@@ -629,6 +630,26 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
   CHECK(error_of(j).rfind("kink.json: /geometry/degrees/1: degree 1 cannot be analysed", 0) == 0);
   j["refinement"] = read_json("tensile_svk.json")["refinement"];  // degree 5: accepted
   CHECK(error_of(j).empty());
+}
+
+TEST_CASE("a surface whose area the shell's quadrature misses is refused at load", "[unit]") {
+  // Session 28: NURBS weights 1, 1, 1, 10 on the one-element tensile patch (the same flat
+  // square) gave 23 % more jaw force, with the area integrated 0.5 % off; weights up to 1e4
+  // ran with exit 0 and results hundreds of times off.
+  json j = read_json("tensile_svk.json");
+  const auto error_of = [](const json& c) { return ::error_of(c, "w.json"); };
+  j["geometry"]["weights"] = {1, 1, 1, 10};
+  CHECK(error_of(j).rfind("w.json: /geometry/weights: the shell's quadrature (p + 1 Gauss points "
+                          "per element and direction) integrates the area of this surface 0.53 "
+                          "% off (more than 0.1 %)",
+                          0) == 0);
+  j["geometry"]["weights"] = {1, 1, 1, 3};  // 2.5e-6 off: accepted
+  CHECK(error_of(j).empty());
+  j["geometry"]["weights"] = {1, 1, 1, 10};
+  j["refinement"]["elements"] = {4, 4};  // 4.2e-6 off: accepted
+  CHECK(error_of(j).empty());
+  CHECK(knit::macro::reference_area(parse_case(j.dump(), "w.json").surface) ==
+        Approx(2500.0).epsilon(1e-5));  // the 50 x 50 mm square
 }
 
 namespace {
