@@ -127,6 +127,7 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/contact/stick_penalty", f.k_T, 0, inf, true, false},
       {"/contact/margin", contact.margin, 0, inf, false, false},
       {"/contact/self_exclusion", contact.self_exclusion, 0, 1, true, false},
+      {"/contact/max_overlap", contact.max_overlap, 0, 1, true, false},
       {"/solver/tolerance", newton.tol, 0, 0.01, true, false},  // 1 accepted the first iterate
       {"/solver/max_iterations", double(newton.max_iterations), 1, kMaxIterations, false, false},
       {"/solver/equilibration_steps", double(equilibration_steps), 1, kMaxIterations, false, false},
@@ -175,7 +176,7 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     const json& c = j["contact"];
     R.object(c, "/contact",
              {"penalty", "allowance", "delta", "soft_penalty", "soft_delta", "mu", "stick_penalty",
-              "margin", "self_exclusion", "reference"});
+              "margin", "self_exclusion", "reference", "max_overlap"});
     if (c.contains("reference")) {
       const json& r = c["reference"];
       if (!r.is_string() || (r != "initial_overlap" && r != "none"))
@@ -192,6 +193,7 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
     R.num(c, "/contact", "stick_penalty", o.contact.friction.k_T, 0, inf, true);
     R.num(c, "/contact", "margin", o.contact.margin, 0, inf, false);
     R.num(c, "/contact", "self_exclusion", o.contact.self_exclusion, 0, 1, true);
+    R.num(c, "/contact", "max_overlap", o.contact.max_overlap, 0, 1, true);
   }
   if (j.contains("solver")) {
     const json& s = j["solver"];

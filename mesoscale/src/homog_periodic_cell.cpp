@@ -153,6 +153,7 @@ bool PeriodicCell::try_solve(const Matrix2d& F, StepResult& res) {
   res.iterations += nr.iterations;
   res.message = nr.message;
   bool accept = nr.converged;
+  last_refused_ = false;
   if (accept) {
     // A converged state whose yarns went through each other is not a solution (contact_set.hpp,
     // pass-through guard): cut back, as for a failed increment.
@@ -163,16 +164,18 @@ bool PeriodicCell::try_solve(const Matrix2d& F, StepResult& res) {
         << pt->course << ", " << pt->depth << " mm beyond the master's centerline)";
     } else {
       // Sunk into each other short of passing through: the same branch at a smaller depth
-      // (contact_set.hpp, kMaxOverlap).
+      // (ContactOptions::max_overlap).
       double g = 0.0;
       for (const auto& p : contact_->active_pairs(sys_, x)) g = std::min(g, p.gap);
-      if (g < -contact::ContactSet::kMaxOverlap * opt_.contact.d)
-        m << "yarns sank " << -g << " mm into each other, more than "
-          << contact::ContactSet::kMaxOverlap << " d";
+      if (g < -opt_.contact.max_overlap * opt_.contact.d)
+        m << "yarns sank " << -g << " mm (" << -g / opt_.contact.d
+          << " d) into each other, more than /contact/max_overlap = " << opt_.contact.max_overlap
+          << " d (a softer contact law needs a larger bound)";
     }
     if (!m.str().empty()) {
       res.message = m.str();
       ++res.pass_throughs;
+      last_refused_ = true;
       accept = false;
     }
   }
@@ -213,7 +216,10 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
         res.message =
             "sub-steps below " + std::to_string(kMinSubstep) + " of the step at load fraction " +
             std::to_string(lam) +
-            " (a limit point: the cell does not pass this strain); last attempt: " + res.message;
+            (last_refused_
+                 ? ": every converged sub-step was refused by the pass-through guard: "
+                 : " (a limit point: the cell does not pass this strain); last attempt: ") +
+            res.message;
         break;
       }
     }

@@ -394,14 +394,17 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
   }
   // Resolution check (knit/meso/rod/resolution.hpp): the same path on the bisected mesh.
   if (rep.completed && c.check_resolution) {
+    // The named points and the whole centerline: the ends and every span's midpoint (review of
+    // session 28: with only the clamped root named, one element of degree 3 "changed by 0 %").
     std::vector<RodPoint> where;
     for (const auto& p : c.points) where.push_back({p.rod, p.xi});
-    if (where.empty())
-      for (int k = 0; k < sys.num_rods(); ++k) {
-        const auto& b = sys.spec(k).basis;
-        where.push_back({k, b.lo()});
-        where.push_back({k, b.hi()});
+    for (int k = 0; k < sys.num_rods(); ++k) {
+      const std::vector<double> br = spline::unique_knots(sys.spec(k).basis.knots());
+      for (std::size_t i = 0; i < br.size(); ++i) {
+        where.push_back({k, br[i]});
+        if (i + 1 < br.size()) where.push_back({k, 0.5 * (br[i] + br[i + 1])});
       }
+    }
     rep.resolution = check_resolution(sys, x, rep.lambda_reached, c.path, where);
   }
   io::CsvWriter csv(dir / "load_displacement.csv", header);

@@ -175,6 +175,23 @@ TEST_CASE("knit material: the output field beyond_law_data marks samples beyond 
     CHECK(beyond(m, {5.0, 0.0, 0.0}) == 1.0);  // far beyond the box in any frame
     CHECK(beyond(m, {NAN, 0.0, 0.0}) == 1.0);
   }
+  {
+    // Judged in the material frame: inside the box there (test law: [-0.3, 0.45]^2 x
+    // [-0.5, 0.5]), outside it in the patch's frame, and the other way round (review of
+    // session 28).
+    const double alpha = 0.6;
+    const KnitMaterial m = energy_material(alpha);
+    const Eigen::Matrix3d TE = knit::mech::T_E(alpha);
+    auto in_test_box = [](const Eigen::Vector3d& e) {
+      return e(0) >= -0.3 && e(0) <= 0.45 && e(1) >= -0.3 && e(1) <= 0.45 && std::abs(e(2)) <= 0.5;
+    };
+    const Eigen::Vector3d E1 = TE.inverse() * Eigen::Vector3d(0.44, -0.29, 0.0);
+    REQUIRE_FALSE(in_test_box(E1));
+    CHECK(beyond(m, E1) == 0.0);
+    const Eigen::Vector3d E2(0.44, -0.29, 0.0);
+    REQUIRE_FALSE(in_test_box(TE * E2));
+    CHECK(beyond(m, E2) == 1.0);
+  }
   // The paper's response surfaces (law "paper"): beyond the last step of the fan.
   const std::string db = db_file("beyond_v1.h5", false, 1);
   const Case c = parse_case(

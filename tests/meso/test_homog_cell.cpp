@@ -210,7 +210,7 @@ TEST_CASE("a periodic cell is refused where its loop does not interlock", "[unit
 // compression under tension, for (8.7, 15.4) MPa in 40 steps, converged and exit 0. Wale
 // stretch F22 = 1.8 in one step converged with the yarns sunk 0.93 d into each other, S = (8.7,
 // 10.2) MPa for (17.8, 17.2). Both states are now refused and the step cut back
-// (contact_set.hpp, pass-through guard and kMaxOverlap).
+// (contact_set.hpp, pass-through guard and ContactOptions::max_overlap).
 TEST_CASE("a step whose yarns pass through each other is cut back, not accepted", "[case]") {
   for (const int axis : {0, 1}) {
     INFO("stretch along " << (axis == 0 ? "the course" : "the wale"));

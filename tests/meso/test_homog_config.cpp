@@ -29,6 +29,9 @@ TEST_CASE("cell config: fields are read, defaults kept", "[unit]") {
   CHECK(o.elements == 24);
   CHECK(o.section.d == 0.4);
   CHECK(o.contact.penalty.delta == CellOptions{}.contact.penalty.delta);
+  CHECK(o.contact.max_overlap == 0.8);  // the pass-through guard's default bound
+  CHECK(read_cell_options(write_tmp("cell_cfg_mo.json", R"({"contact": {"max_overlap": 1}})"))
+            .contact.max_overlap == 1.0);
 }
 
 TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
@@ -53,6 +56,8 @@ TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
   // A residual tolerance of 1 accepted the first iterate (session 21): at most 0.01.
   CHECK(pointer_of(R"({"solver": {"tolerance": 0.5}})") == "/solver/tolerance");
   CHECK(pointer_of(R"({"solver": {"tolerance": 0.01}})") == "<no error>");
+  CHECK(pointer_of(R"({"contact": {"max_overlap": 0}})") == "/contact/max_overlap");
+  CHECK(pointer_of(R"({"contact": {"max_overlap": 1.5}})") == "/contact/max_overlap");
   CHECK(pointer_of(R"({"bogus": 1})") == "");
   CHECK(pointer_of(R"({not json)") == "");
 }

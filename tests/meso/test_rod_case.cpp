@@ -137,6 +137,41 @@ TEST_CASE("rod case: a mesh too coarse for the case is reported by the bisection
     cs << csv.rdbuf();
     CHECK(cs.str().find("# resolution: the output displacements change by") != std::string::npos);
   }
+  // The whole centerline is compared, not only the named points (review of session 28: with
+  // only the clamped root named, the one-element mesh "changed by 0 %").
+  {
+    std::string t = text;
+    t.replace(at, mesh.size(), R"("degree": 3, "elements": 1)");
+    const auto o = t.find(R"("points": [)");
+    const auto e = t.find("]", o);
+    REQUIRE(o != std::string::npos);
+    t.replace(o, e - o + 1, R"("points": [{"name": "root", "rod": "beam", "xi": 0.0}])");
+    write(kTmp / "coarse_root.json", t);
+    std::string msg;
+    CHECK(run("rod " + (kTmp / "coarse_root.json").string() + " -q -o " + (kTmp / "root").string(),
+              &msg) == 0);
+    INFO(msg);
+    CHECK(msg.find("knit-meso rod: warning: the output displacements change by") !=
+          std::string::npos);
+  }
+  // Where nothing moves (pure torsion), round-off is not compared with round-off: the scale has
+  // a floor of 1e-6 L (review of session 28: "change by 191 %", a warning).
+  {
+    write(kTmp / "torsion.json",
+          R"({"section": {"E": 800.0, "nu": 0.3, "d": 0.1},
+              "rods": [{"name": "b", "curve": {"type": "line", "from": [0,0,0], "to": [10,0,0],
+                        "degree": 3, "elements": 4},
+                        "start": {"position": "fixed", "rotation": "fixed"},
+                        "end": {"position": "free", "rotation": "free", "moment": [1e-3, 0, 0]}}],
+              "steps": {"count": 4},
+              "output": {"points": [{"name": "tip", "rod": "b", "xi": 1.0}]}})");
+    std::string msg;
+    CHECK(run("rod " + (kTmp / "torsion.json").string() + " -q -o " + (kTmp / "torsion").string(),
+              &msg) == 0);
+    INFO(msg);
+    CHECK(msg.find("below the floor 1e-6 L") != std::string::npos);
+    CHECK(msg.find("warning") == std::string::npos);
+  }
   // The check can be switched off.
   std::string t = text;
   t.replace(at, mesh.size(), R"("degree": 3, "elements": 1)");

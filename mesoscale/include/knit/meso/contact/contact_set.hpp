@@ -62,6 +62,14 @@ struct ContactOptions {
   double self_exclusion = 0.3;  ///< loop-parameter distance below which the own yarn is skipped
   double match_tol = 0.08;      ///< history matching tolerance in u
   int slave_points_per_element = 4;  ///< Gauss points per element that act as slaves
+  /// Pass-through guard (below): a converged state with a pair overlapping by more than
+  /// max_overlap d is refused as well (choice, /contact/max_overlap, 1 = off): the centerlines
+  /// are then within (1 - max_overlap) d of each other, one step short of passing through.
+  /// 4.5 mm, wale stretch F22 = 1.8 in one step converged at an overlap of 0.93 d with S =
+  /// (8.7, 10.2) MPa for (17.8, 17.2) in 40 steps, whose deepest overlap is 0.66 d. A softer
+  /// contact law sinks deeper in equilibrium (k_N = 250 MPa: 0.775 d on the paper's (0.4, 0.4)
+  /// path at 4.5 mm) and needs a larger bound.
+  double max_overlap = 0.8;
 };
 
 /// One active contact of the current state (for output and homogenization).
@@ -116,12 +124,6 @@ class ContactSet : public rod::ExternalContribution {
   /// Pairs farther apart at the last commit are not watched (a step that moves a yarn through
   /// another from farther away is not caught).
   static constexpr double kWatchRadius = 2.0;  ///< in yarn diameters (choice)
-  /// A converged state with a pair overlapping by more than kMaxOverlap d is refused as well
-  /// (choice): the centerlines are then within 0.2 d of each other, one small step from a
-  /// pass-through, with a penalty line load two orders above the yarn forces. 4.5 mm, wale
-  /// stretch F22 = 1.8 in one step converged there (overlap 0.93 d, S = (8.7, 10.2) MPa for
-  /// (17.8, 17.2) in 40 steps, whose deepest overlap is 0.66 d).
-  static constexpr double kMaxOverlap = 0.8;
   struct Side {
     int point = 0, course = 0, k = 0;
     double u = 0;

@@ -104,7 +104,7 @@ struct StepResult {
   int iterations = 0;  ///< Newton iterations (all increments of the step)
   int cutbacks = 0;
   int pass_throughs = 0;  ///< of the cut-backs: converged increments whose yarns went through
-                          ///< (or sank kMaxOverlap d into) each other (contact_set.hpp)
+                          ///< (or sank max_overlap d into) each other (contact_set.hpp)
   double seconds = 0;
   int active_contacts = 0;
   double min_gap = 0;
@@ -165,6 +165,7 @@ class PeriodicCell {
   Eigen::VectorXd x_;
   Eigen::Matrix2d F_ = Eigen::Matrix2d::Identity();
   Eigen::Vector3d r_fix_;
+  bool last_refused_ = false;  ///< try_solve's last state was refused by the pass-through guard
 };
 
 }  // namespace knit::meso::homog

@@ -9,9 +9,11 @@
 // is within 0.04 %, was 0.2 of |n|/L), so the check is the classic one: solve again with every
 // knot span halved and compare the displacements of the output points.
 //
-//   difference = max_i |u_i - u_i'| / max_i |u_i'|   (u on the case's mesh, u' on the bisected
-//                                                      mesh, i over the output points, or the
-//                                                      rod ends when none are named)
+//   difference = max_i |u_i - u_i'| / max(max_i |u_i'|, 1e-6 L)
+//     u on the case's mesh, u' on the bisected mesh, i over the output points of the case and
+//     the knot breakpoints and span midpoints of every rod, L the longest rod's length (the
+//     floor keeps a case in which nothing moves, pure torsion, from comparing round-off).
+// Rotations are not compared.
 //
 // The bisected mesh keeps the degree, the geometry (knot insertion, The NURBS Book A5.4) and
 // every load and end condition. It costs one more solve on twice the elements.
@@ -30,6 +32,8 @@ namespace knit::meso::rod {
 /// Above this difference the case's mesh is called under-resolved (a warning of
 /// `knit-meso rod`; choice: 1 %, the accuracy the verification cases are held to).
 inline constexpr double kResolutionTolerance = 0.01;
+/// The displacement scale's floor, relative to the longest rod.
+inline constexpr double kDisplacementFloor = 1e-6;
 
 /// A point on a rod: rod index and parameter.
 struct RodPoint {
@@ -45,6 +49,7 @@ struct ResolutionCheck {
   bool checked = false;     ///< false when the bisected run did not reach the same load factor
   double difference = 0.0;  ///< as above, at the case's final load factor
   double u_max = 0.0;       ///< max_i |u_i'| [mm]
+  double floor = 0.0;       ///< 1e-6 L [mm], the scale when u_max is below it
   std::string note;         ///< why not checked (when checked is false)
   /// "changes by 12 % (max |u| 6.7 mm)" or "not checked: ..."
   std::string describe() const;
