@@ -133,13 +133,17 @@ std::shared_ptr<const ResponseSurface> KnitMaterial::surface_at(double l) const 
 void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   bound_.clear();
   bound_.reserve(theta.size());
+  // Points with the same l share one law (energy_at's cache is bounded; these are kept here).
+  std::map<double, std::shared_ptr<const material::EnergyLawAt>> laws;
   for (const auto& t : theta) {
     const double l = stitch_value(t);
     const double a = knitting_angle(t);
-    if (energy_)
-      bound_.push_back({nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), energy_at(l).get()});
-    else
-      bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a)});
+    if (energy_) {
+      auto& law = laws[l];
+      if (!law) law = energy_at(l);
+      bound_.push_back({nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), law.get(), law});
+    } else
+      bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a), nullptr, {}});
   }
 }
 

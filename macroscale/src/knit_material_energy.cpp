@@ -44,7 +44,7 @@ std::shared_ptr<const material::EnergyLawAt> KnitMaterial::energy_at(double l) c
   auto it = energy_cache_.find(l);
   if (it != energy_cache_.end()) return it->second;
   auto at = std::make_shared<const material::EnergyLawAt>(energy_->at(l));
-  energy_cache_.emplace(l, at);
+  if (energy_cache_.size() < kEnergyCacheEntries) energy_cache_.emplace(l, at);
   return at;
 }
 

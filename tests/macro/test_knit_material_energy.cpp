@@ -203,6 +203,22 @@ TEST_CASE("knit material: the output field beyond_law_data marks samples beyond 
   CHECK(beyond(paper, {5.0, 5.0, 0.0}) == 1.0);
 }
 
+// Session 28: the output samples' laws were kept, one per distinct stitch value: 873 MB on a
+// 201 x 201 grid with l graded both ways (about 20 GB at the schema's 1001 x 1001).
+TEST_CASE("knit material, energy law: the unbound points' laws are not all kept", "[unit]") {
+  const KnitMaterial m = energy_material(0.3);  // graded stitch value
+  MaterialPoint p;                              // unbound (point_id -1), as the output samples
+  Eigen::Vector3d S_first = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 500; ++i) {
+    p.theta = Eigen::Vector2d((i + 0.5) / 500.0, 0.5);
+    const MaterialResponse r = m.evaluate({0.05, 0.02, 0.01}, p);
+    if (i == 0) S_first = r.S;
+  }
+  CHECK(m.cached_energy_laws() <= 64);
+  p.theta = Eigen::Vector2d(0.5 / 500.0, 0.5);  // evicted or not: the same response
+  CHECK((m.evaluate({0.05, 0.02, 0.01}, p).S - S_first).norm() == 0.0);
+}
+
 TEST_CASE("knit material: the case key /material/law", "[unit]") {
   const std::string with = db_file("law_energy.h5", true, 2), v1 = db_file("law_v1.h5", false, 1);
   auto material = [](const std::string& db, const std::string& law) {
