@@ -183,45 +183,53 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
   const std::string out = without_trailing_slash(target).string();
   std::error_code ec;
   if (file_.has_parent_path()) fs::create_directories(file_.parent_path(), ec);  // as the writer
-  // A lock file unlinked by its releasing holder between our open() and flock() is not the lock
-  // any more: retry on the new file (checked by comparing inodes).
-  // An EMPTY lock file that this process did not create is either another knitscale process's,
-  // created a moment ago and not yet tagged (it tags it once it holds the flock), or someone
-  // else's empty file, which must not be taken over and unlinked on release (session 28: an
-  // empty "out.lock" of the user's was). So: create with O_EXCL to know whether it is ours, and
-  // an empty file that is not ours and not held is looked at again a few times, then refused.
-  constexpr int kEmptyRetries = 10;
-  int empty_seen = 0;
-  for (int attempt = 0; attempt < 20 + kEmptyRetries; ++attempt) {
-    bool created = true;
-    int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
-    if (fd < 0 && errno == EEXIST) {
-      created = false;
-      fd = ::open(file_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
-      if (fd < 0 && errno == ENOENT) continue;  // released between the two opens: again
+  // A knitscale lock file never appears untagged at its final path: it is written and locked
+  // under a private name, then link()ed to "<target>.lock" (atomic; EEXIST if one is there).
+  // So a "<target>.lock" that is empty or holds anything but the tag is someone else's and is
+  // refused at once. (Session 28: an empty one of the user's was taken over, and unlinked on
+  // release. The first mend, waiting for an empty file to be tagged by its creator, could
+  // refuse two runs started together and leave an empty lock that refused every later run;
+  // found by review.) A lock file unlinked by its releasing holder between our open() and
+  // flock() is not the lock any more: retry on the new file (checked by comparing inodes).
+  const std::string me = kLockTag + std::to_string(::getpid()) + "\n";
+  const auto cannot = [&](const std::string& what, int err) {
+    return InputError(out, "", what + " " + file_.string() + " (" + std::strerror(err) + ")");
+  };
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    // 1. A new lock: tagged and locked under a private name, then linked into place.
+    std::string tmpl = file_.string() + ".new-XXXXXX";
+    int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
+    if (fd < 0) throw cannot("cannot create the lock file", errno);
+    ::fchmod(fd, 0644);
+    const bool tagged = ::pwrite(fd, me.data(), me.size(), 0) == static_cast<ssize_t>(me.size());
+    if (tagged && ::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::link(tmpl.c_str(), file_.c_str()) == 0) {
+      ::unlink(tmpl.c_str());
+      fd_ = fd;
+      return;
     }
-    if (fd < 0)
-      throw InputError(
-          out, "",
-          "cannot create the lock file " + file_.string() + " (" + std::strerror(errno) + ")");
+    const int err = errno;
+    ::unlink(tmpl.c_str());
+    ::close(fd);
+    if (!tagged || err != EEXIST) throw cannot("cannot create the lock file", err);
+    // 2. There is one: a held lock (refused), a stale one of a killed process (taken over), or
+    // not a knitscale lock file (refused, untouched).
+    fd = ::open(file_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0 && errno == ENOENT) continue;  // released in between: again
+    if (fd < 0) throw cannot("cannot open the lock file", errno);
     struct stat a {};
     const std::string have = read_small(fd);
-    if (::fstat(fd, &a) != 0 || !S_ISREG(a.st_mode) ||
-        (!have.empty() && have.rfind(kLockTag, 0) != 0)) {
+    if (::fstat(fd, &a) != 0 || !S_ISREG(a.st_mode) || have.rfind(kLockTag, 0) != 0) {
       ::close(fd);
       throw InputError(out, "",
-                       file_.string() +
-                           " exists and is not a knitscale lock file; rename or remove "
-                           "it, or choose another output");
+                       file_.string() + " exists and is not a knitscale lock file" +
+                           (have.empty() ? " (it is empty)" : "") +
+                           "; rename or remove it, or choose another output");
     }
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-      const int err = errno;
-      const std::string who = read_small(fd);
+      const int e = errno;
       ::close(fd);
-      if (err != EWOULDBLOCK)
-        throw InputError(out, "",
-                         "cannot lock " + file_.string() + " (" + std::strerror(err) + ")");
-      std::string pid = who.size() > std::strlen(kLockTag) ? who.substr(std::strlen(kLockTag)) : "";
+      if (e != EWOULDBLOCK) throw cannot("cannot lock", e);
+      std::string pid = have.substr(std::strlen(kLockTag));
       while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
       throw InputError(out, "",
                        "is being written by another knitscale process (pid " +
@@ -234,17 +242,6 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
       ::close(fd);
       continue;
     }
-    if (!created && read_small(fd).empty()) {
-      ::close(fd);
-      if (++empty_seen > kEmptyRetries)
-        throw InputError(out, "",
-                         file_.string() +
-                             " exists, is empty and is not a knitscale lock file; rename or "
-                             "remove it, or choose another output");
-      ::usleep(20000);  // 20 ms: time for its creator to tag it
-      continue;
-    }
-    const std::string me = kLockTag + std::to_string(::getpid()) + "\n";
     if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) < 0) {
       // Holding the lock is what counts; the pid is for the message of the refused one.
     }

@@ -109,21 +109,61 @@ std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& 
 
 namespace knit::macro {
 
-double reference_area(const spline::SplineSurface& surface, int points_per_span) {
-  const auto qu = spline::gauss_legendre_on_spans(
-      points_per_span > 0 ? points_per_span : surface.basis_u().degree() + 1,
-      surface.basis_u().knots());
-  const auto qv = spline::gauss_legendre_on_spans(
-      points_per_span > 0 ? points_per_span : surface.basis_v().degree() + 1,
-      surface.basis_v().knots());
-  double area = 0.0;
+namespace {
+/// |A1 x A2| at (u, v), the basis workspace kept.
+double area_density(const spline::SplineSurface& s, double u, double v, spline::SurfaceBasis& sb) {
+  s.basis(u, v, 1, sb);
+  const Eigen::MatrixXd& P = s.control_points();
+  Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = Eigen::Vector3d::Zero();
+  for (Eigen::Index l = 0; l < sb.index.size(); ++l) {
+    A1 += sb.R(1, l) * P.row(sb.index(l)).transpose();
+    A2 += sb.R(2, l) * P.row(sb.index(l)).transpose();
+  }
+  return A1.cross(A2).norm();
+}
+
+/// The area of the element [u0, u1] x [v0, v1] by nu x nv Gauss points.
+double element_area(const spline::SplineSurface& s, double u0, double u1, double v0, double v1,
+                    int nu, int nv, spline::SurfaceBasis& sb) {
+  const auto qu = spline::gauss_legendre(nu, u0, u1), qv = spline::gauss_legendre(nv, v0, v1);
+  double a = 0.0;
   for (std::size_t j = 0; j < qv.points.size(); ++j)
-    for (std::size_t i = 0; i < qu.points.size(); ++i) {
-      const Eigen::MatrixXd d = surface.derivatives(qu.points[i], qv.points[j], 1);
-      const Eigen::Vector3d a1 = d.row(1).transpose(), a2 = d.row(2).transpose();
-      area += qu.weights[i] * qv.weights[j] * a1.cross(a2).norm();
-    }
+    for (std::size_t i = 0; i < qu.points.size(); ++i)
+      a += qu.weights[i] * qv.weights[j] * area_density(s, qu.points[i], qv.points[j], sb);
+  return a;
+}
+}  // namespace
+
+double reference_area(const spline::SplineSurface& surface, int points_per_span) {
+  const int nu = points_per_span > 0 ? points_per_span : surface.basis_u().degree() + 1;
+  const int nv = points_per_span > 0 ? points_per_span : surface.basis_v().degree() + 1;
+  const auto bu = spline::unique_knots(surface.basis_u().knots());
+  const auto bv = spline::unique_knots(surface.basis_v().knots());
+  spline::SurfaceBasis sb;
+  double area = 0.0;
+  for (std::size_t j = 0; j + 1 < bv.size(); ++j)
+    for (std::size_t i = 0; i + 1 < bu.size(); ++i)
+      area += element_area(surface, bu[i], bu[i + 1], bv[j], bv[j + 1], nu, nv, sb);
   return area;
+}
+
+std::optional<AreaQuadratureDefect> area_quadrature_defect(const spline::SplineSurface& surface) {
+  const int pu = surface.basis_u().degree(), pv = surface.basis_v().degree();
+  const auto bu = spline::unique_knots(surface.basis_u().knots());
+  const auto bv = spline::unique_knots(surface.basis_v().knots());
+  spline::SurfaceBasis sb;
+  for (std::size_t j = 0; j + 1 < bv.size(); ++j)
+    for (std::size_t i = 0; i + 1 < bu.size(); ++i) {
+      const double a =
+          element_area(surface, bu[i], bu[i + 1], bv[j], bv[j + 1], pu + 1, pv + 1, sb);
+      const double exact = element_area(surface, bu[i], bu[i + 1], bv[j], bv[j + 1],
+                                        pu + 1 + kAreaExtraPoints, pv + 1 + kAreaExtraPoints, sb);
+      const double err = std::abs(a - exact) / exact;
+      if (!(err <= kMaxAreaQuadratureError))
+        return AreaQuadratureDefect{Eigen::Vector2d(bu[i], bv[j]),
+                                    Eigen::Vector2d(bu[i + 1], bv[j + 1]), err};
+    }
+  return std::nullopt;
 }
 
 }  // namespace knit::macro

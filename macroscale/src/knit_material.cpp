@@ -139,8 +139,10 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
     const double l = stitch_value(t);
     const double a = knitting_angle(t);
     if (energy_) {
-      auto& law = laws[l];
-      if (!law) law = energy_at(l);
+      auto& law = laws[l];  // not from energy_at: its few entries are for the output samples
+      if (!law)
+        law = std::make_shared<const material::EnergyLawAt>(
+            energy_->at(std::clamp(l, l_min(), l_max())));
       bound_.push_back({nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), law.get(), law});
     } else
       bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a), nullptr, {}});

@@ -217,7 +217,7 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
             "sub-steps below " + std::to_string(kMinSubstep) + " of the step at load fraction " +
             std::to_string(lam) +
             (last_refused_
-                 ? ": every converged sub-step was refused by the pass-through guard: "
+                 ? ": the last converged sub-step was refused by the pass-through guard: "
                  : " (a limit point: the cell does not pass this strain); last attempt: ") +
             res.message;
         break;

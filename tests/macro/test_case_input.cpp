@@ -640,8 +640,8 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
   const auto error_of = [](const json& c) { return ::error_of(c, "w.json"); };
   j["geometry"]["weights"] = {1, 1, 1, 10};
   CHECK(error_of(j).rfind("w.json: /geometry/weights: the shell's quadrature (p + 1 Gauss points "
-                          "per element and direction) integrates the area of this surface 0.53 "
-                          "% off (more than 0.1 %)",
+                          "per element and direction) integrates the area of the element [0, 1] "
+                          "x [0, 1] 0.53 % off (more than 0.1 %): the NURBS weights",
                           0) == 0);
   j["geometry"]["weights"] = {1, 1, 1, 3};  // 2.5e-6 off: accepted
   CHECK(error_of(j).empty());
@@ -650,6 +650,36 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
   CHECK(error_of(j).empty());
   CHECK(knit::macro::reference_area(parse_case(j.dump(), "w.json").surface) ==
         Approx(2500.0).epsilon(1e-5));  // the 50 x 50 mm square
+  // Element by element (review of session 28): a flat 8 x 8 quadratic patch with the corner
+  // weight 10 is 1.4e-4 off in all, but 0.88 % off in its corner element.
+  j = read_json("tensile_svk.json");
+  j.erase("refinement");
+  j["boundary_conditions"] =
+      json::array({{{"all", true}, {"fix", {"z"}}}, {{"edge", "u0"}, {"fix", {"x", "y"}}}});
+  j.erase("output");
+  j["geometry"]["degrees"] = {2, 2};
+  std::vector<double> U{0, 0, 0};
+  for (int k = 1; k < 8; ++k) U.push_back(k / 8.0);
+  U.insert(U.end(), {1, 1, 1});
+  j["geometry"]["knots_u"] = U;
+  j["geometry"]["knots_v"] = U;
+  json cp = json::array(), w = json::array();
+  for (int b = 0; b < 10; ++b)
+    for (int a = 0; a < 10; ++a) {
+      cp.push_back({50.0 * a / 9.0, 50.0 * b / 9.0, 0.0});
+      w.push_back(a == 9 && b == 9 ? 10.0 : 1.0);
+    }
+  j["geometry"]["control_points"] = cp;
+  j["geometry"]["weights"] = w;
+  const std::string e = error_of(j);
+  CHECK(e.rfind("w.json: /geometry/weights: the shell's quadrature (p + 1 Gauss points per "
+                "element and direction) integrates the area of the element [0.88, 1] x [0.88, 1] "
+                "0.81 % off",
+                0) == 0);
+  j["geometry"]["weights"][99] = 1.0;  // all weights 1: accepted
+  const std::string e1 = error_of(j);
+  INFO(e1);
+  CHECK(e1.empty());
 }
 
 namespace {

@@ -64,9 +64,9 @@ void check_output_target(const std::filesystem::path& target, OutputKind kind,
 /// (or another OutputLock in this process) asking for the same target is refused with a
 /// knit::InputError naming the holder's pid. A lock file left by a killed process is not held
 /// (the kernel drops flock locks with the process) and is taken over. The file is removed when
-/// the lock is released. A "<target>.lock" that is not a knitscale lock file is never touched,
-/// an empty one included unless this process created it (an empty lock of another knitscale
-/// process, not tagged yet, is looked at again for 0.2 s).
+/// the lock is released. A knitscale lock file is tagged and locked under a private name
+/// ("<target>.lock.new-XXXXXX") and then linked into place, so it is never seen untagged; a
+/// "<target>.lock" that is not a knitscale lock file, an empty one included, is never touched.
 /// Missing parent directories of the target are created (as the writer would).
 class OutputLock {
  public:
