@@ -110,9 +110,9 @@ class ContactSet : public rod::ExternalContribution {
   void commit(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   /// Pass-through guard (session 28). The gap |x_s - x_m| - d has no sign, so a slave point
   /// that crosses its master's centerline within one increment sees the pair open again on
-  /// the other side, and Newton converges to yarns that went through each other (4.5 mm, wale
-  /// stretch F22 = 1.8 in one step: S = (0.002, 0.004) MPa for (17.8, 17.2) in 40 steps, exit 0).
-  /// commit() records, for every pair within kWatchRadius diameters of each other, the side of
+  /// the other side, and Newton converges to yarns that went through each other (4.5 mm, course
+  /// stretch F11 = 1.8 in one step: S = (-1.2, -3.8) MPa for (8.7, 15.4) in 40 steps, exit 0).
+  /// commit() records, for every pair within kWatchRadius d + margin of each other, the side of
   /// the master on which the slave point lies: n = (x_s - x_m(u)) / |x_s - x_m(u)| at the
   /// master's material point (copy k, parameter u). A converged state in which
   /// (x_s - x_m(u)) . n < 0 for one of them has the slave point on the other side of the same
