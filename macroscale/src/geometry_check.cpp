@@ -40,6 +40,37 @@ std::string where(const Eigen::Vector2d& t, const std::vector<double>& su,
   return os.str();
 }
 
+/// The tangents A1, A2 at (u, v), the basis workspace kept (both checks below).
+void tangents(const spline::SplineSurface& s, double u, double v, spline::SurfaceBasis& sb,
+              Eigen::Vector3d& A1, Eigen::Vector3d& A2) {
+  s.basis(u, v, 1, sb);
+  const Eigen::MatrixXd& P = s.control_points();
+  A1.setZero();
+  A2.setZero();
+  for (Eigen::Index l = 0; l < sb.index.size(); ++l) {
+    A1 += sb.R(1, l) * P.row(sb.index(l)).transpose();
+    A2 += sb.R(2, l) * P.row(sb.index(l)).transpose();
+  }
+}
+
+/// |A1 x A2| at (u, v).
+double area_density(const spline::SplineSurface& s, double u, double v, spline::SurfaceBasis& sb) {
+  Eigen::Vector3d A1, A2;
+  tangents(s, u, v, sb, A1, A2);
+  return A1.cross(A2).norm();
+}
+
+/// The area of the element [u0, u1] x [v0, v1] by nu x nv Gauss points.
+double element_area(const spline::SplineSurface& s, double u0, double u1, double v0, double v1,
+                    int nu, int nv, spline::SurfaceBasis& sb) {
+  const auto qu = spline::gauss_legendre(nu, u0, u1), qv = spline::gauss_legendre(nv, v0, v1);
+  double a = 0.0;
+  for (std::size_t j = 0; j < qv.points.size(); ++j)
+    for (std::size_t i = 0; i < qu.points.size(); ++i)
+      a += qu.weights[i] * qv.weights[j] * area_density(s, qu.points[i], qv.points[j], sb);
+  return a;
+}
+
 }  // namespace
 
 double patch_size(const spline::SplineSurface& s) {
@@ -59,7 +90,6 @@ int dense_samples_per_span(const spline::SplineSurface& s) {
 
 std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& s,
                                                    int samples_per_span) {
-  const Eigen::MatrixXd& P = s.control_points();
   double scale = patch_size(s);
   if (!(scale > 0)) scale = 1.0;
   const std::vector<double> su =
@@ -73,12 +103,8 @@ std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& 
   for (std::size_t j = 0; j < sv.size(); ++j) {
     for (std::size_t i = 0; i < nu; ++i) {
       const Eigen::Vector2d t(su[i], sv[j]);
-      s.basis(t(0), t(1), 1, sb);
-      Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = Eigen::Vector3d::Zero();
-      for (Eigen::Index l = 0; l < sb.index.size(); ++l) {
-        A1 += sb.R(1, l) * P.row(sb.index(l)).transpose();
-        A2 += sb.R(2, l) * P.row(sb.index(l)).transpose();
-      }
+      Eigen::Vector3d A1, A2;
+      tangents(s, t(0), t(1), sb, A1, A2);
       const Eigen::Vector3d a3 = A1.cross(A2);
       const double J = a3.norm();
       if (!(J > 1e-10 * scale * scale) || !(A1.norm() > 1e-12 * scale) ||
@@ -104,35 +130,6 @@ std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& 
   }
   return std::nullopt;
 }
-
-}  // namespace knit::macro
-
-namespace knit::macro {
-
-namespace {
-/// |A1 x A2| at (u, v), the basis workspace kept.
-double area_density(const spline::SplineSurface& s, double u, double v, spline::SurfaceBasis& sb) {
-  s.basis(u, v, 1, sb);
-  const Eigen::MatrixXd& P = s.control_points();
-  Eigen::Vector3d A1 = Eigen::Vector3d::Zero(), A2 = Eigen::Vector3d::Zero();
-  for (Eigen::Index l = 0; l < sb.index.size(); ++l) {
-    A1 += sb.R(1, l) * P.row(sb.index(l)).transpose();
-    A2 += sb.R(2, l) * P.row(sb.index(l)).transpose();
-  }
-  return A1.cross(A2).norm();
-}
-
-/// The area of the element [u0, u1] x [v0, v1] by nu x nv Gauss points.
-double element_area(const spline::SplineSurface& s, double u0, double u1, double v0, double v1,
-                    int nu, int nv, spline::SurfaceBasis& sb) {
-  const auto qu = spline::gauss_legendre(nu, u0, u1), qv = spline::gauss_legendre(nv, v0, v1);
-  double a = 0.0;
-  for (std::size_t j = 0; j < qv.points.size(); ++j)
-    for (std::size_t i = 0; i < qu.points.size(); ++i)
-      a += qu.weights[i] * qv.weights[j] * area_density(s, qu.points[i], qv.points[j], sb);
-  return a;
-}
-}  // namespace
 
 double reference_area(const spline::SplineSurface& surface, int points_per_span) {
   const int nu = points_per_span > 0 ? points_per_span : surface.basis_u().degree() + 1;

@@ -230,9 +230,7 @@ std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(
   // 201 x 201 grid with a stitch value graded both ways.
   bool beyond = !Ehat.allFinite();
   if (!beyond && energy_) {
-    const auto& d = energy_->data();
-    beyond =
-        !((Ehat.array() >= d.box_min.array()).all() && (Ehat.array() <= d.box_max.array()).all());
+    beyond = !energy_->data().inside_box(Ehat);
   } else if (!beyond) {
     beyond = surface_at(l)->evaluate(Ehat).flags != 0;
   }

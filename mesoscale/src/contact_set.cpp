@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include "knit/spline/knot_vector.hpp"
 #include "knit/spline/quadrature.hpp"
@@ -50,7 +51,7 @@ Chain ContactSet::chain(const Eigen::MatrixXd& Q, int course) const {
   return c;
 }
 
-std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, double reach) const {
+std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, double inflate) const {
   const int n = basis_.size(), p = basis_.degree();
   const std::vector<double> br = spline::unique_knots(basis_.knots());
   const int ne = static_cast<int>(br.size()) - 1;
@@ -61,7 +62,6 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, doub
     lo[e] = Q.middleRows(f, p + 1).colwise().minCoeff().transpose();
     hi[e] = Q.middleRows(f, p + 1).colwise().maxCoeff().transpose();
   }
-  const double inflate = reach;
   std::vector<Found> out;
   const int ns = static_cast<int>(xi_.size());
   (void)n;
@@ -315,6 +315,25 @@ std::optional<ContactSet::PassThrough> ContactSet::pass_through(const rod::RodSy
       worst = PassThrough{s.point, s.course, xi_[s.point], s.u, -side};
   }
   return worst;
+}
+
+std::string ContactSet::guard_refusal(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
+  std::ostringstream m;
+  m.precision(3);
+  if (const auto pt = pass_through(sys, x)) {
+    m << "yarns passed through each other (slave point at xi = " << pt->xi << ", course "
+      << pt->course << ", " << pt->depth << " mm beyond the master's centerline)";
+    return m.str();
+  }
+  // Sunk into each other short of passing through: the same branch at a smaller depth. The
+  // deepest pair of the state (its search is cached from Newton's last residual).
+  double g = 0.0;
+  for (const Found& f : found(positions(sys, x))) g = std::min(g, f.pr.distance - opt_.d);
+  if (g < -opt_.max_overlap * opt_.d)
+    m << "yarns sank " << -g << " mm (" << -g / opt_.d
+      << " d) into each other, more than /contact/max_overlap = " << opt_.max_overlap
+      << " d (a softer contact law needs a larger bound)";
+  return m.str();
 }
 
 }  // namespace knit::meso::contact

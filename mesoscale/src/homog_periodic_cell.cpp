@@ -4,7 +4,6 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "knit/meso/rod/quaternion.hpp"
@@ -157,23 +156,9 @@ bool PeriodicCell::try_solve(const Matrix2d& F, StepResult& res) {
   if (accept) {
     // A converged state whose yarns went through each other is not a solution (contact_set.hpp,
     // pass-through guard): cut back, as for a failed increment.
-    std::ostringstream m;
-    m.precision(3);
-    if (const auto pt = contact_->pass_through(sys_, x)) {
-      m << "yarns passed through each other (slave point at xi = " << pt->xi << ", course "
-        << pt->course << ", " << pt->depth << " mm beyond the master's centerline)";
-    } else {
-      // Sunk into each other short of passing through: the same branch at a smaller depth
-      // (ContactOptions::max_overlap).
-      double g = 0.0;
-      for (const auto& p : contact_->active_pairs(sys_, x)) g = std::min(g, p.gap);
-      if (g < -opt_.contact.max_overlap * opt_.contact.d)
-        m << "yarns sank " << -g << " mm (" << -g / opt_.contact.d
-          << " d) into each other, more than /contact/max_overlap = " << opt_.contact.max_overlap
-          << " d (a softer contact law needs a larger bound)";
-    }
-    if (!m.str().empty()) {
-      res.message = m.str();
+    const std::string refusal = contact_->guard_refusal(sys_, x);
+    if (!refusal.empty()) {
+      res.message = refusal;
       ++res.pass_throughs;
       last_refused_ = true;
       accept = false;

@@ -405,7 +405,7 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
         if (i + 1 < br.size()) where.push_back({k, 0.5 * (br[i] + br[i + 1])});
       }
     }
-    rep.resolution = check_resolution(sys, x, rep.lambda_reached, c.path, where);
+    rep.resolution = check_resolution(sys, x, c.path, where);
   }
   io::CsvWriter csv(dir / "load_displacement.csv", header);
   csv.add_comment("provenance: " + provenance);

@@ -40,22 +40,10 @@ std::string ResolutionCheck::describe() const {
 }
 
 ResolutionCheck check_resolution(const RodSystem& sys, const Eigen::VectorXd& x,
-                                 double lambda_reached, PathOptions path,
-                                 const std::vector<RodPoint>& points) {
+                                 const PathOptions& path, const std::vector<RodPoint>& points) {
   ResolutionCheck rc;
   const RodSystem fine = bisected(sys);
   Eigen::VectorXd xf = fine.initial_state();
-  if (lambda_reached != path.lambda_end) {
-    // Stop the check at the case's last converged load factor, keeping the nominal increment.
-    const double nominal = (path.lambda_end - path.lambda_start) / path.steps;
-    path.steps = std::max(
-        1, static_cast<int>(std::ceil((lambda_reached - path.lambda_start) / nominal - 1e-9)));
-    path.lambda_end = lambda_reached;
-  }
-  if (lambda_reached == path.lambda_start) {
-    rc.note = "no converged step";
-    return rc;
-  }
   const PathReport rep = solve_path(fine, xf, path);
   if (!rep.completed) {
     rc.note =

@@ -80,6 +80,10 @@ struct EnergyLawData {
   double floor = 0.0;  ///< MPa
   /// The data strain box (Voigt e; E12 symmetric): evaluations outside it extrapolate.
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  /// True if e lies in the data strain box.
+  bool inside_box(const Eigen::Vector3d& e) const {
+    return (e.array() >= box_min.array()).all() && (e.array() <= box_max.array()).all();
+  }
 
   int n_s() const { return s_spans + s_degree; }
   int n_l() const { return static_cast<int>(l_knots.size()) - l_degree - 1; }

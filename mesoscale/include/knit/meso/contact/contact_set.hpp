@@ -44,6 +44,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "knit/meso/contact/law.hpp"
@@ -137,6 +138,9 @@ class ContactSet : public rod::ExternalContribution {
   /// The deepest pass-through of the converged state x against the last commit, or nullopt.
   std::optional<PassThrough> pass_through(const rod::RodSystem& sys,
                                           const Eigen::VectorXd& x) const;
+  /// Why the converged state x is refused by the guard (a pass-through, or a pair overlapping
+  /// more than ContactOptions::max_overlap d), or an empty string.
+  std::string guard_refusal(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   int num_watched_pairs() const { return static_cast<int>(sides_.size()); }
 
   /// Everything commit() changes (friction anchors, references, dissipation, sides): trial
@@ -169,8 +173,8 @@ class ContactSet : public rod::ExternalContribution {
     int point, course;
     Projection pr;
   };
-  /// Pairs within `reach` of each other (d + margin for the contact loads).
-  std::vector<Found> search(const Eigen::MatrixXd& Q, double reach) const;
+  /// Pairs within `inflate` of each other (d + margin for the contact loads).
+  std::vector<Found> search(const Eigen::MatrixXd& Q, double inflate) const;
   /// search(Q) at the current periods, remembered for the last (Q, a1, a2): a converged state
   /// is searched by the Newton's last residual, commit() (twice) and homogenization
   /// (active_pairs()); the search is a pure function of them, so the result is reused.

@@ -46,7 +46,7 @@ struct RodPoint {
 RodSystem bisected(const RodSystem& sys);
 
 struct ResolutionCheck {
-  bool checked = false;     ///< false when the bisected run did not reach the same load factor
+  bool checked = false;     ///< false when the bisected run did not complete the path
   double difference = 0.0;  ///< as above, at the case's final load factor
   double u_max = 0.0;       ///< max_i |u_i'| [mm]
   double floor = 0.0;       ///< 1e-6 L [mm], the scale when u_max is below it
@@ -55,10 +55,9 @@ struct ResolutionCheck {
   std::string describe() const;
 };
 
-/// Solves the bisected system along `path` up to `lambda_reached` and compares the
-/// displacements at `points` with those of the state x of sys at lambda_reached.
+/// Solves the bisected system along `path` and compares the displacements at `points` with
+/// those of the state x of sys at the path's end (a completed path of the case).
 ResolutionCheck check_resolution(const RodSystem& sys, const Eigen::VectorXd& x,
-                                 double lambda_reached, PathOptions path,
-                                 const std::vector<RodPoint>& points);
+                                 const PathOptions& path, const std::vector<RodPoint>& points);
 
 }  // namespace knit::meso::rod
