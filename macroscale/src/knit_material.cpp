@@ -122,19 +122,16 @@ double KnitMaterial::knitting_angle(const Eigen::Vector2d& t) const {
 std::shared_ptr<const ResponseSurface> KnitMaterial::surface_at(double l) const {
   // The field is a convex combination of in-range control values; clamp round-off.
   l = std::clamp(l, family_->min(), family_->max());
-  std::lock_guard<std::mutex> lock(cache_mutex_);
-  auto it = cache_.find(l);
-  if (it != cache_.end()) return it->second;
-  auto rs = family_->surface(l);
-  cache_.emplace(l, rs);
-  return rs;
+  return surface_cache_.get(l, [this](double x) { return family_->surface(x); });
 }
 
 void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
   bound_.clear();
   bound_.reserve(theta.size());
-  // Points with the same l share one law (energy_at's cache is bounded; these are kept here).
+  // Points with the same l share one law; the bound points own their laws (the caches of
+  // energy_at and surface_at are bounded, for the output samples).
   std::map<double, std::shared_ptr<const material::EnergyLawAt>> laws;
+  std::map<double, std::shared_ptr<const ResponseSurface>> surfaces;
   for (const auto& t : theta) {
     const double l = stitch_value(t);
     const double a = knitting_angle(t);
@@ -143,9 +140,12 @@ void KnitMaterial::bind_points(const std::vector<Eigen::Vector2d>& theta) {
       if (!law)
         law = std::make_shared<const material::EnergyLawAt>(
             energy_->at(std::clamp(l, l_min(), l_max())));
-      bound_.push_back({nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), law.get(), law});
-    } else
-      bound_.push_back({surface_at(l).get(), l, a, mech::T_E(a), mech::T_S_inv(a), nullptr, {}});
+      bound_.push_back({nullptr, nullptr, l, a, mech::T_E(a), mech::T_S_inv(a), law.get(), law});
+    } else {
+      auto& rs = surfaces[l];
+      if (!rs) rs = family_->surface(std::clamp(l, l_min(), l_max()));
+      bound_.push_back({rs.get(), rs, l, a, mech::T_E(a), mech::T_S_inv(a), nullptr, {}});
+    }
   }
 }
 
@@ -226,8 +226,9 @@ std::vector<std::pair<std::string, double>> KnitMaterial::output_fields(
   // the response surface's extension kinds 0-3 (beyond the last step, outside the fan, linear
   // compression, beyond the shear data) and a failed inversion. The response surface is the
   // cached one that the sample's stresses use already (ShellModel::sample evaluates the
-  // material at the same theta): building it afresh per sample took 99 s instead of 20 s on a
-  // 201 x 201 grid with a stitch value graded both ways.
+  // material at the same theta; LawCache's ring holds it even beyond the kept surfaces):
+  // building it afresh per sample took 99 s instead of 20 s on a 201 x 201 grid with a stitch
+  // value graded both ways.
   bool beyond = !Ehat.allFinite();
   if (!beyond && energy_) {
     beyond = !energy_->data().inside_box(Ehat);

@@ -40,12 +40,9 @@ long KnitMaterial::failed_evaluations() const {
 std::shared_ptr<const material::EnergyLawAt> KnitMaterial::energy_at(double l) const {
   // The field is a convex combination of in-range control values; clamp round-off.
   l = std::clamp(l, l_min(), l_max());
-  std::lock_guard<std::mutex> lock(cache_mutex_);
-  auto it = energy_cache_.find(l);
-  if (it != energy_cache_.end()) return it->second;
-  auto at = std::make_shared<const material::EnergyLawAt>(energy_->at(l));
-  if (energy_cache_.size() < kEnergyCacheEntries) energy_cache_.emplace(l, at);
-  return at;
+  return energy_cache_.get(l, [this](double x) {
+    return std::make_shared<const material::EnergyLawAt>(energy_->at(x));
+  });
 }
 
 Eigen::Vector3d KnitMaterial::dS_dl(const Eigen::Vector3d& E, const MaterialPoint& where,

@@ -190,3 +190,51 @@ TEST_CASE("knit material: the paper law's converged states are audited and warne
   m.end_converged_audit();
   CHECK(m.warning().empty());
 }
+
+// Session 29: the paper law's response surfaces were kept for every distinct l the output
+// samples met (485 MB on a 201 x 201 grid with l graded both ways, about 12 GB at the schema's
+// 1001 x 1001). LawCache keeps its first `kept` laws and a ring of the `recent` last ones.
+TEST_CASE("law cache: at most kept + recent laws, the kept and recent ones not rebuilt", "[unit]") {
+  const LawCache<double> cache(4, 2);
+  int built = 0;
+  auto build = [&built](double l) {
+    ++built;
+    return std::make_shared<const double>(2.0 * l);
+  };
+  std::vector<std::shared_ptr<const double>> first;
+  for (int k = 0; k < 10; ++k) first.push_back(cache.get(k, build));
+  CHECK(built == 10);
+  CHECK(cache.size() == 6);
+  CHECK(cache.get(0, build) == first[0]);  // kept: the same object
+  CHECK(cache.get(3, build) == first[3]);
+  CHECK(cache.get(9, build) == first[9]);  // one of the recent two
+  CHECK(cache.get(8, build) == first[8]);
+  CHECK(built == 10);
+  CHECK(*cache.get(5, build) == 10.0);  // neither kept nor recent: built again
+  CHECK(built == 11);
+  CHECK(cache.size() == 6);
+}
+
+TEST_CASE("knit material, paper law: the bound points own their surfaces, the samples share",
+          "[unit]") {
+  KnitMaterial m = graded(0.3);
+  std::vector<Eigen::Vector2d> theta;
+  for (int i = 0; i < 50; ++i) theta.emplace_back((i + 0.5) / 50.0, 0.5);
+  m.bind_points(theta);
+  MaterialPoint p;
+  const Eigen::Vector3d E(0.1, 0.05, 0.02);
+  std::vector<Eigen::Vector3d> S_bound;
+  for (int i = 0; i < 50; ++i) {
+    p.point_id = i;
+    p.theta = theta[static_cast<std::size_t>(i)];
+    S_bound.push_back(m.evaluate(E, p).S);
+  }
+  CHECK(m.cached_surfaces() == 0);  // not in the samples' cache
+  p.point_id = -1;                  // the same points unbound, as output samples
+  for (int i = 0; i < 50; ++i) {
+    p.theta = theta[static_cast<std::size_t>(i)];
+    CHECK((m.evaluate(E, p).S - S_bound[static_cast<std::size_t>(i)]).norm() == 0.0);
+    (void)m.output_fields(p.theta, E);  // the same l: no further surface
+  }
+  CHECK(m.cached_surfaces() == 50);
+}

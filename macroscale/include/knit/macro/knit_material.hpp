@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "knit/macro/law_cache.hpp"
 #include "knit/macro/material.hpp"
 #include "knit/macro/material_factory.hpp"
 #include "knit/material/energy_law.hpp"
@@ -154,15 +155,21 @@ class KnitMaterial : public Material {
   EnergyStats energy_stats() const;
   void reset_stats();
   static constexpr int kMaxLocations = 10;
-  /// Energy laws kept for unbound points (at most kEnergyCacheEntries; for tests).
-  std::size_t cached_energy_laws() const {
-    std::lock_guard<std::mutex> lock(cache_mutex_);
-    return energy_cache_.size();
-  }
+  /// Laws held for unbound points (energy law / the paper's response surfaces; for tests).
+  std::size_t cached_energy_laws() const { return energy_cache_.size(); }
+  std::size_t cached_surfaces() const { return surface_cache_.size(); }
+  /// The response surfaces kept for unbound points (law "paper"), and the ring beyond them
+  /// (LawCache): 65,536 surfaces of the default database's 11 x 11 nets take about 750 MB and
+  /// hold a 256 x 256 output grid with l graded both ways (the default grid is 21 x 21); a
+  /// larger grid's further samples build their surface at every output step (0.6 ms each).
+  static constexpr std::size_t kSurfaceCacheEntries = 65536;
+  static constexpr std::size_t kEnergyCacheEntries = 64;
+  static constexpr std::size_t kRecentLaws = 8;
 
  private:
   struct Bound {
     const material::ResponseSurface* rs;
+    std::shared_ptr<const material::ResponseSurface> rs_owner;  ///< keeps *rs alive
     double l, alpha;
     Eigen::Matrix3d TE, TSinv;  ///< T_E(alpha) = T^-T and T_S(-alpha) = T^-1, precomputed
     const material::EnergyLawAt* ea = nullptr;              ///< law "energy"
@@ -183,13 +190,12 @@ class KnitMaterial : public Material {
 
   std::shared_ptr<const material::LoopLengthFamily> family_;
   std::shared_ptr<const material::EnergyLaw> energy_;
-  /// Laws of the unbound points (the output samples), at most kEnergyCacheEntries: a stitch
-  /// value graded in both directions gives every sample its own l, and keeping them all took
-  /// 873 MB on a 201 x 201 grid (about 20 GB at the schema's 1001 x 1001); a law is cheap to
-  /// build (the same run took 1.4 s instead of 3.1 s without the growing map). The bound points
-  /// own theirs (Bound::ea_owner).
-  mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_cache_;
-  static constexpr std::size_t kEnergyCacheEntries = 64;
+  /// Laws of the unbound points (the output samples), at most kEnergyCacheEntries kept: a
+  /// stitch value graded in both directions gives every sample its own l, and keeping them all
+  /// took 873 MB on a 201 x 201 grid (about 20 GB at the schema's 1001 x 1001); a law is cheap
+  /// to build (the same run took 1.4 s instead of 3.1 s without the growing map). The bound
+  /// points own theirs (Bound::ea_owner).
+  LawCache<material::EnergyLawAt> energy_cache_{kEnergyCacheEntries, kRecentLaws};
   /// Laws built with their l-derivative (dS_dl() only; the runs do not pay for it).
   mutable std::map<double, std::shared_ptr<const material::EnergyLawAt>> energy_dl_cache_;
   mutable std::atomic<long> outside_box_{0}, failed_{0};
@@ -201,8 +207,9 @@ class KnitMaterial : public Material {
   spline::SplineSurface l_field_, a_field_;
   Source source_;
   std::vector<Bound> bound_;
-  mutable std::mutex cache_mutex_;
-  mutable std::map<double, std::shared_ptr<const material::ResponseSurface>> cache_;
+  mutable std::mutex cache_mutex_;  ///< energy_dl_cache_
+  /// The unbound points' response surfaces (law "paper"); the bound points own theirs.
+  LawCache<material::ResponseSurface> surface_cache_{kSurfaceCacheEntries, kRecentLaws};
   mutable std::atomic<long> evaluations_{0};
   mutable std::array<std::atomic<long>, 5> counts_{};
   mutable std::mutex where_mutex_;
