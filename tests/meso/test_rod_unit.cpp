@@ -277,3 +277,35 @@ TEST_CASE("rod: the bisected system keeps the geometry and doubles the spans", "
   fine.residual(fine.initial_state(), 0.0, F);
   CHECK(F.cwiseProduct(fine.row_scales()).cwiseAbs().maxCoeff() < 1e-12);
 }
+
+// Session 29: the check compared displacements only, and a twisted rod does not move. A straight
+// rod twisted by M L / GJ = 1.655 rad (94.8 degrees; uniform torsion, exact) on one element of
+// degree 2: the rotations change by 5.4 % on bisection, and the check said 0 %.
+TEST_CASE("rod: the resolution check compares rotations (uniform torsion, M L / GJ)", "[unit]") {
+  const Section sec;
+  const double L = 10.0, GJ = sec.C_K()(2);
+  const double twist = 1.655;
+  auto check = [&](int p, int elements) {
+    RodSystem sys;
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), p, elements, sec);
+    s.end.moment = Vector3d(twist * GJ / L, 0, 0);
+    sys.add_rod(s);
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = 4;
+    REQUIRE(solve_path(sys, x, po).completed);
+    return check_resolution(sys, x, po, {{0, 1.0}, {0, 0.5}});
+  };
+  const ResolutionCheck fine = check(3, 8);
+  REQUIRE(fine.checked);
+  CHECK(fine.angle_max == Approx(twist).epsilon(1e-4));  // the bisected mesh's tip: M L / GJ
+  CHECK(fine.u_max < 1e-10);
+  CHECK(fine.difference < kResolutionTolerance);
+  const ResolutionCheck coarse = check(2, 1);
+  REQUIRE(coarse.checked);
+  INFO(coarse.describe());
+  CHECK(coarse.displacement_difference < 1e-6);  // nothing moves on either mesh
+  CHECK(coarse.rotation_difference > kResolutionTolerance);
+  CHECK(coarse.difference == coarse.rotation_difference);
+  CHECK(coarse.describe().find("and the rotations by") != std::string::npos);
+}
