@@ -1,4 +1,4 @@
-// knit-macro knitmap CASE.json [--output DIR] [--angle-tolerance DEG]
+// knit-macro knitmap CASE.json [--output DIR] [--angle-tolerance DEG] [--max-stitches N]
 //   The knitting map of a planar knit case (docs/design.md "The knitting map"): course by
 //   course and needle by needle, the loop length of each stitch. Writes DIR (default: the
 //   case file's name without extension + "_knitmap") with knitmap.csv, courses.csv and
@@ -23,6 +23,7 @@ namespace {
 struct Options {
   std::string case_file, output;
   double angle_tolerance = knit::macro::KnitMapOptions{}.angle_tolerance_deg;
+  double max_stitches = knit::macro::KnitMapOptions{}.max_stitches;
 };
 
 knit::cli::SubcommandRegistrar reg(
@@ -37,10 +38,15 @@ knit::cli::SubcommandRegistrar reg(
           // A finite angle in (0, 180]: CLI::PositiveNumber let "nan" through, which passed
           // every patch (session 21).
           ->check(knit::cli::number(0, 180, knit::cli::Ends::kOpenLow));
+      sub.add_option("--max-stitches", o->max_stitches,
+                     "largest number of stitches of the map, estimated before the layout from "
+                     "the patch's extent and the smallest stitch (default 1e7)")
+          ->check(knit::cli::number(1, 1e9, knit::cli::Ends::kClosed));
       return [o]() -> int {
         const auto in = knit::macro::load_knitmap_input(o->case_file);
         knit::macro::KnitMapOptions opt;
         opt.angle_tolerance_deg = o->angle_tolerance;
+        opt.max_stitches = o->max_stitches;
         const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
         const std::filesystem::path dir =
             o->output.empty()

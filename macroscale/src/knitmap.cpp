@@ -19,19 +19,27 @@ CellTable::CellTable(const material::Database& db, const std::string& db_file) {
   for (std::size_t k = 0; k < db.entries.size(); ++k) {
     const auto& e = db.entries[k];
     const std::string g = "/loop_" + std::to_string(k);
-    if (!(std::isfinite(e.cell.wale_width) && e.cell.wale_width > 0))
-      throw InputError(db_file, g + "/wale_width",
-                       "the knitting map needs a positive wale width (cell parameter) at l = " +
-                           std::to_string(e.loop_length) + " mm");
-    if (!(std::isfinite(e.cell.course_height) && e.cell.course_height > 0))
-      throw InputError(db_file, g + "/course_height",
-                       "the knitting map needs a positive course height (cell parameter) at l = " +
-                           std::to_string(e.loop_length) + " mm");
+    auto check = [&](double v, const char* what, const char* attr) {
+      if (v >= kMinCellSize && v <= kMaxCellSize) return;  // NaN: refused
+      std::ostringstream os;
+      os << "the knitting map needs a " << what << " (cell parameter) in [" << kMinCellSize << ", "
+         << kMaxCellSize << "] mm at l = " << e.loop_length << " mm, got " << v;
+      throw InputError(db_file, g + "/" + attr, os.str());
+    };
+    check(e.cell.wale_width, "wale width", "wale_width");
+    check(e.cell.course_height, "course height", "course_height");
     l_.push_back(e.loop_length);
     w_.push_back(e.cell.wale_width);
     c_.push_back(e.cell.course_height);
   }
   if (l_.empty()) throw InputError(db_file, "/loop_lengths", "the database has no loop length");
+}
+
+double CellTable::min_wale_width() const {
+  return *std::min_element(w_.begin(), w_.end());
+}
+double CellTable::min_course_height() const {
+  return *std::min_element(c_.begin(), c_.end());
 }
 
 double CellTable::interpolate(const std::vector<double>& y, double l) const {
@@ -201,6 +209,20 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     t_max = std::max(t_max, q.y());
   }
   const double s_mid = 0.5 * (s_min + s_max);
+  {
+    const double estimate = std::ceil((s_max - s_min) / cells.min_wale_width()) *
+                            std::ceil((t_max - t_min) / cells.min_course_height());
+    if (!(estimate <= opt.max_stitches)) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "the patch (" << s_max - s_min << " x " << t_max - t_min
+         << " mm along and across the courses) would hold up to " << estimate
+         << " stitches (smallest wale width " << cells.min_wale_width() << " mm, course height "
+         << cells.min_course_height() << " mm), more than the " << opt.max_stitches
+         << " a map may have (--max-stitches); check the geometry's units (mm)";
+      throw InputError(c.file, "/geometry/control_points", os.str());
+    }
+  }
 
   auto l_at = [&](double s, double t) {
     return patch.stitch_value(patch.invert(R.transpose() * Eigen::Vector2d(s, t)));

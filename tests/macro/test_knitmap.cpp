@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -106,13 +107,19 @@ TEST_CASE("knitmap: cell table interpolates w and c linearly in l", "[unit]") {
   CHECK(t.wale_width(5.0) == Approx(1.25));
   CHECK(t.course_height(6.0) == Approx(3.5));
   CHECK(t.wale_width(6.5) == Approx(2.0));
-  db.entries[1].cell.course_height = 0.0;
-  try {
-    CellTable bad(db, "db.h5");
-    FAIL("no error");
-  } catch (const knit::InputError& e) {
-    CHECK(e.file() == "db.h5");
-    CHECK(e.pointer() == "/loop_1/course_height");
+  CHECK(t.min_wale_width() == 1.0);
+  CHECK(t.min_course_height() == 2.0);
+  // Outside [1e-3, 1e3] mm, NaN included (session 29: w = 1e-9 mm made the map run without end).
+  for (double bad : {0.0, 1e-9, 2e3, std::numeric_limits<double>::quiet_NaN()}) {
+    INFO(bad);
+    db.entries[1].cell.course_height = bad;
+    try {
+      CellTable b(db, "db.h5");
+      FAIL("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.file() == "db.h5");
+      CHECK(e.pointer() == "/loop_1/course_height");
+    }
   }
 }
 
@@ -237,15 +244,19 @@ TEST_CASE("knitmap: a linear grading and the command's outputs", "[case]") {
       CHECK(m.stitches[i].l > m.stitches[i - 1].l);
 }
 
-/// A patch of straight-sided rows (degree 1 across): row k spans x in [cx - hw_k, cx + hw_k]
-/// at y_k. Courses run along x (alpha 0).
+/// A patch whose rows of control points (degree 1 across) span x in [cx - hw_k, cx + hw_k] at
+/// y_k, one Bezier of degree n - 1 along v (C^1: a degree-1 patch with interior knots, the
+/// session-26 form, has hinges, which the case loader refuses since session 27). Courses run
+/// along x (alpha 0).
 std::string tapered_case(const std::string& material, const std::vector<double>& y,
                          const std::vector<double>& half_width, double cx = 25.0) {
   std::ostringstream os;
   os.precision(17);
-  os << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0)";
-  for (std::size_t k = 1; k + 1 < y.size(); ++k) os << ", " << double(k) / double(y.size() - 1);
-  os << R"(, 1, 1], "control_points": [)";
+  const std::size_t n = y.size();
+  os << R"({"geometry": {"degrees": [1, )" << n - 1
+     << R"(], "knots_u": [0, 0, 1, 1], "knots_v": [)";
+  for (std::size_t k = 0; k < 2 * n; ++k) os << (k ? ", " : "") << (k < n ? 0 : 1);
+  os << R"(], "control_points": [)";
   for (std::size_t k = 0; k < y.size(); ++k)
     os << (k ? ", " : "") << "[" << cx - half_width[k] << ", " << y[k] << ", 0], ["
        << cx + half_width[k] << ", " << y[k] << ", 0]";
@@ -260,12 +271,13 @@ std::string tapered_case(const std::string& material, const std::vector<double>&
 // Session 26 (found by a helper's audit): the first course line whose chord held no stitch
 // ended the map, so an hourglass with a 0.1 mm waist lost its upper half with exit 0, and a V
 // whose tip is narrower than a stitch was refused as "holds no course".
-TEST_CASE("knitmap: a waist narrower than a stitch is refused; a narrow tip is left out",
+TEST_CASE("knitmap: a waist narrower than a stitch is refused, a narrow tip is left out",
           "[case]") {
   const std::string db = database();
   const std::string m = knit_material(db, "5.0");
+  // Half-widths 25, -24.9, 25 as control values: 25 - 99.8 v (1 - v), a waist of 0.05 mm.
   const std::string hourglass =
-      write_case("hourglass.json", tapered_case(m, {0, 25, 50}, {25, 0.05, 25}));
+      write_case("hourglass.json", tapered_case(m, {0, 25, 50}, {25, -24.9, 25}));
   try {
     const auto in = load_knitmap_input(hourglass);
     (void)make_knitmap(in.c, in.cells);
@@ -342,4 +354,20 @@ TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothin
   }
   CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance 180") ==
         0);
+  // More stitches than a map may have, estimated before the layout (session 29: a 500 m x 500 m
+  // patch ran without limit in time and memory): the 10 x 10 mm patch holds about 80 stitches.
+  KnitMapOptions few;
+  few.max_stitches = 20;
+  const auto in = load_knitmap_input(ok);
+  try {
+    (void)make_knitmap(in.c, in.cells, few);
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/geometry/control_points");
+    CHECK(std::string(e.what()).find("--max-stitches") != std::string::npos);
+  }
+  few.max_stitches = 200;
+  CHECK_NOTHROW(make_knitmap(in.c, in.cells, few));
+  CHECK(run_knitmap(ok + " --output " + (kDir / "few_out").string() + " --max-stitches 20") == 2);
+  CHECK(!fs::exists(kDir / "few_out"));
 }

@@ -44,7 +44,13 @@ class CellTable {
   CellTable(const material::Database& db, const std::string& db_file);
   double wale_width(double l) const { return interpolate(w_, l); }
   double course_height(double l) const { return interpolate(c_, l); }
+  /// The smallest w and c of the table (piecewise linear: no smaller value in between).
+  double min_wale_width() const;
+  double min_course_height() const;
   const std::vector<double>& loop_lengths() const { return l_; }
+  /// The cell parameters' sane range (mm): a stitch is a yarn loop of a textile; anything
+  /// outside is a damaged database (session 29: w = 1e-9 mm made the map run without end).
+  static constexpr double kMinCellSize = 1e-3, kMaxCellSize = 1e3;
 
  private:
   double interpolate(const std::vector<double>& y, double l) const;
@@ -56,6 +62,11 @@ struct KnitMapOptions {
   double angle_tolerance_deg = 2.0;
   /// Samples per patch edge for the boundary polygon (chords of the courses).
   int boundary_samples = 400;
+  /// Largest number of stitches a map may have, estimated before the layout from the patch's
+  /// extent and the smallest w and c (session 29: a 500 m x 500 m patch, about 2e11 stitches,
+  /// ran without limit in time and memory). 1e7 stitches: a CSV of about 0.5 GB, a panel of
+  /// about 3.5 x 3 m at 4.5 mm. `knit-macro knitmap --max-stitches`.
+  double max_stitches = 1e7;
 };
 
 struct KnitStitch {
