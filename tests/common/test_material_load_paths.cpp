@@ -237,7 +237,7 @@ RawPath raw(const LoadPath& p) {
 }
 }  // namespace
 
-TEST_CASE("database: the new path fields round trip; old raw paths read as set paper", "[unit]") {
+TEST_CASE("database: the new path fields round trip, old raw paths read as set paper", "[unit]") {
   Database db;
   db.provenance = current_provenance();
   db.generator = "test";
@@ -279,9 +279,12 @@ TEST_CASE("database: the new path fields round trip; old raw paths read as set p
           std::vector<std::string>{"paper", "coverage", "holdout"});
     CHECK(f.read_matrix("/sweep/load_path_H")(2, 1) == 1.0 / 3.0);
   }
-  // An older file: the path group as the format-1 writer made it (no axis, H, set).
+  // An older file: the path group as the format-1 writer made it (no axis, H, set), in a file
+  // of format 1 (from format 2 on a missing attribute is a damaged file, commit 37e5153; this
+  // test, its name holding a ';', had not run under CTest since, session 29).
   {
     auto f = knit::io::H5File::open_rw(file);
+    f.set_attribute(".", "format_version", 1);
     const std::string p = "/loop_0/raw/path_01";
     f.remove(p);
     auto g0 = f.create_group(p);

@@ -262,7 +262,7 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
   }
 }
 
-TEST_CASE("malformed JSON reports the line and column; duplicate keys are errors", "[unit]") {
+TEST_CASE("malformed JSON reports the line and column, duplicate keys are errors", "[unit]") {
   std::string text = read_json("tensile_svk.json").dump(2);
   text.insert(text.find("\"geometry\""), "oops ");
   try {

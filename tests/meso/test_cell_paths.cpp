@@ -23,7 +23,7 @@ homog::CellOptions fast_options() {
 constexpr double kZeroStress = 1e-10;
 }  // namespace
 
-TEST_CASE("stress-free reference cell: no stress unloaded; the old reference keeps its residual",
+TEST_CASE("stress-free reference cell: no stress unloaded, the old reference keeps its residual",
           "[unit]") {
   for (double l : {4.5, 6.5}) {
     INFO("l = " << l);

@@ -81,7 +81,7 @@ TEST_CASE("knit-meso fit keeps what the database holds beyond the laws", "[unit]
   CHECK(refit.entries[0].surface);
 }
 
-TEST_CASE("knit-meso synth writes the energy law; fit --law energy adds it to a v1 file",
+TEST_CASE("knit-meso synth writes the energy law, fit --law energy adds it to a v1 file",
           "[unit]") {
   const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_synth_energy.h5";

@@ -39,7 +39,7 @@ PathSpec shear(double gamma, int steps) {
 
 }  // namespace
 
-TEST_CASE("pure shear: E11 = E22 = 0 and E12 = sin(gamma)/2; biaxial E", "[unit]") {
+TEST_CASE("pure shear: E11 = E22 = 0 and E12 = sin(gamma)/2, biaxial E", "[unit]") {
   for (double g : {0.1, 0.5, -0.7}) {
     const Eigen::Matrix2d E = green_lagrange(path_F(shear(g, 1), 1.0));
     CHECK(std::abs(E(0, 0)) < 1e-15);
@@ -86,7 +86,7 @@ TEST_CASE("4.5 mm cell is stiffer than 6.5 mm in both directions", "[unit]") {
   CHECK(dS[1][1] > 0);
 }
 
-TEST_CASE("energy balance: boundary work = stored energy + friction work; D never negative",
+TEST_CASE("energy balance: boundary work = stored energy + friction work, D never negative",
           "[unit]") {
   CellOptions o = fast_options();
   o.elements = 32;  // the balance holds to ~1 % from 32 elements on (docs/unit-cell.md)

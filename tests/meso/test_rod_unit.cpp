@@ -27,7 +27,7 @@ RodSpec helix_rod(int p, int elements) {
 
 }  // namespace
 
-TEST_CASE("quaternion: rotation is orthogonal and scale-invariant; log/exp round trip", "[unit]") {
+TEST_CASE("quaternion: rotation is orthogonal and scale-invariant, log/exp round trip", "[unit]") {
   const Vector3d th(0.3, -1.1, 2.0);
   const Quat<double> q = quat_from_rotation_vector(th);
   const Eigen::Matrix3d R = rotation(q);
@@ -157,7 +157,7 @@ TEST_CASE("rod: rigid-body motions of a stressed state give zero residual", "[un
   CHECK(x.segment<3>(sys.dof(0, n - 1, kFieldN)).norm() > 0.1 * EI);
 }
 
-TEST_CASE("rod: load stepping cuts back a too large increment; failure is a status", "[unit]") {
+TEST_CASE("rod: load stepping cuts back a too large increment, failure is a status", "[unit]") {
   const Section sec;
   const double L = 10.0, EI = sec.C_K()(0);
   auto make = [&](RodSystem& sys) {
