@@ -190,8 +190,17 @@ void remove_marked_tree(const fs::path& dir) {
   fs::remove(dir, ec);
 }
 
+/// True if `dir` is an output that process `pid` was moving aside ("replaced by pid" in its
+/// marker, written just before the rename to "<target>.old-<pid>").
+bool moved_aside_by(const fs::path& dir, long pid) {
+  const auto m = read_output_marker(dir);
+  return m && m->replaced_by_pid == pid;
+}
+
 /// Removes "<target>.partial-<pid>" and "<target>.old-<pid>" left by killed runs: only those
-/// whose pid is dead (or ours: an earlier run with a recycled pid) and which hold the marker.
+/// whose pid is dead (or ours: an earlier run with a recycled pid) and whose marker says that
+/// a run of ours left them (a partial directory "for: <target>", an output "replaced by pid
+/// <pid>").
 void remove_stale_siblings(const fs::path& target) {
   const std::string name = target.filename().string();
   std::error_code ec;
@@ -202,7 +211,7 @@ void remove_stale_siblings(const fs::path& target) {
     for (auto it = fs::directory_iterator(parent_or_dot(target), ec);
          !ec && it != fs::directory_iterator(); it.increment(ec)) {
       const long pid = pid_in_name(it->path().filename().string(), name + ".old-", false);
-      if (pid >= 0 && (pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path()) &&
+      if (pid >= 0 && (pid == ::getpid() || pid_is_dead(pid)) && moved_aside_by(it->path(), pid) &&
           ::rename(it->path().c_str(), target.c_str()) == 0)
         break;
     }
@@ -213,9 +222,14 @@ void remove_stale_siblings(const fs::path& target) {
     const std::string f = it->path().filename().string();
     for (const char* tag : {".partial-", ".old-"}) {
       const long pid = pid_in_name(f, name + tag, false);
-      if (pid < 0) continue;
-      if ((pid == ::getpid() || pid_is_dead(pid)) && is_knitscale_output(it->path()))
-        remove_marked_tree(it->path());
+      if (pid < 0 || !(pid == ::getpid() || pid_is_dead(pid))) continue;
+      // Only what a run of ours left there: a partial directory written for this target, or
+      // an output that run moved aside (session 29: any marked directory of that name went,
+      // a user's copy "cp -a out out.old-2024" or an output asked for as "out.partial-31337").
+      const auto m = read_output_marker(it->path());
+      if (!m) continue;
+      const bool partial = std::string(tag) == ".partial-";
+      if (partial ? m->for_name == name : m->replaced_by_pid == pid) remove_marked_tree(it->path());
     }
   }
 }
@@ -248,7 +262,8 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   std::ofstream marker(partial_ / kOutputMarker, std::ios::binary);
   // The first line names the writer (output_owner): only it replaces this output later.
   marker << "knitscale output" << (output_owner().empty() ? "" : ": " + output_owner()) << "\n"
-         << Provenance::current().to_json_string() << "\n";
+         << Provenance::current().to_json_string() << "\n"
+         << "for: " << target_.filename().string() << "\n";
   if (!marker) fail(partial_ / kOutputMarker, "cannot write");
 }
 
@@ -279,6 +294,20 @@ void AtomicDirectory::commit() {
   if (committed_) return;
   if (!active_) fail(target_, "commit() on a moved-from AtomicDirectory");
   std::error_code ec;
+  // The manifest: every file and directory of the run, so that a later run replaces only
+  // these (check_output_target refuses an output holding others; session 29).
+  {
+    std::string manifest;
+    for (auto it = fs::recursive_directory_iterator(partial_, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      const std::string rel = it->path().lexically_relative(partial_).generic_string();
+      if (rel != kOutputMarker) manifest += "file: " + rel + "\n";
+    }
+    if (ec) fail(partial_, "cannot list the outputs: " + ec.message());
+    std::ofstream marker(partial_ / kOutputMarker, std::ios::binary | std::ios::app);
+    marker << manifest;
+    if (!marker.flush()) fail(partial_ / kOutputMarker, "cannot write");
+  }
   // Make the contents durable before they become visible under the final name.
   for (auto it = fs::recursive_directory_iterator(partial_, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
@@ -295,7 +324,8 @@ void AtomicDirectory::commit() {
   } else {
     if (!fs::is_directory(fs::symlink_status(target_, ec)))
       fail(target_, "exists and is not a directory");
-    if (!is_own_output(target_) && !fs::is_empty(target_, ec)) {
+    const std::vector<std::string> foreign = foreign_entries(target_);
+    if ((!is_own_output(target_) || !foreign.empty()) && !fs::is_empty(target_, ec)) {
       // Keep the new output beside it under a name of its own (the clean-up of partial
       // directories would remove it; session 26: the message named it, and it was gone).
       std::string where;
@@ -311,6 +341,11 @@ void AtomicDirectory::commit() {
                 " removes it)";
       }
       active_ = false;  // nothing to remove or mark
+      if (!foreign.empty())
+        fail(target_, "received entries that the earlier run did not write (" + foreign[0] +
+                          (foreign.size() > 1 ? ", ..." : "") +
+                          ") while the run went on: left alone; the new output is kept in " +
+                          where);
       fail(target_, "became a non-empty directory that is not this program's output (its " +
                         std::string(kOutputMarker) + " is missing or names another) while " +
                         "the run went on: left alone; the new output is kept in " + where);
@@ -324,6 +359,11 @@ void AtomicDirectory::commit() {
       old += std::to_string(::getpid());
       if (fs::exists(fs::symlink_status(old, ec)))
         fail(old, "exists and is not ours to remove; rename or remove it");
+      {  // so that the clean-up after a kill knows this DIR.old-<pid> for ours
+        std::ofstream marker(target_ / kOutputMarker, std::ios::binary | std::ios::app);
+        marker << "replaced by pid " << ::getpid() << "\n";
+        if (!marker.flush()) fail(target_ / kOutputMarker, "cannot write");
+      }
       if (::rename(target_.c_str(), old.c_str()) != 0)
         fail(target_, "cannot move the previous output aside", errno);
       if (::rename(partial_.c_str(), target_.c_str()) != 0) {

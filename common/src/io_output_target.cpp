@@ -7,12 +7,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -82,12 +84,55 @@ std::optional<std::string> output_marker_owner(const fs::path& dir) {
   static const std::string tag = "knitscale output";
   if (line == tag) return std::string();
   if (line.rfind(tag + ": ", 0) == 0) return line.substr(tag.size() + 2);
-  return line;
+  // Any other first line names somebody else; an empty marker is no marker of ours either
+  // (session 29: an empty .knitscale-output was taken for an output naming no owner).
+  return line.empty() ? std::string("an unknown program (its marker file is empty)") : line;
 }
 
 bool is_own_output(const fs::path& dir) {
   const auto owner = output_marker_owner(dir);
   return owner && (owner->empty() || *owner == output_owner());
+}
+
+std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
+  if (!is_knitscale_output(dir)) return std::nullopt;
+  std::ifstream in(dir / kOutputMarker, std::ios::binary);
+  OutputMarker m;
+  std::string line;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (k < 2) continue;  // the owner and the provenance
+    if (line.rfind("for: ", 0) == 0) {
+      m.for_name = line.substr(5);
+    } else if (line.rfind("file: ", 0) == 0) {
+      m.has_manifest = true;
+      m.files.push_back(line.substr(6));
+    } else if (line.rfind("replaced by pid ", 0) == 0) {
+      char* end = nullptr;
+      const long pid = std::strtol(line.c_str() + 16, &end, 10);
+      if (end && *end == '\0' && pid > 0) m.replaced_by_pid = pid;
+    }
+  }
+  return m;
+}
+
+std::vector<std::string> foreign_entries(const fs::path& dir, std::size_t max) {
+  std::vector<std::string> out;
+  const auto m = read_output_marker(dir);
+  if (!m || !m->has_manifest) return out;
+  const std::set<std::string> ours(m->files.begin(), m->files.end());
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    const std::string rel = it->path().lexically_relative(dir).generic_string();
+    if (rel == kOutputMarker || ours.count(rel)) continue;
+    out.push_back(rel);  // a foreign directory is named once, not its contents
+    if (it->is_directory(ec) && !it->is_symlink(ec)) it.disable_recursion_pending();
+  }
+  std::sort(out.begin(), out.end());
+  if (out.size() > max) out.resize(max);
+  if (ec) out.push_back("(" + dir.string() + " could not be listed: " + ec.message() + ")");
+  return out;
 }
 
 void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option,
@@ -130,6 +175,18 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
                " says so), not of " +
                (output_owner().empty() ? std::string("this program") : output_owner()) +
                ": not ours to replace; give another directory");
+      if (!ec && !empty) {
+        const auto foreign = foreign_entries(target, 6);
+        if (!foreign.empty()) {
+          std::string list;
+          for (std::size_t k = 0; k < std::min<std::size_t>(foreign.size(), 5); ++k)
+            list += (k ? ", " : "") + foreign[k];
+          refuse("is an earlier output that now holds entries its run did not write (" + list +
+                 (foreign.size() > 5 ? ", ..." : "") +
+                 "): a new run replaces the directory as a whole, and they are not ours to "
+                 "delete; move them out, or give another directory");
+        }
+      }
     } else {
       if (fs::is_directory(st)) refuse("is a directory; give the name of the file to write");
       if (!fs::is_regular_file(st)) refuse("exists and is not a regular file");

@@ -347,20 +347,30 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   }
   CHECK_THAT(slurp(target / knit::io::kOutputMarker), Catch::StartsWith("knitscale output\n"));
   CHECK_FALSE(fs::exists(d / "out.lock"));
-  // Stale partial directories: of a dead pid with the marker -> removed; without the marker, or
-  // of a live process, or of another output -> kept.
-  const std::string dead = std::to_string(999999999);
-  auto make = [&](const std::string& name, bool marker) {
+  // Stale partial directories: of a dead pid whose marker says a run of ours left it (a partial
+  // directory written "for: out", an output "replaced by pid <pid>") -> removed; without the
+  // marker, or of a live process, or of another output, or a marked directory that a run did not
+  // leave there (session 29: a user's copy "cp -a out out.old-2024", an output asked for as
+  // "out.partial-31337") -> kept.
+  const std::string dead = std::to_string(999999999), dead2 = std::to_string(999999998);
+  const std::string partial_of_out = "knitscale output\n{}\nfor: out\n";
+  const std::string moved_by_dead =
+      "knitscale output\n{}\nfor: out\nfile: x\nreplaced by pid " + dead + "\n";
+  const std::string complete_out = "knitscale output\n{}\nfor: out\nfile: x\n";
+  auto make = [&](const std::string& name, const std::string& marker) {
     fs::create_directories(d / name);
     std::ofstream(d / name / "x") << "x";
-    if (marker) std::ofstream(d / name / knit::io::kOutputMarker) << "knitscale output\n";
+    if (!marker.empty()) std::ofstream(d / name / knit::io::kOutputMarker) << marker;
   };
-  make("out.partial-" + dead, true);
-  make("out.old-" + dead, true);
-  make("out.partial-1", true);               // pid 1 lives
-  make("out.partial-99999999x", true);       // not a pid
-  make("out.partial-" + dead + "0", false);  // no marker
-  make("other.partial-" + dead, true);       // another output
+  make("out.partial-" + dead, partial_of_out);
+  make("out.old-" + dead, moved_by_dead);
+  make("out.partial-1", partial_of_out);                                // pid 1 lives
+  make("out.partial-99999999x", partial_of_out);                        // not a pid
+  make("out.partial-" + dead + "0", "");                                // no marker
+  make("other.partial-" + dead, "knitscale output\n{}\nfor: other\n");  // another output
+  make("out.old-" + dead2, complete_out);  // a user's copy of an output
+  make("out.partial-" + dead2, "knitscale output\n{}\nfor: out.partial-" + dead2 + "\nfile: x\n");
+  make("out.old-" + dead2 + "1", "knitscale output\n");  // a marker of before session 29
   {
     knit::io::AtomicDirectory a(target);
     a.commit();
@@ -371,17 +381,89 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(fs::exists(d / "out.partial-99999999x"));
   CHECK(fs::exists(d / ("out.partial-" + dead + "0")));
   CHECK(fs::exists(d / ("other.partial-" + dead)));
+  CHECK(slurp(d / ("out.old-" + dead2) / "x") == "x");
+  CHECK(slurp(d / ("out.partial-" + dead2) / "x") == "x");
+  CHECK(slurp(d / ("out.old-" + dead2 + "1") / "x") == "x");
   // Killed between the two renames of a replacement without RENAME_EXCHANGE: no DIR, the
   // earlier output in DIR.old-<pid>. The next run puts it back, and a run that then fails
   // leaves it there (session 26: the clean-up deleted it).
   fs::remove_all(target);
-  make("out.old-" + dead, true);
+  make("out.old-" + dead, moved_by_dead);
   {
     knit::io::AtomicDirectory a(target);  // abandoned: no commit
     CHECK(slurp(target / "x") == "x");
   }
   CHECK(slurp(target / "x") == "x");
   CHECK_FALSE(fs::exists(d / ("out.old-" + dead)));
+  // A user's copy is not put in place of a missing output (and so not replaced by the run).
+  fs::remove_all(target);
+  {
+    knit::io::AtomicDirectory a(target);
+    a.commit();
+  }
+  CHECK(slurp(d / ("out.old-" + dead2) / "x") == "x");
+}
+
+// Session 29 (found by two helpers' audits): a rerun replaced its earlier output directory as a
+// whole and deleted what a user had put in it (notes, a database, the case file the run read).
+// The marker lists what the run wrote; an output holding anything else is refused at once.
+TEST_CASE("AtomicDirectory does not replace an output holding entries its run did not write",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("manifest");
+  const fs::path target = d / "out";
+  {
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "results.csv") << "1";
+    fs::create_directories(a.path() / "vtk");
+    std::ofstream(a.path() / "vtk" / "s0.vtu") << "v";
+    a.commit();
+  }
+  const auto m = knit::io::read_output_marker(target);
+  REQUIRE(m);
+  CHECK(m->for_name == "out");
+  CHECK(m->has_manifest);
+  CHECK(m->files.size() == 3);
+  CHECK(knit::io::foreign_entries(target).empty());
+  {  // its own files only: replaced
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "results.csv") << "2";
+    a.commit();
+  }
+  CHECK(slurp(target / "results.csv") == "2");
+  CHECK_FALSE(fs::exists(target / "vtk"));
+  std::ofstream(target / "notes.txt") << "mine";
+  fs::create_directories(target / "mine" / "deep");
+  std::ofstream(target / "mine" / "deep" / "a") << "a";
+  CHECK(knit::io::foreign_entries(target) == std::vector<std::string>{"mine", "notes.txt"});
+  CHECK_THROWS_WITH(knit::io::AtomicDirectory(target),
+                    Catch::Contains("holds entries its run did not write (mine, notes.txt)") &&
+                        Catch::Contains("move them out"));
+  CHECK(slurp(target / "notes.txt") == "mine");
+  // Put there while the run went on: the earlier output is left alone, the new one kept beside.
+  fs::remove_all(target / "mine");
+  fs::remove(target / "notes.txt");
+  {
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "results.csv") << "3";
+    std::ofstream(target / "late.txt") << "late";
+    CHECK_THROWS_WITH(a.commit(), Catch::Contains("received entries that the earlier run did not "
+                                                  "write (late.txt"));
+  }
+  CHECK(slurp(target / "late.txt") == "late");
+  CHECK(slurp(target / "results.csv") == "2");
+  bool kept = false;
+  for (const auto& e : fs::directory_iterator(d))
+    if (e.path().filename().string().rfind("out.new-", 0) == 0)
+      kept = slurp(e.path() / "results.csv") == "3";
+  CHECK(kept);
+  // An empty marker file names no program of ours (it was taken for one naming no owner).
+  const fs::path fake = d / "fake";
+  fs::create_directories(fake);
+  std::ofstream(fake / knit::io::kOutputMarker).flush();
+  std::ofstream(fake / "data.txt") << "d";
+  CHECK_FALSE(knit::io::is_own_output(fake));
+  CHECK_THROWS_AS(knit::io::AtomicDirectory(fake), knit::InputError);
+  CHECK(slurp(fake / "data.txt") == "d");
 }
 
 // Session 26 (found by a helper's audit): `knit-macro run case.json -o out` replaced the
@@ -438,7 +520,8 @@ TEST_CASE("AtomicDirectory replaces only outputs of its own program", "[unit][io
     // any other: refused at once, not after the run (review of session 26).
     const fs::path moved = d / "run2.old-999999999";
     fs::create_directories(moved);
-    std::ofstream(moved / knit::io::kOutputMarker) << "knitscale output: knit-macro design\n";
+    std::ofstream(moved / knit::io::kOutputMarker)
+        << "knitscale output: knit-macro design\n{}\nreplaced by pid 999999999\n";
     std::ofstream(moved / "y.txt") << "y";
     CHECK_THROWS_WITH(knit::io::AtomicDirectory(d / "run2"),
                       Catch::Contains("is the output of knit-macro design"));

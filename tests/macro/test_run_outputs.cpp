@@ -106,6 +106,9 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
   // An earlier output that a killed replacement had moved aside (no DIR, DIR.old-<dead pid>)
   // is put back and kept by the failed rerun as well.
   fs::rename(d / "out", d / "out.old-999999999");
+  // (what the run that moved it aside writes into its marker just before, since session 29)
+  std::ofstream(d / "out.old-999999999" / ".knitscale-output", std::ios::app)
+      << "replaced by pid 999999999\n";
   r = macro((d / "fail.json").string() + " --output " + (d / "out").string());
   CHECK(r.rc == 1);
   std::ifstream back_in(d / "out" / "load_strain.csv");

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace knit::io {
 
@@ -40,6 +41,27 @@ std::optional<std::string> output_marker_owner(const std::filesystem::path& dir)
 /// report -- because any marker was taken for the program's own.
 bool is_own_output(const std::filesystem::path& dir);
 
+/// The marker's further lines (session 29), below the owner and the provenance:
+///   "for: NAME"            the name of the output the directory was written for (at creation)
+///   "file: REL/PATH"       one per file and directory the run wrote (at commit: the manifest)
+///   "replaced by pid N"    the output is being moved aside by process N (DIR.old-<N>)
+/// A rerun replaced its output directory as a whole and deleted the files a user had put in
+/// it; and the clean-up after killed runs deleted any marked "DIR.partial-<N>" or "DIR.old-<N>"
+/// of a dead N -- a user's copy "cp -a out out.old-2024" or an output asked for by that name.
+struct OutputMarker {
+  std::string for_name;            ///< empty when the marker has no "for:" line
+  bool has_manifest = false;       ///< any "file:" line (a committed output of session >= 29)
+  std::vector<std::string> files;  ///< the manifest, relative paths with '/'
+  long replaced_by_pid = -1;       ///< -1 without that line
+};
+/// The marker of `dir`, read; nothing without a marker.
+std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);
+
+/// Entries inside the output directory `dir` that the run which wrote it did not write (not in
+/// its marker's manifest), relative to dir, at most `max` of them; empty for a directory whose
+/// marker has no manifest (written before session 29: nothing to tell them by).
+std::vector<std::string> foreign_entries(const std::filesystem::path& dir, std::size_t max = 5);
+
 enum class OutputKind { kDirectory, kFile };
 
 /// Refuses, before any work, an output target the run could not (or must not) write. Throws
@@ -48,7 +70,8 @@ enum class OutputKind { kDirectory, kFile };
 ///  * a symbolic link (dangling or not: the rename would replace the link, not its target);
 ///  * kDirectory: an existing non-directory; the current directory or one of its ancestors; a
 ///    non-empty directory that is not a knitscale output (no marker file), or the output of
-///    another program (is_own_output);
+///    another program (is_own_output), or an output holding entries its run did not write
+///    (foreign_entries: a user's notes in a run's directory);
 ///  * kFile (an HDF5 file: the database outputs): an existing directory (or other non-regular
 ///    file); an existing non-empty file that is not HDF5 (not ours to replace); with
 ///    `hdf5_format` given, an existing HDF5 file whose root attribute "format" is not
