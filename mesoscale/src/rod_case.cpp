@@ -341,6 +341,30 @@ RodCase load_rod_case(const std::filesystem::path& path) {
       }
     }
   }
+  // Loads the solver cannot see (session 29, found by a helper's fuzzing audit): the residual is
+  // scaled per row (force rows L/EA, moment rows 1/EA, ...: row_scales()), so on a long slender
+  // rod a real load is within the tolerance at the reference state. A 1000 mm rod of d = 0.1 mm
+  // with an end moment of 1e-7 N mm (tip deflection M L^2 / 2EI = 12.7 mm) "completed" with 0
+  // Newton iterations and u = 0, exit 0. The full load's scaled residual at the reference state
+  // must exceed the tolerance by kLoadResolution (choice: 1e3, three digits of the load resolved).
+  {
+    Eigen::VectorXd F;
+    c.system.residual(c.system.initial_state(), c.path.lambda_end, F);
+    const double raw = F.size() ? F.cwiseAbs().maxCoeff() : 0.0;
+    const double scaled =
+        F.size() ? F.cwiseProduct(c.system.row_scales()).cwiseAbs().maxCoeff() : 0.0;
+    if (raw > 0.0 && scaled <= kLoadResolution * c.path.newton.tol) {
+      std::ostringstream o;
+      o.precision(3);
+      o << "the loads' residual at the reference state, " << scaled
+        << " (dimensionless: force rows scaled by L/EA, moment rows by 1/EA), is within "
+        << kLoadResolution << " x the tolerance " << c.path.newton.tol
+        << ": the solver would resolve them to fewer than three digits, or stop at once with "
+           "nothing moved; lower /steps/tolerance to about "
+        << scaled * 1e-3 << " or below, or raise the loads";
+      R.fail("/steps/tolerance", o.str());
+    }
+  }
   return c;
 }
 

@@ -185,6 +185,39 @@ TEST_CASE("rod case: a mesh too coarse for the case is reported by the bisection
   CHECK(msg.find("resolution") == std::string::npos);
 }
 
+// Session 29 (found by a helper's fuzzing audit): the residual is scaled per row (L/EA for
+// forces), so a real load on a long slender rod was within the tolerance at the reference state:
+// 1000 mm, d = 0.1 mm, end moment 1e-7 N mm (tip deflection M L^2 / 2EI = 12.73 mm) "completed"
+// with 0 Newton iterations and u = 0, exit 0.
+TEST_CASE("rod case: loads within the tolerance are refused, and resolved with a smaller one",
+          "[case]") {
+  auto text = [](const std::string& tol) {
+    return R"({"section": {"E": 800.0, "nu": 0.3, "d": 0.1},
+      "rods": [{"name": "b", "curve": {"type": "line", "from": [0,0,0], "to": [1000,0,0],
+                "degree": 4, "elements": 16},
+                "start": {"position": "fixed", "rotation": "fixed"},
+                "end": {"position": "free", "rotation": "free", "moment": [0, -1e-7, 0]}}],
+      "steps": {"count": 4)" +
+           tol + R"(},
+      "output": {"points": [{"name": "tip", "rod": "b", "xi": 1.0}]}})";
+  };
+  write(kTmp / "slender.json", text(""));
+  std::string msg;
+  CHECK(run("rod " + (kTmp / "slender.json").string() + " -q -o " + (kTmp / "slender").string(),
+            &msg) == 2);
+  INFO(msg);
+  CHECK(msg.find("slender.json: /steps/tolerance: the loads' residual at the reference state") !=
+        std::string::npos);
+  CHECK_FALSE(fs::exists(kTmp / "slender"));
+  // With the tolerance the message suggests, the linear answer (the rotation is 0.0255 rad).
+  write(kTmp / "slender_tol.json", text(R"(, "tolerance": 1.5e-14)"));
+  REQUIRE(run("rod " + (kTmp / "slender_tol.json").string() + " -q -o " +
+              (kTmp / "slender_tol").string()) == 0);
+  const auto rows = read_csv(kTmp / "slender_tol" / "load_displacement.csv");
+  const double EI = 800.0 * M_PI * std::pow(0.1, 4) / 64.0;
+  CHECK(rows.back()[5] == Approx(1e-7 * 1e6 / (2 * EI)).epsilon(1e-3));
+}
+
 TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output", "[case]") {
   const std::string good_rod =
       R"({"name": "b", "curve": {"type": "line", "from": [0,0,0], "to": [1,0,0], "degree": 3, "elements": 2},

@@ -45,6 +45,10 @@ struct CasePathReport : PathReport {
   std::optional<ResolutionCheck> resolution;
 };
 
+/// The full load's scaled residual at the reference state must exceed the Newton tolerance by
+/// this factor, or the case is refused at /steps/tolerance (the loads would not be resolved).
+inline constexpr double kLoadResolution = 1e3;
+
 /// Reads and checks a case file; throws knit::InputError(file, pointer, message).
 RodCase load_rod_case(const std::filesystem::path& file);
 
