@@ -577,6 +577,13 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   } catch (const std::exception& e) {
     return refuse(std::string("the fitted law is not usable: ") + e.what());
   }
+  // Session 29 (a helper's fuzzing audit): a raw stress of 1e308 gave rms = inf, written into
+  // the database with exit 0.
+  if (!(out.diagnostics.rms.allFinite() && out.diagnostics.max.allFinite() &&
+        std::isfinite(out.diagnostics.max_relative)))
+    return refuse("the fitted law's errors against the cell data are not finite (rms " +
+                  std::to_string(out.diagnostics.rms.maxCoeff()) +
+                  "): the raw data hold values too large to fit");
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();
   return out;

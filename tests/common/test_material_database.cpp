@@ -9,6 +9,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 
 #include "knit/core/errors.hpp"
@@ -260,6 +261,43 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     const auto f = tmp("nonfinite_unconverged.h5");
     write_database(f, db);
     CHECK_NOTHROW(read_database(f));
+  }
+  SECTION("values no database holds") {
+    // Session 29 (a helper's fuzzing audit): decreasing loop lengths, a NaN yarn or cell
+    // attribute and a raw stress of 1e308 were read (fit --law paper wrote rms = inf, exit 0).
+    auto mutate = [&](const std::function<void(knit::io::H5File&)>& m) {
+      const auto bad = tmp("values.h5");
+      fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        m(f);
+      }
+      return bad;
+    };
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        auto l = f.read_doubles("/loop_lengths");
+                        std::swap(l[0], l[1]);
+                        f.write("/loop_lengths", l);
+                      })),
+                      Catch::Contains("/loop_lengths: loop lengths must be finite, positive and "
+                                      "strictly increasing"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        f.set_attribute("/yarn", "youngs_modulus", std::nan(""));
+                      })),
+                      Catch::Contains("/yarn: attribute youngs_modulus is not finite"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        f.set_attribute("/loop_1", "wale_width", -1.0);
+                      })),
+                      Catch::Contains("/loop_1/wale_width: attribute wale_width must be finite"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        auto S = f.read_matrix("/loop_1/raw/path_03/S");
+                        S(0, 0) = 1e308;
+                        f.write("/loop_1/raw/path_03/S", S);
+                      })),
+                      Catch::Contains("/loop_1/raw/path_03/S: step 1 holds |value| 1e+308"));
+    CHECK_NOTHROW(read_database(mutate([](knit::io::H5File& f) {
+      f.set_attribute("/loop_1", "wale_width", 0.0);  // 0: not known
+    })));
   }
   SECTION("a path attribute of format 2 missing") {
     // Deleting /loop_k/raw/path_q's set read it as "paper": a coverage path joined the eq. 17

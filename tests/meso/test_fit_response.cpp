@@ -282,3 +282,17 @@ TEST_CASE("fit: weights large enough to overflow are refused with the option's n
   CHECK_THROWS_WITH(FitOptions::from_json(R"({"smoothing": 1e308})", "o.json"),
                     Catch::Contains("o.json: /smoothing: must be in [0, 1000]"));
 }
+
+// Session 29 (a helper's fuzzing audit): a raw stress of 1e308 gave the paper fit rms = inf,
+// written into the database with exit 0. The database reader now refuses such values; the fit
+// refuses non-finite errors itself as well (data handed over by the API).
+TEST_CASE("fit: non-finite errors against the data are a failed fit", "[unit]") {
+  SyntheticOptions so;
+  auto raw = synthetic_paths(so, 5.5);
+  REQUIRE(fit_loop_length(raw, FitOptions{}).ok());
+  for (auto& r : raw)
+    if (r.path.kind == PathKind::kShear) r.S(r.steps() - 1, 2) = 1e300;  // squared: inf
+  const FitSummary fs = fit_loop_length(raw, FitOptions{});
+  CHECK_FALSE(fs.ok());
+  CHECK_THAT(fs.reason, Catch::Contains("not finite"));
+}
