@@ -30,6 +30,7 @@ std::string path_group(std::size_t q) {
 
 /// The oldest format version this build still reads (version 1: no /energy_law).
 constexpr int kOldestReadableVersion = 1;
+constexpr const char* kDatabaseUnits = "length mm, force N, stress MPa";
 constexpr double kMaxRawKinematic = 1e3;  // |F|, |E| of a raw step (dimensionless)
 constexpr double kMaxRawStress = 1e9;     // |P|, |S| of a raw step (MPa)
 
@@ -107,7 +108,7 @@ void write_database(const std::filesystem::path& file, const Database& db,
     f.set_attribute(".", "generator", db.generator);
     // The writing process (program, host, command line) in the io module's common form.
     io::write_provenance(f, io::Provenance::current(""));
-    f.set_attribute(".", "units", "length mm, force N, stress MPa");
+    f.set_attribute(".", "units", kDatabaseUnits);
     f.set_attribute(".", "voigt_order", "E = (E11, E22, 2E12), S = (S11, S22, S12)");
     f.set_attribute(".", "frame", "material frame: 1 = course, 2 = wale");
     H5Group sw = f.create_group("/sweep");
@@ -275,6 +276,12 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     auto require_dataset = [&](const std::string& p) {
       if (!f.is_dataset(p)) throw InputError(fname, p, "dataset missing");
     };
+    // The units every database is written in (session 29: "m, kN, kPa" was read, unread).
+    if (f.has_attribute(".", "units") && f.attribute_string(".", "units") != kDatabaseUnits)
+      throw InputError(fname, "/",
+                       "attribute units is \"" + f.attribute_string(".", "units") +
+                           "\"; knitscale's databases are in \"" + kDatabaseUnits +
+                           "\" (no conversion is made)");
     db.provenance.software_version = f.attribute_string(".", "software_version");
     db.provenance.git_revision = f.attribute_string(".", "git_revision");
     db.provenance.created = f.attribute_string(".", "created");

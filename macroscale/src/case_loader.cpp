@@ -35,6 +35,8 @@ constexpr double kMaxAbsoluteTolerance = 1e-3;
 constexpr double kMinThicknessPerSize = 1e-4;
 constexpr double kMaxThicknessPerSize = 1.0;
 constexpr double kMinGaugePerSize = 1e-2;
+/// The smallest non-zero prescribed displacement, relative to the patch's size D (session 29).
+constexpr double kMinPrescribedPerSize = 1e-12;
 constexpr double kMaxGaugePerSize = 10.0;
 
 /// "[lo, hi] mm (a and b times the patch's size D = ... mm)"
@@ -211,6 +213,12 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
   c.thickness = r.positive(g.at("thickness"), "/geometry/thickness");
   c.input_surface = spline::SplineSurface(bu, bv, P, w);
   const double size = patch_size(c.input_surface);
+  // Session 29 (a helper's fuzzing audit): control points of 1e308 gave an infinite size, and
+  // the message blamed the thickness ("must lie in [inf, inf] mm").
+  if (!(std::isfinite(size) && size > 0.0))
+    r.fail("/geometry/control_points",
+           "the patch's size (its largest extent) is " + std::to_string(size) +
+               " mm: the control points must span a finite, non-degenerate patch");
   if (!(c.thickness >= kMinThicknessPerSize * size && c.thickness <= kMaxThicknessPerSize * size))
     r.fail("/geometry/thickness",
            "the thickness must lie in " +
@@ -261,6 +269,7 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
 }
 
 void read_bcs(const Reader& r, const json& root, Case& c) {
+  const double size = patch_size(c.input_surface);
   if (!root.contains("boundary_conditions")) return;
   const json& bcs = r.array(root.at("boundary_conditions"), "/boundary_conditions");
   for (size_t k = 0; k < bcs.size(); ++k) {
@@ -315,6 +324,15 @@ void read_bcs(const Reader& r, const json& root, Case& c) {
         const int comp = parse_component(it.key());
         if (bc.fix[comp]) r.fail(ptr + "/prescribe/" + it.key(), "component is also in \"fix\"");
         bc.prescribe[comp] = r.number(it.value(), ptr + "/prescribe/" + it.key());
+        // Below 1e-12 of the patch's size a displacement is round-off of the geometry, and
+        // below about 1e-154 mm its square underflows to 0: 1e-200 ran 0 iterations to a noise
+        // load with exit 0 (session 29, a helper's fuzzing audit). 0 stays "held at 0".
+        const double v = *bc.prescribe[comp];
+        if (v != 0.0 && std::abs(v) < kMinPrescribedPerSize * size)
+          r.fail(ptr + "/prescribe/" + it.key(),
+                 "a prescribed displacement of " + it.value().dump() +
+                     " mm is below 1e-12 of the patch's size (" + std::to_string(size) +
+                     " mm): round-off, not a load; give 0 or a displacement the patch can feel");
       }
     }
     if (j.contains("clamp")) {

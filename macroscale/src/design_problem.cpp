@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -280,6 +281,16 @@ DesignProblem load_design(const std::string& path) {
   if (!root.contains("case") || !root.at("case").is_string())
     throw InputError(path, "/case", "needs the case file (a string, relative to this file)");
   d.case_file = io::resolve_input_path(path, root.at("case").get<std::string>()).string();
+  // A case file that cannot be read is named with the design file and /case (session 29: the
+  // message named only the case's path); errors inside a readable case name the case file.
+  {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(d.case_file, ec))
+      throw InputError(
+          path, "/case",
+          d.case_file + (std::filesystem::exists(d.case_file, ec) ? " is not a regular file"
+                                                                  : ": file not found"));
+  }
   d.c = load_case(d.case_file);
   const json case_root = io::parse_json(d.c.text, d.case_file);
   if (d.c.material->name() != "knit")

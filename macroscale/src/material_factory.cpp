@@ -47,6 +47,11 @@ std::unique_ptr<Material> make_material(const nlohmann::json& m, const CaseConte
       throw InputError(ctx.file, u->pointer,
                        "unknown key for a saint_venant_kirchhoff material" + u->note);
     const double E = positive_number(m, "youngs_modulus", ctx);
+    // From 1 Pa (a gel) to 1e9 MPa (beyond any solid): E = 1e-170 underflowed the stresses
+    // and ran 0 iterations to a wrong answer with exit 0 (session 29, a helper's fuzzing audit).
+    if (!(E >= 1e-6 && E <= 1e9))
+      throw InputError(ctx.file, ctx.pointer + "/youngs_modulus",
+                       "must lie in [1e-6, 1e9] MPa, got " + m.at("youngs_modulus").dump());
     if (!m.contains("poisson_ratio"))
       throw InputError(ctx.file, ctx.pointer, "missing required key \"poisson_ratio\"");
     const auto& nu = m.at("poisson_ratio");

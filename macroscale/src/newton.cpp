@@ -323,8 +323,11 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
 
   // Whether anything loads the patch: forces, or prescribed displacements (a zero-load case
   // converges at the undeformed state by right).
-  const bool loaded = fext_red.norm() > 0.0 ||
-                      dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).squaredNorm() > 0.0;
+  // (The largest entry, not the 2-norm, whose square underflows to 0 below about 1e-154:
+  // session 29.)
+  const bool loaded =
+      fext_red.lpNorm<Eigen::Infinity>() > 0.0 ||
+      dofs.expand(Eigen::VectorXd::Zero(ufree.size()), 1.0).lpNorm<Eigen::Infinity>() > 0.0;
   // No converged state may fold over itself (fold_guard.hpp). The first check point whose
   // normal at the converged u turned by 90 degrees or more, or -1; -2 if the configuration
   // degenerated. The quadrature points' normals come from `trial`'s point states, evaluated

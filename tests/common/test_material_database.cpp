@@ -298,6 +298,10 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     CHECK_NOTHROW(read_database(mutate([](knit::io::H5File& f) {
       f.set_attribute("/loop_1", "wale_width", 0.0);  // 0: not known
     })));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        f.set_attribute(".", "units", "m, kN, kPa");
+                      })),
+                      Catch::Contains("/: attribute units is \"m, kN, kPa\""));
   }
   SECTION("a path attribute of format 2 missing") {
     // Deleting /loop_k/raw/path_q's set read it as "paper": a coverage path joined the eq. 17

@@ -151,6 +151,26 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
           0);
   }
   {
+    // Values below what double precision can carry through the shell ran 0 iterations to a
+    // wrong answer with exit 0 (session 29, a helper's fuzzing audit).
+    json j = base;
+    j["boundary_conditions"][1]["prescribe"]["y"] = 1e-200;
+    CHECK(error_of(j).rfind("bad.json: /boundary_conditions/1/prescribe/y: a prescribed "
+                            "displacement of 1e-200 mm is below 1e-12 of the patch's size",
+                            0) == 0);
+    j["boundary_conditions"][1]["prescribe"]["y"] = 1e-6;  // small, but a load
+    CHECK(error_of(j).empty());
+    j = base;
+    j["material"]["youngs_modulus"] = 1e-170;
+    CHECK(error_of(j).rfind("bad.json: /material/youngs_modulus: ", 0) == 0);
+  }
+  {
+    // An infinite patch size blamed the thickness ("must lie in [inf, inf] mm"; session 29).
+    json j = base;
+    j["geometry"]["control_points"][1][0] = 1e308;
+    CHECK(error_of(j).rfind("bad.json: /geometry/control_points: the patch's size", 0) == 0);
+  }
+  {
     json j = base;
     j["geometry"]["knots_u"] = {0, 0, 1, 0.5};
     CHECK(error_of(j).rfind("bad.json: /geometry/knots_u: ", 0) == 0);

@@ -142,6 +142,12 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
       design(R"([{"field": "knitting_angle", "indices": [0], "lower": -10, "upper": 200}])", kObjs),
       "/variables/0/upper");
   expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
+  // A case file that is not there (session 29: the message named only the case's path).
+  {
+    std::string t = design(kVars, kObjs);
+    t.replace(t.find("case.json"), 9, "no_such_case.json");
+    expect("missing_case.json", t, "/case");
+  }
   expect("unknown_reaction.json",
          design(kVars, R"([{"type": "reaction", "reaction": "fx", "at_strain": [0.1],
                             "target": [1]}])"),
