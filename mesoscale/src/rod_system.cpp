@@ -2,6 +2,7 @@
 #include "knit/meso/rod/rod_system.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseLU>
 #include <cmath>
 #include <stdexcept>
 #include <unsupported/Eigen/AutoDiff>
@@ -86,7 +87,14 @@ int RodSystem::add_rod(RodSpec spec) {
     }
     d1.normalize();
     Eigen::MatrixXd Q(n, 4);
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+    // The interpolation matrix is banded (p + 1 entries a row). Dense up to kDenseInterpolation
+    // rows (the unit cell's curves have ~36: bitwise the results of before); sparse beyond
+    // (session 29, a helper's fuzzing audit: 5,000 elements took 90 s and 1.8 GB in the dense
+    // LU, and 20,000 more than 3 GB, which the schema allows up to 1e6).
+    constexpr int kDenseInterpolation = 2000;
+    const bool dense = n <= kDenseInterpolation;
+    Eigen::MatrixXd A = dense ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd();
+    std::vector<Eigen::Triplet<double>> At;
     Quat<double> prev(1, 0, 0, 0);
     for (int j = 0; j < n; ++j) {
       if (j > 0) {
@@ -106,9 +114,22 @@ int RodSystem::add_rod(RodSpec spec) {
       prev = q;
       Q.row(j) = q.transpose();
       const int f = R.geo.basis_derivatives(xi[j], 0, B.topRows(1));
-      A.row(j).segment(f, p + 1) = B.row(0);
+      if (dense)
+        A.row(j).segment(f, p + 1) = B.row(0);
+      else
+        for (int i = 0; i <= p; ++i)
+          if (B(0, i) != 0.0) At.emplace_back(j, f + i, B(0, i));
     }
-    spec.q0 = A.partialPivLu().solve(Q);
+    if (dense) {
+      spec.q0 = A.partialPivLu().solve(Q);
+    } else {
+      Eigen::SparseMatrix<double> As(n, n);
+      As.setFromTriplets(At.begin(), At.end());
+      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(As);
+      if (lu.info() != Eigen::Success)
+        throw std::invalid_argument(who + "reference frame: singular interpolation matrix");
+      spec.q0 = lu.solve(Q);
+    }
   }
 
   // Collocation points.

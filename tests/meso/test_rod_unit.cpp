@@ -309,3 +309,23 @@ TEST_CASE("rod: the resolution check compares rotations (uniform torsion, M L / 
   CHECK(coarse.difference == coarse.rotation_difference);
   CHECK(coarse.describe().find("and the rotations by") != std::string::npos);
 }
+
+// Session 29 (a helper's fuzzing audit): the reference frame's interpolation was a dense LU of
+// n x n (5,000 elements: 90 s and 1.8 GB; the schema allows 1e6). Beyond 2,000 control points it
+// is a sparse LU. Its director d3 is the centerline's tangent (the frame it interpolates).
+TEST_CASE("rod: a long curve's reference frame (sparse interpolation) follows the tangent",
+          "[unit]") {
+  for (int elements : {100, 2500}) {
+    RodSystem sys;
+    sys.add_rod(helix_rod(3, elements));
+    INFO(elements);
+    CHECK(sys.num_control_points(0) == elements + 3);
+    const Eigen::VectorXd x0 = sys.initial_state();
+    double worst = 0.0;
+    for (int k = 0; k <= 200; ++k) {
+      const PointState ps = sys.state(0, k / 200.0, x0);
+      worst = std::max(worst, (ps.R.col(2) - ps.r_xi.normalized()).norm());
+    }
+    CHECK(worst < 1e-6);
+  }
+}
