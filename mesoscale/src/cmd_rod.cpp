@@ -20,6 +20,7 @@ namespace {
 struct Options {
   std::string file;
   std::string outdir;
+  std::string max_output_size;
   bool quiet = false;
 };
 
@@ -31,6 +32,9 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_option("-o,--output", o->outdir,
                      "output directory (default: <case stem>.out in the working directory)");
       sub.add_flag("-q,--quiet", o->quiet, "no progress lines");
+      sub.add_option("--max-output-size", o->max_output_size,
+                     "refuse the case before the run if its outputs are estimated above this "
+                     "size (default 2GB; e.g. 500MB, 10GB; 0 = no cap)");
       return [o]() -> int {
         namespace rod = knit::meso::rod;
         const std::filesystem::path out =
@@ -39,8 +43,13 @@ knit::cli::SubcommandRegistrar reg(
                 : std::filesystem::path(o->outdir);
         knit::io::check_output_target(out, knit::io::OutputKind::kDirectory,
                                       o->outdir.empty() ? "output directory" : "--output");
+        const std::uint64_t cap =
+            o->max_output_size.empty()
+                ? rod::kDefaultMaxOutputBytes
+                : knit::io::parse_size(o->max_output_size, "--max-output-size");
         const rod::RodCase c =
             rod::load_rod_case(o->file);  // InputError -> exit 2, nothing written
+        rod::check_output_size(c, cap);
         const rod::CasePathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
         std::cout << "rod: " << rep.message << "; lambda = " << rep.lambda_reached << ", "
                   << rep.increments << " increments, " << rep.cutbacks << " cut-backs, "

@@ -11,6 +11,7 @@
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/meso/rod/builders.hpp"
 #include "knit/meso/rod/output.hpp"
@@ -366,6 +367,32 @@ RodCase load_rod_case(const std::filesystem::path& path) {
     }
   }
   return c;
+}
+
+std::uint64_t estimate_output_bytes(const RodCase& c) {
+  std::uint64_t points = 0;
+  for (int k = 0; k < c.system.num_rods(); ++k) {
+    const auto& U = c.system.spec(k).basis.knots();
+    std::uint64_t spans = 0;
+    for (std::size_t i = 0; i + 1 < U.size(); ++i) spans += U[i + 1] > U[i] ? 1 : 0;
+    points += spans * static_cast<std::uint64_t>(c.samples_per_element) + 1;
+  }
+  const auto steps = static_cast<std::uint64_t>(std::max(1, c.path.steps)) + 1;
+  const std::uint64_t vtp = c.write_vtp ? steps * (points * 200 + 2000) : 0;
+  const std::uint64_t csv = steps * (40 + 60 * static_cast<std::uint64_t>(c.points.size()));
+  return vtp + csv;
+}
+
+void check_output_size(const RodCase& c, std::uint64_t max_bytes) {
+  const std::uint64_t est = estimate_output_bytes(c);
+  if (max_bytes > 0 && est > max_bytes)
+    throw InputError(
+        c.file, "/steps/count",
+        "the estimated output size " + io::format_bytes(est) + " (" +
+            std::to_string(c.path.steps + 1) +
+            " VTP files of the centerlines) exceeds the cap of " + io::format_bytes(max_bytes) +
+            ": use fewer steps, /output/vtp false or fewer /output/samples_per_element, "
+            "or raise the cap with --max-output-size");
 }
 
 CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,

@@ -160,6 +160,10 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
                             0) == 0);
     j["boundary_conditions"][1]["prescribe"]["y"] = 1e-6;  // small, but a load
     CHECK(error_of(j).empty());
+    j["boundary_conditions"][1]["prescribe"]["y"] = 2147483648.0;  // 1e7 times the patch
+    CHECK(error_of(j).rfind("bad.json: /boundary_conditions/1/prescribe/y: a prescribed "
+                            "displacement of 2147483648.0 mm is more than 100 times",
+                            0) == 0);
     j = base;
     j["material"]["youngs_modulus"] = 1e-170;
     CHECK(error_of(j).rfind("bad.json: /material/youngs_modulus: ", 0) == 0);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../process_tmp.hpp"
+#include "knit/meso/rod/rod_case.hpp"
 
 namespace fs = std::filesystem;
 
@@ -216,6 +217,37 @@ TEST_CASE("rod case: loads within the tolerance are refused, and resolved with a
   const auto rows = read_csv(kTmp / "slender_tol" / "load_displacement.csv");
   const double EI = 800.0 * M_PI * std::pow(0.1, 4) / 64.0;
   CHECK(rows.back()[5] == Approx(1e-7 * 1e6 / (2 * EI)).epsilon(1e-3));
+}
+
+// Session 29 (a helper's fuzzing audit): 1e6 steps, which the schema allows, would have written
+// 1e6 VTP files (about 12 GB) with no word before. The estimate is checked before the run.
+TEST_CASE("rod case: the output size is estimated and capped before the run", "[case]") {
+  const fs::path out = kTmp / "size_elastica";
+  REQUIRE(run("rod " + (kCases / "elastica.json").string() + " -q -o " + out.string()) == 0);
+  std::uintmax_t bytes = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    if (e.is_regular_file()) bytes += e.file_size();
+  namespace rod = knit::meso::rod;
+  const auto est = rod::estimate_output_bytes(rod::load_rod_case(kCases / "elastica.json"));
+  INFO("estimate " << est << " B, written " << bytes << " B");
+  CHECK(est >= 0.5 * static_cast<double>(bytes));
+  CHECK(est <= 2.0 * static_cast<double>(bytes));
+  std::ifstream in(kCases / "elastica.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string t = ss.str();
+  const std::string count = R"("count": 8)";
+  const auto at = t.find(count);
+  REQUIRE(at != std::string::npos);
+  t.replace(at, count.size(), R"("count": 1000000)");
+  write(kTmp / "many_steps.json", t);
+  std::string msg;
+  CHECK(
+      run("rod " + (kTmp / "many_steps.json").string() + " -q -o " + (kTmp / "many_steps").string(),
+          &msg) == 2);
+  INFO(msg);
+  CHECK(msg.find("many_steps.json: /steps/count: the estimated output size") != std::string::npos);
+  CHECK_FALSE(fs::exists(kTmp / "many_steps"));
 }
 
 TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output", "[case]") {

@@ -9,6 +9,7 @@
 // nothing written.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -48,6 +49,16 @@ struct CasePathReport : PathReport {
 /// The full load's scaled residual at the reference state must exceed the Newton tolerance by
 /// this factor, or the case is refused at /steps/tolerance (the loads would not be resolved).
 inline constexpr double kLoadResolution = 1e3;
+
+/// The estimated size of a case's outputs in bytes: one VTP per load step and the start (about
+/// 200 bytes per sampled centerline point), and the CSV.
+std::uint64_t estimate_output_bytes(const RodCase& c);
+/// The default cap on it (knit-meso rod --max-output-size), as knit-macro run's: 2 GB.
+inline constexpr std::uint64_t kDefaultMaxOutputBytes = 2'000'000'000;
+/// Throws knit::InputError(file, "/steps/count", ...) if the estimate exceeds max_bytes (0: no
+/// cap). Session 29 (a helper's fuzzing audit): 1e6 steps, which the schema allows, would
+/// write 1e6 VTP files, about 12 GB, with no word before.
+void check_output_size(const RodCase& c, std::uint64_t max_bytes);
 
 /// Reads and checks a case file; throws knit::InputError(file, pointer, message).
 RodCase load_rod_case(const std::filesystem::path& file);
