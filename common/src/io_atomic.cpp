@@ -229,7 +229,10 @@ void remove_stale_siblings(const fs::path& target) {
       const auto m = read_output_marker(it->path());
       if (!m) continue;
       const bool partial = std::string(tag) == ".partial-";
-      if (partial ? m->for_name == name : m->replaced_by_pid == pid) remove_marked_tree(it->path());
+      // A partial directory has no manifest yet (written at commit): a copy of a finished
+      // output under that name keeps its "for:" line and is not ours to remove (review).
+      if (partial ? m->for_name == name && !m->has_manifest : m->replaced_by_pid == pid)
+        remove_marked_tree(it->path());
     }
   }
 }
@@ -359,10 +362,12 @@ void AtomicDirectory::commit() {
       old += std::to_string(::getpid());
       if (fs::exists(fs::symlink_status(old, ec)))
         fail(old, "exists and is not ours to remove; rename or remove it");
-      {  // so that the clean-up after a kill knows this DIR.old-<pid> for ours
+      // So that the clean-up after a kill knows this DIR.old-<pid> for ours: appended to a
+      // marker of ours only (an empty target has none), best effort (without it a killed run
+      // leaves DIR.old-<pid> for the user instead of putting it back).
+      if (read_output_marker(target_)) {
         std::ofstream marker(target_ / kOutputMarker, std::ios::binary | std::ios::app);
         marker << "replaced by pid " << ::getpid() << "\n";
-        if (!marker.flush()) fail(target_ / kOutputMarker, "cannot write");
       }
       if (::rename(target_.c_str(), old.c_str()) != 0)
         fail(target_, "cannot move the previous output aside", errno);

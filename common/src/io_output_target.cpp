@@ -131,7 +131,8 @@ std::vector<std::string> foreign_entries(const fs::path& dir, std::size_t max) {
   }
   std::sort(out.begin(), out.end());
   if (out.size() > max) out.resize(max);
-  if (ec) out.push_back("(" + dir.string() + " could not be listed: " + ec.message() + ")");
+  if (ec)  // what cannot be listed cannot be told ours: named as such
+    out.insert(out.begin(), "(some of it could not be listed: " + ec.message() + ")");
   return out;
 }
 
@@ -147,6 +148,12 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
         "names no new file or directory (\".\", \"..\" and \"/\" cannot be replaced); give "
         "the name of the output to create, e.g. " +
         std::string(kind == OutputKind::kDirectory ? "out/run1" : "out/database.h5"));
+  // Control characters (a newline above all) in the output's path: the marker is written line
+  // by line, and a name "o\nfile: notes.txt" put notes.txt into the run's manifest (review of
+  // session 29); no one means them in a file name.
+  for (const char ch : target.string())
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
+      refuse("holds a control character (a newline, a tab, ...): give a plain path");
   std::error_code ec;
   const fs::file_status st = fs::symlink_status(target, ec);
   if (fs::is_symlink(st)) {

@@ -582,7 +582,8 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   if (!(out.diagnostics.rms.allFinite() && out.diagnostics.max.allFinite() &&
         std::isfinite(out.diagnostics.max_relative)))
     return refuse("the fitted law's errors against the cell data are not finite (rms " +
-                  std::to_string(out.diagnostics.rms.maxCoeff()) +
+                  std::to_string(out.diagnostics.rms.maxCoeff()) + ", max " +
+                  std::to_string(out.diagnostics.max.maxCoeff()) +
                   "): the raw data hold values too large to fit");
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();

@@ -1,7 +1,9 @@
 // JSON case reader and runner of `knit-meso rod` (see rod_case.hpp, schemas/rod.schema.json).
 #include "knit/meso/rod/rod_case.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -355,6 +357,10 @@ RodCase load_rod_case(const std::filesystem::path& path) {
     const double scaled =
         F.size() ? F.cwiseProduct(c.system.row_scales()).cwiseAbs().maxCoeff() : 0.0;
     if (raw > 0.0 && scaled <= kLoadResolution * c.path.newton.tol) {
+      // The suggestion: scaled x 1e-3 rounded down to two digits, so that it passes this check.
+      double suggest = scaled * 1e-3;
+      const double p10 = std::pow(10.0, std::floor(std::log10(suggest)) - 1.0);
+      suggest = std::floor(suggest / p10) * p10;
       std::ostringstream o;
       o.precision(3);
       o << "the loads' residual at the reference state, " << scaled
@@ -362,7 +368,7 @@ RodCase load_rod_case(const std::filesystem::path& path) {
         << kLoadResolution << " x the tolerance " << c.path.newton.tol
         << ": the solver would resolve them to fewer than three digits, or stop at once with "
            "nothing moved; lower /steps/tolerance to about "
-        << scaled * 1e-3 << " or below, or raise the loads";
+        << std::setprecision(2) << suggest << " or below, or raise the loads";
       R.fail("/steps/tolerance", o.str());
     }
   }

@@ -8,7 +8,7 @@ knitting-angle field alpha (case.json) over the parameter domain, with the profi
 mid-height when a field varies; the final run's load-strain curve (run/load_strain.csv, the
 first reaction) with the straight line through its last point; with --section, that strain
 component of the final run along the central section v = 0.5 (run/results.h5, last step). Writes
-DIR/design.png unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
+DIR_design.png (beside DIR) unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
 designs); the C++ command never needs python.
 """
 import argparse
@@ -139,7 +139,9 @@ def main():
     if a.title:
         fig.suptitle(a.title)
     fig.tight_layout()
-    out = a.out or os.path.join(a.dir, "design.png")
+    # Beside DIR, not inside it: DIR is the C++ command's output, replaced by its next run only
+    # while it holds nothing else (its manifest; docs/io.md, session 29).
+    out = a.out or os.path.normpath(a.dir) + "_design.png"
     fig.savefig(out, dpi=110)
     print(out)
 

@@ -5,7 +5,7 @@
 
 Left: the machine's view, course (row) by needle (column), coloured by the loop length;
 needles out of work are blank. Right: the stitches at their positions in the patch's plane
-(mm), same colours. Writes DIR/knitmap.png unless --out is given. The pipeline calls it; the
+(mm), same colours. Writes DIR_knitmap.png (beside DIR) unless --out is given. The pipeline calls it; the
 C++ command never needs python.
 """
 import argparse
@@ -69,7 +69,9 @@ def main():
     fig.colorbar(im, ax=[ax1, ax2], label="loop length l (mm)")
     fig.suptitle("%s  stitches %s, yarn %.1f mm" % (
         a.title, s.get("stitches", "?"), float(s.get("yarn_length_mm", "nan"))))
-    out = a.out or os.path.join(a.dir, "knitmap.png")
+    # Beside DIR, not inside it: DIR is the C++ command's output, replaced by its next run only
+    # while it holds nothing else (its manifest; docs/io.md, session 29).
+    out = a.out or os.path.normpath(a.dir) + "_knitmap.png"
     fig.savefig(out, dpi=120)
     print("wrote", out)
 

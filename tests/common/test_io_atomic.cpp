@@ -371,6 +371,7 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   make("out.old-" + dead2, complete_out);  // a user's copy of an output
   make("out.partial-" + dead2, "knitscale output\n{}\nfor: out.partial-" + dead2 + "\nfile: x\n");
   make("out.old-" + dead2 + "1", "knitscale output\n");  // a marker of before session 29
+  make("out.partial-999999997", complete_out);           // a copy of a finished output (review)
   {
     knit::io::AtomicDirectory a(target);
     a.commit();
@@ -384,6 +385,7 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(slurp(d / ("out.old-" + dead2) / "x") == "x");
   CHECK(slurp(d / ("out.partial-" + dead2) / "x") == "x");
   CHECK(slurp(d / ("out.old-" + dead2 + "1") / "x") == "x");
+  CHECK(slurp(d / "out.partial-999999997" / "x") == "x");
   // Killed between the two renames of a replacement without RENAME_EXCHANGE: no DIR, the
   // earlier output in DIR.old-<pid>. The next run puts it back, and a run that then fails
   // leaves it there (session 26: the clean-up deleted it).
@@ -456,6 +458,11 @@ TEST_CASE("AtomicDirectory does not replace an output holding entries its run di
     if (e.path().filename().string().rfind("out.new-", 0) == 0)
       kept = slurp(e.path() / "results.csv") == "3";
   CHECK(kept);
+  // A control character in the output's name (the marker is written line by line: a name
+  // "o\nfile: notes.txt" put notes.txt into the manifest; review of session 29).
+  CHECK_THROWS_WITH(
+      knit::io::check_output_target(d / "o\nfile: notes.txt", knit::io::OutputKind::kDirectory),
+      Catch::Contains("holds a control character"));
   // An empty marker file names no program of ours (it was taken for one naming no owner).
   const fs::path fake = d / "fake";
   fs::create_directories(fake);
