@@ -302,6 +302,30 @@ Clearance minimum_clearance(const LoopShape& sh, double c) {
   return best;
 }
 
+GeometryBlame geometry_blame(double loop_length, const GeometryOptions& failing, bool d_chosen,
+                             bool gamma_chosen) {
+  auto builds = [loop_length](const GeometryOptions& go) {
+    try {
+      const CellGeometry g = make_cell_geometry(loop_length, go);
+      return !interlock_defect(g.shape, g.dim.c).has_value();
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  const GeometryOptions def;
+  if (d_chosen && failing.d != def.d) {
+    GeometryOptions go = failing;
+    go.d = def.d;
+    if (builds(go)) return GeometryBlame::kDiameter;
+  }
+  if (gamma_chosen && failing.gamma_over_w != def.gamma_over_w) {
+    GeometryOptions go = failing;
+    go.gamma_over_w = def.gamma_over_w;
+    if (builds(go)) return GeometryBlame::kGamma;
+  }
+  return GeometryBlame::kLoopLength;
+}
+
 std::string loop_length_message(double loop_length, double d, const GeometryError& e) {
   std::ostringstream msg;  // (std::to_string printed 1e308 with 309 digits)
   msg << "no cell geometry for " << loop_length << " mm with yarn diameter " << d

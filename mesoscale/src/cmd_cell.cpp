@@ -68,7 +68,22 @@ int run(const Options& o) {
       if (const auto bad = interlock_defect(built.shape, built.dim.c)) throw GeometryError(*bad);
       return built;
     } catch (const GeometryError& e) {  // a loop that cannot be built or does not interlock
-      throw knit::InputError("", "--loop-length", loop_length_message(o.loop_length, go.d, e));
+      // Named where the culprit was given: the config file's field, the flag, or the loop
+      // length (session 29: a config's /yarn/d = 1.5 mm was reported at --loop-length).
+      const std::string msg = loop_length_message(o.loop_length, go.d, e);
+      const bool from_file = !o.config.empty();
+      switch (
+          geometry_blame(o.loop_length, go, o.d_given || from_file, o.gamma_given || from_file)) {
+        case GeometryBlame::kDiameter:
+          if (o.d_given) throw knit::InputError("", "--diameter", msg);
+          throw knit::InputError(o.config, "/yarn/d", msg);
+        case GeometryBlame::kGamma:
+          if (o.gamma_given) throw knit::InputError("", "--gamma-over-w", msg);
+          throw knit::InputError(o.config, "/loop/gamma_over_w", msg);
+        case GeometryBlame::kLoopLength:
+          break;
+      }
+      throw knit::InputError("", "--loop-length", msg);
     }
   }();
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");

@@ -117,8 +117,23 @@ int run(const Options& o) {
     try {
       return std::make_unique<PeriodicCell>(o.loop_length, co);
     } catch (const knit::meso::cell::GeometryError& e) {
-      throw knit::InputError("", "--loop-length",
-                             knit::meso::cell::loop_length_message(o.loop_length, co.section.d, e));
+      namespace kc = knit::meso::cell;
+      const std::string msg = kc::loop_length_message(o.loop_length, co.section.d, e);
+      // The config file's field when its value alone fails (session 29: /yarn/d = 1.5 mm and
+      // /loop/gamma_over_w = 0 were reported at --loop-length).
+      if (!o.config.empty()) {
+        kc::GeometryOptions go = co.geometry;
+        go.d = co.section.d;
+        switch (kc::geometry_blame(o.loop_length, go, true, true)) {
+          case kc::GeometryBlame::kDiameter:
+            throw knit::InputError(o.config, "/yarn/d", msg);
+          case kc::GeometryBlame::kGamma:
+            throw knit::InputError(o.config, "/loop/gamma_over_w", msg);
+          case kc::GeometryBlame::kLoopLength:
+            break;
+        }
+      }
+      throw knit::InputError("", "--loop-length", msg);
     }
   }();
   PeriodicCell& cell = *cell_ptr;

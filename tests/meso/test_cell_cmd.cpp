@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -148,7 +149,8 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       // Session 24: a NaN residual of the loop-length match passed its test (the cell was
       // written with a measured length of NaN, exit 0); a loop too short for its yarn was exit
       // 1 in `path`, naming no option; an empty value was taken as the option left out.
-      {"cell --loop-length 5 --diameter 1e308", "--loop-length", "could not match"},
+      // (session 29: named at the flag that makes it impossible, not at --loop-length)
+      {"cell --loop-length 5 --diameter 1e308", "--diameter", "could not match"},
       {"path --loop-length 2.5 --shear 5", "--loop-length", "no cell geometry for 2.5 mm"},
       {"cell --loop-length 4.5 --config ''", "--config", "must not be empty"},
   };
@@ -198,6 +200,22 @@ TEST_CASE("knit-meso cell --config reads the cell parameter file", "[unit]") {
                    log) == 2);
   CHECK(log.find("bad.json: /contact/penalty") != std::string::npos);
   CHECK_FALSE(fs::exists(dir + "/c"));
+  // A loop the file's yarn diameter or bulge makes impossible is named at that field (session
+  // 29, a helper's fuzzing audit: both were reported at --loop-length).
+  for (const auto& [name, text, field] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"d15.json", R"({"yarn": {"d": 1.5}})", "d15.json: /yarn/d: no cell geometry"},
+           {"g0.json", R"({"loop": {"gamma_over_w": 0}})",
+            "g0.json: /loop/gamma_over_w: no cell geometry"}}) {
+    std::ofstream(dir + "/" + name) << text;
+    for (const std::string cmd : {"cell --loop-length 4.5", "path --loop-length 4.5 --shear 5"}) {
+      INFO(cmd << " " << name);
+      CHECK(run_logged(cmd + " --config " + dir + "/" + name + " --out " + dir + "/d", log) == 2);
+      INFO(log);
+      CHECK(log.find(field) != std::string::npos);
+      CHECK_FALSE(fs::exists(dir + "/d"));
+    }
+  }
   fs::remove_all(dir);
 }
 

@@ -90,6 +90,15 @@ CellGeometry make_cell_geometry(double loop_length, const GeometryOptions& opt =
 /// --loop-length error of `knit-meso cell` and `knit-meso path`.
 std::string loop_length_message(double loop_length, double d, const GeometryError& e);
 
+/// Which of the loop's inputs makes it impossible, for the commands' error (session 29: a
+/// config file's /yarn/d = 1.5 mm was reported at --loop-length). Given the failing options
+/// and which of d and gamma/w were chosen by the user (not defaults), returns kDiameter or
+/// kGamma when that value alone fails (the loop builds and interlocks with the default in its
+/// place), else kLoopLength.
+enum class GeometryBlame { kLoopLength, kDiameter, kGamma };
+GeometryBlame geometry_blame(double loop_length, const GeometryOptions& failing, bool d_chosen,
+                             bool gamma_chosen);
+
 /// Arc length of a spline curve (Gauss-Legendre, `npts` points per knot span).
 double spline_length(const spline::SplineCurve& curve, int npts = 12);
 
