@@ -414,7 +414,12 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 d[k][2].get<double>());
     }
   }
-  if (const std::string why = o.validate(); !why.empty()) throw InputError(file, pointer, why);
+  // Each message of validate() starts with the option's key: named by its JSON pointer
+  // (session 29: "o.json: floor must be <= 1000 MPa" named no field).
+  if (const std::string why = o.validate(); !why.empty()) {
+    const std::string key = why.substr(0, why.find(' '));
+    throw InputError(file, j.contains(key) ? pointer + "/" + key : pointer, why);
+  }
   return o;
 }
 

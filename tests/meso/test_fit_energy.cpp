@@ -186,6 +186,11 @@ TEST_CASE("energy fit: a floor or weights large enough to overflow are refused",
   o.smoothing = 1e-9;
   o.loss_scale = 1e308;
   CHECK(o.validate() == "loss_scale must be in (0, 1000]");
+  // From a file: named by the option's JSON pointer (session 29: the key in prose only).
+  CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"floor": 1e308})", "o.json"),
+                    Catch::StartsWith("o.json: /floor: floor must be <= 1000 MPa"));
+  CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube_weight": -1})", "o.json"),
+                    Catch::StartsWith("o.json: /tube_weight: "));
 }
 
 TEST_CASE("energy fit: the monotonicity bound of the data", "[unit]") {
@@ -507,7 +512,7 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
   }
   SECTION("bad options") {
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"s_spans": 0})", "f.json", "/energy_fit"),
-                      Catch::Contains("f.json: /energy_fit: s_spans"));
+                      Catch::Contains("f.json: /energy_fit/s_spans: s_spans"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"floor_relative": "x"})", "f.json"),
                       Catch::Contains("f.json: /floor_relative: must be a number"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"weight_relative": -1})", "f.json"),
