@@ -154,6 +154,18 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
   for (const char ch : target.string())
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
       refuse("holds a control character (a newline, a tab, ...): give a plain path");
+  // Names the file system cannot hold (session 29: a 5,000-character path failed later with
+  // exit 1, naming no option). The partial and lock names add up to 30 characters.
+  for (const auto& part : target)
+    if (part.string().size() + 30 > 255)
+      refuse("has a name of " + std::to_string(part.string().size()) +
+             " characters; the file system allows 255 (with the run's partial and lock suffixes: "
+             "at most 225)");
+  {
+    std::error_code aec;
+    if (fs::absolute(target, aec).string().size() + 30 >= 4096)
+      refuse("is too long for the file system (4096 characters with the run's suffixes)");
+  }
   std::error_code ec;
   const fs::file_status st = fs::symlink_status(target, ec);
   if (fs::is_symlink(st)) {

@@ -463,6 +463,16 @@ TEST_CASE("AtomicDirectory does not replace an output holding entries its run di
   CHECK_THROWS_WITH(
       knit::io::check_output_target(d / "o\nfile: notes.txt", knit::io::OutputKind::kDirectory),
       Catch::Contains("holds a control character"));
+  // Names the file system cannot hold were refused only later, with exit 1 (session 29).
+  CHECK_THROWS_WITH(
+      knit::io::check_output_target(d / std::string(300, 'a'), knit::io::OutputKind::kDirectory),
+      Catch::Contains("the file system allows 255"));
+  fs::path deep = d;
+  for (int k = 0; k < 40; ++k) deep /= std::string(120, 'b');
+  CHECK_THROWS_WITH(knit::io::check_output_target(deep, knit::io::OutputKind::kFile),
+                    Catch::Contains("too long for the file system"));
+  CHECK_NOTHROW(
+      knit::io::check_output_target(d / std::string(200, 'c'), knit::io::OutputKind::kDirectory));
   // An empty marker file names no program of ours (it was taken for one naming no owner).
   const fs::path fake = d / "fake";
   fs::create_directories(fake);
