@@ -7,6 +7,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/material/database.hpp"
@@ -33,13 +34,6 @@ constexpr int kOldestReadableVersion = 1;
 constexpr const char* kDatabaseUnits = "length mm, force N, stress MPa";
 constexpr double kMaxRawKinematic = 1e3;  // |F|, |E| of a raw step (dimensionless)
 constexpr double kMaxRawStress = 1e9;     // |P|, |S| of a raw step (MPa)
-
-std::string short_number(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 void write_surface(H5Group& g, const ResponseSurfaceData& d) {
   g.set_attribute(".", "degree_1", d.degree1);
@@ -302,7 +296,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       if (!(std::isfinite(ls[k]) && ls[k] > 0.0) || (k > 0 && !(ls[k] > ls[k - 1])))
         throw InputError(fname, "/loop_lengths",
                          "loop lengths must be finite, positive and strictly increasing (entry " +
-                             std::to_string(k) + ": " + short_number(ls[k]) + ")");
+                             std::to_string(k) + ": " + io::format_number(ls[k]) + ")");
     for (std::size_t k = 0; k < ls.size(); ++k) {
       const std::string g = loop_group(k);
       where = g;
@@ -323,7 +317,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
         if (!(std::isfinite(v) && v >= 0.0))
           throw InputError(fname, g + "/" + a,
                            "attribute " + std::string(a) + " must be finite and >= 0 mm, got " +
-                               short_number(v));
+                               io::format_number(v));
       require_group(g + "/raw");
       if (with_raw) {
         const int np = f.attribute_int(g + "/raw", "paths");
@@ -403,7 +397,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
               if (m->row(s).cwiseAbs().maxCoeff() > bound)
                 throw InputError(fname, p + "/" + d,
                                  "step " + std::to_string(s + 1) + " holds |value| " +
-                                     short_number(m->row(s).cwiseAbs().maxCoeff()) +
+                                     io::format_number(m->row(s).cwiseAbs().maxCoeff()) +
                                      " (F, E at most 1e3; P, S at most 1e9 MPa): a damaged "
                                      "database");
             }

@@ -378,9 +378,7 @@ RodCase load_rod_case(const std::filesystem::path& path) {
 std::uint64_t estimate_output_bytes(const RodCase& c) {
   std::uint64_t points = 0;
   for (int k = 0; k < c.system.num_rods(); ++k) {
-    const auto& U = c.system.spec(k).basis.knots();
-    std::uint64_t spans = 0;
-    for (std::size_t i = 0; i + 1 < U.size(); ++i) spans += U[i + 1] > U[i] ? 1 : 0;
+    const auto spans = spline::unique_knots(c.system.spec(k).basis.knots()).size() - 1;
     points += spans * static_cast<std::uint64_t>(c.samples_per_element) + 1;
   }
   const auto steps = static_cast<std::uint64_t>(std::max(1, c.path.steps)) + 1;
