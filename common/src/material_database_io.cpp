@@ -32,8 +32,6 @@ std::string path_group(std::size_t q) {
 /// The oldest format version this build still reads (version 1: no /energy_law).
 constexpr int kOldestReadableVersion = 1;
 constexpr const char* kDatabaseUnits = "length mm, force N, stress MPa";
-constexpr double kMaxRawKinematic = 1e3;  // |F|, |E| of a raw step (dimensionless)
-constexpr double kMaxRawStress = 1e9;     // |P|, |S| of a raw step (MPa)
 
 void write_surface(H5Group& g, const ResponseSurfaceData& d) {
   g.set_attribute(".", "degree_1", d.degree1);

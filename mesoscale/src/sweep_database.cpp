@@ -9,8 +9,11 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
+#include "knit/io/json_input.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
@@ -201,8 +204,29 @@ PathRunner synthetic_runner() {
   };
 }
 
+PathRunner synthetic_runner(const SweepInput& in) {
+  // The stand-in's stiffness (l_ref / l)^2 grows without bound as l -> 0: a sweep with a loop
+  // length of 1e-320 mm ran every case and then failed at the database write (exit 1, naming
+  // a raw dataset, the checkpoints kept for a --resume that fails again). Refused before any
+  // case runs, at its JSON pointer, when the stress at E_ij = 2 (the largest side the sweep
+  // schema allows the strain box) exceeds what a database may hold, as cell_runner refuses a
+  // cell it cannot build.
+  const Eigen::Vector3d corner = Eigen::Vector3d::Constant(2.0);
+  for (std::size_t k = 0; k < in.loop_lengths.size(); ++k) {
+    const Eigen::Vector3d s = fit::SyntheticLaw{}.stress(corner, in.loop_lengths[k]);
+    if (!(s.cwiseAbs().maxCoeff() <= material::kMaxRawStress))
+      throw InputError(in.file, io::json_pointer_append("/loop_lengths", k),
+                       "the synthetic stand-in's stiffness (4.5 / l)^2 MPa at l = " +
+                           io::format_number(in.loop_lengths[k]) +
+                           " mm gives stresses beyond what a database holds (" +
+                           io::format_number(material::kMaxRawStress) +
+                           " MPa); give loop lengths of a knit (a few mm)");
+  }
+  return synthetic_runner();
+}
+
 PathRunner make_runner(const SweepInput& in) {
-  return in.runner == RunnerKind::kSynthetic ? synthetic_runner() : cell_runner(in);
+  return in.runner == RunnerKind::kSynthetic ? synthetic_runner(in) : cell_runner(in);
 }
 
 }  // namespace knit::meso::sweep

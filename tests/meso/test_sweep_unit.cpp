@@ -742,3 +742,21 @@ TEST_CASE("sweep: a sweep in which no case converged leaves the output as it was
   CHECK(text.str() == "an earlier database");
   CHECK_FALSE(std::filesystem::exists(out.string() + ".parts"));
 }
+
+TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows is an input error",
+          "[unit]") {
+  // Before: a loop length of 1e-320 mm ran every case and failed at the database write (exit 1,
+  // naming a raw dataset; the checkpoints kept for a --resume that failed again). The stand-in's
+  // stiffness is (4.5 / l)^2 MPa: at 1e-3 mm its stress at E_ij = 2 is ~2e9 MPa, above the 1e9
+  // a database holds; at 2e-3 mm it is ~5e8.
+  SweepInput in =
+      parse_sweep_input(R"({"loop_lengths": [4.5, 6.5], "runner": "synthetic"})", "synth.json");
+  CHECK_NOTHROW(make_runner(in));
+  in.loop_lengths = {2e-3, 4.5};
+  CHECK_NOTHROW(make_runner(in));
+  for (double tiny : {1e-3, 1e-320}) {
+    in.loop_lengths = {4.5, tiny};
+    CHECK_THROWS_WITH(make_runner(in),
+                      Catch::StartsWith("synth.json: /loop_lengths/1: the synthetic stand-in's"));
+  }
+}

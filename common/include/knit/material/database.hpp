@@ -37,6 +37,10 @@ namespace knit::material {
 /// network family (version 2 laws are ridge laws). Versions 1 and 2 still load.
 inline constexpr int kDatabaseFormatVersion = 3;
 inline constexpr const char* kDatabaseFormatName = "knitscale-material-database";
+/// Largest |F|, |E| (dimensionless) and |P|, |S| (MPa) of a raw step a database may hold: no
+/// state of a textile cell lies beyond (session 29: 1e308 made the paper fit's rms inf).
+inline constexpr double kMaxRawKinematic = 1e3;
+inline constexpr double kMaxRawStress = 1e9;
 
 using RowMatrixX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 

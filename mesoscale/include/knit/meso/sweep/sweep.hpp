@@ -88,6 +88,9 @@ void write_sweep_database(const std::filesystem::path& output, const material::D
 /// Test hooks (environment): KNIT_SWEEP_TEST_DELAY_MS sleeps per case; KNIT_SWEEP_TEST_COUNT_FILE
 /// gets one line appended per case computed.
 PathRunner synthetic_runner();
+/// The same for a sweep input, whose loop lengths it checks first: an InputError at
+/// /loop_lengths/k where the stand-in's stress would exceed what a database holds.
+PathRunner synthetic_runner(const SweepInput& in);
 
 /// The unit-cell runner (knit/meso/homog), configured by the input's "cell" object.
 /// Throws knit::InputError for cell parameters the cell rejects.
