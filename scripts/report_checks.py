@@ -90,18 +90,45 @@ def missing(key, section, statement, paper, threshold, why):
     return Check(key, section, statement, paper, threshold, why, False)
 
 
+def curve_defect(curve):
+    """Why a curve is no data to judge, or None (session 30: a helper's mutation audit found
+    NaN, all-zero and strain-shuffled curves passing monotonicity, convergence and "much
+    stiffer"): a non-finite strain or load, a strain that does not grow in magnitude from step
+    to step (the rows are in run order; a shuffled or repeated strain is a damaged file), or
+    loads that are zero throughout."""
+    e, f = (np.asarray(c, dtype=float) for c in curve)
+    if not (np.all(np.isfinite(e)) and np.all(np.isfinite(f))):
+        return "non-finite strain or load in its curve"
+    s = math.copysign(1.0, e[-1]) if e.size and e[-1] != 0 else 1.0
+    if np.any(np.diff(s * e) <= 0):
+        k = int(np.argmax(np.diff(s * e) <= 0))
+        return (f"its strain does not grow from step to step ({pct(e[k], 3)} then "
+                f"{pct(e[k + 1], 3)})")
+    if not np.any(f != 0):
+        return "its load is zero at every step"
+    return None
+
+
 def stop_note(name, curve, target):
-    """Why a curve cannot be judged, or None: no result, or it stopped early."""
+    """Why a curve cannot be judged, or None: no result, it stopped early, or it is no data
+    (curve_defect)."""
     if curve is None or len(curve[0]) < 2:
         return f"{name}: no converged step"
     if not reaches(curve, target):
-        return f"{name} stopped at {pct(end_strain(curve))} of {pct(target)}"
-    return None
+        return f"{name} stopped at {pct(end_strain(curve), 3)} of {pct(target)}"
+    bad = curve_defect(curve)
+    return f"{name}: {bad}" if bad else None
 
 
 def check_reaches(key, section, name, curve, target):
     ok = curve is not None and reaches(curve, target)
     got = "no converged step" if curve is None or len(curve[0]) < 2 else pct(end_strain(curve), 2)
+    if curve is not None and len(curve[0]) >= 2:
+        if not ok and got == pct(target, 2):  # short by less than the printed digits
+            got = pct(end_strain(curve), 6)
+        bad = curve_defect(curve)
+        if bad:
+            ok, got = False, f"{got}, but {bad}"
     thr = (f"last converged strain >= {pct(target, 1)}" if target > 0 else
            f"last converged strain <= {pct(target, 1)} (compression)")
     return Check(key, section, f"{name} runs to the paper's strain", pct(target, 1),
@@ -115,6 +142,9 @@ def check_monotone(key, section, name, curve):
     if curve is None or len(curve[0]) < 2:
         return missing(key, section, f"{name}: monotone load-strain curve", "monotone", thr,
                        "no converged step")
+    bad = curve_defect(curve)
+    if bad:
+        return missing(key, section, f"{name}: monotone load-strain curve", "monotone", thr, bad)
     drop, at = largest_drop(curve)
     fmax = float(np.max(np.abs(curve[1])))
     ok = drop <= TOL_MONOTONE * max(fmax, 1e-300)
@@ -150,7 +180,14 @@ def check_much_stiffer(key, section, statement, stiff, soft, target, names):
             return missing(key, section, statement, "much stiffer", thr, note)
     grid = np.linspace(EPS_MIN_STIFFER, abs(target), GRID_POINTS)
     fa, fb = on_grid(stiff, grid), on_grid(soft, grid)
-    ratio = np.where(fb > 0, fa / np.where(fb > 0, fb, 1.0), np.inf)
+    if np.any(fb <= 0) or np.any(fa <= 0):
+        # A tensile load that is not positive is no stiffness to compare (session 30: a soft
+        # curve of zero or negative loads passed as ratio infinity).
+        c, n = (fb, names[1]) if np.any(fb <= 0) else (fa, names[0])
+        k = int(np.argmax(c <= 0))
+        return missing(key, section, statement, "much stiffer", thr,
+                       f"F({n}) = {c[k]:.3g} N <= 0 at {pct(grid[k])}")
+    ratio = fa / fb
     k = int(np.argmin(ratio))
     return Check(key, section, statement, "much stiffer", thr,
                  f"smallest ratio {ratio[k]:.2f} at {pct(grid[k])} ({fa[k]:.3g} vs {fb[k]:.3g} N); "
@@ -193,6 +230,23 @@ def check_stiffening(key, section, name, curve, target, stiffening=True):
 
 
 # ---- fields -----------------------------------------------------------------------------------
+def field_defect(*fields):
+    """Why sampled fields are no data to judge, or None: a missing field, a non-finite sample,
+    or zero everywhere (session 30: a NaN moved the argmax of E22 to the "right" place, and
+    zero fields passed "more uniform", "larger" and the mirror symmetry)."""
+    for v in fields:
+        if v is None:
+            return "no field"
+        a = np.asarray(v, dtype=float)
+        if a.size == 0:
+            return "no samples"
+        if not np.all(np.isfinite(a)):
+            return f"{int(np.sum(~np.isfinite(a)))} non-finite sample(s)"
+        if not np.any(a != 0):
+            return "zero at every sample"
+    return None
+
+
 def cv(values):
     """Coefficient of variation std / |mean| of the samples."""
     v = np.asarray(values, dtype=float).ravel()
@@ -201,21 +255,27 @@ def cv(values):
 
 
 def check_more_uniform(key, section, statement, a, b, labels):
-    """`a` more uniform than `b`: CV(a) <= FACTOR_MORE_UNIFORM x CV(b)."""
+    """`a` more uniform than `b`: CV(a) <= FACTOR_MORE_UNIFORM x CV(b), both finite."""
+    thr = f"CV({labels[0]}) <= {FACTOR_MORE_UNIFORM:g} x CV({labels[1]})"
+    bad = field_defect(a, b)
+    if bad:
+        return missing(key, section, statement, f"{labels[0]} more uniform", thr, bad)
     ca, cb = cv(a), cv(b)
-    return Check(key, section, statement, f"{labels[0]} more uniform",
-                 f"CV({labels[0]}) <= {FACTOR_MORE_UNIFORM:g} x CV({labels[1]})",
+    return Check(key, section, statement, f"{labels[0]} more uniform", thr,
                  f"CV {ca:.3f} ({labels[0]}) vs {cb:.3f} ({labels[1]})",
-                 bool(ca <= FACTOR_MORE_UNIFORM * cb))
+                 bool(math.isfinite(ca) and math.isfinite(cb) and ca <= FACTOR_MORE_UNIFORM * cb))
 
 
 def check_larger(key, section, statement, a, b, labels, factor):
-    """mean(a) >= factor x mean(b)."""
+    """mean(a) >= factor x mean(b), with mean(b) > 0 (tensile strains)."""
+    thr = f"mean({labels[0]}) >= {factor:g} x mean({labels[1]}) > 0"
+    bad = field_defect(a, b)
+    if bad:
+        return missing(key, section, statement, f"{labels[0]} larger", thr, bad)
     ma, mb = float(np.mean(a)), float(np.mean(b))
-    return Check(key, section, statement, f"{labels[0]} larger",
-                 f"mean({labels[0]}) >= {factor:g} x mean({labels[1]})",
+    return Check(key, section, statement, f"{labels[0]} larger", thr,
                  f"mean {ma:.4f} ({labels[0]}) vs {mb:.4f} ({labels[1]}); ratio "
-                 f"{ma / mb if mb else float('inf'):.3f}", bool(ma >= factor * mb))
+                 f"{ma / mb if mb else float('inf'):.3f}", bool(mb > 0 and ma >= factor * mb))
 
 
 def stretch_bound(applied):
@@ -231,6 +291,9 @@ def check_e22_bound(key, section, name, e22, applied):
     thr = f">= (({1 + applied:g})^2 - 1)/2 = {pct(b)} (sampling allowance {pct(TOL_BOUND)})"
     if e22 is None:
         return missing(key, section, st, "-", thr, "no field at this strain")
+    bad = field_defect(e22)
+    if bad:
+        return missing(key, section, st, "-", thr, bad)
     m = float(np.max(e22))
     return Check(key, section, st, "-", thr, pct(m), bool(m >= b - TOL_BOUND))
 
@@ -271,6 +334,9 @@ def check_max_location(key, section, name, e22, X, length, applied):
            f"[{MIDDLE[0] * length:.1f}, {MIDDLE[1] * length:.1f}] mm")
     if e22 is None or X is None:
         return missing(key, section, st, "central boundaries", thr, "no field")
+    bad = field_defect(e22, X)
+    if bad:
+        return missing(key, section, st, "central boundaries", thr, bad)
     j, i = np.unravel_index(int(np.argmax(e22)), e22.shape)
     inside = bool(central_boundary_mask(X, length)[j, i])
     return Check(key, section, st, "central boundaries", thr,
@@ -287,10 +353,13 @@ def interpolate_fields(ea, fa, eb, fb, e):
 
 def mirror_deviation(e11, e22, e12):
     """3.2.1: E11(x, y) = E22(y, x) and E12(x, y) = E12(y, x) on a square grid aligned with the
-    diagonal's mirror (the paper's 'anti-symmetric' E11/E22, symmetric E12)."""
-    scale = max(float(np.max(np.abs(e11))), float(np.max(np.abs(e22))), 1e-300)
+    diagonal's mirror (the paper's 'anti-symmetric' E11/E22, symmetric E12). NaN for a field
+    that is no data (field_defect: zero fields were symmetric by 0 / 1e-300, session 30)."""
+    if field_defect(e11, e22, e12):
+        return float("nan"), float("nan")
+    scale = max(float(np.max(np.abs(e11))), float(np.max(np.abs(e22))))
     d1 = float(np.max(np.abs(e11 - e22.T)) / scale)
-    d2 = float(np.max(np.abs(e12 - e12.T)) / max(float(np.max(np.abs(e12))), 1e-300))
+    d2 = float(np.max(np.abs(e12 - e12.T)) / float(np.max(np.abs(e12))))
     return d1, d2
 
 
@@ -364,6 +433,9 @@ def check_alpha(key, section, alpha, exact):
     if alpha is None or exact is None:
         return missing(key, section, "alpha aligns the course direction with x1",
                        "0 ... pi/4, aligned", thr, "no knitting_angle field")
+    if not (np.all(np.isfinite(alpha)) and np.all(np.isfinite(exact))):
+        return missing(key, section, "alpha aligns the course direction with x1",
+                       "0 ... pi/4, aligned", thr, "non-finite samples of alpha")
     d = np.abs(np.asarray(alpha) - np.asarray(exact))
     k = np.unravel_index(int(np.argmax(d)), d.shape)
     return Check(key, section, "alpha aligns the course direction with x1 (compared with the "

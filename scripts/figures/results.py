@@ -133,6 +133,34 @@ class Result:
             return self._steps[-1][0]
         return min(have, key=lambda s: abs(by_step[s] - target))
 
+    def csv_load_factor(self, step):
+        """load_strain.csv's load factor of `step`, or None (no such row or column)."""
+        steps, lf = self.csv.get("step"), self.csv.get("load_factor")
+        if steps is None or lf is None:
+            return None
+        hit = [float(v) for s, v in zip(steps.astype(int), lf) if s == step]
+        return hit[0] if hit else None
+
+    def load_factor_of_step(self, step):
+        """The load factor stored with the fields that fields(step) reads: the load_factor
+        attribute of results.h5's fields/step_NNNN, else the PVD's timestep of the VTU file;
+        None when neither says."""
+        path = os.path.join(self.dir, "results.h5")
+        if os.path.exists(path):
+            try:
+                import h5py
+                with h5py.File(path, "r") as f:
+                    g = f.get(f"fields/step_{step:04d}")
+                    if g is not None:
+                        v = g.attrs.get("load_factor")
+                        return None if v is None else float(v)
+            except (ImportError, OSError):
+                pass
+        for s, t, p in self._steps:
+            if s == step and p is not None:
+                return t
+        return None
+
     def strain_of_step(self, step):
         steps = self.csv.get("step")
         strain = self.csv.get("strain")
