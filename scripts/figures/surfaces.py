@@ -4,6 +4,11 @@ of one loop length, with the homogenized data points (black dots), from the mate
 (schemas/database.layout.json: /loop_k/fit/{knots_1, knots_2, E_ctrl, S_ctrl}, /loop_k/fit/shear,
 /loop_k/raw/path_qq/{E, S, status}).
 
+The data drawn as the surface's data are the paths of set "paper" (the paper's fan, to which
+eq. 17 is fitted; scripts/cell_paths.py path_set). The "coverage" biaxial paths are drawn faint
+(grey x), only where they lie inside the surface's strain range (the image of [0, 1]^2 in the
+E11-E22 plane): outside it the surface says nothing about them.
+
 The surfaces are drawn as the paper defines them (eq. 17): E(xi) and S(xi) evaluated on a grid
 of the shared parameter domain [0, 1]^2, plotted as S over E.
 
@@ -18,9 +23,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.path import Path as MplPath  # noqa: E402
 
 sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from cell_paths import open_database  # noqa: E402  (scripts/cell_paths.py)
+from cell_paths import open_database, path_set  # noqa: E402  (scripts/cell_paths.py)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from figure_inputs import guarded_main  # noqa: E402
 
@@ -88,7 +94,8 @@ def main():
                 st = np.array(pg["status"]) if "status" in pg else np.zeros(len(E))
                 kind = pg.attrs.get("kind", b"biaxial")
                 kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-                data.append((kind, E[st == 0], S[st == 0]))
+                ok = (st == 0) & np.all(np.isfinite(E), axis=1) & np.all(np.isfinite(S), axis=1)
+                data.append((path_set(f, pg), kind, E[ok], S[ok]))
     n2 = Ec.shape[0] // n1
     xi = np.linspace(0, 1, 41)
     B1, B2 = basis(p1, U1, xi), basis(p2, U2, xi)  # (41, n1), (41, n2)
@@ -97,26 +104,47 @@ def main():
         return B2 @ C[:, c].reshape(n2, n1) @ B1.T  # (xi2, xi1)
 
     E1, E2, S1, S2 = surf(Ec, 0), surf(Ec, 1), surf(Sc, 0), surf(Sc, 1)
+    if not all(np.all(np.isfinite(v)) for v in (E1, E2, S1, S2)):
+        raise SystemExit(f"surfaces.py: {a.database}: loop_{k}/fit: the surface has "
+                         "non-finite values (E_ctrl or S_ctrl)")
+    paper = [(E, Sd) for st, kind, E, Sd in data if st == "paper" and kind == "biaxial" and len(E)]
+    if not paper:
+        raise SystemExit(f"surfaces.py: {a.database}: loop_{k}/raw: no converged biaxial path "
+                         "of set \"paper\" (the data of the surface)")
+    Ep, Sp = np.vstack([E for E, _ in paper]), np.vstack([S for _, S in paper])
+    # The surface's strain range: the image of the boundary of [0, 1]^2 in the E11-E22 plane.
+    rim = np.concatenate([np.c_[E1[0, :], E2[0, :]], np.c_[E1[:, -1], E2[:, -1]],
+                          np.c_[E1[-1, ::-1], E2[-1, ::-1]], np.c_[E1[::-1, 0], E2[::-1, 0]]])
+    cov = [(E, Sd) for st, kind, E, Sd in data if st == "coverage" and kind == "biaxial"]
+    Ec_all = np.vstack([E for E, _ in cov]) if cov else np.zeros((0, 3))
+    Sc_all = np.vstack([S for _, S in cov]) if cov else np.zeros((0, 3))
+    inside = MplPath(rim).contains_points(Ec_all[:, :2]) if len(Ec_all) else np.zeros(0, bool)
+    Ecov, Scov = Ec_all[inside], Sc_all[inside]
     fig = plt.figure(figsize=(17, 5))
     fig.subplots_adjust(wspace=0.35)
     for c, (S, lab) in enumerate(((S1, "S11"), (S2, "S22"))):
         ax = fig.add_subplot(1, 3, c + 1, projection="3d")
         ax.plot_surface(E1, E2, S, cmap="viridis", alpha=0.75, linewidth=0)
-        for kind, E, Sd in data:
-            if kind == "biaxial" and len(E):
-                ax.scatter(E[:, 0], E[:, 1], Sd[:, c], color="k", s=4)
-        ax.set_xlabel("E11")
-        ax.set_ylabel("E22")
+        ax.scatter(Ep[:, 0], Ep[:, 1], Sp[:, c], color="k", s=4,
+                   label=f"data: paper fan ({len(paper)} paths, {len(Ep)} points)")
+        if len(Ecov):
+            ax.scatter(Ecov[:, 0], Ecov[:, 1], Scov[:, c], color="tab:red", marker="x", s=12,
+                       linewidths=0.8, alpha=0.6,
+                       label=f"coverage paths inside the range ({len(Ecov)} of {len(Ec_all)} "
+                       "points)")
+        ax.legend(fontsize=7, loc="upper left")
+        ax.set_xlabel("E11 [-]")
+        ax.set_ylabel("E22 [-]")
         ax.set_zlabel(f"{lab} [MPa]")
         ax.set_title(f"({'ab'[c]}) {lab}(E11, E22)", fontsize=10)
     ax = fig.add_subplot(1, 3, 3)
     t = np.linspace(0, 1, 200)
     Bs = basis(ps, Us, t)
     ax.plot(Bs @ E12c, Bs @ S12c, "-", label="response curve")
-    for kind, E, Sd in data:
-        if kind == "shear" and len(E):
-            ax.plot(E[:, 2], Sd[:, 2], "k.", label="data")
-    ax.set_xlabel("E12")
+    shear = [(E, Sd) for st, kind, E, Sd in data if st == "paper" and kind == "shear" and len(E)]
+    for i, (E, Sd) in enumerate(shear):
+        ax.plot(E[:, 2], Sd[:, 2], "k.", label="data" if i == 0 else None)
+    ax.set_xlabel("E12 [-]")
     ax.set_ylabel("S12 [MPa]")
     ax.set_title("(c) S12(E12)", fontsize=10)
     ax.grid(True, alpha=0.3)
