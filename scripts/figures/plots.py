@@ -3,13 +3,17 @@
 
   plots.py --results DIR load --title T --out F.png CASE...      load (N) vs applied strain
   plots.py --results DIR deformed --case C --field E22 --at 0.3 --title T --out F.png
+           [--share-limits CASE...]                          one colour scale with CASE...
   plots.py --results DIR fields --case C --title T --out F.png   stitch value / knitting angle
   plots.py --results DIR placeholder --title T --message M --out F.png
 
-Deformed shapes are drawn in the x1-x2 plane (the 3-D hyperbolic paraboloid is projected),
-coloured by a Green-Lagrange strain component of the local Cartesian frame (E11, E22, E12 as
-in the paper's figures); the reference outline is dashed. Design fields are drawn on the
-reference surface with arrows along the knitting (course) direction Q(alpha) e1.
+Deformed shapes are coloured by a Green-Lagrange strain component of the local Cartesian frame
+(E11, E22, E12 as in the paper's figures): a planar patch in the x1-x2 plane with the reference
+outline dashed, a shell that leaves the plane (the hyperbolic paraboloid) as a 3-D surface with
+the reference surface as a grey wire mesh. Colour limits: colour_limits() (spikes at loaded
+corners clipped to the 1st/99th percentile, the true extremes in the title; --share-limits gives
+several figures one scale). Design fields are drawn on the reference surface with arrows along
+the knitting (course) direction Q(alpha) e1.
 """
 import argparse
 import os
@@ -18,6 +22,8 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.cm  # noqa: E402
+import matplotlib.colors  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -121,32 +127,126 @@ def outline(ax, P, **kw):
     ax.plot(b[:, 0], b[:, 1], **kw)
 
 
-def cmd_deformed(a):
-    r = Result(a.results, a.case)
-    step = r.step_at(a.at) if r.ok else None
+# A colour limit moves in from the field's extreme to its 1st/99th percentile when the extreme
+# lies more than this fraction of the field's range beyond it (a spike at a loaded corner: the
+# E11 of Fig. 14a reaches 0.430 where its 99th percentile is 0.18, and the rest of the patch was
+# drawn in two colours). The true extremes stay in the title; the colour bar's end says clipped.
+SPIKE_FRACTION = 0.2
+
+
+def colour_limits(values, diverging):
+    """(vmin, vmax, extend) of a field's colour scale: its extremes, or its 1st/99th percentiles
+    on a side where the extreme is a spike (SPIKE_FRACTION); symmetric about 0 when diverging.
+    `values` holds finite numbers only."""
+    v = np.asarray(values, dtype=float).ravel()
+    vmin, vmax = float(v.min()), float(v.max())
+    p1, p99 = (float(q) for q in np.percentile(v, [1, 99]))
+    spread = vmax - vmin
+    lo = p1 if p1 - vmin > SPIKE_FRACTION * spread else vmin
+    hi = p99 if vmax - p99 > SPIKE_FRACTION * spread else vmax
+    if diverging:
+        lim = max(abs(lo), abs(hi))
+        lo, hi = -lim, lim
+    if hi <= lo:  # a constant field
+        lo, hi = lo - 0.5, hi + 0.5
+    below, above = vmin < lo, vmax > hi
+    extend = "both" if below and above else "min" if below else "max" if above else "neither"
+    return lo, hi, extend
+
+
+def is_diverging(values):
+    """A strain field with both signs of comparable size is drawn with a diverging map centred
+    on 0 (the rule of before the clipped limits: decided on the extremes)."""
+    lim = max(abs(values.min()), abs(values.max()))
+    return bool(values.min() < -0.25 * lim)
+
+
+def not_flat(P, rel=1e-6):
+    """True when the grid P (n_v, n_u, 3) leaves the x1-x2 plane (x3 varies)."""
+    size = max(np.ptp(P[..., 0]), np.ptp(P[..., 1]), 1e-300)
+    return np.ptp(P[..., 2]) > rel * size
+
+
+def field_at(results, case, field, at):
+    """(Result, step, fields) of `case` at `at`, or a message saying what is missing."""
+    r = Result(results, case)
+    step = r.step_at(at) if r.ok else None
     if step is None:
-        placeholder(a.out, a.title, f"{a.case}: no field output (run failed)")
-        return
+        return f"{case}: no field output (run failed)"
     f = r.fields(step)
-    if a.field not in f:
-        placeholder(a.out, a.title, f"{a.case}: no field {a.field}")
+    if field not in f:
+        return f"{case}: no field {field}"
+    if not np.isfinite(f[field]).any():
+        return f"{case}: field {field} has no finite value at step {step}"
+    return r, step, f
+
+
+def cmd_deformed(a):
+    got = field_at(a.results, a.case, a.field, a.at)
+    if isinstance(got, str):
+        placeholder(a.out, a.title, got)
         return
+    r, step, f = got
     x, v = f["x"], f[a.field]
-    fig, ax = plt.subplots(figsize=(5.6, 4.6))
-    lim = max(abs(v.min()), abs(v.max()))
-    cmap = "RdBu_r" if v.min() < -0.25 * lim else "jet"
-    pc = ax.pcolormesh(x[..., 0], x[..., 1], v, shading="gouraud", cmap=cmap,
-                       vmin=-lim if cmap == "RdBu_r" else None, vmax=lim if cmap == "RdBu_r" else None)
-    if "X" in f:
-        outline(ax, f["X"], color="k", ls="--", lw=0.8)
-    outline(ax, x, color="k", lw=1.0)
-    cb = fig.colorbar(pc, ax=ax, shrink=0.85)
-    cb.set_label(a.field)
+    finite = np.isfinite(v)
+    pool = [v[finite]]
+    for other in a.share_limits or []:  # one colour scale for the figures of a comparison
+        g = field_at(a.results, other, a.field, a.at)
+        if isinstance(g, str):
+            raise SystemExit(f"plots.py: --share-limits: {g}")
+        w = g[2][a.field]
+        pool.append(w[np.isfinite(w)])
+    pool = np.concatenate(pool)
+    diverging = is_diverging(pool)
+    cmap = "RdBu_r" if diverging else "jet"
+    lo, hi, extend = colour_limits(pool, diverging)
+    norm = matplotlib.colors.Normalize(lo, hi)
+    X = f.get("X")
+    three_d = not_flat(x) or (X is not None and not_flat(X))
+    if three_d:
+        fig = plt.figure(figsize=(7.2, 5.6))
+        ax = fig.add_subplot(projection="3d")
+        colours = plt.get_cmap(cmap)(norm(np.where(finite, v, np.nan)))
+        colours[~finite] = (0.8, 0.8, 0.8, 1.0)
+        ax.plot_surface(x[..., 0], x[..., 1], x[..., 2], facecolors=colours, rstride=1,
+                        cstride=1, linewidth=0, antialiased=False, shade=False)
+        if X is not None:  # the reference surface: a grey wire mesh
+            sk = max(1, X.shape[1] // 10)
+            ax.plot_wireframe(X[..., 0], X[..., 1], X[..., 2], rstride=sk, cstride=sk,
+                              color="0.35", lw=0.5, ls="--", label="reference surface")
+            ax.legend(fontsize=7, loc="upper left")
+        ax.set_zlabel("x3 [mm]")
+        pts = x.reshape(-1, 3) if X is None else np.vstack([x.reshape(-1, 3), X.reshape(-1, 3)])
+        ax.set_box_aspect(np.maximum(np.ptp(pts, axis=0), 1e-3 * np.ptp(pts).max()))
+        ax.view_init(elev=28, azim=-60)
+        sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+        cb = fig.colorbar(sm, ax=ax, shrink=0.7, pad=0.1, extend=extend)
+        u3 = f["u"][..., 2] if "u" in f else x[..., 2] - (X[..., 2] if X is not None else 0.0)
+        geo = f"\nout-of-plane displacement u3 in [{np.nanmin(u3):.1f}, {np.nanmax(u3):.1f}] mm"
+    else:
+        fig, ax = plt.subplots(figsize=(5.6, 4.6))
+        pc = ax.pcolormesh(x[..., 0], x[..., 1], np.ma.masked_invalid(v), shading="gouraud",
+                           cmap=cmap, norm=norm)
+        if X is not None:
+            outline(ax, X, color="k", ls="--", lw=0.8)
+        outline(ax, x, color="k", lw=1.0)
+        cb = fig.colorbar(pc, ax=ax, shrink=0.85, extend=extend)
+        ax.set_aspect("equal")
+        geo = ""
+    cb.set_label(f"{a.field} [-]")
     eps = r.strain_of_step(step)
     state = "" if r.completed else " [run stopped early]"
+    vf = v[finite]
+    scale = ""
+    if extend != "neither" or a.share_limits:
+        scale = f", colour scale [{lo:.3g}, {hi:.3g}]"
+    if a.share_limits:
+        scale += " shared with " + ", ".join(a.share_limits)
+    bad = "" if finite.all() else (f"\n{(~finite).sum()} points with non-finite {a.field} "
+                                   + ("(grey)" if three_d else "(left blank)"))
     ax.set_title(f"{a.title}\nstep {step}, applied strain {100 * eps:.1f} %, "
-                 f"{a.field} in [{v.min():.3f}, {v.max():.3f}]{state}", fontsize=9)
-    ax.set_aspect("equal")
+                 f"{a.field} in [{vf.min():.3g}, {vf.max():.3g}]{scale}{state}{geo}{bad}",
+                 fontsize=9)
     ax.set_xlabel("x1 [mm]")
     ax.set_ylabel("x2 [mm]")
     save(fig, a.out)
@@ -211,6 +311,8 @@ def main():
     s.add_argument("--case", required=True)
     s.add_argument("--field", required=True)
     s.add_argument("--at", default="last")
+    s.add_argument("--share-limits", nargs="+", metavar="CASE",
+                   help="one colour scale for this case and these (same field, same --at)")
     s.add_argument("--title", default="")
     s.add_argument("--out", required=True)
     s = sub.add_parser("fields")
