@@ -148,11 +148,11 @@ PLOT_B_DEPS :=
 PLOT_B_JOBS :=
 PLOTJOB = '$(FIG)/$(1).png $(FIGPY)/plots.py --results $(RES) $(2)'
 
-define deformed # name, case, field, step-strain (or "last"), title
+define deformed # name, case, field, step-strain (or "last"), title[, cases sharing the colour scale]
 FIGURES += $(FIG)/$(1).png
 PLOT_A_FIGS += $(FIG)/$(1).png
-PLOT_A_DEPS += $(call st,$(2))
-PLOT_A_JOBS += $(call PLOTJOB,$(1),deformed --case $(2) --field $(3) --at $(4) --title "$(5)")
+PLOT_A_DEPS += $(call st,$(2) $(6))
+PLOT_A_JOBS += $(call PLOTJOB,$(1),deformed --case $(2) --field $(3) --at $(4) $(if $(6),--share-limits $(6)) --title "$(5)")
 endef
 
 define fields # name, case, title
@@ -186,9 +186,9 @@ $(DB_FIGS) &: $(DB) $(FIGPY)/surfaces.py $(FIGPY)/energy_law.py $(FIGPY)/batch.p
 	  '$(FIG)/fig06_response_surfaces.png $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5' \
 	  '$(FIG)/fig06e_energy_law.png $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5'
 
-# Sect. 3.1.2 (Fig. 7)
-$(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22)))
-$(eval $(call deformed,fig07b_uniform65_wale_E22,s312_uniform_65_wale,E22,0.3,Fig. 7b: l = 6.5 mm wale-wise at 30 % (E22)))
+# Sect. 3.1.2 (Fig. 7): 7a and 7b share their colour scale (the paper compares their uniformity).
+$(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22),s312_uniform_65_wale))
+$(eval $(call deformed,fig07b_uniform65_wale_E22,s312_uniform_65_wale,E22,0.3,Fig. 7b: l = 6.5 mm wale-wise at 30 % (E22),s312_uniform_45_wale))
 $(eval $(call load,fig07c_convergence,Fig. 7c: convergence wale-wise l = 4.5 mm,conv7c_p3h1 conv7c_p5h1 conv7c_p7h1 conv7c_p3h4 conv7c_p5h4 conv7c_p7h4))
 $(eval $(call load,fig07d_load_strain,Fig. 7d: uniform stitch values,s312_uniform_45_course s312_uniform_45_wale s312_uniform_65_course s312_uniform_65_wale))
 # Sect. 3.1.3 (Figs. 8-9)
