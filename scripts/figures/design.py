@@ -1,13 +1,18 @@
 #!/usr/bin/python3
 """The objective history and the designed fields of a `knit-macro design` directory (PNG).
 
-  design.py DIR [--out F.png] [--title T] [--section E22]
+  design.py DIR [--out F.png] [--title T] [--section E22] [--design DESIGN.json]
 
-Panels: J per iteration (history.csv, log scale); the designed case's stitch-value field l and
-knitting-angle field alpha (case.json) over the parameter domain, with the profile at
-mid-height when a field varies; the final run's load-strain curve (run/load_strain.csv, the
-first reaction) with the straight line through its last point; with --section, that strain
-component of the final run along the central section v = 0.5 (run/results.h5, last step). Writes
+Panels: J per iteration (history.csv, log scale), and the J of the design written (J_final of
+summary.txt: the best of all evaluations, which can lie below the last accepted iteration's);
+the designed case's stitch-value field l and knitting-angle field alpha (case.json) over the
+parameter domain, with the profile at mid-height when a field varies; the final run's
+load-strain curve (run/load_strain.csv: the reaction an objective names, else the first) with
+the objectives drawn on it: a `reaction` objective's targets as points, a `reaction_linearity`
+objective's straight line through the origin and the curve at its last strain; with --section,
+that strain component of the final run along the central section v = 0.5 (run/results.h5, last
+step). The objectives are read from the design file
+(--design; by default the pipeline's DIR/../inputs/NAME.json when it exists). Writes
 DIR_design.png (beside DIR) unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
 designs); the C++ command never needs python.
 """
@@ -20,6 +25,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 try:
     import h5py  # noqa: E402
@@ -60,15 +66,48 @@ def field_grid(spec, n=81):
     return u, v, Bv @ C @ Bu.T, C, scale
 
 
+def read_summary(path):
+    """summary.txt of a design -> {key: text} of its 'key: value' lines ({} when missing)."""
+    if not os.path.exists(path):
+        return {}
+    out = {}
+    with open(path) as f:
+        for line in f:
+            key, sep, value = line.partition(":")
+            if sep and key.strip() not in out:
+                out[key.strip()] = value.strip()
+    return out
+
+
+def design_file(a):
+    """The design file whose objectives are drawn: --design, else the pipeline's
+    OUT/design/inputs/NAME.json beside DIR = OUT/design/NAME (None when there is none)."""
+    if a.design:
+        return a.design
+    d = os.path.normpath(os.path.abspath(a.dir))
+    guess = os.path.join(os.path.dirname(d), "inputs", os.path.basename(d) + ".json")
+    return guess if os.path.exists(guess) else None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dir")
     ap.add_argument("--out")
     ap.add_argument("--title", default="")
     ap.add_argument("--section", default="", help="strain field along v = 0.5 of the final run (E11, E22, E12)")
+    ap.add_argument("--design", default="",
+                    help="the design file, for its objectives (default: DIR/../inputs/NAME.json)")
     a = ap.parse_args()
-    h = read_history(os.path.join(a.dir, "history.csv"))
+    history = os.path.join(a.dir, "history.csv")
+    h = read_history(history)
+    if h.dtype.names is None or not {"iteration", "J"} <= set(h.dtype.names):
+        raise ValueError(f"{history}: the columns iteration and J are missing")
+    if not np.all(np.isfinite(np.atleast_1d(h["J"]))):
+        raise ValueError(f"{history}: J has a non-finite value")
     case = read_json(os.path.join(a.dir, "case.json"))
+    summary = read_summary(os.path.join(a.dir, "summary.txt"))
+    dfile = design_file(a)
+    objectives = read_json(dfile).get("objectives", []) if dfile else None
     fields = [(k, case["material"].get(k)) for k in ("stitch_value", "knitting_angle")]
     fields = [(k, field_grid(s)) for k, s in fields if field_grid(s) is not None]
     run = os.path.join(a.dir, "run")
@@ -76,6 +115,9 @@ def main():
     if os.path.exists(os.path.join(run, "load_strain.csv")):
         ls = read_history(os.path.join(run, "load_strain.csv"))
         loads = [n for n in ls.dtype.names if n.endswith("_N")]
+        named = [o.get("reaction", "") + "_N" for o in objectives or []
+                 if o.get("type") in ("reaction", "reaction_linearity")]
+        loads = [n for n in named if n in loads][:1] + loads
         if loads:
             curve = (np.atleast_1d(ls["strain"]), np.atleast_1d(ls[loads[0]]), loads[0])
     section = None
@@ -91,10 +133,26 @@ def main():
     fig, axes = plt.subplots(1, npan, figsize=(4.2 * npan, 3.8), squeeze=False)
     ax = axes[0][0]
     J = np.maximum(np.atleast_1d(h["J"]), 1e-300)
-    ax.semilogy(np.atleast_1d(h["iteration"]), J, "o-")
+    it = np.atleast_1d(h["iteration"])
+    ax.semilogy(it, J, "o-", label="accepted iterations (history.csv)")
+    status = summary.get("status", "")
+    try:
+        j_final = float(summary["J_final"])
+    except (KeyError, ValueError):
+        j_final = None
+    if j_final is not None and np.isfinite(j_final):
+        # The design written is the best of all evaluations (docs/design.md): its J can lie below
+        # the last accepted iteration's (uniform_load: 2.44e-26 against 3.08e-18).
+        x_final = it[-1]
+        ax.semilogy([x_final], [max(j_final, 1e-300)], "*", ms=13, color="tab:red", zorder=3,
+                    label=f"final design (summary.txt): J = {j_final:.3g}")
     ax.set_xlabel("iteration")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("objective J")
-    ax.set_title("objective history")
+    missing = "" if j_final is not None else "\n(no J_final in summary.txt)"
+    ax.set_title("objective history" + (f" ({status})" if status else "") + missing,
+                 fontsize=11 if len(status) < 20 else 9)
+    ax.legend(fontsize=7, loc="best")
     ax.grid(True, which="both", alpha=0.3)
     for i, (name, (u, v, F, C, scale)) in enumerate(fields):
         ax = axes[0][i + 1]
@@ -120,20 +178,43 @@ def main():
         ax = axes[0][k]
         e, F, name = curve
         ax.plot(100 * e, F, "o-", ms=3, label="designed")
-        if len(e) and e[-1] != 0:
-            ax.plot([0, 100 * e[-1]], [0, F[-1]], "k--", lw=1, label="line through the last point")
+        reaction = name[:-len("_N")]
+        e0, F0 = np.concatenate([[0.0], e]), np.concatenate([[0.0], F])  # the unloaded start
+        for o in objectives or []:
+            if o.get("reaction") != reaction:
+                continue
+            at = np.atleast_1d(np.array(o.get("at_strain", []), float))
+            tag = o.get("name", o.get("type"))
+            if o.get("type") == "reaction" and len(o.get("target", [])) == len(at):
+                ax.plot(100 * at, o["target"], "D", ms=8, mfc="none", mec="tab:red", mew=1.6,
+                        zorder=3, label=f"target of {tag}: " + ", ".join(
+                            f"{t:.4g} N at {100 * x:.3g} %" for x, t in zip(at, o["target"])))
+            elif o.get("type") == "reaction_linearity" and len(at):
+                # The objective: the curve's distance from the line through the origin and
+                # its value at the last strain of the objective (docs/design.md).
+                R = np.interp(at, e0, F0)
+                ax.plot([0, 100 * at[-1]], [0, R[-1]], "k--", lw=1,
+                        label=f"{tag}: line through 0 and the last point")
+                ax.plot(100 * at, R, "s", ms=6, mfc="none", mec="tab:red", zorder=3,
+                        label=f"{tag}: strains of the objective")
         ax.set_xlabel("applied strain (%)")
-        ax.set_ylabel(name.replace("_N", "") + " (N)")
-        ax.set_title("final run: load-strain")
+        ax.set_ylabel(reaction + " (N)")
+        note = "" if objectives is not None else "\n(no design file: objectives not drawn)"
+        ax.set_title("final run: load-strain" + note, fontsize=11 if not note else 9)
         ax.legend(fontsize=7)
         ax.grid(True, alpha=0.3)
         k += 1
     if section is not None:
         ax = axes[0][k]
         u, E = section
-        ax.plot(u, E, "-")
+        ax.plot(u, E, "-", label="final run")
+        if any(o.get("type") == "strain_variance" and o.get("component") == a.section
+               for o in objectives or []):  # the objective's ideal: a uniform strain
+            ax.axhline(np.mean(E), color="tab:red", ls="--", lw=1,
+                       label=f"uniform (strain_variance target): mean {np.mean(E):.3g}")
+            ax.legend(fontsize=7)
         ax.set_xlabel("theta1 (u) at v = 0.5")
-        ax.set_ylabel(a.section)
+        ax.set_ylabel(a.section + " [-]")
         ax.set_title(f"final run: {a.section} along the section\n(std {np.std(E):.2g})", fontsize=10)
         ax.grid(True, alpha=0.3)
     if a.title:
