@@ -52,8 +52,9 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("dirs", nargs="+")
     a = ap.parse_args()
-    fig, axs = plt.subplots(1, len(a.dirs), figsize=(5 * len(a.dirs), 5))
+    fig, axs = plt.subplots(1, len(a.dirs), figsize=(5 * len(a.dirs), 5.6))
     axs = np.atleast_1d(axs)
+    extent = []  # (x0, x1, y0, y1) of each panel's drawing: one scale for all (below)
     for ax, d in zip(axs, a.dirs):
         info = read_json(os.path.join(d, "cell.json"))
         polys, image = read_vtp(os.path.join(d, "cell.vtp"))
@@ -64,13 +65,27 @@ def main():
         own = np.concatenate([P for P, im in zip(polys, image) if im == 0])
         cx, cy = 0.5 * (own[:, 0].min() + own[:, 0].max()), 0.5 * (own[:, 1].min() + own[:, 1].max())
         ax.add_patch(plt.Rectangle((cx - 0.5 * w, cy - 0.5 * c), w, c, fill=False, ec="b", lw=1.5, zorder=3))
-        ax.set_aspect("equal")
+        every = np.concatenate(polys)
+        if not np.all(np.isfinite(every[:, :2])):
+            raise ValueError(f"{os.path.join(d, 'cell.vtp')}: a point is not finite")
+        extent.append((every[:, 0].min(), every[:, 0].max(), every[:, 1].min(), every[:, 1].max()))
         ax.set_title(f"l = {info['loop_length']} mm: w = {w:.2f} mm, c = {c:.2f} mm\n"
                      f"measured length {info.get('measured_length', float('nan')):.3f} mm, "
                      f"min clearance {info.get('min_clearance', float('nan')):.3f} mm", fontsize=9)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
-    fig.suptitle("Fig. 5: unit cells with their w x c bounding boxes (blue)", fontsize=11)
+    # The same limits and equal aspect in every panel, so that the cells compare by size (the
+    # 4.5 mm cell, 1.26 mm wide, was drawn wider than the 6.5 mm one, 1.41 mm, each panel on
+    # its own scale).
+    e = np.array(extent)
+    pad = 0.04 * max(e[:, 1].max() - e[:, 0].min(), e[:, 3].max() - e[:, 2].min())
+    for ax in axs:
+        ax.set_xlim(e[:, 0].min() - pad, e[:, 1].max() + pad)
+        ax.set_ylim(e[:, 2].min() - pad, e[:, 3].max() + pad)
+        ax.set_aspect("equal", adjustable="box")
+        ax.grid(True, alpha=0.25)
+    fig.suptitle("Fig. 5: unit cells with their w x c bounding boxes (blue), on one scale",
+                 fontsize=11)
     tmp = a.out + ".tmp.png"
     fig.savefig(tmp, dpi=110, bbox_inches="tight")
     os.replace(tmp, a.out)
