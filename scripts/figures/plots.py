@@ -190,12 +190,16 @@ def cmd_deformed(a):
     x, v = f["x"], f[a.field]
     finite = np.isfinite(v)
     pool = [v[finite]]
+    shared, unshared = [], []
     for other in a.share_limits or []:  # one colour scale for the figures of a comparison
         g = field_at(a.results, other, a.field, a.at)
-        if isinstance(g, str):
-            raise SystemExit(f"plots.py: --share-limits: {g}")
+        if isinstance(g, str):  # this figure is still drawn, on the scale of what there is
+            print(f"plots.py: warning: --share-limits: {g}", file=sys.stderr)
+            unshared.append(other)
+            continue
         w = g[2][a.field]
         pool.append(w[np.isfinite(w)])
+        shared.append(other)
     pool = np.concatenate(pool)
     diverging = is_diverging(pool)
     cmap = "RdBu_r" if diverging else "jet"
@@ -240,8 +244,10 @@ def cmd_deformed(a):
     scale = ""
     if extend != "neither" or a.share_limits:
         scale = f", colour scale [{lo:.3g}, {hi:.3g}]"
-    if a.share_limits:
-        scale += " shared with " + ", ".join(a.share_limits)
+    if shared:
+        scale += " shared with " + ", ".join(shared)
+    if unshared:
+        scale += " (not shared with " + ", ".join(unshared) + ": no field)"
     bad = "" if finite.all() else (f"\n{(~finite).sum()} points with non-finite {a.field} "
                                    + ("(grey)" if three_d else "(left blank)"))
     ax.set_title(f"{a.title}\nstep {step}, applied strain {100 * eps:.1f} %, "

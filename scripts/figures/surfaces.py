@@ -6,7 +6,7 @@ of one loop length, with the homogenized data points (black dots), from the mate
 
 The data drawn as the surface's data are the paths of set "paper" (the paper's fan, to which
 eq. 17 is fitted; scripts/cell_paths.py path_set). The "coverage" biaxial paths are drawn faint
-(grey x), only where they lie inside the surface's strain range (the image of [0, 1]^2 in the
+(faint red x), only where they lie inside the surface's strain range (the image of [0, 1]^2 in the
 E11-E22 plane): outside it the surface says nothing about them.
 
 The surfaces are drawn as the paper defines them (eq. 17): E(xi) and S(xi) evaluated on a grid

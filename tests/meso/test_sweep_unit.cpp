@@ -747,16 +747,26 @@ TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows
           "[unit]") {
   // Before: a loop length of 1e-320 mm ran every case and failed at the database write (exit 1,
   // naming a raw dataset; the checkpoints kept for a --resume that failed again). The stand-in's
-  // stiffness is (4.5 / l)^2 MPa: at 1e-3 mm its stress at E_ij = 2 is ~2e9 MPa, above the 1e9
-  // a database holds; at 2e-3 mm it is ~5e8.
+  // stiffness is (4.5 / l)^2 MPa; the default paths stay within |E_ij| <= 1 (the check's floor),
+  // where S22 = 13.1 k: at 5e-4 mm ~1.06e9 MPa, above the 1e9 a database holds; at 2e-3 mm
+  // ~6.6e7.
   SweepInput in =
       parse_sweep_input(R"({"loop_lengths": [4.5, 6.5], "runner": "synthetic"})", "synth.json");
   CHECK_NOTHROW(make_runner(in));
   in.loop_lengths = {2e-3, 4.5};
   CHECK_NOTHROW(make_runner(in));
-  for (double tiny : {1e-3, 1e-320}) {
+  for (double tiny : {5e-4, 1e-320}) {
     in.loop_lengths = {4.5, tiny};
     CHECK_THROWS_WITH(make_runner(in),
                       Catch::StartsWith("synth.json: /loop_lengths/1: the synthetic stand-in's"));
   }
+  // A gradient path to F = [[3, 2], [2, 3]] reaches E_ij = 6 (review of session 30: judged at
+  // E_ij = 2, 2e-3 mm passed and failed at the database write with ~1.3e10 MPa).
+  in.loop_lengths = {2e-3, 4.5};
+  knit::material::LoadPath g;
+  g.kind = knit::material::PathKind::kGradient;
+  g.H << 2.0, 2.0, 2.0, 2.0;
+  g.steps = 4;
+  in.paths.push_back(g);
+  CHECK_THROWS_WITH(make_runner(in), Catch::Contains("at |E_ij| = 6 along the paths"));
 }

@@ -357,6 +357,17 @@ def v_stale_fields(r):  # the fields at 30 % carry the load factor of 15 %
     r["s313_discontinuous_course"].last_fields_factor = 0.5
 
 
+def v_exit1_314(r):  # exit 1 after completing, on a run two field checks share (review)
+    r["s314_linear_wale"].exit_code = 1
+
+
+def v_material_failure_stopped(r):  # failed evaluations of the step that stopped the run
+    r["s312_uniform_45_course"].stop_at(0.2)
+    r["s312_uniform_45_course"].summary_extra = ("material failures: stopped with 2 failed "
+                                                 "material evaluations; results are not "
+                                                 "trustworthy\n")
+
+
 def v_case_missing(r):  # a case of cases/paper has no result at all
     del r["mesh322_p5h4"]
 
@@ -412,7 +423,13 @@ VARIANTS = {
     "zero strain fields in 3.2.1": (v_zero_321, {"mirror321", "sym321"}, True),
     "exit 1 after completing": (v_exit1_completed, CURVE_45C, True),
     "no status file": (v_no_status, CURVE_45C, True),
-    "fields of 15 % stored as 30 %": (v_stale_fields, {"e11right313"}, False),
+    "fields of 15 % stored as 30 %": (v_stale_fields, {"e11right313", "reach:s313_discontinuous_course", "monotone:s313_discontinuous_course", "stiffening:s313_discontinuous_course"}, True),
+    "exit 1 after completing, 3.1.4 wale": (v_exit1_314, {
+        "reach:s314_linear_wale", "monotone:s314_linear_wale", "stiffening:s314_linear_wale",
+        "larger314", "uniform314"}, True),
+    "a stop with failed evaluations": (v_material_failure_stopped, {
+        "reach:s312_uniform_45_course", "stiffening:s312_uniform_45_course", "stiffer:course"},
+        True),
     "a case without a result": (v_case_missing, {"reach:mesh322_p5h4",
                                                  "monotone:mesh322_p5h4"}, True),
     "every curve drops at 2/3": (v_all_dip, set(MONO), False),
@@ -444,11 +461,11 @@ def law_check_failures(tmp):
         with h5py.File(db, "w") as f:
             f["loop_lengths"] = [4.5, 6.5]
             f.attrs["format_version"] = 3
-            for k in range(2):  # `runs` held-out paths per loop length (no converged step)
-                for q in range(runs + 2):
+            for k in range(2):  # `runs` held-out paths per loop length (one converged step),
+                for q in range(runs + 3):  # a held-out one not converged, two fit paths
                     g = f.create_group(f"loop_{k}/raw/path_{q:02d}")
-                    g.attrs["set"] = "holdout" if q < runs else "paper"
-                    g["status"] = [2]
+                    g.attrs["set"] = "holdout" if q <= runs else "paper"
+                    g["status"] = [0 if q < runs else 2]
                     g["E"] = np.zeros((1, 3))
                     g["S"] = np.zeros((1, 3))
             if energy and not diagnostics:
