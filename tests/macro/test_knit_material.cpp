@@ -240,3 +240,23 @@ TEST_CASE("knit material, paper law: the bound points own their surfaces, the sa
   }
   CHECK(m.cached_surfaces() == 50);
 }
+
+TEST_CASE("knit material: the output strains are the tensor E rotated into the course/wale frame",
+          "[unit]") {
+  // Session 30, a helper's mutation testing: E_course_wale written as the engineering shear
+  // 2 E12 instead of the tensor component survived (the output test ran at alpha = 0 with
+  // E12 unread). Uniaxial E11 = e rotated by 45 degrees: the tensor diag(e, 0) has e/2 on
+  // every entry in the rotated frame (up to the shear's sign, which depends on the sense).
+  const double e = 0.1;
+  KnitMaterial m = graded(M_PI / 4);
+  const auto f = m.output_fields({0.5, 0.5}, Eigen::Vector3d(e, 0, 0));
+  REQUIRE(f.size() == 6);
+  CHECK(f[1].first == "knitting_angle");
+  CHECK(f[1].second == Approx(M_PI / 4));
+  CHECK(f[2].first == "E_course");
+  CHECK(f[2].second == Approx(e / 2));
+  CHECK(f[3].first == "E_wale");
+  CHECK(f[3].second == Approx(e / 2));
+  CHECK(f[4].first == "E_course_wale");
+  CHECK(std::abs(f[4].second) == Approx(e / 2));
+}

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "knit/material/load_paths.hpp"
 #include "knit/meso/homog/path.hpp"
 
 using namespace knit::meso::homog;
@@ -235,5 +236,47 @@ TEST_CASE("a step whose yarns pass through each other is cut back, not accepted"
     // At the stresses of the small steps (friction's path dependence: a few %).
     CHECK(r1.S(0, 0) == Approx(rn.S(0, 0)).epsilon(0.1));
     CHECK(r1.S(1, 1) == Approx(rn.S(1, 1)).epsilon(0.1));
+  }
+}
+
+// Session 30, a helper's mutation testing: a transposed P (eq. 8) and S = P F^-1 instead of
+// F^-1 P (eq. 9) survived every test, since the biaxial energy balance does no work with the
+// off-diagonal P and the mirror test cannot tell them apart; a wrong periodic offset of the
+// contacts (F^T for F) was caught only by accident.
+TEST_CASE("shear path: stress work equals boundary work (eq. 8), S is the sweep's F^-1 P (eq. 9)",
+          "[unit]") {
+  PeriodicCell cell(4.5, fast_options());
+  const PathResult r = run_path(cell, shear(0.35, 4));
+  REQUIRE(r.completed);
+  const auto& d = cell.dimensions();
+  const double Wb = boundary_work(r.steps, d.w, d.c, cell.thickness());
+  const double Ws = stress_work(r.steps);
+  INFO("Ws = " << Ws << " Wb = " << Wb);
+  CHECK(Wb > 0);
+  CHECK(Ws == Approx(Wb).epsilon(1e-12));
+  for (const StepResult& s : r.steps) {
+    const Eigen::Matrix2d S_sweep = knit::material::second_piola_kirchhoff(s.F, s.P);
+    const Eigen::Matrix2d S_sym = 0.5 * (s.S + s.S.transpose());
+    INFO("S =\n" << s.S << "\nsweep's S =\n" << S_sweep);
+    CHECK((S_sym - S_sweep).cwiseAbs().maxCoeff() <= 1e-12 * (1 + S_sweep.cwiseAbs().maxCoeff()));
+  }
+  // The converged cell's F^-1 P is nearly symmetric (docs/unit-cell.md: within a few % of
+  // max |S| at 20 deg); S = P F^-1 was not (33 %).
+  const Eigen::Matrix2d& S = r.steps.back().S;
+  CHECK(std::abs(S(0, 1) - S(1, 0)) <= 0.05 * S.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE("rigid rotation of the cell: S is the stress at rest (objectivity)", "[unit]") {
+  PeriodicCell cell(4.5, fast_options());
+  const StepResult r0 = cell.equilibrate();
+  REQUIRE(r0.converged);
+  for (int k = 1; k <= 4; ++k) {
+    const double a = k * 2.5 * M_PI / 180.0;
+    Eigen::Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    const StepResult r = cell.solve(R);
+    REQUIRE(r.converged);
+    INFO("rotation " << k * 2.5 << " deg: S =\n" << r.S << "\nat rest\n" << r0.S);
+    CHECK((r.S - r0.S).cwiseAbs().maxCoeff() <= 1e-6);
   }
 }

@@ -32,6 +32,10 @@ TEST_CASE("cell config: fields are read, defaults kept", "[unit]") {
   CHECK(o.contact.max_overlap == 0.8);  // the pass-through guard's default bound
   CHECK(read_cell_options(write_tmp("cell_cfg_mo.json", R"({"contact": {"max_overlap": 1}})"))
             .contact.max_overlap == 1.0);
+  // The paper's Coulomb coefficient is the default of the code and of an empty config (session
+  // 30: a default of 0.3 was caught only indirectly, by a test pinned to a step number).
+  CHECK(CellOptions{}.contact.friction.mu == 0.15);
+  CHECK(read_cell_options(write_tmp("cell_cfg_empty.json", "{}")).contact.friction.mu == 0.15);
 }
 
 TEST_CASE("cell config: errors name the JSON pointer", "[unit]") {
