@@ -175,8 +175,9 @@ def law_checks(db_path, extrapolations):
     want = db_loops if db_loops is not None else loops
     whole = (len(want) > 0 and len(loops) == len(want) and np.allclose(loops, want, rtol=1e-6)
              and len(rms) == len(want) and len(mx) == len(want))
-    short = "" if whole else (f" (errors for {len(rms)} / {len(mx)} of the database's "
-                              f"{len(want)} loop lengths)")
+    short = "" if whole else (f" (errors for {len(rms)} / {len(mx)} loop lengths "
+                              f"{', '.join(f'{x:g}' for x in loops)} mm; the database has "
+                              f"{', '.join(f'{x:g}' for x in want)} mm)")
     rows.append(("fit data: RMS error per loop length, % of its stress range",
                  f"<= {100 * LAW_BOUND:g} %, every loop length", per_l + pct(rms) + short,
                  whole and all(math.isfinite(x) and x <= LAW_BOUND for x in rms)))
@@ -319,9 +320,10 @@ class Data:
         """Why a run's results are no data to judge although it may have reached its strain,
         or None: no status file (exit code unknown), an exit code other than 0 that is not
         an early stop (summary "stopped": the stop is judged by the checks themselves),
-        summary lines of failed material evaluations or non-finite output fields in a run
-        that completed (in a stopped run they belong to the step that failed), or a field
-        step whose stored load factor is not the CSV's. Computed once per run, before any
+        summary lines of failed material evaluations or non-finite output fields (knit-macro's
+        own "results are not trustworthy", whether the run completed or stopped: the count of
+        failed evaluations is the whole run's), or a field step whose stored load factor is
+        not the CSV's. Computed once per run, before any
         check reads its fields, so that every check of the run is judged alike. Session 30:
         every check passed with exit code 1 in every status file."""
         if name not in self.defects:
@@ -338,7 +340,7 @@ class Data:
         lines = r.summary().splitlines()
         stopped = "status: stopped" in lines
         bad = [l for l in lines if l.startswith(("material failures:", "output failure:"))]
-        if bad and not stopped:
+        if bad:
             return bad[0]
         ex = r.status.get("exit_code")
         if ex != 0 and not stopped:
@@ -831,7 +833,7 @@ def design_section(out):
             with open(os.path.join(out, "design", n + ".status")) as f:
                 st = json.load(f)
         except (OSError, ValueError):
-            st = {}
+            st = None  # unreadable
         summ = {}
         try:
             with open(os.path.join(out, "design", n, "summary.txt")) as f:
@@ -840,12 +842,14 @@ def design_section(out):
                     summ.setdefault(k.strip(), v.strip())
         except OSError:
             pass
-        status = summ.get("status", f"no output (exit {st.get('exit_code', '?')})")
-        if "status" in summ and st.get("exit_code") != 0:  # the summary alone is not the verdict
-            status += f" (exit {st['exit_code']})" if st else " (no status file)"
+        exit_code = "? (status file unreadable)" if st is None else st.get("exit_code", "?")
+        status = summ.get("status", f"no output (exit {exit_code})")
+        if "status" in summ and exit_code != 0:  # the summary alone is not the verdict
+            status += f" (exit {exit_code})"
         L.append(f"| {n} | {md(status)} | {md(summ.get('J_initial', '-'))} | "
                  f"{md(summ.get('J_final', '-'))} | {summ.get('iterations', '-')} | "
-                 f"{summ.get('evaluations', '-')} | {fmt(st.get('seconds', float('nan')), 1)} |")
+                 f"{summ.get('evaluations', '-')} | "
+                 f"{fmt((st or {}).get('seconds', float('nan')), 1)} |")
         fig = f"design_{n}.png"
         if os.path.exists(os.path.join(out, "figures", fig)):
             figs.append(fig)

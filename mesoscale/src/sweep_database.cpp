@@ -208,33 +208,32 @@ PathRunner synthetic_runner(const SweepInput& in) {
   // The stand-in's stiffness (l_ref / l)^2 grows without bound as l -> 0: a sweep with a loop
   // length of 1e-320 mm ran every case and then failed at the database write (exit 1, naming
   // a raw dataset, the checkpoints kept for a --resume that fails again). Refused before any
-  // case runs, at its JSON pointer, when the stress exceeds what a database may hold at
-  // E_ij = m, the largest |E_ij| along the input's paths (every coefficient of the law is
-  // positive, so |S| there bounds |S| at every strain with |E_ij| <= m; a uniaxial path's
-  // lateral strain is found by the runner and counted as its target). As cell_runner refuses
-  // a cell it cannot build. (Review of session 30: the corner E_ij = 2 missed gradient paths
-  // reaching E_ij = 6.)
-  double m = 1.0;
+  // case runs, at its JSON pointer, when S or P = F S may exceed what a database holds at
+  // E_ij = m, the largest |E_ij| along the input's steps, with |F_ij| <= f (every coefficient
+  // of the law is positive, so |S| at E_ij = m bounds |S| at every strain with |E_ij| <= m,
+  // and |P_ij| <= 2 f max|S|). A uniaxial path's prescribed stretch counts; its lateral
+  // strain, found by the runner, is a contraction within the floor m >= 1. As cell_runner
+  // refuses a cell it cannot build. (Reviews of session 30: the corner E_ij = 2 missed
+  // gradient paths reaching E_ij = 6; P = F S, which the reader bounds too, was not checked.)
+  double m = 1.0, f = 1.0;
   for (const auto& path : in.paths)
     for (int k = 1; k <= path.steps; ++k) {
-      if (path.kind == material::PathKind::kUniaxial) {
-        m = std::max(m, std::abs(path.target(0)));
-        break;
-      }
       const Eigen::Matrix2d F = material::deformation_gradient(path, double(k) / path.steps);
       const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
       m = std::max(m, E.cwiseAbs().maxCoeff());
+      f = std::max(f, F.cwiseAbs().maxCoeff());
     }
   const Eigen::Vector3d corner = Eigen::Vector3d::Constant(m);
   for (std::size_t k = 0; k < in.loop_lengths.size(); ++k) {
     const Eigen::Vector3d s = fit::SyntheticLaw{}.stress(corner, in.loop_lengths[k]);
-    if (!(s.cwiseAbs().maxCoeff() <= material::kMaxRawStress))
+    if (!(2.0 * f * s.cwiseAbs().maxCoeff() <= material::kMaxRawStress))
       throw InputError(in.file, io::json_pointer_append("/loop_lengths", k),
                        "the synthetic stand-in's stiffness (4.5 / l)^2 MPa at l = " +
                            io::format_number(in.loop_lengths[k]) +
                            " mm gives stresses beyond what a database holds (" +
                            io::format_number(material::kMaxRawStress) +
-                           " MPa at |E_ij| = " + io::format_number(m) +
+                           " MPa for S and P = F S at |E_ij| = " + io::format_number(m) +
+                           ", |F_ij| = " + io::format_number(f) +
                            " along the paths); give loop lengths of a knit (a few mm)");
   }
   return synthetic_runner();

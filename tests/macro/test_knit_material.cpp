@@ -259,4 +259,10 @@ TEST_CASE("knit material: the output strains are the tensor E rotated into the c
   CHECK(f[3].second == Approx(e / 2));
   CHECK(f[4].first == "E_course_wale");
   CHECK(std::abs(f[4].second) == Approx(e / 2));
+  // Pure shear, 2 E12 = g: rotated by 45 degrees it is diag(g/2, -g/2) up to the sense, no shear.
+  const double g = 0.08;
+  const auto s = m.output_fields({0.5, 0.5}, Eigen::Vector3d(0, 0, g));
+  CHECK(std::abs(s[2].second) == Approx(g / 2));
+  CHECK(s[3].second == Approx(-s[2].second));
+  CHECK(std::abs(s[4].second) < 1e-15);
 }

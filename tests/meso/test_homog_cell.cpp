@@ -266,17 +266,27 @@ TEST_CASE("shear path: stress work equals boundary work (eq. 8), S is the sweep'
   CHECK(std::abs(S(0, 1) - S(1, 0)) <= 0.05 * S.cwiseAbs().maxCoeff());
 }
 
-TEST_CASE("rigid rotation of the cell: S is the stress at rest (objectivity)", "[unit]") {
+TEST_CASE("rigid rotation of a stretched cell: S does not change (objectivity)", "[unit]") {
+  // Stretched first (at rest S = 0, which any S = P, P F^-1 would keep; review of session 30),
+  // then rotated rigidly by 2.5 ... 10 deg: S(R U) = S(U) (measured ~1e-11 MPa; S = P F^-1
+  // differs by 5e-4 ... 2e-3, S = P by 0.04 ... 0.14).
   PeriodicCell cell(4.5, fast_options());
-  const StepResult r0 = cell.equilibrate();
-  REQUIRE(r0.converged);
+  REQUIRE(cell.equilibrate().converged);
+  Eigen::Matrix2d U = Eigen::Matrix2d::Identity();
+  StepResult rU;
+  for (int k = 1; k <= 4; ++k) {
+    U.diagonal() << 1.0 + 0.025 * k, 1.0 + 0.0125 * k;
+    rU = cell.solve(U);
+    REQUIRE(rU.converged);
+  }
+  REQUIRE(rU.S.cwiseAbs().maxCoeff() > 0.01);  // a stressed state
   for (int k = 1; k <= 4; ++k) {
     const double a = k * 2.5 * M_PI / 180.0;
     Eigen::Matrix2d R;
     R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-    const StepResult r = cell.solve(R);
+    const StepResult r = cell.solve(R * U);
     REQUIRE(r.converged);
-    INFO("rotation " << k * 2.5 << " deg: S =\n" << r.S << "\nat rest\n" << r0.S);
-    CHECK((r.S - r0.S).cwiseAbs().maxCoeff() <= 1e-6);
+    INFO("rotation " << k * 2.5 << " deg: S =\n" << r.S << "\nunrotated\n" << rU.S);
+    CHECK((r.S - rU.S).cwiseAbs().maxCoeff() <= 1e-6);
   }
 }

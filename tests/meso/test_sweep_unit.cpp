@@ -747,9 +747,9 @@ TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows
           "[unit]") {
   // Before: a loop length of 1e-320 mm ran every case and failed at the database write (exit 1,
   // naming a raw dataset; the checkpoints kept for a --resume that failed again). The stand-in's
-  // stiffness is (4.5 / l)^2 MPa; the default paths stay within |E_ij| <= 1 (the check's floor),
-  // where S22 = 13.1 k: at 5e-4 mm ~1.06e9 MPa, above the 1e9 a database holds; at 2e-3 mm
-  // ~6.6e7.
+  // stiffness is (4.5 / l)^2 MPa; the default paths stay within |E_ij| <= 1 and |F_ij| below
+  // 1.5 or so, where S22 = 13.1 k and |P| up to 2 |F| |S|: at 5e-4 mm ~1.06e9 MPa and more,
+  // above the 1e9 a database holds; at 2e-3 mm ~2e8.
   SweepInput in =
       parse_sweep_input(R"({"loop_lengths": [4.5, 6.5], "runner": "synthetic"})", "synth.json");
   CHECK_NOTHROW(make_runner(in));
@@ -768,5 +768,9 @@ TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows
   g.H << 2.0, 2.0, 2.0, 2.0;
   g.steps = 4;
   in.paths.push_back(g);
-  CHECK_THROWS_WITH(make_runner(in), Catch::Contains("at |E_ij| = 6 along the paths"));
+  CHECK_THROWS_WITH(make_runner(in), Catch::Contains("at |E_ij| = 6, |F_ij| = 3 along the paths"));
+  // ... and P = F S: at 0.01 mm S stays below 1e9 there (~5.3e8), but P reached 1.9e9, written
+  // by the sweep and refused by the reader (review of session 30).
+  in.loop_lengths = {0.01, 4.5};
+  CHECK_THROWS_WITH(make_runner(in), Catch::StartsWith("synth.json: /loop_lengths/0:"));
 }
