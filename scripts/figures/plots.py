@@ -5,6 +5,7 @@
   plots.py --results DIR deformed --case C --field E22 --at 0.3 --title T --out F.png
            [--share-limits CASE...]                          one colour scale with CASE...
   plots.py --results DIR fields --case C --title T --out F.png   stitch value / knitting angle
+  plots.py --results DIR geometry --case C --title T --out F.png reference surface (Fig. 16a)
   plots.py --results DIR placeholder --title T --message M --out F.png
 
 Deformed shapes are coloured by a Green-Lagrange strain component of the local Cartesian frame
@@ -270,6 +271,43 @@ def course_direction(X, alpha):
     return c * e1 + s * e2, e1
 
 
+def cmd_geometry(a):
+    """The reference mid-surface X of a case (paper Fig. 16a: the hyperbolic paraboloid
+    x3 = 0.24 (x1 - 2.5)(x2 - 2.5) mm, corners moved up or down by 15 mm) in 3-D, coloured by
+    its height x3, the corners labelled with their x3."""
+    r = Result(a.results, a.case)
+    steps = r.steps() if r.ok else []
+    if not steps:
+        placeholder(a.out, a.title, f"{a.case}: no field output (run failed)")
+        return
+    f = r.fields(steps[0])
+    X = f.get("X")
+    if X is None or not np.all(np.isfinite(X)):
+        placeholder(a.out, a.title, f"{a.case}: no finite reference coordinates")
+        return
+    z = X[..., 2]
+    fig = plt.figure(figsize=(6.4, 5.2))
+    ax = fig.add_subplot(projection="3d")
+    lo, hi = float(z.min()), float(z.max())
+    norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1.0)
+    ax.plot_surface(X[..., 0], X[..., 1], z, facecolors=plt.get_cmap("viridis")(norm(z)),
+                    rstride=1, cstride=1, linewidth=0, antialiased=False, shade=False)
+    for j, i in ((0, 0), (0, -1), (-1, 0), (-1, -1)):
+        p = X[j, i]
+        ax.scatter([p[0]], [p[1]], [p[2]], color="k", s=12)
+        ax.text(p[0], p[1], p[2], f"  x3 = {p[2]:+.1f}", fontsize=8)
+    ax.set_box_aspect(np.maximum(np.ptp(X.reshape(-1, 3), axis=0), 1e-3 * np.ptp(X).max()))
+    ax.view_init(elev=28, azim=-60)
+    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap="viridis")
+    fig.colorbar(sm, ax=ax, shrink=0.7, pad=0.1).set_label("x3 [mm]")
+    ax.set_xlabel("x1 [mm]")
+    ax.set_ylabel("x2 [mm]")
+    ax.set_zlabel("x3 [mm]")
+    ax.set_title(f"{a.title}\nreference mid-surface of {a.case}: x3 in [{lo:.1f}, {hi:.1f}] mm",
+                 fontsize=9)
+    save(fig, a.out)
+
+
 def cmd_fields(a):
     r = Result(a.results, a.case)
     steps = r.steps() if r.ok else []
@@ -325,6 +363,10 @@ def main():
     s.add_argument("--case", required=True)
     s.add_argument("--title", default="")
     s.add_argument("--out", required=True)
+    s = sub.add_parser("geometry", help="the reference surface in 3-D (Fig. 16a)")
+    s.add_argument("--case", required=True)
+    s.add_argument("--title", default="")
+    s.add_argument("--out", required=True)
     s = sub.add_parser("placeholder", help="a PNG that says why a figure is missing")
     s.add_argument("--title", default="")
     s.add_argument("--message", default="")
@@ -333,7 +375,8 @@ def main():
     if a.cmd == "placeholder":
         placeholder(a.out, a.title, a.message)
         return
-    {"load": cmd_load, "deformed": cmd_deformed, "fields": cmd_fields}[a.cmd](a)
+    {"load": cmd_load, "deformed": cmd_deformed, "fields": cmd_fields,
+     "geometry": cmd_geometry}[a.cmd](a)
 
 
 if __name__ == "__main__":
