@@ -155,18 +155,11 @@ PLOT_A_DEPS += $(call st,$(2) $(6))
 PLOT_A_JOBS += $(call PLOTJOB,$(1),deformed --case $(2) --field $(3) --at $(4) $(if $(6),--share-limits $(6)) --title "$(5)")
 endef
 
-define fields # name, case, title
+define fields # name, case, title[, sub-command: fields (default) or geometry]
 FIGURES += $(FIG)/$(1).png
 PLOT_B_FIGS += $(FIG)/$(1).png
 PLOT_B_DEPS += $(call st,$(2))
-PLOT_B_JOBS += $(call PLOTJOB,$(1),fields --case $(2) --title "$(3)")
-endef
-
-define geometry # name, case, title
-FIGURES += $(FIG)/$(1).png
-PLOT_B_FIGS += $(FIG)/$(1).png
-PLOT_B_DEPS += $(call st,$(2))
-PLOT_B_JOBS += $(call PLOTJOB,$(1),geometry --case $(2) --title "$(3)")
+PLOT_B_JOBS += $(call PLOTJOB,$(1),$(or $(4),fields) --case $(2) --title "$(3)")
 endef
 
 define load # name, title, cases...
@@ -228,7 +221,7 @@ $(eval $(call deformed,fig15d_curved_E22,s322_curved_horizontal,E22,0.3,Fig. 15d
 $(eval $(call deformed,fig15e_curved_E12,s322_curved_horizontal,E12,0.3,Fig. 15e: horizontal test at 30 % (E12)))
 $(eval $(call load,fig15f_load_strain,Fig. 15f: curved patch horizontal test,s322_curved_horizontal))
 # Sect. 3.2.3 (Fig. 16)
-$(eval $(call geometry,fig16a_hypar_geometry,s323_hypar_tension,Fig. 16a: geometry of the hyperbolic paraboloid))
+$(eval $(call fields,fig16a_hypar_geometry,s323_hypar_tension,Fig. 16a: geometry of the hyperbolic paraboloid,geometry))
 $(eval $(call fields,fig16b_hypar_fields,s323_hypar_tension,Fig. 16b: stitch value and knitting direction))
 $(eval $(call deformed,fig16c_hypar_tension_E12,s323_hypar_tension,E12,last,Fig. 16c: diagonal tension ~21 % (E12)))
 $(eval $(call deformed,fig16d_hypar_compression_E12,s323_hypar_compression,E12,last,Fig. 16d: diagonal compression ~14 % (E12)))

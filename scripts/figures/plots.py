@@ -271,16 +271,24 @@ def course_direction(X, alpha):
     return c * e1 + s * e2, e1
 
 
-def cmd_geometry(a):
-    """The reference mid-surface X of a case (paper Fig. 16a: the hyperbolic paraboloid
-    x3 = 0.24 (x1 - 2.5)(x2 - 2.5) mm, corners moved up or down by 15 mm) in 3-D, coloured by
-    its height x3, the corners labelled with their x3."""
+def first_fields(a):
+    """The fields of the first output step of `a.case`, or None after drawing a placeholder
+    that says the run wrote none."""
     r = Result(a.results, a.case)
     steps = r.steps() if r.ok else []
     if not steps:
         placeholder(a.out, a.title, f"{a.case}: no field output (run failed)")
+        return None
+    return r.fields(steps[0])
+
+
+def cmd_geometry(a):
+    """The reference mid-surface X of a case (paper Fig. 16a: the hyperbolic paraboloid
+    x3 = 0.24 (x1 - 2.5)(x2 - 2.5) mm, corners moved up or down by 15 mm) in 3-D, coloured by
+    its height x3, the corners labelled with their x3."""
+    f = first_fields(a)
+    if f is None:
         return
-    f = r.fields(steps[0])
     X = f.get("X")
     if X is None or not np.all(np.isfinite(X)):
         placeholder(a.out, a.title, f"{a.case}: no finite reference coordinates")
@@ -309,12 +317,9 @@ def cmd_geometry(a):
 
 
 def cmd_fields(a):
-    r = Result(a.results, a.case)
-    steps = r.steps() if r.ok else []
-    if not steps:
-        placeholder(a.out, a.title, f"{a.case}: no field output (run failed)")
+    f = first_fields(a)
+    if f is None:
         return
-    f = r.fields(steps[0])
     if "stitch_value" not in f or "X" not in f:
         placeholder(a.out, a.title, f"{a.case}: the material wrote no design fields")
         return
