@@ -13,9 +13,10 @@ Usage: report.py --out-dir OUT --database OUT/database.h5 [--cells yes] [--sensi
 
 Every case of --cases-dir counts: one without a status file or a result is "no result", not
 left out of the count (session 30: deleting two status files gave "24 of 24 cases
-completed"). A check FAILs when a run it reads ended in error although it reached its strain
-(exit code not 0 with summary "completed": failed material evaluations, non-finite fields),
-has no status file, or has a field step whose load factor is not the CSV's (run_defect).
+completed"). A check FAILs when a run it reads has an exit code other than 0 while its summary
+says "completed", knit-macro's "results are not trustworthy" (summary lines of failed material
+evaluations or non-finite output fields, whether it completed or stopped), no status file, or
+a field step whose load factor is not the CSV's (Data.run_defect).
 Exit code 1, with the reason on stderr and report.md left as it was, when there is nothing to
 judge: no case has a result.
 """
@@ -323,9 +324,9 @@ class Data:
         summary lines of failed material evaluations or non-finite output fields (knit-macro's
         own "results are not trustworthy", whether the run completed or stopped: the count of
         failed evaluations is the whole run's), or a field step whose stored load factor is
-        not the CSV's. Computed once per run, before any
-        check reads its fields, so that every check of the run is judged alike. Session 30:
-        every check passed with exit code 1 in every status file."""
+        not the CSV's. Computed once per run, before any check reads its fields, so that every
+        check of the run is judged alike. Session 30: every check passed with exit code 1 in
+        every status file."""
         if name not in self.defects:
             self.defects[name] = self._run_defect(name)
         return self.defects[name]
