@@ -35,6 +35,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
 from results import Result  # noqa: E402
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
+from design import read_summary as read_design_summary  # noqa: E402
 
 import report_checks as rc  # noqa: E402
 from report_checks import Check, pct  # noqa: E402
@@ -835,14 +836,7 @@ def design_section(out):
                 st = json.load(f)
         except (OSError, ValueError):
             st = None  # unreadable
-        summ = {}
-        try:
-            with open(os.path.join(out, "design", n, "summary.txt")) as f:
-                for line in f:
-                    k, _, v = line.partition(":")
-                    summ.setdefault(k.strip(), v.strip())
-        except OSError:
-            pass
+        summ = read_design_summary(os.path.join(out, "design", n, "summary.txt"))
         exit_code = "? (status file unreadable)" if st is None else st.get("exit_code", "?")
         status = summ.get("status", f"no output (exit {exit_code})")
         if "status" in summ and exit_code != 0:  # the summary alone is not the verdict

@@ -68,14 +68,15 @@ def field_grid(spec, n=81):
 
 def read_summary(path):
     """summary.txt of a design -> {key: text} of its 'key: value' lines ({} when missing)."""
-    if not os.path.exists(path):
-        return {}
     out = {}
-    with open(path) as f:
-        for line in f:
-            key, sep, value = line.partition(":")
-            if sep and key.strip() not in out:
-                out[key.strip()] = value.strip()
+    try:
+        with open(path) as f:
+            for line in f:
+                key, sep, value = line.partition(":")
+                if sep and key.strip() not in out:
+                    out[key.strip()] = value.strip()
+    except OSError:  # missing or unreadable: the callers say what is missing
+        return {}
     return out
 
 

@@ -103,15 +103,24 @@ class Result:
             out.append((step, float(ds.get("timestep")), os.path.join(self.dir, f)))
         return out
 
+    def _h5_load_factors(self):
+        """{step: load_factor attribute (None when absent)} of results.h5's fields/step_NNNN,
+        read once ({} without the file or h5py)."""
+        if not hasattr(self, "_h5_lf"):
+            self._h5_lf = {}
+            try:
+                import h5py
+                with h5py.File(os.path.join(self.dir, "results.h5"), "r") as f:
+                    for k, g in f.get("fields", {}).items():
+                        v = g.attrs.get("load_factor")
+                        self._h5_lf[int(k.split("_")[-1])] = None if v is None else float(v)
+            except (ImportError, OSError, KeyError, ValueError):
+                self._h5_lf = {}
+        return self._h5_lf
+
     def _h5_steps(self):
-        h = os.path.join(self.dir, "results.h5")
-        try:
-            import h5py
-            with h5py.File(h, "r") as f:
-                return sorted((int(k.split("_")[-1]), float(f["fields"][k].attrs.get("load_factor", 0)),
-                               None) for k in f.get("fields", {}))
-        except (ImportError, OSError, KeyError, ValueError):
-            return []
+        return sorted((s, 0.0 if lf is None else lf, None)
+                      for s, lf in self._h5_load_factors().items())
 
     def steps(self):
         return [s for s, _, _ in self._steps]
@@ -145,17 +154,9 @@ class Result:
         """The load factor stored with the fields that fields(step) reads: the load_factor
         attribute of results.h5's fields/step_NNNN, else the PVD's timestep of the VTU file;
         None when neither says."""
-        path = os.path.join(self.dir, "results.h5")
-        if os.path.exists(path):
-            try:
-                import h5py
-                with h5py.File(path, "r") as f:
-                    g = f.get(f"fields/step_{step:04d}")
-                    if g is not None:
-                        v = g.attrs.get("load_factor")
-                        return None if v is None else float(v)
-            except (ImportError, OSError):
-                pass
+        h5 = self._h5_load_factors()
+        if step in h5:
+            return h5[step]
         for s, t, p in self._steps:
             if s == step and p is not None:
                 return t
