@@ -133,6 +133,36 @@ TEST_CASE("membrane patch test: a homogeneous deformation of a flat patch gives 
       CHECK(ev.fint.segment<3>(3 * (i + nu * j)).norm() < 1e-12 * ev.fint.norm());
 }
 
+TEST_CASE(
+    "membrane strain in the local Cartesian frame: T eps equals the Green strain tensor's "
+    "components on a curved, skew-parameterized surface",
+    "[unit]") {
+  // reference_point's T maps the covariant membrane strain eps_ab = (a_a.a_b - A_a.A_b)/2 to
+  // (E11, E22, 2 E12) in (e1, e2). Under an affine map x = F X + c the tangents map as a_a = F A_a,
+  // so eps_ab = A_a . G A_b with G = (F^T F - I)/2, and the Cartesian components are e_i . G e_j
+  // wherever the surface is curved or its parameter lines are oblique (L21 != 0 in T).
+  const auto surf = curved_patch(3, 3, 2, 2, 2.0, 1.3, 0.6, true);
+  Eigen::Matrix3d F;
+  F << 1.08, 0.07, -0.04, -0.03, 0.93, 0.06, 0.05, -0.02, 1.12;
+  const Eigen::Matrix3d G = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d c(0.4, -1.0, 0.25);
+  double largest_skew = 0;
+  for (double s : {0.05, 0.42, 0.9})
+    for (double t : {0.1, 0.63, 0.97}) {
+      const SurfaceDerivs dX = surf.derivatives(s, t, 2);
+      const ReferencePoint r = reference_point(dX, Eigen::Vector2d(s, t), 2.0);
+      SurfaceDerivs dx = dX * F.transpose();
+      dx.row(0) += c.transpose();
+      const CurrentPoint cur = current_point(dx, r);
+      const Eigen::Vector3d E = r.T * cur.eps;
+      CHECK(E(0) == Approx(r.e1.dot(G * r.e1)).margin(1e-13));
+      CHECK(E(1) == Approx(r.e2.dot(G * r.e2)).margin(1e-13));
+      CHECK(E(2) == Approx(2 * r.e1.dot(G * r.e2)).margin(1e-13));
+      largest_skew = std::max(largest_skew, std::abs(r.A(2)) / std::sqrt(r.A(0) * r.A(1)));
+    }
+  CHECK(largest_skew > 0.02);  // the parameter lines are oblique somewhere: T is not diagonal
+}
+
 TEST_CASE("3-point thickness integration equals the analytic one for St. Venant-Kirchhoff",
           "[unit]") {
   auto mat = std::make_shared<SaintVenantKirchhoff>(2100.0, 0.3);
