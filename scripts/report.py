@@ -288,6 +288,14 @@ def near_visited_text(db_path, res_dir):
                        "no run wrote material-frame strains")
 
 
+def held_out_text(db_path):
+    """Which held-out cell states the law misses (scripts/law_held_out.py)."""
+    import law_held_out as m
+    return beside_text("Where the held-out states miss",
+                       lambda: m.summary(m.held_out_misses(db_path)),
+                       "the database has no energy law or no held-out path")
+
+
 def small_strain_text(db_path):
     """The law over the cell at small strains (scripts/law_small_strain.py)."""
     import law_small_strain as m
@@ -709,6 +717,7 @@ class Report:
             for statement, threshold, measured, ok in law:
                 L.append(f"| {md(statement)} | {md(threshold)} | {md(measured)} | {verdict(ok)} |")
             L.append("")
+            L.append(held_out_text(db_path))
             L.append(near_visited_text(db_path, os.path.join(self.out, "results")))
             L.append(small_strain_text(db_path))
         L.append("## Statements of the paper against our numbers\n")

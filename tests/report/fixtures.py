@@ -21,3 +21,24 @@ def raw_path(f, name, set_, E, S, loop=0):
     g["status"] = np.zeros(len(E), dtype=np.int32)
     g.attrs["set"], g.attrs["kind"], g.attrs["axis"] = set_, "gradient", 0
     return g
+
+
+def script_refuses(c, script, args, needle, what):
+    """Checks with the Checklist `c` that `script` run on `args` by this Python exits non-zero
+    with `needle` on stderr and no traceback; `what` names the check."""
+    import subprocess
+    import sys
+    out = subprocess.run([sys.executable, script, *args], capture_output=True, text=True)
+    c(out.returncode != 0 and needle in out.stderr and "Traceback" not in out.stderr,
+      "%s: %s" % (what, out.stderr.strip()[-200:]))
+
+
+def call_refuses(c, call, needle, what):
+    """Checks with the Checklist `c` that call() raises a ValueError whose text holds
+    `needle`; `what` names the check."""
+    try:
+        call()
+    except ValueError as e:
+        c(needle in str(e), "%s: %s" % (what, e))
+        return
+    c(False, "%s: no error" % what)
