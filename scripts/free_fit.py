@@ -1,6 +1,6 @@
 """Free (law-free) reference fits of the cell's stresses, for the held-out criterion of issue 11:
 how well a smooth function trained on the fit paths alone predicts the held-out states, with no
-energy and no convexity (docs/database.md, "What predicts the held-out states"). Used by
+energy and no convexity (docs/law-experiments.md, "What predicts the held-out states"). Used by
 fit_bounds.py and by report.py (the reference printed beside the held-out verdict). numpy only.
 
   * free energy: S = grad W with W a tensor-product cubic B-spline over the strain box;

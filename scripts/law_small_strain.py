@@ -5,9 +5,9 @@ The law's acceptance measures every error against the loop length's stress range
 within 5 % of it). Near the unloaded state the cell's stresses are a few thousandths of that
 range (0.001-0.013 MPa at 1 % uniaxial strain against ranges of 21-33 MPa), so the acceptance
 cannot see how well the law does there, while the first part of every load-strain curve
-depends on it (docs/database.md, "Small strains are not pinned by the fit"). This script
-prints, per loop length, the law's stress over the cell's, |S_law| / |S_cell| (norm of the
-stress tensor), at the fit states whose strain components all lie within SMALL:
+depends on it (docs/law-experiments.md, "Small strains are not pinned by the fit"). This
+script prints, per loop length, the law's stress over the cell's, |S_law| / |S_cell| (norm of
+the stress tensor), at the fit states whose strain components all lie within SMALL:
 
     /usr/bin/python3 scripts/law_small_strain.py out/database.h5
     /usr/bin/python3 scripts/law_small_strain.py out/database.h5 --small 0.03
@@ -82,7 +82,7 @@ def summary(rows, small=SMALL):
             f"every |E_ij| <= {small:g}, whose stresses reach {top_text} % of the stress range "
             f"at most, the law's stress over the cell's is, median (10th-90th percentile): "
             f"{'; '.join(parts)}. The acceptance, relative to the range, does not see this "
-            f"(docs/database.md, \"Small strains are not pinned by the fit\").")
+            f"(docs/law-experiments.md, \"Small strains are not pinned by the fit\").")
 
 
 def main():

@@ -14,8 +14,8 @@
 // stress range / sS, on the uniaxial states at most tube_uniaxial x |own axial stress| / sS;
 // m_p = tube_uniaxial_weight on the uniaxial states, 1 on the others). With the softness prior
 // (prior_points > 0) the sums also run over its states (target t = 0, no tube: m_p = 0), and
-// both n and sum w count them (the tube fits with the prior in docs/database.md were measured
-// so).
+// both n and sum w count them (the tube fits with the prior in docs/law-experiments.md were
+// measured so).
 // S_W the stress of the mirror-averaged, normalized law (S(0) = 0). With the exponential outer
 // function (option outer "exp", session 15) the law is built from exp(N) instead of N:
 // S_W = 1/2 (g'(N(x)) S_N(x) + M g'(N(Mx)) S_N(Mx)) - g'(N(0)) S_N0, and the gradient adds

@@ -66,18 +66,19 @@ struct StrainBox {
 ///     whole box (E12 of both signs): the R3 sequence (fill_point), a different low-discrepancy
 ///     sequence than the held-out paths' Halton points, so no fill path ends on a held-out state.
 ///     They sample shear combined with stretch and compression throughout the box, where the
-///     rays above leave gaps (issue 11, docs/database.md "Fit"). States whose area ratio
-///     J = det F is below `fill_min_J` (0.5) are skipped: there the cell locks up (one fill
-///     state at J = 0.19 reached S = 114 MPa, 5x the stress range of every other state, just
-///     before its path diverged); the held-out states all have J >= 0.56.
+///     rays above leave gaps (issue 11, docs/law-experiments.md "Denser sampling, measured
+///     (session 5)"). States whose area ratio J = det F is below `fill_min_J` (0.5) are skipped:
+///     there the cell locks up (one fill state at J = 0.19 reached S = 114 MPa, 5x the stress
+///     range of every other state, just before its path diverged); the held-out states all have
+///     J >= 0.56.
 ///   * `rays` gradient paths of `ray_steps` steps along rays of the whole 3-D box (issue 11,
-///     docs/database.md "The compressed-and-sheared corner"): the ray directions are the `rays`
-///     points of a Fibonacci lattice on the half-sphere E12 > 0 in box-normalized strain (each axis
-///     scaled by the box's extent on that side of 0, so the box is the cube [-1, 1]^3), each
-///     ray from E = 0 out to the box's surface; a ray whose end has J = det F < `fill_min_J`
-///     is shortened to J = fill_min_J. The full circle of biaxial directions above is the
-///     E12 = 0 section of this sphere; the rays add every mix of stretch, compression and
-///     shear out to the box's faces, edges and corners (the fill paths sample the interior).
+///     docs/law-experiments.md "The compressed-and-sheared corner"): the ray directions are the
+///     `rays` points of a Fibonacci lattice on the half-sphere E12 > 0 in box-normalized strain
+///     (each axis scaled by the box's extent on that side of 0, so the box is the cube [-1, 1]^3),
+///     each ray from E = 0 out to the box's surface; a ray whose end has J = det F < `fill_min_J`
+///     is shortened to J = fill_min_J. The full circle of biaxial directions above is the E12 = 0
+///     section of this sphere; the rays add every mix of stretch, compression and shear out to the
+///     box's faces, edges and corners (the fill paths sample the interior).
 ///     The law is even in E12, so one half-sphere suffices.
 struct CoverageOptions {
   StrainBox box;

@@ -38,10 +38,10 @@
 
 namespace knit::meso::fit {
 
-/// The data's own floor for any convex law, in units of `range` (docs/database.md "What
-/// convexity itself costs"): the gradient of a convex W is monotone, (S_i - S_j) . (e_i - e_j)
-/// >= 0, and stress errors |d_ic| <= delta * range change that product by at most
-/// 2 delta range |e_i - e_j|_1, so every pair needs
+/// The data's own floor for any convex law, in units of `range` (docs/law-experiments.md
+/// "What convexity itself costs"): the gradient of a convex W is monotone,
+/// (S_i - S_j) . (e_i - e_j) >= 0, and stress errors |d_ic| <= delta * range change that
+/// product by at most 2 delta range |e_i - e_j|_1, so every pair needs
 /// delta >= -(S_i - S_j) . (e_i - e_j) / (2 range |e_i - e_j|_1). Returns the largest over all
 /// pairs (0 for monotone data). e = (E11, E22, 2E12); O(n^2), no allocation.
 double monotonicity_bound(const std::vector<Eigen::Vector3d>& e,
@@ -86,7 +86,8 @@ struct EnergyFitOptions {
   double tube_uniaxial = -1.0;
   /// Network family, with a tube: the uniaxial-stress paths' states' tube penalty, a multiple
   /// of tube_weight (1: alike). Their excess is a fraction of a small stress, so at the same
-  /// weight the jammed corners win (docs/database.md "The softness prior").
+  /// weight the jammed corners win (docs/law-experiments.md "The softness prior: measurements
+  /// (session 13)").
   double tube_uniaxial_weight = 1.0;
   /// Network family: a softness prior (choice, docs/database.md "The softness prior"). n
   /// quasi-random strain states per loop length (a Kronecker sequence in the box of that loop

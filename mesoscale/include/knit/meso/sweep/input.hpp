@@ -39,7 +39,7 @@ struct RetryPolicy {
   /// "substeps", session 18; retries multiply it by step_factor). With friction the cell is
   /// path-dependent, and a large step can land on another equilibrium branch than the
   /// quasi-static path: in the default sweep two held-out paths' stresses change by up to
-  /// 21.8 % of the range with 4 times the steps (docs/database.md). 1: every solve recorded.
+  /// 21.8 % of the range with 4 times the steps (docs/law-experiments.md). 1: every solve recorded.
   int substeps_paper = 1, substeps_coverage = 1, substeps_holdout = 1;
   int substeps_for(const material::LoadPath& p) const {
     return p.set == "paper" ? substeps_paper
