@@ -13,7 +13,8 @@ Deformed shapes are coloured by a Green-Lagrange strain component of the local C
 outline dashed, a shell that leaves the plane (the hyperbolic paraboloid) as a 3-D surface with
 the reference surface as a grey wire mesh. Colour limits: colour_limits() (spikes at loaded
 corners clipped to the 1st/99th percentile, the true extremes in the title; --share-limits gives
-several figures one scale). Design fields are drawn on the reference surface with arrows along
+several figures one scale); the map: is_diverging() (a diverging map centred on 0 where the
+field's bulk has both signs of comparable size, a sequential one otherwise). Design fields are drawn on the reference surface with arrows along
 the knitting (course) direction Q(alpha) e1.
 """
 import argparse
@@ -155,11 +156,21 @@ def colour_limits(values, diverging):
     return lo, hi, extend
 
 
+# Both signs count as "of comparable size" when the smaller side reaches this fraction of the
+# larger one.
+DIVERGING_FRACTION = 0.25
+
+
 def is_diverging(values):
-    """A strain field with both signs of comparable size is drawn with a diverging map centred
-    on 0 (the rule of before the clipped limits: decided on the extremes)."""
-    lim = max(abs(values.min()), abs(values.max()))
-    return bool(values.min() < -0.25 * lim)
+    """A strain field with both signs of comparable size (each side at least DIVERGING_FRACTION
+    of the other) is drawn with a diverging map centred on 0, any other with a sequential one.
+    Decided on the 1st/99th percentiles, the bulk of the field, as the colour limits are: a
+    spike at a loaded corner no longer picks the map (session 31: the extremes decided it, and
+    the test lacked the positive side, so a field of one sign, s315's E11 in [-0.31, 0.02], was
+    drawn on a diverging scale with half of it unused)."""
+    p1, p99 = (float(q) for q in np.percentile(np.asarray(values, dtype=float), [1, 99]))
+    lim = max(abs(p1), abs(p99))
+    return bool(lim > 0 and p1 < -DIVERGING_FRACTION * lim and p99 > DIVERGING_FRACTION * lim)
 
 
 def not_flat(P, rel=1e-6):
