@@ -224,10 +224,16 @@ int DesignSolve::level(double lambda) const {
 Sensitive DesignSolve::reaction(int k, const ReactionOutput& r) const {
   const ShellModel& m = *problem_->model;
   const Level& L = levels_.at(static_cast<std::size_t>(k));
+  // A corner reaction sums over the corner's pad, corner_region(radius), as run_case writes it
+  // (session 31: only the corner control point was read, so a design on an output with a
+  // radius optimized another number than the one its run reports).
+  const std::vector<int> pad =
+      r.at_edge ? std::vector<int>{} : corner_region(c_.surface, r.corner, r.radius);
   auto apply = [&](const Eigen::VectorXd& f) {
     if (r.at_edge) return edge_reaction(m, f, r.edge, r.component, r.rows);
-    const int a = corner_control_point(c_.surface.size_u(), c_.surface.size_v(), r.corner);
-    return f(3 * a + r.component);
+    double sum = 0.0;
+    for (int a : pad) sum += f(3 * a + r.component);
+    return sum;
   };
   Sensitive s;
   s.value = apply(L.fint);

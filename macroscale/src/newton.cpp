@@ -453,7 +453,10 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       stop(StopReason::kIncrementFloor, s.str(), lam1, o.why);
       return report;
     }
-    h *= 0.5;
+    // Half the increment that failed, not half of h: after a doubling, lam1 may have been
+    // clipped at the nominal level, and h / 2 then retried the same increment from the same
+    // state (session 31: 0.5 -> 1 failed twice, one cut-back and 36 iterations spent on it).
+    h = 0.5 * (lam1 - lambda);
   }
   return report;
 }

@@ -529,6 +529,24 @@ TEST_CASE("cut-back: one load step for the large-deflection cantilever still rea
   CHECK(r.rows.back().points[0](2) == Approx(6.698).epsilon(0.02));
 }
 
+TEST_CASE("cut-back: a halved increment is never the one that just failed", "[verification]") {
+  // The one-step cantilever above, allowed two cut-backs in a row: 0 -> 1 fails, 0 -> 0.5
+  // converges, the increment doubles to 1 and is clipped at 1, 0.5 -> 1 fails; the next try is
+  // 0.5 -> 0.75. Session 31: h / 2 = 0.5 retried 0.5 -> 1 from the same state, failed again
+  // and spent the second cut-back, so the run stopped "after 2 cut-backs".
+  json j = read_json("sze_cantilever.json");
+  j["solver"]["steps"] = 1;
+  j["solver"]["max_iterations"] = 12;
+  j["solver"]["max_cutbacks"] = 2;
+  j["refinement"]["elements"] = {8, 1};
+  const RunResult r = run_case(parse_case(j.dump(), "one_step.json"), {});
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  std::vector<double> lambdas;
+  for (const StepRow& row : r.rows) lambdas.push_back(row.lambda);
+  CHECK(lambdas == std::vector<double>{0.5, 0.75, 1.0});
+}
+
 TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provenance", "[unit]") {
   const fs::path d = temp_dir("out");
   json j = read_json("tensile_svk.json");
