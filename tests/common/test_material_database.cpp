@@ -295,6 +295,31 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
                         f.write("/loop_1/raw/path_03/S", S);
                       })),
                       Catch::Contains("/loop_1/raw/path_03/S: step 1 holds |value| 1e+308"));
+    // Session 31 (a mutation audit): the edges of these refusals. Equal loop lengths, a strain
+    // beyond 1e3 (a stress bound alone passed it), a status of 3 (one past the last known) and
+    // a group whose loop_length is not its entry in /loop_lengths.
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        auto l = f.read_doubles("/loop_lengths");
+                        l[1] = l[0];
+                        f.write("/loop_lengths", l);
+                      })),
+                      Catch::Contains("strictly increasing (entry 1"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        auto E = f.read_matrix("/loop_1/raw/path_03/E");
+                        E(0, 1) = 1e4;
+                        f.write("/loop_1/raw/path_03/E", E);
+                      })),
+                      Catch::Contains("/loop_1/raw/path_03/E: step 1 holds |value| 10000"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        auto st = f.read_ints("/loop_1/raw/path_03/status");
+                        st[0] = 3;
+                        f.write("/loop_1/raw/path_03/status", st);
+                      })),
+                      Catch::Contains("/loop_1/raw/path_03/status: step 1: status 3"));
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        f.set_attribute("/loop_1", "loop_length", 5.25);
+                      })),
+                      Catch::Contains("/loop_1: loop_length 5.25"));
     CHECK_NOTHROW(read_database(mutate([](knit::io::H5File& f) {
       f.set_attribute("/loop_1", "wale_width", 0.0);  // 0: not known
     })));
