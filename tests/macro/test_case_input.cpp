@@ -574,6 +574,18 @@ TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provena
   CHECK(json::parse(h5.read_strings("case_json").at(0)) == j);
   CHECK(h5.read_doubles("fields/step_0004/E22").size() == 35u);
   CHECK(h5.read_doubles("steps/reactions/jaw_force").size() == 4u);
+  // The strain column is the applied displacement over the gauge length (15 mm over 50 mm at
+  // lambda = 1), not the displacement (session 31: a mutant writing it survived).
+  const std::vector<double> lam = h5.read_doubles("steps/load_factor"),
+                            eps = h5.read_doubles("steps/strain"),
+                            app = h5.read_doubles("steps/applied_displacement");
+  REQUIRE(lam.size() == 4u);
+  REQUIRE(eps.size() == 4u);
+  REQUIRE(app.size() == 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    CHECK(app[k] == Approx(15.0 * lam[k]));
+    CHECK(eps[k] == Approx(0.3 * lam[k]));
+  }
   // Every dataset states its unit; n and m say which stress measure they are (session 27).
   CHECK(h5.attribute_string("steps/reactions/jaw_force", "units") == "N");
   CHECK(h5.attribute_string("steps/strain", "units") == "1");

@@ -126,6 +126,8 @@ TEST_CASE("knitmap: cell table interpolates w and c linearly in l", "[unit]") {
 TEST_CASE("knitmap: a uniform patch needs round(W/w) needles and round(H/c) courses", "[case]") {
   const std::string db = database();
   const double W = 40.0, H = 30.0, l = 5.5;  // a database loop length: w, c exact
+  const int n_uniform = static_cast<int>(std::lround(W / w_of(l)));
+  const std::size_t k_uniform = static_cast<std::size_t>(std::lround(H / c_of(l)));
   for (double beta : {0.0, 0.6}) {
     INFO("patch rotated by " << beta);
     const KnitMap m = map_of("uniform.json", case_text(knit_material(db, "5.5"), W, H, beta));
@@ -153,6 +155,17 @@ TEST_CASE("knitmap: a uniform patch needs round(W/w) needles and round(H/c) cour
       map_of("uniform90.json", case_text(knit_material(db, "5.5", "1.5707963267948966"), W, H));
   CHECK(m.needles == std::lround(H / w_of(l)));
   CHECK(m.courses.size() == std::size_t(std::lround(W / c_of(l))));
+  // Session 31 (a mutation audit): alpha turns about the surface normal, so on a mirrored
+  // patch (y -> -y: the normal along -z) alpha = 0.3 rad turns the course direction by -17.19
+  // deg (a mutant that ignored the orientation survived); and a patch turned by 180 deg, where
+  // the course direction sits at the branch cut of the mean angle, is mapped, not refused.
+  const KnitMap mirrored =
+      map_of("mirrored.json", case_text(knit_material(db, "5.5", "0.3"), W, -H));
+  CHECK(mirrored.course_direction_deg == Approx(-0.3 * 180 / M_PI).margin(1e-9));
+  KnitMap turned;
+  REQUIRE_NOTHROW(turned = map_of("turned.json", case_text(knit_material(db, "5.5"), W, H, M_PI)));
+  CHECK(turned.needles == n_uniform);
+  CHECK(turned.courses.size() == k_uniform);
 }
 
 TEST_CASE("knitmap: a discontinuous 4.5|6.5 patch gives two blocks", "[case]") {
