@@ -109,6 +109,37 @@ TEST_CASE("loop-length family: reproduces each fitted loop length exactly (eq. 2
   CHECK_THROWS_WITH(fam.weights(4.4), Catch::Contains("outside"));
 }
 
+TEST_CASE("loop-length family: cubic in l from four intervals on, and its refusals", "[unit]") {
+  // Session 31 (a mutation audit): every family of the tests had at most 3 loop lengths, where
+  // the interpolation's degree min(3, m - 1) is 2 whatever the cap; five loop lengths whose
+  // laws scale by a cubic f(l) are reproduced between them exactly only by a cubic.
+  const auto f = [](double l) {
+    const double x = l - 4.5;
+    return 1.0 + 0.2 * x + 0.1 * x * x + 0.05 * x * x * x;
+  };
+  const std::vector<double> l = {4.5, 5.0, 5.5, 6.0, 6.5};
+  const ResponseSurfaceData base = make_test_surface();
+  std::vector<ResponseSurfaceData> laws;
+  for (double li : l) {
+    ResponseSurfaceData d = base;
+    d.S_ctrl *= f(li);
+    d.S12_ctrl *= f(li);
+    laws.push_back(d);
+  }
+  const LoopLengthFamily fam(l, laws);
+  for (double at : {4.7, 5.25, 6.1}) {
+    INFO("l = " << at);
+    CHECK((fam.at(at).S_ctrl - f(at) * base.S_ctrl).norm() <= 1e-12 * base.S_ctrl.norm());
+  }
+  // Equal loop lengths, and laws on other knots, are refused.
+  CHECK_THROWS_WITH(LoopLengthFamily({4.5, 5.0, 5.0}, {laws[0], laws[1], laws[2]}),
+                    Catch::Contains("increase strictly"));
+  ResponseSurfaceData other = laws[1];
+  other.knots2[other.knots2.size() / 2] += 0.05;
+  CHECK_THROWS_WITH(LoopLengthFamily({4.5, 5.0}, {laws[0], other}),
+                    Catch::Contains("other degrees or knots"));
+}
+
 TEST_CASE("response surface: inversion never fails in a large box, tangent consistent", "[unit]") {
   const ResponseSurface rs(make_test_surface());
   std::mt19937 gen(7);

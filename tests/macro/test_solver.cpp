@@ -212,6 +212,14 @@ TEST_CASE("energy line search: the full step first, backtracking decreases Pi", 
       [](double a) { return std::optional<double>((a - 1) * (a - 1)); }, 1.0, -2.0, 1.0);
   CHECK(q.alpha == 1.0);
   CHECK(q.evaluations == 1);
+  // A quadratic whose minimum is at alpha = 0.3: the backtrack's quadratic model is exact, so
+  // the second evaluation lands on 0.3 (session 31: a sign error in the model's curvature
+  // term survived the test above, which only asked for some decrease).
+  const EnergyLineSearch q3 = energy_line_search(
+      [](double a) { return std::optional<double>((a - 0.3) * (a - 0.3)); }, 0.09, -0.6, 1.0);
+  CHECK(q3.alpha == Approx(0.3).epsilon(1e-12));
+  CHECK(q3.evaluations == 2);
+  CHECK(q3.Pi == Approx(0.0).margin(1e-15));
 }
 
 TEST_CASE("ShellModel energy: its derivative is f_int (finite differences)", "[unit]") {
