@@ -14,8 +14,8 @@ outline dashed, a shell that leaves the plane (the hyperbolic paraboloid) as a 3
 the reference surface as a grey wire mesh. Colour limits: colour_limits() (spikes at loaded
 corners clipped to the 1st/99th percentile, the true extremes in the title; --share-limits gives
 several figures one scale); the map: is_diverging() (a diverging map centred on 0 where the
-field's bulk has both signs of comparable size, a sequential one otherwise). Design fields are drawn on the reference surface with arrows along
-the knitting (course) direction Q(alpha) e1.
+field's bulk has both signs of comparable size, a sequential one otherwise). Design fields are
+drawn on the reference surface with arrows along the knitting (course) direction Q(alpha) e1.
 """
 import argparse
 import os
