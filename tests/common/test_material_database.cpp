@@ -165,6 +165,29 @@ TEST_CASE("database: a write that fails names the target and leaves the earlier 
     CHECK(e.path().filename().string().find("full.h5.tmp-") == std::string::npos);
 }
 
+TEST_CASE("database: the strain domain is that of the converged steps, |E12| both signs",
+          "[unit]") {
+  // Session 31 (a mutation audit): domain() was never compared with known values; a status
+  // test of "> 1" (a step that did not converge read as data) and E12 without abs survived.
+  Database db;
+  LoopLengthEntry e;
+  e.loop_length = 5.0;
+  RawPath r;
+  r.E.resize(3, 3);
+  r.E << 0.1, -0.05, -0.5,  //
+      0.9, 0.8, 0.7,        // status 1: did not converge, no data
+      -0.2, 0.3, 0.2;
+  r.status = {0, 1, 0};
+  e.raw.push_back(r);
+  db.entries.push_back(e);
+  const StrainDomain d = db.domain();
+  CHECK(d.E11_min == -0.2);
+  CHECK(d.E11_max == 0.1);
+  CHECK(d.E22_min == -0.05);
+  CHECK(d.E22_max == 0.3);
+  CHECK(d.E12_max == 0.5);
+}
+
 TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
   const auto good = tmp("good.h5");
   write_database(good, small_db());

@@ -278,13 +278,21 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
 
 // The smoothness penalty is a regularization: a design that meets its targets with J > 0 from
 // the penalty alone is "converged" (review of session 26).
-TEST_CASE("design status: the smoothness penalty does not count against the targets", "[unit]") {
+namespace {
+/// A design of one stitch value in [4.5, 6.5] and one objective, for the status tests.
+DesignProblem one_variable_design(double smoothness) {
   DesignProblem d;
   d.variables.resize(1);
   d.variables[0].lower = 4.5;
   d.variables[0].upper = 6.5;
   d.objectives.resize(1);
-  d.smoothness = 0.1;
+  d.smoothness = smoothness;
+  return d;
+}
+}  // namespace
+
+TEST_CASE("design status: the smoothness penalty does not count against the targets", "[unit]") {
+  const DesignProblem d = one_variable_design(0.1);
   OptimizeOptions opt;
   DesignResult r;
   r.x = {5.5};
@@ -301,6 +309,27 @@ TEST_CASE("design status: the smoothness penalty does not count against the targ
   CHECK(r.status == DesignStatus::kTargetNotMet);
   CHECK_THAT(r.message, Catch::StartsWith("no descent step found; the objectives' J = 1 is 0.1 x"));
   CHECK_THAT(r.message, Catch::Contains("the smoothness penalty left out"));
+}
+
+// Either bound counts: a stop with the objectives above `feasible` x their start is
+// "infeasible target" with a variable on its lower or on its upper bound, "target not met"
+// inside (session 31: a mutant that looked at the lower bound only survived).
+TEST_CASE("design status: a variable on either bound makes a stop an infeasible target", "[unit]") {
+  const DesignProblem d = one_variable_design(0.0);
+  const OptimizeOptions opt;
+  for (const auto& [x, expected] :
+       {std::pair{4.5, DesignStatus::kInfeasible}, std::pair{6.5, DesignStatus::kInfeasible},
+        std::pair{5.5, DesignStatus::kTargetNotMet}}) {
+    INFO("x = " << x);
+    DesignResult r;
+    r.x = {x};
+    r.terms0 = {{"load", 10.0}};
+    r.J0 = 10.0;
+    r.terms = {{"load", 1.0}};
+    r.J = 1.0;
+    classify_result(d, opt, true, r);
+    CHECK(r.status == expected);
+  }
 }
 
 // Session 23 made a final run that is not a plain success end `knit-macro design` with exit 1;
