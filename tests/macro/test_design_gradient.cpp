@@ -89,5 +89,9 @@ TEST_CASE("design gradient: a variable outside the field names the field", "[uni
     FAIL("no error");
   } catch (const knit::InputError& e) {
     CHECK(e.pointer() == "/material/stitch_value/values");
+    // Index 2 of a 2-value field: refused as such (session 31: with the bound test at '>', the
+    // index read past the end, the JSON array grew a null and another error gave the same
+    // pointer).
+    CHECK_THAT(e.what(), Catch::Contains("control value 2 is outside the field's 2 values"));
   }
 }
