@@ -297,11 +297,25 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
       }
       return bad;
     };
-    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
-                        auto l = f.read_doubles("/loop_lengths");
-                        std::swap(l[0], l[1]);
-                        f.write("/loop_lengths", l);
-                      })),
+    // Mutations of /loop_lengths' first two entries and of one raw value of /loop_1/path_03.
+    auto loop_lengths = [](double first, double second) {
+      return [=](knit::io::H5File& f) {
+        auto l = f.read_doubles("/loop_lengths");
+        l[0] = first;
+        l[1] = second;
+        f.write("/loop_lengths", l);
+      };
+    };
+    auto raw_value = [](const std::string& dataset, int row, int col, double value) {
+      return [=](knit::io::H5File& f) {
+        const std::string p = "/loop_1/raw/path_03/" + dataset;
+        auto m = f.read_matrix(p);
+        m(row, col) = value;
+        f.write(p, m);
+      };
+    };
+    const auto ls = knit::io::H5File::open_read(good).read_doubles("/loop_lengths");
+    CHECK_THROWS_WITH(read_database(mutate(loop_lengths(ls[1], ls[0]))),
                       Catch::Contains("/loop_lengths: loop lengths must be finite, positive and "
                                       "strictly increasing"));
     CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
@@ -312,26 +326,14 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
                         f.set_attribute("/loop_1", "wale_width", -1.0);
                       })),
                       Catch::Contains("/loop_1/wale_width: attribute wale_width must be finite"));
-    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
-                        auto S = f.read_matrix("/loop_1/raw/path_03/S");
-                        S(0, 0) = 1e308;
-                        f.write("/loop_1/raw/path_03/S", S);
-                      })),
+    CHECK_THROWS_WITH(read_database(mutate(raw_value("S", 0, 0, 1e308))),
                       Catch::Contains("/loop_1/raw/path_03/S: step 1 holds |value| 1e+308"));
     // Session 31 (a mutation audit): the edges of these refusals. Equal loop lengths, a strain
     // beyond 1e3 (a stress bound alone passed it), a status of 3 (one past the last known) and
     // a group whose loop_length is not its entry in /loop_lengths.
-    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
-                        auto l = f.read_doubles("/loop_lengths");
-                        l[1] = l[0];
-                        f.write("/loop_lengths", l);
-                      })),
+    CHECK_THROWS_WITH(read_database(mutate(loop_lengths(ls[0], ls[0]))),
                       Catch::Contains("strictly increasing (entry 1"));
-    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
-                        auto E = f.read_matrix("/loop_1/raw/path_03/E");
-                        E(0, 1) = 1e4;
-                        f.write("/loop_1/raw/path_03/E", E);
-                      })),
+    CHECK_THROWS_WITH(read_database(mutate(raw_value("E", 0, 1, 1e4))),
                       Catch::Contains("/loop_1/raw/path_03/E: step 1 holds |value| 10000"));
     CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
                         auto st = f.read_ints("/loop_1/raw/path_03/status");
