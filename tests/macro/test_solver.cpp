@@ -3,7 +3,8 @@
 // detects the limit point of a strip in compression; the energy line search decreases the
 // total potential; ShellModel's energy has f_int as its derivative; robustness (non-finite
 // residuals, the floor of the increment and the cap on the work, fewer than five constraints,
-// `output.vtk: false`).
+// `output.vtk: false`); load stepping's bookkeeping (cut-backs, doubling, the counts of
+// negative pivots over a run that passes a softening window, a patch with no free DOF).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -288,6 +289,13 @@ TEST_CASE("load stepping: a floor on the increment and a cap on the work, named 
   CHECK(floor.report.status == RunStatus::kNotConverged);
   CHECK(floor.report.reason == StopReason::kIncrementFloor);
   CHECK(floor.report.message.find("min_increment = 0.001") != std::string::npos);
+  // The increment the message names is the one that failed: halving it would pass the floor.
+  const std::string what = "with the increment at its floor (";
+  const std::size_t at = floor.report.message.find(what);
+  REQUIRE(at != std::string::npos);
+  const double failed = std::stod(floor.report.message.substr(at + what.size()));
+  CHECK(failed >= 1e-3);
+  CHECK(failed < 2e-3);
   CHECK(floor.report.last_lambda == Approx(0.158).margin(2e-3));
   const RunResult cap = run(j, [&](Case& c) {
     brittle(c);
@@ -426,4 +434,128 @@ TEST_CASE("fold guard: a mirrored state is found, a rotation below 90 degrees pa
   CHECK(check(Eigen::VectorXd::Zero(m.num_dofs())) == 0);
   // The element corners are checked too: their index follows the quadrature points'.
   CHECK(guard.where(m.num_quadrature_points()).isApprox(Eigen::Vector2d(0.0, 0.0)));
+}
+
+// Load stepping's bookkeeping (newton.cpp), each part of it seen in a run's load factors or
+// messages (session 32: mutants of these lines survived the suite, docs/solver.md).
+TEST_CASE("load stepping: after a cut-back the increment doubles back, and the count restarts",
+          "[unit]") {
+  // The Sze cantilever in 2 nominal steps of 0.5 with at most 8 iterations a step: 0 -> 0.5
+  // fails, 0.25 converges (1 cut-back), 0.25 -> 0.5 fails (2), 0.375 fails (3), 0.3125
+  // converges; the increment doubles to 0.125 (0.4375) and 0.25 (clipped at the nominal level
+  // 0.5); there the count starts again: 0.5 -> 1 fails (1), 0.75 and 1 converge. Without the
+  // doubling the increment stays at 0.0625 (0.375, 0.4375, ...); without the restart the fourth
+  // cut-back at 0.5 -> 1 stops the run.
+  json j = verification_case("sze_cantilever.json");
+  j["solver"]["steps"] = 2;
+  j["solver"]["max_iterations"] = 8;
+  j["solver"]["max_cutbacks"] = 3;
+  const RunResult r = run(j);
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  std::vector<double> lambdas;
+  for (const StepRow& row : r.rows) lambdas.push_back(row.lambda);
+  CHECK(lambdas == std::vector<double>{0.25, 0.3125, 0.4375, 0.5, 0.75, 1.0});
+  // Two cut-backs allowed: the third, at 0.25 -> 0.375, stops the run, and the message names
+  // the count and the increment that failed last.
+  j["solver"]["max_cutbacks"] = 2;
+  const RunResult s = run(j);
+  CHECK(s.report.status == RunStatus::kNotConverged);
+  CHECK(s.report.reason == StopReason::kCutbacks);
+  CHECK(s.report.converged_steps == 1);
+  CHECK_THAT(s.report.message,
+             Catch::StartsWith("load step to lambda = 0.375 failed after 2 cut-backs of the "
+                               "increment (last increment 0.125): no convergence in 8 "
+                               "iterations"));
+  CHECK_THAT(s.report.message, Catch::EndsWith("1 converged steps kept, last lambda = 0.25"));
+}
+
+namespace {
+
+/// St. Venant-Kirchhoff (E = 1, nu = 0) with a wave in S11: S11 = E11 + A sin(k E11),
+/// W = E11^2 / 2 + A (1 - cos(k E11)) / k + (SVK's other terms). With A k = 1.88 the slope
+/// dS11/dE11 = 1 + A k cos(k E11) is negative for k E11 in (2.13, 4.15): a softening window
+/// E11 in (0.034, 0.066) between two stable branches (k = 2 pi / 0.1).
+struct Wavy final : Material {
+  SaintVenantKirchhoff svk{1.0, 0.0};
+  double A = 0.03, k = 2.0 * std::acos(-1.0) / 0.1;
+  std::string name() const override { return "wavy"; }
+  bool hyperelastic() const override { return true; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& w) const override {
+    MaterialResponse r = svk.evaluate(E, w);
+    r.S(0) += A * std::sin(k * E(0));
+    r.C(0, 0) += A * k * std::cos(k * E(0));
+    r.W += A * (1.0 - std::cos(k * E(0))) / k;
+    return r;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("stability: a run that passes a softening window and stiffens again", "[unit]") {
+  // The strip stretched to s = 1.1 in 10 steps under a prescribed end displacement: E11 =
+  // (s^2 - 1) / 2 = 0.010, 0.020, ..., 0.105; the steps inside the window (E11 = 0.041, 0.051,
+  // 0.062: steps 4-6) have negative pivots, the later ones none. The run's figures keep the
+  // unstable stretch: its first step, and the largest count (not the last step's 0).
+  const json bc = json::parse(R"({"edge": "u1", "fix": ["y", "z"], "prescribe": {"x": 1.0}})");
+  std::ostringstream log;
+  const Case c = [&] {
+    Case x = parse_case(strip(bc, true).dump(), "wavy.json");
+    x.material = std::make_shared<Wavy>();
+    return x;
+  }();
+  RunOptions o;
+  o.progress = &log;
+  const RunResult r = run_case(c, o);
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  REQUIRE(r.rows.size() == 10);
+  std::vector<int> unstable;
+  for (const StepRow& row : r.rows)
+    if (row.negative_pivots > 0) unstable.push_back(row.step);
+  CHECK(unstable == std::vector<int>{4, 5, 6});
+  CHECK(r.rows.back().negative_pivots == 0);
+  CHECK(r.report.first_unstable_step == 4);
+  CHECK(r.report.max_negative_pivots > 0);
+  CHECK(
+      r.report.max_negative_pivots ==
+      std::max({r.rows[3].negative_pivots, r.rows[4].negative_pivots, r.rows[5].negative_pivots}));
+  CHECK_THAT(stability_summary(r.report), Catch::StartsWith("unstable from step 4 (load factor "));
+  // The step log flags exactly the unstable steps.
+  std::istringstream lines(log.str());
+  int flagged = 0;
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("UNSTABLE: ") != std::string::npos) ++flagged;
+  CHECK(flagged == 3);
+  // The same run on the LU path has no inertia: -1 everywhere, nothing flagged, and the
+  // summary says why.
+  Case lu = c;
+  lu.solver.symmetric = false;
+  std::ostringstream lu_log;
+  o.progress = &lu_log;
+  const RunResult u = run_case(lu, o);
+  REQUIRE(u.report.status == RunStatus::kCompleted);
+  for (const StepRow& row : u.rows) CHECK(row.negative_pivots == -1);
+  CHECK(u.report.max_negative_pivots == -1);
+  CHECK(u.report.first_unstable_step == -1);
+  CHECK(lu_log.str().find("UNSTABLE") == std::string::npos);
+  CHECK_THAT(stability_summary(u.report),
+             Catch::StartsWith("not available (unsymmetric tangent, LU factorization)"));
+}
+
+TEST_CASE("stability: a patch with no free DOF has 0 negative pivots, or none on the LU path",
+          "[unit]") {
+  // Every DOF fixed, an edge load on the supports: the reduced tangent is 0 x 0 and every
+  // step converges at once.
+  json j = strip(json::parse(R"({"type": "edge", "edge": "u1", "force_per_length": [0.1, 0, 0]})"),
+                 true);
+  j["boundary_conditions"].push_back(json::parse(R"({"all": true, "fix": ["x", "y", "z"]})"));
+  const RunResult r = run(j);
+  INFO(r.report.message);
+  REQUIRE(r.report.status == RunStatus::kCompleted);
+  CHECK(r.report.stats.unknowns == 0);
+  for (const StepRow& row : r.rows) CHECK(row.negative_pivots == 0);
+  const RunResult u = run(j, [](Case& c) { c.solver.symmetric = false; });
+  REQUIRE(u.report.status == RunStatus::kCompleted);
+  for (const StepRow& row : u.rows) CHECK(row.negative_pivots == -1);
 }
