@@ -1032,6 +1032,19 @@ TEST_CASE("a refinement that cannot fit in memory is refused at load with the es
   // 256 elements x 256 points x (11 x 256 x 8 + 256) bytes of quadrature data.
   CHECK(m.quadrature == 256ull * 256 * (11 * 256 * 8 + 256));
   CHECK(m.element_tangents == 256ull * 768 * 768 * 8);
+  // The global system: a dense matrix (two copies, the factor's too) up to N = 2500 unknowns,
+  // else 3 copies of 16 bytes per entry of the sparse pattern (bounded by N^2). Here 31 x 31
+  // control points: N = 2883, and the pattern of degree 15 (3 x 31 x 31 per row) is full.
+  CHECK(m.global_system == 48ull * 2883 * 2883);
+  // 15 x 15 elements: 30 x 30 control points, N = 2700, and a row of the pattern (3 x 31 x 31
+  // = 2883 entries) is longer than N: the bound N^2 is what counts.
+  j["refinement"] = {{"degree", 15}, {"elements", {15, 15}}};
+  CHECK(estimate_shell_memory(parse_case(j.dump(), "t.json").surface).global_system ==
+        48ull * 2700 * 2700);
+  const double n_small = 3.0 * small.surface.size_u() * small.surface.size_v();
+  REQUIRE(n_small <= 2500);
+  CHECK(estimate_shell_memory(small.surface).global_system ==
+        static_cast<std::uint64_t>(2.0 * n_small * n_small * 8.0));
 }
 
 TEST_CASE("a knit field degree of 1e10 is an input error before any int conversion", "[unit]") {

@@ -1,18 +1,27 @@
 // knit-macro run and its output directory (issue 14, docs/io.md "Output targets"): it never
 // deletes what it did not write, refuses a target it cannot write before any work (exit 2,
 // naming the option and the path), locks the output against a concurrent run, and refuses a
-// run whose estimated output is larger than the cap.
+// run whose estimated output is larger than the cap; what it writes: the sampled fields,
+// `output.every`, and a non-finite sample named where it is.
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "../output_test_util.hpp"
+#include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/run.hpp"
+#include "knit/macro/shell_model.hpp"
+#include "knit/macro/svk_material.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -231,5 +240,157 @@ TEST_CASE("knit-macro run: the output size estimate matches what is written", "[
   INFO("estimated " << est << " bytes, written " << bytes);
   CHECK(est > 0.8 * static_cast<double>(bytes));
   CHECK(est < 1.2 * static_cast<double>(bytes));
+  fs::remove_all(d);
+}
+
+namespace {
+
+std::string verification_text(const std::string& name) {
+  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+}  // namespace
+
+TEST_CASE("results.h5: the fields are the shell's samples on the output grid", "[unit][outputs]") {
+  // The Scordelis-Lo roof (curved: every strain, curvature and resultant is non-zero somewhere)
+  // on a 4 x 3 grid: row k = i + 4 j at (theta1, theta2) = (i / 3, j / 2), the Voigt shears
+  // (2E12, 2k12) stored as tensor components, n and m as they are (session 32: a writer with
+  // E12 = 2E12, or grid rows in the other order, survived the suite).
+  using namespace knit::macro;
+  const fs::path d = scratch("fields");
+  json j = json::parse(verification_text("scordelis_lo.json"));
+  j["solver"]["steps"] = 1;
+  j["output"]["grid"] = {4, 3};
+  const Case c = parse_case(j.dump(), "roof.json");
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  const RunResult r = run_case(c, ro);
+  REQUIRE(r.succeeded());
+  const Problem p = setup_problem(c);
+  auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+  const std::string g = "fields/step_0001/";
+  const auto X = h5.read_matrix(g + "X"), x = h5.read_matrix(g + "x");
+  std::map<std::string, std::vector<double>> f;
+  for (const char* n : {"E11", "E22", "E12", "kappa11", "kappa22", "kappa12", "n11", "n22", "n12",
+                        "m11", "m22", "m12"})
+    f[n] = h5.read_doubles(g + n);
+  Eigen::Vector3d largest = Eigen::Vector3d::Zero();  // |2E12|, |2k12|, |m12| over the grid
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();   // |E11|, |k11|, |m11|
+  for (int jj = 0; jj < 3; ++jj)
+    for (int i = 0; i < 4; ++i) {
+      const int k = i + 4 * jj;
+      const ShellSample s = p.model->sample(r.u, Eigen::Vector2d(i / 3.0, jj / 2.0));
+      INFO("grid point " << k);
+      CHECK((X.row(k).transpose() - s.X).norm() <= 1e-12 * s.X.norm());
+      CHECK((x.row(k).transpose() - s.x).norm() <= 1e-12 * s.x.norm());
+      const double want[12] = {s.E(0),     s.E(1),           0.5 * s.E(2), s.kappa(0),
+                               s.kappa(1), 0.5 * s.kappa(2), s.n(0),       s.n(1),
+                               s.n(2),     s.m(0),           s.m(1),       s.m(2)};
+      const char* names[12] = {"E11", "E22", "E12", "kappa11", "kappa22", "kappa12",
+                               "n11", "n22", "n12", "m11",     "m22",     "m12"};
+      for (int q = 0; q < 12; ++q)
+        CHECK(f[names[q]][k] == Approx(want[q]).epsilon(1e-12).margin(1e-300));
+      largest = largest.cwiseMax(
+          Eigen::Vector3d(std::abs(s.E(2)), std::abs(s.kappa(2)), std::abs(s.m(2))));
+      normal = normal.cwiseMax(
+          Eigen::Vector3d(std::abs(s.E(0)), std::abs(s.kappa(0)), std::abs(s.m(0))));
+    }
+  // The shears are well above round-off (against the normal components), so their factor is
+  // seen: on this grid |2E12| reaches 1 % of |E11|, |2k12| and |m12| more than |k11| and |m11|.
+  CHECK(largest(0) > 1e-3 * normal(0));
+  CHECK(largest(1) > 1e-3 * normal(1));
+  CHECK(largest(2) > 1e-3 * normal(2));
+  for (const char* n : {"n11", "n22", "n12", "m11", "m22", "m12"})
+    CHECK_THAT(h5.attribute_string(g + n, "measure"),
+               Catch::StartsWith("2nd Piola-Kirchhoff stress resultant"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("output every: every n-th step and the last, and a stopped run writes its last state",
+          "[unit][outputs]") {
+  using namespace knit::macro;
+  const fs::path d = scratch("every");
+  auto steps_written = [](const fs::path& out) {
+    auto h5 = knit::io::H5File::open_read(out / "results.h5");
+    std::vector<std::string> vtu;
+    for (const auto& e : fs::directory_iterator(out / "vtk")) vtu.push_back(e.path().stem());
+    std::sort(vtu.begin(), vtu.end());
+    CHECK(vtu == h5.children("fields"));  // the VTU files and the HDF5 groups agree
+    CHECK(h5.read_doubles("steps/load_factor").size() == h5.read_doubles("steps/step").size());
+    return h5.children("fields");
+  };
+  json j = json::parse(verification_text("tensile_svk.json"));
+  j["solver"]["steps"] = 5;
+  j["output"]["grid"] = {3, 3};
+  j["output"]["every"] = 2;
+  RunOptions ro;
+  ro.output_dir = d / "every2";
+  REQUIRE(run_case(parse_case(j.dump(), "t.json"), ro).succeeded());
+  CHECK(steps_written(ro.output_dir) ==
+        std::vector<std::string>{"step_0002", "step_0004", "step_0005"});
+  // Every row of the load-strain curve is kept whatever `every` is.
+  CHECK(knit::io::H5File::open_read(ro.output_dir / "results.h5")
+            .read_doubles("steps/load_factor")
+            .size() == 5u);
+  // The estimate counts ceil(steps / every) output steps: 3 for 5 steps, 2 for 4.
+  const std::uint64_t five = estimate_output_bytes(parse_case(j.dump(), "t.json"));
+  j["solver"]["steps"] = 4;
+  const std::uint64_t four = estimate_output_bytes(parse_case(j.dump(), "t.json"));
+  CHECK(2 * five == 3 * four);
+  // A run that stops (the Sze cantilever in one step with 8 iterations and 2 cut-backs
+  // converges at 0.25 only) writes the state it reached although 1 is not a multiple of 1000.
+  json sze = json::parse(verification_text("sze_cantilever.json"));
+  sze["solver"]["steps"] = 1;
+  sze["solver"]["max_iterations"] = 8;
+  sze["solver"]["max_cutbacks"] = 2;
+  sze["output"]["grid"] = {3, 3};
+  sze["output"]["every"] = 1000;
+  ro.output_dir = d / "stopped";
+  const RunResult s = run_case(parse_case(sze.dump(), "sze.json"), ro);
+  REQUIRE(s.report.status == RunStatus::kNotConverged);
+  REQUIRE(s.rows.size() == 1u);
+  CHECK(steps_written(ro.output_dir) == std::vector<std::string>{"step_0001"});
+  fs::remove_all(d);
+}
+
+namespace {
+
+/// St. Venant-Kirchhoff whose stress is NaN at one point of the output grid, (theta1, theta2) =
+/// (1, 0.25), where no quadrature point lies.
+struct NanAtOnePoint final : knit::macro::Material {
+  knit::macro::SaintVenantKirchhoff svk{1000.0, 0.3};
+  std::string name() const override { return "nan_at_one_point"; }
+  bool hyperelastic() const override { return true; }
+  knit::macro::MaterialResponse evaluate(const Eigen::Vector3d& E,
+                                         const knit::macro::MaterialPoint& w) const override {
+    knit::macro::MaterialResponse r = svk.evaluate(E, w);
+    if (std::abs(w.theta(0) - 1.0) < 1e-12 && std::abs(w.theta(1) - 0.25) < 1e-12)
+      r.S.setConstant(NAN);
+    return r;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a non-finite output sample is named by its field, step and grid point",
+          "[unit][outputs]") {
+  // A 3 x 5 grid: the bad sample is row k = 2 + 3 * 1 (theta1 = 2 / 2, theta2 = 1 / 4), in both
+  // steps; n11 is the first field it spoils.
+  using namespace knit::macro;
+  const fs::path d = scratch("nan");
+  json j = json::parse(verification_text("tensile_svk.json"));
+  j["solver"]["steps"] = 2;
+  j["output"]["grid"] = {3, 5};
+  Case c = parse_case(j.dump(), "t.json");
+  c.material = std::make_shared<NanAtOnePoint>();
+  RunOptions ro;
+  ro.output_dir = d / "out";
+  const RunResult r = run_case(c, ro);
+  CHECK(r.report.status == RunStatus::kCompleted);
+  CHECK_FALSE(r.succeeded());
+  CHECK_THAT(r.output_failure,
+             Catch::StartsWith("output field n11 is not finite at step 1, (theta1, theta2) = (1, "
+                               "0.25) of the output grid (2 non-finite sample(s) in all)"));
   fs::remove_all(d);
 }
