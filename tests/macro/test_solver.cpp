@@ -396,6 +396,33 @@ TEST_CASE("Newton: the round-off floor, by the correction or by a stalled residu
   CHECK_FALSE(at_round_off_floor(1e-4, ref, 3e-8, 1e-4, opt));
 }
 
+namespace {
+
+/// The displacement that moves every control point of m by the linear map Q (a rigid rotation,
+/// a mirror).
+Eigen::VectorXd linear_motion(const ShellModel& m, const Eigen::Matrix3d& Q) {
+  const Eigen::MatrixXd& P = m.surface().control_points();
+  Eigen::VectorXd u(m.num_dofs());
+  for (int a = 0; a < P.rows(); ++a)
+    u.segment<3>(3 * a) = Q * P.row(a).transpose() - P.row(a).transpose();
+  return u;
+}
+
+/// The quadrature points' states of m at u.
+std::vector<kernel::PointState> points_at(const ShellModel& m, const Eigen::VectorXd& u) {
+  ShellModel::Evaluation ev;
+  m.evaluate(u, false, ev, /*keep_points=*/true);
+  REQUIRE(ev.ok);
+  return ev.points;
+}
+
+Eigen::Matrix3d rotation_about_x(double degrees) {
+  return Eigen::AngleAxisd(degrees * std::acos(-1.0) / 180.0, Eigen::Vector3d::UnitX())
+      .toRotationMatrix();
+}
+
+}  // namespace
+
 // The fold guard (fold_guard.hpp; session 27's check, a class of its own since session 28): a
 // mirrored patch (x -> -x, which the Green-Lagrange strains do not see) has every normal
 // turned by 180 degrees; a rigid rotation by 60 degrees about x turns none by 90 or more.
@@ -403,24 +430,10 @@ TEST_CASE("fold guard: a mirrored state is found, a rotation below 90 degrees pa
   auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
   const ShellModel m(test::curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, true), 0.1, mat);
   FoldGuard guard(m);
-  const Eigen::MatrixXd& P = m.surface().control_points();
-  auto displaced = [&](const Eigen::Matrix3d& Q) {
-    Eigen::VectorXd u(m.num_dofs());
-    for (int a = 0; a < P.rows(); ++a)
-      u.segment<3>(3 * a) = Q * P.row(a).transpose() - P.row(a).transpose();
-    return u;
-  };
-  auto check = [&](const Eigen::VectorXd& u) {
-    ShellModel::Evaluation ev;
-    m.evaluate(u, false, ev, /*keep_points=*/true);
-    REQUIRE(ev.ok);
-    return guard.check(u, ev.points);
-  };
+  auto displaced = [&](const Eigen::Matrix3d& Q) { return linear_motion(m, Q); };
+  auto check = [&](const Eigen::VectorXd& u) { return guard.check(u, points_at(m, u)); };
   CHECK(check(Eigen::VectorXd::Zero(m.num_dofs())) == -1);
-  const Eigen::Matrix3d rot60 =
-      Eigen::AngleAxisd(60.0 * std::acos(-1.0) / 180.0, Eigen::Vector3d::UnitX())
-          .toRotationMatrix();
-  CHECK(check(displaced(rot60)) == -1);
+  CHECK(check(displaced(rotation_about_x(60.0))) == -1);
   const Eigen::Matrix3d mirror = Eigen::Vector3d(-1.0, 1.0, 1.0).asDiagonal();
   const int q = check(displaced(mirror));
   CHECK(q == 0);  // the first check point already
@@ -434,6 +447,32 @@ TEST_CASE("fold guard: a mirrored state is found, a rotation below 90 degrees pa
   CHECK(check(Eigen::VectorXd::Zero(m.num_dofs())) == 0);
   // The element corners are checked too: their index follows the quadrature points'.
   CHECK(guard.where(m.num_quadrature_points()).isApprox(Eigen::Vector2d(0.0, 0.0)));
+}
+
+TEST_CASE("fold guard: the line is 90 degrees, and the corners' normals come from u", "[unit]") {
+  // Rigid rotations about x by 80 and 100 degrees on either side of the guard's line (session
+  // 32: a guard at 120 degrees survived the suite, whose rotations were 60 and 180 degrees).
+  auto mat = std::make_shared<SaintVenantKirchhoff>(1000.0, 0.3);
+  const ShellModel m(test::curved_patch(2, 3, 2, 1, 2.0, 1.5, 0.4, true), 0.1, mat);
+  auto rotated = [&](double degrees) { return linear_motion(m, rotation_about_x(degrees)); };
+  auto points = [&](const Eigen::VectorXd& u) { return points_at(m, u); };
+  // A rotation by theta about x turns a unit normal n by phi, cos phi = n_x^2 + (1 - n_x^2)
+  // cos theta: positive for every normal at 80 degrees, negative at 100 degrees wherever
+  // |n_x| < 0.38 (the first check point's normal among them).
+  {
+    FoldGuard guard(m);
+    CHECK(guard.check(rotated(80.0), points(rotated(80.0))) == -1);
+  }
+  {
+    FoldGuard guard(m);
+    CHECK(guard.check(rotated(100.0), points(rotated(100.0))) == 0);
+  }
+  // The quadrature points' normals come from the evaluation handed in, the corners' from u:
+  // with the reference state's points and a rotated u only the corners can see the turn.
+  FoldGuard guard(m);
+  const int q = guard.check(rotated(100.0), points(Eigen::VectorXd::Zero(m.num_dofs())));
+  CHECK(q == m.num_quadrature_points());  // the first corner, (0, 0)
+  CHECK_THAT(guard.describe(q), Catch::Contains("(theta1, theta2) = (0, 0)"));
 }
 
 // Load stepping's bookkeeping (newton.cpp), each part of it seen in a run's load factors or
