@@ -1,10 +1,14 @@
 // The adjoint gradient of a reaction with respect to control values of the l and alpha fields
 // equals central finite differences of the whole solve (issue 13 acceptance, relative 1e-5).
+// A load level on a step of the forward run is taken from that step, one off it solved alone.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "knit/core/errors.hpp"
 #include "knit/macro/design_gradient.hpp"
+#include "knit/macro/design_sensitivity.hpp"
 #include "knit/macro/run.hpp"
 #include "knit_test_database.hpp"
 
@@ -93,5 +97,42 @@ TEST_CASE("design gradient: a variable outside the field names the field", "[uni
     // index read past the end, the JSON array grew a null and another error gave the same
     // pointer).
     CHECK_THAT(e.what(), Catch::Contains("control value 2 is outside the field's 2 values"));
+  }
+}
+
+// A load level that falls on a step of the forward run is that step's state, within round-off
+// of its load factor; a level off every step is solved on its own (design_sensitivity.hpp,
+// docs/design.md "Cost": lambda_k / lambda_max = i / steps). Session 32, a mutation audit: the
+// capture's tolerance (1e-9 lambda_max) could be changed without a test failing, since a level
+// taken from a nearby step and one solved separately agree to the solver's tolerance. Here
+// the solver's tolerance is loose (1e-2), so a state depends on the path that reached it: a
+// level taken from the run's step 0.5 and one solved from 0 in its own 2 steps differ by
+// ~5e-5, far more than the round-off the comparison allows. Checked at lambda_max = 1 and 1e-3
+// (the capture's tolerance is relative to lambda_max) for a level one ulp above the step
+// (taken from it) and one a relative 1e-7 above it (solved on its own).
+TEST_CASE("design solve: a level on a load step is that step's state, one off it is solved",
+          "[case]") {
+  std::string text = tiny_case(gradient_database());
+  const std::string tight = R"("tolerance": 1e-13)";
+  text.replace(text.find(tight), tight.size(), R"("tolerance": 0.01)");
+  const Case c = parse_case(text, "tiny.json");
+  for (double L : {1.0, 1e-3}) {
+    INFO("largest level " << L);
+    const double on = std::nextafter(0.5 * L, 1.0), off = 0.5 * L * (1 + 1e-7);
+    // The reactions of `knit-macro run` on the case scaled to L (steps 0.5 L, L), and on the
+    // cases scaled to `off` and to `on` (each solved from 0 in 2 steps).
+    const RunResult run = run_case(scaled_case(c, L), {});
+    REQUIRE(run.rows.size() == 2);
+    const double step = run.rows[0].reactions[0], end = run.rows[1].reactions[0];
+    const double alone_off = run_case(scaled_case(c, off), {}).rows.back().reactions[0];
+    const double alone_on = run_case(scaled_case(c, on), {}).rows.back().reactions[0];
+    CHECK(std::abs(alone_on - step) > 1e-7 * std::abs(step));  // the paths differ
+    CHECK(std::abs(alone_off - step) > 1e-7 * std::abs(step));
+    const DesignSolve s(text, "tiny.json", {}, {L, on, off}, false);
+    REQUIRE(s.status() == RunStatus::kCompleted);
+    const ReactionOutput& ro = s.case_().output.reactions[0];
+    CHECK(s.reaction(s.level(L), ro).value == Approx(end).epsilon(1e-12));
+    CHECK(s.reaction(s.level(on), ro).value == Approx(step).epsilon(1e-12));
+    CHECK(s.reaction(s.level(off), ro).value == Approx(alone_off).epsilon(1e-12));
   }
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "../process_tmp.hpp"
@@ -274,6 +275,60 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
     CHECK(t.x[0] < 6.5 - 0.01);
     CHECK(t.J < t.J0);
   }
+}
+
+// The projected gradient's step control and stopping rule, read from its history (session 32,
+// a mutation audit: steps that never grew, and a function tolerance measured against the J
+// after the step or taken as absolute, survived the twin experiment above).
+// design_problem.hpp: the first step moves the variable with the largest gradient by 10 % of
+// its bound interval, an accepted step doubles the next trial and a rejected one halves it; it
+// stops when an accepted step lowers J by less than function_tolerance x J (docs/design.md
+// "The design file", `optimizer`).
+TEST_CASE("design optimizer (projected gradient): steps double and the tolerance is relative",
+          "[case]") {
+  write_case();
+  write(kDir / "steps.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2],
+                            "target": [0, 0]}],
+            "optimizer": {"method": "projected_gradient"}})");
+  DesignProblem d = load_design((kDir / "steps.json").string());
+  // The targets: the loads of l = 5.0 at 10 % and 20 % (the residuals at target 0); from 6.0.
+  const DesignEvaluation at5 = evaluate_design(d, {5.0}, false);
+  REQUIRE(at5.status == RunStatus::kCompleted);
+  d.objectives[0].target = {at5.residuals(0), at5.residuals(1)};
+  d.variables[0].initial = 6.0;
+  auto history = [](const DesignResult& r) {
+    std::ostringstream os;
+    os.precision(10);
+    for (const auto& h : r.history) os << h.iteration << ": l " << h.x[0] << ", J " << h.J << "\n";
+    return os.str();
+  };
+  // One variable: a step is s x 2 mm (the interval). l goes 6.0 -> 5.8 (s = 0.1) -> 5.4 (0.2,
+  // doubled) -> 5.0 (the trial 0.4 to 4.6 overshoots and raises J: halved to 0.2, exact).
+  const DesignResult r = optimize_design(d);
+  INFO("function tolerance 1e-6:\n" << history(r));
+  REQUIRE(r.history.size() >= 4);
+  CHECK(r.history[1].x[0] == Approx(5.8).epsilon(1e-12));
+  CHECK(r.history[2].x[0] == Approx(5.4).epsilon(1e-12));
+  CHECK(r.history[3].x[0] == Approx(5.0).epsilon(1e-12));
+  CHECK(r.status == DesignStatus::kConverged);
+  // The first step lowers J by 29 % of J (3.044 -> 2.164): a function tolerance of 0.35 stops
+  // there, with the target not met. Measured against the J after the step (0.35 x 2.164 =
+  // 0.757) or as an absolute (0.35), the same decrease of 0.880 would not stop it.
+  const double J0 = r.history[0].J, J1 = r.history[1].J;
+  CHECK(J0 - J1 < 0.35 * J0);
+  CHECK(J0 - J1 > 0.35 * J1);
+  CHECK(J0 - J1 > 0.35);
+  DesignProblem loose = d;
+  loose.optimizer.function_tolerance = 0.35;
+  const DesignResult l = optimize_design(loose);
+  INFO("function tolerance 0.35:\n" << history(l));
+  CHECK(l.history.size() == 2);
+  CHECK(l.x[0] == Approx(5.8).epsilon(1e-12));
+  CHECK(l.J == Approx(J1).epsilon(1e-12));
+  CHECK(l.status == DesignStatus::kTargetNotMet);
 }
 
 // The smoothness penalty is a regularization: a design that meets its targets with J > 0 from

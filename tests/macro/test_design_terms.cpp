@@ -3,8 +3,10 @@
 // smoothness penalty; reactions are in
 // test_design_problem.cpp) has the gradient of central finite differences of the whole solve
 // to a relative 1e-5 (issue 13), with the paper law and with the energy law's analytic dS/dl.
-// And the optimizers: Ceres recovers a linear l grading (twin experiment), respects the
-// bounds, and ends an infeasible target with its status and the best design.
+// A target-strain term's value equals its misfits on strains sampled independently, and the
+// strain-variance term's Jacobian the differences of its residuals. And the optimizers:
+// Ceres recovers a linear l grading (twin experiment), respects the bounds, and ends an
+// infeasible target with its status and the best design.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -15,6 +17,7 @@
 
 #include "../process_tmp.hpp"
 #include "knit/macro/design_problem.hpp"
+#include "knit/macro/run.hpp"
 #include "knit_test_database.hpp"
 
 using namespace knit::macro;
@@ -128,6 +131,98 @@ TEST_CASE("design terms: the gradient of every objective term equals finite diff
           "at_strain": [0.2], "target": [1.0]}])",
                              0.5),
                      x);
+    }
+  }
+}
+
+// The value of a target-strain term against strains sampled independently (session 32, a
+// mutation audit): a gradient check cannot see a wrong sample grid, a wrong weight w/n or the
+// shear's factor, since the value and its derivative change together. docs/design.md "The
+// design file": r_i = sqrt(w/n) (E_i - target_k) over a uniform [nu, nv] grid of the region
+// (ends included; a section [lo, lo] has one sample across), E12 the tensor component, half
+// the 2E12 that ShellModel::sample gives. The reference: the case run by run_case to its end
+// (20 %, the at_strain of the terms), its strains sampled at the grid points by hand.
+TEST_CASE("design terms: a target-strain term is w/n times the squared misfits on its grid",
+          "[case]") {
+  const std::string c = write_case(false);
+  const DesignProblem d = problem(c, "target_value.json", R"([
+      {"type": "target_strain", "component": "E12", "region": {"u": [0.2, 0.8], "v": [0.2, 0.8]},
+       "samples": [4, 3], "at_strain": [0.2], "target": [0.01], "weight": 100},
+      {"type": "target_strain", "component": "E22", "region": {"u": [0.1, 0.9], "v": [0.3, 0.3]},
+       "samples": [5, 7], "at_strain": [0.2], "target": [0.15], "weight": 30}])");
+  std::vector<double> x;
+  for (const auto& v : d.variables) x.push_back(v.initial);  // the case as written
+  const DesignEvaluation e = evaluate_design(d, x, false);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.terms.size() == 2);
+  REQUIRE(e.residuals.size() == 12 + 5);
+  const Case k = load_case((kDir / c).string());
+  const RunResult run = run_case(k, {});
+  REQUIRE(run.report.status == RunStatus::kCompleted);
+  const Problem p = setup_problem(k);
+  // E (local Cartesian Voigt: E11, E22, 2E12) of the run's last step at (u, v).
+  auto E = [&](double u, double v) { return p.model->sample(run.u, {u, v}).E; };
+  // Term 1: E12 on u = 0.2, 0.4, 0.6, 0.8 (u fastest) x v = 0.2, 0.5, 0.8; w/n = 100/12.
+  double sum = 0.0, lo = 1e300, hi = -1e300;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const double E12 = 0.5 * E(0.2 + 0.2 * i, 0.2 + 0.3 * j)(2);
+      const double r = std::sqrt(100.0 / 12.0) * (E12 - 0.01);
+      INFO("sample (" << i << ", " << j << "): E12 " << E12);
+      CHECK(e.residuals(4 * j + i) == Approx(r).epsilon(1e-8));
+      sum += (E12 - 0.01) * (E12 - 0.01);
+      lo = std::min(lo, E12);
+      hi = std::max(hi, E12);
+    }
+  CHECK(e.terms[0].second == Approx(100.0 / 12.0 * sum).epsilon(1e-8));
+  // The check means something: the shear is not small against its target and varies over
+  // the grid (another grid or the Voigt 2E12 gives another value).
+  CHECK(hi - lo > 1e-3);
+  CHECK(std::abs(hi) > 0.02);
+  // Term 2: E22 along the section v = 0.3 at u = 0.1, 0.3, .., 0.9 (one sample across, whatever
+  // "samples" says); w/n = 30/5.
+  sum = 0.0;
+  for (int i = 0; i < 5; ++i) {
+    const double E22 = E(0.1 + 0.2 * i, 0.3)(1);
+    CHECK(e.residuals(12 + i) == Approx(std::sqrt(30.0 / 5.0) * (E22 - 0.15)).epsilon(1e-8));
+    sum += (E22 - 0.15) * (E22 - 0.15);
+  }
+  CHECK(e.terms[1].second == Approx(30.0 / 5.0 * sum).epsilon(1e-8));
+  CHECK(e.J == Approx(e.terms[0].second + e.terms[1].second));
+}
+
+// The strain-variance term's Jacobian, row by row, against central differences of the
+// residual vector (session 32, a mutation audit). Its residuals are sqrt(w/n) (E_i - mean E),
+// so each row carries -d(mean E)/dx; in the gradient J^T r that part cancels (sum_i r_i = 0)
+// and the gradient check of the first test cannot see it, but Ceres' Levenberg-Marquardt
+// builds its steps from J^T J, where it does not cancel (docs/design.md "The optimizer").
+TEST_CASE("design terms: the strain-variance Jacobian equals differences of the residuals",
+          "[case]") {
+  const std::string c = write_case(false);
+  const DesignProblem d = problem(c, "variance_jacobian.json", R"([
+      {"type": "strain_variance", "component": "E22", "region": {"u": [0, 1], "v": [0.5, 0.5]},
+       "samples": [7, 1], "at_strain": [0.2], "weight": 1000}])");
+  const std::vector<double> x = {5.1, 5.7, 6.0, 8.0, 12.0};
+  const DesignEvaluation e = evaluate_design(d, x);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.residuals.size() == 7);
+  REQUIRE(e.jacobian.rows() == 7);
+  REQUIRE(e.jacobian.cols() == 5);
+  CHECK(std::abs(e.residuals.sum()) < 1e-12 * e.residuals.norm());  // about the mean
+  for (Eigen::Index j = 0; j < 5; ++j) {
+    const double h = 1e-3;
+    std::vector<double> xp = x, xm = x;
+    xp[static_cast<std::size_t>(j)] += h;
+    xm[static_cast<std::size_t>(j)] -= h;
+    const DesignEvaluation ep = evaluate_design(d, xp, false), em = evaluate_design(d, xm, false);
+    REQUIRE(ep.status == RunStatus::kCompleted);
+    REQUIRE(em.status == RunStatus::kCompleted);
+    const Eigen::VectorXd fd = (ep.residuals - em.residuals) / (2 * h);
+    REQUIRE(fd.norm() > 0.0);
+    for (Eigen::Index i = 0; i < 7; ++i) {
+      INFO("residual " << i << ", variable " << j << ": Jacobian " << e.jacobian(i, j)
+                       << ", finite difference " << fd(i) << ", column norm " << fd.norm());
+      CHECK(std::abs(e.jacobian(i, j) - fd(i)) <= 1e-5 * std::abs(fd(i)) + 1e-7 * fd.norm());
     }
   }
 }

@@ -1,6 +1,8 @@
 // The knitting map (issue 13): a uniform patch needs round(W/w) needles and round(H/c)
-// courses; a discontinuous 4.5|6.5 patch gives two blocks; the yarn length is the sum of the
-// loop lengths; bad input names the file and the JSON pointer, exits 2 and writes nothing.
+// courses; a discontinuous 4.5|6.5 patch gives two blocks, a narrower block centred on the
+// needles also when the stitch counts differ by an odd number; a sheared patch needs its
+// courses' spread in needles; the yarn length is the sum of the loop lengths; bad input names
+// the file and the JSON pointer, exits 2 and writes nothing.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
@@ -36,9 +39,10 @@ std::string database(bool with_cells = true) {
       with_cells ? "knitmap_db.h5" : "knitmap_db_nocells.h5", {4.5, 5.5, 6.5}, with_cells);
 }
 
-/// A W x H rectangle rotated by beta in the plane z = z0 (z1 for the last control point).
+/// A W x H rectangle rotated by beta in the plane z = z0 (z1 for the last control point);
+/// with `shear`, a parallelogram whose upper edge is moved by `shear` along x (before turning).
 std::string case_text(const std::string& material, double W, double H, double beta = 0.0,
-                      double z1 = 0.0) {
+                      double z1 = 0.0, double shear = 0.0) {
   const double c = std::cos(beta), s = std::sin(beta);
   std::ostringstream os;
   os.precision(17);
@@ -51,9 +55,9 @@ std::string case_text(const std::string& material, double W, double H, double be
   os << ", ";
   pt(W, 0, 0);
   os << ", ";
-  pt(0, H, 0);
+  pt(shear, H, 0);
   os << ", ";
-  pt(W, H, z1);
+  pt(W + shear, H, z1);
   os << R"(], "thickness": 0.76},
     "refinement": {"degree": 2, "elements": [1, 1]},
     "material": )"
@@ -214,6 +218,78 @@ TEST_CASE("knitmap: a discontinuous 4.5|6.5 patch gives two blocks", "[case]") {
           Approx(std::max(std::abs(c_of(4.5) - h), std::abs(c_of(6.5) - h)) / h));
     CHECK(m.warnings.size() == 1);
     CHECK(m.yarn_length == Approx(sum_l(m)));
+  }
+}
+
+// The needles of courses whose stitch counts differ by an odd number (session 32, a mutation
+// audit: the rounding of the needle offset could be changed without a test failing, since the
+// test above has counts of one parity, 32 and 28 on 40 mm). docs/design.md rule 5: a course
+// is centred on the machine, its first needle offset by its chord midpoint's distance from the
+// patch's (0 here: every chord is the whole width) in stitch widths minus half its stitch
+// count, half-integers rounding up.
+//  * 37.8 mm wide: 30 stitches of w(4.5) = 1.26 mm (37.8 / 1.26 = 30; the 30th centre at
+//    37.17 mm) and 27 of w(6.5) = 1.41 mm (the 27th centre at 37.365 mm, a 28th at 38.775).
+//    Offsets -14.5 -> -14 and -13 -> -13: the wider block on needles 1..30, the narrower on
+//    2..28, first_needle - 1 = 1 = (30 - 27) / 2 in integer division (the odd needle left out
+//    at the high end);
+//  * 39 mm wide: 31 and 28 stitches (the last centres at 38.43 and 38.775 mm). Offsets -15 ->
+//    -15 and -13.5 -> -13: the narrower block on needles 3..30, first_needle - 1 = 2 =
+//    (31 - 28 + 1) / 2 (the odd needle left out at the low end).
+TEST_CASE("knitmap: a narrower course with an odd difference in stitches is centred", "[case]") {
+  const std::string db = database();
+  const std::string l = knit_material(db, R"({"degrees": [0, 0], "knots_u": [0, 1],
+      "knots_v": [0, 0.5, 1], "values": [4.5, 6.5]})");
+  for (const auto& [W, n1, n2, first] :
+       {std::tuple{37.8, 30, 27, 2}, std::tuple{39.0, 31, 28, 3}}) {
+    INFO("W = " << W << " mm");
+    const KnitMap m = map_of("odd_blocks.json", case_text(l, W, 30.0));
+    REQUIRE(m.courses.size() > 2);
+    CHECK(m.needles == n1);
+    std::vector<double> l_of(m.courses.size() + 1, 0.0);  // the l of each course's stitches
+    for (const auto& st : m.stitches) l_of[std::size_t(st.course)] = st.l;
+    for (const auto& cr : m.courses) {
+      const bool wide = l_of[std::size_t(cr.index)] == 4.5;
+      INFO("course " << cr.index << ": " << cr.stitches << " stitches from needle "
+                     << cr.first_needle);
+      CHECK(cr.stitches == (wide ? n1 : n2));
+      CHECK(cr.first_needle == (wide ? 1 : first));
+    }
+    CHECK(l_of[1] == 4.5);
+    CHECK(l_of.back() == 6.5);
+  }
+}
+
+// The needle count of a sheared patch (session 32, a mutation audit: the widest course's stitch
+// count in place of the largest needle index survived; on every other patch of these tests the
+// first needles are all 1). A parallelogram 40 x 30 mm, its upper edge moved by 20 mm along
+// the courses, uniform l = 5.5 (w = 1.335 mm, c = 1.2403 mm): 24 courses of 30 stitches (the
+// 30th centre at 39.38 mm), each chord 40 mm long and centred S t / H - S / 2 from the middle
+// of the patch's extent (60 mm). In stitch widths, minus 14.5: the first course (t = c / 2)
+// at -7.18 - 14.5 -> first needle offset -22, the last (t = 23.5 c) at +7.06 - 14.5 -> -7; so
+// needles 1..30 to 16..45: 45 needles (docs/design.md rule 5: more than the widest course).
+TEST_CASE("knitmap: a sheared patch needs its courses' spread in needles", "[case]") {
+  const std::string db = database();
+  const double W = 40.0, H = 30.0, S = 20.0, l = 5.5;
+  const KnitMap m = map_of("sheared.json", case_text(knit_material(db, "5.5"), W, H, 0.0, 0.0, S));
+  REQUIRE(m.courses.size() == 24);
+  for (const auto& cr : m.courses) CHECK(cr.stitches == 30);
+  CHECK(m.courses.front().first_needle == 1);
+  CHECK(m.courses.back().first_needle == 16);
+  CHECK(m.needles == 45);
+  // Each stitch's needle follows its position along the courses: x / w - needle lies in a
+  // window narrower than one needle (the rounding of each course's offset), and the needles
+  // climb with the shear, about S / w = 15 of them over the patch.
+  double lo = 1e300, hi = -1e300;
+  for (const auto& st : m.stitches) {
+    const double d = st.position.x() / w_of(l) - st.needle;
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+  CHECK(hi - lo < 1.0);
+  int last = 0;
+  for (const auto& cr : m.courses) {
+    CHECK(cr.first_needle >= last);
+    last = cr.first_needle;
   }
 }
 
