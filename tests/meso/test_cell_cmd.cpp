@@ -2,6 +2,7 @@
 // consistent (pure shear: E11 = E22 = 0, E12 = sin(gamma)/2 per step), bad input exits with 2.
 #include <unistd.h>
 
+#include <Eigen/Core>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -70,6 +71,18 @@ TEST_CASE("knit-meso path: shear CSV rows and VTP files", "[unit]") {
     CHECK(std::abs(std::stod(r[col("E11")])) < 1e-12);
     CHECK(std::abs(std::stod(r[col("E22")])) < 1e-12);
     CHECK(std::stod(r[col("E12")]) == Approx(0.5 * std::sin(g)).margin(1e-12));
+    // The columns of F, P and S (the cell's F^-1 P, S12 and S21 apart) satisfy P = F S
+    // (session 32, a mutation audit: P12 written from P21 passed; under shear they differ).
+    auto m2 = [&](const char* a, const char* b, const char* c, const char* d) {
+      Eigen::Matrix2d M;
+      M << std::stod(r[col(a)]), std::stod(r[col(b)]), std::stod(r[col(c)]), std::stod(r[col(d)]);
+      return M;
+    };
+    const Eigen::Matrix2d F = m2("F11", "F12", "F21", "F22"), P = m2("P11", "P12", "P21", "P22"),
+                          S = m2("S11", "S12", "S21", "S22");
+    INFO("step " << k << ": P =\n" << P << "\nF S =\n" << F * S);
+    CHECK((F * S - P).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + P.cwiseAbs().maxCoeff()));
+    if (k == 3) CHECK(std::abs(P(0, 1) - P(1, 0)) > 0.05);
   }
   CHECK(fs::exists(out + "/yarn_0003.vtp"));
   CHECK(fs::exists(out + "/yarn.pvd"));

@@ -54,6 +54,30 @@ TEST_CASE("stress-free reference cell: no stress unloaded, the old reference kee
   CHECK(r0.P(1, 1) > 0.05);
 }
 
+TEST_CASE("cell step: max_cutbacks counts the halvings in a row, not all of a step's", "[unit]") {
+  // A course stretch of 0.8 in one step from the unloaded cell needs cut-backs; each halving
+  // that converges resets the count (homog/periodic_cell.hpp), so a step whose failures are
+  // each followed by a success passes with max_cutbacks 1 however many cut-backs it took in all
+  // (session 32, a mutation audit: '>= max_cutbacks' passed every test).
+  homog::CellOptions co = fast_options();
+  const Eigen::Matrix2d F = Eigen::Vector2d(1.8, 1.0).asDiagonal();
+  auto step = [&](int max_cutbacks) {
+    co.max_cutbacks = max_cutbacks;
+    homog::PeriodicCell cell(4.5, co);
+    REQUIRE(cell.equilibrate().converged);
+    return cell.solve(F);
+  };
+  const homog::StepResult r = step(1);
+  INFO(r.message);
+  CHECK(r.converged);
+  CHECK(r.cutbacks >= 2);
+  CHECK(r.F.isApprox(F));
+  // No cut-back allowed: the first failure ends the step.
+  const homog::StepResult none = step(0);
+  CHECK_FALSE(none.converged);
+  CHECK(none.cutbacks == 1);
+}
+
 TEST_CASE("uniaxial path: the lateral stress vanishes at every converged step", "[unit]") {
   homog::CellOptions co = fast_options();
   for (int axis : {0, 1}) {
@@ -113,6 +137,56 @@ TEST_CASE("sweep cell runner: uniaxial and gradient paths record F, E, S consist
     CHECK(grad.raw.E(k, 2) == Approx(E(0, 1)).epsilon(1e-12));
   }
   CHECK(grad.raw.S(2, 2) > 0);  // positive shear
+}
+
+TEST_CASE("sweep cell runner: raw P is the cell's, raw S is sym(F^-1 P), the residual is S(I)",
+          "[unit]") {
+  // What the database stores against an independent run of the same cell (session 32, a
+  // mutation audit: the cell's unsymmetrized S, the P row with P12 and P21 swapped, or the
+  // residual's S22 taken from S11 passed every test). The old reference (contact.reference
+  // none) and the loop of before issue 12 (gamma = 0.198 w), so that the unloaded cell carries
+  // a residual stress with S11 != S22 (about 0.27 and 0.11 MPa), and a gradient path with shear.
+  sweep::SweepInput in = sweep::parse_sweep_input(
+      R"({"loop_lengths": [4.5], "fit": false,
+          "cell": {"analysis": {"elements": 16}, "contact": {"reference": "none"},
+                   "loop": {"gamma_over_w": 0.198}},
+          "load_paths": [{"kind": "gradient", "H": [[0.05, 0.3], [0.0, 0.04]], "steps": 3}]})",
+      "raw.json");
+  const sweep::PathOutcome out = sweep::cell_runner(in)(4.5, in.paths[0]);
+  REQUIRE(out.raw.status == std::vector<int>{0, 0, 0});
+  homog::CellOptions co = fast_options();
+  co.contact.reference = contact::ContactOptions::Reference::kNone;
+  co.geometry.gamma_over_w = 0.198;
+  homog::PeriodicCell cell(4.5, co);
+  const homog::StepResult eq = cell.equilibrate();
+  REQUIRE(eq.converged);
+  // The residual: the equilibrated cell's (S11, S22, S12), S12 symmetrized; S11 != S22 here.
+  CHECK(out.residual(0) == Approx(eq.S(0, 0)).epsilon(1e-12));
+  CHECK(out.residual(1) == Approx(eq.S(1, 1)).epsilon(1e-12));
+  CHECK(out.residual(2) == Approx(0.5 * (eq.S(0, 1) + eq.S(1, 0))).margin(1e-12));
+  CHECK(std::abs(eq.S(0, 0) - eq.S(1, 1)) > 0.05);
+  for (int k = 0; k < 3; ++k) {
+    INFO("step " << k + 1);
+    const homog::StepResult s =
+        cell.solve(Eigen::Matrix2d::Identity() + (k + 1) / 3.0 * in.paths[0].H);
+    REQUIRE(s.converged);
+    // P row (P11, P12, P21, P22) as the cell gives it; the shear makes P12 and P21 differ.
+    CHECK(out.raw.P(k, 0) == Approx(s.P(0, 0)).epsilon(1e-10));
+    CHECK(out.raw.P(k, 1) == Approx(s.P(0, 1)).epsilon(1e-10));
+    CHECK(out.raw.P(k, 2) == Approx(s.P(1, 0)).epsilon(1e-10));
+    CHECK(out.raw.P(k, 3) == Approx(s.P(1, 1)).epsilon(1e-10));
+    CHECK(std::abs(s.P(0, 1) - s.P(1, 0)) > 0.01);
+    // S = sym(F^-1 P) of the stored rows, by hand.
+    Eigen::Matrix2d F, P;
+    F << out.raw.F(k, 0), out.raw.F(k, 1), out.raw.F(k, 2), out.raw.F(k, 3);
+    P << out.raw.P(k, 0), out.raw.P(k, 1), out.raw.P(k, 2), out.raw.P(k, 3);
+    const Eigen::Matrix2d A = F.inverse() * P, S = 0.5 * (A + A.transpose());
+    CHECK(out.raw.S(k, 0) == Approx(S(0, 0)).epsilon(1e-12));
+    CHECK(out.raw.S(k, 1) == Approx(S(1, 1)).epsilon(1e-12));
+    CHECK(out.raw.S(k, 2) == Approx(S(0, 1)).epsilon(1e-12));
+    // F^-1 P is not symmetric in the cell's discretization: the symmetrization matters.
+    CHECK(std::abs(A(0, 1) - A(1, 0)) > 1e-4 * std::abs(A(0, 1)));
+  }
 }
 
 TEST_CASE("sweep cell runner: a loop length the cell cannot be built for is an input error",

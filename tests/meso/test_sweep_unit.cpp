@@ -141,6 +141,31 @@ TEST_CASE("sweep input: the default, dense, wale-compressed-rays and reduced cas
   CHECK(r.paths[8].set == "holdout");
 }
 
+TEST_CASE("sweep report: only a paper path that stops, or a runner error, fails the sweep",
+          "[unit]") {
+  // docs/sweep.md: coverage and held-out paths often end where the cell jams or buckles; such a
+  // path is kept with its converged steps and counted as stopped, not failed. A paper path that
+  // stops fails the sweep (its fan is the eq. 17 fit's grid), and a runner that threw fails it
+  // whatever the path (session 32, a mutation audit: treating a stopped coverage path as a
+  // failure passed every test).
+  SweepReport r;
+  for (const char* set : {"paper", "coverage", "holdout"})
+    for (JobStatus st :
+         {JobStatus::kConverged, JobStatus::kPartial, JobStatus::kFailed, JobStatus::kError}) {
+      JobResult j;
+      j.status = st;
+      j.raw.path.set = set;
+      const bool fails =
+          st == JobStatus::kError || (st != JobStatus::kConverged && std::string(set) == "paper");
+      INFO(set << ", " << to_string(st));
+      CHECK(fails_sweep(j) == fails);
+      r.results.push_back(j);
+    }
+  // Of the 12: 2 paper (partial, failed) + 3 errors fail; the other 4 not converged stopped.
+  CHECK(r.failed_cases() == 5);
+  CHECK(r.stopped_cases() == 4);
+}
+
 TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
   auto pointer_of = [](const std::string& text) {
     try {
