@@ -343,6 +343,22 @@ TEST_CASE("sweep job: non-convergence retried with smaller steps and the recorde
   CHECK(bad.raw.status.back() == kStepNotReached);
   CHECK(bad.converged_steps() >= 1);
   CHECK(bad.converged_steps() < 6);
+  // Among attempts that reach as far, the first (the coarsest) is kept (session 32, a mutation
+  // audit: keeping the last of equals passed): a runner whose every attempt converges exactly
+  // one recorded step (the first m sub-steps of m x 6).
+  const JobResult tie = run_job(j, in.retry, [](double l, const LoadPath& p) {
+    PathOutcome out = synthetic_runner()(l, p);
+    const int m = p.steps / 6;
+    for (int k = 0; k < p.steps; ++k)
+      out.raw.status[static_cast<std::size_t>(k)] = k < m ? 0 : (k == m ? 1 : 2);
+    out.message = "attempt with " + std::to_string(m) + " sub-steps";
+    return out;
+  });
+  CHECK(tie.attempts == 1 + in.retry.max_retries);
+  CHECK(tie.status == JobStatus::kPartial);
+  CHECK(tie.converged_steps() == 1);
+  CHECK(tie.step_factor == 1);
+  CHECK(tie.message == "attempt with 1 sub-steps");
   for (int k = 0; k < 6; ++k)
     if (bad.raw.status[static_cast<std::size_t>(k)] != 0) CHECK(bad.raw.S.row(k).isZero());
   // A runner that throws: recorded as an error, not thrown.
@@ -512,6 +528,31 @@ TEST_CASE(
   // Every other case is as in the clean run.
   for (std::size_t p = 0; p < 13; ++p)
     if (p != 5) CHECK((df.entries[1].raw[p].S - d1.entries[1].raw[p].S).isZero());
+
+  // Case 7 of the first loop length fails at its first step: no converged state. It fails the
+  // sweep, stays out of the fit (which is made from the other 12 paper paths) and out of
+  // case_in_fit (session 32, a mutation audit: counting a path with no converged step as usable
+  // for the fit, or as in it, passed every test).
+  const int dead = 7;
+  const PathRunner dying = [&](double l, const LoadPath& p) {
+    PathOutcome out = synthetic_runner()(l, p);
+    if (l == jobs[dead].loop_length && p.target == jobs[dead].load_path.target) {
+      for (int k = 0; k < p.steps; ++k) out.raw.status[static_cast<std::size_t>(k)] = k ? 2 : 1;
+      out.raw.F.setZero();
+      out.raw.S.setConstant(99.0);
+    }
+    return out;
+  };
+  const SweepReport rd = run_sweep(in, quiet(dir / "dead.h5"), dying);
+  CHECK(rd.failed_cases() == 1);
+  CHECK(rd.results[dead].status == JobStatus::kFailed);
+  CHECK(rd.fits_ok());
+  REQUIRE(rd.fits.size() == 2);
+  CHECK(rd.fits[0].ok());
+  const auto f = knit::io::H5File::open_read(dir / "dead.h5");
+  const auto in_fit = f.read_int_matrix("/sweep/report/case_in_fit");
+  CHECK(in_fit(0, dead) == 0);
+  CHECK(in_fit.sum() == 25);
 }
 
 TEST_CASE("sweep: resume recomputes only the missing cases and gives the same database", "[unit]") {
