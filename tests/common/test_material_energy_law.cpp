@@ -256,6 +256,39 @@ TEST_CASE("energy law: the energy interpolation is each knot's law, and their me
   CHECK(theta_vs_energy > 1e-3);
 }
 
+TEST_CASE("energy law: at an inner knot dS/dl is the slope of the span above it", "[unit]") {
+  // With LInterpolation::kEnergy the law is piecewise linear in l, kinked at the knots, so at a
+  // knot dS/dl is one-sided. The code takes the span [l_j, l_j+1) that holds l (the span
+  // search's upper_bound): at l = 5.5 of the knots 4.5, 5.5, 6.5 the slope of [5.5, 6.5],
+  // (S(6.5) - S(5.5)) / 1 mm, which is the forward difference in l and not the backward one
+  // (the slope of [4.5, 5.5]). Session 32, a mutation audit: building the next knot's law only
+  // for t > 0 (so dS/dl = 0 on every knot) survived every test (they took l inside a span).
+  EnergyLawData d = testing::make_test_network_law();
+  d.network.l_interpolation = LInterpolation::kEnergy;
+  const EnergyLaw law(d);
+  const EnergyLawAt at = law.at(5.5, true), lo = law.at(4.5), mid = law.at(5.5), hi = law.at(6.5);
+  const double h = 1e-6;
+  const EnergyLawAt ahead = law.at(5.5 + h), behind = law.at(5.5 - h);
+  std::mt19937 gen(13);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  double backward_gap = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    const Eigen::Vector3d S = mid.evaluate(e).S, dS = at.dS_dl(e);
+    const Eigen::Vector3d span = hi.evaluate(e).S - S;  // over 1 mm
+    const Eigen::Vector3d forward = (ahead.evaluate(e).S - S) / h;
+    const Eigen::Vector3d backward = (S - behind.evaluate(e).S) / h;
+    INFO("e = " << e.transpose() << ": dS/dl = " << dS.transpose() << ", span slope "
+                << span.transpose());
+    CHECK((dS - span).norm() <= 1e-12 * (1 + span.norm()));
+    CHECK((dS - forward).norm() <= 1e-6 * (1 + dS.norm()));
+    // The backward difference is the slope of [4.5, 5.5]: the kink is real.
+    CHECK((backward - (S - lo.evaluate(e).S)).norm() <= 1e-6 * (1 + backward.norm()));
+    backward_gap = std::max(backward_gap, (dS - backward).norm());
+  }
+  CHECK(backward_gap > 1e-3);
+}
+
 TEST_CASE("energy law: validation refuses bad data", "[unit]") {
   const EnergyLawData good = testing::make_test_energy_law();
   CHECK_NOTHROW(validate(good));

@@ -18,6 +18,30 @@ TEST_CASE("cell dimensions: published cells exactly, rule in between", "[unit]")
   CHECK_THROWS(cell_dimensions(-1));
 }
 
+TEST_CASE("closed-form loop: the derivatives are the finite differences of the shape", "[unit]") {
+  // LoopShape::point(s, k) gives the centerline (w s + gamma sin 4 pi s, (h/2) cos 2 pi s,
+  // (d/2) cos 4 pi s) and its first and second derivatives in s in closed form; the loop
+  // length (LoopShape::length, the h solve) integrates |point(s, 1)|. So every component of
+  // point(s, 1) is the central difference of point(s, 0), and point(s, 2) that of point(s, 1).
+  // The s avoid the zeros of sin 4 pi s and sin 2 pi s. Session 32, a mutation audit: z' with
+  // 2 pi for 4 pi survived every test (the h solve matches the length whatever it integrates).
+  LoopShape shape;
+  shape.h = 1.62;  // not the default, so a swapped h and d would show
+  const double step = 1e-6;
+  for (const double s : {0.05, 0.13, 0.3, 0.41, 0.56, 0.71, 0.9}) {
+    for (int k = 1; k <= 2; ++k) {
+      const Eigen::Vector3d fd =
+          (shape.point(s + step, k - 1) - shape.point(s - step, k - 1)) / (2 * step);
+      const Eigen::Vector3d an = shape.point(s, k);
+      for (int i = 0; i < 3; ++i) {
+        INFO("s = " << s << ", derivative " << k << ", component " << i);
+        CHECK(an(i) == Approx(fd(i)).epsilon(1e-7).margin(1e-6));
+      }
+    }
+  }
+  CHECK_THROWS(shape.point(0.2, 3));
+}
+
 TEST_CASE("four quartic curves with 12 control points, length l exactly, C0 joins", "[unit]") {
   for (double l : {4.5, 5.0, 6.5}) {
     const auto g = make_cell_geometry(l);

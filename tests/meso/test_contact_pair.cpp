@@ -3,7 +3,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "knit/meso/contact/contact_set.hpp"
 #include "knit/meso/contact/pair.hpp"
+#include "knit/meso/rod/builders.hpp"
 #include "knit/spline/knot_vector.hpp"
 
 using namespace knit::meso::contact;
@@ -228,4 +230,128 @@ TEST_CASE("stress-free reference pairs: offset and tie branches, tangent against
     CHECK((r.df_dz - fd_f).norm() <= 1e-6 * (1 + fd_f.norm()));
     CHECK((r.dm_dz - fd_m).norm() <= 1e-6 * (1 + fd_m.norm()));
   }
+}
+
+TEST_CASE("reference pairs: the energy's derivative in the gap is -p, and it is 0 at g_r",
+          "[unit]") {
+  // The energy of a stress-free reference pair (docs/unit-cell.md "Stress-free reference
+  // cell") is the potential of its line load: pressed (g <= g_r), p(g) - p(g_r) with the energy
+  // Pi(g) - Pi(g_r) - p(g_r) (g_r - g); opened (g_r < g < 0), the tie p = -k_0 (g - g_r) g / g_r
+  // with the energy k_0 / g_r (g^3/3 - g_r g^2/2 + g_r^3/6). Both are 0 at g = g_r (the
+  // unloaded reference stores nothing) and dE/dg = -p on either branch, so the central
+  // difference of the pair's energy in the gap is -p and the energy vanishes on both sides of
+  // g_r. Session 32, a mutation audit: the sign of p(g_r) (g_r - g) flipped, and the tie's
+  // g_r^3/6 made g_r^3/3, survived every test (the force was checked, never its energy).
+  Fixture F;
+  const PenaltyLaw law{1000.0, 0.05, 0.14, 0.5, 0.02};  // the defaults, fixed here
+  const FrictionLaw fr{0.15, 20.0};
+  const double d = 0.38, u0 = 0.4, gr = -0.15;
+  const ChainPoint cp = eval_chain(F.chain, u0, 0);
+  const Vector3d tau = cp.x_u.normalized();
+  const Vector3d n = tau.cross(Vector3d::UnitY()).normalized();  // normal to the master at u0
+  // The pair of a slave point at the gap g along n from x_m(u0), anchored at u0 (no stick
+  // energy: the closest point stays at u0).
+  auto at_gap = [&](double g, double g_ref) {
+    const Vector3d xs = cp.x + (d + g) * n;
+    const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, u0);
+    REQUIRE(pr.ok);
+    REQUIRE(std::abs(pr.u - u0) < 1e-12);
+    PairHistory h;
+    h.u_anchor = u0;
+    h.g_ref = g_ref;
+    return evaluate_pair(xs, F.chain, pr, d, law, fr, h, false);
+  };
+  const double step = 1e-6;
+  // Pressed: both onsets, the stiff branch's linear part; opened: the tie up to 0.
+  for (const double g : {-0.25, -0.17, -0.155, -0.12, -0.05, -0.01}) {
+    const PairResult r = at_gap(g, gr), rp = at_gap(g + step, gr), rm = at_gap(g - step, gr);
+    REQUIRE(r.active);
+    REQUIRE(!r.slip);
+    const double fd = (rp.energy - rm.energy) / (rp.gap - rm.gap);
+    INFO("g = " << g << ": p = " << r.p << ", dE/dg = " << fd);
+    CHECK(fd == Approx(-r.p).epsilon(1e-6).margin(1e-8));
+  }
+  // At g_r itself (the reference taken from the pair's own gap): exactly nothing stored.
+  const PairResult r0 = at_gap(gr, 0.0);
+  CHECK(at_gap(gr, r0.gap).energy == 0.0);
+  // Just beyond g_r on either side: E ~ |dp/dg| (g - g_r)^2 / 2, below 1e-10 N for 1e-7 mm.
+  CHECK(std::abs(at_gap(gr - 1e-7, gr).energy) < 1e-10);
+  CHECK(std::abs(at_gap(gr + 1e-7, gr).energy) < 1e-10);
+}
+
+TEST_CASE("friction: the stored energy is continuous across the stick/slip limit", "[unit]") {
+  // Below the limit |k_T e| <= mu p the stick spring stores k_T e^2 / 2; beyond it the
+  // return mapping moves the anchor so that k_T |e| = mu p, and the spring stores
+  // (mu p)^2 / (2 k_T), its energy at the limit (and no more however far it slips). So the
+  // energy is continuous at the limit, on either side of the anchor. Session 32, a mutation
+  // audit: the slip energy (mu p)^2 / k_T, without the 1/2, survived every test.
+  Fixture F;
+  const PenaltyLaw law{100.0, 0.1, 0.1, 0.0};  // fixed here, independent of the defaults
+  const FrictionLaw fr{0.15, 20.0};
+  const Vector3d xs(0.9, 0.1, 0.12);
+  const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
+  REQUIRE(pr.ok);
+  const double ell = eval_chain(F.chain, pr.u, 0).x_u.norm();
+  auto with_e = [&](double e) {  // the pair with tangential gap e = ell (u - u_anchor)
+    PairHistory h;
+    h.u_anchor = pr.u - e / ell;
+    return evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, false);
+  };
+  const PairResult r0 = with_e(0.0);  // the normal energy alone
+  REQUIRE(r0.active);
+  const double lim = fr.mu * r0.p, e_lim = lim / fr.k_T;
+  for (const double sgn : {1.0, -1.0}) {
+    const PairResult below = with_e(sgn * e_lim * (1 - 1e-9));
+    const PairResult above = with_e(sgn * e_lim * (1 + 1e-9));
+    const PairResult far = with_e(sgn * 3 * e_lim);
+    REQUIRE(!below.slip);
+    REQUIRE(above.slip);
+    REQUIRE(far.slip);
+    INFO("sign " << sgn << ": below " << below.energy << ", above " << above.energy);
+    CHECK(above.energy == Approx(below.energy).epsilon(1e-8));
+    CHECK(above.energy - r0.energy == Approx(0.5 * lim * lim / fr.k_T).epsilon(1e-8));
+    CHECK(far.energy == Approx(above.energy).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("contact set: friction work of a slip between neighbouring courses in closed form",
+          "[unit]") {
+  // A straight yarn along x of length w (the period a1 = (w, 0, 0)) with its courses c apart
+  // (a2 = (0, c, 0), c < d): every slave point presses on the courses +1 and -1 at the gap
+  // g = c - d with the same line load p(g). Shifting the courses by s along the yarn
+  // (a2 = (s, c, 0)) slides each pair by |e| = s (the master is parametrized uniformly, so
+  // |x_m,u| = w); with k_T s > mu p it slips by s - mu p / k_T under the force mu p. The cell
+  // holds one interface with a neighbouring course (two, each shared by two cells), so the
+  // friction work of the increment is w mu p (s - mu p / k_T). ContactSet sees each interface
+  // twice (from the slave points against course +1 and against course -1) and weights each
+  // pass by half (docs/unit-cell.md, the factor 2 fixed in ContactSet::commit). Session 32, a
+  // mutation audit: the full weight per pass (twice the friction work) survived every test.
+  const double w = 2.0, c = 0.26, s = 0.1;
+  knit::meso::rod::RodSystem sys;
+  sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
+  const Eigen::VectorXd x = sys.initial_state();
+  ContactOptions opt;
+  opt.reference = ContactOptions::Reference::kNone;
+  opt.penalty = PenaltyLaw{100.0, 0.1, 0.0, 0.0, 0.02};  // p = k_N (d - c - delta/2), no g0
+  opt.friction = FrictionLaw{0.15, 20.0};
+  opt.d = 0.38;
+  ContactSet cs(sys, 0, opt);
+  const Vector3d a1(w, 0, 0);
+  cs.set_periods(a1, Vector3d(0, c, 0));
+  cs.commit(sys, x);  // the anchors where the pairs are found: no slip
+  CHECK(cs.dissipation() == 0.0);
+  cs.set_periods(a1, Vector3d(s, c, 0));
+  const double p = opt.penalty.eval(c - opt.d).p, lim = opt.friction.mu * p;
+  REQUIRE(p == Approx(100.0 * (opt.d - c - 0.05)));
+  REQUIRE(opt.friction.k_T * s > lim);
+  const auto pairs = cs.active_pairs(sys, x);
+  CHECK(pairs.size() == 2u * static_cast<unsigned>(cs.num_slave_points()));
+  for (const ActivePair& a : pairs) {
+    REQUIRE(a.slip);
+    REQUIRE(a.p == Approx(p));
+  }
+  cs.commit(sys, x);
+  const double expected = w * lim * (s - lim / opt.friction.k_T);
+  CHECK(cs.last_increment_dissipation() == Approx(expected).epsilon(1e-10));
+  CHECK(cs.dissipation() == Approx(expected).epsilon(1e-10));
 }
