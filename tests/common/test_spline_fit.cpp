@@ -95,6 +95,22 @@ TEST_CASE("least squares recovers a curve from noise-free samples", "[unit][spli
   CHECK(r.max_residual < 1e-12);
 }
 
+TEST_CASE("least squares with data weights: the weighted mean and the weighted RMS",
+          "[unit][spline][fit]") {
+  // One constant (degree 0 on [0, 1]) fitted to y = 0 and 1 with data weights 1 and 3: the
+  // minimizer of sum c_k (P - y_k)^2 is the weighted mean P = 0.75, and the RMS residual is
+  // sqrt((1 x 0.75^2 + 3 x 0.25^2) / 4) = sqrt(0.1875) (fit.hpp). Session 32, a mutation audit:
+  // squared weights (P = 0.9) and an RMS over the sample count (0.612) survived every test,
+  // whose data were exact, so that the weights changed nothing.
+  const BSplineBasis b(0, {0, 1});
+  LeastSquaresOptions o;
+  o.data_weights = Eigen::Vector2d(1.0, 3.0);
+  const LeastSquaresResult r = least_squares(b, {0.2, 0.7}, Eigen::Vector2d(0.0, 1.0), o);
+  CHECK(r.P(0, 0) == Approx(0.75).epsilon(1e-14));
+  CHECK(r.rms_residual == Approx(std::sqrt(0.1875)).epsilon(1e-14));
+  CHECK(r.max_residual == Approx(0.75).epsilon(1e-14));
+}
+
 TEST_CASE("least squares with interpolated ends and noisy data", "[unit][spline][fit]") {
   const BSplineBasis b(3, uniform_knots(3, 3));
   std::vector<double> t;

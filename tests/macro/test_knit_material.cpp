@@ -155,6 +155,26 @@ TEST_CASE("knit material: alpha aligned with a vector at the Greville points", "
                     "align: the vector v is normal to the surface at a Greville point");
 }
 
+TEST_CASE("knit material: alpha aligned across the branch cut at +-pi is not torn", "[unit]") {
+  // A bilinear patch whose a1 = (50, 5 - 10 v) turns through the x axis; aligned with v =
+  // (-1, 0, 0) the raw angles are +3.042 at v = 0 and -3.042 at v = 1, either side of +-pi. The
+  // field is unwrapped before it is interpolated, so at v = 0.25 alpha is pi - atan(2.5 / 50)
+  // (mod 2 pi), not the mean of the raw angles near 0 (session 32, a mutation audit: the
+  // unwrapping removed survived every test).
+  Eigen::MatrixXd P(4, 3);
+  P << 0, 0, 0, 50, 5, 0, 0, 50, 0, 50, 45, 0;
+  const knit::spline::SplineSurface geo(knit::spline::BSplineBasis(1, {0, 0, 1, 1}),
+                                        knit::spline::BSplineBasis(1, {0, 0, 1, 1}), P);
+  const auto alpha =
+      align_alpha_field(geo, 1, {0, 0, 1, 1}, 1, {0, 0, 1, 1}, Eigen::Vector3d(-1, 0, 0));
+  for (const double v : {0.0, 0.25, 0.5, 1.0}) {
+    const double want = std::numbers::pi - std::atan((5.0 - 10.0 * v) / 50.0);
+    INFO("v = " << v << ": alpha " << alpha.eval(0.5, v)(0) << ", want " << want << " mod 2 pi");
+    CHECK(std::abs(std::sin(alpha.eval(0.5, v)(0) - want)) < 1e-3);
+    CHECK(std::cos(alpha.eval(0.5, v)(0) - want) > 0.0);
+  }
+}
+
 TEST_CASE("knit material: failed inversions are its failed evaluations", "[unit]") {
   // Material::failed_evaluations() is what knit-macro run checks before reporting success.
   KnitMaterial m = graded(0.0);
@@ -265,4 +285,56 @@ TEST_CASE("knit material: the output strains are the tensor E rotated into the c
   CHECK(std::abs(s[2].second) == Approx(g / 2));
   CHECK(s[3].second == Approx(-s[2].second));
   CHECK(std::abs(s[4].second) < 1e-15);
+  // The sense (session 32, a mutation audit: T_E(-alpha) survived the checks above, which the
+  // 45-degree case cannot tell apart): alpha turns e1 into the course direction e_c = (cos a,
+  // sin a), e_w = (-sin a, cos a), so E_course_wale = e_c . E e_w = -cs e for the uniaxial
+  // strain and E_course = cs g = -E_wale for the shear.
+  CHECK(f[4].second == Approx(-e / 2));
+  CHECK(s[2].second == Approx(g / 2));
+  CHECK(s[3].second == Approx(-g / 2));
+}
+
+TEST_CASE("knit material: a failed inversion is a failure, not an extrapolation, on both paths",
+          "[unit]") {
+  // Session 32, a mutation audit: the converged-state audit counting a failed inversion as
+  // beyond the data, the rotated path not counting failed inversions, and its recorded
+  // locations in the shell's frame instead of the material's all passed every test (the tests
+  // ran at alpha = 0 only).
+  KnitMaterial m = graded(0.0);
+  REQUIRE(m.begin_converged_audit());
+  m.evaluate(Eigen::Vector3d(std::nan(""), 0.0, 0.0), at(0.3, 0.6));
+  m.evaluate(Eigen::Vector3d(0.1, 0.1, 0.0), at(0.3, 0.6));
+  m.end_converged_audit();
+  CHECK(m.failed_evaluations() == 1);
+  CHECK_THAT(m.report(), Catch::Contains("at converged states: 0 of 2 evaluations extrapolated"));
+  CHECK(m.warning().empty());
+  // Rotated: a failed inversion is counted as one too.
+  const double alpha = 0.3;
+  KnitMaterial r = graded(alpha);
+  r.evaluate(Eigen::Vector3d(std::nan(""), 0.0, 0.0), at(0.3, 0.6));
+  CHECK(r.failed_evaluations() == 1);
+  // A strain beyond the fan is recorded in the material frame, T_E(alpha) E.
+  const Eigen::Vector3d E(-0.3, -0.3, 0.2);
+  r.evaluate(E, at(0.3, 0.6));
+  REQUIRE(r.stats().first.size() == 2);
+  const Eigen::Vector3d Ehat = knit::mech::T_E(alpha) * E;
+  CHECK((r.stats().first[1].E_material - Ehat).norm() < 1e-12);
+  CHECK((Ehat - E).norm() > 0.05);
+}
+
+TEST_CASE("knit material, paper law: dS/dl at the end of the range is a one-sided difference",
+          "[unit]") {
+  // l = 4.5, the database's first loop length: dS/dl = (S(l + h) - S(l)) / h (knit_material.hpp),
+  // against a material whose l is 1e-4 higher (session 32, a mutation audit: dividing by 2h
+  // there survived; the design tests ran inside the range).
+  const KnitMaterial m1 = graded(0.3, 4.5, 4.5), m2 = graded(0.3, 4.5 + 1e-4, 4.5 + 1e-4);
+  for (const Eigen::Vector3d& E :
+       {Eigen::Vector3d(0.1, 0.05, 0.02), Eigen::Vector3d(0.2, -0.05, 0.1)}) {
+    const Eigen::Vector3d fd =
+        (m2.evaluate(E, at(0.5, 0.5)).S - m1.evaluate(E, at(0.5, 0.5)).S) / 1e-4;
+    const Eigen::Vector3d d = m1.dS_dl(E, at(0.5, 0.5));
+    INFO("dS/dl " << d.transpose() << ", difference " << fd.transpose());
+    REQUIRE(fd.norm() > 0.0);
+    CHECK((d - fd).norm() <= 1e-3 * fd.norm());
+  }
 }

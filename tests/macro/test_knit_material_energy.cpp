@@ -162,6 +162,24 @@ std::string db_file(const std::string& name, bool energy, int version) {
 
 // Session 28: the report counted the extrapolated evaluations at the quadrature points, but
 // the output grid's samples, which the figures show, carried no mark.
+TEST_CASE("knit material, energy law: the box and its counts are in the material frame", "[unit]") {
+  // Rotated by alpha = 0.6: a strain whose material-frame image (0.44, -0.29, 0) lies inside
+  // the test law's box is not extrapolated and widens the visited box to E11 = 0.44; the same
+  // numbers as a shell-frame strain lie outside it in the material frame (session 32, a
+  // mutation audit: both the count and the visited box taken in the shell's frame survived,
+  // the tests running at alpha = 0).
+  const double alpha = 0.6;
+  KnitMaterial m = energy_material(alpha);
+  const Eigen::Vector3d inside(0.44, -0.29, 0.0);
+  m.evaluate(knit::mech::T_E(alpha).inverse() * inside, at(0.5, 0.5));
+  auto s = m.energy_stats();
+  CHECK(s.outside_box == 0);
+  CHECK(s.visited_max(0) == Approx(0.44).epsilon(1e-12));
+  CHECK(s.visited_min(1) == Approx(-0.29).epsilon(1e-12));
+  m.evaluate(inside, at(0.5, 0.5));
+  CHECK(m.energy_stats().outside_box == 1);
+}
+
 TEST_CASE("knit material: the output field beyond_law_data marks samples beyond the data",
           "[unit]") {
   auto beyond = [](const KnitMaterial& m, const Eigen::Vector3d& E) {
