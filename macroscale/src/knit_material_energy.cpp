@@ -58,9 +58,14 @@ Eigen::Vector3d KnitMaterial::dS_dl(const Eigen::Vector3d& E, const MaterialPoin
     const double h = step * std::max(1.0, std::abs(l));
     const double lp = std::min(l + h, l_max()), lm = std::max(l - h, l_min());
     const Eigen::Matrix3d TSinv = mech::T_S_inv(alpha);
-    const Eigen::Vector3d Sp = evaluate_at(E, *surface_at(lp), alpha, TE, TSinv, where.theta).S;
-    const Eigen::Vector3d Sm = evaluate_at(E, *surface_at(lm), alpha, TE, TSinv, where.theta).S;
-    return (Sp - Sm) / (lp - lm);
+    // The surfaces evaluated directly, as evaluate_at() does (T_E(0) E = E and T_S(0)^-1 S = S
+    // exactly), but not counted: the difference quotient's evaluations at l +- h are not the
+    // run's, and went into the extrapolation counts and the report's first locations (session
+    // 32, a helper's audit).
+    auto S_at = [&](double ll) -> Eigen::Vector3d {
+      return TSinv * surface_at(ll)->evaluate(TE * E).S;
+    };
+    return (S_at(lp) - S_at(lm)) / (lp - lm);
   }
   std::shared_ptr<const material::EnergyLawAt> law;
   {

@@ -337,4 +337,23 @@ TEST_CASE("knit material, paper law: dS/dl at the end of the range is a one-side
     REQUIRE(fd.norm() > 0.0);
     CHECK((d - fd).norm() <= 1e-3 * fd.norm());
   }
+  // The difference quotient's evaluations are not the material's: beyond the fan, dS/dl leaves
+  // the counts and the recorded locations alone (they went into the report before session 32).
+  KnitMaterial m3 = graded(0.3);
+  const Eigen::Vector3d beyond(-0.3, -0.3, 0.2);
+  m3.evaluate(beyond, at(0.5, 0.5));
+  const auto before = m3.stats();
+  REQUIRE(before.evaluations == 1);
+  REQUIRE(before.first.size() == 1);
+  const Eigen::Vector3d d = m3.dS_dl(beyond, at(0.5, 0.5));
+  CHECK(d.allFinite());
+  CHECK(m3.stats().evaluations == 1);
+  CHECK(m3.stats().count == before.count);
+  CHECK(m3.stats().first.size() == 1);
+  // ... and it is still the difference of what evaluate() gives at l +- h (h = 1e-5 l).
+  const double l = m3.stitch_value(Eigen::Vector2d(0.5, 0.5)), h = 1e-5 * l;
+  const KnitMaterial up = graded(0.3, l + h, l + h), down = graded(0.3, l - h, l - h);
+  const Eigen::Vector3d fd =
+      (up.evaluate(beyond, at(0.5, 0.5)).S - down.evaluate(beyond, at(0.5, 0.5)).S) / (2 * h);
+  CHECK((d - fd).norm() <= 1e-6 * (1.0 + fd.norm()));
 }
