@@ -321,6 +321,31 @@ TEST_CASE("DofMap: a rigid mode is found with fewer than five constrained DOFs",
   }
 }
 
+TEST_CASE("DofMap: supports on a line leave the rotation about it, off the line by 1e-7 they don't",
+          "[unit]") {
+  // Three fixed control points: two on the x axis, the third at height delta above their
+  // middle. The rotation about x moves only the third, by delta per radian: the smallest
+  // singular value of the supports' rigid-mode matrix is of order delta / L, and the threshold
+  // is 1e-8 of the largest (the verdict flips between delta = 3e-8 and 1e-8 here). Session 32:
+  // a threshold 100 times larger or smaller survived the suite. delta = 1e-7 L holds the
+  // patch; delta = 3e-9 L counts as a line.
+  for (const double delta : {1e-7, 3e-9}) {
+    INFO("delta = " << delta);
+    Eigen::MatrixXd X(4, 3);
+    X << 0, 0, 0, 1, 0, 0, 0.5, delta, 0, 0.5, 0.5, 1;  // the fourth point is free
+    Constraints c(12);
+    for (int d = 0; d < 9; ++d) c.fix(d);
+    const auto mode = DofMap(c).unconstrained_rigid_mode(X);
+    if (delta > 1e-8) {
+      CHECK_FALSE(mode.has_value());
+    } else {
+      REQUIRE(mode.has_value());
+      CHECK_THAT(*mode, Catch::StartsWith("rotation about the direction (1, 0, 0)") ||
+                            Catch::StartsWith("rotation about the direction (-1, 0, 0)"));
+    }
+  }
+}
+
 TEST_CASE("output.vtk false writes no VTU or PVD files", "[unit]") {
   const fs::path d = fs::temp_directory_path() / ("knit_solver_vtk_" + std::to_string(::getpid()));
   fs::remove_all(d);
