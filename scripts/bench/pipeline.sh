@@ -6,11 +6,16 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="$(cd "${1:-$root/build}" && pwd)"
-out="$(mktemp -d "${TMPDIR:-/tmp}/knit-pipeline-bench.XXXXXX")"
-trap 'rm -rf "$out"' EXIT
+# The pipeline's OUT is a new directory inside the scratch one and the log lies beside it:
+# a log inside OUT made it a non-empty directory without the pipeline's marker, which the
+# pipeline refuses as not its own (session 32: this benchmark stopped there).
+work="$(mktemp -d "${TMPDIR:-/tmp}/knit-pipeline-bench.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+out="$work/out"
+log="$work/bench.log"
 start=$(date +%s.%N)
 make -s -f "$root/scripts/pipeline.mk" ROOT="$root" BUILD="$build" OUT="$out" \
-  DB_SOURCE="${DB_SOURCE:-auto}" -j2 all > "$out/bench.log" 2>&1 || { tail -20 "$out/bench.log"; exit 1; }
+  DB_SOURCE="${DB_SOURCE:-auto}" -j2 all > "$log" 2>&1 || { tail -20 "$log"; exit 1; }
 end=$(date +%s.%N)
 /usr/bin/python3 - "$out" "$start" "$end" <<'PY'
 import glob, json, sys
