@@ -10,7 +10,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -36,10 +35,15 @@ fs::path scratch(const std::string& tag) {
   return d;
 }
 
+/// A case file of cases/verification, parsed.
+json verification_case(const std::string& name) {
+  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
+  return json::parse(in);
+}
+
 /// The tensile case with a few steps and a small output grid, written to d/t.json.
 std::string small_case(const fs::path& d, int grid = 5, int steps = 2) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/tensile_svk.json");
-  json j = json::parse(in);
+  json j = verification_case("tensile_svk.json");
   j["solver"]["steps"] = steps;
   j["output"]["grid"] = {grid, grid};
   std::ofstream(d / "t.json") << j.dump(2);
@@ -243,15 +247,6 @@ TEST_CASE("knit-macro run: the output size estimate matches what is written", "[
   fs::remove_all(d);
 }
 
-namespace {
-
-std::string verification_text(const std::string& name) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-}  // namespace
-
 TEST_CASE("results.h5: the fields are the shell's samples on the output grid", "[unit][outputs]") {
   // The Scordelis-Lo roof (curved: every strain, curvature and resultant is non-zero somewhere)
   // on a 4 x 3 grid: row k = i + 4 j at (theta1, theta2) = (i / 3, j / 2), the Voigt shears
@@ -259,7 +254,7 @@ TEST_CASE("results.h5: the fields are the shell's samples on the output grid", "
   // E12 = 2E12, or grid rows in the other order, survived the suite).
   using namespace knit::macro;
   const fs::path d = scratch("fields");
-  json j = json::parse(verification_text("scordelis_lo.json"));
+  json j = verification_case("scordelis_lo.json");
   j["solver"]["steps"] = 1;
   j["output"]["grid"] = {4, 3};
   const Case c = parse_case(j.dump(), "roof.json");
@@ -320,7 +315,7 @@ TEST_CASE("output every: every n-th step and the last, and a stopped run writes 
     CHECK(h5.read_doubles("steps/load_factor").size() == h5.read_doubles("steps/step").size());
     return h5.children("fields");
   };
-  json j = json::parse(verification_text("tensile_svk.json"));
+  json j = verification_case("tensile_svk.json");
   j["solver"]["steps"] = 5;
   j["output"]["grid"] = {3, 3};
   j["output"]["every"] = 2;
@@ -340,7 +335,7 @@ TEST_CASE("output every: every n-th step and the last, and a stopped run writes 
   CHECK(2 * five == 3 * four);
   // A run that stops (the Sze cantilever in one step with 8 iterations and 2 cut-backs
   // converges at 0.25 only) writes the state it reached although 1 is not a multiple of 1000.
-  json sze = json::parse(verification_text("sze_cantilever.json"));
+  json sze = verification_case("sze_cantilever.json");
   sze["solver"]["steps"] = 1;
   sze["solver"]["max_iterations"] = 8;
   sze["solver"]["max_cutbacks"] = 2;
@@ -379,7 +374,7 @@ TEST_CASE("a non-finite output sample is named by its field, step and grid point
   // steps; n11 is the first field it spoils.
   using namespace knit::macro;
   const fs::path d = scratch("nan");
-  json j = json::parse(verification_text("tensile_svk.json"));
+  json j = verification_case("tensile_svk.json");
   j["solver"]["steps"] = 2;
   j["output"]["grid"] = {3, 5};
   Case c = parse_case(j.dump(), "t.json");
