@@ -357,3 +357,38 @@ TEST_CASE("knit material, paper law: dS/dl at the end of the range is a one-side
       (up.evaluate(beyond, at(0.5, 0.5)).S - down.evaluate(beyond, at(0.5, 0.5)).S) / (2 * h);
   CHECK((d - fd).norm() <= 1e-6 * (1.0 + fd.norm()));
 }
+
+TEST_CASE("knit material, paper law: bound points on graded l and alpha fields", "[unit]") {
+  // As the energy law's test: l grades in theta1, alpha is bilinear (u index fastest); each
+  // bound point equals the unbound evaluation and the definition S = T_S(-alpha) S_hat(T_E E),
+  // C = T_S(-alpha) C_hat T_E (eqs. 21-22).
+  ScalarFieldSpec a;
+  a.degree_u = a.degree_v = 1;
+  a.knots_u = a.knots_v = {0, 0, 1, 1};
+  const double a00 = 0.2, a10 = 0.5, a01 = -0.9, a11 = 1.3;
+  a.values = {a00, a10, a01, a11};
+  const auto fam = test_family();
+  KnitMaterial m(fam, make_scalar_field(knit::testing::graded_stitch_value()),
+                 make_scalar_field(a));
+  const std::vector<Eigen::Vector2d> pts = {{0.1, 0.8}, {0.7, 0.15}, {0.45, 0.55}};
+  m.bind_points(pts);
+  const Eigen::Vector3d E(0.12, 0.04, 0.09);
+  for (int k = 0; k < 3; ++k) {
+    const double u = pts[k](0), v = pts[k](1);
+    const double alpha =
+        (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + (1 - u) * v * a01 + u * v * a11;
+    INFO("point " << k << ", alpha " << alpha);
+    CHECK(m.knitting_angle(pts[k]) == Approx(alpha).epsilon(1e-14));
+    const Eigen::Matrix3d TE = knit::mech::T_E(alpha), TSinv = knit::mech::T_S_inv(alpha);
+    const auto ref = ResponseSurface(fam->at(4.5 + 2.0 * u)).evaluate(TE * E);
+    MaterialPoint bound = at(u, v), unbound = at(u, v);
+    bound.point_id = k;
+    const auto rb = m.evaluate(E, bound), ru = m.evaluate(E, unbound);
+    CHECK((rb.S - TSinv * ref.S).norm() <= 1e-12 * (1 + ref.S.norm()));
+    CHECK((rb.C - TSinv * ref.C * TE).norm() <= 1e-11 * (1 + ref.C.norm()));
+    CHECK((rb.S - ru.S).norm() <= 1e-13 * (1 + ru.S.norm()));
+    CHECK((rb.C - ru.C).norm() <= 1e-12 * (1 + ru.C.norm()));
+    CHECK((m.dS_dl(E, bound, 1e-6) - m.dS_dl(E, unbound, 1e-6)).norm() <=
+          1e-12 * (1 + m.dS_dl(E, unbound, 1e-6).norm()));
+  }
+}

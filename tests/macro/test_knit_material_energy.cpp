@@ -285,3 +285,46 @@ TEST_CASE("knit material: a case in other units is refused", "[unit]") {
   j["units"] = "m, N, Pa";
   CHECK_NOTHROW(parse_case(j.dump(), "c.json"));
 }
+
+TEST_CASE("knit material, energy law: bound points on graded l and alpha fields", "[unit]") {
+  // The knit-material tests bound points at alpha = 0 with constant alpha fields; two mutants
+  // (the bound law rotated by -alpha, the alpha field's u/v order) were caught only by the
+  // design-gradient tests (session 32's audit). Here l grades in theta1 and alpha is bilinear
+  // (u index fastest, docs/case-format.md): every bound point must equal the unbound
+  // evaluation and the definition W(E) = W_hat(T_E(alpha) E; l), S = T_E^T S_hat (eq. 22).
+  const bool network = GENERATE(false, true);
+  auto law = std::make_shared<const EnergyLaw>(network ? testing::make_test_network_law()
+                                                       : testing::make_test_energy_law());
+  ScalarFieldSpec a;
+  a.degree_u = a.degree_v = 1;
+  a.knots_u = a.knots_v = {0, 0, 1, 1};
+  const double a00 = 0.2, a10 = 0.5, a01 = -0.9, a11 = 1.3;
+  a.values = {a00, a10, a01, a11};
+  KnitMaterial m(nullptr, law, make_scalar_field(knit::testing::graded_stitch_value()),
+                 make_scalar_field(a));
+  const std::vector<Eigen::Vector2d> pts = {{0.1, 0.8}, {0.7, 0.15}, {0.45, 0.55}};
+  m.bind_points(pts);
+  const Eigen::Vector3d E(0.12, -0.04, 0.09);
+  for (int k = 0; k < 3; ++k) {
+    const double u = pts[k](0), v = pts[k](1);
+    const double alpha =
+        (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + (1 - u) * v * a01 + u * v * a11;
+    const double l = 4.5 + 2.0 * u;
+    INFO((network ? "network" : "ridge") << " law, point " << k << ", alpha " << alpha);
+    CHECK(m.knitting_angle(pts[k]) == Approx(alpha).epsilon(1e-14));
+    const Eigen::Matrix3d TE = knit::mech::T_E(alpha);
+    const auto ref = law->at(l).evaluate(TE * E);
+    MaterialPoint bound = at(u, v), unbound = at(u, v);
+    bound.point_id = k;
+    const auto rb = m.evaluate(E, bound), ru = m.evaluate(E, unbound);
+    CHECK(rb.W == Approx(ref.W).epsilon(1e-12));
+    CHECK((rb.S - TE.transpose() * ref.S).norm() <= 1e-12 * (1 + ref.S.norm()));
+    CHECK((rb.C - TE.transpose() * ref.C * TE).norm() <= 1e-11 * (1 + ref.C.norm()));
+    CHECK((rb.S - ru.S).norm() <= 1e-13 * (1 + ru.S.norm()));
+    CHECK((rb.C - ru.C).norm() <= 1e-12 * (1 + ru.C.norm()));
+    // dS/dl at fixed E and alpha: T_E^T dS_hat/dl, bound or not.
+    const Eigen::Vector3d d_ref = TE.transpose() * law->at(l, true).dS_dl(TE * E);
+    CHECK((m.dS_dl(E, bound, 1e-6) - d_ref).norm() <= 1e-12 * (1 + d_ref.norm()));
+    CHECK((m.dS_dl(E, unbound, 1e-6) - d_ref).norm() <= 1e-12 * (1 + d_ref.norm()));
+  }
+}
