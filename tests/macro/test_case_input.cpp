@@ -20,6 +20,7 @@
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
 #include "knit/material/database.hpp"
+#include "verification_case.hpp"
 
 using namespace knit::macro;
 namespace fs = std::filesystem;
@@ -27,10 +28,7 @@ using nlohmann::json;
 
 namespace {
 
-json read_json(const std::string& name) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
-  return json::parse(in);
-}
+using knit::macro::test::verification_case;
 
 /// The error message of parsing (and setting up) a modified tensile case, or "" if it passed.
 std::string error_of(const json& j, const std::string& file = "bad.json") {
@@ -83,7 +81,7 @@ std::string slurp(const fs::path& p) {
 // Session 25: the schema-driven readers (rod, cell, sweep) gave the line, the case loader only
 // the pointer. A document on one line (a generated case) is left without "(line 1)".
 TEST_CASE("bad case input of several lines also names the line", "[unit]") {
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["thickness"] = -1;
   j["boundary_conditions"][1]["edge"] = "u2";
   const std::string text = j.dump(2);
@@ -110,7 +108,7 @@ TEST_CASE("bad case input of several lines also names the line", "[unit]") {
   CHECK(message(j.dump()).find("(line") == std::string::npos);
   // An unknown key holding '/' or '~' is named by its escaped pointer (RFC 6901), so its line
   // is found too (session 27: "/material/x/y: unknown key", no line).
-  j = read_json("tensile_svk.json");
+  j = verification_case("tensile_svk.json");
   j["material"]["x/y~z"] = 1;
   const std::string odd = j.dump(2);
   const auto odd_at = odd.find("\"x/y~z\"");
@@ -124,13 +122,13 @@ TEST_CASE("bad case input of several lines also names the line", "[unit]") {
           std::to_string(1 + std::count(odd.begin(),
                                         odd.begin() + static_cast<std::ptrdiff_t>(odd_at), '\n')) +
           ")") != std::string::npos);
-  j = read_json("tensile_svk.json");
+  j = verification_case("tensile_svk.json");
   j["solver"]["a/b"] = 1;
   CHECK(message(j.dump()).rfind("bad.json: /solver/a~1b: unknown key (allowed: ", 0) == 0);
 }
 
 TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
-  const json base = read_json("tensile_svk.json");
+  const json base = verification_case("tensile_svk.json");
   CHECK(error_of(base).empty());
   {
     json j = base;
@@ -287,7 +285,7 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
 }
 
 TEST_CASE("malformed JSON reports the line and column, duplicate keys are errors", "[unit]") {
-  std::string text = read_json("tensile_svk.json").dump(2);
+  std::string text = verification_case("tensile_svk.json").dump(2);
   text.insert(text.find("\"geometry\""), "oops ");
   try {
     parse_case(text, "broken.json");
@@ -300,7 +298,7 @@ TEST_CASE("malformed JSON reports the line and column, duplicate keys are errors
 }
 
 TEST_CASE("a missing support is reported as such, not as NaNs", "[unit]") {
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["boundary_conditions"][0]["fix"] = {"y", "z"};  // nothing holds x on the fixed jaw...
   j["boundary_conditions"][1]["fix"] = {"z"};       // ...nor on the moving one
   const std::string e = error_of(j);
@@ -311,7 +309,7 @@ TEST_CASE("a missing support is reported as such, not as NaNs", "[unit]") {
 }
 
 TEST_CASE("a degenerate geometry is reported with where it is", "[unit]") {
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 0, 0}, {50, 0, 0}};  // zero height
   const std::string e = error_of(j);
   CHECK(e.rfind("bad.json: /geometry/control_points: degenerate geometry: the surface Jacobian",
@@ -321,7 +319,7 @@ TEST_CASE("a degenerate geometry is reported with where it is", "[unit]") {
 
 TEST_CASE("knit-macro run: bad input exits with 2 and writes no output directory", "[unit]") {
   const fs::path d = temp_dir("bad");
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["thickness"] = -0.5;
   std::ofstream(d / "neg.json") << j.dump(2);
   const int rc =
@@ -344,7 +342,7 @@ TEST_CASE(
     "the target",
     "[unit]") {
   const fs::path d = temp_dir("full");
-  std::ofstream(d / "case.json") << read_json("tensile_svk.json").dump(2);
+  std::ofstream(d / "case.json") << verification_case("tensile_svk.json").dump(2);
   const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
   REQUIRE(run_exe(args, d / "log0.txt") == 0);
   const std::string csv = slurp(d / "out" / "load_strain.csv");
@@ -516,7 +514,7 @@ TEST_CASE("case file: corner-driven diagonal test is symmetric about the diagona
 
 TEST_CASE("cut-back: one load step for the large-deflection cantilever still reaches the full load",
           "[verification]") {
-  json j = read_json("sze_cantilever.json");
+  json j = verification_case("sze_cantilever.json");
   j["solver"]["steps"] = 1;
   j["solver"]["max_iterations"] = 12;
   j["refinement"]["elements"] = {8, 1};
@@ -534,7 +532,7 @@ TEST_CASE("cut-back: a halved increment is never the one that just failed", "[ve
   // converges, the increment doubles to 1 and is clipped at 1, 0.5 -> 1 fails; the next try is
   // 0.5 -> 0.75. Session 31: h / 2 = 0.5 retried 0.5 -> 1 from the same state, failed again
   // and spent the second cut-back, so the run stopped "after 2 cut-backs".
-  json j = read_json("sze_cantilever.json");
+  json j = verification_case("sze_cantilever.json");
   j["solver"]["steps"] = 1;
   j["solver"]["max_iterations"] = 12;
   j["solver"]["max_cutbacks"] = 2;
@@ -549,7 +547,7 @@ TEST_CASE("cut-back: a halved increment is never the one that just failed", "[ve
 
 TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provenance", "[unit]") {
   const fs::path d = temp_dir("out");
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["solver"]["steps"] = 4;
   j["output"]["grid"] = {5, 7};
   std::ofstream(d / "t.json") << j.dump(2);
@@ -602,7 +600,7 @@ TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry
   // Issue 14: the corner u1v1 pulled in so that A1 || A2 there: |A1 x A2| = 0 only at that
   // corner, positive at every quadrature point -- the loader used to accept it and the run
   // stopped after step 1.
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 50, 0}, {25, 25, 0}};
   std::string e;
   try {
@@ -615,7 +613,7 @@ TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry
 }
 
 TEST_CASE("a folded (flipped) reference surface is refused at load", "[unit]") {
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 50, 0}, {-10, -10, 0}};
   std::string e;
   try {
@@ -632,7 +630,7 @@ TEST_CASE("a fold between the quadrature points is refused at load", "[unit]") {
   // Session 27: a one-span cubic whose x runs 0, 51, -1, 50 folds back over theta1 in about
   // (0.451, 0.549), between the 6 Gauss points of the p = 5 analysis surface: it ran
   // "completed" with exit 0. The input surface is now sampled densely as well.
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["geometry"]["degrees"] = {3, 1};
   j["geometry"]["knots_u"] = {0, 0, 0, 0, 1, 1, 1, 1};
   j["geometry"]["control_points"] = {{0, 0, 0},  {51, 0, 0},  {-1, 0, 0},  {50, 0, 0},
@@ -647,7 +645,7 @@ TEST_CASE("a fold between the quadrature points is refused at load", "[unit]") {
 TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector", "[unit]") {
   // Session 27: a C^0 knot acted as a hinge (a kinked plate deflected 36 % more, exit 0) and a
   // C^-1 knot tore the patch (1e-13 N at 30 % strain, exit 0).
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   const auto error_of = [](const json& c) { return ::error_of(c, "kink.json"); };
   j["geometry"]["degrees"] = {2, 1};
   j["geometry"]["knots_u"] = {0, 0, 0, 0.5, 0.5, 1, 1, 1};
@@ -660,7 +658,7 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
                           0) == 0);
   j["geometry"]["knots_u"] = {0, 0, 0, 0.25, 0.5, 1, 1, 1};  // C^1 everywhere: accepted
   CHECK(error_of(j).empty());
-  j = read_json("tensile_svk.json");
+  j = verification_case("tensile_svk.json");
   j["geometry"]["knots_v"] = {0, 0, 0.5, 0.5, 1, 1};
   cp = json::array();
   for (const double y : {0.0, 25.0, 25.0, 50.0})
@@ -671,7 +669,7 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
                           0) == 0);
   // Session 28: the analysis basis could still be degree 1 (hinge lines between its elements),
   // through "refinement" to degree 1 or a degree-1 patch without refinement.
-  j = read_json("tensile_svk.json");
+  j = verification_case("tensile_svk.json");
   j["refinement"] = {{"degree", 1}, {"elements", {4, 4}}};
   CHECK(error_of(j).rfind("kink.json: /refinement/degree: the analysis degree must be >= 2", 0) ==
         0);
@@ -682,7 +680,7 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
   j["geometry"]["control_points"] = {{0, 0, 0},  {25, 0, 0},  {50, 0, 0},
                                      {0, 50, 0}, {25, 50, 0}, {50, 50, 0}};
   CHECK(error_of(j).rfind("kink.json: /geometry/degrees/1: degree 1 cannot be analysed", 0) == 0);
-  j["refinement"] = read_json("tensile_svk.json")["refinement"];  // degree 5: accepted
+  j["refinement"] = verification_case("tensile_svk.json")["refinement"];  // degree 5: accepted
   CHECK(error_of(j).empty());
 }
 
@@ -690,7 +688,7 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
   // Session 28: NURBS weights 1, 1, 1, 10 on the one-element tensile patch (the same flat
   // square) gave 23 % more jaw force, with the area integrated 0.5 % off; weights up to 1e4
   // ran with exit 0 and results hundreds of times off.
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   const auto error_of = [](const json& c) { return ::error_of(c, "w.json"); };
   j["geometry"]["weights"] = {1, 1, 1, 10};
   CHECK(error_of(j).rfind("w.json: /geometry/weights: the shell's quadrature (p + 1 Gauss points "
@@ -706,7 +704,7 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
         Approx(2500.0).epsilon(1e-5));  // the 50 x 50 mm square
   // Element by element (review of session 28): a flat 8 x 8 quadratic patch with the corner
   // weight 10 is 1.4e-4 off in all, but 0.88 % off in its corner element.
-  j = read_json("tensile_svk.json");
+  j = verification_case("tensile_svk.json");
   j.erase("refinement");
   j["boundary_conditions"] =
       json::array({{{"all", true}, {"fix", {"z"}}}, {{"edge", "u0"}, {"fix", {"x", "y"}}}});
@@ -800,7 +798,7 @@ TEST_CASE("a converged state that folds over itself is not accepted", "[unit]") 
   // patch compressed by 30 % ran "completed" (exit 0) with its corners turned inside out. The
   // same with a St. Venant-Kirchhoff patch compressed by 80 % in plane: the run stops where the
   // normal flips, and no written state is inverted.
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["refinement"] = {{"degree", 3}, {"elements", {2, 2}}};
   j["boundary_conditions"][1]["prescribe"] = {{"y", -40.0}};
   j["boundary_conditions"].push_back({{"all", true}, {"fix", {"z"}}});
@@ -926,7 +924,7 @@ TEST_CASE("a folded database surface is refused at load, naming the database and
   const int n = 11;
   E.row(2 + n * (n - 1)).swap(E.row(3 + n * (n - 1)));
   write_database(d / "db.h5", db);
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["material"] = {{"type", "knit"}, {"database", (d / "db.h5").string()}, {"stitch_value", 5.0}};
   std::string e;
   try {
@@ -955,7 +953,7 @@ std::string load_error_of(const std::string& text) {
 }  // namespace
 
 TEST_CASE("output names are checked at load: characters, length, '.', uniqueness", "[unit]") {
-  const json base = read_json("tensile_svk.json");
+  const json base = verification_case("tensile_svk.json");
   REQUIRE(base["output"].contains("points"));
   auto with_name = [&](const std::string& n) {
     json j = base;
@@ -982,7 +980,7 @@ TEST_CASE("output names are checked at load: characters, length, '.', uniqueness
 }
 
 TEST_CASE("a number outside the double range in a case names file and pointer, exit 2", "[unit]") {
-  std::string text = read_json("tensile_svk.json").dump();
+  std::string text = verification_case("tensile_svk.json").dump();
   text.replace(text.find("\"thickness\":0.76"), 16, "\"thickness\":1e400");
   CHECK(load_error_of(text) ==
         "bad.json: /geometry/thickness: the number 1e400 is outside the range of a double (line "
@@ -1006,7 +1004,7 @@ TEST_CASE("a case path that is a FIFO or a device is refused at once", "[unit]")
 }
 
 TEST_CASE("a refinement that cannot fit in memory is refused at load with the estimate", "[unit]") {
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["refinement"] = {{"degree", 15}, {"elements", {256, 256}}};  // schema-legal
   const std::string e = load_error_of(j.dump());
   CHECK_THAT(e, Catch::StartsWith("bad.json: /refinement: 271 x 271 control points of degree "
@@ -1024,7 +1022,7 @@ TEST_CASE("a refinement that cannot fit in memory is refused at load with the es
   ::unsetenv("KNIT_MAX_MEMORY_MB");
   CHECK(memory_limit_bytes() > 0);
   // The estimate itself: 1 element of degree 5 is small; 16 x 16 of degree 15 is not.
-  const Case small = parse_case(read_json("tensile_svk.json").dump(), "t.json");
+  const Case small = parse_case(verification_case("tensile_svk.json").dump(), "t.json");
   CHECK(estimate_shell_memory(small.surface).total() < (64ull << 20));
   j["refinement"] = {{"degree", 15}, {"elements", {16, 16}}};
   const Case mid = parse_case(j.dump(), "t.json");
@@ -1060,7 +1058,7 @@ TEST_CASE("a knit field degree of 1e10 is an input error before any int conversi
     db.entries.push_back(e);
   }
   knit::material::write_database(dir / "db.h5", db);
-  json j = read_json("tensile_svk.json");
+  json j = verification_case("tensile_svk.json");
   j["material"] = {{"type", "knit"},
                    {"database", (dir / "db.h5").string()},
                    {"stitch_value",

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "knit/io/json_input.hpp"
+#include "verification_case.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -30,8 +31,7 @@ TEST_CASE("every macroscale case file validates against the case schema", "[unit
 
 TEST_CASE("the case schema rejects unknown keys, bad edges and points outside [0,1]^2", "[unit]") {
   const auto& schema = knit::io::JsonSchema::embedded("case");
-  std::ifstream in(fs::path(KNIT_SOURCE_DIR) / "cases/verification/tensile_svk.json");
-  const json base = json::parse(in);
+  const json base = knit::macro::test::verification_case("tensile_svk.json");
   json a = base;
   a["solver"]["stepz"] = 1;
   CHECK(!schema.errors(a).empty());

@@ -9,6 +9,7 @@
 #include "knit/macro/case.hpp"
 #include "knit/macro/patch.hpp"
 #include "knit/macro/run.hpp"
+#include "verification_case.hpp"
 
 using namespace knit::macro;
 using nlohmann::json;
@@ -17,8 +18,7 @@ namespace {
 
 /// The corner-driven diagonal test (50 x 50 mm, St. Venant-Kirchhoff) at degree p, h x h.
 json diagonal(int p, int h) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/diagonal_svk.json");
-  json j = json::parse(in);
+  json j = test::verification_case("diagonal_svk.json");
   j["refinement"] = {{"degree", p}, {"elements", {h, h}}};
   j["solver"]["steps"] = 4;
   return j;

@@ -21,6 +21,7 @@
 #include "knit/macro/run.hpp"
 #include "knit/macro/shell_model.hpp"
 #include "knit/macro/svk_material.hpp"
+#include "verification_case.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -35,11 +36,7 @@ fs::path scratch(const std::string& tag) {
   return d;
 }
 
-/// A case file of cases/verification, parsed.
-json verification_case(const std::string& name) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
-  return json::parse(in);
-}
+using knit::macro::test::verification_case;
 
 /// The tensile case with a few steps and a small output grid, written to d/t.json.
 std::string small_case(const fs::path& d, int grid = 5, int steps = 2) {

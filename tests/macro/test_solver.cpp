@@ -20,6 +20,7 @@
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
 #include "shell_test_util.hpp"
+#include "verification_case.hpp"
 
 using namespace knit::macro;
 namespace fs = std::filesystem;
@@ -27,10 +28,7 @@ using nlohmann::json;
 
 namespace {
 
-json verification_case(const std::string& name) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
-  return json::parse(in);
-}
+using knit::macro::test::verification_case;
 
 /// A St. Venant-Kirchhoff strip 10 x 1 (t = 1, E = 1, nu = 0) on x in [0, 10], supported at
 /// x = 0, loaded at x = 10 by `load` (edge force per length) or by a prescribed displacement.
