@@ -621,3 +621,52 @@ TEST_CASE("stability: a patch with no free DOF has 0 negative pivots, or none on
   REQUIRE(u.report.status == RunStatus::kCompleted);
   for (const StepRow& row : u.rows) CHECK(row.negative_pivots == -1);
 }
+
+namespace {
+
+/// St. Venant-Kirchhoff (E = 1, nu = 0) stiffening in S11 = E11 + b E11^3, declared not
+/// hyperelastic: the run takes the LU path and the secant line search (newton.cpp).
+struct Stiffening final : Material {
+  SaintVenantKirchhoff svk{1.0, 0.0};
+  double b = 200.0;
+  std::string name() const override { return "stiffening"; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& w) const override {
+    MaterialResponse r = svk.evaluate(E, w);
+    r.S(0) += b * E(0) * E(0) * E(0);
+    r.C(0, 0) += 3.0 * b * E(0) * E(0);
+    r.W = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("secant line search: an overshooting step is shortened, to the same solution", "[unit]") {
+  // The strip pulled at its end by 5 N/mm in one step: stretch s with s S11(E11) = 5, E11 =
+  // (s^2 - 1) / 2, S11 = E11 + 200 E11^3 (s = 1.23790). Newton's first step, with the tangent
+  // of the undeformed state, overshoots to a residual far above the start; plain Newton then
+  // creeps back (18 iterations here), the secant search on du . r(u + a du) (newton.cpp, the
+  // non-hyperelastic path) shortens that step (4). Session 33: deleting the search failed no
+  // test.
+  auto solve = [](bool line_search) {
+    json j = strip(json::parse(R"({"type": "edge", "edge": "u1", "force_per_length": [5, 0, 0]})"),
+                   true);
+    j["solver"]["steps"] = 1;
+    j["solver"]["max_iterations"] = 60;
+    j["solver"]["max_cutbacks"] = 0;
+    j["solver"]["line_search"] = line_search;
+    Case c = parse_case(j.dump(), "stiffening.json");
+    c.material = std::make_shared<Stiffening>();
+    return run_case(c, {});
+  };
+  const RunResult with = solve(true), without = solve(false);
+  REQUIRE(with.report.status == RunStatus::kCompleted);
+  REQUIRE(without.report.status == RunStatus::kCompleted);
+  CHECK(with.rows[0].iterations <= 6);
+  CHECK(without.rows[0].iterations >= 12);
+  for (const RunResult* r : {&with, &without}) {
+    const double s = 1.0 + r->rows[0].points[0](0) / 10.0;
+    const double E = 0.5 * (s * s - 1.0);
+    CHECK(s * (E + 200.0 * E * E * E) == Approx(5.0).epsilon(1e-8));
+  }
+}
