@@ -670,3 +670,63 @@ TEST_CASE("secant line search: an overshooting step is shortened, to the same so
     CHECK(s * (E + 200.0 * E * E * E) == Approx(5.0).epsilon(1e-8));
   }
 }
+
+namespace {
+
+/// St. Venant-Kirchhoff (E = 1, nu = 0) locking in S11 = E11 / (1 - E11 / El): the law is
+/// undefined (NaN) from E11 = El on. Hyperelastic or not (W = -El^2 ln(1 - E11/El) - El E11
+/// plus SVK's other terms).
+struct Locking final : Material {
+  SaintVenantKirchhoff svk{1.0, 0.0};
+  double El = 0.3;
+  bool hyper = false;
+  std::string name() const override { return "locking"; }
+  bool hyperelastic() const override { return hyper; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint& w) const override {
+    MaterialResponse r = svk.evaluate(E, w);
+    const double q = 1.0 - E(0) / El, nan = std::numeric_limits<double>::quiet_NaN();
+    r.S(0) += q > 0.0 ? E(0) / q - E(0) : nan;
+    r.C(0, 0) += q > 0.0 ? 1.0 / (q * q) - 1.0 : nan;
+    r.W = hyper ? r.W - 0.5 * E(0) * E(0) + (q > 0.0 ? -El * El * std::log(q) - El * E(0) : nan)
+                : nan;
+    return r;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a Newton step beyond the law's domain is shortened, on both paths", "[unit]") {
+  // The strip pulled by 0.3 N/mm in one step, no cut-back allowed: Newton's first step (the
+  // undeformed tangent, 1 MPa) reaches E11 = 0.345, beyond the lock at 0.3, where the residual
+  // is not finite; half of it stays inside (0.161). The solution is s S11 = 0.3 at s = 1.132.
+  // Not hyperelastic (LU, line search on): the full step is halved once (newton.cpp);
+  // hyperelastic with plain Newton alone (line_search false): halved while it is not finite.
+  // Session 33: deleting either halving failed no test.
+  {
+    Locking m;
+    m.hyper = true;
+    const Eigen::Vector3d E(0.1, 0.02, 0.03);
+    const double h = 1e-6;
+    const double dW = (m.evaluate(E + Eigen::Vector3d(h, 0, 0), {}).W -
+                       m.evaluate(E - Eigen::Vector3d(h, 0, 0), {}).W) /
+                      (2 * h);
+    CHECK(dW == Approx(m.evaluate(E, {}).S(0)).epsilon(1e-7));  // the test's own law
+  }
+  for (const bool hyper : {false, true}) {
+    json j = strip(
+        json::parse(R"({"type": "edge", "edge": "u1", "force_per_length": [0.3, 0, 0]})"), true);
+    j["solver"]["steps"] = 1;
+    j["solver"]["max_cutbacks"] = 0;
+    j["solver"]["line_search"] = !hyper;
+    Case c = parse_case(j.dump(), "locking.json");
+    auto m = std::make_shared<Locking>();
+    m->hyper = hyper;
+    c.material = m;
+    const RunResult r = run_case(c, {});
+    INFO((hyper ? "hyperelastic" : "not hyperelastic") << ": " << r.report.message);
+    REQUIRE(r.report.status == RunStatus::kCompleted);
+    const double s = 1.0 + r.rows[0].points[0](0) / 10.0;
+    const double E = 0.5 * (s * s - 1.0);
+    CHECK(s * E / (1.0 - E / 0.3) == Approx(0.3).epsilon(1e-8));
+  }
+}
