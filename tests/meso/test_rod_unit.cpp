@@ -329,3 +329,41 @@ TEST_CASE("rod: a long curve's reference frame (sparse interpolation) follows th
     CHECK(worst < 1e-6);
   }
 }
+
+TEST_CASE("rod: after a cut-back the increment grows back, and the predictor saves iterations",
+          "[unit]") {
+  // The cantilever rolled up by an end moment (1.9 pi EI / L, almost a full circle). Session 33:
+  // deleting either the growth after an easy step or the secant predictor failed no test.
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0);
+  RodSystem sys;
+  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
+  s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);
+  sys.add_rod(s);
+  auto path = [&](int steps, int max_iterations, bool predictor) {
+    Eigen::VectorXd x = sys.initial_state();
+    PathOptions po;
+    po.steps = steps;
+    po.newton.max_iterations = max_iterations;
+    po.predictor = predictor;
+    const PathReport rep = solve_path(sys, x, po);
+    REQUIRE(rep.completed);
+    std::vector<double> lambdas;
+    for (const auto& r : rep.steps) lambdas.push_back(r.lambda);
+    return std::pair(rep, lambdas);
+  };
+  {
+    // One step, at most 5 iterations: 1 and 0.5 fail, 0.25 converges in 5 iterations (<= 6, an
+    // easy step), so the increment doubles to 0.5: 0.75 fails, 0.5 converges, 1 fails, 0.75 and
+    // 1 converge. Without the growth the increment stays 0.25 and only the first two fail.
+    const auto [rep, lambdas] = path(1, 5, true);
+    CHECK(lambdas == std::vector<double>{0.25, 0.5, 0.75, 1.0});
+    CHECK(rep.cutbacks == 4);
+  }
+  // Four steps of 0.25: the secant predictor from the last converged increment saves an
+  // iteration (at 0.5: 5 instead of 6), with the same converged states.
+  const auto with = path(4, 8, true).first, without = path(4, 8, false).first;
+  CHECK(with.cutbacks == 0);
+  CHECK(without.cutbacks == 0);
+  CHECK(with.total_iterations < without.total_iterations);
+}
