@@ -25,6 +25,16 @@ RodSpec helix_rod(int p, int elements) {
   return s;
 }
 
+/// A cantilever of length 10 (cubic, 8 elements) rolled up by an end moment 1.9 pi EI / L:
+/// almost a full circle, hard enough for load stepping to cut back.
+void add_rolled_cantilever(RodSystem& sys) {
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0);
+  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
+  s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);
+  sys.add_rod(s);
+}
+
 }  // namespace
 
 TEST_CASE("quaternion: rotation is orthogonal and scale-invariant, log/exp round trip", "[unit]") {
@@ -158,13 +168,7 @@ TEST_CASE("rod: rigid-body motions of a stressed state give zero residual", "[un
 }
 
 TEST_CASE("rod: load stepping cuts back a too large increment, failure is a status", "[unit]") {
-  const Section sec;
-  const double L = 10.0, EI = sec.C_K()(0);
-  auto make = [&](RodSystem& sys) {
-    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
-    s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);  // almost a full circle
-    sys.add_rod(s);
-  };
+  const auto make = add_rolled_cantilever;
   {
     RodSystem sys;
     make(sys);
@@ -198,12 +202,8 @@ TEST_CASE("rod: load stepping stops at the step floor and at the work cap, and s
           "[unit]") {
   // Issue 14: a path that only converges with ever smaller increments used to sub-step
   // forever (the successive-halving limit resets after every success).
-  const Section sec;
-  const double L = 10.0, EI = sec.C_K()(0);
   RodSystem sys;
-  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
-  s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);
-  sys.add_rod(s);
+  add_rolled_cantilever(sys);
   PathOptions def;
   CHECK(def.work_cap() == PathOptions::kWorkFactor * def.steps * def.newton.max_iterations);
   {  // one Newton iteration never converges: halvings until the floor
@@ -332,14 +332,10 @@ TEST_CASE("rod: a long curve's reference frame (sparse interpolation) follows th
 
 TEST_CASE("rod: after a cut-back the increment grows back, and the predictor saves iterations",
           "[unit]") {
-  // The cantilever rolled up by an end moment (1.9 pi EI / L, almost a full circle). Session 33:
-  // deleting either the growth after an easy step or the secant predictor failed no test.
-  const Section sec;
-  const double L = 10.0, EI = sec.C_K()(0);
+  // The rolled-up cantilever. Session 33: deleting either the growth after an easy step or the
+  // secant predictor failed no test.
   RodSystem sys;
-  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 3, 8, sec);
-  s.end.moment = Vector3d(0, -1.9 * std::numbers::pi * EI / L, 0);
-  sys.add_rod(s);
+  add_rolled_cantilever(sys);
   auto path = [&](int steps, int max_iterations, bool predictor) {
     Eigen::VectorXd x = sys.initial_state();
     PathOptions po;
