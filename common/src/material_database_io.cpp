@@ -421,11 +421,21 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
         const auto mx = f.read_doubles(fg + "/diagnostics/max");
         if (rms.size() != 5 || mx.size() != 5)
           throw InputError(fname, fg + "/diagnostics", "rms and max need 5 components");
+        // The fit's errors are data the report and a refit pass on: finite (session 33, a
+        // helper's audit: a NaN written here by h5py, which drops the checksum trailer, went
+        // through `knit-meso fit` into the refitted file with exit 0).
         for (int c = 0; c < 5; ++c) {
+          for (const auto& [name, v] : {std::pair{"rms", rms[c]}, std::pair{"max", mx[c]}})
+            if (!std::isfinite(v))
+              throw InputError(fname, fg + "/diagnostics/" + name,
+                               "entry " + std::to_string(c) + " (" + FitDiagnostics::kNames[c] +
+                                   ") is not finite");
           e.diagnostics.rms(c) = rms[c];
           e.diagnostics.max(c) = mx[c];
         }
         e.diagnostics.max_relative = f.attribute_double(fg + "/diagnostics", "max_relative");
+        if (!std::isfinite(e.diagnostics.max_relative))
+          throw InputError(fname, fg + "/diagnostics", "attribute max_relative is not finite");
         e.diagnostics.points_used = f.attribute_int(fg + "/diagnostics", "points_used");
         e.diagnostics.points_skipped = f.attribute_int(fg + "/diagnostics", "points_skipped");
         e.diagnostics.options_json = f.attribute_string(fg + "/diagnostics", "options_json");

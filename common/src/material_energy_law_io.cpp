@@ -225,6 +225,25 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
         static_cast<std::size_t>(rms.rows()) != n || static_cast<std::size_t>(mx.rows()) != n ||
         (n > 0 && (rms.cols() != 3 || mx.cols() != 3)) || (!mono.empty() && mono.size() != n))
       throw InputError(file, d, "per-loop-length datasets differ in length");
+    // The fit's errors are finite (session 33: NaN and inf here passed a refit into its output
+    // with exit 0); the monotonicity bound may be NaN, "unknown" (EnergyFitDiagnostics).
+    auto finite = [&](const std::string& name, const auto& values, bool nan_ok = false) {
+      const Eigen::Index m = static_cast<Eigen::Index>(values.size());
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const double v = *(values.data() + i);
+        if (!std::isfinite(v) && !(nan_ok && std::isnan(v)))
+          throw InputError(file, d + "/" + name,
+                           "entry " + std::to_string(i) + " is not finite" +
+                               (nan_ok ? " (NaN, unknown, is accepted here)" : ""));
+      }
+    };
+    finite("loop_length", l);
+    finite("rms", rms);
+    finite("max", mx);
+    finite("stress_range", range);
+    finite("max_relative", maxrel);
+    finite("rms_relative", rmsrel);
+    finite("monotonicity_bound", mono, true);
     dg.per_loop.clear();
     for (std::size_t k = 0; k < n; ++k) {
       EnergyFitDiagnostics::PerLoop p;
@@ -242,6 +261,8 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
                hm = root.read_doubles(d + "/holdout_max");
     if (hr.size() != 3 || hm.size() != 3)
       throw InputError(file, d, "holdout_rms and holdout_max need 3 values");
+    finite("holdout_rms", hr);
+    finite("holdout_max", hm);
     dg.holdout_rms = Eigen::Vector3d(hr[0], hr[1], hr[2]);
     dg.holdout_max = Eigen::Vector3d(hm[0], hm[1], hm[2]);
     dg.holdout_points = root.attribute_int(d, "holdout_points");
@@ -250,6 +271,10 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
     dg.points_used = root.attribute_int(d, "points_used");
     dg.points_skipped = root.attribute_int(d, "points_skipped");
     dg.min_eigenvalue = root.attribute_double(d, "min_eigenvalue");
+    for (const auto& [name, v] : {std::pair{"holdout_max_relative", dg.holdout_max_relative},
+                                  std::pair{"min_eigenvalue", dg.min_eigenvalue}})
+      if (!std::isfinite(v))
+        throw InputError(file, d, "attribute " + std::string(name) + " is not finite");
     dg.options_json = root.attribute_string(d, "options_json");
   } catch (const InputError&) {
     throw;

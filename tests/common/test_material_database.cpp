@@ -238,6 +238,32 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     knit::io::H5File::open_rw(bad).remove_attribute("/loop_0", "wale_width");
     CHECK_THROWS_WITH(read_database(bad), bad.string() + ": /loop_0: attribute wale_width missing");
   }
+  SECTION("non-finite fit diagnostics") {
+    // Session 33 (a helper's audit): NaN in /loop_0/fit/diagnostics went through `knit-meso
+    // fit` into the refitted file with exit 0; h5py's edits drop the checksum trailer, so the
+    // file read as an older, unverified one.
+    const auto bad = tmp("nandiag.h5");
+    for (const bool attribute : {false, true}) {
+      fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        if (attribute) {
+          f.set_attribute("/loop_0/fit/diagnostics", "max_relative", std::nan(""));
+        } else {
+          std::vector<double> rms = f.read_doubles("/loop_0/fit/diagnostics/rms");
+          rms[3] = std::numeric_limits<double>::infinity();
+          f.write("/loop_0/fit/diagnostics/rms", rms);
+        }
+      }
+      CHECK_THROWS_WITH(read_database(bad),
+                        attribute ? bad.string() +
+                                        ": /loop_0/fit/diagnostics: attribute max_relative is "
+                                        "not finite"
+                                  : bad.string() +
+                                        ": /loop_0/fit/diagnostics/rms: entry 3 (S2) is not "
+                                        "finite");
+    }
+  }
   SECTION("bad surface data") {
     const auto bad = tmp("badsurf.h5");
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);

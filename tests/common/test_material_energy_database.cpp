@@ -2,7 +2,10 @@
 // file still loads and refuses the energy law with file + HDF5 path + what to do, bad
 // /energy_law content is refused with its HDF5 path.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
+#include <functional>
+#include <limits>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -179,6 +182,51 @@ TEST_CASE("database v2: bad /energy_law content is refused with its HDF5 path", 
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("/energy_law: ") &&
                                               Catch::Contains("does not cover /loop_lengths"));
   }
+}
+
+TEST_CASE("database: non-finite energy-law diagnostics are refused with their HDF5 path",
+          "[unit]") {
+  // Session 33 (a helper's audit): NaN and inf in /energy_law/diagnostics went through
+  // `knit-meso fit --law paper` into the refitted file with exit 0. The monotonicity bound may
+  // be NaN ("unknown", EnergyFitDiagnostics), not inf.
+  const auto good = tmp("energy_diag_good.h5"), bad = tmp("energy_diag_bad.h5");
+  write_database(good, db_with_law());
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  const std::string d = "/energy_law/diagnostics";
+  auto with = [&](const std::function<void(knit::io::H5File&)>& edit) {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      edit(f);
+    }
+    try {
+      read_database(bad);
+    } catch (const knit::InputError& e) {
+      return e.pointer() + ": " + e.message();
+    }
+    return std::string("no error");
+  };
+  auto entry = [&](const std::string& name, int i, double v) {
+    return [=](knit::io::H5File& f) {
+      std::vector<double> x = f.read_doubles(d + "/" + name);
+      x[static_cast<std::size_t>(i)] = v;
+      f.write(d + "/" + name, x);
+    };
+  };
+  for (const char* name : {"loop_length", "stress_range", "max_relative", "rms_relative",
+                           "holdout_rms", "holdout_max"})
+    CHECK(with(entry(name, 1, nan)) == d + "/" + name + ": entry 1 is not finite");
+  CHECK(with([&](knit::io::H5File& f) {
+          RowMatrixX m = f.read_matrix(d + "/max");
+          m(1, 2) = inf;
+          f.write(d + "/max", m);
+        }) == d + "/max: entry 5 is not finite");
+  CHECK(with(entry("monotonicity_bound", 0, inf)) ==
+        d + "/monotonicity_bound: entry 0 is not finite (NaN, unknown, is accepted here)");
+  CHECK(with(entry("monotonicity_bound", 0, nan)) == "no error");
+  for (const char* name : {"holdout_max_relative", "min_eigenvalue"})
+    CHECK(with([&](knit::io::H5File& f) { f.set_attribute(d, name, inf); }) ==
+          d + ": attribute " + name + " is not finite");
 }
 
 TEST_CASE("database v3: the network law round trip", "[unit]") {
