@@ -100,6 +100,30 @@ TEST_CASE("database v2: the energy law round trip", "[unit]") {
   CHECK(&require_energy_law(back, file.string()) == &*back.energy_law);
 }
 
+TEST_CASE("database v2: the energy law states its units", "[unit]") {
+  // Session 33 (a helper's audit): dropping the attribute passed the suite.
+  const auto file = tmp("energy_units.h5");
+  write_database(file, db_with_law());
+  const auto f = knit::io::H5File::open_read(file);
+  CHECK(f.attribute_string("/energy_law", "units") == "W MPa (N mm/mm^3), S and C MPa, l mm");
+  CHECK(f.attribute_string("/energy_law/box_min", "units") ==
+        "e = (E11, E22, 2 E12): the data strain box");
+}
+
+TEST_CASE("database v2: per-loop-length diagnostics of different lengths are refused", "[unit]") {
+  // Without the check the reader indexed past the shorter dataset (session 33, a helper's
+  // audit).
+  const auto file = tmp("energy_short.h5");
+  write_database(file, db_with_law());
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    f.write("/energy_law/diagnostics/points", std::vector<int>{17});
+  }
+  CHECK_THROWS_WITH(
+      read_database(file),
+      file.string() + ": /energy_law/diagnostics: per-loop-length datasets differ in length");
+}
+
 TEST_CASE("database: diagnostics written before the monotonicity bound still load", "[unit]") {
   const auto file = tmp("energy_no_mono.h5");
   write_database(file, db_with_law());

@@ -520,6 +520,13 @@ TEST_CASE(
     REQUIRE(st.rows() == 2);
     CHECK(st(1, 5) == static_cast<int>(JobStatus::kPartial));
     CHECK(st.sum() == st(1, 5));
+    // The codes are explained beside them, in the enum's order (session 33, a helper's audit:
+    // dropping the attribute passed the suite).
+    const std::string values = f.attribute_string("/sweep/report/case_status", "values");
+    for (JobStatus s :
+         {JobStatus::kConverged, JobStatus::kPartial, JobStatus::kFailed, JobStatus::kError})
+      CHECK_THAT(values,
+                 Catch::Contains(std::to_string(static_cast<int>(s)) + " = " + to_string(s)));
     CHECK(f.read_int_matrix("/sweep/report/case_converged_steps")(1, 5) ==
           std::count(raw.status.begin(), raw.status.end(), 0));
     CHECK(f.read_int_matrix("/sweep/report/case_in_fit").minCoeff() == 1);
@@ -839,4 +846,41 @@ TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows
   // by the sweep and refused by the reader (review of session 30).
   in.loop_lengths = {0.01, 4.5};
   CHECK_THROWS_WITH(make_runner(in), Catch::StartsWith("synth.json: /loop_lengths/0:"));
+}
+
+TEST_CASE("sweep database: the residual is subtracted from the converged steps only", "[unit]") {
+  // subtract_residual (docs/sweep.md): S -= S0 and P = F S at every converged step; a step that
+  // did not converge is no data and keeps what the run left (session 33, a helper's audit:
+  // subtracting on every step passed the suite). S0 = (S11, S22, S12) = (1, 2, 0.5) MPa.
+  SweepInput in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  std::vector<JobResult> results;
+  for (const auto& j : jobs) {
+    results.push_back(run_job(j, in.retry, synthetic_runner()));
+    results.back().residual = Eigen::Vector3d(1.0, 2.0, 0.5);
+  }
+  JobResult& r = results.at(1);
+  REQUIRE(r.raw.status.size() >= 3);
+  r.raw.status[2] = kStepFailed;  // step 2 did not converge: its numbers are not data
+  in.subtract_residual = false;
+  const knit::material::Database plain = assemble_database(in, results);
+  in.subtract_residual = true;
+  const knit::material::Database sub = assemble_database(in, results);
+  const auto& a = plain.entries.at(0).raw.at(1);
+  const auto& b = sub.entries.at(0).raw.at(1);
+  REQUIRE(a.steps() == b.steps());
+  for (int k = 0; k < a.steps(); ++k) {
+    INFO("step " << k);
+    if (k == 2) {
+      CHECK((b.S.row(k) - a.S.row(k)).norm() == 0.0);
+      CHECK((b.P.row(k) - a.P.row(k)).norm() == 0.0);
+      continue;
+    }
+    CHECK((a.S.row(k) - b.S.row(k) - Eigen::RowVector3d(1.0, 2.0, 0.5)).norm() < 1e-14);
+    Eigen::Matrix2d F, S;
+    F << b.F(k, 0), b.F(k, 1), b.F(k, 2), b.F(k, 3);
+    S << b.S(k, 0), b.S(k, 2), b.S(k, 2), b.S(k, 1);
+    const Eigen::Matrix2d P = F * S;
+    CHECK((Eigen::RowVector4d(P(0, 0), P(0, 1), P(1, 0), P(1, 1)) - b.P.row(k)).norm() < 1e-13);
+  }
 }
