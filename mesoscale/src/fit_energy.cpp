@@ -637,9 +637,16 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
     for (const auto& r : db.entries[k].raw) {
       if (r.path.kind != material::PathKind::kUniaxial || r.steps() == 0) continue;
       const int ax = r.path.axis;
+      // The end is the last converged step (session 33, a helper's audit: the last step, so a
+      // path that stopped where the cell jammed had no end ratio and the report said "no
+      // path" for its axis).
       double smax = 0.0;
+      int end = -1;
       for (int s = 0; s < r.steps(); ++s)
-        if (r.status[static_cast<std::size_t>(s)] == 0) smax = std::max(smax, std::abs(r.S(s, ax)));
+        if (r.status[static_cast<std::size_t>(s)] == 0) {
+          smax = std::max(smax, std::abs(r.S(s, ax)));
+          end = s;
+        }
       for (int s = 0; s < r.steps(); ++s) {
         if (r.status[static_cast<std::size_t>(s)] != 0 || !(smax > 0.0)) continue;
         const double law_s = uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax));
@@ -648,7 +655,7 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
           pl.uniaxial_max_relative = std::isfinite(ratio)
                                          ? std::max(pl.uniaxial_max_relative, std::abs(ratio - 1.0))
                                          : std::numeric_limits<double>::infinity();
-        if (s == r.steps() - 1) pl.uniaxial_end_ratio(ax) = ratio;
+        if (s == end) pl.uniaxial_end_ratio(ax) = ratio;
       }
     }
     if (pl.stress_range > 0) {

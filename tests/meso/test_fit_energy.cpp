@@ -31,7 +31,8 @@ Database synthetic_coverage_db(std::vector<double> ls = {4.5, 5.5, 6.5}, int ste
     material::LoadPath u;
     u.kind = material::PathKind::kUniaxial;
     u.axis = axis;
-    u.target(axis) = 0.4;
+    u.target(0) = 0.4;  // the axial strain, along `axis` (load_paths.hpp); session 33: the
+                        // wale path had target(1) = 0.4 and zero strain at every step
     u.steps = uniaxial_steps;
     u.set = "coverage";
     so.paths.push_back(u);
@@ -450,6 +451,12 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
     }
     db.entries[1].raw.push_back(r);
     const auto dg = diagnose_energy_law(s.law, db);
+    // A path that stopped (the cell jammed): its end is its last converged step (session 33,
+    // a helper's audit: the end ratio was NaN then and the report said "no path").
+    db.entries[1].raw.back().status.back() = 1;
+    db.entries[1].raw.back().S.bottomRows(1).setConstant(99.0);  // not data
+    const auto stopped = diagnose_energy_law(s.law, db);
+    CHECK(stopped.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
     db.entries[1].raw.pop_back();
     CHECK(dg.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
     CHECK(dg.per_loop[1].uniaxial_max_relative == Approx(1.0 - 1.0 / scale).margin(1e-6));

@@ -109,7 +109,8 @@ struct EnergyFitDiagnostics {
     double monotonicity_bound = std::nan("");
     /// The law driven like the cell's uniaxial-stress paths (axial strain prescribed, lateral
     /// strain solved so that the law's lateral stress vanishes): law / cell axial stress at
-    /// the last step, course (0) and wale (1); NaN without such a path. Printed, not stored.
+    /// the last converged step, course (0) and wale (1); NaN without such a path. Printed, not
+    /// stored.
     Eigen::Vector2d uniaxial_end_ratio = Eigen::Vector2d::Constant(std::nan(""));
     /// Largest |law / cell - 1| of that axial stress over the steps whose cell stress is at
     /// least 10 % of the path's largest. Printed, not stored.
