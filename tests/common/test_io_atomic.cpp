@@ -1,4 +1,5 @@
 // Atomic files/directories, CSV writer and provenance records.
+#include <sys/stat.h>
 #include <unistd.h>
 #include <catch2/catch.hpp>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../output_test_util.hpp"
 #include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
@@ -141,6 +143,33 @@ TEST_CASE("AtomicDirectory leaves an existing output intact until commit", "[uni
     d.commit();
     CHECK(fs::exists(fresh / "f.txt"));
   }
+}
+
+// Session 33 (mutation audit): a commit that copied the temporary over the target instead of
+// renaming it failed no test of the atomic files (only a macro test, indirectly), though a
+// reader of the old file (ParaView on a .pvd, another run on a database) then sees it
+// truncated and rewritten under it. Pinned: the target is a new inode, and a stream opened on
+// the old file still reads all of the old content.
+TEST_CASE("write_file_atomically replaces the target by rename, not in place",
+          "[unit][io][atomic]") {
+  const fs::path dir = scratch("rename");
+  fs::create_directories(dir);
+  const fs::path target = dir / "out.txt";
+  const std::string old_content = "old content, longer than the new one";
+  std::ofstream(target) << old_content;
+  struct stat before {};
+  REQUIRE(::stat(target.c_str(), &before) == 0);
+  std::ifstream reader(target);  // opened before the replacement, read after it
+  REQUIRE(reader);
+  knit::io::write_file_atomically(target, "new");
+  struct stat after {};
+  REQUIRE(::stat(target.c_str(), &after) == 0);
+  CHECK(after.st_ino != before.st_ino);
+  std::stringstream seen;
+  seen << reader.rdbuf();
+  CHECK(seen.str() == old_content);
+  CHECK(slurp(target) == "new");
+  CHECK(entries(dir) == 1);  // no temporary left behind
 }
 
 // Session 22: a full file system said "DIR.partial-123/vtk/step_0005.vtu: write failed (disk
@@ -406,6 +435,53 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(slurp(d / ("out.old-" + dead2) / "x") == "x");
 }
 
+// Session 33 (mutation audit): nothing pinned the refusal of a directory "DIR.partial-<our
+// pid>" that is not ours (a user's, or one a run with a recycled pid left without its marker):
+// without it the run wrote its marker into that directory and, abandoned, deleted it with the
+// user's files.
+TEST_CASE("AtomicDirectory refuses a partial directory of its own pid that it did not create",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("own_partial");
+  fs::create_directories(d);
+  const fs::path partial = d / ("out.partial-" + std::to_string(::getpid()));
+  fs::create_directories(partial);
+  std::ofstream(partial / "keep.txt") << "precious";
+  CHECK_THROWS_WITH(knit::io::AtomicDirectory(d / "out"),
+                    Catch::Contains(partial.string() +
+                                    ": exists and is not a knitscale output; rename or remove it"));
+  CHECK(slurp(partial / "keep.txt") == "precious");
+  CHECK_FALSE(fs::exists(partial / knit::io::kOutputMarker));
+  CHECK_FALSE(fs::exists(d / "out"));
+  CHECK_FALSE(fs::exists(d / "out.lock"));  // released with the refusal
+}
+
+// Session 33 (mutation audit): the clean-up removes a stale "DIR.partial-<dead pid>" only if
+// its marker says it was written "for: DIR". One of a dead pid written for another output
+// ("for: other": a run into "other" whose partial directory was moved here by hand) is not
+// ours to remove; the test of the clean-up had none under the name "out.partial-<pid>" without
+// a manifest, so a clean-up ignoring the "for:" line passed.
+TEST_CASE("AtomicDirectory keeps a dead run's partial directory written for another output",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("partial_for_other");
+  fs::create_directories(d);
+  const fs::path other = d / ("out.partial-" + std::to_string(knit_test::dead_pid()));
+  fs::create_directories(other);
+  std::ofstream(other / knit::io::kOutputMarker) << "knitscale output\n{}\nfor: other\n";
+  std::ofstream(other / "x") << "x";
+  const auto m = knit::io::read_output_marker(other);
+  REQUIRE(m);
+  CHECK(m->for_name == "other");
+  CHECK_FALSE(m->has_manifest);  // a partial directory's marker: only the "for:" line decides
+  {
+    knit::io::AtomicDirectory a(d / "out");
+    std::ofstream(a.path() / "y") << "y";
+    a.commit();
+  }
+  CHECK(slurp(d / "out" / "y") == "y");
+  CHECK(slurp(other / "x") == "x");
+  CHECK(slurp(other / knit::io::kOutputMarker) == "knitscale output\n{}\nfor: other\n");
+}
+
 // Session 29 (found by two helpers' audits): a rerun replaced its earlier output directory as a
 // whole and deleted what a user had put in it (notes, a database, the case file the run read).
 // The marker lists what the run wrote; an output holding anything else is refused at once.
@@ -481,6 +557,32 @@ TEST_CASE("AtomicDirectory does not replace an output holding entries its run di
   CHECK_FALSE(knit::io::is_own_output(fake));
   CHECK_THROWS_AS(knit::io::AtomicDirectory(fake), knit::InputError);
   CHECK(slurp(fake / "data.txt") == "d");
+}
+
+// Session 33 (mutation audit): the refusal of long names tested 300 characters only, which
+// the file system's own limit of 255 refuses too; the reserve of 30 characters for the run's
+// suffixes (".partial-<pid>", ".lock", ".new-<pid>-<k>") was not pinned: without it a name
+// of 226 to 255 characters passes the check and fails later, once a suffix is added.
+TEST_CASE("check_output_target keeps 30 characters of a name for the run's suffixes",
+          "[unit][io][atomic]") {
+  using knit::io::OutputKind;
+  const fs::path d = scratch("long_names");
+  fs::create_directories(d);
+  for (const std::size_t n : {std::size_t{240}, std::size_t{226}})
+    CHECK_THROWS_WITH(
+        knit::io::check_output_target(d / std::string(n, 'a'), OutputKind::kDirectory),
+        Catch::Contains("has a name of " + std::to_string(n) +
+                        " characters; the file system allows 255") &&
+            Catch::Contains("at most 225"));
+  // 225 + 30 = 255: accepted, and the run can write it (partial directory, lock, marker).
+  const fs::path longest = d / std::string(225, 'c');
+  CHECK_NOTHROW(knit::io::check_output_target(longest, OutputKind::kDirectory));
+  {
+    knit::io::AtomicDirectory a(longest);
+    std::ofstream(a.path() / "f.txt") << "f";
+    a.commit();
+  }
+  CHECK(slurp(longest / "f.txt") == "f");
 }
 
 // Session 26 (found by a helper's audit): `knit-macro run case.json -o out` replaced the

@@ -393,6 +393,29 @@ TEST_CASE("JSON nested 40,000 levels deep is an input error, not a stack overflo
                                      "t"));
 }
 
+// Session 33 (mutation audit): the tests above nest 40,000 levels and 256 (an object and 255
+// arrays), so a limit off by one (257 accepted) passed. Pinned at the boundary: exactly
+// kMaxJsonDepth levels are read, one more is refused at the bracket that goes too deep.
+TEST_CASE("JSON nesting: kMaxJsonDepth levels are read and one more is refused",
+          "[unit][io][json]") {
+  const std::size_t limit = knit::io::kMaxJsonDepth;
+  REQUIRE(limit == 256);  // the number in the message below
+  auto nested = [](std::size_t levels) {
+    return std::string(levels, '[') + std::string(levels, ']');
+  };
+  CHECK_NOTHROW(knit::io::parse_json(nested(limit), "at_limit.json"));
+  CHECK_THROWS_WITH(knit::io::parse_json(nested(limit + 1), "over.json"),
+                    Catch::Contains("invalid JSON at line 1, column " + std::to_string(limit + 1) +
+                                    ": nested deeper than 256 arrays/objects"));
+  // Objects count as arrays do.
+  std::string objects;
+  for (std::size_t k = 0; k < limit; ++k) objects += "{\"a\":";
+  CHECK_NOTHROW(knit::io::parse_json(objects + "1" + std::string(limit, '}'), "objects.json"));
+  CHECK_THROWS_WITH(
+      knit::io::parse_json(objects + "{}" + std::string(limit, '}'), "objects_over.json"),
+      Catch::Contains("nested deeper than 256"));
+}
+
 TEST_CASE("a number outside the double range names file, pointer, line and column",
           "[unit][io][json]") {
   const fs::path f = scratch("huge.json", "{\"a\": [1,\n   1e400]}");

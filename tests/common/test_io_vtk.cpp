@@ -302,6 +302,59 @@ TEST_CASE("VTK writers reject inconsistent sizes, naming the file and array", "[
   CHECK_THROWS_AS(vector_field("v", RowMatrixXd::Zero(3, 4)), std::invalid_argument);
 }
 
+// Session 33 (mutation audit): an index check off by one (point n accepted of n points) passed,
+// because the only bad-index test was of a polyline (write_vtp). A quad referring to point 4 of
+// 4 points is refused before anything is written; point 3 is the last one accepted.
+TEST_CASE("VTU quads referring to a point past the last are refused, no file written",
+          "[unit][io][vtk]") {
+  QuadMesh mesh{RowMatrixXd::Zero(4, 3), RowMatrixXi(1, 4), {}, {}};
+  mesh.quads.row(0) << 0, 1, 2, 4;
+  const fs::path file = scratch("past_last.vtu");
+  CHECK_THROWS_AS(write_vtu(file, mesh), std::invalid_argument);
+  CHECK_THROWS_WITH(write_vtu(file, mesh),
+                    Catch::Contains("past_last.vtu: quad 0 refers to point 4 of 4"));
+  CHECK_FALSE(fs::exists(file));
+  mesh.quads.row(0) << 0, 1, 2, 3;
+  const fs::path good = scratch("last.vtu");
+  write_vtu(good, mesh);
+  CHECK(
+      values(array_named(parse_file(good)->child("UnstructuredGrid").child("Piece").child("Cells"),
+                         "connectivity")) == std::vector<double>{0, 1, 2, 3});
+}
+
+// Session 33 (mutation audit): names reach the XML as attribute values -- field names in
+// Name="..." and in PointData's Scalars="...", dataset file names in the .pvd's file="..." --
+// and nothing tested one holding a markup character, so writing them unescaped (a file
+// ParaView cannot read) passed. Pinned on the text itself: the reader above does not unescape.
+TEST_CASE("VTK and PVD attribute values escape markup characters", "[unit][io][vtk]") {
+  const std::string name = "a<b&\"c", escaped = "a&lt;b&amp;&quot;c";
+  QuadMesh mesh = structured_quad_mesh(2, 2, RowMatrixXd::Zero(4, 3));
+  mesh.point_data.push_back(scalar_field(name, {1, 2, 3, 4}));
+  const fs::path file = scratch("markup.vtu");
+  write_vtu(file, mesh, VtkEncoding::Ascii);
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  CHECK_THAT(text.str(), Catch::Contains("<PointData Scalars=\"" + escaped + "\">"));
+  CHECK_THAT(text.str(), Catch::Contains("<DataArray type=\"Float64\" Name=\"" + escaped +
+                                         "\" format=\"ascii\">"));
+  CHECK(text.str().find("a<b") == std::string::npos);
+  // Well-formed for an XML reader (one expression: a parse error is one failed check).
+  CHECK(values(array_named(
+            parse_file(file)->child("UnstructuredGrid").child("Piece").child("PointData"),
+            escaped)) == std::vector<double>{1, 2, 3, 4});
+
+  PvdCollection pvd(scratch("markup.pvd"));
+  pvd.add(0.0, "R&D <1>.vtu");
+  pvd.write();
+  std::ifstream pin(scratch("markup.pvd"));
+  std::stringstream ptext;
+  ptext << pin.rdbuf();
+  CHECK_THAT(ptext.str(), Catch::Contains("file=\"R&amp;D &lt;1&gt;.vtu\"/>"));
+  CHECK(parse_file(scratch("markup.pvd"))->child("Collection").child("DataSet").attr.at("file") ==
+        "R&amp;D &lt;1&gt;.vtu");
+}
+
 TEST_CASE("PVD collection lists time steps with relative file names", "[unit][io][vtk]") {
   const fs::path dir = scratch("series");
   fs::create_directories(dir / "steps");
