@@ -134,6 +134,21 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   fs::remove(out);
   CHECK(run("fit " + db.string() + energy + " -o " + out.string()) == 2);
   CHECK_FALSE(fs::exists(out));
+  // A paper fit that fails (15 control points without smoothing: too few steps to determine
+  // them) exits 1, and an energy law refused for its options exits 2; neither writes (session
+  // 33, a helper's audit: a failed paper fit that left the exit code 0 passed the suite).
+  const fs::path clean = dir / "cli_fit_fails_clean.h5";
+  REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + clean.string()) == 0);
+  const std::string clean_before = bytes(clean);
+  const fs::path bad_paper = dir / "cli_fit_fails_paper.json";
+  std::ofstream(bad_paper) << R"({"smoothing": 0, "control_points_1": 15})";
+  CHECK(run("fit " + clean.string() + " --law paper --options " + bad_paper.string()) == 1);
+  CHECK(bytes(clean) == clean_before);
+  const fs::path bad_energy = dir / "cli_fit_fails_directions.json";
+  std::ofstream(bad_energy) << R"({"family": "ridge", "directions": [[1, 0, 0], [2, 0, 0]]})";
+  CHECK(run("fit " + clean.string() + " --law energy --energy-options " + bad_energy.string()) ==
+        2);
+  CHECK(bytes(clean) == clean_before);
 }
 
 // Session 21: the stand-in's stiffness (4.5 / l)^2 overflows for l = 1e-300, and `synth

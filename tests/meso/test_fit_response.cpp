@@ -17,6 +17,13 @@ TEST_CASE("fit: synthetic orthotropic stiffening law reproduced within 1% of its
   INFO("rms " << fs.diagnostics.rms.transpose() << " max " << fs.diagnostics.max.transpose()
               << " relative " << fs.diagnostics.max_relative);
   CHECK(fs.diagnostics.max_relative < 0.01);
+  // The E-surface's distance to the data strains too (E1, E2; session 33, a helper's audit:
+  // fits on a shifted xi2 grid passed, their stress errors staying small).
+  double erange = 0.0;
+  for (const auto& r : raw)
+    for (int k = 0; k < r.steps(); ++k)
+      erange = std::max(erange, r.E.row(k).head<2>().cwiseAbs().maxCoeff());
+  CHECK(fs.diagnostics.max.head<2>().maxCoeff() < 0.01 * erange);
   // Independently of the diagnostics: the law at strains inside the data domain (between the
   // paths and the steps), against the known law.
   const ResponseSurface rs(fs.surface);
