@@ -40,6 +40,19 @@ Database synthetic_coverage_db(std::vector<double> ls = {4.5, 5.5, 6.5}, int ste
   return synthetic_database(so);
 }
 
+/// A raw path of `n` converged steps, all numbers zero (the test fills E and S).
+material::RawPath zero_path(material::PathKind kind, const std::string& set, int n, int axis = 0) {
+  material::RawPath r;
+  r.path.kind = kind;
+  r.path.axis = axis;
+  r.path.set = set;
+  r.E = material::RowMatrixX::Zero(n, 3);
+  r.S = material::RowMatrixX::Zero(n, 3);
+  r.F = r.P = material::RowMatrixX::Zero(n, 4);
+  r.status.assign(static_cast<std::size_t>(n), 0);
+  return r;
+}
+
 /// A network fit of `db` (Ceres L-BFGS, `iterations` iterations from `seed`), required to succeed.
 EnergyFitSummary fit_network(const Database& db, int iterations, int seed = 1) {
   EnergyFitOptions o;
@@ -424,15 +437,8 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
   // A wale-wise uniaxial path made of the law's own uniaxial response: the ratio must be 1;
   // the same path with the cell's stress scaled by 1.5 must give 1 / 1.5.
   for (const double scale : {1.0, 1.5}) {
-    material::RawPath r;
-    r.path.kind = material::PathKind::kUniaxial;
-    r.path.axis = 1;
-    r.path.set = "coverage";
     const int n = 5;
-    r.E = material::RowMatrixX::Zero(n, 3);
-    r.S = material::RowMatrixX::Zero(n, 3);
-    r.F = r.P = material::RowMatrixX::Zero(n, 4);
-    r.status.assign(n, 0);
+    material::RawPath r = zero_path(material::PathKind::kUniaxial, "coverage", n, 1);
     double lateral = 0.0;
     for (int k = 0; k < n; ++k) {
       const double e2 = 0.05 * (k + 1);
@@ -609,14 +615,8 @@ TEST_CASE("energy fit: held-out states and runs are counted against 5 % of the s
   const double range = base.per_loop[1].stress_range;
   REQUIRE(range > 0.0);
   const material::EnergyLawAt at = material::EnergyLaw(s.law).at(6.5);
-  material::RawPath r;
-  r.path.kind = material::PathKind::kGradient;
-  r.path.set = "holdout";
   const int n = 3;
-  r.E = material::RowMatrixX::Zero(n, 3);
-  r.S = material::RowMatrixX::Zero(n, 3);
-  r.F = r.P = material::RowMatrixX::Zero(n, 4);
-  r.status.assign(n, 0);
+  material::RawPath r = zero_path(material::PathKind::kGradient, "holdout", n);
   for (int k = 0; k < n; ++k) {
     const double t = 0.1 * (k + 1);
     r.E.row(k) << 0.5 * t, 0.3 * t, 0.8 * t;  // tensor E12: e3 = 2 E12 = 1.6 t
