@@ -634,3 +634,56 @@ TEST_CASE("energy fit: held-out states and runs are counted against 5 % of the s
   CHECK(dg.holdout_runs_within_5_percent == base.holdout_runs_within_5_percent);
   CHECK(dg.holdout_run_ends_within_5_percent == base.holdout_run_ends_within_5_percent + 1);
 }
+
+TEST_CASE("energy fit: the per-loop-length figures equal their definitions", "[unit]") {
+  // Recomputed here from the converged steps of the fit's paths (not held out): per loop length
+  // the largest and the RMS error per component, the stress range (the largest spread of a
+  // component), max_relative and rms_relative (the largest component over the range), and the
+  // smallest eigenvalue of C over all these states. Session 33, the fit audit: rms_relative as
+  // a mean of components, max_relative the same, and the middle eigenvalue passed the suite.
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  EnergyFitOptions ridge;
+  ridge.family = "ridge";
+  const EnergyFitSummary s = fit_energy_law(db, ridge);
+  REQUIRE(s.ok());
+  const auto& dg = s.diagnostics;
+  REQUIRE(dg.per_loop.size() == 2);
+  const material::EnergyLaw law(s.law);
+  double min_eig = 1e300;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const material::EnergyLawAt at = law.at(db.entries[k].loop_length);
+    Eigen::Vector3d mx = Eigen::Vector3d::Zero(), sq = Eigen::Vector3d::Zero();
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    int n = 0;
+    for (const auto& r : db.entries[k].raw) {
+      if (r.path.set == "holdout") continue;
+      for (int i = 0; i < r.steps(); ++i) {
+        if (r.status[static_cast<std::size_t>(i)] != 0) continue;
+        const Eigen::Vector3d e(r.E(i, 0), r.E(i, 1), 2.0 * r.E(i, 2));
+        const Eigen::Vector3d S = r.S.row(i).transpose();
+        const material::EnergyResponse v = at.evaluate(e);
+        const Eigen::Vector3d err = (v.S - S).cwiseAbs();
+        mx = mx.cwiseMax(err);
+        sq += err.cwiseProduct(err);
+        lo = lo.cwiseMin(S);
+        hi = hi.cwiseMax(S);
+        min_eig = std::min(
+            min_eig, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(v.C).eigenvalues().minCoeff());
+        ++n;
+      }
+    }
+    const auto& p = dg.per_loop[k];
+    INFO("l = " << p.loop_length);
+    CHECK(p.points == n);
+    const double range = (hi - lo).maxCoeff();
+    const Eigen::Vector3d rms = (sq / n).cwiseSqrt();
+    CHECK(p.stress_range == Approx(range).epsilon(1e-12));
+    CHECK((p.max - mx).norm() <= 1e-12 * (1 + mx.norm()));
+    CHECK((p.rms - rms).norm() <= 1e-12 * (1 + rms.norm()));
+    CHECK(p.max_relative == Approx(mx.maxCoeff() / range).epsilon(1e-12));
+    CHECK(p.rms_relative == Approx(rms.maxCoeff() / range).epsilon(1e-12));
+    // the components differ, so a mean or a smallest one would not pass
+    CHECK(mx.minCoeff() < 0.9 * mx.maxCoeff());
+  }
+  CHECK(dg.min_eigenvalue == Approx(min_eig).epsilon(1e-10));
+}
