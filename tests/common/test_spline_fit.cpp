@@ -111,6 +111,25 @@ TEST_CASE("least squares with data weights: the weighted mean and the weighted R
   CHECK(r.max_residual == Approx(0.75).epsilon(1e-14));
 }
 
+TEST_CASE("least squares: a sample of weight 0 is no data", "[unit][spline][fit]") {
+  // Session 33 (the fit audit): an outlier of weight 0 counted in max_residual, and a support
+  // whose only samples weigh 0 was taken as seen, passed the suite. A line through (0.1, 0.1)
+  // and (0.9, 0.9) with an outlier (0.5, 10) of weight 0: the line is exact, residual 0.
+  const BSplineBasis b(1, {0, 0, 1, 1});
+  LeastSquaresOptions o;
+  o.data_weights = Eigen::Vector3d(1.0, 0.0, 1.0);
+  const LeastSquaresResult r =
+      least_squares(b, {0.1, 0.5, 0.9}, Eigen::Vector3d(0.1, 10.0, 0.9), o);
+  CHECK(r.max_residual < 1e-12);
+  CHECK(r.rms_residual < 1e-12);
+  // Two linear spans; the second's only sample weighs 0: its function has no data.
+  const BSplineBasis b2(1, {0, 0, 0.5, 1, 1});
+  o.data_weights = Eigen::Vector3d(1.0, 1.0, 0.0);
+  CHECK_THROWS_WITH(
+      least_squares(b2, {0.0, 0.25, 0.9}, Eigen::Vector3d(1.0, 1.0, 1.0), o),
+      Catch::Contains("basis function 2") && Catch::Contains("no data in its support"));
+}
+
 TEST_CASE("least squares with interpolated ends and noisy data", "[unit][spline][fit]") {
   const BSplineBasis b(3, uniform_knots(3, 3));
   std::vector<double> t;

@@ -459,10 +459,12 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
     const auto dg = diagnose_energy_law(s.law, db);
     // A path that stopped (the cell jammed): its end is its last converged step (session 33,
     // a helper's audit: the end ratio was NaN then and the report said "no path").
+    // The cell's stress there doubled: the end ratio is 1 / (2 scale), not the first step's.
     db.entries[1].raw.back().status.back() = 1;
     db.entries[1].raw.back().S.bottomRows(1).setConstant(99.0);  // not data
+    db.entries[1].raw.back().S(n - 2, 1) *= 2.0;
     const auto stopped = diagnose_energy_law(s.law, db);
-    CHECK(stopped.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
+    CHECK(stopped.per_loop[1].uniaxial_end_ratio(1) == Approx(0.5 / scale).epsilon(1e-6));
     db.entries[1].raw.pop_back();
     CHECK(dg.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
     CHECK(dg.per_loop[1].uniaxial_max_relative == Approx(1.0 - 1.0 / scale).margin(1e-6));

@@ -1,7 +1,9 @@
 // Ceres fit of the response surfaces (eq. 17) against a synthetic, known law.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <sstream>
 
+#include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 
@@ -302,4 +304,25 @@ TEST_CASE("fit: non-finite errors against the data are a failed fit", "[unit]") 
   const FitSummary fs = fit_loop_length(raw, FitOptions{});
   CHECK_FALSE(fs.ok());
   CHECK_THAT(fs.reason, Catch::Contains("not finite"));
+}
+
+TEST_CASE("fit: the summary line names each stress component with its own figures", "[unit]") {
+  // Session 33, the fit audit: the line printing E1's RMS as "rms S1" passed the suite (the
+  // E and S figures sit side by side in FitDiagnostics: E1, E2, S1, S2, S12).
+  Database db;
+  db.entries.resize(2);
+  db.entries[0].loop_length = 4.5;
+  db.entries[1].loop_length = 6.5;
+  std::vector<FitSummary> fits(2);
+  fits[0].diagnostics.max << 1, 2, 3, 4, 5;
+  fits[0].diagnostics.rms << 6, 7, 8, 9, 10;
+  fits[0].diagnostics.max_relative = 0.11;
+  fits[1].status = FitStatus::kRefused;
+  fits[1].reason = "too few steps";
+  std::ostringstream os;
+  print_fit_summaries(os, db, fits);
+  const std::string text = os.str();
+  for (const char* part : {"l = 4.5 mm: max |S error| S1 3, S2 4, S12 5 MPa", "(11 % of",
+                           "rms S1 8, S2 9, S12 10 MPa", "l = 6.5 mm: REFUSED: too few steps"})
+    CHECK_THAT(text, Catch::Contains(part));
 }
