@@ -326,3 +326,26 @@ TEST_CASE("fit: the summary line names each stress component with its own figure
                            "rms S1 8, S2 9, S12 10 MPa", "l = 6.5 mm: REFUSED: too few steps"})
     CHECK_THAT(text, Catch::Contains(part));
 }
+
+TEST_CASE("fit: a loop length whose refit fails keeps no law from before", "[unit]") {
+  // fit_database replaces every entry's law: one whose refit fails loses its old surface and
+  // diagnostics, so no stale law is written beside the new ones (cmd_fit writes nothing then
+  // anyway). Session 33, the fit audit: keeping the old surface passed the suite.
+  SyntheticOptions so;
+  so.loop_lengths = {4.5, 6.5};
+  Database db = synthetic_database(so);
+  for (const auto& f : fit_database(db, FitOptions{})) REQUIRE(f.ok());
+  REQUIRE(db.entries[0].surface);
+  REQUIRE(db.entries[0].diagnostics.max_relative > 0.0);
+  FitOptions bad;
+  bad.smoothing = 0.0;
+  bad.n_ctrl1 = 15;  // too many control points for the steps, without smoothing
+  const auto fits = fit_database(db, bad);
+  REQUIRE(fits.size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    INFO("entry " << k);
+    CHECK_FALSE(fits[k].ok());
+    CHECK_FALSE(db.entries[k].surface);
+    CHECK(db.entries[k].diagnostics.max_relative == 0.0);
+  }
+}

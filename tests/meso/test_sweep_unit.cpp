@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../output_test_util.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/meso/fit/synthetic.hpp"
@@ -651,6 +652,24 @@ TEST_CASE("sweep: --force discards only checkpoints the sweep wrote", "[unit]") 
     CHECK(fs::exists(parts / "notes.txt"));
     CHECK_FALSE(fs::exists(parts / "manifest.json"));
   }
+  // A hidden file of the user's beside our records, or one named like our temporaries but of
+  // another file: not ours, refused and kept (session 33, the I/O audit: taking every dot-file
+  // for the store's passed the suite, and --force then deleted the user's file).
+  for (const char* hidden : {".notes", ".mine.txt.tmp-1-2"}) {
+    fs::remove_all(parts);
+    {
+      CheckpointStore store(out, in.job_definition(), n, false, false);
+      store.store(run_job(jobs[0], in.retry, synthetic_runner()));
+    }
+    std::ofstream(parts / hidden) << "mine";
+    INFO(hidden);
+    CHECK_THROWS_WITH(
+        CheckpointStore(out, in.job_definition(), n, false, true),
+        Catch::Contains(std::string("holds \"") + hidden + "\", which the sweep does not write"));
+    CHECK(knit_test::read_text(parts / hidden) == "mine");
+    CHECK(fs::exists(parts / "job_00000.txt"));
+  }
+  fs::remove_all(parts);
 }
 
 TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consistently", "[unit]") {
