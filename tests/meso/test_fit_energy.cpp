@@ -40,6 +40,19 @@ Database synthetic_coverage_db(std::vector<double> ls = {4.5, 5.5, 6.5}, int ste
   return synthetic_database(so);
 }
 
+/// The ridge family's fit (fast; the diagnostics do not depend on the family).
+EnergyFitOptions ridge_options() {
+  EnergyFitOptions o;
+  o.family = "ridge";
+  return o;
+}
+EnergyFitSummary fit_ridge(const Database& db) {
+  EnergyFitSummary s = fit_energy_law(db, ridge_options());
+  INFO(s.reason);
+  REQUIRE(s.ok());
+  return s;
+}
+
 /// A raw path of `n` converged steps, all numbers zero (the test fills E and S).
 material::RawPath zero_path(material::PathKind kind, const std::string& set, int n, int axis = 0) {
   material::RawPath r;
@@ -429,10 +442,7 @@ TEST_CASE("energy fit: a robust loss and custom directions also fit", "[unit]") 
 TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven like the cell",
           "[unit]") {
   Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  EnergyFitOptions ridge;  // the diagnostic does not depend on the family; the ridge fit is fast
-  ridge.family = "ridge";
-  const EnergyFitSummary s = fit_energy_law(db, ridge);
-  REQUIRE(s.ok());
+  const EnergyFitSummary s = fit_ridge(db);
   const material::EnergyLawAt at = material::EnergyLaw(s.law).at(6.5);
   // A wale-wise uniaxial path made of the law's own uniaxial response: the ratio must be 1;
   // the same path with the cell's stress scaled by 1.5 must give 1 / 1.5.
@@ -609,10 +619,7 @@ TEST_CASE("energy fit: held-out states and runs are counted against 5 % of the s
   // 2 E12)). Session 33, a helper's audit: a threshold of 50 %, a run judged by its last state
   // only and the held-out strain built with E12 instead of 2 E12 each passed the suite.
   Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  EnergyFitOptions ridge;
-  ridge.family = "ridge";
-  const EnergyFitSummary s = fit_energy_law(db, ridge);
-  REQUIRE(s.ok());
+  const EnergyFitSummary s = fit_ridge(db);
   const auto base = diagnose_energy_law(s.law, db);
   const double range = base.per_loop[1].stress_range;
   REQUIRE(range > 0.0);
@@ -644,10 +651,7 @@ TEST_CASE("energy fit: the per-loop-length figures equal their definitions", "[u
   // smallest eigenvalue of C over all these states. Session 33, the fit audit: rms_relative as
   // a mean of components, max_relative the same, and the middle eigenvalue passed the suite.
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  EnergyFitOptions ridge;
-  ridge.family = "ridge";
-  const EnergyFitSummary s = fit_energy_law(db, ridge);
-  REQUIRE(s.ok());
+  const EnergyFitSummary s = fit_ridge(db);
   const auto& dg = s.diagnostics;
   REQUIRE(dg.per_loop.size() == 2);
   const material::EnergyLaw law(s.law);
@@ -688,4 +692,33 @@ TEST_CASE("energy fit: the per-loop-length figures equal their definitions", "[u
     CHECK(mx.minCoeff() < 0.9 * mx.maxCoeff());
   }
   CHECK(dg.min_eigenvalue == Approx(min_eig).epsilon(1e-10));
+}
+
+TEST_CASE("energy fit: steps that did not converge are skipped, counted, and too few refused",
+          "[unit]") {
+  // Session 33, the fit audit: not counting the skipped steps, and refusing below 1 usable
+  // step instead of 4, passed the suite.
+  Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  const EnergyFitSummary s = fit_ridge(db);
+  const int skipped0 = diagnose_energy_law(s.law, db).points_skipped;
+  CHECK(skipped0 == s.diagnostics.points_skipped);
+  // Three steps of loop 0's first coverage path marked not converged: three more skipped.
+  material::RawPath* cov = nullptr;
+  for (auto& r : db.entries[0].raw)
+    if (r.path.set == "coverage" && !cov) cov = &r;
+  REQUIRE(cov);
+  REQUIRE(cov->steps() >= 4);
+  for (int k = 1; k <= 3; ++k) cov->status[static_cast<std::size_t>(k)] = 1;
+  CHECK(diagnose_energy_law(s.law, db).points_skipped == skipped0 + 3);
+  // Loop 0 with exactly 3 converged steps outside the held-out set: refused, naming it.
+  int kept = 0;
+  for (auto& r : db.entries[0].raw) {
+    if (r.path.set == "holdout") continue;
+    for (auto& st : r.status)
+      if (st == 0 && kept++ >= 3) st = 1;
+  }
+  const EnergyFitSummary few = fit_energy_law(db, ridge_options());
+  CHECK(few.status == FitStatus::kRefused);
+  CHECK_THAT(few.reason, Catch::Contains("/loop_0/raw: only 3 converged steps outside the held-out "
+                                         "set (at least 4 needed)"));
 }

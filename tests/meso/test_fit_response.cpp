@@ -349,3 +349,22 @@ TEST_CASE("fit: a loop length whose refit fails keeps no law from before", "[uni
     CHECK(db.entries[k].diagnostics.max_relative == 0.0);
   }
 }
+
+TEST_CASE("fit: a fan of exactly 180 degrees is refused, and paths of too few steps", "[unit]") {
+  // check_fan (fit_loop_length's refusals): a fan spanning pi or more cannot be inverted, and
+  // a surface of degree p along the paths needs p + 1 steps. Session 33, the fit audit: a fan
+  // of exactly 180 degrees accepted, and a steps refusal one short, passed the suite.
+  const FitOptions o;
+  FanShape fan;
+  fan.shear = true;
+  fan.min_steps = o.degree2 + 1;
+  for (int k = 0; k <= o.degree1 + 1; ++k)
+    fan.phi.push_back(M_PI * k / (o.degree1 + 1));  // 0 ... pi
+  CHECK_THAT(check_fan(o, fan), Catch::Contains("span 180 degrees or more"));
+  fan.phi.back() = std::nextafter(M_PI, 0.0);
+  CHECK(check_fan(o, fan).empty());
+  fan.min_steps = o.degree2;
+  CHECK(check_fan(o, fan) == "paths with " + std::to_string(o.degree2) +
+                                 " steps cannot determine a degree-" + std::to_string(o.degree2) +
+                                 " surface along the paths");
+}
