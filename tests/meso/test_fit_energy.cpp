@@ -93,11 +93,7 @@ EnergyFitOptions small_network(int h1, int h2, int iterations) {
 TEST_CASE("energy fit: recovers the synthetic hyperelastic law within 0.3 % of the range",
           "[unit]") {
   const Database db = synthetic_coverage_db();
-  EnergyFitOptions ridge;
-  ridge.family = "ridge";
-  const EnergyFitSummary s = fit_energy_law(db, ridge);
-  INFO(s.reason);
-  REQUIRE(s.ok());
+  const EnergyFitSummary s = fit_ridge(db);
   std::printf("%s", energy_fit_report(s).c_str());
   const auto& d = s.diagnostics;
   REQUIRE(d.per_loop.size() == 3);
