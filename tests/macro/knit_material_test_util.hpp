@@ -17,6 +17,23 @@ inline macro::ScalarFieldSpec graded_stitch_value(double l0 = 4.5, double l1 = 6
   return l;
 }
 
+/// A knitting angle bilinear on [0, 1]^2 with the corner values (0, 0) 0.2, (1, 0) 0.5,
+/// (0, 1) -0.9, (1, 1) 1.3 (u index fastest, docs/case-format.md), and its value computed
+/// independently of the spline code.
+struct BilinearAngle {
+  static constexpr double a00 = 0.2, a10 = 0.5, a01 = -0.9, a11 = 1.3;
+  static macro::ScalarFieldSpec spec() {
+    macro::ScalarFieldSpec a;
+    a.degree_u = a.degree_v = 1;
+    a.knots_u = a.knots_v = {0, 0, 1, 1};
+    a.values = {a00, a10, a01, a11};
+    return a;
+  }
+  static double at(double u, double v) {
+    return (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + (1 - u) * v * a01 + u * v * a11;
+  }
+};
+
 /// A material point at (theta1, theta2), no bound quadrature point.
 inline macro::MaterialPoint at(double t1, double t2) {
   macro::MaterialPoint p;

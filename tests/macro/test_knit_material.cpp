@@ -362,21 +362,16 @@ TEST_CASE("knit material, paper law: bound points on graded l and alpha fields",
   // As the energy law's test: l grades in theta1, alpha is bilinear (u index fastest); each
   // bound point equals the unbound evaluation and the definition S = T_S(-alpha) S_hat(T_E E),
   // C = T_S(-alpha) C_hat T_E (eqs. 21-22).
-  ScalarFieldSpec a;
-  a.degree_u = a.degree_v = 1;
-  a.knots_u = a.knots_v = {0, 0, 1, 1};
-  const double a00 = 0.2, a10 = 0.5, a01 = -0.9, a11 = 1.3;
-  a.values = {a00, a10, a01, a11};
+  using knit::testing::BilinearAngle;
   const auto fam = test_family();
   KnitMaterial m(fam, make_scalar_field(knit::testing::graded_stitch_value()),
-                 make_scalar_field(a));
+                 make_scalar_field(BilinearAngle::spec()));
   const std::vector<Eigen::Vector2d> pts = {{0.1, 0.8}, {0.7, 0.15}, {0.45, 0.55}};
   m.bind_points(pts);
   const Eigen::Vector3d E(0.12, 0.04, 0.09);
   for (int k = 0; k < 3; ++k) {
     const double u = pts[k](0), v = pts[k](1);
-    const double alpha =
-        (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + (1 - u) * v * a01 + u * v * a11;
+    const double alpha = BilinearAngle::at(u, v);
     INFO("point " << k << ", alpha " << alpha);
     CHECK(m.knitting_angle(pts[k]) == Approx(alpha).epsilon(1e-14));
     const Eigen::Matrix3d TE = knit::mech::T_E(alpha), TSinv = knit::mech::T_S_inv(alpha);
