@@ -718,3 +718,49 @@ TEST_CASE("energy fit: steps that did not converge are skipped, counted, and too
   CHECK_THAT(few.reason, Catch::Contains("/loop_0/raw: only 3 converged steps outside the held-out "
                                          "set (at least 4 needed)"));
 }
+
+TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero included",
+          "[unit]") {
+  // One coverage path's stress turns at its fourth step nearly at right angles to its strain
+  // increment, slightly against it (cos(dS, de) = c = -0.05), and stays there. The path gives
+  // way there for every threshold above c and for none below (the later steps have dS = 0, no
+  // direction). c is computed from the data here, so a threshold shifted, a sign or the
+  // increment taken from the wrong state is seen.
+  Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  std::size_t q = 0;
+  while (q < db.entries[0].raw.size() &&
+         (db.entries[0].raw[q].path.set != "coverage" || db.entries[0].raw[q].steps() < 6))
+    ++q;
+  REQUIRE(q < db.entries[0].raw.size());
+  auto& r = db.entries[0].raw[q];
+  const auto e = [&](int s) { return Eigen::Vector3d(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)); };
+  // The path bends at step 4 (its increment no longer points away from zero strain), so an
+  // increment measured from the reference instead of the previous state differs.
+  const Eigen::RowVector3d bend =
+      0.5 * (r.E.row(3) - r.E.row(2)).norm() * Eigen::RowVector3d(-0.6, 0.0, 0.8);
+  for (int s = 3; s < r.steps(); ++s) r.E.row(s) += bend;
+  const Eigen::Vector3d de = e(3) - e(2);
+  REQUIRE(std::abs(de.normalized().dot(e(3).normalized())) < 0.99);
+  const Eigen::Vector3d across = de.cross(Eigen::Vector3d(0.3, -0.5, 0.8)).normalized();
+  const Eigen::Vector3d turn =
+      0.01 * r.S.row(2).norm() * (across - 0.05 * de.normalized()).transpose();
+  for (int s = 3; s < r.steps(); ++s) r.S.row(s) = r.S.row(2) + turn.transpose();
+  const Eigen::Vector3d dS = (r.S.row(3) - r.S.row(2)).transpose();
+  const double c = de.dot(dS) / (de.norm() * dS.norm());
+  REQUIRE(c == Approx(-0.05 / std::sqrt(1.0025)));
+  EnergyFitOptions o;
+  o.family = "ridge";
+  const EnergyFitSummary at0 = fit_energy_law(db, o);
+  REQUIRE(at0.ok());
+  REQUIRE(at0.gave_way.size() == 1);
+  CHECK(at0.gave_way[0] == knit::material::raw_path_location(0, q) + " from step 4");
+  o.stable_min_cos = c + 1e-6;
+  const EnergyFitSummary above = fit_energy_law(db, o);
+  REQUIRE(above.ok());
+  CHECK(above.gave_way.size() == 1);
+  o.stable_min_cos = c - 1e-6;
+  const EnergyFitSummary below = fit_energy_law(db, o);
+  REQUIRE(below.ok());
+  CHECK(below.gave_way.empty());
+  CHECK(below.diagnostics.points_skipped == at0.diagnostics.points_skipped - (r.steps() - 3));
+}

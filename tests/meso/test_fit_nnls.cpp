@@ -130,3 +130,24 @@ TEST_CASE("nnls: bad input and an iteration limit are reported", "[unit]") {
   CHECK_FALSE(z.converged);
   CHECK(z.reason.find("not positive definite") != std::string::npos);
 }
+
+TEST_CASE("nnls: the KKT violation by hand, relative to the largest |b_i|", "[unit]") {
+  // g = M x - b. A variable at its bound violates by max(0, -g_i) (it would lower the
+  // objective by growing), a positive one by |g_i|; the worst over the largest |b_i|.
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(2, 2);
+  CHECK(kkt_violation(I, Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 0)) == 1.0);
+  // b = (2, -1) at x = 0: g = (-2, 1); the first wants to grow by 2, the second is content.
+  CHECK(kkt_violation(I, Eigen::Vector2d(2, -1), Eigen::Vector2d(0, 0)) == 1.0);
+  // b = (4, -1) at x = (3, 0): g = (-1, 1); the positive first is off by 1, of |b|max = 4.
+  CHECK(kkt_violation(I, Eigen::Vector2d(4, -1), Eigen::Vector2d(3, 0)) == 0.25);
+  // ... and at x = (5, 0) by 1 the other way (|g|, not -g, for a positive variable).
+  CHECK(kkt_violation(I, Eigen::Vector2d(4, -1), Eigen::Vector2d(5, 0)) == 0.25);
+  // A variable at its bound with g > 0 is no violation, however large g.
+  CHECK(kkt_violation(I, Eigen::Vector2d(4, -100), Eigen::Vector2d(4, 0)) == 0.0);
+  // The optimum of the 2 x 2 case above: none.
+  Eigen::MatrixXd M(2, 2);
+  M << 2, 1, 1, 2;
+  CHECK(kkt_violation(M, Eigen::Vector2d(1, -3), Eigen::Vector2d(0.5, 0)) == 0.0);
+  // b = 0 does not divide by zero.
+  CHECK(std::isfinite(kkt_violation(I, Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0))));
+}
