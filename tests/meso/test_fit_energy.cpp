@@ -88,6 +88,15 @@ EnergyFitOptions small_network(int h1, int h2, int iterations) {
   return o;
 }
 
+/// The first coverage path of the first loop length with at least `steps` steps (the number
+/// of paths if none).
+std::size_t first_coverage_path(const Database& db, int steps) {
+  const auto& raw = db.entries[0].raw;
+  std::size_t q = 0;
+  while (q < raw.size() && (raw[q].path.set != "coverage" || raw[q].steps() < steps)) ++q;
+  return q;
+}
+
 }  // namespace
 
 TEST_CASE("energy fit: recovers the synthetic hyperelastic law within 0.3 % of the range",
@@ -395,10 +404,7 @@ TEST_CASE("energy fit: states where the cell gives way are left out of the fit",
   const EnergyFitSummary clean = fit_energy_law(db, o);
   REQUIRE(clean.ok());
   CHECK(clean.gave_way.empty());
-  std::size_t q = 0;
-  while (q < db.entries[0].raw.size() &&
-         (db.entries[0].raw[q].path.set != "coverage" || db.entries[0].raw[q].steps() < 6))
-    ++q;
+  const std::size_t q = first_coverage_path(db, 6);
   REQUIRE(q < db.entries[0].raw.size());
   auto& r = db.entries[0].raw[q];
   for (int s = 2; s < r.steps(); ++s) r.S.row(s) = 0.3 * r.S.row(1);  // falls, then stays
@@ -727,10 +733,7 @@ TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero i
   // direction). c is computed from the data here, so a threshold shifted, a sign or the
   // increment taken from the wrong state is seen.
   Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  std::size_t q = 0;
-  while (q < db.entries[0].raw.size() &&
-         (db.entries[0].raw[q].path.set != "coverage" || db.entries[0].raw[q].steps() < 6))
-    ++q;
+  const std::size_t q = first_coverage_path(db, 6);
   REQUIRE(q < db.entries[0].raw.size());
   auto& r = db.entries[0].raw[q];
   const auto e = [&](int s) { return Eigen::Vector3d(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)); };
