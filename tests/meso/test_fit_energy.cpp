@@ -767,3 +767,55 @@ TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero i
   CHECK(below.gave_way.empty());
   CHECK(below.diagnostics.points_skipped == at0.diagnostics.points_skipped - (r.steps() - 3));
 }
+
+TEST_CASE("energy fit: the strain box and the ridge functions' ranges follow the fitted data",
+          "[unit]") {
+  // The box is the fitted strains' bounding box with zero in it, symmetric in 2E12 (W is even
+  // in E12); each ridge function's range [a_g, b_g] spans d . e over its directions and the
+  // fitted states, widened by s_margin times its width on each side (database.md).
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  std::vector<Eigen::Vector3d> es;
+  for (const auto& entry : db.entries)
+    for (const auto& r : entry.raw)
+      if (r.path.set != "holdout")
+        for (int s = 0; s < r.steps(); ++s) es.emplace_back(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2));
+  EnergyFitOptions o = ridge_options();
+  o.s_margin = 0.0;
+  const EnergyFitSummary tight = fit_energy_law(db, o);
+  REQUIRE(tight.ok());
+  REQUIRE(tight.gave_way.empty());
+  const auto& law = tight.law;
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+  for (const auto& e : es) {
+    lo = lo.cwiseMin(e);
+    hi = hi.cwiseMax(e);
+  }
+  CHECK(law.box_min(0) == lo(0));
+  CHECK(law.box_max(0) == hi(0));
+  CHECK(law.box_min(1) == lo(1));
+  CHECK(law.box_max(1) == hi(1));
+  const double g_max = std::max(-lo(2), hi(2));
+  CHECK(law.box_max(2) == g_max);
+  CHECK(law.box_min(2) == -g_max);
+  REQUIRE(lo(2) > -g_max);  // the data are one-sided in E12 somewhere: the symmetry matters
+  o.s_margin = 0.25;
+  const EnergyFitSummary wide = fit_energy_law(db, o);
+  REQUIRE(wide.ok());
+  for (int g = 0; g < law.functions(); ++g) {
+    double a = 0.0, b = 0.0;
+    for (Eigen::Index k = 0; k < law.directions.d.rows(); ++k) {
+      if (law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
+      for (const auto& e : es) {
+        a = std::min(a, law.directions.d.row(k).dot(e));
+        b = std::max(b, law.directions.d.row(k).dot(e));
+      }
+    }
+    INFO("ridge function " << g << ": data from " << a << " to " << b);
+    REQUIRE(a < -0.01 * (b - a));  // both signs reached: the range is the data's own
+    REQUIRE(b > 0.01 * (b - a));
+    CHECK(law.s_range(g, 0) == Approx(a).epsilon(1e-14));
+    CHECK(law.s_range(g, 1) == Approx(b).epsilon(1e-14));
+    CHECK(wide.law.s_range(g, 0) == Approx(a - 0.25 * (b - a)).epsilon(1e-14));
+    CHECK(wide.law.s_range(g, 1) == Approx(b + 0.25 * (b - a)).epsilon(1e-14));
+  }
+}
