@@ -37,7 +37,7 @@ struct NnlsResult {
 double kkt_violation(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, const Eigen::VectorXd& x);
 
 /// The minimizer of 1/2 x^T M x - b^T x over x >= 0 (M symmetric positive definite; the full
-/// matrix is read). max_iterations <= 0: 3 n + 50 passive-set solves. Throws std::invalid_argument
+/// matrix is read). max_iterations <= 0: 20 n + 50 passive-set solves. Throws std::invalid_argument
 /// on mismatched sizes or non-finite entries.
 NnlsResult nnls_normal(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, int max_iterations = 0);
 
