@@ -368,3 +368,57 @@ TEST_CASE("fit: a fan of exactly 180 degrees is refused, and paths of too few st
                                  " steps cannot determine a degree-" + std::to_string(o.degree2) +
                                  " surface along the paths");
 }
+
+TEST_CASE("fit: the diagnostics count the paper's converged steps, each error in its component",
+          "[unit]") {
+  // diagnose(): a pure-shear step is measured as S12 at E = (0, 0, 2 E12) (evaluate() takes
+  // engineering shear), a biaxial step as S11 and S22 at (E11, E22, 0); points_used counts the
+  // converged steps of the paper's paths. One datum moved by 0.5 MPa shows in its own
+  // component's largest error and in no other.
+  SyntheticOptions so;
+  auto raw = synthetic_paths(so, 5.5);
+  const FitSummary fs = fit_loop_length(raw, FitOptions{});
+  REQUIRE(fs.ok());
+  const ResponseSurface law(fs.surface);
+  const FitDiagnostics base = diagnose(fs.surface, raw);
+  int steps = 0;
+  std::size_t shear = raw.size(), biaxial = raw.size();
+  for (std::size_t q = 0; q < raw.size(); ++q) {
+    if (!in_paper_fit(raw[q])) continue;
+    steps += raw[q].steps();
+    (raw[q].path.kind == PathKind::kShear ? shear : biaxial) = q;
+  }
+  REQUIRE(shear < raw.size());
+  REQUIRE(biaxial < raw.size());
+  CHECK(base.points_used == steps);
+  const double shift = 0.5;
+  REQUIRE(base.max.tail<3>().maxCoeff() < 0.1 * shift);
+  {
+    auto moved = raw;
+    const int k = raw[shear].steps() / 2;
+    moved[shear].S(k, 2) += shift;
+    const double err =
+        law.evaluate({0.0, 0.0, 2.0 * raw[shear].E(k, 2)}).S(2) - moved[shear].S(k, 2);
+    const FitDiagnostics d = diagnose(fs.surface, moved);
+    CHECK(d.max(4) == Approx(std::abs(err)).epsilon(1e-12));
+    CHECK(d.max(2) == base.max(2));
+    CHECK(d.max(3) == base.max(3));
+  }
+  {
+    auto moved = raw;
+    const int k = raw[biaxial].steps() - 1;
+    moved[biaxial].S(k, 1) += shift;
+    const double err = law.evaluate({raw[biaxial].E(k, 0), raw[biaxial].E(k, 1), 0.0}).S(1) -
+                       moved[biaxial].S(k, 1);
+    const FitDiagnostics d = diagnose(fs.surface, moved);
+    CHECK(d.max(3) == Approx(std::abs(err)).epsilon(1e-12));
+    CHECK(d.max(2) == base.max(2));
+    CHECK(d.max(4) == base.max(4));
+  }
+  // A step that did not converge is not a point; neither is a step of a path outside the fit.
+  raw[biaxial].status[1] = 1;
+  auto outside = raw[shear];
+  outside.path.set = "coverage";
+  raw.push_back(outside);
+  CHECK(diagnose(fs.surface, raw).points_used == steps - 1);
+}
