@@ -267,7 +267,14 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   marker << "knitscale output" << (output_owner().empty() ? "" : ": " + output_owner()) << "\n"
          << Provenance::current().to_json_string() << "\n"
          << "for: " << target_.filename().string() << "\n";
-  if (!marker) fail(partial_ / kOutputMarker, "cannot write");
+  if (!marker.flush()) {
+    // The directory is ours, just created, and holds only this file: without its marker no
+    // later run would remove it (session 34: a full disk left DIR.partial-<pid> for good).
+    marker.close();
+    fs::remove(partial_ / kOutputMarker, ec);
+    fs::remove(partial_, ec);
+    fail(partial_ / kOutputMarker, "cannot write");
+  }
 }
 
 AtomicDirectory::AtomicDirectory(AtomicDirectory&& o) noexcept
@@ -312,12 +319,15 @@ void AtomicDirectory::commit() {
     if (!marker.flush()) fail(partial_ / kOutputMarker, "cannot write");
   }
   // Make the contents durable before they become visible under the final name.
+  // A file that cannot be made durable fails the commit, as AtomicFile's does (session 34:
+  // ignored, exit 0); directories are best effort (some file systems refuse their fsync).
   for (auto it = fs::recursive_directory_iterator(partial_, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    if (it->is_regular_file(ec))
-      fsync_path(it->path(), false);
-    else if (it->is_directory(ec))
+    if (it->is_regular_file(ec)) {
+      if (const int err = fsync_path(it->path(), false)) fail(it->path(), "fsync failed", err);
+    } else if (it->is_directory(ec)) {
       fsync_path(it->path(), true);
+    }
   }
   fsync_path(partial_, true);
 

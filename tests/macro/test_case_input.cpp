@@ -363,6 +363,49 @@ TEST_CASE(
   fs::remove_all(d);
 }
 
+// Session 34: summary.txt (and a case.json below 1 KiB) were written through std::ofstream and
+// checked before the stream was closed; their bytes stay in its buffer until then, so a full
+// disk refusing them at close went unnoticed: exit 0, the earlier output replaced by one with
+// an empty summary. A preloaded shim (tests/support/fail_io_shim.c) makes the writes of one
+// file fail with ENOSPC, or its fsync with EIO.
+TEST_CASE("knit-macro run: a write or fsync that fails on any output file fails the run",
+          "[unit]") {
+  const fs::path d = temp_dir("fail_io");
+  json c = verification_case("tensile_svk.json");
+  c["output"]["vtk"] = false;
+  std::ofstream(d / "case.json") << c.dump(2);
+  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
+  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const std::string summary = slurp(d / "out" / "summary.txt");
+  REQUIRE(summary.size() > 50);
+  const auto run_failing = [&](const std::string& env) {
+    const std::string cmd = "env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
+                            " ASAN_OPTIONS=verify_asan_link_order=0 " + env + " " +
+                            std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
+                            (d / "log.txt").string() + " 2>&1";
+    const int st = std::system(cmd.c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  };
+  // The shim changes nothing unless asked.
+  CHECK(run_failing("") == 0);
+  for (const std::string env : {"KNIT_FAIL_WRITE=summary.txt", "KNIT_FAIL_WRITE=case.json",
+                                "KNIT_FAIL_WRITE=load_strain.csv", "KNIT_FAIL_WRITE=results.h5",
+                                "KNIT_FAIL_WRITE=.knitscale-output", "KNIT_FAIL_FSYNC=summary.txt",
+                                "KNIT_FAIL_FSYNC=results.h5"}) {
+    INFO(env);
+    CHECK(run_failing(env) == 1);
+    const std::string log = slurp(d / "log.txt");
+    INFO(log);
+    CHECK(log.find("the earlier outputs are left as they were") != std::string::npos);
+    CHECK(slurp(d / "out" / "summary.txt") == summary);
+    // Nothing is left beside the output (a partial directory whose marker could not be
+    // written was left for good: no later run takes a directory without it for its own).
+    for (const auto& e : fs::directory_iterator(d))
+      CHECK(e.path().filename().string().find("out.") == std::string::npos);
+  }
+  fs::remove_all(d);
+}
+
 // Session 22: the exit codes were in the docs only; every --help now ends with them.
 TEST_CASE("knit-macro --help and run --help state the exit codes and units", "[unit]") {
   const fs::path d = temp_dir("help");
