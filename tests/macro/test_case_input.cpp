@@ -406,6 +406,38 @@ TEST_CASE("knit-macro run: a write or fsync that fails on any output file fails 
   fs::remove_all(d);
 }
 
+// Session 26 made every removal of an output of ours delete its marker last, so that a run
+// killed during the removal leaves a directory the next run still knows for its own; no test
+// held the order (the I/O audit, session 33). The shim logs each removal in order.
+TEST_CASE("knit-macro run: the replaced output loses its marker after its files and before itself",
+          "[unit]") {
+  const fs::path d = temp_dir("remove_order");
+  std::ofstream(d / "case.json") << verification_case("tensile_svk.json").dump(2);
+  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
+  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const fs::path log = d / "removed.txt";
+  const std::string cmd = "env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
+                          " ASAN_OPTIONS=verify_asan_link_order=0 KNIT_LOG_REMOVE=" + log.string() +
+                          " " + std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
+                          (d / "log.txt").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 0));
+  // The earlier output, swapped out to out.partial-<pid>, is removed: its files and vtk/ (with
+  // its files) first, then the marker, then the directory.
+  std::vector<std::string> removed;
+  std::istringstream in(slurp(log));
+  for (std::string line; std::getline(in, line);)
+    if (line.find("/out.partial-") != std::string::npos) removed.push_back(line);
+  INFO(slurp(log));
+  REQUIRE(removed.size() > 5);
+  const std::string dir = removed.back();
+  CHECK(removed[removed.size() - 2] == dir + "/.knitscale-output");
+  CHECK(std::count_if(removed.begin(), removed.end(),
+                      [&](const std::string& p) { return p.rfind(dir + "/vtk/", 0) == 0; }) > 1);
+  for (std::size_t k = 0; k + 1 < removed.size(); ++k) CHECK(removed[k].rfind(dir + "/", 0) == 0);
+  fs::remove_all(d);
+}
+
 // Session 22: the exit codes were in the docs only; every --help now ends with them.
 TEST_CASE("knit-macro --help and run --help state the exit codes and units", "[unit]") {
   const fs::path d = temp_dir("help");
