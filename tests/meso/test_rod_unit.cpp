@@ -45,6 +45,9 @@ TEST_CASE("quaternion: rotation is orthogonal and scale-invariant, log/exp round
   CHECK(R.determinant() == Approx(1.0));
   CHECK((rotation(Quat<double>(3.7 * q)) - R).norm() < 1e-14);
   CHECK((rotation_vector(q) - th).norm() < 1e-12);
+  // -q is the same rotation: the log map picks the sign with |theta| <= pi (session 34, the
+  // rod audit: without it -q gave a rotation vector of length 2 pi - |theta|).
+  CHECK((rotation_vector(Quat<double>(-q)) - th).norm() < 1e-12);
   const Quat<double> q2 = quat_from_matrix(R);
   CHECK(std::min((q2 - q).norm(), (q2 + q).norm()) < 1e-12);
   // Rodrigues formula for the rotation vector
@@ -362,4 +365,58 @@ TEST_CASE("rod: after a cut-back the increment grows back, and the predictor sav
   CHECK(with.cutbacks == 0);
   CHECK(without.cutbacks == 0);
   CHECK(with.total_iterations < without.total_iterations);
+}
+
+// Session 34 (the rod audit): the rod case's line_moment and a load on a free start end could
+// change sign and no test saw it (the Jacobian test takes the load factor as given).
+
+TEST_CASE("rod: a distributed moment bends a cantilever by m L^2 / (2 EI) at its tip", "[unit]") {
+  // Clamped at x = 0, a dead line moment (0, -m, 0): no force anywhere, so the bending moment is
+  // m (L - s) whatever the shape, the curvature m (L - s) / EI, and the tangent turns about -y
+  // by theta(s) = (m / EI) (L s - s^2 / 2), towards +z: tip (int cos theta, 0, int sin theta).
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0), m = 0.5 * EI / (L * L);
+  RodSystem sys;
+  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 4, 16, sec);
+  s.line_moment = Vector3d(0, -m, 0);
+  sys.add_rod(s);
+  Eigen::VectorXd x = sys.initial_state();
+  PathOptions po;
+  po.steps = 2;
+  REQUIRE(solve_path(sys, x, po).completed);
+  const double theta_tip = m * L * L / (2.0 * EI);
+  REQUIRE(theta_tip == Approx(0.25));
+  Vector3d tip = Vector3d::Zero();  // Simpson's rule
+  const int n = 2000;
+  for (int i = 0; i <= n; ++i) {
+    const double si = L * i / n, th = m / EI * (L * si - 0.5 * si * si);
+    const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+    tip += w * L / (3.0 * n) * Vector3d(std::cos(th), 0.0, std::sin(th));
+  }
+  const PointState end = sys.state(0, 1.0, x);
+  CHECK((end.r - tip).norm() < 1e-6 * L);
+  CHECK(end.R.col(2).z() == Approx(std::sin(theta_tip)).epsilon(1e-6));
+  CHECK(end.R.col(2).x() == Approx(std::cos(theta_tip)).epsilon(1e-6));
+}
+
+TEST_CASE("rod: a force on a free start end deflects it by P L^3 / (3 EI) + P L / (G As)",
+          "[unit]") {
+  // Clamped at the end x = L, free at the start x = 0, which carries P e_z: the linear cantilever
+  // (Timoshenko: bending and shear), P small enough for the rotation (P L^2 / 2 EI = 5e-4) to
+  // leave it linear to ~1e-6; the internal force at the loaded start balances it, n(0) = -P.
+  const Section sec;
+  const double L = 10.0, EI = sec.C_K()(0), GAs = sec.C_Gamma()(0), P = 1e-3 * EI / (L * L);
+  RodSystem sys;
+  RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(L, 0, 0), 4, 16, sec);
+  s.start = EndCondition::free();
+  s.start.force = Vector3d(0, 0, P);
+  s.end = EndCondition::clamped();
+  sys.add_rod(s);
+  Eigen::VectorXd x = sys.initial_state();
+  PathOptions po;
+  po.steps = 1;
+  REQUIRE(solve_path(sys, x, po).completed);
+  const PointState start = sys.state(0, 0.0, x);
+  CHECK(start.r.z() == Approx(P * L * L * L / (3.0 * EI) + P * L / GAs).epsilon(1e-4));
+  CHECK((start.n - Vector3d(0, 0, -P)).norm() < 1e-8 * P);
 }
