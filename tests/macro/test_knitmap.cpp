@@ -3,14 +3,18 @@
 // needles also when the stitch counts differ by an odd number; a sheared patch needs its
 // courses' spread in needles; the yarn length is the sum of the loop lengths; bad input names
 // the file and the JSON pointer, exits 2 and writes nothing.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
@@ -97,6 +101,53 @@ double sum_l(const KnitMap& m) {
   for (const auto& st : m.stitches) s += st.l;
   return s;
 }
+
+/// The rows of a CSV file of the command as numbers (its comments and header left out).
+std::vector<std::vector<double>> csv_rows(const fs::path& f) {
+  std::ifstream in(f);
+  std::vector<std::vector<double>> rows;
+  bool header = true;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (std::exchange(header, false)) continue;
+    std::istringstream is(line);
+    rows.emplace_back();
+    for (std::string cell; std::getline(is, cell, ',');) rows.back().push_back(std::stod(cell));
+  }
+  return rows;
+}
+
+/// The "key: value" lines of summary.txt, values as numbers (text lines left out).
+std::map<std::string, double> summary_numbers(const fs::path& f) {
+  std::ifstream in(f);
+  std::map<std::string, double> v;
+  for (std::string line; std::getline(in, line);) {
+    const auto colon = line.find(": ");
+    if (colon == std::string::npos || line[0] == '#') continue;
+    try {
+      v[line.substr(0, colon)] = std::stod(line.substr(colon + 2));
+    } catch (const std::invalid_argument&) {  // case:, database:, warning:
+    }
+  }
+  return v;
+}
+
+/// A number the command printed with 10 significant digits (io::format_number, summary.txt).
+Approx printed(double exact) {
+  return Approx(exact).epsilon(1e-9).margin(1e-12);
+}
+
+/// The stitches of course k (1-based) of a map, needle by needle.
+std::vector<KnitStitch> course_stitches(const KnitMap& m, int k) {
+  std::vector<KnitStitch> out;
+  for (const auto& st : m.stitches)
+    if (st.course == k) out.push_back(st);
+  return out;
+}
+
+/// A patch's linear grading of l from 4.5 (u = 0) to 6.5 mm (u = 1), along the courses.
+const std::string kGradedU = R"({"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
+                                 "values": [4.5, 6.5]})";
 
 }  // namespace
 
@@ -293,48 +344,86 @@ TEST_CASE("knitmap: a sheared patch needs its courses' spread in needles", "[cas
   }
 }
 
+// Session 34 (the design/knitmap audit's mutants 10, 21, 22, 30, 31 and 32): a stitch's l
+// taken at its start instead of its centre (rule 7: where it was laid, rule 4: at its centre)
+// changed only the l values, and the command's files could print l_max as l_min, the course
+// count as needles, y as x, last_needle one too high, height and t swapped: no test failed.
+// On 30 x 10 mm, l = 4.5 + 2 x / 30 along the courses, the stitches of a course are laid from
+// x = 0, so stitch i's centre is at sum_(j < i) w(l_j) + w(l_i) / 2 and l_i = 4.5 + 2 / 30 of
+// that; for the first, l_1 = 4.5 + w(l_1) / 30 with w(l) = 1.26 + 0.075 (l - 4.5):
+// l_1 = 4.5 + 0.042 / (1 - 0.0025). The files are compared field by field with the map
+// make_knitmap gives for the same case.
 TEST_CASE("knitmap: a linear grading and the command's outputs", "[case]") {
   const std::string db = database();
-  const std::string file = write_case(
-      "graded.json", case_text(knit_material(db, R"({"degrees": [1, 0], "knots_u": [0, 0, 1, 1],
-                                        "knots_v": [0, 1], "values": [4.5, 6.5]})"),
-                               30.0, 10.0));
+  const std::string file =
+      write_case("graded.json", case_text(knit_material(db, kGradedU), 30.0, 10.0));
   const fs::path out = kDir / "graded_out";
   fs::remove_all(out);
   REQUIRE(run_knitmap(file + " --output " + out.string()) == 0);
   for (const char* f : {"knitmap.csv", "courses.csv", "summary.txt"}) CHECK(fs::exists(out / f));
-  // Yarn length in the summary = sum of the CSV's l column.
-  std::ifstream csv(out / "knitmap.csv");
-  std::string line;
-  double sum = 0;
-  long rows = 0;
-  while (std::getline(csv, line)) {
-    if (line.empty() || line[0] == '#' || line[0] == 'c') continue;
-    std::istringstream is(line);
-    std::string a, b, l;
-    std::getline(is, a, ',');
-    std::getline(is, b, ',');
-    std::getline(is, l, ',');
-    sum += std::stod(l);
-    ++rows;
-  }
-  std::ifstream sm(out / "summary.txt");
-  double yarn = -1;
-  long stitches = -1;
-  while (std::getline(sm, line)) {
-    if (line.rfind("yarn_length_mm: ", 0) == 0) yarn = std::stod(line.substr(16));
-    if (line.rfind("stitches: ", 0) == 0) stitches = std::stol(line.substr(10));
-  }
-  CHECK(stitches == rows);
-  CHECK(yarn == Approx(sum).epsilon(1e-8));
-  // Wider stitches along the grading: fewer stitches than a uniform 4.5 mm course.
   const auto in = load_knitmap_input(file);
   const KnitMap m = make_knitmap(in.c, in.cells);
+  REQUIRE(m.courses.size() > 1);
+  // Wider stitches along the grading: fewer stitches than a uniform 4.5 mm course.
   CHECK(m.courses.front().stitches < std::lround(30.0 / w_of(4.5)));
   CHECK(m.courses.front().stitches > std::lround(30.0 / w_of(6.5)));
+  for (const auto& k : m.courses) {
+    INFO("course " << k.index);
+    double s = 0;  // the laid stitch's start along the course
+    for (const KnitStitch& st : course_stitches(m, k.index)) {
+      const double w = w_of(st.l);
+      CHECK(st.l == Approx(4.5 + 2.0 * (s + 0.5 * w) / 30.0).margin(1e-9));
+      s += w;
+    }
+    CHECK(course_stitches(m, k.index).front().l == Approx(4.5 + 0.042 / 0.9975).margin(1e-9));
+  }
   for (std::size_t i = 1; i < m.stitches.size(); ++i)
     if (m.stitches[i].course == m.stitches[i - 1].course)
       CHECK(m.stitches[i].l > m.stitches[i - 1].l);
+  // knitmap.csv: one row per stitch; courses.csv: one per course.
+  const auto rows = csv_rows(out / "knitmap.csv");
+  REQUIRE(rows.size() == m.stitches.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const KnitStitch& st = m.stitches[i];
+    INFO("stitch " << i);
+    REQUIRE(rows[i].size() == 5);
+    CHECK(rows[i][0] == st.course);
+    CHECK(rows[i][1] == st.needle);
+    CHECK(rows[i][2] == printed(st.l));
+    CHECK(rows[i][3] == printed(st.position.x()));
+    CHECK(rows[i][4] == printed(st.position.y()));
+  }
+  const auto crows = csv_rows(out / "courses.csv");
+  REQUIRE(crows.size() == m.courses.size());
+  for (std::size_t k = 0; k < crows.size(); ++k) {
+    const KnitCourse& c = m.courses[k];
+    INFO("course " << c.index);
+    REQUIRE(crows[k].size() == 7);
+    CHECK(crows[k][0] == c.index);
+    CHECK(crows[k][1] == c.first_needle);
+    CHECK(crows[k][2] == c.first_needle + c.stitches - 1);
+    CHECK(crows[k][3] == c.stitches);
+    CHECK(crows[k][4] == printed(c.height));
+    CHECK(crows[k][5] == printed(c.t));
+    CHECK(crows[k][6] == printed(c.height_mismatch));
+  }
+  // summary.txt: the yarn length is the sum of the CSV's l column (rule 7).
+  auto sm = summary_numbers(out / "summary.txt");
+  double sum = 0;
+  for (const auto& r : rows) sum += r[2];
+  CHECK(sm["yarn_length_mm"] == Approx(sum).epsilon(1e-8));
+  CHECK(sm["yarn_length_mm"] == printed(m.yarn_length));
+  CHECK(sm["stitches"] == double(rows.size()));
+  CHECK(sm["needles"] == m.needles);
+  CHECK(sm["courses"] == double(crows.size()));
+  CHECK(sm["loop_length_min_mm"] == printed(m.l_min));
+  CHECK(sm["loop_length_max_mm"] == printed(m.l_max));
+  CHECK(sm["course_direction_deg"] == printed(m.course_direction_deg));
+  CHECK(sm["course_direction_spread_deg"] == printed(m.angle_spread_deg));
+  CHECK(sm["max_course_height_mismatch"] == printed(m.max_height_mismatch));
+  CHECK(m.l_min == Approx(4.5 + 0.042 / 0.9975).margin(1e-9));  // the first stitches' l
+  CHECK(m.l_min < m.l_max);
+  CHECK(m.needles != int(m.courses.size()));  // a patch that tells needles from courses
 }
 
 /// A patch whose rows of control points (degree 1 across) span x in [cx - hw_k, cx + hw_k] at
@@ -364,24 +453,35 @@ std::string tapered_case(const std::string& material, const std::vector<double>&
 // Session 26 (found by a helper's audit): the first course line whose chord held no stitch
 // ended the map, so an hourglass with a 0.1 mm waist lost its upper half with exit 0, and a V
 // whose tip is narrower than a stitch was refused as "holds no course".
+// Session 34 (the design/knitmap audit's mutant 23): a gap of exactly one empty course line
+// passed (the fabric in two pieces, exit 0); the 50 mm hourglass's waist spans several lines.
+// The same hourglass H = 5 c(5.0) tall has course lines at (k - 1/2) c: only line 3 crosses
+// the waist (at lines 2 and 4, v = 0.3 and 0.7, the patch is 8 mm wide).
 TEST_CASE("knitmap: a waist narrower than a stitch is refused, a narrow tip is left out",
           "[case]") {
   const std::string db = database();
   const std::string m = knit_material(db, "5.0");
   // Half-widths 25, -24.9, 25 as control values: 25 - 99.8 v (1 - v), a waist of 0.05 mm.
-  const std::string hourglass =
-      write_case("hourglass.json", tapered_case(m, {0, 25, 50}, {25, -24.9, 25}));
-  try {
-    const auto in = load_knitmap_input(hourglass);
-    (void)make_knitmap(in.c, in.cells);
-    FAIL("no error");
-  } catch (const knit::InputError& e) {
-    CHECK(e.pointer() == "/geometry");
-    CHECK_THAT(e.what(), Catch::Contains("fall apart into pieces"));
+  const double H1 = 5 * c_of(5.0);
+  for (const auto& [name, H, gap] : {std::tuple{"hourglass", 50.0, ""},
+                                     std::tuple{"hourglass1", H1, "across 1 course line(s)"}}) {
+    INFO(name);
+    const std::string hourglass =
+        write_case(std::string(name) + ".json", tapered_case(m, {0, 0.5 * H, H}, {25, -24.9, 25}));
+    try {
+      const auto in = load_knitmap_input(hourglass);
+      (void)make_knitmap(in.c, in.cells);
+      FAIL("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == "/geometry");
+      CHECK_THAT(e.what(), Catch::Contains("fall apart into pieces"));
+      CHECK_THAT(e.what(), Catch::Contains(gap));
+    }
+    const fs::path out = kDir / (std::string(name) + "_out");
+    fs::remove_all(out);
+    CHECK(run_knitmap(hourglass + " --output " + out.string()) == 2);
+    CHECK(!fs::exists(out));
   }
-  fs::remove_all(kDir / "hourglass_out");
-  CHECK(run_knitmap(hourglass + " --output " + (kDir / "hourglass_out").string()) == 2);
-  CHECK(!fs::exists(kDir / "hourglass_out"));
   // A V: 0.1 mm at the bottom, 50 mm at the top. The courses that hold stitches are all
   // there: about H / c of them, the narrow start left out with a warning.
   const KnitMap v = map_of("v.json", tapered_case(m, {0, 50}, {0.05, 25}));
@@ -490,4 +590,99 @@ TEST_CASE("knitmap: a grading across the courses gives each course the height of
     CHECK(m.courses[k].t - m.courses[k - 1].t ==
           Approx(0.5 * (m.courses[k].height + m.courses[k - 1].height)).epsilon(1e-12));
   CHECK(m.courses.front().height < m.courses.back().height);
+}
+
+// Session 34 (the design/knitmap audit's mutant 16): rule 5 measures a course's offset in its
+// mean stitch width; the first stitch's width in its place changed no first needle on any patch
+// of these tests (each had courses of one l, or no offset). On the sheared patch of the test
+// above graded along the courses (l = 4.5 -> 6.5 mm along u) the first needle of every course
+// is computed here from the map's own stitches: the middle of its first and last stitch
+// centres, from the middle of the patch's extent along the courses (x in [0, 60] mm), in the
+// course's mean w(l), minus half its stitch count, rounded half up, the least made needle 1.
+TEST_CASE("knitmap: first needles of a sheared graded patch follow rule 5", "[unit]") {
+  const KnitMap m = map_of("sheared_graded.json", case_text(knit_material(database(), kGradedU),
+                                                            40.0, 30.0, 0.0, 0.0, 20.0));
+  REQUIRE(m.courses.size() == 24);
+  CHECK(m.course_direction_deg == Approx(0.0).margin(1e-9));  // x along the courses
+  std::vector<long> first;
+  for (const auto& k : m.courses) {
+    const auto st = course_stitches(m, k.index);
+    REQUIRE(st.size() == std::size_t(k.stitches));
+    double wsum = 0;
+    for (const auto& s : st) wsum += w_of(s.l);
+    const double mid = 0.5 * (st.front().position.x() + st.back().position.x());
+    const double r = (mid - 30.0) / (wsum / k.stitches) - 0.5 * (k.stitches - 1);
+    first.push_back(std::lround(std::floor(r + 0.5 + 1e-6)));
+  }
+  const long least = *std::min_element(first.begin(), first.end());
+  for (const auto& k : m.courses) {
+    INFO("course " << k.index);
+    CHECK(k.first_needle == first[std::size_t(k.index - 1)] - least + 1);
+  }
+  CHECK(m.needles == 45);
+}
+
+// Session 34 (the design/knitmap audit's mutant 20): a stitch's position measured across the
+// courses from t = 0 instead of the patch's lowest point t_min passed, since every patch of
+// these tests started at t = 0. The rectangle turned by pi (x in [-40, 0], y in [-30, 0]) has
+// the course direction of the unturned one (a line: phi0 modulo pi), and so has the mirrored
+// one (y in [-30, 0]): their maps are the unturned map moved by (-40, -30) and (0, -30).
+TEST_CASE("knitmap: a turned or a mirrored patch holds the stitches of the unturned one",
+          "[unit]") {
+  const std::string l = knit_material(database(), "5.5");
+  const KnitMap m = map_of("unturned.json", case_text(l, 40.0, 30.0));
+  for (const auto& [name, beta, H, shift] :
+       {std::tuple{"turned.json", M_PI, 30.0, Eigen::Vector2d(-40, -30)},
+        std::tuple{"mirrored0.json", 0.0, -30.0, Eigen::Vector2d(0, -30)}}) {
+    INFO(name);
+    const KnitMap t = map_of(name, case_text(l, 40.0, H, beta));
+    REQUIRE(t.stitches.size() == m.stitches.size());
+    for (std::size_t i = 0; i < t.stitches.size(); ++i) {
+      INFO("stitch " << i);
+      CHECK(t.stitches[i].course == m.stitches[i].course);
+      CHECK(t.stitches[i].needle == m.stitches[i].needle);
+      CHECK((t.stitches[i].position - (m.stitches[i].position + shift)).norm() < 1e-9);
+    }
+  }
+}
+
+// Session 34 (the design/knitmap audit's mutant 24): rule 3 knits a course while its centre
+// line lies inside the patch; a course needing its whole height inside passed, since every
+// patch of these tests had H / c just under an integer plus one half. 40 x 30.5 mm at
+// l = 5.5 (c = 1.2403 mm): H / c = 24.59, so 25 courses, the last one's upper half outside.
+TEST_CASE("knitmap: a course needs only its centre line inside the patch", "[unit]") {
+  const KnitMap m = map_of("tall.json", case_text(knit_material(database(), "5.5"), 40.0, 30.5));
+  CHECK(m.courses.size() == std::size_t(std::lround(30.5 / c_of(5.5))));
+  CHECK(m.courses.size() == 25);
+  CHECK(m.courses.back().t < 30.5);
+  CHECK(m.courses.back().t + 0.5 * m.courses.back().height > 30.5);
+  CHECK(m.stitches.size() == 25 * std::size_t(std::lround(40.0 / w_of(5.5))));
+}
+
+// Session 34 (the design/knitmap audit's mutant 34): the command ignoring --angle-tolerance
+// passed (only bad values of the flag were tested). alpha linear from 0 to 6 deg over a
+// 10 x 10 mm patch: the course direction's mean is 3 deg, its spread 3 deg, beyond the default
+// 2 deg (rule 2: refused, exit 2) and within --angle-tolerance 5 (mapped, exit 0).
+TEST_CASE("knitmap: --angle-tolerance sets the course direction's tolerance", "[unit]") {
+  const std::string file = write_case(
+      "tol6.json",
+      case_text(knit_material(database(), "5.0", R"({"degrees": [1, 0], "knots_u": [0, 0, 1, 1],
+                                      "knots_v": [0, 1], "values": [0, 6], "unit": "deg"})"),
+                10, 10));
+  const auto in = load_knitmap_input(file);
+  CHECK_THROWS_AS(make_knitmap(in.c, in.cells), knit::InputError);
+  KnitMapOptions wide;
+  wide.angle_tolerance_deg = 5;
+  const KnitMap m = make_knitmap(in.c, in.cells, wide);
+  CHECK(m.course_direction_deg == Approx(3.0).margin(1e-9));
+  CHECK(m.angle_spread_deg == Approx(3.0).margin(1e-9));
+  const fs::path out = kDir / "tol6_out";
+  fs::remove_all(out);
+  CHECK(run_knitmap(file + " --output " + out.string()) == 2);
+  CHECK(!fs::exists(out));
+  CHECK(run_knitmap(file + " --output " + out.string() + " --angle-tolerance 5") == 0);
+  CHECK(fs::exists(out / "knitmap.csv"));
+  CHECK(run_knitmap(file + " --output " + (kDir / "tol6_narrow").string() +
+                    " --angle-tolerance 2.9") == 2);
+  CHECK(!fs::exists(kDir / "tol6_narrow"));
 }
