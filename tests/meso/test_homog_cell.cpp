@@ -290,3 +290,26 @@ TEST_CASE("rigid rotation of a stretched cell: S does not change (objectivity)",
     CHECK((r.S - rU.S).cwiseAbs().maxCoeff() <= 1e-6);
   }
 }
+
+// Session 34 (the rod/contact/cell audit): the wale-direction force n2 taken from the contacts
+// with the course above alone (not the mean of above and below) moved P22 by 0.5 %, and the
+// yarn-end imbalance written as |nB + nA| (2 |n1|) instead of |nB - nA|; no test saw either.
+TEST_CASE("homogenization: n2 is the mean of the forces from the courses above and below",
+          "[unit]") {
+  PeriodicCell cell(4.5, fast_options());
+  const PathResult r = run_path(cell, biaxial(0.15, 0.0, 5));
+  REQUIRE(r.completed);
+  const StepResult& s = r.steps.back();
+  Eigen::Vector3d up = Eigen::Vector3d::Zero(), down = Eigen::Vector3d::Zero();
+  for (const auto& p : cell.contacts().active_pairs(cell.system(), cell.state())) {
+    if (p.course == 1) up += p.weight * p.f;
+    if (p.course == -1) down += p.weight * p.f;
+  }
+  REQUIRE(up.norm() > 0.0);
+  REQUIRE((up + down).norm() > 1e-3 * up.norm());  // the two sides differ: the mean matters
+  CHECK((s.n2 - 0.5 * (up - down)).norm() < 1e-12 * up.norm());
+  // Periodic yarn ends carry (nearly) the same force: their imbalance |nB - nA|, the net
+  // contact load not applied (docs/unit-cell.md, imbalance_N), is a small part of n1 (0.037 N
+  // against 0.64 N here).
+  CHECK(s.imbalance < 0.1 * s.n1.norm());
+}
