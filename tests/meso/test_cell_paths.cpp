@@ -205,3 +205,24 @@ TEST_CASE("sweep cell runner: a loop length the cell cannot be built for is an i
                                     "mm (yarn diameter") &&
                         Catch::Contains("could not match the loop length"));
 }
+
+// Session 34 (the rod/contact/cell audit): without the Illinois halving of the regula falsi
+// the lateral-stress iteration of a course stretch to 1.3 in 5 steps (5, 8, 8, 7 and 3 cell
+// solves) ran out of solves at its second step (16), and no test saw it.
+TEST_CASE("uniaxial path: a course stretch to 1.3 in 5 steps needs at most 10 solves a step",
+          "[unit]") {
+  homog::PeriodicCell cell(4.5, fast_options());
+  REQUIRE(cell.equilibrate().converged);
+  homog::UniaxialState st;
+  const homog::UniaxialOptions uo;
+  int total = 0;
+  for (int k = 1; k <= 5; ++k) {
+    const homog::UniaxialStep s = homog::solve_uniaxial_step(cell, 0, 1.0 + 0.06 * k, st, uo);
+    INFO("step " << k << ": " << s.solves << " solves, " << s.step.message);
+    REQUIRE(s.step.converged);
+    CHECK(s.solves <= 10);
+    CHECK(std::abs(s.lateral_stress) <= uo.tol);
+    total += s.solves;
+  }
+  CHECK(total <= 35);
+}
