@@ -76,6 +76,10 @@ TEST_CASE("analysis curve: periodic ends, length l", "[unit]") {
   const auto dim = cell_dimensions(4.5);
   const auto a = analysis_curve(dim, 16);
   CHECK(std::abs(a.length - 4.5) < 1e-10);
+  // 16 quartic elements: 20 control points (session 34, the audit: 19 passed every test but
+  // two pinned to one cell run's rounding).
+  CHECK(a.curve.basis().degree() == 4);
+  CHECK(a.curve.basis().size() == 20);
   Eigen::Vector3d d = a.curve.eval(1.0) - a.curve.eval(0.0);
   CHECK(std::abs(d.x() - dim.w) < 1e-13);
   CHECK(std::abs(d.y()) < 1e-13);
@@ -106,6 +110,17 @@ TEST_CASE("interlocking: crossing order with the next course and clearance", "[u
     const auto cl = minimum_clearance(g.shape, g.dim.c);
     CHECK(cl.min_distance > 0.15);  // overlaps exist but are moderate (notes: 0.22 mm at 4.5)
     CHECK(cl.min_distance < 0.38);
+    // The minimum is a stationary point of the distance (session 34, the rod/contact/cell
+    // audit: a sign error in the Newton refinement's Hessian fell back to the 400-point grid,
+    // 4e-5 mm off, and passed): r = x(s_self) - x(s_other) - (i w, j c) is normal to both
+    // tangents, |r| the distance reported.
+    const Eigen::Vector3d shift(cl.shift_i * g.dim.w, cl.shift_j * g.dim.c, 0.0);
+    const Eigen::Vector3d r = g.shape.point(cl.s_self) - g.shape.point(cl.s_other) - shift;
+    const Eigen::Vector3d a = g.shape.point(cl.s_self, 1), b = g.shape.point(cl.s_other, 1);
+    CHECK(r.norm() == Approx(cl.min_distance).epsilon(1e-12));
+    CHECK(std::abs(r.dot(a)) < 1e-9 * r.norm() * a.norm());
+    CHECK(std::abs(r.dot(b)) < 1e-9 * r.norm() * b.norm());
+    CHECK(cl.clearance == cl.min_distance - g.shape.d);
   }
 }
 
