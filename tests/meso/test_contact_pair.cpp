@@ -72,6 +72,17 @@ void finite_differences(const Fixture& F, const Vector3d& xs, const Projection& 
   }
 }
 
+/// The contact options of the straight-yarn friction tests: no reference pairs, a linear
+/// penalty p = k_N (d - c - delta/2) without g0, mu = 0.15, k_T = 20, d = 0.38.
+ContactOptions straight_yarn_contact() {
+  ContactOptions opt;
+  opt.reference = ContactOptions::Reference::kNone;
+  opt.penalty = PenaltyLaw{100.0, 0.1, 0.0, 0.0, 0.02};
+  opt.friction = FrictionLaw{0.15, 20.0};
+  opt.d = 0.38;
+  return opt;
+}
+
 }  // namespace
 
 TEST_CASE("penalty law: continuity, derivative and energy", "[unit]") {
@@ -330,11 +341,7 @@ TEST_CASE("contact set: friction work of a slip between neighbouring courses in 
   knit::meso::rod::RodSystem sys;
   sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
   const Eigen::VectorXd x = sys.initial_state();
-  ContactOptions opt;
-  opt.reference = ContactOptions::Reference::kNone;
-  opt.penalty = PenaltyLaw{100.0, 0.1, 0.0, 0.0, 0.02};  // p = k_N (d - c - delta/2), no g0
-  opt.friction = FrictionLaw{0.15, 20.0};
-  opt.d = 0.38;
+  const ContactOptions opt = straight_yarn_contact();
   ContactSet cs(sys, 0, opt);
   const Vector3d a1(w, 0, 0);
   cs.set_periods(a1, Vector3d(0, c, 0));
@@ -368,11 +375,7 @@ TEST_CASE("contact set: the friction moment of a slip acts on both yarns with on
   knit::meso::rod::RodSystem sys;
   sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
   const Eigen::VectorXd x = sys.initial_state();
-  ContactOptions opt;
-  opt.reference = ContactOptions::Reference::kNone;
-  opt.penalty = PenaltyLaw{100.0, 0.1, 0.0, 0.0, 0.02};
-  opt.friction = FrictionLaw{0.15, 20.0};
-  opt.d = 0.38;
+  const ContactOptions opt = straight_yarn_contact();
   ContactSet cs(sys, 0, opt);
   cs.set_periods(Vector3d(w, 0, 0), Vector3d(0, c, 0));
   cs.commit(sys, x);
