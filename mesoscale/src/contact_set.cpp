@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "knit/spline/knot_vector.hpp"
 #include "knit/spline/quadrature.hpp"
@@ -13,6 +15,14 @@ namespace knit::meso::contact {
 
 ContactSet::ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions& opt)
     : rod_(rod), opt_(opt), basis_(sys.spec(rod).basis) {
+  // The slave points and the masters use the plain B-spline basis: a rational (NURBS) rod
+  // would get its contact loads at the wrong places, silently (the rod/contact/cell audit,
+  // session 34; the unit cell's yarn is not rational).
+  const Eigen::VectorXd& wts = sys.spec(rod).weights;
+  if (wts.size() > 0 && (wts.array() != 1.0).any())
+    throw std::invalid_argument(
+        "ContactSet: rod " + std::to_string(rod) +
+        " is rational (NURBS weights); contact supports B-spline rods only");
   const int n = basis_.size(), p = basis_.degree();
   const auto rule =
       spline::gauss_legendre_on_spans(std::max(1, opt_.slave_points_per_element), basis_.knots());

@@ -395,3 +395,22 @@ TEST_CASE("contact set: the friction moment of a slip acts on both yarns with on
   CHECK(M.head<2>().norm() < 1e-12 * full);
   CHECK(N.norm() < 1e-12 * full);
 }
+
+// Session 34 (the rod/contact/cell audit): the contact set evaluates the plain B-spline basis,
+// so a rational rod would get its loads at the wrong places; it is refused.
+TEST_CASE("contact set: a rational (NURBS) rod is refused, unit weights are not rational",
+          "[unit]") {
+  knit::meso::rod::RodSpec s =
+      knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(2.0, 0, 0), 4, 8);
+  s.weights = Eigen::VectorXd::Ones(s.basis.size());
+  {
+    knit::meso::rod::RodSystem sys;
+    sys.add_rod(s);
+    CHECK_NOTHROW(ContactSet(sys, 0, straight_yarn_contact()));
+  }
+  s.weights(3) = 1.5;
+  knit::meso::rod::RodSystem sys;
+  sys.add_rod(s);
+  CHECK_THROWS_WITH(ContactSet(sys, 0, straight_yarn_contact()),
+                    Catch::Contains("rational") && Catch::Contains("B-spline rods only"));
+}
