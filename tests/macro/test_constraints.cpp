@@ -41,3 +41,36 @@ TEST_CASE("DOF map: a tied group prescribed two values is refused, naming a DOF"
   CHECK_THROWS_WITH(DofMap(c), Catch::Contains("is tied to a DOF with a different prescribed "
                                                "value"));
 }
+
+// Session 34 (the design audit's mutant 101): one DOF prescribed two different values is
+// refused as soon as the second comes (Constraints::prescribe), the same value twice is not;
+// with that check off the second value silently replaced the first.
+TEST_CASE("constraints: one DOF prescribed two different values is refused", "[unit]") {
+  Constraints c(3);
+  c.prescribe(0, 1.0);
+  CHECK_NOTHROW(c.prescribe(0, 1.0));
+  CHECK_THROWS_AS(c.prescribe(0, 2.0), ConstraintConflict);
+  CHECK_THROWS_WITH(c.prescribe(0, 2.0), Catch::Contains("DOF 0 (control point 0, component x) "
+                                                         "is prescribed twice"));
+}
+
+// Session 34 (the design audit's mutant 107): ties count as supports in the rigid-mode check
+// (a tie u_a = u_b removes the modes that move a and b differently; a clamped edge is such
+// ties). Two fixed points on the x axis leave the rotation about it, which moves each point
+// along z by its y; tying the z of two free points at y = 1 and y = 2 removes it. Without the
+// tie rows the check reported that rotation although the ties hold it.
+TEST_CASE("DofMap: a tie between two free DOFs removes the rigid mode that separates them",
+          "[unit]") {
+  Eigen::MatrixXd X(4, 3);
+  X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 2, 0;
+  Constraints c(12);
+  for (int d = 0; d < 6; ++d) c.fix(d);  // points 0 and 1, all components
+  {
+    const auto mode = DofMap(c).unconstrained_rigid_mode(X);
+    REQUIRE(mode.has_value());
+    CHECK_THAT(*mode, Catch::StartsWith("rotation about the direction (1, 0, 0)") ||
+                          Catch::StartsWith("rotation about the direction (-1, 0, 0)"));
+  }
+  c.tie(3 * 2 + 2, 3 * 3 + 2);  // z of points 2 and 3
+  CHECK_FALSE(DofMap(c).unconstrained_rigid_mode(X).has_value());
+}

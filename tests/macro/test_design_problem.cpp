@@ -2,8 +2,10 @@
 // variable outside the field, bounds outside the database's range and an empty objective list
 // are JSON-pointer errors, and `knit-macro design` exits with 2 for them.
 #include <catch2/catch.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -24,6 +26,11 @@ const knit::testing::RemoveAtExit kRemoveDir{kDir};
 void write(const fs::path& f, const std::string& text) {
   fs::create_directories(f.parent_path());
   std::ofstream(f) << text;
+}
+
+std::string problem_file_text(const fs::path& f) {
+  std::ifstream in(f);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
 /// A wale-wise tensile case with a designable l field (two control values across u).
@@ -83,6 +90,10 @@ TEST_CASE("design file: a valid file loads", "[unit]") {
   CHECK(d.objectives[0].kind == DesignObjective::Kind::kReaction);
   CHECK(d.objectives[0].reaction == 0);
   CHECK(d.objectives[1].component == 1);
+  // Session 34 (the design audit's mutant 83): a strain term without `samples` samples an 11 x
+  // 11 grid of its region (docs/design.md; 10 across u survived).
+  CHECK(d.objectives[1].samples_u == 11);
+  CHECK(d.objectives[1].samples_v == 11);
   CHECK(d.objectives[2].point == 0);
   CHECK(d.smoothness == 0.01);
   CHECK(run_design(kDir / "ok.json") == 0);
@@ -120,28 +131,28 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
     write(f, text);
     try {
       (void)load_design(f.string());
-      FAIL("no error");
+      FAIL_CHECK("no error");
     } catch (const knit::InputError& e) {
       CHECK(e.file() == f.string());
       CHECK(e.pointer() == ptr);
     }
     CHECK(run_design(f) == 2);
   };
+  // A design of one variable, control values `indices` of `field` in [lower, upper].
+  auto one_variable = [](const std::string& field, const std::string& indices,
+                         const std::string& lower, const std::string& upper) {
+    return design(R"([{"field": ")" + field + R"(", "indices": )" + indices + R"(, "lower": )" +
+                      lower + R"(, "upper": )" + upper + "}]",
+                  kObjs);
+  };
   expect("unknown_objective.json",
          design(kVars, R"([{"type": "stiffness", "at_strain": [0.1], "target": [1]}])"),
          "/objectives/0/type");
-  expect(
-      "outside_field.json",
-      design(R"([{"field": "stitch_value", "indices": [2], "lower": 4.5, "upper": 6.5}])", kObjs),
-      "/variables/0/indices/0");
-  expect(
-      "bounds.json",
-      design(R"([{"field": "stitch_value", "indices": [0], "lower": 4.0, "upper": 6.5}])", kObjs),
-      "/variables/0/lower");
-  expect(
-      "angle_bounds.json",
-      design(R"([{"field": "knitting_angle", "indices": [0], "lower": -10, "upper": 200}])", kObjs),
-      "/variables/0/upper");
+  expect("outside_field.json", one_variable("stitch_value", "[2]", "4.5", "6.5"),
+         "/variables/0/indices/0");
+  expect("bounds.json", one_variable("stitch_value", "[0]", "4.0", "6.5"), "/variables/0/lower");
+  expect("angle_bounds.json", one_variable("knitting_angle", "[0]", "-10", "200"),
+         "/variables/0/upper");
   expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
   // A case file that is not there (session 29: the message named only the case's path).
   {
@@ -176,6 +187,34 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
                     {"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}])",
                 kObjs),
          "/variables/1/indices");
+  // Session 34 (the design audit's mutants 76 to 82): each check of the loader, off alone,
+  // survived (`--check` exited 0): equal bounds, an upper bound beyond the database's 6.5, an
+  // angle bound below -180 deg, tied control values that differ in the case (5.0 and 5.6 in
+  // a copy of it), a start outside the bounds, a linearity term whose strains do not end at
+  // the largest, or with one strain.
+  expect("equal_bounds.json", one_variable("stitch_value", "[0]", "5.0", "5.0"),
+         "/variables/0/upper");
+  expect("upper_bound.json", one_variable("stitch_value", "[0]", "4.5", "7.0"),
+         "/variables/0/upper");
+  expect("angle_lower.json", one_variable("knitting_angle", "[0]", "-200", "45"),
+         "/variables/0/lower");
+  {
+    std::string c = problem_file_text(kDir / "case.json");
+    c.replace(c.find("[5.0, 5.0]"), 10, "[5.0, 5.6]");
+    write(kDir / "case_untied.json", c);
+    std::string t = one_variable("stitch_value", "[0, 1]", "4.5", "6.5");
+    t.replace(t.find("case.json"), 9, "case_untied.json");
+    expect("tied_unequal.json", t, "/variables/0/indices");
+  }
+  expect("start_outside.json", one_variable("stitch_value", "[0]", "5.5", "6.5"), "/variables/0");
+  expect("linearity_tied_strains.json",
+         design(kVars, R"([{"type": "reaction_linearity", "reaction": "fy",
+                            "at_strain": [0.2, 0.2]}])"),
+         "/objectives/0/at_strain/0");
+  expect("linearity_one_strain.json",
+         design(kVars, R"([{"type": "reaction_linearity", "reaction": "fy",
+                            "at_strain": [0.2]}])"),
+         "/objectives/0/at_strain");
   expect("function_tolerance.json",
          R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
              R"(, "optimizer": {"function_tolerance": 0}})",
@@ -439,6 +478,9 @@ TEST_CASE("design: the final run names its case by the committed path", "[unit]"
                           (kDir / "prov.log").string() + " 2>&1";
   const int st = std::system(cmd.c_str());
   REQUIRE(WIFEXITED(st));
+  // Session 34 (the design audit's mutant 98): one iteration does not meet these targets: the
+  // iteration limit, exit 1 (docs/design.md), with every output written.
+  CHECK(WEXITSTATUS(st) == 1);
   REQUIRE(fs::exists(out / "run" / "load_strain.csv"));
   std::ifstream in(out / "run" / "load_strain.csv");
   std::string first;
@@ -446,4 +488,38 @@ TEST_CASE("design: the final run names its case by the committed path", "[unit]"
   CHECK(first.rfind("# knit-macro results of " + (out / "case.json").string() + " (", 0) == 0);
   CHECK(first.find(".partial-") == std::string::npos);
   fs::remove_all(out);
+}
+
+// Session 34 (the design audit's mutant 85): case.json names the database by its absolute
+// path (docs/design.md), so that it runs wherever it is written: a case that names it relative
+// to itself, designed into a directory two levels below the case's, left it relative (the
+// final run did not find it).
+TEST_CASE("design: case.json names a relative database by its absolute path", "[unit]") {
+  write_case();
+  std::string c = problem_file_text(kDir / "case.json");
+  const auto key = c.find("\"database\": \"") + 13;
+  const auto end = c.find('"', key);
+  const fs::path db = c.substr(key, end - key);
+  REQUIRE(db.is_absolute());
+  const std::string rel = fs::relative(db, kDir).string();
+  c.replace(key, end - key, rel);
+  write(kDir / "case_relative.json", c);
+  write(kDir / "relative.json",
+        R"({"case": "case_relative.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                            "target": [0]}]})");
+  const fs::path out = kDir / "relative_out" / "deeper" / "design";
+  fs::remove_all(kDir / "relative_out");
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
+                          (kDir / "relative.json").string() + " -o " + out.string() + " > " +
+                          (kDir / "relative.log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));  // l on its upper bound: infeasible target
+  REQUIRE(fs::exists(out / "case.json"));
+  const std::string w = problem_file_text(out / "case.json");
+  INFO(w);
+  CHECK(w.find("\"database\": \"" + db.lexically_normal().string() + "\"") != std::string::npos);
+  CHECK(fs::exists(out / "run" / "load_strain.csv"));  // the final run found it
+  fs::remove_all(kDir / "relative_out");
 }
