@@ -308,6 +308,29 @@ TEST_CASE("a missing support is reported as such, not as NaNs", "[unit]") {
                 0) == 0);
 }
 
+// Session 34 (the design audit's mutant 107): a clamp (the edge's next row of control points
+// tied to it) counts as a support in the rigid-mode check. A 20 x 10 mm strip held in x and y
+// along u0 and in z at its two u1 corners can still turn about the line through those corners
+// (direction y): u0 moves in z. Clamping u0 holds it. With the ties left out of the check the
+// clamped strip was refused as free to turn.
+TEST_CASE("a clamped edge holds the rotation that its supports alone leave", "[unit]") {
+  json j = json::parse(R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1],
+      "knots_v": [0, 0, 1, 1], "control_points": [[0, 0, 0], [20, 0, 0], [0, 10, 0], [20, 10, 0]],
+      "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [2, 1]},
+    "material": {"type": "saint_venant_kirchhoff", "youngs_modulus": 100.0, "poisson_ratio": 0.3},
+    "boundary_conditions": [{"edge": "u0", "fix": ["x", "y"], "clamp": true},
+      {"corner": "u1v0", "fix": ["z"]}, {"corner": "u1v1", "fix": ["z"]}],
+    "loads": [{"type": "edge", "edge": "u1", "force_per_length": [0, 0, 0.001]}],
+    "solver": {"steps": 1}, "output": {"vtk": false, "hdf5": false}})");
+  CHECK(error_of(j).empty());
+  j["boundary_conditions"][0].erase("clamp");
+  CHECK(error_of(j).rfind("bad.json: /boundary_conditions: missing support: the boundary "
+                          "conditions do not prevent a rigid-body rotation about the direction "
+                          "(0, 1, 0)",
+                          0) == 0);
+}
+
 TEST_CASE("a degenerate geometry is reported with where it is", "[unit]") {
   json j = verification_case("tensile_svk.json");
   j["geometry"]["control_points"] = {{0, 0, 0}, {50, 0, 0}, {0, 0, 0}, {50, 0, 0}};  // zero height
