@@ -370,6 +370,45 @@ TEST_CASE("design optimizer (projected gradient): steps double and the tolerance
   CHECK(l.status == DesignStatus::kTargetNotMet);
 }
 
+// Session 34 (the design audit's mutant 87): the projected gradient accepts a step only if it
+// lowers J by at least 1e-4 of the directional derivative, J(x + dx) <= J + 1e-4 g.dx
+// (Armijo; design_problem.hpp), g.dx < 0; with the sign flipped a step that raises J by less
+// than 1e-4 |g.dx| was accepted, and no test had such a step. One variable l from 6.0 and
+// one reaction at 20 %: the first trial is 10 % of the interval, to 5.8. A target just below
+// the midpoint of the loads R(6.0) and R(5.8) makes that trial raise J by 0.5e-4 |g.dx| (J is
+// (R - T)^2: J(5.8) - J(6.0) = (R(5.8) - R(6.0)) (R(5.8) + R(6.0) - 2T)); it is rejected and
+// the halved step, to 5.9, near the target's l, is taken.
+TEST_CASE("design optimizer (projected gradient): a step that raises J is rejected", "[unit]") {
+  write_case();
+  write(kDir / "armijo.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                            "target": [0]}],
+            "optimizer": {"method": "projected_gradient", "max_iterations": 1}})");
+  DesignProblem d = load_design((kDir / "armijo.json").string());
+  d.variables[0].initial = 6.0;
+  // At target 0 the residual is R and its Jacobian dR/dl.
+  const DesignEvaluation e0 = evaluate_design(d, {6.0}), e1 = evaluate_design(d, {5.8}, false);
+  REQUIRE(e0.status == RunStatus::kCompleted);
+  REQUIRE(e1.status == RunStatus::kCompleted);
+  const double R0 = e0.residuals(0), R1 = e1.residuals(0), dR = e0.jacobian(0, 0);
+  const double mid = 0.5 * (R0 + R1), g = 2.0 * (R0 - mid) * dR;  // g > 0: l decreases
+  const double rise = 0.5e-4 * 0.2 * g;                           // 0.5e-4 |g.dx|, dx = -0.2
+  d.objectives[0].target = {mid - rise / (2.0 * (R1 - R0))};
+  // The trial's rise lies inside (0, 1e-4 |g.dx|) with the target's own g.
+  const DesignEvaluation t0 = evaluate_design(d, {6.0}), t1 = evaluate_design(d, {5.8}, false);
+  REQUIRE(t0.gradient(0) > 0.0);
+  INFO("J(6.0) " << t0.J << ", J(5.8) - J(6.0) = " << t1.J - t0.J
+                 << ", 1e-4 |g.dx| = " << 1e-4 * 0.2 * t0.gradient(0));
+  CHECK(t1.J > t0.J);
+  CHECK(t1.J - t0.J < 1e-4 * 0.2 * t0.gradient(0));
+  const DesignResult r = optimize_design(d);
+  REQUIRE(r.history.size() == 2);
+  CHECK(r.history[1].x[0] == Approx(5.9).epsilon(1e-12));
+  CHECK(r.history[1].J < r.history[0].J);
+}
+
 // The smoothness penalty is a regularization: a design that meets its targets with J > 0 from
 // the penalty alone is "converged" (review of session 26).
 namespace {

@@ -585,6 +585,39 @@ TEST_CASE("design optimizer: max_iterations 1 ends at the iteration limit", "[un
   }
 }
 
+// Session 34 (the design audit's mutant 88): the projected gradient that finds no descent step
+// (30 trials, each half the last, all rejected) stops there with the best design kept: a
+// stop, classified as such (here "target not met"), not the iteration limit, which it was
+// with that stop not counted. The trials' sizes only go below the x tolerance of 1e-6 after
+// 17 halvings, so the test sets it to 0 (OptimizeOptions). One variable l_1 from 5.6, a
+// reaction target T = R(5.6) + eps just off its load: J = (R - T)^2 falls only for steps
+// with |dR| <= 2 eps (1 - 1e-4) (Armijo), and eps is a quarter of |dR/dl| times the smallest
+// trial, 0.1 x 2^-29 of the interval 2 mm.
+TEST_CASE("design optimizer (projected gradient): no descent step found is a stop", "[unit]") {
+  const std::string c = write_case(false);
+  DesignProblem d = problem(c, "no_descent.json", R"([{"type": "reaction", "reaction": "fy",
+      "at_strain": [0.2], "target": [0]}])",
+                            0.0,
+                            R"([{"field": "stitch_value", "indices": [1], "lower": 4.5,
+                                 "upper": 6.5}])");
+  d.optimizer.method = DesignOptimizerSpec::Method::kProjectedGradient;
+  d.optimizer.max_iterations = 5;
+  const DesignEvaluation e = evaluate_design(d, {5.6});  // at target 0: R and dR/dl
+  REQUIRE(e.status == RunStatus::kCompleted);
+  const double smallest = 0.1 * std::ldexp(1.0, -29) * 2.0;
+  const double eps = 0.25 * std::abs(e.jacobian(0, 0)) * smallest;
+  d.objectives[0].target = {e.residuals(0) + eps};
+  OptimizeOptions opt;
+  opt.x_tolerance = 0.0;
+  const DesignResult r = optimize_design(d, opt);
+  INFO("status " << to_string(r.status) << ", " << r.message << ", J " << r.J0 << " -> " << r.J
+                 << ", evaluations " << r.evaluations);
+  CHECK(r.evaluations == 1 + 30);
+  CHECK(r.x == std::vector<double>{5.6});
+  CHECK(r.message.find("no descent step found") != std::string::npos);
+  CHECK(r.status == DesignStatus::kTargetNotMet);
+}
+
 // Session 34 (the design audit's mutant 92): Ceres keeps the upper bounds (the existing test
 // of an infeasible target reaches the lower ones). No load at all (target 0 N) asks for the
 // softest patch, l as long as possible: with bounds at 6.4, inside the database's 6.5, every
