@@ -420,3 +420,44 @@ TEST_CASE("rod: a force on a free start end deflects it by P L^3 / (3 EI) + P L 
   CHECK(start.r.z() == Approx(P * L * L * L / (3.0 * EI) + P * L / GAs).epsilon(1e-4));
   CHECK((start.n - Vector3d(0, 0, -P)).norm() < 1e-8 * P);
 }
+
+// Session 34 (the rod audit): the row weights make the residual dimensionless for Newton's
+// convergence test (docs/rod.md); a curvature row weighted 1 instead of L (L times looser)
+// survived every test. The same rod and state in mm and in m (lengths / 1000, E and line
+// forces * 1e6 and 1e3, moments / 1000, forces unchanged) must give the same scaled residual.
+TEST_CASE("rod: the scaled residual does not depend on the length unit", "[unit]") {
+  const double k = 1e-3;  // mm -> m
+  Section mm;
+  Section m = mm;
+  m.E = mm.E / (k * k);
+  m.d = mm.d * k;
+  const auto scaled_residual = [](const Section& sec, double unit) {
+    RodSystem sys;
+    RodSpec s = straight_rod(Vector3d::Zero(), Vector3d(10.0 * unit, 0, 0), 4, 6, sec);
+    s.end.force = Vector3d(0.01, 0.02, -0.03);          // N
+    s.end.moment = Vector3d(0.05, -0.02, 0.04) * unit;  // N mm -> N m
+    s.line_force = Vector3d(1e-3, -2e-3, 3e-3) / unit;  // N/mm -> N/m
+    s.line_moment = Vector3d(2e-3, 1e-3, -1e-3);        // N mm/mm = N
+    sys.add_rod(s);
+    Eigen::VectorXd x = sys.initial_state();
+    // A state away from equilibrium in every field, the same in both units.
+    for (int a = 0; a < s.basis.size(); ++a) {
+      const double t = 0.37 * a + 0.2;
+      x.segment<3>(sys.dof(0, a, kFieldR)) +=
+          unit * Vector3d(0.1 * t, -0.05 * t * t, 0.2 * std::sin(t));
+      x.segment<4>(sys.dof(0, a, kFieldQ)) += Eigen::Vector4d(0.01 * t, 0.02, -0.03 * t, 0.01);
+      x.segment<3>(sys.dof(0, a, kFieldN)) += Vector3d(0.3 * t, -0.2, 0.1 * t * t);
+      x.segment<3>(sys.dof(0, a, kFieldM)) += unit * Vector3d(-0.1, 0.2 * t, 0.05);
+    }
+    Eigen::VectorXd F;
+    sys.residual(x, 0.7, F);
+    return Eigen::VectorXd(F.cwiseProduct(sys.row_scales()));
+  };
+  const Eigen::VectorXd a = scaled_residual(mm, 1.0), b = scaled_residual(m, k);
+  REQUIRE(a.size() == b.size());
+  REQUIRE(a.norm() > 0.0);
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    INFO("row " << i);
+    CHECK(b(i) == Approx(a(i)).epsilon(1e-9).margin(1e-12 * a.norm()));
+  }
+}
