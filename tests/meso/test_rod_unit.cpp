@@ -461,3 +461,23 @@ TEST_CASE("rod: the scaled residual does not depend on the length unit", "[unit]
     CHECK(b(i) == Approx(a(i)).epsilon(1e-9).margin(1e-12 * a.norm()));
   }
 }
+
+// Session 34 (the rod audit): the reference frame is rotation-minimizing (parallel transported,
+// docs/rod.md): its directors do not twist about the tangent. A sign error in the transport
+// added a smooth twist that the circular section's stiffnesses cannot see; only the d1
+// director of the output moved.
+TEST_CASE("rod: the reference frame of a helix does not twist about its tangent", "[unit]") {
+  RodSystem sys;
+  sys.add_rod(helix_rod(4, 24));
+  const Eigen::VectorXd x = sys.initial_state();
+  double twist = 0.0, bend = 0.0;
+  for (int i = 0; i <= 200; ++i) {
+    const PointState s = sys.state(0, i / 200.0, x);
+    const Vector3d K = material_curvature(s.q, s.q_xi) / s.jac;
+    twist = std::max(twist, std::abs(K(2)));
+    bend = std::max(bend, K.head<2>().norm());
+  }
+  INFO("largest twist " << twist << " 1/mm, bending curvature " << bend << " 1/mm");
+  CHECK(bend > 0.1);
+  CHECK(twist < 1e-4 * bend);
+}
