@@ -481,3 +481,23 @@ TEST_CASE("rod: the reference frame of a helix does not twist about its tangent"
   CHECK(bend > 0.1);
   CHECK(twist < 1e-4 * bend);
 }
+
+// Session 34 (the rod audit): Newton stops as "diverged" once the scaled residual exceeds
+// divergence_factor times the initial one; without the check it ran on to its iteration limit
+// and said so. The rolled-up cantilever in one step from the straight rod: the residual first
+// rises (history[1] > history[0]), so a factor 1 stops it there, at iteration 1.
+TEST_CASE("rod: Newton stops as diverged when the residual rises past the factor", "[unit]") {
+  RodSystem sys;
+  add_rolled_cantilever(sys);
+  Eigen::VectorXd x = sys.initial_state();
+  NewtonOptions o;
+  const NewtonReport free_run = solve_newton(sys, x, 1.0, {}, o);
+  REQUIRE(free_run.history.size() > 2);
+  REQUIRE(free_run.history[1] > free_run.history[0]);
+  x = sys.initial_state();
+  o.divergence_factor = 1.0;
+  const NewtonReport stopped = solve_newton(sys, x, 1.0, {}, o);
+  CHECK_FALSE(stopped.converged);
+  CHECK(stopped.message == "diverged");
+  CHECK(stopped.iterations == 1);
+}
