@@ -994,10 +994,15 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
   // file is complete on disk when close() returns and its structure checksum is final.
   H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG);
   if (mode == Mode::Truncate) {
+    errno = 0;
     file_id_ = H5Handle(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
+    // The system's reason when HDF5 leaves one (session 34: a full disk was reported as
+    // "directory missing or not writable?").
     if (!file_id_.valid())
-      throw std::runtime_error(name +
-                               ": cannot create HDF5 file (directory missing or not writable?)");
+      throw std::runtime_error(
+          name + ": cannot create HDF5 file (" +
+          (errno != 0 ? std::string(std::strerror(errno)) : "directory missing or not writable?") +
+          ")");
   } else {
     // Regular files only (a FIFO or a device is refused before HDF5 touches it); the
     // structure checksum before HDF5 parses anything.

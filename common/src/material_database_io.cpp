@@ -201,10 +201,12 @@ void write_database(const std::filesystem::path& file, const Database& db,
     if (db.energy_law) detail::write_energy_law(f, *db.energy_law, db.energy_diagnostics);
     if (extra) extra(f);
     f.close();
+    // In the try too: a failed fsync or rename of the commit leaves the earlier file as well,
+    // and says so (session 34: "db.h5: fsync failed", no word of the earlier file).
+    out.commit();
   } catch (const std::exception& e) {
     throw database_not_written(file, existed, out.temp_path(), e);
   }
-  out.commit();
 }
 
 std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File& to,
@@ -233,7 +235,7 @@ std::runtime_error database_not_written(const std::filesystem::path& target, boo
                                         const std::exception& e) {
   // The writer's messages name the temporary file, which AtomicFile removes: name the target
   // and say what became of it (session 22: a full file system named only the temporary).
-  std::string why = strip_file(e.what(), temp.string());
+  std::string why = strip_file(strip_file(e.what(), temp.string()), target.string());
   for (const char* inner : {"database not written (no file was created): ",
                             "database not written (the earlier file is left as it was): "})
     if (why.rfind(inner, 0) == 0) why = why.substr(std::string(inner).size());

@@ -161,3 +161,56 @@ TEST_CASE("knit-meso path: a killed run leaves the previous output as it was", "
   CHECK(fs::exists(live));
   fs::remove_all(d);
 }
+
+// Session 34: a full disk or a failing fsync, made by a shim preloaded into knit-meso
+// (tests/support/fail_io_shim.c), on the database (a single file, written atomically) and on a
+// path's directory: exit 1, the earlier output unchanged, nothing left beside it, and the
+// system's reason in the message (a database that could not be created said "directory
+// missing or not writable?" on a full disk).
+TEST_CASE("knit-meso: a write or fsync that fails leaves the earlier database and path output",
+          "[unit][outputs]") {
+  const fs::path d = knit_test::scratch("meso_outputs_fail_io");
+  const auto failing = [&](const std::string& env, const std::string& args) {
+    return knit_test::run_command("env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
+                                  " ASAN_OPTIONS=verify_asan_link_order=0 " + env + " " + kExe +
+                                  " " + args);
+  };
+  const auto nothing_beside = [&](const std::string& name) {
+    for (const auto& e : fs::directory_iterator(d)) {
+      const std::string f = e.path().filename().string();
+      INFO(f);
+      CHECK((f == name || f.rfind(name + ".", 0) != 0));
+      CHECK(f.rfind("." + name + ".tmp", 0) != 0);
+    }
+  };
+  const fs::path db = d / "db.h5";
+  const std::string synth = "synth --no-coverage --loop-lengths 4.5,6.5 --out " + db.string();
+  REQUIRE(failing("", synth).rc == 0);  // the shim changes nothing unless asked
+  const std::string before = knit_test::read_text(db);
+  for (const std::string env : {"KNIT_FAIL_WRITE=.db.h5.tmp", "KNIT_FAIL_FSYNC=.db.h5.tmp"}) {
+    const auto r = failing(env, synth);
+    INFO(env << ": " << r.output);
+    CHECK(r.rc == 1);
+    CHECK(r.output.find("database not written (the earlier file is left as it was)") !=
+          std::string::npos);
+    CHECK((r.output.find("No space left on device") != std::string::npos ||
+           r.output.find("Input/output error") != std::string::npos));
+    CHECK(knit_test::read_text(db) == before);
+    nothing_beside("db.h5");
+  }
+  const fs::path out = d / "p";
+  const std::string path =
+      "path --loop-length 4.5 --shear 10 --steps 2 --elements 16 --out " + out.string();
+  REQUIRE(meso(path).rc == 0);
+  const std::string csv = knit_test::read_text(out / "path.csv");
+  for (const std::string env : {"KNIT_FAIL_WRITE=path.csv", "KNIT_FAIL_FSYNC=path.csv",
+                                "KNIT_FAIL_WRITE=yarn_0001.vtp", "KNIT_FAIL_FSYNC=yarn_0002.vtp"}) {
+    const auto r = failing(env, path);
+    INFO(env << ": " << r.output);
+    CHECK(r.rc == 1);
+    CHECK(r.output.find("outputs not written (the earlier outputs are left as they were)") !=
+          std::string::npos);
+    CHECK(knit_test::read_text(out / "path.csv") == csv);
+    nothing_beside("p");
+  }
+}
