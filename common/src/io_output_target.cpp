@@ -15,6 +15,7 @@
 #include <cstring>
 #include <fstream>
 #include <set>
+#include <stdexcept>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -268,14 +269,18 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
   // found by review.) A lock file unlinked by its releasing holder between our open() and
   // flock() is not the lock any more: retry on the new file (checked by comparing inodes).
   const std::string me = kLockTag + std::to_string(::getpid()) + "\n";
+  // A full or failing disk is no bad input: exit code 1, not 2 (session 34, found with the
+  // test shim that makes the disk full).
   const auto cannot = [&](const std::string& what, int err) {
-    return InputError(out, "", what + " " + file_.string() + " (" + std::strerror(err) + ")");
+    const std::string msg = what + " " + file_.string() + " (" + std::strerror(err) + ")";
+    if (err == ENOSPC || err == EDQUOT || err == EIO) throw std::runtime_error(out + ": " + msg);
+    throw InputError(out, "", msg);
   };
   for (int attempt = 0; attempt < 20; ++attempt) {
     // 1. A new lock: tagged and locked under a private name, then linked into place.
     std::string tmpl = file_.string() + ".new-XXXXXX";
     int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
-    if (fd < 0) throw cannot("cannot create the lock file", errno);
+    if (fd < 0) cannot("cannot create the lock file", errno);
     ::fchmod(fd, 0644);
     const bool tagged = ::pwrite(fd, me.data(), me.size(), 0) == static_cast<ssize_t>(me.size());
     if (tagged && ::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::link(tmpl.c_str(), file_.c_str()) == 0) {
@@ -286,12 +291,12 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
     const int err = errno;
     ::unlink(tmpl.c_str());
     ::close(fd);
-    if (!tagged || err != EEXIST) throw cannot("cannot create the lock file", err);
+    if (!tagged || err != EEXIST) cannot("cannot create the lock file", err);
     // 2. There is one: a held lock (refused), a stale one of a killed process (taken over), or
     // not a knitscale lock file (refused, untouched).
     fd = ::open(file_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
     if (fd < 0 && errno == ENOENT) continue;  // released in between: again
-    if (fd < 0) throw cannot("cannot open the lock file", errno);
+    if (fd < 0) cannot("cannot open the lock file", errno);
     struct stat a {};
     const std::string have = read_small(fd);
     if (::fstat(fd, &a) != 0 || !S_ISREG(a.st_mode) || have.rfind(kLockTag, 0) != 0) {
@@ -304,7 +309,7 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
       const int e = errno;
       ::close(fd);
-      if (e != EWOULDBLOCK) throw cannot("cannot lock", e);
+      if (e != EWOULDBLOCK) cannot("cannot lock", e);
       std::string pid = have.substr(std::strlen(kLockTag));
       while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
       throw InputError(out, "",

@@ -198,6 +198,16 @@ TEST_CASE("knit-meso: a write or fsync that fails leaves the earlier database an
     CHECK(knit_test::read_text(db) == before);
     nothing_beside("db.h5");
   }
+  // The lock file cannot be created: a full disk is no bad input (it was exit 2).
+  {
+    const auto r = failing("KNIT_FAIL_WRITE=db.h5.lock", synth);
+    INFO(r.output);
+    CHECK(r.rc == 1);
+    CHECK(r.output.find("cannot create the lock file") != std::string::npos);
+    CHECK(r.output.find("No space left on device") != std::string::npos);
+    CHECK(knit_test::read_text(db) == before);
+    nothing_beside("db.h5");
+  }
   const fs::path out = d / "p";
   const std::string path =
       "path --loop-length 4.5 --shear 10 --steps 2 --elements 16 --out " + out.string();
