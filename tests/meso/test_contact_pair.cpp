@@ -2,6 +2,7 @@
 // contact tangent against central finite differences (stick and slip).
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <numbers>
 
 #include "knit/meso/contact/contact_set.hpp"
 #include "knit/meso/contact/pair.hpp"
@@ -413,4 +414,39 @@ TEST_CASE("contact set: a rational (NURBS) rod is refused, unit weights are not 
   sys.add_rod(s);
   CHECK_THROWS_WITH(ContactSet(sys, 0, straight_yarn_contact()),
                     Catch::Contains("rational") && Catch::Contains("B-spline rods only"));
+}
+
+// Session 34 (the rod/contact/cell audit): where Newton's step would go uphill (phi_u >= 0,
+// the curve bends away from the slave point more than it runs), the projection takes a fixed
+// step in the descent direction sign(phi); the opposite direction survived every test (the
+// cell's starts lie where Newton works). A wavy master, x(u) = (8u - 4, sin(4 pi u), 0), and a
+// slave point above its middle: from every start, troughs included, the projection ends at a
+// local minimum of the distance (ok) no farther than its start. Writing this test found a full
+// Newton step jumping over the nearest minimum (start 0.475: distance 2.78 against 2.31 at the
+// start); a step that moves away from the slave point is now halved.
+TEST_CASE("closest point: from a start where the curve bends away, the projection descends",
+          "[unit]") {
+  knit::spline::BSplineBasis basis{4, knit::spline::uniform_knots(4, 40, 0.0, 1.0)};
+  const int n = basis.size();
+  MatrixXd Q(n, 3);
+  const auto g = basis.greville();
+  for (int i = 0; i < n; ++i)
+    Q.row(i) << 8.0 * g[i] - 4.0, std::sin(4.0 * std::numbers::pi * g[i]), 0.0;
+  Chain c;
+  c.basis = &basis;
+  c.Q = &Q;
+  const Vector3d xs(0.0, 2.0, 0.0);
+  int bent = 0;
+  for (int i = 0; i <= 40; ++i) {
+    const double u0 = i / 40.0;
+    const ChainPoint s = eval_chain(c, u0, 0);
+    const Vector3d r = xs - s.x;
+    if (-s.x_u.squaredNorm() + r.dot(s.x_uu) >= 0.0) ++bent;
+    const Projection pr = project(c, xs, 0, 0.0, 1.0, u0);
+    INFO("start u0 = " << u0 << ": end u = " << pr.u << ", distance " << pr.distance << " from "
+                       << r.norm());
+    CHECK(pr.ok);
+    CHECK(pr.distance <= r.norm() + 1e-12);
+  }
+  CHECK(bent >= 4);  // starts where Newton would climb
 }
