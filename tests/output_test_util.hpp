@@ -21,6 +21,15 @@ struct CommandResult {
   std::string output;  ///< stdout and stderr
 };
 
+/// The prefix of a command run with the failing-disk shim preloaded (tests/support/
+/// fail_io_shim.c) and its variables `env` ("KNIT_FAIL_WRITE=NAME", "KNIT_FAIL_FSYNC=NAME",
+/// "KNIT_LOG_REMOVE=FILE"; empty: the shim changes nothing). ASan's link-order check is off in
+/// the sanitizer build, since the shim comes before ASan's runtime.
+inline std::string with_fail_io_shim(const std::string& env) {
+  return "env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
+         " ASAN_OPTIONS=verify_asan_link_order=0 " + env + " ";
+}
+
 /// Runs `command` with /bin/sh (stdout and stderr captured; killed after `timeout_s`).
 inline CommandResult run_command(const std::string& command, int timeout_s = 120) {
   const std::string log =

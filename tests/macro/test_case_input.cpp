@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "../common/test_material_util.hpp"
+#include "../output_test_util.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
@@ -402,10 +403,8 @@ TEST_CASE("knit-macro run: a write or fsync that fails on any output file fails 
   const std::string summary = slurp(d / "out" / "summary.txt");
   REQUIRE(summary.size() > 50);
   const auto run_failing = [&](const std::string& env) {
-    const std::string cmd = "env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
-                            " ASAN_OPTIONS=verify_asan_link_order=0 " + env + " " +
-                            std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
-                            (d / "log.txt").string() + " 2>&1";
+    const std::string cmd = knit_test::with_fail_io_shim(env) + std::string(KNIT_BIN_DIR) +
+                            "/knit-macro run " + args + " > " + (d / "log.txt").string() + " 2>&1";
     const int st = std::system(cmd.c_str());
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   };
@@ -439,9 +438,8 @@ TEST_CASE("knit-macro run: the replaced output loses its marker after its files 
   const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
   REQUIRE(run_exe(args, d / "log0.txt") == 0);
   const fs::path log = d / "removed.txt";
-  const std::string cmd = "env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
-                          " ASAN_OPTIONS=verify_asan_link_order=0 KNIT_LOG_REMOVE=" + log.string() +
-                          " " + std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
+  const std::string cmd = knit_test::with_fail_io_shim("KNIT_LOG_REMOVE=" + log.string()) +
+                          std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
                           (d / "log.txt").string() + " 2>&1";
   const int st = std::system(cmd.c_str());
   REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 0));

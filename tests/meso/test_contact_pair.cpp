@@ -2,6 +2,7 @@
 // contact tangent against central finite differences (stick and slip).
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "knit/meso/contact/contact_set.hpp"
@@ -83,6 +84,25 @@ ContactOptions straight_yarn_contact() {
   opt.d = 0.38;
   return opt;
 }
+
+/// The friction tests' straight yarn along x of length w (the period a1 = (w, 0, 0)), its
+/// courses c apart, the pairs found and committed (no slip); slip() shifts the courses by s
+/// along the yarn (a2 = (s, c, 0)).
+struct StraightYarn {
+  const double w = 2.0, c = 0.26, s = 0.1;
+  knit::meso::rod::RodSystem sys;
+  Eigen::VectorXd x;
+  const ContactOptions opt = straight_yarn_contact();
+  std::unique_ptr<ContactSet> cs;
+  StraightYarn() {
+    sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
+    x = sys.initial_state();
+    cs = std::make_unique<ContactSet>(sys, 0, opt);
+    cs->set_periods(Vector3d(w, 0, 0), Vector3d(0, c, 0));
+    cs->commit(sys, x);  // the anchors where the pairs are found: no slip
+  }
+  void slip() { cs->set_periods(Vector3d(w, 0, 0), Vector3d(s, c, 0)); }
+};
 
 }  // namespace
 
@@ -338,17 +358,14 @@ TEST_CASE("contact set: friction work of a slip between neighbouring courses in 
   // twice (from the slave points against course +1 and against course -1) and weights each
   // pass by half (docs/unit-cell.md, the factor 2 fixed in ContactSet::commit). Session 32, a
   // mutation audit: the full weight per pass (twice the friction work) survived every test.
-  const double w = 2.0, c = 0.26, s = 0.1;
-  knit::meso::rod::RodSystem sys;
-  sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
-  const Eigen::VectorXd x = sys.initial_state();
-  const ContactOptions opt = straight_yarn_contact();
-  ContactSet cs(sys, 0, opt);
-  const Vector3d a1(w, 0, 0);
-  cs.set_periods(a1, Vector3d(0, c, 0));
-  cs.commit(sys, x);  // the anchors where the pairs are found: no slip
+  StraightYarn y;
+  const double w = y.w, c = y.c, s = y.s;
+  const auto& sys = y.sys;
+  const auto& x = y.x;
+  const ContactOptions& opt = y.opt;
+  ContactSet& cs = *y.cs;
   CHECK(cs.dissipation() == 0.0);
-  cs.set_periods(a1, Vector3d(s, c, 0));
+  y.slip();
   const double p = opt.penalty.eval(c - opt.d).p, lim = opt.friction.mu * p;
   REQUIRE(p == Approx(100.0 * (opt.d - c - 0.05)));
   REQUIRE(opt.friction.k_T * s > lim);
@@ -372,15 +389,13 @@ TEST_CASE("contact set: friction work of a slip between neighbouring courses in 
 // twice at half weight) that is -w d mu p, less the share of the two periodicity rows (which
 // take no contact load, docs/unit-cell.md): 95 % of it here. The forces cancel.
 TEST_CASE("contact set: the friction moment of a slip acts on both yarns with one sign", "[unit]") {
-  const double w = 2.0, c = 0.26, s = 0.1;
-  knit::meso::rod::RodSystem sys;
-  sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
-  const Eigen::VectorXd x = sys.initial_state();
-  const ContactOptions opt = straight_yarn_contact();
-  ContactSet cs(sys, 0, opt);
-  cs.set_periods(Vector3d(w, 0, 0), Vector3d(0, c, 0));
-  cs.commit(sys, x);
-  cs.set_periods(Vector3d(w, 0, 0), Vector3d(s, c, 0));
+  StraightYarn y;
+  const double w = y.w, c = y.c;
+  const auto& sys = y.sys;
+  const auto& x = y.x;
+  const ContactOptions& opt = y.opt;
+  ContactSet& cs = *y.cs;
+  y.slip();
   Eigen::VectorXd F = Eigen::VectorXd::Zero(x.size());
   std::vector<Eigen::Triplet<double>> jac;
   cs.add(sys, x, 1.0, F, jac);

@@ -838,7 +838,7 @@ TEST_CASE("energy fit: the smoothing along l makes the law linear in l at its li
     REQUIRE(s.ok());
     const material::EnergyLaw law(s.law);
     double worst = 0.0;
-    for (const Eigen::Vector3d e :
+    for (const Eigen::Vector3d& e :
          {Eigen::Vector3d(0.2, 0.05, 0.0), Eigen::Vector3d(0.05, 0.25, 0.1),
           Eigen::Vector3d(0.15, 0.15, -0.2)}) {
       const Eigen::Vector3d mid = law.at(5.5).evaluate(e).S;

@@ -171,9 +171,7 @@ TEST_CASE("knit-meso: a write or fsync that fails leaves the earlier database an
           "[unit][outputs]") {
   const fs::path d = knit_test::scratch("meso_outputs_fail_io");
   const auto failing = [&](const std::string& env, const std::string& args) {
-    return knit_test::run_command("env LD_PRELOAD=" + std::string(KNIT_FAIL_IO_SHIM) +
-                                  " ASAN_OPTIONS=verify_asan_link_order=0 " + env + " " + kExe +
-                                  " " + args);
+    return knit_test::run_command(knit_test::with_fail_io_shim(env) + kExe + " " + args);
   };
   const auto nothing_beside = [&](const std::string& name) {
     for (const auto& e : fs::directory_iterator(d)) {
