@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "../output_test_util.hpp"
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/design_problem.hpp"
@@ -26,11 +27,6 @@ const knit::testing::RemoveAtExit kRemoveDir{kDir};
 void write(const fs::path& f, const std::string& text) {
   fs::create_directories(f.parent_path());
   std::ofstream(f) << text;
-}
-
-std::string problem_file_text(const fs::path& f) {
-  std::ifstream in(f);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
 /// A wale-wise tensile case with a designable l field (two control values across u).
@@ -199,7 +195,7 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_lower.json", one_variable("knitting_angle", "[0]", "-200", "45"),
          "/variables/0/lower");
   {
-    std::string c = problem_file_text(kDir / "case.json");
+    std::string c = knit_test::read_text(kDir / "case.json");
     c.replace(c.find("[5.0, 5.0]"), 10, "[5.0, 5.6]");
     write(kDir / "case_untied.json", c);
     std::string t = one_variable("stitch_value", "[0, 1]", "4.5", "6.5");
@@ -535,7 +531,7 @@ TEST_CASE("design: the final run names its case by the committed path", "[unit]"
 // final run did not find it).
 TEST_CASE("design: case.json names a relative database by its absolute path", "[unit]") {
   write_case();
-  std::string c = problem_file_text(kDir / "case.json");
+  std::string c = knit_test::read_text(kDir / "case.json");
   const auto key = c.find("\"database\": \"") + 13;
   const auto end = c.find('"', key);
   const fs::path db = c.substr(key, end - key);
@@ -556,7 +552,7 @@ TEST_CASE("design: case.json names a relative database by its absolute path", "[
   const int st = std::system(cmd.c_str());
   CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));  // l on its upper bound: infeasible target
   REQUIRE(fs::exists(out / "case.json"));
-  const std::string w = problem_file_text(out / "case.json");
+  const std::string w = knit_test::read_text(out / "case.json");
   INFO(w);
   CHECK(w.find("\"database\": \"" + db.lexically_normal().string() + "\"") != std::string::npos);
   CHECK(fs::exists(out / "run" / "load_strain.csv"));  // the final run found it

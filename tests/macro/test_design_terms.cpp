@@ -17,12 +17,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "../output_test_util.hpp"
 #include "../process_tmp.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/run.hpp"
@@ -88,15 +88,10 @@ DesignProblem problem(const std::string& case_name, const std::string& name,
   return load_design((kDir / name).string());
 }
 
-std::string terms_file_text(const fs::path& f) {
-  std::ifstream in(f);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
-
 /// The paper-law case of write_case with `from` replaced by `to`, written as `name`.
 std::string write_case_variant(const std::string& name, const std::string& from,
                                const std::string& to) {
-  std::string text = terms_file_text(kDir / write_case(false));
+  std::string text = knit_test::read_text(kDir / write_case(false));
   const auto at = text.find(from);
   REQUIRE(at != std::string::npos);
   text.replace(at, from.size(), to);
@@ -666,16 +661,16 @@ TEST_CASE("knit-macro design: case.json and summary.txt hold the best design", "
                           (kDir / "best.log").string() + " 2>&1";
   const int st = std::system(cmd.c_str());
   CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));  // an infeasible target
-  const auto root = nlohmann::json::parse(terms_file_text(out / "case.json"));
+  const auto root = nlohmann::json::parse(knit_test::read_text(out / "case.json"));
   const auto x = root.at("material").at("stitch_value").at("values").get<std::vector<double>>();
   REQUIRE(x.size() == 3);
-  const std::string summary = "\n" + terms_file_text(out / "summary.txt");
+  const std::string summary = "\n" + knit_test::read_text(out / "summary.txt");
   INFO(summary);
   for (std::size_t k = 0; k < 3; ++k)
     CHECK(x[k] ==
           Approx(after_arrow(summary, "variable x" + std::to_string(k) + ":")).margin(1e-5));
   // The last history row: iteration, J, gradient norm, seconds, x0, x1, x2.
-  std::istringstream history(terms_file_text(out / "history.csv"));
+  std::istringstream history(knit_test::read_text(out / "history.csv"));
   std::string line, last;
   while (std::getline(history, line))
     if (!line.empty() && line[0] != '#') last = line;
