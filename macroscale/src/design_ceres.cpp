@@ -150,13 +150,22 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.callbacks.push_back(&history);
   ceres::Solver::Summary summary;
   ceres::Solve(o, &problem, &summary);
-  if (summary.termination_type == ceres::FAILURE ||
-      summary.termination_type == ceres::USER_FAILURE) {
-    res.message = summary.message;
-    if (res.evaluations <= 1) res.status = DesignStatus::kFailed;
+  const bool failed =
+      summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE;
+  if (failed) {
+    // Levenberg-Marquardt fails after several trial designs in a row whose runs failed: say
+    // what the last of them said, beside Ceres' own words.
+    res.message = t.have_last && t.last.status != RunStatus::kCompleted && !t.last.message.empty()
+                      ? "the last trial design's run failed: " + t.last.message +
+                            " (Ceres: " + summary.message + ")"
+                      : summary.message;
   }
   // A converged J = 0 (an exact target) ends by the function tolerance as well.
-  classify_result(d, opt, summary.termination_type == ceres::CONVERGENCE, res);
+  classify_result(d, opt,
+                  failed                                           ? SolverEnd::kFailed
+                  : summary.termination_type == ceres::CONVERGENCE ? SolverEnd::kConverged
+                                                                   : SolverEnd::kIterationLimit,
+                  res);
   if (res.message.empty() && summary.termination_type != ceres::CONVERGENCE)
     res.message = summary.message;
   return res;

@@ -37,10 +37,11 @@ std::string to_string(DesignStatus s) {
   return "failed";
 }
 
-void classify_result(const DesignProblem& d, const OptimizeOptions& opt, bool converged,
+void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverEnd end,
                      DesignResult& r) {
+  if (end == SolverEnd::kFailed) r.status = DesignStatus::kFailed;
   if (r.status == DesignStatus::kFailed) return;
-  if (!converged) {
+  if (end == SolverEnd::kIterationLimit) {
     r.status = DesignStatus::kIterationLimit;
     return;
   }
@@ -170,7 +171,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
   }
   res.J = cur.J;
   res.terms = cur.terms;
-  classify_result(d, opt, converged, res);
+  classify_result(d, opt, converged ? SolverEnd::kConverged : SolverEnd::kIterationLimit, res);
   return res;
 }
 

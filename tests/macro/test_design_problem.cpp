@@ -429,15 +429,51 @@ TEST_CASE("design status: the smoothness penalty does not count against the targ
   r.J0 = 11.0;
   r.terms = {{"load", 0.0}, {"smoothness", 0.5}};
   r.J = 0.5;
-  classify_result(d, opt, true, r);
+  classify_result(d, opt, SolverEnd::kConverged, r);
   CHECK(r.status == DesignStatus::kConverged);
   r.terms = {{"load", 1.0}, {"smoothness", 0.5}};
   r.J = 1.5;
   r.message = "no descent step found";
-  classify_result(d, opt, true, r);
+  classify_result(d, opt, SolverEnd::kConverged, r);
   CHECK(r.status == DesignStatus::kTargetNotMet);
   CHECK_THAT(r.message, Catch::StartsWith("no descent step found; the objectives' J = 1 is 0.1 x"));
   CHECK_THAT(r.message, Catch::Contains("the smoothness penalty left out"));
+}
+
+// Session 35: a solver that failed after its first evaluation (Levenberg-Marquardt after
+// several trial designs in a row whose runs failed) was labelled "iteration limit". It is
+// "failed", whatever the count of evaluations, with the solver's message; a stop at the
+// iteration limit stays that, and a met target after a failure is still a failure.
+TEST_CASE("design status: a failed solver is failed after any number of evaluations", "[unit]") {
+  const DesignProblem d = one_variable_design(0.0);
+  const OptimizeOptions opt;
+  DesignResult r;
+  r.x = {5.5};
+  r.terms0 = {{"load", 10.0}};
+  r.J0 = 10.0;
+  r.terms = {{"load", 0.0}};
+  r.J = 0.0;
+  r.evaluations = 7;
+  r.message = "the last trial design's run failed: step 3 did not converge";
+  classify_result(d, opt, SolverEnd::kFailed, r);
+  CHECK(r.status == DesignStatus::kFailed);
+  CHECK(r.message == "the last trial design's run failed: step 3 did not converge");
+  RunResult run;
+  run.report.status = RunStatus::kCompleted;
+  const DesignVerdict v = design_verdict(r, run);
+  CHECK(v.exit_code == knit::kExitFailure);
+  CHECK(v.reason == "failed: the last trial design's run failed: step 3 did not converge");
+  DesignResult s;
+  s.x = {5.5};
+  s.terms0 = r.terms0;
+  s.J0 = 10.0;
+  s.terms = {{"load", 1.0}};
+  s.J = 1.0;
+  s.evaluations = 7;
+  classify_result(d, opt, SolverEnd::kIterationLimit, s);
+  CHECK(s.status == DesignStatus::kIterationLimit);
+  classify_result(d, opt, SolverEnd::kConverged, s);
+  CHECK(s.status == DesignStatus::kTargetNotMet);
 }
 
 // Either bound counts: a stop with the objectives above `feasible` x their start is
@@ -456,7 +492,7 @@ TEST_CASE("design status: a variable on either bound makes a stop an infeasible 
     r.J0 = 10.0;
     r.terms = {{"load", 1.0}};
     r.J = 1.0;
-    classify_result(d, opt, true, r);
+    classify_result(d, opt, SolverEnd::kConverged, r);
     CHECK(r.status == expected);
   }
 }

@@ -151,8 +151,13 @@ struct DesignResult {
 DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options = {});
 DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOptions& options);
 DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions& options);
-/// Sets the status from the termination (converged or not) and the bounds (shared by both).
-void classify_result(const DesignProblem& d, const OptimizeOptions& options, bool converged,
+/// How the optimizer stopped: by its tolerances, at its iteration limit, or by a failure of
+/// the solver itself (Ceres' FAILURE: e.g. the runs of several trial designs in a row failed).
+enum class SolverEnd { kConverged, kIterationLimit, kFailed };
+/// Sets the status from the termination and the bounds (shared by both optimizers): kFailed
+/// for a failed solver, whatever the count of evaluations before it (session 35: a failure
+/// after the first evaluation said "iteration limit"); the best design so far is kept.
+void classify_result(const DesignProblem& d, const OptimizeOptions& options, SolverEnd end,
                      DesignResult& r);
 
 struct RunResult;  // knit/macro/run.hpp
