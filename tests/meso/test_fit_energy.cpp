@@ -820,6 +820,52 @@ TEST_CASE("energy fit: the strain box and the ridge functions' ranges follow the
   }
 }
 
+// Session 35 (the fit audit's gap: the floor was untested): a ridge function whose data lie on
+// one side of zero (d . e >= 0 at every fitted state, the unloaded state at 0) still gets a
+// range reaching 1 % of its width past zero, so that zero strain is inside every function's
+// spline, not on its end.
+TEST_CASE("energy fit: a ridge function with one-sided data reaches past zero", "[unit]") {
+  Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  std::vector<Eigen::Vector3d> es;
+  for (auto& entry : db.entries) {
+    std::erase_if(entry.raw, [](const material::RawPath& r) {
+      for (int s = 0; s < r.steps(); ++s)
+        if (r.E(s, 0) < 0.0 || r.E(s, 1) < 0.0 || r.E(s, 2) < 0.0) return true;
+      return false;
+    });
+    for (const auto& r : entry.raw)
+      if (r.path.set != "holdout")
+        for (int s = 0; s < r.steps(); ++s) es.emplace_back(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2));
+  }
+  REQUIRE(es.size() > 20);
+  EnergyFitOptions o = ridge_options();
+  o.s_margin = 0.0;
+  // (1, 1, 0) sees the data above zero only, (-1, -0.5, 0) below only, (1, -1, 0) both.
+  o.directions = {{1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {-1, -0.5, 0}, {1, -1, 0}, {0, 0, 1}};
+  const EnergyFitSummary fit = fit_energy_law(db, o);
+  INFO(fit.reason);
+  REQUIRE(fit.ok());
+  int below_only = 0, above_only = 0;
+  for (int g = 0; g < fit.law.functions(); ++g) {
+    double a = 0.0, b = 0.0;
+    for (Eigen::Index k = 0; k < fit.law.directions.d.rows(); ++k) {
+      if (fit.law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
+      for (const auto& e : es) {
+        a = std::min(a, fit.law.directions.d.row(k).dot(e));
+        b = std::max(b, fit.law.directions.d.row(k).dot(e));
+      }
+    }
+    INFO("ridge function " << g << ": data from " << a << " to " << b);
+    const double w = b - a;
+    CHECK(fit.law.s_range(g, 0) == Approx(std::min(a, -0.01 * w)).epsilon(1e-14));
+    CHECK(fit.law.s_range(g, 1) == Approx(std::max(b, 0.01 * w)).epsilon(1e-14));
+    below_only += b < 0.01 * w ? 1 : 0;
+    above_only += a > -0.01 * w ? 1 : 0;
+  }
+  CHECK(below_only > 0);  // each floor is reached by some function
+  CHECK(above_only > 0);
+}
+
 TEST_CASE("energy fit: the smoothing along l makes the law linear in l at its limit", "[unit]") {
   // Three loop lengths, three linear l-functions (degree 1, knots at the loop lengths): with
   // the largest smoothing the second differences along l vanish, so the law at 5.5 mm is the
