@@ -79,9 +79,10 @@ Projection project(const Chain& c, const Eigen::Vector3d& xs, int k, double lo, 
   double buf[3 * (spline::kMaxDegree + 1)];
   Eigen::Map<Eigen::MatrixXd> N(buf, 3, c.basis->degree() + 1);
   ChainPoint cp;  // x, x_u, x_uu only (N lives in buf)
+  eval_chain_at(c, u, k, N, cp.x, cp.x_u, cp.x_uu);
+  double f = (xs - cp.x).squaredNorm();
   for (int it = 0; it < 30; ++it) {
     pr.iterations = it + 1;
-    eval_chain_at(c, u, k, N, cp.x, cp.x_u, cp.x_uu);
     const Eigen::Vector3d r = xs - cp.x;
     const double phi = r.dot(cp.x_u);
     const double phiu = -cp.x_u.squaredNorm() + r.dot(cp.x_uu);
@@ -89,12 +90,23 @@ Projection project(const Chain& c, const Eigen::Vector3d& xs, int k, double lo, 
     double du = (phiu < 0) ? -phi / phiu : (phi > 0 ? 1 : -1) * 0.25 * (hi - lo);
     const double lim = 0.5 * (hi - lo);
     du = std::clamp(du, -lim, lim);
-    const double un = std::clamp(u + du, lo, hi);
+    double un = std::clamp(u + du, lo, hi);
+    // A step that moves away from xs is halved (session 34: a full Newton step from where the
+    // curve bends could jump over the nearest minimum to a farther one; the relative 1e-12
+    // keeps round-off at convergence from halving).
+    eval_chain_at(c, un, k, N, cp.x, cp.x_u, cp.x_uu);
+    double fn = (xs - cp.x).squaredNorm();
+    for (int h = 0; h < 40 && fn > f * (1.0 + 1e-12); ++h) {
+      du *= 0.5;
+      un = std::clamp(u + du, lo, hi);
+      eval_chain_at(c, un, k, N, cp.x, cp.x_u, cp.x_uu);
+      fn = (xs - cp.x).squaredNorm();
+    }
     const double step = std::abs(un - u);
     u = un;
+    f = fn;
     if (step < 1e-14 * std::max(1.0, std::abs(u))) break;
   }
-  eval_chain_at(c, u, k, N, cp.x, cp.x_u, cp.x_uu);
   const Eigen::Vector3d r = xs - cp.x;
   pr.u = u;
   pr.distance = r.norm();
