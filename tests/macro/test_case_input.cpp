@@ -50,11 +50,22 @@ fs::path temp_dir(const std::string& tag) {
   return d;
 }
 
-int run_exe(const std::string& args, const fs::path& log) {
-  const std::string cmd =
-      std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " + log.string() + " 2>&1";
+/// knit-macro run ARGS with its output in LOG; `prefix` goes before the command (an
+/// environment, e.g. knit_test::with_fail_io_shim). The exit code, -1 if it did not exit.
+int run_exe(const std::string& args, const fs::path& log, const std::string& prefix = "") {
+  const std::string cmd = prefix + std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
+                          log.string() + " 2>&1";
   const int st = std::system(cmd.c_str());
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/// Writes case C to D/case.json and runs it into D/out (required to succeed): the earlier
+/// output that the failure tests must leave as it was. Returns the arguments of that run.
+std::string earlier_output(const fs::path& d, const json& c) {
+  std::ofstream(d / "case.json") << c.dump(2);
+  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
+  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  return args;
 }
 
 /// A St. Venant-Kirchhoff strip 10 x 1 mm (E = 1 MPa, nu = 0, t = 1 mm), held at u0 and loaded
@@ -366,9 +377,7 @@ TEST_CASE(
     "the target",
     "[unit]") {
   const fs::path d = temp_dir("full");
-  std::ofstream(d / "case.json") << verification_case("tensile_svk.json").dump(2);
-  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
-  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const std::string args = earlier_output(d, verification_case("tensile_svk.json"));
   const std::string csv = slurp(d / "out" / "load_strain.csv");
   // 64 KiB per file: a VTU of the 41 x 41 grid (~300 KiB) does not fit.
   const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 64; " + std::string(KNIT_BIN_DIR) +
@@ -397,16 +406,11 @@ TEST_CASE("knit-macro run: a write or fsync that fails on any output file fails 
   const fs::path d = temp_dir("fail_io");
   json c = verification_case("tensile_svk.json");
   c["output"]["vtk"] = false;
-  std::ofstream(d / "case.json") << c.dump(2);
-  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
-  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const std::string args = earlier_output(d, c);
   const std::string summary = slurp(d / "out" / "summary.txt");
   REQUIRE(summary.size() > 50);
   const auto run_failing = [&](const std::string& env) {
-    const std::string cmd = knit_test::with_fail_io_shim(env) + std::string(KNIT_BIN_DIR) +
-                            "/knit-macro run " + args + " > " + (d / "log.txt").string() + " 2>&1";
-    const int st = std::system(cmd.c_str());
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return run_exe(args, d / "log.txt", knit_test::with_fail_io_shim(env));
   };
   // The shim changes nothing unless asked.
   CHECK(run_failing("") == 0);
@@ -434,15 +438,10 @@ TEST_CASE("knit-macro run: a write or fsync that fails on any output file fails 
 TEST_CASE("knit-macro run: the replaced output loses its marker after its files and before itself",
           "[unit]") {
   const fs::path d = temp_dir("remove_order");
-  std::ofstream(d / "case.json") << verification_case("tensile_svk.json").dump(2);
-  const std::string args = (d / "case.json").string() + " --output " + (d / "out").string();
-  REQUIRE(run_exe(args, d / "log0.txt") == 0);
+  const std::string args = earlier_output(d, verification_case("tensile_svk.json"));
   const fs::path log = d / "removed.txt";
-  const std::string cmd = knit_test::with_fail_io_shim("KNIT_LOG_REMOVE=" + log.string()) +
-                          std::string(KNIT_BIN_DIR) + "/knit-macro run " + args + " > " +
-                          (d / "log.txt").string() + " 2>&1";
-  const int st = std::system(cmd.c_str());
-  REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 0));
+  REQUIRE(run_exe(args, d / "log.txt",
+                  knit_test::with_fail_io_shim("KNIT_LOG_REMOVE=" + log.string())) == 0);
   // The earlier output, swapped out to out.partial-<pid>, is removed: its files and vtk/ (with
   // its files) first, then the marker, then the directory.
   std::vector<std::string> removed;
