@@ -768,17 +768,42 @@ TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero i
   CHECK(below.diagnostics.points_skipped == at0.diagnostics.points_skipped - (r.steps() - 3));
 }
 
+namespace {
+
+/// The fitted states' strains (E11, E22, 2E12): every raw step outside the held-out set.
+std::vector<Eigen::Vector3d> fitted_strains(const Database& db) {
+  std::vector<Eigen::Vector3d> es;
+  for (const auto& entry : db.entries)
+    for (const auto& r : entry.raw)
+      if (r.path.set != "holdout")
+        for (int s = 0; s < r.steps(); ++s) es.emplace_back(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2));
+  return es;
+}
+
+/// [a, b]: the range of d_k . e over ridge function g's directions and the strains es, zero
+/// included (the unloaded state).
+std::pair<double, double> data_range(const material::EnergyLawData& law, int g,
+                                     const std::vector<Eigen::Vector3d>& es) {
+  double a = 0.0, b = 0.0;
+  for (Eigen::Index k = 0; k < law.directions.d.rows(); ++k) {
+    if (law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
+    for (const auto& e : es) {
+      a = std::min(a, law.directions.d.row(k).dot(e));
+      b = std::max(b, law.directions.d.row(k).dot(e));
+    }
+  }
+  return {a, b};
+}
+
+}  // namespace
+
 TEST_CASE("energy fit: the strain box and the ridge functions' ranges follow the fitted data",
           "[unit]") {
   // The box is the fitted strains' bounding box with zero in it, symmetric in 2E12 (W is even
   // in E12); each ridge function's range [a_g, b_g] spans d . e over its directions and the
   // fitted states, widened by s_margin times its width on each side (database.md).
   const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  std::vector<Eigen::Vector3d> es;
-  for (const auto& entry : db.entries)
-    for (const auto& r : entry.raw)
-      if (r.path.set != "holdout")
-        for (int s = 0; s < r.steps(); ++s) es.emplace_back(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2));
+  const std::vector<Eigen::Vector3d> es = fitted_strains(db);
   EnergyFitOptions o = ridge_options();
   o.s_margin = 0.0;
   const EnergyFitSummary tight = fit_energy_law(db, o);
@@ -802,14 +827,7 @@ TEST_CASE("energy fit: the strain box and the ridge functions' ranges follow the
   const EnergyFitSummary wide = fit_energy_law(db, o);
   REQUIRE(wide.ok());
   for (int g = 0; g < law.functions(); ++g) {
-    double a = 0.0, b = 0.0;
-    for (Eigen::Index k = 0; k < law.directions.d.rows(); ++k) {
-      if (law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
-      for (const auto& e : es) {
-        a = std::min(a, law.directions.d.row(k).dot(e));
-        b = std::max(b, law.directions.d.row(k).dot(e));
-      }
-    }
+    const auto [a, b] = data_range(law, g, es);
     INFO("ridge function " << g << ": data from " << a << " to " << b);
     REQUIRE(a < -0.01 * (b - a));  // both signs reached: the range is the data's own
     REQUIRE(b > 0.01 * (b - a));
@@ -826,17 +844,13 @@ TEST_CASE("energy fit: the strain box and the ridge functions' ranges follow the
 // spline, not on its end.
 TEST_CASE("energy fit: a ridge function with one-sided data reaches past zero", "[unit]") {
   Database db = synthetic_coverage_db({4.5, 6.5}, 6);
-  std::vector<Eigen::Vector3d> es;
-  for (auto& entry : db.entries) {
+  for (auto& entry : db.entries)
     std::erase_if(entry.raw, [](const material::RawPath& r) {
       for (int s = 0; s < r.steps(); ++s)
         if (r.E(s, 0) < 0.0 || r.E(s, 1) < 0.0 || r.E(s, 2) < 0.0) return true;
       return false;
     });
-    for (const auto& r : entry.raw)
-      if (r.path.set != "holdout")
-        for (int s = 0; s < r.steps(); ++s) es.emplace_back(r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2));
-  }
+  const std::vector<Eigen::Vector3d> es = fitted_strains(db);
   REQUIRE(es.size() > 20);
   EnergyFitOptions o = ridge_options();
   o.s_margin = 0.0;
@@ -847,14 +861,7 @@ TEST_CASE("energy fit: a ridge function with one-sided data reaches past zero", 
   REQUIRE(fit.ok());
   int below_only = 0, above_only = 0;
   for (int g = 0; g < fit.law.functions(); ++g) {
-    double a = 0.0, b = 0.0;
-    for (Eigen::Index k = 0; k < fit.law.directions.d.rows(); ++k) {
-      if (fit.law.directions.function_of[static_cast<std::size_t>(k)] != g) continue;
-      for (const auto& e : es) {
-        a = std::min(a, fit.law.directions.d.row(k).dot(e));
-        b = std::max(b, fit.law.directions.d.row(k).dot(e));
-      }
-    }
+    const auto [a, b] = data_range(fit.law, g, es);
     INFO("ridge function " << g << ": data from " << a << " to " << b);
     const double w = b - a;
     CHECK(fit.law.s_range(g, 0) == Approx(std::min(a, -0.01 * w)).epsilon(1e-14));
