@@ -376,6 +376,13 @@ bool H5Group::is_dataset(const std::string& path) const {
   return exists(path) && object_type(id_.get(), h5name(path)) == H5O_TYPE_DATASET;
 }
 
+bool H5Group::has_checksum(const std::string& path) const {
+  silence_hdf5();
+  if (!is_dataset(path)) return false;
+  H5Handle ds(H5Dopen2(id_.get(), h5name(path).c_str(), H5P_DEFAULT));
+  return ds.valid() && (has_filter(ds.get(), H5Z_FILTER_FLETCHER32) || read_digest(ds.get()));
+}
+
 void H5Group::copy_from(const H5Group& from, const std::string& path) {
   silence_hdf5();
   if (!from.exists(path)) fail(path, "cannot copy from " + from.file_name() + ": missing there");
@@ -937,10 +944,11 @@ void stamp_structure(const std::string& name) {
     throw std::runtime_error(name + ": cannot write the checksum trailer (disk full?)");
 }
 
-/// Verifies the trailer of a file, if it has one (files written before it existed do not).
-void verify_structure(const std::string& name, std::uint64_t file_size) {
+/// Verifies the trailer of a file, if it has one (files written before it existed do not);
+/// returns whether it had one.
+bool verify_structure(const std::string& name, std::uint64_t file_size) {
   const std::uint64_t tail = 3 * 8 + sizeof kTrailerMagic;
-  if (file_size < tail) return;
+  if (file_size < tail) return false;
   CFile c{std::fopen(name.c_str(), "rb")};
   if (!c.f) throw InputError(name, "", "cannot read file");
   char magic[8];
@@ -948,7 +956,7 @@ void verify_structure(const std::string& name, std::uint64_t file_size) {
   if (std::fseek(c.f, static_cast<long>(file_size - tail), SEEK_SET) != 0 ||
       std::fread(last, 8, 3, c.f) != 3 || std::fread(magic, 1, 8, c.f) != 8 ||
       std::memcmp(magic, kTrailerMagic, 8) != 0)
-    return;  // no trailer: an older file, read unverified
+    return false;  // no trailer: an older file (or one opened for writing since), unverified
   const auto bad = [&](const std::string& why) {
     throw InputError(name, "",
                      "the file's structure checksum does not match (" + why +
@@ -970,6 +978,7 @@ void verify_structure(const std::string& name, std::uint64_t file_size) {
       bad("trailer damaged");
   }
   if (structure_digest(c.f, end, ex) != digest) bad("FNV-1a 64");
+  return true;
 }
 
 }  // namespace
@@ -1007,7 +1016,7 @@ H5File::H5File(const std::filesystem::path& file, Mode mode)
     // Regular files only (a FIFO or a device is refused before HDF5 touches it); the
     // structure checksum before HDF5 parses anything.
     const std::uint64_t size = check_input_file(file, kMaxHdf5InputBytes);
-    verify_structure(name, size);
+    sealed_ = verify_structure(name, size);
     if (!is_hdf5_file(file)) throw std::runtime_error(name + ": not an HDF5 file (or truncated)");
     const unsigned flags = mode == Mode::ReadOnly ? H5F_ACC_RDONLY : H5F_ACC_RDWR;
     file_id_ = H5Handle(H5Fopen(name.c_str(), flags, fapl.get()));

@@ -257,6 +257,19 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       throw InputError(fname, "/",
                        std::string("not a material database (attribute format != \"") +
                            kDatabaseFormatName + "\")");
+    // A database written with checksums but without its structure checksum was opened for
+    // writing after it was written (session 36: h5py "r+" scaled /energy_law/theta by 1.5,
+    // HDF5 recomputed the Fletcher32 sums and dropped the trailer, and knit-macro ran the
+    // edited law as an old, unverifiable file with exit 0: 27,148 N instead of 84.6 N).
+    // Only files written before the checksums existed are read unverified.
+    if (!f.structure_sealed() && f.has_checksum("/loop_lengths"))
+      throw InputError(
+          fname, "",
+          "the file was written with checksums but its structure checksum is gone: it was "
+          "opened for writing after it was written (h5py's \"r+\" and \"a\" modes drop it even "
+          "without a change), so a change to its law or data cannot be ruled out; use the "
+          "database as knit-meso wrote it (a copy made with cp keeps the checksum), or write a "
+          "new one (knit-meso sweep, or knit-meso fit from the original)");
     db.format_version = f.attribute_int(".", "format_version");
     if (db.format_version < kOldestReadableVersion || db.format_version > kDatabaseFormatVersion)
       throw InputError(fname, "/",

@@ -163,6 +163,15 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
       if (root.has_attribute(g, "stiff2"))
         law.network.shape.stiff2 = root.attribute_int(g, "stiff2");
       // Optional (written since session 15): the outer function; none in older databases.
+      // Its parameters without it are a file changed since (session 36: the attribute
+      // deleted, the law read as "none" with exit 0: 5.2 N instead of 84.6 N).
+      if (!root.has_attribute(g, "outer"))
+        for (const char* a : {"outer_scale", "outer_cap"})
+          if (root.has_attribute(g, a))
+            throw InputError(file, g,
+                             std::string("attribute outer is missing but ") + a +
+                                 " is there: the outer function's kind is unknown (\"exp\" "
+                                 "or \"none\"); the file was changed after it was written");
       if (root.has_attribute(g, "outer")) {
         const std::string outer = root.attribute_string(g, "outer");
         if (outer != "none" && outer != "exp")

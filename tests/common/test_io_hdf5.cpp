@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <array>
 
 #include <catch2/catch.hpp>
 #include <csignal>
@@ -332,10 +333,33 @@ TEST_CASE("HDF5 files written without checksums still load", "[unit][io][hdf5]")
     f.write("/v", std::vector<double>{1.0, 2.0}, {.checksum = false});
     f.write_dataset("/s", std::vector<double>{3.0}, {}, {.checksum = false});
   }
+  {
+    const H5File f = H5File::open_read(file);
+    CHECK(f.structure_sealed());
+  }
   strip_trailer(file);
   H5File f = H5File::open_read(file);
+  CHECK_FALSE(f.structure_sealed());
   CHECK(f.read_doubles("/v") == std::vector<double>{1.0, 2.0});
   CHECK(f.read_doubles("/s") == std::vector<double>{3.0});
+}
+
+TEST_CASE("HDF5: has_checksum sees the Fletcher32 filter and the digest attribute",
+          "[unit][io][hdf5]") {
+  const fs::path file = scratch("has_checksum.h5");
+  {
+    H5File f = H5File::create(file);
+    f.write("/v", std::vector<double>{1.0, 2.0});         // Fletcher32
+    f.write_dataset("/s", std::vector<double>{3.0}, {});  // a scalar: the digest
+    f.write_strings("/names", {"a"});                     // strings: the digest
+    f.write("/old", std::vector<double>{1.0}, {.checksum = false});
+    f.write_dataset("/old_s", std::vector<double>{3.0}, {}, {.checksum = false});
+    f.create_group("/g");
+  }
+  const H5File f = H5File::open_read(file);
+  for (const char* with : {"/v", "/s", "/names"}) CHECK(f.has_checksum(with));
+  for (const char* without : {"/old", "/old_s", "/g", "/missing"})
+    CHECK_FALSE(f.has_checksum(without));
 }
 
 TEST_CASE("HDF5: a declared extent larger than the file or the cap is refused before allocating",
@@ -447,29 +471,60 @@ TEST_CASE("HDF5: a create that meets a file size limit names the system's reason
   }
 }
 
-TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",
-          "[unit][io][hdf5]") {
-  // Issue 14: this ran to completion with 18.6 N instead of 41.4 N.
+namespace {
+/// A one-loop-length test database written to scratch(name), read back once.
+fs::path written_test_database(const std::string& name) {
   using namespace knit::material;
   Database db = testing::make_test_database();
   LoopLengthEntry e = testing::make_test_entry(5.0);
   e.surface = testing::make_test_surface(1.0);
   e.diagnostics.options_json = "{}";
   db.entries.push_back(e);
-  const fs::path file = scratch("db_flip.h5");
+  const fs::path file = scratch(name);
   write_database(file, db);
   REQUIRE_NOTHROW(read_database(file));
+  return file;
+}
+
+/// read_database(file)'s InputError: its file, HDF5 path and message.
+std::array<std::string, 3> database_error_of(const fs::path& file) {
+  try {
+    knit::material::read_database(file);
+  } catch (const knit::InputError& err) {
+    return {err.file(), err.pointer(), err.message()};
+  } catch (const std::exception& err) {
+    return {"", "", std::string("not an InputError: ") + err.what()};
+  }
+  return {"", "", "<no exception>"};
+}
+}  // namespace
+
+TEST_CASE("database: a database of ours without its structure checksum is refused",
+          "[unit][io][hdf5]") {
+  // Session 36 (a helper's red team): h5py "r+" scaled /energy_law/theta by 1.5; HDF5
+  // recomputed the Fletcher32 sums and cut the trailer, and the edited law ran as an old,
+  // unverifiable file with exit 0 (27,148 N instead of 84.6 N).
+  const fs::path file = written_test_database("db_unsealed.h5");
+  strip_trailer(file);  // what a program that opens it for writing leaves
+  const auto [where, pointer, message] = database_error_of(file);
+  CHECK(where == file.string());
+  CHECK(pointer.empty());
+  CHECK_THAT(message, Catch::StartsWith("the file was written with checksums but its structure "
+                                        "checksum is gone: it was opened for writing after it "
+                                        "was written"));
+}
+
+TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",
+          "[unit][io][hdf5]") {
+  // Issue 14: this ran to completion with 18.6 N instead of 41.4 N.
+  const fs::path file = written_test_database("db_flip.h5");
   const knit::io::RowMatrixXd S = H5File::open_read(file).read_matrix("/loop_0/fit/S_ctrl");
   bool flipped = false;
   for (Eigen::Index i = 0; i < S.size() && !flipped; ++i)
     if (S.data()[i] != 0.0) flipped = flip_sign_bit_of(file, S.data()[i]);
   REQUIRE(flipped);
-  try {
-    read_database(file);
-    FAIL("no exception");
-  } catch (const knit::InputError& err) {
-    CHECK(err.file() == file.string());
-    CHECK(err.pointer() == "/loop_0/fit/S_ctrl");
-    CHECK_THAT(err.message(), Catch::StartsWith("checksum mismatch (Fletcher32)"));
-  }
+  const auto [where, pointer, message] = database_error_of(file);
+  CHECK(where == file.string());
+  CHECK(pointer == "/loop_0/fit/S_ctrl");
+  CHECK_THAT(message, Catch::StartsWith("checksum mismatch (Fletcher32)"));
 }

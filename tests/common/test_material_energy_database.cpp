@@ -352,6 +352,35 @@ TEST_CASE("database v3: an unknown outer function is refused with its HDF5 path"
                     Catch::Contains("/energy_law") && Catch::Contains("outer is \"log\""));
 }
 
+TEST_CASE("database v3: the outer function's parameters without its kind are refused", "[unit]") {
+  // Session 36 (a helper's red team): /energy_law@outer deleted, outer_scale and outer_cap
+  // left, read as "none" with exit 0 (5.2 N instead of 84.6 N).
+  for (const bool exp : {true, false}) {
+    const auto file = tmp(exp ? "network_outer_gone_exp.h5" : "network_outer_gone_none.h5");
+    Database db = db_with_law();
+    db.energy_law = testing::make_test_network_law();
+    if (exp) {
+      db.energy_law->network.shape.outer = 1;
+      db.energy_law->network.shape.outer_scale = 0.3;
+      db.energy_law->network.shape.outer_cap = 1.7;
+    }
+    write_database(file, db);
+    {
+      auto f = knit::io::H5File::open_rw(file);
+      REQUIRE(f.has_attribute("/energy_law", "outer_scale") == exp);
+      f.remove_attribute("/energy_law", "outer");
+    }
+    if (exp)
+      CHECK_THROWS_WITH(read_database(file, false),
+                        file.string() +
+                            ": /energy_law: attribute outer is missing but outer_scale is "
+                            "there: the outer function's kind is unknown (\"exp\" or "
+                            "\"none\"); the file was changed after it was written");
+    else  // a law without an outer function: as written before session 15
+      CHECK(read_database(file, false).energy_law->network.shape.outer == 0);
+  }
+}
+
 TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit]") {
   Database db = db_with_law();
   db.energy_law = testing::make_test_network_law();

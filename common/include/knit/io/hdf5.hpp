@@ -25,9 +25,11 @@
 // every non-empty numeric array is written chunked with HDF5's Fletcher32 filter
 // (verified by every read); scalar and string datasets carry a digest attribute
 // "knit_fnv1a64" (FNV-1a 64 of the values), verified on read. Files written before this
-// (no filter, no digest) are read without verification and without a warning: HDF5 cannot
-// tell "written without checksums" from "checksums stripped", so a warning would only be
-// noise on every old database. Attributes are not checksummed.
+// (no filter, no digest) are read without verification and without a warning. A file of
+// ours that another program opened for writing has lost its trailer (HDF5 cuts the file to
+// its own end when it closes it) but keeps its data checksums: structure_sealed() and
+// has_checksum() tell it from an old file, and the database reader refuses it (session 36).
+// Attributes are covered by the structure checksum only.
 // Reading: only regular files are opened (knit/io/input_file.hpp, at most kMaxHdf5InputBytes);
 // every declared extent is checked against kMaxH5DatasetBytes and the file size before
 // allocating.
@@ -126,6 +128,9 @@ class H5Group {
   void copy_from(const H5Group& from, const std::string& path);
   bool is_group(const std::string& path) const;
   bool is_dataset(const std::string& path) const;
+  /// True if the dataset at path carries a checksum of ours: the Fletcher32 filter or the
+  /// digest attribute "knit_fnv1a64" (every dataset written since the checksums exist).
+  bool has_checksum(const std::string& path) const;
   /// Names of the direct children (groups and datasets) of the group at path, sorted by name.
   std::vector<std::string> children(const std::string& path = ".") const;
   /// Removes the link at path (the space is not reclaimed by HDF5; fine for our sizes).
@@ -230,10 +235,17 @@ class H5File : public H5Group {
   /// destructor does the same but cannot report failures: call close() to see them.
   void close();
   bool is_open() const { return file_id_.valid(); }
+  /// Whether the opened file had a structure checksum (verified at open; a mismatch throws).
+  /// False for files written before the checksum existed, and for files of ours opened for
+  /// writing by another program afterwards: HDF5 cuts a file it closes to its own end, so
+  /// h5py's "r+" or "a" drops the checksum even without a change. Readers tell the two apart
+  /// with has_checksum() on a dataset every such file holds (material::read_database).
+  bool structure_sealed() const { return sealed_; }
 
  private:
   H5Handle file_id_;
   Mode mode_ = Mode::ReadOnly;
+  bool sealed_ = false;
 };
 
 /// An HDF5 file written atomically: created at a temporary path next to `target`, closed and
