@@ -149,6 +149,12 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
         "names no new file or directory (\".\", \"..\" and \"/\" cannot be replaced); give "
         "the name of the output to create, e.g. " +
         std::string(kind == OutputKind::kDirectory ? "out/run1" : "out/database.h5"));
+  // A file output named with a trailing slash ("db/"): a directory's name, which the atomic
+  // writer refuses only when it writes, after the whole sweep (session 36's red team: every
+  // case run, then exit 1 with a --resume advice that the same name then refused).
+  if (kind == OutputKind::kFile && target != target_in)
+    refuse("ends in \"/\", the name of a directory; give the file's name, e.g. " +
+           (target / "database.h5").string());
   // Control characters (a newline above all) in the output's path: the marker is written line
   // by line, and a name "o\nfile: notes.txt" put notes.txt into the run's manifest (review of
   // session 29); no one means them in a file name.

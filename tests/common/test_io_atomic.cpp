@@ -273,6 +273,13 @@ TEST_CASE("check_output_target refuses what a run must not or cannot write", "[u
   CHECK_THAT(why(d / "link", dirk), Catch::Contains("symbolic link"));
   CHECK_THAT(why(d / "file" / "sub" / "out", dirk), Catch::Contains("is not a directory"));
   CHECK_THAT(why(d / "empty", filek), Catch::Contains("is a directory"));
+  // A file output named like a directory, new or not (session 36: `knit-meso sweep IN -o
+  // newdir/` ran every case, then failed to write).
+  for (const fs::path& t : {d / "newdir/", d / "empty/", d / "earlier.h5/"})
+    CHECK(why(t, filek) ==
+          "ends in \"/\", the name of a directory; give the file's name, "
+          "e.g. " +
+              (t.parent_path() / "database.h5").string());
   for (const fs::path& t :
        {fs::path("."), fs::path(".."), fs::path("/"), d / "ours" / ".", d / "ours" / ".."})
     CHECK_THAT(why(t, dirk), Catch::Contains("cannot be replaced"));

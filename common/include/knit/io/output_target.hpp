@@ -72,10 +72,10 @@ enum class OutputKind { kDirectory, kFile };
 ///    non-empty directory that is not a knitscale output (no marker file), or the output of
 ///    another program (is_own_output), or an output holding entries its run did not write
 ///    (foreign_entries: a user's notes in a run's directory);
-///  * kFile (an HDF5 file: the database outputs): an existing directory (or other non-regular
-///    file); an existing non-empty file that is not HDF5 (not ours to replace); with
-///    `hdf5_format` given, an existing HDF5 file whose root attribute "format" is not
-///    `hdf5_format` (session 21: somebody else's HDF5 file was taken for an earlier database
+///  * kFile (an HDF5 file: the database outputs): a name ending in "/"; an existing directory
+///    (or other non-regular file); an existing non-empty file that is not HDF5 (not ours to
+///    replace); with `hdf5_format` given, an existing HDF5 file whose root attribute "format" is
+///    not `hdf5_format` (session 21: somebody else's HDF5 file was taken for an earlier database
 ///    and replaced);
 ///  * a target whose nearest existing ancestor is not a writable directory (missing parents
 ///    are created by the writer, so "a/b/out" needs "a" — or the first existing one — writable).
