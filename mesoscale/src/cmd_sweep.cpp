@@ -145,7 +145,18 @@ int run(const Cli& c) {
     o.tty = c.plain ? 0 : -1;
     o.log = mpi.rank() == 0 ? stdout : nullptr;
     const PathRunner runner = make_runner(in);
-    if (mpi.rank() == 0) explain_interrupt(c);
+    if (mpi.rank() == 0) {
+      explain_interrupt(c);
+      // From here on the database is complete (session 36's red team: a stop while the
+      // checkpoints were removed advised --resume, which then refused what was left).
+      o.on_written = [&c] {
+        knit::cli::on_interrupt_say(
+            "knit-meso sweep: interrupted after the database was "
+            "written: " +
+            c.output + " is complete; what is left of its checkpoints in " + c.output +
+            ".parts is no longer needed");
+      };
+    }
     const SweepReport rep = run_sweep(in, o, runner, &mpi);
     if (mpi.rank() != 0) return knit::kExitOk;
     print_summary(in, rep, c.output);

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -76,6 +77,17 @@ std::string not_ours(const fs::path& dir) {
   }
   return "";
 }
+
+/// Whether the store `dir` (ours) holds a finished case's record (a job_NNNNN.txt).
+bool holds_job_records(const fs::path& dir) {
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name[0] != '.' && name != kManifest && is_store_file(name)) return true;
+  }
+  return false;
+}
 }  // namespace
 
 fs::path CheckpointStore::parts_dir(const fs::path& database) {
@@ -86,8 +98,8 @@ fs::path CheckpointStore::parts_dir(const fs::path& database) {
 
 CheckpointStore::CheckpointStore(const fs::path& database, const std::string& job_definition,
                                  int job_count, bool resume, bool force)
-    : dir_(parts_dir(database)) {
-  const std::string fp = fingerprint(job_definition);
+    : dir_(parts_dir(database)), fingerprint_(fingerprint(job_definition)) {
+  const std::string& fp = fingerprint_;
   std::error_code ec;
   if (fs::exists(fs::symlink_status(dir_, ec))) {
     // Session 26 (found by a helper's audit): --force deleted a directory of that name with
@@ -97,6 +109,17 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                        why +
                            ": not ours to continue or discard; rename or remove it, or give "
                            "the database another --output");
+    // No finished case in it (a run stopped while it wrote its first manifest left only the
+    // manifest's temporary; session 36's red team): nothing to continue or to lose, so it is
+    // discarded and the sweep starts afresh, with or without --resume.
+    if (!holds_job_records(dir_)) {
+      remove();
+      if (fs::exists(fs::symlink_status(dir_, ec)))
+        throw InputError(dir_.string(), "", "cannot discard the empty checkpoint directory");
+      resume = false;
+    }
+  }
+  if (fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
       throw InputError(dir_.string(), "",
                        "checkpoints of an unfinished sweep exist: continue it with --resume, or "
@@ -132,8 +155,27 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
 
 namespace {
 
-std::string seal_record(const std::string& record) {
-  return record + kDigestTag + fingerprint(record) + "\n";
+// Since session 36 a record names the sweep it belongs to (the manifest's fingerprint) in a
+// line before its digest: a job file copied from another sweep's checkpoints (another cell,
+// friction, ...) was taken on --resume with exit 0, since a record holds only its path.
+constexpr const char* kSweepTag = "sweep ";
+
+std::string seal_record(const std::string& record, const std::string& sweep) {
+  const std::string text = record + kSweepTag + sweep + "\n";
+  return text + kDigestTag + fingerprint(text) + "\n";
+}
+
+/// Splits the sweep line off a record (its fingerprint, or "" for a record written before
+/// session 36, which has none).
+std::string take_sweep_line(std::string& record) {
+  if (record.empty() || record.back() != '\n') return "";
+  const std::size_t start = record.rfind('\n', record.size() - 2);
+  const std::size_t line = start == std::string::npos ? 0 : start + 1;
+  if (record.compare(line, std::string(kSweepTag).size(), kSweepTag) != 0) return "";
+  std::string sweep = record.substr(line + std::string(kSweepTag).size());
+  sweep.pop_back();
+  record.resize(line);
+  return sweep;
 }
 
 std::string open_record(const std::string& text, const std::string& file, const std::string& what) {
@@ -165,7 +207,9 @@ std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& 
     const std::string what = "checkpoint record of job " + std::to_string(j.index) +
                              " (l = " + std::to_string(j.loop_length) + " mm, load case " +
                              std::to_string(j.path) + ")";
-    const std::string record = open_record(slurp(p), p.string(), what);
+    std::string record = open_record(slurp(p), p.string(), what);
+    const std::string sweep = take_sweep_line(record);
+    if (!sweep.empty() && sweep != fingerprint_) continue;  // another sweep's: recomputed
     JobResult r;
     try {
       r = deserialize(record);
@@ -178,18 +222,22 @@ std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& 
 }
 
 void CheckpointStore::store(const JobResult& r) const {
-  io::write_file_atomically(dir_ / job_file(r.index), seal_record(serialize(r)));
+  io::write_file_atomically(dir_ / job_file(r.index), seal_record(serialize(r), fingerprint_));
 }
 
 void CheckpointStore::remove() const {
   // Only the store's own files, then the directory if that emptied it: a file somebody put
-  // there meanwhile stays, with the directory.
+  // there meanwhile stays, with the directory. The manifest goes last, so a run stopped in
+  // between leaves a store that --resume continues (session 36's red team: the manifest went
+  // first in directory order, and --resume then refused the job files left).
   std::error_code ec;
   std::vector<fs::path> ours;
   for (auto it = fs::directory_iterator(dir_, ec); !ec && it != fs::directory_iterator();
        it.increment(ec))
     if (is_store_file(it->path().filename().string()) && it->is_regular_file(ec))
       ours.push_back(it->path());
+  std::stable_partition(ours.begin(), ours.end(),
+                        [](const fs::path& p) { return p.filename() != kManifest; });
   for (const auto& p : ours) fs::remove(p, ec);
   fs::remove(dir_, ec);  // fails (and keeps it) unless empty
 }

@@ -319,6 +319,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_sweep_database(opt.output, db, in, rep.results, rep);
   rep.wrote_database = true;
+  if (opt.on_written) opt.on_written();
   if (!opt.keep_parts) store->remove();
   return rep;
 }

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "../output_test_util.hpp"
@@ -677,6 +678,99 @@ TEST_CASE("sweep: --force discards only checkpoints the sweep wrote", "[unit]") 
     CHECK(fs::exists(parts / "job_00000.txt"));
   }
   fs::remove_all(parts);
+}
+
+TEST_CASE("sweep: a job file copied from another sweep's checkpoints is recomputed on --resume",
+          "[unit]") {
+  // Session 36's red team: job files of a sweep with another friction, copied into this
+  // sweep's parts directory, were taken on --resume with exit 0 (a record holds its path, not
+  // the cell it was run with). Every record now names its sweep's fingerprint.
+  namespace fs = std::filesystem;
+  const auto dir = knit_test::scratch("sweep_unit_foreign_jobs");
+  const auto in = synthetic_input();
+  const auto jobs = make_jobs(in);
+  const int n = static_cast<int>(jobs.size());
+  auto other_definition = nlohmann::json::parse(in.job_definition());
+  other_definition["session36_other_cell"] = 0.3;  // same paths, another sweep
+  const auto other = dir / "other.h5", out = dir / "db.h5";
+  {
+    CheckpointStore a(other, other_definition.dump(), n, false, false);
+    for (int i : {0, 3})
+      a.store(run_job(jobs[static_cast<std::size_t>(i)], in.retry, synthetic_runner()));
+    CheckpointStore b(out, in.job_definition(), n, false, false);
+    b.store(run_job(jobs[1], in.retry, synthetic_runner()));
+  }
+  const auto parts = CheckpointStore::parts_dir(out);
+  for (const char* f : {"job_00000.txt", "job_00003.txt"})
+    fs::copy_file(CheckpointStore::parts_dir(other) / f, parts / f);
+  const CheckpointStore b(out, in.job_definition(), n, true, false);
+  const auto finished = b.load_finished(jobs);
+  REQUIRE(finished.size() == 1);
+  CHECK(finished.count(1) == 1);
+  // A record written before session 36 (no sweep line, sealed as then) is still taken.
+  std::string text = knit_test::read_text(parts / "job_00000.txt");
+  const auto sweep_line = text.rfind("\nsweep ");
+  REQUIRE(sweep_line != std::string::npos);
+  text.resize(sweep_line + 1);
+  knit_test::write_text(parts / "job_00000.txt",
+                        text + "digest fnv1a64 " + knit::meso::sweep::fingerprint(text) + "\n");
+  CHECK(b.load_finished(jobs).size() == 2);
+}
+
+TEST_CASE("sweep: checkpoints without a finished case are discarded, with or without --resume",
+          "[unit]") {
+  // Session 36's red team: a run stopped while it wrote its first manifest left only the
+  // manifest's temporary; --resume then said "manifest is missing or damaged ... use --force"
+  // and a plain run "checkpoints of an unfinished sweep exist".
+  namespace fs = std::filesystem;
+  const auto dir = knit_test::scratch("sweep_unit_empty_parts");
+  const auto in = synthetic_input();
+  const int n = static_cast<int>(make_jobs(in).size());
+  const auto out = dir / "db.h5";
+  const auto parts = CheckpointStore::parts_dir(out);
+  for (const bool resume : {false, true}) {
+    fs::remove_all(parts);
+    fs::create_directories(parts);
+    std::ofstream(parts / ".manifest.json.tmp-999999999-0") << "{\"form";
+    INFO("resume " << resume);
+    CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, resume, false));
+    CHECK(fs::exists(parts / "manifest.json"));
+    CHECK_FALSE(fs::exists(parts / ".manifest.json.tmp-999999999-0"));
+  }
+  // A manifest of another sweep input without any record: nothing to lose either.
+  {
+    fs::remove_all(parts);
+    CheckpointStore(out, R"({"other": 1})", n, false, false);
+  }
+  CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, true, false));
+  // With a record, the refusals stand.
+  CheckpointStore(out, in.job_definition(), n, true, false)
+      .store(run_job(make_jobs(in)[0], in.retry, synthetic_runner()));
+  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, false),
+                    Catch::Contains("checkpoints of an unfinished sweep exist"));
+  CHECK_THROWS_WITH(CheckpointStore(out, R"({"other": 1})", n, true, false),
+                    Catch::Contains("different sweep input"));
+}
+
+TEST_CASE(
+    "sweep: on_written is called with the database in place and the checkpoints not yet "
+    "removed",
+    "[unit]") {
+  // The command changes its interrupt line there (session 36's red team: a stop while the
+  // checkpoints were removed said "continue with --resume" of a complete database).
+  namespace fs = std::filesystem;
+  const auto dir = knit_test::scratch("sweep_unit_on_written");
+  const auto in = synthetic_input();
+  auto o = quiet(dir / "db.h5");
+  int calls = 0;
+  o.on_written = [&] {
+    ++calls;
+    CHECK(fs::exists(dir / "db.h5"));
+    CHECK(fs::exists(CheckpointStore::parts_dir(dir / "db.h5") / "manifest.json"));
+  };
+  CHECK(run_sweep(in, o, synthetic_runner()).wrote_database);
+  CHECK(calls == 1);
+  CHECK_FALSE(fs::exists(CheckpointStore::parts_dir(dir / "db.h5")));
 }
 
 TEST_CASE("sweep: the residual stress at F* = I is subtracted (or kept) consistently", "[unit]") {

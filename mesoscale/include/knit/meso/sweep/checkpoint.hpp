@@ -5,9 +5,10 @@
 // that finished and loses nothing. Every job file ends with a digest line (64-bit FNV-1a of the
 // record text above it); on --resume a record whose digest does not match (edited by hand,
 // damaged on disk) or that does not parse is refused with knit::InputError naming the file and
-// the record (exit 2): delete that file to recompute the case, or use --force. The database itself
-// is assembled from the job files and written atomically at the end; the parts directory is then
-// removed.
+// the record (exit 2): delete that file to recompute the case, or use --force. Before the
+// digest, a "sweep <fingerprint>" line ties the record to its sweep (session 36). The database
+// itself is assembled from the job files and written atomically at the end; the parts directory is
+// then removed.
 #pragma once
 
 #include <filesystem>
@@ -29,13 +30,17 @@ class CheckpointStore {
   ///                  --resume or --force), unless force = true (then it is discarded);
   ///  resume = true:  an existing directory must carry the same fingerprint (InputError
   ///                  otherwise); a missing one starts fresh.
+  /// A directory of ours without a finished case's record (a run stopped while it wrote its
+  /// first manifest) is discarded either way: nothing in it can be continued or lost.
   CheckpointStore(const std::filesystem::path& database, const std::string& job_definition,
                   int job_count, bool resume, bool force);
 
   const std::filesystem::path& dir() const { return dir_; }
   /// Finished results found on opening, validated against the jobs: a record with a missing
   /// or wrong digest, or one that does not parse, throws knit::InputError (file + record);
-  /// a valid record of another job definition is ignored and recomputed.
+  /// a valid record of another job definition, or one sealed for another sweep (its sweep
+  /// line names another fingerprint: a job file copied from other checkpoints), is ignored
+  /// and recomputed.
   std::map<int, JobResult> load_finished(const std::vector<Job>& jobs) const;
   /// Persists one result atomically.
   void store(const JobResult& r) const;
@@ -44,6 +49,7 @@ class CheckpointStore {
 
  private:
   std::filesystem::path dir_;
+  std::string fingerprint_;  ///< of the job definition; every record carries it
 };
 
 }  // namespace knit::meso::sweep

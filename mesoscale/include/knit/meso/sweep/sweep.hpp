@@ -12,6 +12,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct SweepOptions {
   std::FILE* progress = stderr;  ///< progress bar / lines (nullptr: silent)
   int tty = -1;                  ///< -1 detect, 0 plain lines, 1 bar
   std::FILE* log = stdout;       ///< summary, time per case (nullptr: silent)
+  /// Called once the database is in place, before the checkpoints are removed (the command
+  /// changes what an interrupt from then on says: the database is complete).
+  std::function<void()> on_written;
 };
 
 struct SweepReport {
