@@ -11,6 +11,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
@@ -55,6 +56,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
         auto db = knit::material::read_database(o->db, true);
         const bool paper = o->law != "energy", energy = o->law != "paper";
         int rc = knit::kExitOk;
+        std::string first_failure;  // for stderr (session 36: only stdout said why)
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()
                   << " loop lengths, law " << o->law << ")\n";
         if (paper) {
@@ -63,8 +65,14 @@ static knit::cli::SubcommandRegistrar reg_fit(
                                     : FitOptions::from_json(read_text_file(o->options), o->options);
           const auto fits = fit_paper_law(db, fo);
           print_fit_summaries(std::cout, db, fits);
-          for (const auto& f : fits)
-            if (!f.ok()) rc = knit::kExitFailure;
+          for (std::size_t k = 0; k < fits.size(); ++k)
+            if (!fits[k].ok()) {
+              rc = knit::kExitFailure;
+              if (first_failure.empty())
+                first_failure =
+                    "the paper law at l = " + knit::io::format_number(db.entries[k].loop_length) +
+                    " mm: " + fits[k].reason;
+            }
         }
         if (energy) {
           EnergyFitOptions eo = o->energy_options.empty()
@@ -76,7 +84,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
           std::cout << energy_fit_report(s);
           if (s.status == FitStatus::kRefused)
             throw knit::InputError(o->db, "", "energy law refused: " + s.reason);
-          if (!s.ok()) rc = knit::kExitFailure;
+          if (!s.ok()) {
+            rc = knit::kExitFailure;
+            if (first_failure.empty()) first_failure = "the energy law: " + s.reason;
+          }
         }
         // A fit that failed writes nothing: the database would otherwise carry the laws that
         // were fitted beside the old law of the one that failed (or none), and replacing the
@@ -84,6 +95,9 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // data). The target is left as it was.
         if (rc != knit::kExitOk) {
           std::cout << "database NOT written: a fit failed; " << target << " is left as it was\n";
+          std::cout.flush();
+          std::cerr << "knit-meso fit: error: " << first_failure << "; " << target
+                    << " is left as it was (the fit's report is on stdout)\n";
           return rc;
         }
         db.provenance = knit::material::current_provenance();

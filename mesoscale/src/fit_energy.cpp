@@ -237,7 +237,17 @@ std::string EnergyFitOptions::validate() const {
   if (!(std::isfinite(stable_min_cos) && stable_min_cos <= 1.0))
     return "stable_min_cos must be finite and <= 1 (below -1: keep every state)";
   for (const auto& d : directions)
-    if (!d.allFinite() || d.norm() == 0.0) return "directions must be finite and non-zero";
+    if (!d.allFinite() || !(std::isfinite(d.norm()) && d.norm() > 0.0))
+      return "directions must be finite and non-zero, with a finite length";
+  // Two parallel directions (with their mirrors): refused where the law is laid out, which
+  // is after every case of a sweep (session 36's red team: exit 1 after the whole sweep).
+  if (!directions.empty()) try {
+      (void)material::mirror_closed(directions);
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      return "directions must not hold parallel ones (with their mirrors, (a, b, -c)): " +
+             what.substr(what.find(':') + 2);
+    }
   if (family != "ridge" && family != "network") return "family must be \"ridge\" or \"network\"";
   if (hidden1 < 1 || hidden1 > 64 || hidden2 < 1 || hidden2 > 64)
     return "hidden1 and hidden2 must be in 1..64";

@@ -23,6 +23,20 @@ int run(const std::string& args) {
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
+/// As run(), with the command's stderr returned in `err`.
+int run_with_stderr(const std::string& args, const std::filesystem::path& err_file,
+                    std::string& err) {
+  std::string cmd = KNIT_BIN_DIR;
+  cmd += "/knit-meso ";
+  cmd += args;
+  cmd += " > /dev/null 2> ";
+  cmd += err_file.string();
+  const int rc = std::system(cmd.c_str());
+  std::ifstream in(err_file);
+  err.assign(std::istreambuf_iterator<char>(in), {});
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
 /// The whole file, byte for byte.
 std::string bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -147,8 +161,14 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   const std::string clean_before = bytes(clean);
   const fs::path bad_paper = dir / "cli_fit_fails_paper.json";
   std::ofstream(bad_paper) << R"({"smoothing": 0, "control_points_1": 15})";
-  CHECK(run("fit " + clean.string() + " --law paper --options " + bad_paper.string()) == 1);
+  std::string err;
+  CHECK(run_with_stderr("fit " + clean.string() + " --law paper --options " + bad_paper.string(),
+                        dir / "cli_fit_fails_paper.err", err) == 1);
   CHECK(bytes(clean) == clean_before);
+  // The reason on stderr too (session 36's red team: stderr was empty, only stdout said why).
+  CHECK_THAT(err, Catch::StartsWith("knit-meso fit: error: the paper law at l = 4.5 mm: ") &&
+                      Catch::EndsWith(clean.string() +
+                                      " is left as it was (the fit's report is on stdout)\n"));
   const fs::path bad_energy = dir / "cli_fit_fails_directions.json";
   std::ofstream(bad_energy) << R"({"family": "ridge", "directions": [[1, 0, 0], [2, 0, 0]]})";
   CHECK(run("fit " + clean.string() + " --law energy --energy-options " + bad_energy.string()) ==

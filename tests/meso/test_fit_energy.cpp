@@ -580,6 +580,20 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("/seeed: unknown energy-fit option (did you mean \"seed\"?"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"directions": [[1, 0]]})", "f.json"),
                       Catch::Contains("/directions/0"));
+    // Parallel directions, and one whose length overflows, are refused with the options (a
+    // sweep refused them only when it laid out the law, after every case: session 36).
+    CHECK_THROWS_WITH(
+        EnergyFitOptions::from_json(R"({"directions": [[1, 0, 0], [-2, 0, 0]]})", "f.json"),
+        "f.json: /directions: directions must not hold parallel ones (with their mirrors, (a, "
+        "b, -c)): two directions are parallel");
+    CHECK_THROWS_WITH(
+        EnergyFitOptions::from_json(R"({"directions": [[0, 1, 1], [0, 1, -1]]})", "f.json"),
+        Catch::Contains("/directions: directions must not hold parallel ones"));
+    CHECK_THROWS_WITH(
+        EnergyFitOptions::from_json(R"({"directions": [[1e308, 1e308, 1e308]]})", "f.json"),
+        "f.json: /directions: directions must be finite and non-zero, with a finite length");
+    CHECK_NOTHROW(
+        EnergyFitOptions::from_json(R"({"directions": [[1e150, 0, 1], [0, 1, 1]]})", "f.json"));
     EnergyFitOptions o;
     o.family = "ridge";
     o.directions = {{1, 0, 0}, {2, 0, 0}};
