@@ -41,6 +41,8 @@ std::string describe_range(double lo, double hi, Ends ends) {
     os << "a finite number";
   else if (std::isinf(hi))
     os << (lo_open ? "> " : ">= ") << lo;
+  else if (hi >= 1e300 && !hi_open)  // the inputs' "finite" bound (homog_cell_config.cpp)
+    os << (lo_open ? "> " : ">= ") << lo << " and finite (at most 1e300)";
   else if (std::isinf(lo))
     os << (hi_open ? "< " : "<= ") << hi;
   else
@@ -57,7 +59,10 @@ CLI::Validator number(double lo, double hi, Ends ends) {
         errno = 0;
         char* end = nullptr;
         const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || end == text.c_str() || *end != '\0')
+        // Decimal only: strtod also reads "0x4" (as 4, session 36's red team) and leading
+        // blanks, which the JSON inputs and the integer options refuse.
+        const bool decimal = text.find_first_of("xXpP \t\n") == std::string::npos;
+        if (text.empty() || end == text.c_str() || *end != '\0' || !decimal)
           return "must be a number " + range + ", got \"" + text + "\"";
         if (!std::isfinite(v) || errno == ERANGE)
           return "must be a finite number " + range + ", got " + text;

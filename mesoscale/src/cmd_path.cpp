@@ -200,16 +200,19 @@ knit::cli::SubcommandRegistrar reg(
       auto* ne =
           sub.add_option("--elements", o->elements_arg, "analysis-curve elements (default 32)")
               ->check(knit::cli::integer(4, knit::meso::homog::CellOptions::kMaxElements));
+      // The contact's flags have the bounds of the same keys in --config (finite: below
+      // 1e300; session 36's red team: --penalty 1e308 was taken here, refused there).
+      const double finite = 1e300;
       auto* kn = sub.add_option("--penalty", o->k_N_arg, "normal penalty stiffness k_N (MPa)")
-                     ->check(number(0, inf, Ends::kOpenLow));
+                     ->check(number(0, finite, Ends::kOpenLow));
       auto* g0 = sub.add_option("--allowance", o->g0_arg, "penetration allowance g0 (mm)")
-                     ->check(number(0, inf));
+                     ->check(number(0, finite));
       auto* dl = sub.add_option("--delta", o->delta_arg, "quadratic onset width delta (mm)")
-                     ->check(number(0, inf, Ends::kOpenLow));
+                     ->check(number(0, finite, Ends::kOpenLow));
       auto* mu = sub.add_option("--mu", o->mu_arg, "Coulomb friction coefficient (default 0.15)")
-                     ->check(number(0, inf));
+                     ->check(number(0, finite));
       auto* kt = sub.add_option("--stick", o->k_T_arg, "stick penalty k_T (MPa)")
-                     ->check(number(0, inf, Ends::kOpenLow));
+                     ->check(number(0, finite, Ends::kOpenLow));
       sub.add_flag("--no-vtp", o->no_vtp, "skip the per-step VTP files");
       sub.add_option("--config", o->config,
                      "JSON cell parameters (schemas/cell.schema.json); flags override it");

@@ -159,6 +159,14 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"path --loop-length 4.5 --shear 5 --stick 0", "--stick", "> 0"},
       {"path --loop-length 4.5 --shear 5 --delta 1e999", "--delta", "> 0"},
       {"sweep nothing.json --threads -3", "--threads", "[0, 4096]"},
+      // Session 36's red team: hex and blanks were read by strtod ("0x4" as 4 mm), and the
+      // contact flags took 1e308, which --config refuses.
+      {"cell --loop-length 0x4", "--loop-length", "must be a number in (0, 50], got \"0x4\""},
+      {"cell --loop-length ' 4.5'", "--loop-length", "must be a number in (0, 50]"},
+      {"cell --loop-length 4.5 --diameter 0x1p-2", "--diameter", "got \"0x1p-2\""},
+      {"path --loop-length 4.5 --shear 5 --penalty 1e308", "--penalty",
+       "> 0 and finite (at most 1e300)"},
+      {"path --loop-length 4.5 --shear 5 --mu 1e301", "--mu", ">= 0 and finite (at most 1e300)"},
       // Session 24: a NaN residual of the loop-length match passed its test (the cell was
       // written with a measured length of NaN, exit 0); a loop too short for its yarn was exit
       // 1 in `path`, naming no option; an empty value was taken as the option left out.

@@ -36,7 +36,8 @@ struct SubcommandRegistrar {
 enum class Ends { kClosed, kOpenLow, kOpenHigh, kOpen };
 
 /// A validator for a floating-point option: the value must parse completely as a finite
-/// number within [lo, hi] (ends excluded as `ends` says). Use +-infinity for no bound.
+/// decimal number (no hex, no blanks) within [lo, hi] (ends excluded as `ends` says). Use
+/// +-infinity for no bound.
 CLI::Validator number(double lo, double hi, Ends ends = Ends::kClosed);
 
 /// A validator for an integer option: an integer within [lo, hi].
