@@ -249,6 +249,9 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
   std::string where;  // HDF5 path being read, for messages
   try {
     if (!std::filesystem::exists(file)) throw InputError(fname, "", "file not found");
+    // A directory, a FIFO or a device (session 36's red team: "not an HDF5 file" for each).
+    if (std::error_code ec; !std::filesystem::is_regular_file(file, ec))
+      throw InputError(fname, "", "not a regular file (a directory, a device or a pipe?)");
     if (!io::is_hdf5_file(file)) throw InputError(fname, "", "not an HDF5 file (or truncated)");
     const H5File f = H5File::open_read(file);
     Database db;

@@ -171,6 +171,9 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
       throw InputError(ctx.file, p, std::string("missing required key \"") + k + "\"");
   if (!m.at("database").is_string())
     throw InputError(ctx.file, p + "/database", "must be a file name");
+  // "" resolved to the case's own directory (session 36's red team).
+  if (m.at("database").get<std::string>().empty())
+    throw InputError(ctx.file, p + "/database", "must not be empty: give the database's file");
   if (!ctx.patch) throw InputError(ctx.file, p, "the knit material needs the patch");
   std::filesystem::path db = m.at("database").get<std::string>();
   if (db.is_relative() && !ctx.file.empty())

@@ -214,6 +214,14 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     std::ofstream(bad) << "hello";
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("not an HDF5 file"));
   }
+  SECTION("not a regular file") {  // session 36: a directory or /dev/zero was "not an HDF5 file"
+    const auto dir = tmp("a_directory.h5");
+    fs::create_directories(dir);
+    for (const fs::path& p : {dir, fs::path("/dev/zero")})
+      CHECK_THROWS_WITH(read_database(p), p.string() +
+                                              ": not a regular file (a directory, a "
+                                              "device or a pipe?)");
+  }
   SECTION("another format version") {
     const auto bad = tmp("v3.h5");
     fs::copy_file(good, bad, fs::copy_options::overwrite_existing);

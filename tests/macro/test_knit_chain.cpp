@@ -197,4 +197,7 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
   CHECK_THROWS_WITH(
       load(R"({"type": "knit", "database": "/nonexistent/db.h5", "stitch_value": 5})"),
       Catch::Contains("bad.json: /material/database: /nonexistent/db.h5: file not found"));
+  // "" was resolved to the case's directory ("...: not an HDF5 file"; session 36).
+  CHECK_THROWS_WITH(load(R"({"type": "knit", "database": "", "stitch_value": 5})"),
+                    Catch::Contains("bad.json: /material/database: must not be empty"));
 }
