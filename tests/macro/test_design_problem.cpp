@@ -174,6 +174,16 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0],
                             "target": [1]}])"),
          "/objectives/0/at_strain/0");
+  // Session 36's red team: 1e-300 passed --check, then the solve failed (exit 1, no field).
+  // The floor is 1e-6 of the end: 2e-7 here.
+  expect("tiny_strain.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 1.9e-7],
+                            "target": [1, 2]}])"),
+         "/objectives/0/at_strain/1");
+  write(kDir / "floor_strain.json",
+        design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [3e-7],
+                           "target": [1]}])"));
+  CHECK_NOTHROW(load_design((kDir / "floor_strain.json").string()));
   expect("huge_target.json",
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
                             "target": [1e308]}])"),
