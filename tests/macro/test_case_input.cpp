@@ -885,6 +885,19 @@ TEST_CASE("a load within the solver's tolerance stops the run instead of reporti
   RunOptions ro;
   ro.output_dir = d / "supports";
   CHECK(run_case(parse_case(j.dump(), "supports.json"), ro).report.status == RunStatus::kCompleted);
+  // A load the solver must see beside a huge one the supports carry (an area load of 1e10
+  // MPa along z on a patch held in z): the relative tolerance hides the step. Refused, and
+  // said so (session 36's red team: "the loads are too small for the solver to see them").
+  j = strip_case(1e-3);
+  j["loads"].push_back({{"type", "area"}, {"force_per_area", {0, 0, 1e10}}});
+  j["solver"] = {{"steps", 2}};
+  ro.output_dir = d / "hidden";
+  const RunReport hidden = run_case(parse_case(j.dump(), "hidden.json"), ro).report;
+  CHECK(hidden.reason == StopReason::kLoadBelowTolerance);
+  CHECK_THAT(hidden.message, Catch::Contains("lost beside the reference force") &&
+                                 Catch::Contains("lower /solver/tolerance") &&
+                                 !Catch::Contains("too small"));
+  CHECK_THAT(tiny.message, !Catch::Contains("lost beside"));
   fs::remove_all(d);
 }
 
