@@ -325,7 +325,26 @@ DesignProblem load_design(const std::string& path) {
   }
   for (std::size_t k = 0; k < root.at("objectives").size(); ++k) {
     DesignObjective o;
-    read_objective(root.at("objectives")[k], "/objectives/" + std::to_string(k), d.c, path, o);
+    const std::string ptr = "/objectives/" + std::to_string(k);
+    read_objective(root.at("objectives")[k], ptr, d.c, path, o);
+    // Each term is reported by its name (summary.txt, the history): two of one name could not
+    // be told apart (session 36's red team: two "term load_at_20" lines, exit 0). A given name
+    // must be new; a default one (the type) already taken gets the term's index ("_1").
+    const auto taken = [&](const std::string& name) {
+      return std::any_of(d.objectives.begin(), d.objectives.end(),
+                         [&](const DesignObjective& q) { return q.name == name; });
+    };
+    if (taken(o.name)) {
+      if (root.at("objectives")[k].contains("name"))
+        throw InputError(path, ptr + "/name",
+                         "\"" + o.name +
+                             "\" names an earlier term too; terms are reported by name, so each "
+                             "needs its own");
+      o.name += "_" + std::to_string(k);
+      if (taken(o.name))
+        throw InputError(path, ptr,
+                         "its default name \"" + o.name + "\" is taken: give it a \"name\"");
+    }
     d.objectives.push_back(o);
   }
   if (root.contains("smoothness") && root.at("smoothness").contains("weight"))

@@ -174,6 +174,31 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0],
                             "target": [1]}])"),
          "/objectives/0/at_strain/0");
+  // Session 36's red team: two objectives of one name (given, or the type by default) were
+  // reported as two indistinguishable lines of summary.txt.
+  expect("same_name.json",
+         design(kVars, R"([{"type": "reaction", "name": "a", "reaction": "fy", "at_strain": [0.1],
+                            "target": [1]},
+                           {"type": "reaction", "name": "a", "reaction": "fy", "at_strain": [0.2],
+                            "target": [2]}])"),
+         "/objectives/1/name");
+  expect("default_name_given.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1],
+                            "target": [1]},
+                           {"type": "reaction", "name": "reaction", "reaction": "fy",
+                            "at_strain": [0.2], "target": [2]}])"),
+         "/objectives/1/name");
+  {  // default names: the type, then the type with the term's index
+    write(kDir / "default_names.json",
+          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1],
+                             "target": [1]},
+                            {"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                             "target": [2]}])"));
+    const auto p = load_design((kDir / "default_names.json").string());
+    REQUIRE(p.objectives.size() == 2);
+    CHECK(p.objectives[0].name == "reaction");
+    CHECK(p.objectives[1].name == "reaction_1");
+  }
   // Session 36's red team: 1e-300 passed --check, then the solve failed (exit 1, no field).
   // The floor is 1e-6 of the end: 2e-7 here.
   expect("tiny_strain.json",
