@@ -13,6 +13,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/macro/knitmap.hpp"
 
 // A named namespace per command: the cmd_*.cpp files share one unity translation unit
@@ -47,12 +48,16 @@ knit::cli::SubcommandRegistrar reg(
         knit::macro::KnitMapOptions opt;
         opt.angle_tolerance_deg = o->angle_tolerance;
         opt.max_stitches = o->max_stitches;
-        const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
         const std::filesystem::path dir =
             o->output.empty()
                 ? std::filesystem::path(std::filesystem::path(o->case_file).stem().string() +
                                         "_knitmap")
                 : std::filesystem::path(o->output);
+        // Before the map is made, named as run and design name it (session 36's red team:
+        // knitmap said "output directory:" for --output, after the layout).
+        knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
+                                      o->output.empty() ? "output directory" : "--output");
+        const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
         knit::macro::write_knitmap(map, in, dir);
         std::cout << knit::macro::knitmap_summary(map) << "wrote " << dir.string() << "\n";
         // Warnings on stderr as well, as the help's footer says (session 26: only on stdout

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "../output_test_util.hpp"
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/macro/knitmap.hpp"
@@ -563,6 +564,16 @@ TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothin
   CHECK_NOTHROW(make_knitmap(in.c, in.cells, few));
   CHECK(run_knitmap(ok + " --output " + (kDir / "few_out").string() + " --max-stitches 20") == 2);
   CHECK(!fs::exists(kDir / "few_out"));
+  // A user's directory as --output: refused and kept, named "--output" as run and design name
+  // it (session 36's red team: "output directory:").
+  const fs::path user = kDir / "knitmap_user_dir";
+  fs::create_directories(user);
+  std::ofstream(user / "notes.txt") << "mine";
+  CHECK(run_knitmap(ok + " --output " + user.string()) == 2);
+  CHECK_THAT(knit_test::read_text(kDir / "cmd.log"),
+             Catch::Contains(user.string() + ": --output: is a non-empty directory that is not "
+                                             "a knitscale output"));
+  CHECK(knit_test::read_text(user / "notes.txt") == "mine");
 }
 
 TEST_CASE("knitmap: a grading across the courses gives each course the height of its stitches",
