@@ -1,5 +1,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,13 @@
 namespace knit::meso::sweep {
 
 namespace {
+
+/// The shortest text that reads back as x (4.500000000000001, not %g's 4.5).
+std::string shortest(double x) {
+  char b[32];
+  const auto r = std::to_chars(b, b + sizeof b, x);
+  return std::string(b, r.ptr);
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -166,12 +174,16 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
   in.file = file;
   in.json = text;
   in.loop_lengths = j.at("loop_lengths").get<std::vector<double>>();
+  // At least kMinLoopLengthSpacing apart (session 36's red team: 4.5 and 4.500000000000001
+  // were two loop lengths, both reported as "l=4.50", and a repeated one was "got 4.500000
+  // after 4.500000"); printed in full.
+  constexpr double kMinLoopLengthSpacing = 1e-3;
   for (std::size_t k = 1; k < in.loop_lengths.size(); ++k)
-    if (!(in.loop_lengths[k] > in.loop_lengths[k - 1]))
+    if (!(in.loop_lengths[k] >= in.loop_lengths[k - 1] + kMinLoopLengthSpacing))
       throw InputError(file, io::json_pointer_append("/loop_lengths", k),
-                       "loop lengths must be strictly increasing, got " +
-                           std::to_string(in.loop_lengths[k]) + " after " +
-                           std::to_string(in.loop_lengths[k - 1]));
+                       "loop lengths must increase by at least 0.001 mm, got " +
+                           shortest(in.loop_lengths[k]) + " after " +
+                           shortest(in.loop_lengths[k - 1]));
   const int steps = j.value("steps", 20);
 
   const nlohmann::json lp = j.value("load_paths", nlohmann::json{{"preset", "default"}});

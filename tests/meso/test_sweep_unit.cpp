@@ -179,6 +179,11 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
   };
   CHECK(pointer_of(R"({"loop_lengths": [4.5, 4.0]})") == "/loop_lengths/1");
   CHECK(pointer_of(R"({"loop_lengths": [4.5, -1]})") == "/loop_lengths/1");
+  // Session 36's red team: 4.5 and 4.500000000000001 were two loop lengths, both "l=4.50".
+  CHECK_THROWS_WITH(parse_sweep_input(R"({"loop_lengths": [4.5, 4.500000000000001]})", "t.json"),
+                    "t.json: /loop_lengths/1: loop lengths must increase by at least 0.001 mm, "
+                    "got 4.500000000000001 after 4.5");
+  CHECK_NOTHROW(parse_sweep_input(R"({"loop_lengths": [4.5, 4.501]})", "t.json"));
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "steps": 0})") == "/steps");
   // unknown keys: reported on the object that holds them, naming the key
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "stepz": 3})") == "|stepz");
