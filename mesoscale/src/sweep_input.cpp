@@ -122,6 +122,14 @@ std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int ste
         break;
       }
     }
+    // A path that ends where it starts carries no data (session 36's red team: a paper
+    // biaxial path to (0, 0) passed the early checks and folded the surface after the sweep).
+    const bool gradient = p.kind == material::PathKind::kGradient;
+    if (gradient ? p.H.isZero(0.0) : p.target.isZero(0.0))
+      throw InputError(file, io::json_pointer_append(pointer, i),
+                       std::string("the path ends at the reference state (") +
+                           (gradient ? "H = 0" : "a zero end strain") +
+                           "): it carries no data; give it a nonzero end");
     out.push_back(p);
   }
   return out;

@@ -184,6 +184,20 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
                     "t.json: /loop_lengths/1: loop lengths must increase by at least 0.001 mm, "
                     "got 4.500000000000001 after 4.5");
   CHECK_NOTHROW(parse_sweep_input(R"({"loop_lengths": [4.5, 4.501]})", "t.json"));
+  // Paths that end at the reference state carry no data (session 36's red team: a paper
+  // biaxial path to (0, 0) folded the surface after the whole sweep).
+  // (A shear path of 0 deg is the schema's: gamma_deg > 0.)
+  for (const char* path : {R"({"kind": "biaxial", "E11": 0, "E22": 0})",
+                           R"({"kind": "uniaxial", "axis": "wale", "E": 0})",
+                           R"({"kind": "gradient", "H": [[0, 0], [0, 0]]})"}) {
+    INFO(path);
+    CHECK_THROWS_WITH(
+        parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": {"preset": )"
+                                      R"("default", "extra": [)") +
+                              path + "]}}",
+                          "t.json"),
+        Catch::StartsWith("t.json: /load_paths/extra/0: the path ends at the reference state"));
+  }
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "steps": 0})") == "/steps");
   // unknown keys: reported on the object that holds them, naming the key
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "stepz": 3})") == "|stepz");
