@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
@@ -71,8 +72,22 @@ long pid_in_name(const std::string& f, const std::string& prefix, bool with_coun
   return std::stol(digits);
 }
 
+/// Whether a file's content could be a temporary of ours that a kill cut short: empty, or an
+/// HDF5 file (the databases; text outputs are written inside output directories, which are
+/// replaced whole). Session 36's red team: a user's text file named ".X.h5.tmp-999999-0" was
+/// deleted by `knit-meso synth -o X.h5`.
+bool looks_like_our_temporary(const fs::path& p) {
+  static constexpr char kHdf5Signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  std::ifstream in(p, std::ios::binary);
+  char head[8] = {};
+  in.read(head, sizeof head);
+  const std::streamsize n = in.gcount();
+  return n == 0 || (n == 8 && std::memcmp(head, kHdf5Signature, 8) == 0);
+}
+
 /// Removes the temporaries ".<name>.tmp-<pid>-<n>" of `target` left by killed runs: regular
-/// files only, and only when their pid is dead (ours may be writing another one right now).
+/// files only, only when their pid is dead (ours may be writing another one right now), and
+/// only when their content could be ours (looks_like_our_temporary).
 void remove_stale_temporaries(const fs::path& target) {
   std::string prefix(".");
   prefix += target.filename().string();
@@ -82,7 +97,8 @@ void remove_stale_temporaries(const fs::path& target) {
        !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const long pid = pid_in_name(it->path().filename().string(), prefix, true);
     std::error_code st;
-    if (pid > 0 && pid_is_dead(pid) && fs::is_regular_file(fs::symlink_status(it->path(), st))) {
+    if (pid > 0 && pid_is_dead(pid) && fs::is_regular_file(fs::symlink_status(it->path(), st)) &&
+        looks_like_our_temporary(it->path())) {
       std::error_code rm;
       fs::remove(it->path(), rm);
     }

@@ -691,9 +691,14 @@ TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its tar
   fs::remove_all(d);
   fs::create_directories(d);
   const std::string dead = std::to_string(999999999);
-  auto make = [&](const std::string& name) { std::ofstream(d / name) << "partial"; };
-  make(".db.h5.tmp-" + dead + "-0");                          // dead writer: removed
-  make(".db.h5.tmp-" + dead + "-17");                         // dead writer: removed
+  // A killed writer's temporary: an HDF5 file cut short (its signature), or empty.
+  const std::string hdf5_head("\x89HDF\r\n\x1a\n", 8);
+  auto make = [&](const std::string& name) { std::ofstream(d / name) << hdf5_head + "partial"; };
+  make(".db.h5.tmp-" + dead + "-0");                         // dead writer: removed
+  make(".db.h5.tmp-" + dead + "-17");                        // dead writer: removed
+  std::ofstream(d / (".db.h5.tmp-" + dead + "-5")).close();  // empty: removed
+  // A user's text file of that name: not ours, kept (session 36's red team: deleted).
+  std::ofstream(d / (".db.h5.tmp-" + dead + "-9")) << "my notes";
   make(".db.h5.tmp-1-0");                                     // pid 1 lives: kept
   make(".db.h5.tmp-" + dead);                                 // no counter: not our pattern
   make(".db.h5.tmp-" + dead + "-x");                          // not a counter
@@ -703,6 +708,8 @@ TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its tar
   CHECK(slurp(d / "db.h5") == "new");
   CHECK_FALSE(fs::exists(d / (".db.h5.tmp-" + dead + "-0")));
   CHECK_FALSE(fs::exists(d / (".db.h5.tmp-" + dead + "-17")));
+  CHECK_FALSE(fs::exists(d / (".db.h5.tmp-" + dead + "-5")));
+  CHECK(slurp(d / (".db.h5.tmp-" + dead + "-9")) == "my notes");
   CHECK(fs::exists(d / ".db.h5.tmp-1-0"));
   CHECK(fs::exists(d / (".db.h5.tmp-" + dead)));
   CHECK(fs::exists(d / (".db.h5.tmp-" + dead + "-x")));

@@ -29,7 +29,8 @@ namespace knit::io {
 
 /// One output file written to "<dir>/.<name>.tmp-<pid>-<n>" and renamed over the target on
 /// commit(). Not copyable; movable. The constructor removes stale temporaries of the same
-/// target left by killed processes (regular files of that name whose pid is dead).
+/// target left by killed processes (regular files of that name whose pid is dead and whose
+/// content is empty or HDF5: a user's file of that name is not ours to delete).
 class AtomicFile {
  public:
   /// The target's directory must exist (throws std::runtime_error otherwise).
