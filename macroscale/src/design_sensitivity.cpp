@@ -227,18 +227,14 @@ Sensitive DesignSolve::reaction(int k, const ReactionOutput& r) const {
   // A corner reaction sums over the corner's pad, corner_region(radius), as run_case writes it
   // (session 31: only the corner control point was read, so a design on an output with a
   // radius optimized another number than the one its run reports).
-  const std::vector<int> pad =
-      r.at_edge ? std::vector<int>{} : corner_region(c_.surface, r.corner, r.radius);
-  auto apply = [&](const Eigen::VectorXd& f) {
-    if (r.at_edge) return edge_reaction(m, f, r.edge, r.component, r.rows);
-    double sum = 0.0;
-    for (int a : pad) sum += f(3 * a + r.component);
-    return sum;
-  };
+  // The support reaction as run_case writes it (the dead load at the points taken off; it
+  // does not depend on the design, so the derivatives are those of f_int alone).
+  const std::vector<int> points = reaction_points(m, r);
   Sensitive s;
-  s.value = apply(L.fint);
+  s.value = support_reaction(L.fint, problem_->fext, L.lambda, points, r.component);
   s.d.resize(L.df.cols());
-  for (Eigen::Index j = 0; j < L.df.cols(); ++j) s.d(j) = apply(L.df.col(j));
+  for (Eigen::Index j = 0; j < L.df.cols(); ++j)
+    s.d(j) = sum_over(L.df.col(j), points, r.component);
   return s;
 }
 

@@ -86,13 +86,19 @@ Problem setup_problem(const Case& c) {
   return p;
 }
 
-double edge_reaction(const ShellModel& m, const Eigen::VectorXd& fint, Edge edge, int component,
-                     int rows) {
+std::vector<int> reaction_points(const ShellModel& m, const ReactionOutput& r) {
+  if (!r.at_edge) return corner_region(m.surface(), r.corner, r.radius);
   const int nu = m.surface().size_u(), nv = m.surface().size_v();
-  double f = 0.0;
-  for (int r = 0; r < rows; ++r)
-    for (int a : edge_row(nu, nv, edge, r)) f += fint(3 * a + component);
-  return f;
+  std::vector<int> points;
+  for (int row = 0; row < r.rows; ++row)
+    for (int a : edge_row(nu, nv, r.edge, row)) points.push_back(a);
+  return points;
+}
+
+double sum_over(const Eigen::VectorXd& f, const std::vector<int>& points, int component) {
+  double sum = 0.0;
+  for (int a : points) sum += f(3 * a + component);
+  return sum;
 }
 
 std::string material_failure_message(const RunReport& report, long n) {
@@ -127,10 +133,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   const bool had_output = writer && std::filesystem::is_directory(opt.output_dir, ec) &&
                           !std::filesystem::is_empty(opt.output_dir, ec);
   RunResult res;
-  std::vector<std::vector<int>> corner_sets;  // the control points of each corner reaction
-  for (const ReactionOutput& r : c.output.reactions)
-    corner_sets.push_back(r.at_edge ? std::vector<int>{}
-                                    : corner_region(c.surface, r.corner, r.radius));
+  std::vector<std::vector<int>> reaction_sets;  // the control points of each reaction
+  for (const ReactionOutput& r : c.output.reactions) reaction_sets.push_back(reaction_points(m, r));
   int outputs = 0;
   Eigen::VectorXd last_written;
   ShellModel::Evaluation audit;
@@ -147,15 +151,9 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
       row.applied = s.lambda * c.output.applied->value;
       row.strain = row.applied / c.output.applied->gauge_length;
     }
-    for (size_t k = 0; k < c.output.reactions.size(); ++k) {
-      const ReactionOutput& r = c.output.reactions[k];
-      double f = 0.0;
-      if (r.at_edge)
-        f = edge_reaction(m, s.fint, r.edge, r.component, r.rows);
-      else
-        for (int a : corner_sets[k]) f += s.fint(3 * a + r.component);
-      row.reactions.push_back(f);
-    }
+    for (size_t k = 0; k < c.output.reactions.size(); ++k)
+      row.reactions.push_back(support_reaction(s.fint, p.fext, s.lambda, reaction_sets[k],
+                                               c.output.reactions[k].component));
     for (const OutputPoint& op : c.output.points) row.points.push_back(m.displacement(s.u, op.at));
     row.iterations = s.iterations;
     row.residual = s.residual;

@@ -577,6 +577,32 @@ TEST_CASE("case file: Sze cantilever", "[case][verification]") {
   CHECK(checked == 2);
 }
 
+TEST_CASE("reactions balance the applied loads, an area load on the supported row included",
+          "[unit]") {
+  // Session 36's physics red team: the edge reaction summed f_int alone, so the share of an
+  // area load on the supported row's control points was missing from the balance (3.05 % of
+  // the applied total at 2 x 2 elements). Now sum f_int - lambda f_ext, here at every step:
+  // the u0 edge (x fixed) carries the whole x load of the strip, edge and area load together.
+  for (const int elements : {2, 4}) {
+    json j = strip_case(0.3);  // 0.3 N/mm on the free edge u1 (1 mm long): 0.3 N
+    j["refinement"]["elements"] = {elements, 1};
+    j["loads"].push_back({{"type", "area"}, {"force_per_area", {0.02, 0, 0}}});  // 10 mm^2
+    j["solver"] = {{"steps", 3}};
+    j["output"] = {
+        {"vtk", false},
+        {"hdf5", false},
+        {"reactions", json::array({{{"name", "rx"}, {"edge", "u0"}, {"component", "x"}},
+                                   {{"name", "ry"}, {"edge", "u0"}, {"component", "y"}}})}};
+    const RunResult r = run_case(parse_case(j.dump(), "balance.json"), {});
+    REQUIRE(r.report.status == RunStatus::kCompleted);
+    INFO(elements << " elements");
+    for (const StepRow& row : r.rows) {
+      CHECK(row.reactions[0] == Approx(-row.lambda * 0.5).epsilon(1e-9));
+      CHECK(std::abs(row.reactions[1]) < 1e-12);
+    }
+  }
+}
+
 TEST_CASE("case file: tensile test with an isotropic stand-in material", "[case]") {
   const Case c = load_case(std::string(KNIT_SOURCE_DIR) + "/cases/verification/tensile_svk.json");
   const RunResult r = run_case(c, {});
