@@ -54,6 +54,12 @@ st = $(addprefix $(RES)/,$(addsuffix .status,$(1)))
 # output (the marker .knitscale-output, as scripts/run.sh; docs/reproduction.md): the targets
 # below write figures/, results/, logs/ ... into it, so another directory's files are not ours
 # to replace. Checked when the makefile is read, for every goal but clean (which has its own).
+# An OUT make cannot carry as one word (a space: `clean` removed a user's directory and the
+# caller's out/..., session 36) is refused for every goal, clean included (scripts/run.sh also
+# refuses $ ; # : , ~ and quotes, which make expands or parses before this is read).
+ifneq ($(words $(OUT)),1)
+$(error OUT="$(OUT)" holds a space (or is empty): make cannot carry it as one path; give a path of letters, digits and / . _ - + @)
+endif
 ifneq ($(filter-out clean,$(or $(MAKECMDGOALS),all)),)
 OUT_STATE := $(shell d='$(OUT)'; \
   if [ -e "$$d" ] && [ ! -d "$$d" ]; then echo notdir; \
@@ -325,8 +331,8 @@ clean:
 	@if [ "$(OUT)" != "$(ROOT)/out" ] && [ ! -f "$(OUT)/.knitscale-output" ]; then \
 	  echo "clean: $(OUT) holds no .knitscale-output file: not a pipeline output, nothing removed" >&2; \
 	  exit 2; fi
-	rm -rf $(OUT)/database.h5 $(OUT)/database.source $(OUT)/database.time $(OUT)/cases \
-	  $(OUT)/results $(OUT)/figures $(OUT)/logs $(OUT)/cells $(OUT)/knitmap $(OUT)/design \
-	  $(OUT)/report.md
+	rm -rf "$(OUT)/database.h5" "$(OUT)/database.source" "$(OUT)/database.time" "$(OUT)/cases" \
+	  "$(OUT)/results" "$(OUT)/figures" "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" \
+	  "$(OUT)/design" "$(OUT)/report.md"
 
 FORCE:

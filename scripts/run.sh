@@ -3,14 +3,23 @@
 # reproduction pipeline on its defaults. Outputs go to out/ (override with KNIT_OUT=DIR).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$root/scripts/setup.sh"
-# Only the executables the pipeline runs; the test executables are built by scripts/test.sh.
 out="${KNIT_OUT:-$root/out}"
 # A KNIT_OUT of the user's is written only if it is new, empty or an earlier run's output (the
 # marker file .knitscale-output, written below): the pipeline writes figures/, results/, logs/
 # ... into it and `make clean` removes them, so another directory's files are not ours to
 # replace. The default out/ of the checkout is the pipeline's own.
 marker="$out/.knitscale-output"
+# make cannot carry every path: a space splits it into two words (`make clean` then removed
+# "DIR/my" and "out/..." of the current directory: session 36's red team), a $ is expanded by
+# make (the outputs went to another directory, exit 0), ; # : = % and quotes break its syntax.
+# The output path is refused before anything is written, with the character named.
+case "$out" in
+  *[!A-Za-z0-9/._+@-]*)
+    bad=$(printf '%s' "$out" | tr -d 'A-Za-z0-9/._+@-' | cut -c1)
+    echo "run: KNIT_OUT=$out holds the character '$bad', which the pipeline's makefile cannot" \
+      "carry in a path (use letters, digits and / . _ - + @); give another directory" >&2
+    exit 2 ;;
+esac
 if [ -n "${KNIT_OUT:-}" ]; then
   if [ -e "$out" ] && [ ! -d "$out" ]; then
     echo "run: KNIT_OUT=$out exists and is not a directory" >&2
@@ -22,9 +31,12 @@ if [ -n "${KNIT_OUT:-}" ]; then
     exit 2
   fi
 fi
+# The output path is judged first (above), then what is missing is installed.
+"$root/scripts/setup.sh"
 mkdir -p "$out"
 [ -f "$marker" ] || echo "knitscale output: the reproduction pipeline (scripts/run.sh)" > "$marker"
 if [ -f "$root/scripts/pipeline.mk" ]; then
+  # Only the executables the pipeline runs; the test executables are built by scripts/test.sh.
   pipeline=(make -f "$root/scripts/pipeline.mk" ROOT="$root" BUILD="$root/build" OUT="$out")
   # knit-meso first; then the material database (the mesoscale sweep, the pipeline's longest
   # step, which needs knit-meso only) runs while knit-macro is compiled: the cores idle at

@@ -1,0 +1,77 @@
+#!/usr/bin/python3
+"""scripts/run.sh and scripts/pipeline.mk (session 36's red team): output paths that make cannot
+carry are refused before anything is written, and `make clean` never reaches outside OUT.
+
+A space in OUT split it into two words: `make clean` removed "DIR/my" (a user's directory) and
+"out/..." of the caller's directory; a $ was expanded by make, so every output went to another
+directory with exit 0. run.sh refuses such a KNIT_OUT before it installs or builds anything;
+the makefile refuses an OUT of more than one word for every goal, clean included. Run by CTest
+(tests/CMakeLists.txt, label report); needs make and bash only (no build, no Python modules).
+"""
+import os
+import subprocess
+import tempfile
+
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def run_sh(out):
+    env = dict(os.environ, KNIT_OUT=out)
+    r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "run.sh")], env=env,
+                       capture_output=True, text=True, timeout=60)
+    return r.returncode, r.stdout + r.stderr
+
+
+def make_clean(out, cwd):
+    r = subprocess.run(["make", "-f", os.path.join(ROOT, "scripts", "pipeline.mk"),
+                        "ROOT=" + ROOT, "BUILD=" + os.path.join(cwd, "nobuild"), "OUT=" + out,
+                        "clean"], cwd=cwd, capture_output=True, text=True, timeout=60)
+    return r.returncode, r.stdout + r.stderr
+
+
+def main():
+    check = Checklist()
+    with tempfile.TemporaryDirectory() as d:
+        mine = os.path.join(d, "my")
+        os.makedirs(mine)
+        thesis = os.path.join(mine, "thesis.txt")
+        with open(thesis, "w") as f:
+            f.write("precious")
+        # The caller's own out/ (the relative word "out/..." of a split path).
+        os.makedirs(os.path.join(d, "out"))
+        callers = os.path.join(d, "out", "database.h5")
+        with open(callers, "w") as f:
+            f.write("the caller's")
+        for bad, char in ((mine + " out", " "), (os.path.join(d, "res$x"), "$"),
+                          (os.path.join(d, "a;b"), ";"), (os.path.join(d, "a#b"), "#"),
+                          (os.path.join(d, "a,b"), ","), (os.path.join(d, "a:b"), ":")):
+            rc, out = run_sh(bad)
+            check(rc == 2 and ("holds the character '%s'" % char) in out
+                  and not os.path.exists(bad),
+                  "run.sh refuses KNIT_OUT=%r (exit %d), nothing created" % (bad, rc), out)
+        check(not os.path.exists(os.path.join(d, "res")), "a $ did not redirect to DIR/res")
+        # The makefile's clean with a spaced OUT (the marker made as run.sh made it before).
+        spaced = mine + " out"
+        os.makedirs(spaced)
+        with open(os.path.join(spaced, ".knitscale-output"), "w") as f:
+            f.write("knitscale output: the reproduction pipeline (scripts/run.sh)\n")
+        rc, out = make_clean(spaced, d)
+        check(rc != 0 and "holds a space" in out, "make clean refuses OUT with a space", out)
+        check(os.path.exists(thesis) and open(callers).read() == "the caller's",
+              "the user's directory and the caller's out/ are kept")
+        # A plain OUT: clean removes the pipeline's files only inside it.
+        plain = os.path.join(d, "plain")
+        os.makedirs(os.path.join(plain, "figures"))
+        with open(os.path.join(plain, ".knitscale-output"), "w") as f:
+            f.write("knitscale output: the reproduction pipeline (scripts/run.sh)\n")
+        rc, out = make_clean(plain, d)
+        check(rc == 0 and not os.path.exists(os.path.join(plain, "figures"))
+              and open(callers).read() == "the caller's",
+              "make clean of a plain OUT removes its figures/ only", out)
+    return check.exit_code()
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
