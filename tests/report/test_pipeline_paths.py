@@ -8,6 +8,7 @@ directory with exit 0. run.sh refuses such a KNIT_OUT before it installs or buil
 the makefile refuses an OUT of more than one word for every goal, clean included. Run by CTest
 (tests/CMakeLists.txt, label report); needs make and bash only (no build, no Python modules).
 """
+import json
 import os
 import subprocess
 import tempfile
@@ -70,6 +71,24 @@ def main():
         check(rc == 0 and not os.path.exists(os.path.join(plain, "figures"))
               and open(callers).read() == "the caller's",
               "make clean of a plain OUT removes its figures/ only", out)
+        # resolve_case.py writes the database relative to the resolved case, so a copied or
+        # moved output directory runs its cases against its own database (session 36).
+        a = os.path.join(d, "outA")
+        os.makedirs(os.path.join(a, "cases"))
+        case = os.path.join(a, "cases", "s312_uniform_45_wale.json")
+        subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "figures",
+                                                         "resolve_case.py"),
+                        os.path.join(ROOT, "cases", "paper", "s312_uniform_45_wale.json"),
+                        os.path.join(a, "database.h5"), case], check=True)
+        with open(case) as f:
+            db = json.load(f)["material"]["database"]
+        check(db == os.path.join("..", "database.h5"), "the resolved case names ../database.h5",
+              db)
+        b = os.path.join(d, "outB")
+        os.rename(a, b)
+        moved = os.path.join(b, "cases", "s312_uniform_45_wale.json")
+        check(os.path.normpath(os.path.join(os.path.dirname(moved), db)) ==
+              os.path.join(b, "database.h5"), "moved, it names the moved directory's database")
     return check.exit_code()
 
 
