@@ -749,6 +749,44 @@ def l_interpolation_failures(tmp):
     return out + unknown_value_failures(db, "l_interpolation", "spline", "l_interpolation")
 
 
+def held_out_agreement_failures(tmp):
+    """The held-out verdict against the stored law re-evaluated (session 36's red team: the
+    diagnostics' attributes set to all within with h5py turned it to PASS while the sentence
+    below it said otherwise). A law S = 2 e, 24 held-out runs (12 per loop length's record, one
+    loop length) on the law; the stored figures say so (PASS); the same law with its stored
+    count raised above the re-evaluation, or one state moved off the law with the stored count
+    left at all within (FAIL, the disagreement said)."""
+    import h5py
+    out = []
+    db = os.path.join(tmp, "agree.h5")
+
+    def write(within=24, off=0.0):
+        with h5py.File(db, "w") as f:
+            f["loop_lengths"] = [5.0]
+            law = linear_network_law(f, 2.0)
+            d = law.create_group("diagnostics")
+            d["loop_length"], d["rms_relative"], d["max_relative"] = [5.0], [0.01], [0.02]
+            d.attrs["holdout_points"], d.attrs["holdout_within_5_percent"] = 24, within
+            d.attrs["holdout_max_relative"] = 0.0
+            raw_path(f, "path_00", "coverage", [[0, 0, 0], [5.0, 0, 0]], [[0, 0, 0], [10.0, 0, 0]])
+            for q in range(24):
+                e = 0.01 * (q + 1)
+                raw_path(f, f"path_{q + 1:02d}", "holdout", [[e, 0, 0]],
+                         [[2 * e + (off if q == 0 else 0.0), 0, 0]])
+
+    def row():
+        return report.law_checks(db, {})[2]
+
+    write()
+    if row()[3] is not True or "disagree" in row()[2]:
+        out.append(f"held-out agreement: the law and its figures agree, got {row()}")
+    write(within=24, off=1.0)  # one state 10 % of the range off; stored: all within
+    r = row()
+    if r[3] is not False or "gives 23 of 24: the stored figures disagree" not in r[2]:
+        out.append(f"held-out agreement: stored 24 of 24, the law 23 of 24, got {r}")
+    return out
+
+
 def main():
     failures = []
     tmp = tempfile.mkdtemp(prefix="knit_report_test_")
@@ -841,6 +879,7 @@ def main():
         failures.extend(outer_exp_failures(tmp))
         failures.extend(l_interpolation_failures(tmp))
         failures.extend(held_out_reference_failures(tmp))
+        failures.extend(held_out_agreement_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
