@@ -33,7 +33,7 @@ except ImportError:  # the section panel is then left out
     h5py = None
 from scipy.interpolate import BSpline  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main, read_json  # noqa: E402
+from figure_inputs import guarded_main, read_json, save_figure  # noqa: E402
 
 
 def read_history(path):
@@ -224,7 +224,7 @@ def main():
     # Beside DIR, not inside it: DIR is the C++ command's output, replaced by its next run only
     # while it holds nothing else (its manifest; docs/io.md, session 29).
     out = a.out or os.path.normpath(a.dir) + "_design.png"
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     print(out)
 
 

@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(1, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from figure_inputs import guarded_main  # noqa: E402
+from figure_inputs import guarded_main, save_figure  # noqa: E402
 from cell_paths import open_database, path_set  # noqa: E402  (scripts/cell_paths.py)
 from surfaces import basis, database_figure_args, pick_loop  # noqa: E402
 
@@ -259,7 +259,7 @@ def main():
         axk.set_title(f"{title}, l = {l:g} mm, E12 = 0")
         axk.legend(loc="lower right", fontsize=7)
     fig.suptitle(f"Energy-based law ({family} W; dashed: data strain box)")
-    fig.savefig(a.out, dpi=130)
+    save_figure(fig, a.out, dpi=130)
     print(f"wrote {a.out}")
 
 

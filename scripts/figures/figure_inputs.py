@@ -35,6 +35,17 @@ def guarded_main(main):
                          f"{tb.lineno}; the command line: {_command_line()})")
 
 
+def save_figure(fig, out, **savefig_args):
+    """Writes `fig` to `out` through a temporary beside it and a rename, so a figure killed
+    while it is drawn leaves no empty or half-written PNG that make would take as complete
+    (session 36's red team: a SIGKILL left a 0-byte fig06e_energy_law.png, never redrawn and
+    embedded in the report). The temporary's name is that of plots.save."""
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    tmp = out + ".tmp.png"
+    fig.savefig(tmp, **savefig_args)
+    os.replace(tmp, out)
+
+
 def read_json(path):
     """json.load of `path`; a parse error keeps the path for guarded_main's message."""
     with open(path) as f:

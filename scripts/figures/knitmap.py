@@ -18,7 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main  # noqa: E402
+from figure_inputs import guarded_main, save_figure  # noqa: E402
 
 
 def read_map(path):
@@ -72,7 +72,7 @@ def main():
     # Beside DIR, not inside it: DIR is the C++ command's output, replaced by its next run only
     # while it holds nothing else (its manifest; docs/io.md, session 29).
     out = a.out or os.path.normpath(a.dir) + "_knitmap.png"
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     print("wrote", out)
 
 

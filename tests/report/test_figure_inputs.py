@@ -70,6 +70,34 @@ def main():
     c(plots.label_of("s321_bilinear_diagonal", point, study=True) == "p = 5, h = 1 (corner point)"
       and plots.label_of("s321_bilinear_diagonal", point) == plots.LABELS["s321_bilinear_diagonal"],
       "label_of: by mesh in a study only")
+    # Figures are written through a temporary and a rename (figure_inputs.save_figure, session
+    # 36): a drawing killed or failing half-way leaves no PNG that make takes as complete.
+    sys.path.insert(0, FIG)
+    import re
+    from figure_inputs import save_figure
+
+    class Failing:
+        def savefig(self, path, **kw):
+            with open(path, "w") as f:
+                f.write("half a PNG")
+            raise RuntimeError("killed while drawing")
+
+    with tempfile.TemporaryDirectory(prefix="figure_save_test_") as tmp:
+        out = os.path.join(tmp, "fig.png")
+        try:
+            save_figure(Failing(), out)
+        except RuntimeError:
+            pass
+        c(not os.path.exists(out), "a drawing that fails half-way leaves no figure at its name")
+    # Every figure script saves through a temporary: no savefig straight to its output.
+    direct = []
+    for name in sorted(os.listdir(FIG)):
+        if name.endswith(".py") and name != "figure_inputs.py":
+            with open(os.path.join(FIG, name)) as f:
+                for m in re.finditer(r"\.savefig\(\s*([A-Za-z_.]+)", f.read()):
+                    if m.group(1) != "tmp":
+                        direct.append(f"{name}: savefig({m.group(1)}")
+    c(not direct, "no figure script saves straight to its output: %s" % direct)
     return c.exit_code()
 
 
