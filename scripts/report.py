@@ -357,6 +357,8 @@ class Data:
     def _run_defect(self, name):
         # Not through r(): that would count the run as read by the next check.
         r = self.cache[name] if name in self.cache else Result(self.res_dir, name)
+        if r.problem:
+            return r.problem
         if not r.ok:
             return None  # no result: every check that needs it says so
         if not r.status:
@@ -764,7 +766,7 @@ class Report:
             r = self.r(n)
             ex = r.status.get("exit_code", "?")
             stopped = "status: stopped" in r.summary().splitlines()
-            st = ("completed" if r.completed else
+            st = (f"not taken: {md(r.problem)}" if r.problem else "completed" if r.completed else
                   ("no status file" if r.ok else "no result (no status file)") if not r.status
                   else f"stopped (exit {ex})" if r.ok and stopped
                   else f"ended in error (exit {ex})" if r.ok else f"failed (exit {ex})")

@@ -44,13 +44,41 @@ class Result:
     def __init__(self, results_dir, name):
         self.name = name
         self.dir = os.path.join(results_dir, name)
+        # Why this result cannot be taken, or "" (session 36's red team: a truncated status
+        # file or a damaged CSV ended the report in a traceback naming no file, and the results
+        # of another case copied over these were judged as this case's).
+        self.problem = ""
         self.status = {}
         sp = os.path.join(results_dir, name + ".status")
         if os.path.exists(sp):
-            with open(sp) as f:
-                self.status = json.load(f)
+            try:
+                with open(sp) as f:
+                    self.status = json.load(f)
+                if not isinstance(self.status, dict):
+                    raise ValueError("not a JSON object")
+            except (OSError, ValueError) as e:
+                self.status = {}
+                self.problem = f"{sp} is unreadable ({e}); delete it to rerun the case"
         self.ok = os.path.isdir(self.dir) and os.path.exists(os.path.join(self.dir, "load_strain.csv"))
-        self.csv = read_csv(os.path.join(self.dir, "load_strain.csv")) if self.ok else {}
+        marker = os.path.join(self.dir, ".knitscale-output")
+        if self.ok and os.path.exists(marker):
+            with open(marker, errors="replace") as f:
+                made_for = [l[5:].strip() for l in f if l.startswith("for: ")]
+            if made_for and made_for[0] != name:
+                self.problem = (f"{self.dir} holds the output written for {made_for[0]}, not "
+                                f"for {name}")
+        self.csv = {}
+        if self.ok:
+            try:
+                self.csv = read_csv(os.path.join(self.dir, "load_strain.csv"))
+                if not self.csv:
+                    raise ValueError("no rows")
+            except (OSError, ValueError) as e:
+                self.problem = self.problem or (f"{os.path.join(self.dir, 'load_strain.csv')} is "
+                                                f"unreadable ({e})")
+                self.csv = {}
+        if self.problem:
+            self.ok = False
         self.case = {}
         cp = os.path.join(self.dir, "case.json")
         if os.path.exists(cp):

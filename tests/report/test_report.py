@@ -749,6 +749,56 @@ def l_interpolation_failures(tmp):
     return out + unknown_value_failures(db, "l_interpolation", "spline", "l_interpolation")
 
 
+def unusable_result_failures(tmp):
+    """A case's result that cannot be taken is named and not judged as completed (session 36's
+    red team): a truncated status file and a non-numeric CSV ended in tracebacks naming no
+    file; results/NAME copied from another case were judged as NAME's; an empty CSV counted
+    as a completed case."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
+    from results import Result
+    out = []
+    res = os.path.join(tmp, "unusable")
+
+    def fresh(name):
+        shutil.rmtree(res, ignore_errors=True)
+        d = os.path.join(res, name)
+        os.makedirs(d)
+        with open(os.path.join(d, "load_strain.csv"), "w") as f:
+            f.write("step,strain,load_N\n1,0.1,2.0\n2,0.2,5.0\n")
+        with open(os.path.join(d, ".knitscale-output"), "w") as f:
+            f.write(f"knitscale output: knit-macro run\n{{}}\nfor: {name}\nfile: load_strain.csv\n")
+        with open(os.path.join(res, name + ".status"), "w") as f:
+            json.dump({"case": name, "exit_code": 0, "seconds": 0.1}, f)
+        return d
+
+    fresh("a")
+    r = Result(res, "a")
+    if not r.completed or r.problem:
+        out.append(f"unusable results: a good result is not completed ({r.problem})")
+    variants = {
+        "a truncated status file": (lambda d: open(os.path.join(res, "a.status"), "w").write(
+            '{"case": "a", "exit_co'), "a.status is unreadable"),
+        "a non-numeric CSV value": (lambda d: open(os.path.join(d, "load_strain.csv"), "w").write(
+            "step,strain,load_N\n1,0.1,abc\n"), "load_strain.csv is unreadable"),
+        "an empty CSV": (lambda d: open(os.path.join(d, "load_strain.csv"), "w").close(),
+                         "load_strain.csv is unreadable (no rows)"),
+        "another case's output": (lambda d: open(os.path.join(d, ".knitscale-output"), "w").write(
+            "knitscale output: knit-macro run\n{}\nfor: b\n"),
+            "holds the output written for b, not for a"),
+    }
+    for what, (damage, needle) in variants.items():
+        damage(fresh("a"))
+        try:
+            r = Result(res, "a")
+        except Exception as e:  # noqa: BLE001 (the point: no exception at all)
+            out.append(f"unusable results, {what}: {type(e).__name__}: {e}")
+            continue
+        if r.completed or r.ok or needle not in r.problem:
+            out.append(f"unusable results, {what}: completed={r.completed}, problem "
+                       f"{r.problem!r}")
+    return out
+
+
 def held_out_agreement_failures(tmp):
     """The held-out verdict against the stored law re-evaluated (session 36's red team: the
     diagnostics' attributes set to all within with h5py turned it to PASS while the sentence
@@ -880,6 +930,7 @@ def main():
         failures.extend(l_interpolation_failures(tmp))
         failures.extend(held_out_reference_failures(tmp))
         failures.extend(held_out_agreement_failures(tmp))
+        failures.extend(unusable_result_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
