@@ -117,7 +117,13 @@ $(OUT)/cases/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
 
 # knit-macro exits 1 when a load step fails (the converged steps are kept): the pipeline goes on
 # and the report shows the failure; the status file records the exit code and the wall time.
-$(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO)
+# A case whose status says it completed but whose results are gone is run again (FORCE through
+# the second expansion; session 36's red team: results/NAME removed, the rerun re-made nothing
+# and the report kept its PASS verdicts on data that no longer existed).
+.SECONDEXPANSION:
+$(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO) \
+  $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(RES)/$$*.status && \
+    [ ! -f $(RES)/$$*/load_strain.csv ] && echo gone),FORCE)
 	@mkdir -p $(RES) $(LOGS)
 	@echo "case: $*"
 	@start=$$(date +%s.%N); rc=0; \
