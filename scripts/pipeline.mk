@@ -338,7 +338,17 @@ clean:
 	  echo "clean: $(OUT) holds no .knitscale-output file: not a pipeline output, nothing removed" >&2; \
 	  exit 2; fi
 	rm -rf "$(OUT)/database.h5" "$(OUT)/database.source" "$(OUT)/database.time" "$(OUT)/cases" \
-	  "$(OUT)/results" "$(OUT)/figures" "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" \
-	  "$(OUT)/design" "$(OUT)/report.md"
+	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md"
+# figures/ and results/ file by file: what the pipeline writes there (its figures and their
+# temporaries; each case's status, output directory, partial directories and lock), then the
+# directory if that emptied it (session 36's red team: a user's figures/my_plot.png and
+# results/my_analysis/ went with the whole directories).
+	@for f in $(FIGURES) $(KNITMAP_FIGURES) $(DESIGN_FIGURES); do \
+	  rm -f "$$f" "$$f.tmp.png"; done
+	@for c in $(CASES); do \
+	  rm -rf "$(RES)/$$c" "$(RES)/$$c.status" "$(RES)/$$c.lock" "$(RES)/$$c".partial-*; done
+	@for d in "$(FIG)" "$(RES)"; do \
+	  if [ -d "$$d" ]; then rmdir "$$d" 2>/dev/null \
+	    || echo "clean: kept $$d: it holds files the pipeline did not write" >&2; fi; done
 
 FORCE:

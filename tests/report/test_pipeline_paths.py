@@ -72,6 +72,22 @@ def main():
         check(rc == 0 and not os.path.exists(os.path.join(plain, "figures"))
               and open(callers).read() == "the caller's",
               "make clean of a plain OUT removes its figures/ only", out)
+        # A user's files inside figures/ and results/ stay, with the pipeline's own removed.
+        for sub, mine_name, ours in (("figures", "my_plot.png", "fig07d_load_strain.png"),
+                                     ("results", "my_analysis.txt", "s312_uniform_45_wale.status")):
+            os.makedirs(os.path.join(plain, sub), exist_ok=True)
+            for n in (mine_name, ours):
+                with open(os.path.join(plain, sub, n), "w") as f:
+                    f.write(n)
+        rc, out = make_clean(plain, d)
+        check(rc == 0 and os.path.exists(os.path.join(plain, "figures", "my_plot.png"))
+              and os.path.exists(os.path.join(plain, "results", "my_analysis.txt"))
+              and not os.path.exists(os.path.join(plain, "figures", "fig07d_load_strain.png"))
+              and not os.path.exists(os.path.join(plain, "results",
+                                                  "s312_uniform_45_wale.status"))
+              and "kept" in out,
+              "make clean keeps a user's files in figures/ and results/, removes the pipeline's",
+              out)
         # resolve_case.py writes the database relative to the resolved case, so a copied or
         # moved output directory runs its cases against its own database (session 36).
         a = os.path.join(d, "outA")
