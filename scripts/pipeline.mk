@@ -65,6 +65,9 @@ OUT_STATE := $(shell d='$(OUT)'; \
   if [ -e "$$d" ] && [ ! -d "$$d" ]; then echo notdir; \
   elif [ "$$d" != '$(ROOT)/out' ] && [ -d "$$d" ] && [ -n "$$(ls -A "$$d")" ] \
        && [ ! -f "$$d/.knitscale-output" ]; then echo foreign; \
+  elif [ -f "$$d/.knitscale-output" ] \
+       && ! head -n 1 "$$d/.knitscale-output" | grep -q "reproduction pipeline"; then \
+    echo other; \
   else mkdir -p "$$d" && { [ -f "$$d/.knitscale-output" ] || echo "knitscale output: the \
 reproduction pipeline (scripts/pipeline.mk)" > "$$d/.knitscale-output"; } && echo ours; fi)
 ifeq ($(OUT_STATE),notdir)
@@ -72,6 +75,9 @@ $(error OUT=$(OUT) exists and is not a directory)
 endif
 ifeq ($(OUT_STATE),foreign)
 $(error OUT=$(OUT) is a non-empty directory that is not a knitscale output (no .knitscale-output file): its files are not ours to replace; give a new or empty directory)
+endif
+ifeq ($(OUT_STATE),other)
+$(error OUT=$(OUT) is the output of another knitscale program (its .knitscale-output names it), not of the pipeline: its files are not ours to replace; give another directory)
 endif
 ifneq ($(OUT_STATE),ours)
 $(error OUT=$(OUT): cannot create the directory or its .knitscale-output marker)
@@ -336,6 +342,10 @@ report: $(OUT)/report.md
 clean:
 	@if [ "$(OUT)" != "$(ROOT)/out" ] && [ ! -f "$(OUT)/.knitscale-output" ]; then \
 	  echo "clean: $(OUT) holds no .knitscale-output file: not a pipeline output, nothing removed" >&2; \
+	  exit 2; fi
+	@if [ -f "$(OUT)/.knitscale-output" ] \
+	  && ! head -n 1 "$(OUT)/.knitscale-output" | grep -q "reproduction pipeline"; then \
+	  echo "clean: $(OUT) is another program's output, not the pipeline's: nothing removed" >&2; \
 	  exit 2; fi
 	rm -rf "$(OUT)/database.h5" "$(OUT)/database.source" "$(OUT)/database.time" "$(OUT)/cases" \
 	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md"

@@ -21,6 +21,17 @@ case "$out" in
     exit 2 ;;
 esac
 if [ -n "${KNIT_OUT:-}" ]; then
+  if [ -L "$out" ] && [ ! -e "$out" ]; then
+    echo "run: KNIT_OUT=$out is a dangling symbolic link; give a real directory" >&2
+    exit 2
+  fi
+  # The output of another knitscale program (knit-macro run writes the same marker file, with
+  # its own name; session 36's red team: such a directory was taken for the pipeline's).
+  if [ -f "$marker" ] && ! head -n 1 "$marker" | grep -q "reproduction pipeline"; then
+    echo "run: KNIT_OUT=$out is the output of another program ($(head -n 1 "$marker")), not" \
+      "of the pipeline: its files are not ours to replace; give another directory" >&2
+    exit 2
+  fi
   if [ -e "$out" ] && [ ! -d "$out" ]; then
     echo "run: KNIT_OUT=$out exists and is not a directory" >&2
     exit 2

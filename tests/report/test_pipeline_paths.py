@@ -11,6 +11,7 @@ the makefile refuses an OUT of more than one word for every goal, clean included
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 
@@ -20,10 +21,19 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 def run_sh(out):
+    """run.sh with KNIT_OUT=out: (exit code, output). Expected to refuse at once; if it goes
+    on (a regression), its whole process group (builds, the pipeline) is killed after 60 s."""
     env = dict(os.environ, KNIT_OUT=out)
-    r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "run.sh")], env=env,
-                       capture_output=True, text=True, timeout=60)
-    return r.returncode, r.stdout + r.stderr
+    p = subprocess.Popen(["bash", os.path.join(ROOT, "scripts", "run.sh")], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         start_new_session=True)
+    try:
+        text = p.communicate(timeout=60)[0]
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
+        return -1, "run.sh did not refuse: it ran on for 60 s (killed)"
+    return p.returncode, text
 
 
 def make_clean(out, cwd):
@@ -88,6 +98,27 @@ def main():
               and "kept" in out,
               "make clean keeps a user's files in figures/ and results/, removes the pipeline's",
               out)
+        # Another program's output (knit-macro run writes the same marker with its own name)
+        # and a dangling symbolic link are refused (session 36's red team: the first was taken
+        # for the pipeline's, the second failed in mkdir with "File exists").
+        other = os.path.join(d, "run_output")
+        os.makedirs(other)
+        with open(os.path.join(other, ".knitscale-output"), "w") as f:
+            f.write("knitscale output: knit-macro run\n{}\nfile: load_strain.csv\n")
+        with open(os.path.join(other, "load_strain.csv"), "w") as f:
+            f.write("step\n")
+        rc, out = run_sh(other)
+        check(rc == 2 and "is the output of another program" in out,
+              "run.sh refuses knit-macro run's output (exit %d)" % rc, out)
+        rc, out = make_clean(other, d)
+        check(rc != 0 and "another program's output" in out
+              and os.path.exists(os.path.join(other, "load_strain.csv")),
+              "make clean refuses it and removes nothing", out)
+        dangling = os.path.join(d, "dangling")
+        os.symlink(os.path.join(d, "nowhere"), dangling)
+        rc, out = run_sh(dangling)
+        check(rc == 2 and "dangling symbolic link" in out,
+              "run.sh refuses a dangling symbolic link (exit %d)" % rc, out)
         # resolve_case.py writes the database relative to the resolved case, so a copied or
         # moved output directory runs its cases against its own database (session 36).
         a = os.path.join(d, "outA")
