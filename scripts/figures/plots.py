@@ -391,6 +391,15 @@ def main():
     if a.cmd == "placeholder":
         placeholder(a.out, a.title, a.message)
         return
+    # A results directory or a case the pipeline never made is a mistake on the command line,
+    # not a failed run (session 36's red team: a typo drew "no results (the runs failed)" with
+    # exit 0). A case counts as made once its status file or its output exists.
+    if not os.path.isdir(a.results):
+        p.error(f"--results: {a.results} is not a directory")
+    for name in getattr(a, "cases", None) or [a.case] + (getattr(a, "share_limits", None) or []):
+        if not (os.path.exists(os.path.join(a.results, name + ".status"))
+                or os.path.isdir(os.path.join(a.results, name))):
+            p.error(f"{name}: no status file and no output in {a.results} (a misspelt case?)")
     {"load": cmd_load, "deformed": cmd_deformed, "fields": cmd_fields,
      "geometry": cmd_geometry}[a.cmd](a)
 

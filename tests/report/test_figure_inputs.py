@@ -70,6 +70,25 @@ def main():
     c(plots.label_of("s321_bilinear_diagonal", point, study=True) == "p = 5, h = 1 (corner point)"
       and plots.label_of("s321_bilinear_diagonal", point) == plots.LABELS["s321_bilinear_diagonal"],
       "label_of: by mesh in a study only")
+    # plots.py: a results directory or a case the pipeline never made is a command-line
+    # mistake (exit 2, named), not a failed run drawn as a placeholder with exit 0 (session 36).
+    with tempfile.TemporaryDirectory(prefix="plots_args_test_") as tmp:
+        res = os.path.join(tmp, "results")
+        os.makedirs(os.path.join(res, "made"))
+        png = os.path.join(tmp, "x.png")
+        for args, needle in (
+                (("--results", os.path.join(tmp, "nope"), "load", "--out", png, "made"),
+                 "--results: " + os.path.join(tmp, "nope") + " is not a directory"),
+                (("--results", res, "load", "--out", png, "made", "mdae"),
+                 "mdae: no status file and no output in " + res),
+                (("--results", res, "deformed", "--case", "mdae", "--field", "E22", "--out", png),
+                 "mdae: no status file and no output")):
+            r = run("plots.py", *args)
+            c(r.returncode == 2 and needle in r.stderr and "Traceback" not in r.stderr
+              and not os.path.exists(png), "plots.py %s: exit 2, named" % args[2], r.stderr)
+        r = run("plots.py", "--results", res, "load", "--out", png, "made")
+        c(r.returncode == 0 and os.path.exists(png),
+          "plots.py on a made case without a curve draws its placeholder", r.stderr)
     # Figures are written through a temporary and a rename (figure_inputs.save_figure, session
     # 36): a drawing killed or failing half-way leaves no PNG that make takes as complete.
     sys.path.insert(0, FIG)
