@@ -175,7 +175,6 @@ knit::cli::SubcommandRegistrar reg(
       auto o = std::make_shared<Options>();
       using knit::cli::Ends;
       using knit::cli::number;
-      const double inf = std::numeric_limits<double>::infinity();
       // Ranges: the cell schema's (schemas/cell.schema.json) for the cell parameters; strains
       // of a path in (-1, 10], shear angles in (-80, 80) degrees.
       sub.add_option("--loop-length", o->loop_length, "loop length l (mm)")
