@@ -1,12 +1,17 @@
 #!/usr/bin/python3
-"""scripts/run.sh and scripts/pipeline.mk (session 36's red team): output paths that make cannot
-carry are refused before anything is written, and `make clean` never reaches outside OUT.
+"""scripts/run.sh, scripts/pipeline.mk and resolve_case.py against session 36's red team: what
+the pipeline writes stays inside its own output, and what it judges is its own.
 
-A space in OUT split it into two words: `make clean` removed "DIR/my" (a user's directory) and
-"out/..." of the caller's directory; a $ was expanded by make, so every output went to another
-directory with exit 0. run.sh refuses such a KNIT_OUT before it installs or builds anything;
-the makefile refuses an OUT of more than one word for every goal, clean included. Run by CTest
-(tests/CMakeLists.txt, label report); needs make and bash only (no build, no Python modules).
+* Output paths make cannot carry are refused before anything is written: a space in OUT split
+  it into two words (`make clean` removed "DIR/my", a user's directory, and "out/..." of the
+  caller's directory), a $ was expanded by make (every output went elsewhere, exit 0).
+* `make clean` keeps a user's files in figures/ and results/, and refuses another program's
+  output (knit-macro run writes the same marker file); run.sh names a dangling symbolic link.
+* resolve_case.py names the database relative to the resolved case, so a moved or copied
+  output runs against its own database.
+* A case whose results were removed is run again (this part needs the built executables:
+  KNIT_BUILD, set by CTest; a synthetic database and one case keep it to seconds).
+Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
 """
 import json
 import os
