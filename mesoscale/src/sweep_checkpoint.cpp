@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -165,17 +166,22 @@ std::string seal_record(const std::string& record, const std::string& sweep) {
   return text + kDigestTag + fingerprint(text) + "\n";
 }
 
+/// If `text` ends with a line "TAG value\n", cuts that line off and returns value; otherwise
+/// returns nothing and leaves `text` as it is.
+std::optional<std::string> take_last_line(std::string& text, const std::string& tag) {
+  if (text.empty() || text.back() != '\n') return std::nullopt;
+  const std::size_t start = text.rfind('\n', text.size() - 2);
+  const std::size_t line = start == std::string::npos ? 0 : start + 1;
+  if (text.compare(line, tag.size(), tag) != 0) return std::nullopt;
+  std::string value = text.substr(line + tag.size(), text.size() - 1 - line - tag.size());
+  text.resize(line);
+  return value;
+}
+
 /// Splits the sweep line off a record (its fingerprint, or "" for a record written before
 /// session 36, which has none).
 std::string take_sweep_line(std::string& record) {
-  if (record.empty() || record.back() != '\n') return "";
-  const std::size_t start = record.rfind('\n', record.size() - 2);
-  const std::size_t line = start == std::string::npos ? 0 : start + 1;
-  if (record.compare(line, std::string(kSweepTag).size(), kSweepTag) != 0) return "";
-  std::string sweep = record.substr(line + std::string(kSweepTag).size());
-  sweep.pop_back();
-  record.resize(line);
-  return sweep;
+  return take_last_line(record, kSweepTag).value_or("");
 }
 
 std::string open_record(const std::string& text, const std::string& file, const std::string& what) {
@@ -185,13 +191,10 @@ std::string open_record(const std::string& text, const std::string& file, const 
                          "; the checkpoint was edited or damaged -- delete this file to "
                          "recompute the case, or discard all checkpoints with --force");
   };
-  if (text.empty() || text.back() != '\n') refuse("no digest line at the end");
-  const std::size_t start = text.rfind('\n', text.size() - 2);
-  const std::size_t line = start == std::string::npos ? 0 : start + 1;
-  const std::string last = text.substr(line, text.size() - 1 - line);
-  if (last.rfind(kDigestTag, 0) != 0) refuse("no digest line at the end");
-  const std::string record = text.substr(0, line);
-  const std::string have = last.substr(std::string(kDigestTag).size());
+  std::string record = text;
+  const std::optional<std::string> stored = take_last_line(record, kDigestTag);
+  if (!stored) refuse("no digest line at the end");
+  const std::string& have = *stored;
   const std::string want = fingerprint(record);
   if (have != want) refuse("digest mismatch (stored " + have + ", record hashes to " + want + ")");
   return record;
