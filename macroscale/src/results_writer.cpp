@@ -204,6 +204,11 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
   if (!material_warning_.empty()) h5.set_attribute(".", "material_warning", material_warning_);
+  if (!load_drops_.empty()) {
+    std::string all;
+    for (const std::string& d : load_drops_) all += (all.empty() ? "" : "\n") + d;
+    h5.set_attribute(".", "load_drops", all);
+  }
   if (!nonfinite_output_.empty()) h5.set_attribute(".", "output_failure", output_failure());
   h5.write_strings("case_json", {case_.text});
   // The CSV columns.
@@ -288,6 +293,7 @@ void ResultsWriter::finish(const RunReport& report) {
     csv.add_comment("run stopped early: " + report.message);
   if (!material_failure_.empty()) csv.add_comment(material_failure_);
   if (!material_warning_.empty()) csv.add_comment(material_warning_);
+  for (const std::string& d : load_drops_) csv.add_comment(d);
   if (!nonfinite_output_.empty()) csv.add_comment(output_failure());
   for (const StepRow& r : rows_) {
     std::vector<io::CsvCell> row = {r.step, r.lambda};
@@ -304,6 +310,7 @@ void ResultsWriter::finish(const RunReport& report) {
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n";
   if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
   if (!material_warning_.empty()) sum << material_warning_ << "\n";
+  for (const std::string& d : load_drops_) sum << d << "\n";
   if (!nonfinite_output_.empty()) sum << "output failure: " << output_failure() << "\n";
   sum << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";

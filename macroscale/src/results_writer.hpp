@@ -35,6 +35,9 @@ class ResultsWriter {
   void set_material_failure(std::string m) { material_failure_ = std::move(m); }
   /// Material::warning(): a comment in the CSV, a line in summary.txt, an HDF5 attribute.
   void set_material_warning(std::string m) { material_warning_ = std::move(m); }
+  /// Load drops (load_drop.hpp), a line each: CSV comments, summary.txt lines and the HDF5
+  /// attribute "load_drops" (the lines joined by newlines).
+  void set_load_drops(std::vector<std::string> d) { load_drops_ = std::move(d); }
   /// Empty, or where the sampled output fields first held a non-finite number (the first
   /// field, step and point, and how many values in all): the quadrature points, which Newton
   /// checks, may never reach a strain where the material's stress overflows, the output grid
@@ -63,6 +66,7 @@ class ResultsWriter {
   std::string material_report_;
   std::string material_failure_;
   std::string material_warning_;
+  std::vector<std::string> load_drops_;
   std::string nonfinite_output_;
   long nonfinite_values_ = 0;
 };

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "knit/core/errors.hpp"
+#include "knit/macro/load_drop.hpp"
 #include "results_writer.hpp"
 
 namespace knit::macro {
@@ -188,6 +189,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   res.material_warning = c.material->warning();
   if (opt.warnings && !res.material_warning.empty())
     *opt.warnings << res.material_warning << std::endl;
+  for (const LoadDrop& d : find_load_drops(c, res.rows))
+    res.load_drops.push_back(load_drop_message(d));
+  if (opt.warnings)
+    for (const std::string& w : res.load_drops) *opt.warnings << "warning: " << w << std::endl;
   if (opt.progress && res.report.first_unstable_step > 0)
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
   // A run in which no load step converged does not replace an earlier output of the same
@@ -202,6 +207,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     writer->set_material_report(material_report);
     writer->set_material_warning(res.material_warning);
     writer->set_material_failure(failure);
+    writer->set_load_drops(res.load_drops);
     // A stopped run still writes its last converged state.
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)

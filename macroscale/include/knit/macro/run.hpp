@@ -94,6 +94,9 @@ struct RunResult {
   long failed_material_evaluations = 0;
   /// Material::warning() at the end of the run (empty: none).
   std::string material_warning;
+  /// load_drop_message() of each reaction whose load falls between converged steps
+  /// (load_drop.hpp): warnings, not failures (a buckling test may drop on purpose).
+  std::vector<std::string> load_drops;
   /// Empty, or where the written output fields held a non-finite number (results_writer.hpp:
   /// the output grid reached a strain where the material's stress is not finite).
   std::string output_failure;

@@ -1,0 +1,52 @@
+#include "knit/macro/load_drop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace knit::macro {
+
+std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>& rows,
+                                      double tolerance) {
+  std::vector<LoadDrop> drops;
+  if (!c.output.applied || rows.size() < 2) return drops;
+  for (size_t r = 0; r < c.output.reactions.size(); ++r) {
+    if (c.output.reactions[r].component != c.output.applied->component) continue;
+    double max_load = 0.0;
+    for (const StepRow& row : rows) max_load = std::max(max_load, std::abs(row.reactions[r]));
+    LoadDrop d;
+    d.reaction = c.output.reactions[r].name;
+    d.max_load = max_load;
+    for (size_t k = 0; k + 1 < rows.size(); ++k) {
+      const double f0 = rows[k].reactions[r], f1 = rows[k + 1].reactions[r];
+      const double drop = std::abs(f0) - std::abs(f1);
+      if (!(drop > tolerance * max_load)) continue;
+      ++d.count;
+      if (drop > d.largest) {
+        d.largest = drop;
+        d.from_step = rows[k].step, d.to_step = rows[k + 1].step;
+        d.from_load = f0, d.to_load = f1;
+        d.from_strain = rows[k].strain, d.to_strain = rows[k + 1].strain;
+      }
+    }
+    if (d.count > 0) drops.push_back(d);
+  }
+  return drops;
+}
+
+std::string load_drop_message(const LoadDrop& d, double tolerance) {
+  std::ostringstream m;
+  m.precision(4);
+  m << "load drop: reaction '" << d.reaction << "' falls from " << d.from_load << " to "
+    << d.to_load << " N (" << 100.0 * d.largest / d.max_load << " % of its largest "
+    << d.max_load << " N) between step " << d.from_step << " (strain " << d.from_strain
+    << ") and step " << d.to_step << " (strain " << d.to_strain
+    << ") while the applied displacement grows";
+  if (d.count > 1) m << "; " << d.count << " drops in all";
+  m << " (threshold " << tolerance
+    << " x the largest load). A tensile test's load does not fall: a snap of the material "
+       "law or a lost stability (summary.txt's stability line tells the second)";
+  return m.str();
+}
+
+}  // namespace knit::macro
