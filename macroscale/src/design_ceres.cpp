@@ -84,15 +84,22 @@ class DesignCost : public ceres::CostFunction {
 
 class History : public ceres::IterationCallback {
  public:
-  History(DesignResult& r, const std::vector<double>& x, Clock::time_point t0)
-      : r_(r), x_(x), t0_(t0) {}
+  History(DesignResult& r, Tracker& t, const std::vector<double>& x, Clock::time_point t0)
+      : r_(r), t_(t), x_(x), t0_(t0) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     // A rejected step leaves x where it was (its cost is the trial's): not a history point.
     if (s.iteration > 0 && !s.step_is_successful) return ceres::SOLVER_CONTINUE;
     DesignIteration h;
     h.iteration = s.iteration;
     h.J = 2.0 * s.cost;  // Ceres' cost is (1/2) sum r^2
-    h.gradient_norm = 2.0 * s.gradient_norm;
+    // |dJ/dp| (DesignEvaluation::gradient) at the accepted design, as the projected-gradient method
+    // reports it (session 37's red team: Ceres' gradient_norm of a bounded problem is |x - P(x -
+    // g)|, the step to the bounds' projection, so 2 x it read 2.0 at l = 5.5 with upper bound 6.5
+    // where |dJ/dl| is 13 to 397, and 200.067 by the other method). The accepted design is the last
+    // one evaluated, so the cached evaluation answers (update_state_every_iteration: x_ is it).
+    const DesignEvaluation& e = t_.evaluate(x_);
+    h.gradient_norm = e.status == RunStatus::kCompleted ? e.gradient.norm()
+                                                        : std::numeric_limits<double>::quiet_NaN();
     h.seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
     h.x = x_;
     r_.history.push_back(h);
@@ -101,6 +108,7 @@ class History : public ceres::IterationCallback {
 
  private:
   DesignResult& r_;
+  Tracker& t_;
   const std::vector<double>& x_;
   Clock::time_point t0_;
 };
@@ -146,7 +154,7 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.minimizer_progress_to_stdout = false;
   o.num_threads = 1;
   o.update_state_every_iteration = true;
-  History history(res, x, t0);
+  History history(res, t, x, t0);
   o.callbacks.push_back(&history);
   ceres::Solver::Summary summary;
   ceres::Solve(o, &problem, &summary);

@@ -38,10 +38,9 @@ std::string load_drop_message(const LoadDrop& d, double tolerance) {
   std::ostringstream m;
   m.precision(4);
   m << "load drop: reaction '" << d.reaction << "' falls from " << d.from_load << " to "
-    << d.to_load << " N (" << 100.0 * d.largest / d.max_load << " % of its largest "
-    << d.max_load << " N) between step " << d.from_step << " (strain " << d.from_strain
-    << ") and step " << d.to_step << " (strain " << d.to_strain
-    << ") while the applied displacement grows";
+    << d.to_load << " N (" << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load
+    << " N) between step " << d.from_step << " (strain " << d.from_strain << ") and step "
+    << d.to_step << " (strain " << d.to_strain << ") while the applied displacement grows";
   if (d.count > 1) m << "; " << d.count << " drops in all";
   m << " (threshold " << tolerance
     << " x the largest load). A tensile test's load does not fall: a snap of the material "

@@ -321,6 +321,15 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
     CHECK(r.x[0] >= 4.5);
     CHECK(r.x[0] <= 6.5);
     CHECK(r.history.back().J < r.history.front().J);
+    // history.csv's gradient_norm is |dJ/dp| at the row's design, by either method (session
+    // 37: Ceres' own gradient_norm of a bounded problem is the step to the bounds' projection:
+    // 2.0 at l = 5.5 below an upper bound of 6.5 where |dJ/dl| was 397).
+    for (const DesignIteration& h : r.history) {
+      const DesignEvaluation eh = evaluate_design(twin, h.x);
+      INFO("iteration " << h.iteration << ": history " << h.gradient_norm << ", |dJ/dp| "
+                        << eh.gradient.norm());
+      CHECK(h.gradient_norm == Approx(eh.gradient.norm()).epsilon(1e-9).margin(1e-12));
+    }
     // A loose function tolerance stops at the first step that lowers J by less than 99 % of J
     // (Ceres then keeps the point before that step; the projected gradient takes it).
     DesignProblem loose = twin;

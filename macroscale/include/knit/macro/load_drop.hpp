@@ -19,9 +19,9 @@ inline constexpr double kLoadDropTolerance = 1e-6;
 
 /// The drops of one reaction: how many, and the largest (the steps on either side of it).
 struct LoadDrop {
-  std::string reaction;  ///< the name in output.reactions
-  int count = 0;         ///< consecutive-step decrements above the threshold
-  double largest = 0.0;  ///< |F_from| - |F_to| of the largest (N)
+  std::string reaction;   ///< the name in output.reactions
+  int count = 0;          ///< consecutive-step decrements above the threshold
+  double largest = 0.0;   ///< |F_from| - |F_to| of the largest (N)
   double max_load = 0.0;  ///< max_j |F_j| over the run (N)
   int from_step = 0, to_step = 0;
   double from_load = 0.0, to_load = 0.0;      ///< F at those steps (N)
