@@ -132,6 +132,28 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
                          "\" (allowed: reaction, displacement, strain_variance, target_strain, "
                          "reaction_linearity)");
   o.kind = static_cast<DesignObjective::Kind>(k - std::begin(kKinds));
+  // The keys of this type only (session 37's red team: a strain_variance "target", a
+  // reaction's "component", a displacement's "region" were read by no one, with exit 0; the
+  // schema lists the keys of every type together).
+  {
+    std::vector<std::string> keys = {"type", "name", "weight", "at_strain"};
+    using K = DesignObjective::Kind;
+    const std::vector<std::string> extra =
+        o.kind == K::kReaction            ? std::vector<std::string>{"reaction", "target"}
+        : o.kind == K::kReactionLinearity ? std::vector<std::string>{"reaction"}
+        : o.kind == K::kDisplacement      ? std::vector<std::string>{"point", "component", "target"}
+        : o.kind == K::kStrainVariance
+            ? std::vector<std::string>{"component", "region", "samples"}
+            : std::vector<std::string>{"component", "region", "samples", "target"};
+    keys.insert(keys.end(), extra.begin(), extra.end());
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
+        std::string list;
+        for (const auto& key : keys) list += (list.empty() ? "" : ", ") + key;
+        throw InputError(file, p + "/" + io::json_pointer_escape(it.key()),
+                         "not used by a " + type + " term (its keys: " + list + ")");
+      }
+  }
   o.name = j.contains("name") && j.at("name").is_string() ? j.at("name").get<std::string>() : type;
   if (j.contains("weight")) o.weight = number(j.at("weight"), file, p + "/weight");
   if (!j.contains("at_strain")) throw InputError(file, p, "missing required key \"at_strain\"");
@@ -221,8 +243,17 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     if (n.size() != 2 || n[0] < 1 || n[1] < 1 || n[0] != std::floor(n[0]) ||
         n[1] != std::floor(n[1]) || n[0] > 1000 || n[1] > 1000)
       throw InputError(file, p + "/samples", "must be two integers in 1..1000 (u, v)");
-    o.samples_u = o.u_range(0) == o.u_range(1) ? 1 : static_cast<int>(n[0]);
-    o.samples_v = o.v_range(0) == o.v_range(1) ? 1 : static_cast<int>(n[1]);
+    // Across a section (lo = hi) there is one sample: another count was overridden silently.
+    for (int d = 0; d < 2; ++d) {
+      const Eigen::Vector2d& r = d == 0 ? o.u_range : o.v_range;
+      if (r(0) == r(1) && n[static_cast<std::size_t>(d)] != 1)
+        throw InputError(file, p + "/samples/" + std::to_string(d),
+                         std::string("must be 1: the region's ") + (d == 0 ? "u" : "v") +
+                             " is a section (" + fmt(r(0)) + " to " + fmt(r(1)) +
+                             "), with one sample across it");
+    }
+    o.samples_u = static_cast<int>(n[0]);
+    o.samples_v = static_cast<int>(n[1]);
   }
 }
 
@@ -309,17 +340,41 @@ DesignProblem load_design(const std::string& path) {
       root.at("objectives").empty())
     throw InputError(path, "/objectives", "needs at least one objective");
   std::vector<std::pair<int, int>> used;
+  std::vector<std::string> columns;  // history.csv's variable columns
   for (std::size_t k = 0; k < root.at("variables").size(); ++k) {
     const std::string p = "/variables/" + std::to_string(k);
     DesignVariableSpec v;
     read_variable(root.at("variables")[k], p, case_root, d.c, path, v);
-    for (int i : v.indices) {
+    for (std::size_t n = 0; n < v.indices.size(); ++n) {
+      const int i = v.indices[n];
       const std::pair<int, int> key(static_cast<int>(v.field), i);
+      const auto mine = v.indices.begin() + static_cast<std::ptrdiff_t>(n);
+      if (std::find(v.indices.begin(), mine, i) != mine)
+        throw InputError(path, p + "/indices/" + std::to_string(n),
+                         "control value " + std::to_string(i) + " is listed twice");
       if (std::find(used.begin(), used.end(), key) != used.end())
         throw InputError(
-            path, p + "/indices",
+            path, p + "/indices/" + std::to_string(n),
             "control value " + std::to_string(i) + " is already set by another variable");
       used.push_back(key);
+    }
+    // Variables are history.csv columns beside iteration, J, gradient_norm and seconds, named
+    // "x<k>" when unnamed (session 37's red team: two "l" columns, or a variable "J" beside the
+    // objective's, with exit 0).
+    {
+      const std::string column = v.name.empty() ? "x" + std::to_string(k) : v.name;
+      const std::vector<std::string> reserved = {"iteration", "J", "gradient_norm", "seconds"};
+      if (std::find(reserved.begin(), reserved.end(), column) != reserved.end())
+        throw InputError(path, p + "/name",
+                         "\"" + column +
+                             "\" is a column of history.csv already (iteration, J, "
+                             "gradient_norm, seconds): choose another name");
+      if (std::find(columns.begin(), columns.end(), column) != columns.end())
+        throw InputError(path, v.name.empty() ? p : p + "/name",
+                         "\"" + column +
+                             "\" names an earlier variable too (history.csv has a column per "
+                             "variable, \"x<k>\" for an unnamed one): each needs its own name");
+      columns.push_back(column);
     }
     d.variables.push_back(v);
   }

@@ -217,7 +217,52 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(R"([{"field": "stitch_value", "indices": [0], "lower": 4.5, "upper": 6.5},
                     {"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}])",
                 kObjs),
-         "/variables/1/indices");
+         "/variables/1/indices/0");
+  // Session 37's red team: each of these ran with exit 0, the key read by no one or the
+  // history's columns ambiguous.
+  expect("repeated_index.json",
+         design(R"([{"field": "stitch_value", "indices": [0, 0], "lower": 4.5, "upper": 6.5}])",
+                kObjs),
+         "/variables/0/indices/1");
+  const std::string kOneVar = R"([{"name": "l", "field": "stitch_value", "indices": [0, 1],
+                                   "lower": 4.5, "upper": 6.5},)";
+  expect("variable_twice.json",
+         design(kOneVar + R"({"name": "l", "field": "knitting_angle", "indices": [0],
+                               "lower": -45, "upper": 45}])",
+                kObjs),
+         "/variables/1/name");
+  expect("variable_J.json",
+         design(R"([{"name": "J", "field": "stitch_value", "indices": [0, 1], "lower": 4.5,
+                     "upper": 6.5}])",
+                kObjs),
+         "/variables/0/name");
+  expect("variable_x1.json",
+         design(R"([{"name": "x1", "field": "stitch_value", "indices": [0, 1], "lower": 4.5,
+                     "upper": 6.5}, {"field": "knitting_angle", "indices": [0], "lower": -45,
+                     "upper": 45}])",
+                kObjs),
+         "/variables/1");
+  const std::string kL = R"([{"field": "stitch_value", "indices": [0, 1], "lower": 4.5,
+                              "upper": 6.5}])";
+  expect("variance_target.json",
+         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                         "region": {"u": [0, 1], "v": [0.4, 0.6]}, "target": [5]}])"),
+         "/objectives/0/target");
+  expect("reaction_component.json",
+         design(kL, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                         "target": [1], "component": "x"}])"),
+         "/objectives/0/component");
+  expect("linearity_target.json", design(kL, R"([{"type": "reaction_linearity", "reaction": "fy",
+                         "at_strain": [0.1, 0.2], "target": [1, 2]}])"),
+         "/objectives/0/target");
+  expect("displacement_region.json",
+         design(kL, R"([{"type": "displacement", "point": "mid", "component": "y",
+                         "at_strain": [0.2], "target": [2], "region": {"u": [0, 1], "v": [0, 1]}}])"),
+         "/objectives/0/region");
+  expect("section_samples.json",
+         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                         "region": {"u": [0, 1], "v": [0.5, 0.5]}, "samples": [5, 7]}])"),
+         "/objectives/0/samples/1");
   // Session 34 (the design audit's mutants 76 to 82): each check of the loader, off alone,
   // survived (`--check` exited 0): equal bounds, an upper bound beyond the database's 6.5, an
   // angle bound below -180 deg, tied control values that differ in the case (5.0 and 5.6 in

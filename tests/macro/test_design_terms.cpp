@@ -198,7 +198,7 @@ TEST_CASE("design terms: a target-strain term is w/n times the squared misfits o
       {"type": "target_strain", "component": "E12", "region": {"u": [0.2, 0.8], "v": [0.2, 0.8]},
        "samples": [4, 3], "at_strain": [0.2], "target": [0.01], "weight": 100},
       {"type": "target_strain", "component": "E22", "region": {"u": [0.1, 0.9], "v": [0.3, 0.3]},
-       "samples": [5, 7], "at_strain": [0.2], "target": [0.15], "weight": 30}])");
+       "samples": [5, 1], "at_strain": [0.2], "target": [0.15], "weight": 30}])");
   std::vector<double> x;
   for (const auto& v : d.variables) x.push_back(v.initial);  // the case as written
   const DesignEvaluation e = evaluate_design(d, x, false);
