@@ -203,6 +203,9 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "units", "mm, N, MPa");
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
+  // A run whose material failed says so in every output (session 37: results.h5 read "status
+  // completed" and nothing else for one that ended with exit 1).
+  if (!material_failure_.empty()) h5.set_attribute(".", "material_failure", material_failure_);
   if (!material_warning_.empty()) h5.set_attribute(".", "material_warning", material_warning_);
   if (!load_drops_.empty()) {
     std::string all;

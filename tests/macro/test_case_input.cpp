@@ -980,6 +980,9 @@ TEST_CASE("a run with failed material evaluations does not report plain success"
   REQUIRE(fs::exists(d / "out" / "summary.txt"));  // outputs kept
   CHECK(slurp(d / "out" / "summary.txt").find(msg) != std::string::npos);
   CHECK(slurp(d / "out" / "load_strain.csv").find(msg) != std::string::npos);
+  auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+  REQUIRE(h5.has_attribute(".", "material_failure"));
+  CHECK(h5.attribute_string(".", "material_failure") == msg);
   fs::remove_all(d);
 }
 
