@@ -99,7 +99,7 @@ void write_database(const std::filesystem::path& file, const Database& db,
     f.set_attribute(".", "created", db.provenance.created);
     f.set_attribute(".", "generator", db.generator);
     // The writing process (program, host, command line) in the io module's common form.
-    io::write_provenance(f, io::Provenance::current(""));
+    io::write_provenance(f, io::Provenance::current(db.provenance.input));
     f.set_attribute(".", "units", kDatabaseUnits);
     f.set_attribute(".", "voigt_order", "E = (E11, E22, 2E12), S = (S11, S22, S12)");
     f.set_attribute(".", "frame", "material frame: 1 = course, 2 = wale");

@@ -101,6 +101,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
           return rc;
         }
         db.provenance = knit::material::current_provenance();
+        db.provenance.input = o->db;  // the database the laws were refitted from
         // What the Database does not hold (the sweep's /sweep/report, groups a user added)
         // comes along from the input, in the same atomic write.
         std::vector<std::string> carried;

@@ -42,6 +42,7 @@ double cell_value(const nlohmann::json& cell, const char* group, const char* key
 material::Database assemble_database(const SweepInput& in, const std::vector<JobResult>& results) {
   material::Database db;
   db.provenance = material::current_provenance();
+  db.provenance.input = in.file;
   db.generator = in.runner == RunnerKind::kCell ? "sweep" : "sweep (synthetic runner)";
   db.sweep_input = in.json;
   const nlohmann::json cell = nlohmann::json::parse(in.cell_json);

@@ -132,6 +132,9 @@ struct EnergyFitDiagnostics {
 
 struct Provenance {
   std::string software_version, git_revision, created;  ///< created: ISO 8601 UTC
+  /// The file the database was made from, as given (the sweep's input, the database a fit
+  /// read; "" for synth): the root attribute `input` (session 37: it was "" for every file).
+  std::string input;
 };
 
 struct Database {
