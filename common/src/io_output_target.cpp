@@ -359,7 +359,7 @@ std::string format_bytes(std::uint64_t bytes) {
   if (u == 0)
     std::snprintf(b, sizeof b, "%llu bytes", static_cast<unsigned long long>(bytes));
   else
-    std::snprintf(b, sizeof b, v < 10 ? "%.1f %s" : "%.0f %s", v, units[u]);
+    std::snprintf(b, sizeof b, "%.3g %s", v, units[u]);  // 18.5 MB, not "18 MB" (session 37)
   return b;
 }
 

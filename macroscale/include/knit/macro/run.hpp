@@ -80,8 +80,9 @@ struct RunOptions {
   std::uint64_t max_output_bytes = kDefaultMaxOutputBytes;
 };
 
-/// Estimated size in bytes of the output directory of a case (VTU and HDF5 fields; the CSV is
-/// negligible): output steps x grid samples x fields x bytes per value, with
+/// Estimated size in bytes of the output directory of a case, an upper bound for a run without
+/// cut-backs (docs/io.md, "Output size"): output steps x (grid samples x fields x bytes per
+/// value + each file's and HDF5 dataset's overhead) + 1 % + 48 kB, with
 ///   output steps = ceil(solver.steps / output.every) (cut-backs may add a few),
 ///   fields       = 3 coordinates + 3 displacements + 12 strains/curvatures/stress resultants
 ///                  + the material's extra fields, base64 float64 in VTU (10.7 bytes each),
