@@ -13,6 +13,7 @@
 //   design so far is written; nothing if the first solve fails), 2 bad input (nothing is written).
 // Example:
 //   knit-macro design cases/design/uniform_load.json --output out/design/uniform_load
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -31,6 +32,11 @@
 namespace knit::macro::cmd_design {
 namespace {
 
+/// A variable's history.csv column: its name, or x<k>.
+std::string column_name(const knit::macro::DesignProblem& d, std::size_t k) {
+  return d.variables[k].name.empty() ? "x" + std::to_string(k) : d.variables[k].name;
+}
+
 struct Options {
   std::string file, output;
   bool check = false;
@@ -44,7 +50,7 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_flag("--check", o->check, "read and check the design file, print the problem");
       sub.add_option("--output,-o", o->output, "output directory");
       return [o]() -> int {
-        const auto d = knit::macro::load_design(o->file);
+        auto d = knit::macro::load_design(o->file);
         std::cout << "design: " << o->file << "\ncase: " << d.case_file << "\n";
         for (const auto& v : d.variables) {
           std::cout << "variable " << v.name << ": "
@@ -66,7 +72,19 @@ knit::cli::SubcommandRegistrar reg(
         // it was checked only when the results were written, after minutes of optimizing).
         knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
                                       o->output.empty() ? "output directory" : "--output");
+        if (!d.twin.empty()) {
+          std::cout << "twin:";
+          for (std::size_t k = 0; k < d.variables.size(); ++k)
+            std::cout << " " << column_name(d, k) << " = " << d.twin[k];
+          std::cout << " (the reaction and displacement terms' targets come from its run)\n";
+        }
         if (o->check) return knit::kExitOk;
+        // The twin's targets: the case solved at the twin's values (not for --check).
+        if (const std::string why = knit::macro::set_twin_targets(d); !why.empty()) {
+          std::cerr << "knit-macro design: " << o->file << ": " << why << "\n";
+          std::cout << "status: failed\n";
+          return knit::kExitFailure;
+        }
         const auto r = knit::macro::optimize_design(d);
         using knit::macro::DesignStatus;
         if (r.status == DesignStatus::kFailed && r.evaluations <= 1) {
@@ -76,9 +94,7 @@ knit::cli::SubcommandRegistrar reg(
         }
         knit::io::AtomicDirectory out(dir);
         std::vector<std::string> header = {"iteration", "J", "gradient_norm", "seconds"};
-        for (std::size_t k = 0; k < d.variables.size(); ++k)
-          header.push_back(d.variables[k].name.empty() ? "x" + std::to_string(k)
-                                                       : d.variables[k].name);
+        for (std::size_t k = 0; k < d.variables.size(); ++k) header.push_back(column_name(d, k));
         knit::io::CsvWriter csv(out / "history.csv", header);
         for (const auto& h : r.history) {
           std::vector<knit::io::CsvCell> row = {h.iteration, h.J, h.gradient_norm, h.seconds};
@@ -120,6 +136,20 @@ knit::cli::SubcommandRegistrar reg(
         for (std::size_t k = 0; k < d.variables.size(); ++k)
           sum << "variable " << header[4 + k] << ": " << d.variables[k].initial << " -> " << r.x[k]
               << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "]\n";
+        // A twin experiment: its targets and how far the design ends from the twin, per
+        // variable in % of its bound interval (docs/design.md, "Twin experiments").
+        for (std::size_t k = 0; k < d.objectives.size() && !d.twin.empty(); ++k)
+          if (d.twin_targets[k]) {
+            sum << "twin target " << d.objectives[k].name << ":";
+            for (double t : d.objectives[k].target) sum << " " << t;
+            sum << "\n";
+          }
+        for (std::size_t k = 0; k < d.twin.size(); ++k) {
+          const auto& v = d.variables[k];
+          sum << "twin " << header[4 + k] << ": " << d.twin[k] << " (recovered " << r.x[k]
+              << ", off by " << 100.0 * std::abs(r.x[k] - d.twin[k]) / (v.upper - v.lower)
+              << " % of the bounds)\n";
+        }
         const std::string run_failure = knit::macro::run_failure_message(run);
         sum << "final run: " << (run.succeeded() ? "completed" : run_failure) << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());

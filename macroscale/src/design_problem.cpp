@@ -121,7 +121,7 @@ int find_name(const std::vector<std::string>& names, const json& j, const std::s
 }
 
 void read_objective(const json& j, const std::string& p, const Case& c, const std::string& file,
-                    DesignObjective& o) {
+                    bool twin, DesignObjective& o) {
   if (!j.is_object() || !j.contains("type") || !j.at("type").is_string())
     throw InputError(file, p, "an objective needs a \"type\"");
   const std::string type = j.at("type").get<std::string>();
@@ -194,7 +194,14 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     if (!(o.at_strain.back() > 0.0))
       throw InputError(file, p + "/at_strain", "the last strain must be positive");
   }
-  if (targets) {
+  const bool from_twin = twin && (o.kind == DesignObjective::Kind::kReaction ||
+                                  o.kind == DesignObjective::Kind::kDisplacement);
+  if (from_twin) {
+    if (j.contains("target"))
+      throw InputError(file, p + "/target",
+                       "the twin (/twin) gives this term's targets: remove one or the other");
+    o.target.assign(o.at_strain.size(), 0.0);  // set_twin_targets() fills them
+  } else if (targets) {
     if (!j.contains("target")) throw InputError(file, p, "missing required key \"target\"");
     o.target = numbers(j.at("target"), file, p + "/target");
     if (o.target.size() != o.at_strain.size())
@@ -310,8 +317,8 @@ DesignProblem load_design(const std::string& path) {
   d.file = path;
   const json root = io::read_json_file(path);
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
-  const std::vector<std::string> top_keys = {"$schema",    "description", "case",     "variables",
-                                             "objectives", "smoothness",  "optimizer"};
+  const std::vector<std::string> top_keys = {"$schema",    "description", "case",      "variables",
+                                             "objectives", "smoothness",  "optimizer", "twin"};
   if (auto u = io::find_unknown_key(root, "", top_keys))
     throw InputError(path, u->pointer, "unknown key" + u->note);
   if (!root.contains("case") || !root.at("case").is_string())
@@ -378,10 +385,41 @@ DesignProblem load_design(const std::string& path) {
     }
     d.variables.push_back(v);
   }
+  // The twin: a value inside its bounds for every variable, by its history.csv column.
+  const bool twin = root.contains("twin");
+  if (twin) {
+    const json& t = root.at("twin");
+    if (!t.is_object() || t.empty())
+      throw InputError(path, "/twin",
+                       "must be an object of one value per design variable (by name)");
+    for (auto it = t.begin(); it != t.end(); ++it)
+      if (std::find(columns.begin(), columns.end(), it.key()) == columns.end()) {
+        std::string list;
+        for (const auto& c : columns) list += (list.empty() ? "" : ", ") + c;
+        throw InputError(path, "/twin/" + io::json_pointer_escape(it.key()),
+                         "names no design variable (the variables: " + list + ")");
+      }
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const std::string tp = "/twin/" + io::json_pointer_escape(columns[k]);
+      if (!t.contains(columns[k]))
+        throw InputError(
+            path, "/twin",
+            "gives no value for the variable \"" + columns[k] + "\" (a twin sets every variable)");
+      const double x = number(t.at(columns[k]), path, tp);
+      const DesignVariableSpec& v = d.variables[k];
+      if (!(x >= v.lower && x <= v.upper))
+        throw InputError(path, tp,
+                         "must lie within the variable's bounds [" + fmt(v.lower) + ", " +
+                             fmt(v.upper) + "], got " + fmt(x));
+      d.twin.push_back(x);
+    }
+  }
   for (std::size_t k = 0; k < root.at("objectives").size(); ++k) {
     DesignObjective o;
     const std::string ptr = "/objectives/" + std::to_string(k);
-    read_objective(root.at("objectives")[k], ptr, d.c, path, o);
+    read_objective(root.at("objectives")[k], ptr, d.c, path, twin, o);
+    d.twin_targets.push_back(twin && (o.kind == DesignObjective::Kind::kReaction ||
+                                      o.kind == DesignObjective::Kind::kDisplacement));
     // Each term is reported by its name (summary.txt, the history): two of one name could not
     // be told apart (session 36's red team: two "term load_at_20" lines, exit 0). A given name
     // must be new; a default one (the type) already taken gets the term's index ("_1").
@@ -402,6 +440,10 @@ DesignProblem load_design(const std::string& path) {
     }
     d.objectives.push_back(o);
   }
+  if (twin && std::none_of(d.twin_targets.begin(), d.twin_targets.end(), [](bool b) { return b; }))
+    throw InputError(path, "/twin",
+                     "no objective takes its targets from it (only reaction and displacement "
+                     "terms do)");
   if (root.contains("smoothness") && root.at("smoothness").contains("weight"))
     d.smoothness = number(root.at("smoothness").at("weight"), path, "/smoothness/weight");
   if (root.contains("optimizer")) read_optimizer(root.at("optimizer"), path, d.optimizer);

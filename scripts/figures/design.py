@@ -109,6 +109,18 @@ def main():
     summary = read_summary(os.path.join(a.dir, "summary.txt"))
     dfile = design_file(a)
     objectives = read_json(dfile).get("objectives", []) if dfile else None
+    # A twin experiment's targets are computed by knit-macro design: summary.txt's
+    # 'twin target NAME: v1 v2 ...' lines (docs/design.md, `twin`).
+    for k, o in enumerate(objectives or []):
+        if "target" not in o:
+            name = o.get("name", o.get("type"))
+            line = summary.get("twin target " + str(name))
+            if line:
+                try:
+                    o["target"] = [float(x) for x in line.split()]
+                    o["twin"] = True
+                except ValueError:
+                    pass  # drawn without its target
     fields = [(k, case["material"].get(k)) for k in ("stitch_value", "knitting_angle")]
     fields = [(k, field_grid(s)) for k, s in fields if field_grid(s) is not None]
     run = os.path.join(a.dir, "run")
@@ -188,7 +200,8 @@ def main():
             tag = o.get("name", o.get("type"))
             if o.get("type") == "reaction" and len(o.get("target", [])) == len(at):
                 ax.plot(100 * at, o["target"], "D", ms=8, mfc="none", mec="tab:red", mew=1.6,
-                        zorder=3, label=f"target of {tag}: " + ", ".join(
+                        zorder=3, label=f"{'twin ' if o.get('twin') else ''}target of {tag}: "
+                        + ", ".join(
                             f"{t:.4g} N at {100 * x:.3g} %" for x, t in zip(at, o["target"])))
             elif o.get("type") == "reaction_linearity" and len(at):
                 # The objective: the curve's distance from the line through the origin and

@@ -72,6 +72,22 @@ int run_design(const fs::path& file) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/// The design file `text`, written as kDir/name, is refused by load_design with an InputError
+/// naming the file and `ptr`, and by `knit-macro design --check` with exit 2.
+void expect_refused(const std::string& name, const std::string& text, const std::string& ptr) {
+  INFO(name);
+  const fs::path f = kDir / name;
+  write(f, text);
+  try {
+    (void)load_design(f.string());
+    FAIL_CHECK("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == f.string());
+    CHECK(e.pointer() == ptr);
+  }
+  CHECK(run_design(f) == 2);
+}
+
 }  // namespace
 
 TEST_CASE("design file: a valid file loads", "[unit]") {
@@ -121,19 +137,7 @@ TEST_CASE("design: an output directory that is not ours is refused before any wo
 
 TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]") {
   write_case();
-  auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr) {
-    INFO(name);
-    const fs::path f = kDir / name;
-    write(f, text);
-    try {
-      (void)load_design(f.string());
-      FAIL_CHECK("no error");
-    } catch (const knit::InputError& e) {
-      CHECK(e.file() == f.string());
-      CHECK(e.pointer() == ptr);
-    }
-    CHECK(run_design(f) == 2);
-  };
+  const auto expect = expect_refused;
   // A design of one variable, control values `indices` of `field` in [lower, upper].
   auto one_variable = [](const std::string& field, const std::string& indices,
                          const std::string& lower, const std::string& upper) {
@@ -682,4 +686,103 @@ TEST_CASE("design: case.json names a relative database by its absolute path", "[
   CHECK(w.find("\"database\": \"" + db.lexically_normal().string() + "\"") != std::string::npos);
   CHECK(fs::exists(out / "run" / "load_strain.csv"));  // the final run found it
   fs::remove_all(kDir / "relative_out");
+}
+
+// Session 37: a twin experiment ("twin" in the design file, docs/design.md): the reaction and
+// displacement terms take their targets from the case solved at the twin's values, and the
+// design recovers them on any database (the shipped example's fixed target had drifted to
+// another loop length's load as the database changed).
+TEST_CASE("design twin: the targets come from the twin's solve and the design recovers it",
+          "[case]") {
+  write_case();
+  const std::string vars =
+      R"([{"name": "l", "field": "stitch_value", "indices": [0, 1], "lower": 4.5,
+           "upper": 6.5}])";
+  const std::string objs =
+      R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2]},
+          {"type": "displacement", "point": "mid", "component": "x", "at_strain": [0.2]},
+          {"type": "strain_variance", "component": "E22", "region": {"u": [0, 1],
+           "v": [0.4, 0.6]}, "at_strain": [0.2], "weight": 1e-6}])";
+  write(kDir / "twin.json", R"({"case": "case.json", "variables": )" + vars +
+                                R"(, "objectives": )" + objs + R"(, "twin": {"l": 5.0}})");
+  DesignProblem d = load_design((kDir / "twin.json").string());
+  REQUIRE(d.twin == std::vector<double>{5.0});
+  REQUIRE(d.twin_targets == std::vector<bool>{true, true, false});
+  CHECK(d.objectives[0].target == std::vector<double>{0.0, 0.0});  // until set
+  REQUIRE(set_twin_targets(d).empty());
+  // The targets: the same terms evaluated at l = 5.0 with zero targets and unit weights.
+  DesignProblem probe = d;
+  probe.objectives.resize(2);
+  probe.smoothness = 0.0;
+  for (auto& o : probe.objectives) o.target.assign(o.at_strain.size(), 0.0);
+  const DesignEvaluation e = evaluate_design(probe, {5.0}, false);
+  REQUIRE(e.residuals.size() == 3);
+  CHECK(d.objectives[0].target[0] == e.residuals(0));
+  CHECK(d.objectives[0].target[1] == e.residuals(1));
+  CHECK(d.objectives[1].target[0] == e.residuals(2));
+  CHECK(d.objectives[0].target[1] > d.objectives[0].target[0]);  // the load grows
+  CHECK(d.objectives[0].target[0] > 0.0);
+  // At the twin the two terms vanish; the design started at 6.0 recovers l = 5.0.
+  CHECK(evaluate_design(d, {5.0}, false).terms[0].second < 1e-20);
+  d.variables[0].initial = 6.0;
+  const DesignResult r = optimize_design(d);
+  INFO("recovered l = " << r.x[0] << ", status " << to_string(r.status));
+  CHECK(std::abs(r.x[0] - 5.0) < 1e-3);
+}
+
+TEST_CASE("design twin: bad twins are JSON-pointer errors and exit 2", "[unit]") {
+  write_case();
+  const std::string vars =
+      R"([{"name": "l", "field": "stitch_value", "indices": [0, 1], "lower": 4.5,
+           "upper": 6.5},
+          {"field": "knitting_angle", "indices": [0], "lower": -45, "upper": 45}])";
+  const std::string reaction = R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2]}])";
+  auto expect = [&](const std::string& name, const std::string& objs, const std::string& twin,
+                    const std::string& ptr) {
+    expect_refused(name,
+                   R"({"case": "case.json", "variables": )" + vars + R"(, "objectives": )" + objs +
+                       R"(, "twin": )" + twin + "}",
+                   ptr);
+  };
+  expect("twin_unknown.json", reaction, R"({"l": 5, "x1": 0, "m": 1})", "/twin/m");
+  expect("twin_missing.json", reaction, R"({"l": 5})", "/twin");
+  expect("twin_outside.json", reaction, R"({"l": 6.6, "x1": 0})", "/twin/l");
+  expect("twin_not_number.json", reaction, R"({"l": "5", "x1": 0})", "/twin/l");
+  expect("twin_and_target.json",
+         R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2], "target": [1]}])",
+         R"({"l": 5, "x1": 0})", "/objectives/0/target");
+  expect("twin_unused.json",
+         R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+              "region": {"u": [0, 1], "v": [0.4, 0.6]}}])",
+         R"({"l": 5, "x1": 0})", "/twin");
+  // Without a twin a reaction term still needs its target (the schema no longer requires it).
+  write(kDir / "no_target.json",
+        R"({"case": "case.json", "variables": )" + vars + R"(, "objectives": )" + reaction + "}");
+  CHECK_THROWS_AS(load_design((kDir / "no_target.json").string()), knit::InputError);
+}
+
+TEST_CASE("design twin: knit-macro design writes the twin's targets and distance", "[case]") {
+  write_case();
+  write(kDir / "twin_cli.json",
+        R"({"case": "case.json",
+            "variables": [{"name": "l", "field": "stitch_value", "indices": [0, 1],
+                           "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "name": "load", "reaction": "fy",
+                            "at_strain": [0.2]}],
+            "twin": {"l": 5.5}})");
+  const fs::path out = kDir / "twin_cli_out";
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
+                          (kDir / "twin_cli.json").string() + " -o " + out.string() + " > " +
+                          (kDir / "twin_cli.log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(st));
+  CHECK(WEXITSTATUS(st) == 0);
+  const std::string summary = knit_test::read_text(out / "summary.txt");
+  INFO(summary);
+  CHECK(summary.find("status: converged") != std::string::npos);
+  CHECK(summary.find("twin target load: ") != std::string::npos);
+  // The case's l is 5.0, the twin 5.5: the design moves there.
+  CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5]") != std::string::npos);
+  CHECK(summary.find("twin l: 5.5 (recovered 5.5, off by ") != std::string::npos);
+  fs::remove_all(out);
 }

@@ -62,6 +62,15 @@ struct DesignProblem {
   double smoothness = 0.0;
   std::vector<DesignFieldGrid> fields;  ///< every field that has a variable
   DesignOptimizerSpec optimizer;
+  /// `twin` of the design file (session 37): one value per variable, in variable order; empty
+  /// without a twin. The reaction and displacement terms then take their targets from the
+  /// case run at these values (set_twin_targets), so that the design must recover them: a
+  /// twin experiment that stays one on any database (cases/design/uniform_load.json's fixed
+  /// target, the 20 % load of l = 6.0 on session 25's database, was met at l = 5.904 on
+  /// session 36's).
+  std::vector<double> twin;
+  /// The objectives whose targets come from the twin (reaction and displacement terms).
+  std::vector<bool> twin_targets;
   /// The control values each variable sets, as DesignVariable entries (for case_with_design).
   std::vector<DesignVariable> expanded() const;
 };
@@ -69,6 +78,12 @@ struct DesignProblem {
 /// Reads and checks a design file. Every problem throws knit::InputError naming the design
 /// file (or the case file, for errors inside the case) and the JSON pointer.
 DesignProblem load_design(const std::string& path);
+
+/// The targets of the twin-target terms (DesignProblem::twin_targets) from the case solved at
+/// the twin's values: each term's reaction or displacement at each of its applied strains, the
+/// same solve the optimizer makes (evaluate_design). Returns "" or, when that solve fails, why
+/// (a numerical outcome: knit-macro design then exits with 1). Nothing to do without a twin.
+std::string set_twin_targets(DesignProblem& d);
 
 }  // namespace knit::macro
 

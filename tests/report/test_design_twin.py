@@ -1,0 +1,79 @@
+#!/usr/bin/python3
+"""The report's verdict on twin experiments (scripts/report.py, twin_verdict; session 37): a
+design with a twin recovers it when its status is converged and every variable ends within
+TWIN_TOLERANCE of its bound interval of the twin's value, recomputed from the summary's
+variable lines; a design off by more, one that did not converge, one whose twin line disagrees
+with its variable line and one whose lines cannot be read do not; a design without a twin has
+no verdict. The design table and the summary's count say so. Run by CTest (label report).
+"""
+import os
+import sys
+import tempfile
+
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
+import report  # noqa: E402
+
+# summary.txt of knit-macro design with a twin (the lines the verdict reads).
+SUMMARY = """status: {status}
+J_initial: 122.66
+J_final: 2.97785e-23
+variable l: 5.5 -> {end} in [4.5, 6.5]
+twin target load_at_20: 48.0437
+twin l: 6 (recovered {got}, off by 0 % of the bounds)
+final run: completed
+"""
+
+
+def write_design(out, name, text):
+    os.makedirs(os.path.join(out, "design", name), exist_ok=True)
+    with open(os.path.join(out, "design", name + ".status"), "w") as f:
+        f.write('{"design": "%s", "exit_code": 0, "seconds": 0.1}\n' % name)
+    with open(os.path.join(out, "design", name, "summary.txt"), "w") as f:
+        f.write(text)
+
+
+def main():
+    c = Checklist()
+    tol = 2.0 * report.TWIN_TOLERANCE  # the bound interval is 2 mm
+    cases = {
+        "recovered": (dict(status="converged", end="6", got="6"), True),
+        "just inside": (dict(status="converged", end=repr(6 - 0.9 * tol),
+                             got=repr(6 - 0.9 * tol)), True),
+        "off by more than the tolerance": (dict(status="converged", end=repr(6 - 1.1 * tol),
+                                                got=repr(6 - 1.1 * tol)), False),
+        "recovered but not converged": (dict(status="target not met", end="6", got="6"), False),
+        "twin line disagrees with the variable line": (dict(status="converged", end="6",
+                                                            got="5.9"), False),
+        "unreadable numbers": (dict(status="converged", end="nan", got="nan"), False),
+    }
+    for what, (fields, expect) in cases.items():
+        summ = {}
+        for line in SUMMARY.format(**fields).splitlines():
+            k, _, v = line.partition(":")
+            summ.setdefault(k.strip(), v.strip())
+        got = report.twin_verdict(summ)
+        c(got is not None and got[0] is expect, "%s: %s" % (what, "recovered" if expect else
+                                                          "not recovered"), repr(got))
+    c(report.twin_verdict({"status": "converged", "variable l": "5.5 -> 6 in [4.5, 6.5]"}) is None,
+      "a design without a twin has no verdict")
+    with tempfile.TemporaryDirectory(prefix="design_twin_test_") as out:
+        write_design(out, "good", SUMMARY.format(status="converged", end="6", got="6"))
+        write_design(out, "bad", SUMMARY.format(status="converged", end="5.9", got="5.9"))
+        write_design(out, "plain", "status: converged\nvariable l: 5.5 -> 6 in [4.5, 6.5]\n")
+        c(report.twin_counts(out) == (1, 2), "the count: 1 of 2 twin experiments recovered",
+          repr(report.twin_counts(out)))
+        table = "\n".join(report.design_section(out))
+        c("| good |" in table and "**pass**: l 6 (twin 6" in table, "the table: good passes", table)
+        c("**FAIL**: l 5.9 (twin 6, off by 5 %" in table, "the table: bad fails with its distance",
+          table)
+        c("| plain |" in table and table.split("| plain |")[1].split("\n")[0].rstrip().endswith(
+            "| - |"), "the table: no twin, no verdict", table)
+    return c.exit_code()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
