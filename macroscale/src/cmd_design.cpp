@@ -48,7 +48,7 @@ knit::cli::SubcommandRegistrar reg(
       auto o = std::make_shared<Options>();
       sub.add_option("design", o->file, "design file (JSON)")->required();
       sub.add_flag("--check", o->check, "read and check the design file, print the problem");
-      sub.add_option("--output,-o", o->output, "output directory");
+      sub.add_option("-o,--output,--out", o->output, "output directory");
       return [o]() -> int {
         auto d = knit::macro::load_design(o->file);
         std::cout << "design: " << o->file << "\ncase: " << d.case_file << "\n";

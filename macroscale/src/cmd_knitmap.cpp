@@ -33,7 +33,7 @@ knit::cli::SubcommandRegistrar reg(
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->case_file, "case file (JSON, knit material, planar patch)")
           ->required();
-      sub.add_option("--output,-o", o->output, "output directory");
+      sub.add_option("-o,--output,--out", o->output, "output directory");
       sub.add_option("--angle-tolerance", o->angle_tolerance,
                      "largest deviation of the course direction from its mean (deg)")
           // A finite angle in (0, 180]: CLI::PositiveNumber let "nan" through, which passed

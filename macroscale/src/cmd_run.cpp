@@ -31,7 +31,7 @@ knit::cli::SubcommandRegistrar reg(
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->case_file, "case file (JSON)")->required();
-      sub.add_option("--output,-o", o->output, "output directory");
+      sub.add_option("-o,--output,--out", o->output, "output directory");
       sub.add_option("--max-output-size", o->max_output_size,
                      "refuse a run whose estimated output is larger (default 2G; 0: no cap)");
       return [o]() -> int {

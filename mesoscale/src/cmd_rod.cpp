@@ -29,7 +29,7 @@ knit::cli::SubcommandRegistrar reg(
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->file, "case file (schema: schemas/rod.schema.json)")->required();
-      sub.add_option("-o,--output", o->outdir,
+      sub.add_option("-o,--output,--out", o->outdir,
                      "output directory (default: <case stem>.out in the working directory)");
       sub.add_flag("-q,--quiet", o->quiet, "no progress lines");
       sub.add_option("--max-output-size", o->max_output_size,

@@ -187,7 +187,8 @@ knit::cli::SubcommandRegistrar reg(
       auto c = std::make_shared<Cli>();
       sub.add_option("input", c->input, "sweep input (JSON, schemas/sweep.schema.json)")
           ->required();
-      sub.add_option("--output,-o", c->output, "material database to write (default database.h5)");
+      sub.add_option("-o,--output,--out", c->output,
+                     "material database to write (default database.h5)");
       sub.add_flag("--resume", c->resume, "continue an interrupted sweep from OUTPUT.parts");
       sub.add_flag("--force", c->force, "discard checkpoints of an unfinished earlier sweep");
       sub.add_option("--threads", c->threads, "worker threads per rank (default: all cores)")

@@ -509,6 +509,13 @@ TEST_CASE("knit-macro: every error line starts with the program and its subcomma
   CHECK(first_line(" run " + (d / "strip.json").string() + " --no-such-flag") ==
         "knit-macro run: The following argument was not expected: --no-such-flag");
   CHECK(first_line("") == "knit-macro: A subcommand is required");
+  // Session 37: an unknown subcommand is named with the known ones (CLI11 said "A subcommand
+  // is required"), and an option's bad value names the option, not "<input>".
+  CHECK(first_line(" frobnicate") ==
+        "knit-macro: unknown subcommand 'frobnicate' (subcommands: design, knitmap, run); run "
+        "knit-macro --help");
+  CHECK(first_line(" run " + (d / "strip.json").string() + " --max-output-size 5MiB")
+            .rfind("knit-macro run: error: --max-output-size: \"5MiB\" is not a size", 0) == 0);
   CHECK(first_line(" run " + (d / "missing.json").string()) ==
         "knit-macro run: error: " + (d / "missing.json").string() + ": file not found");
   fs::remove_all(d);

@@ -32,6 +32,9 @@ class InputError : public std::runtime_error {
 
  private:
   static std::string compose(const std::string& f, const std::string& p, const std::string& m) {
+    // A command-line option ("--max-output-size") names itself; "<input>" stands for a file
+    // that has no name (session 37: "<input>: --max-output-size: ..." read as a file).
+    if (f.empty() && p.rfind("-", 0) == 0) return p + ": " + m;
     std::string s = f.empty() ? std::string("<input>") : f;
     s += ": ";
     if (!p.empty()) s += p + ": ";
