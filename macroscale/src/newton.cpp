@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <iomanip>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -112,7 +113,29 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   stats.symmetric = K.symmetric();
   stats.supernodal = K.supernodal();
   stats.ordering = K.ordering();
+  // Every return: whether CHOLMOD failed where it was wanted (SolverStats).
+  const auto done = [&]() -> RunReport& {
+    stats.supernodal_failure = K.supernodal_failure();
+    stats.fallback_factorizations = K.fallback_factorizations();
+    return report;
+  };
   stats.threads = model.assembly_threads();
+  // Progress of long runs (SolverOptions::progress): the setup, then slow iterations.
+  auto last_line = Clock::now();
+  if (opt.progress && stats.setup > opt.progress_after) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "setup: " << n << " unknowns, "
+      << (!sparse            ? "dense"
+          : stats.supernodal ? "supernodal Cholesky (ordering " + stats.ordering + ")"
+          : stats.symmetric  ? "sparse LDLT"
+                             : "sparse LU")
+      << ", " << stats.setup << " s";
+    if (!K.supernodal_failure().empty())
+      s << " (the supernodal Cholesky failed in " << K.supernodal_failure() << ")";
+    opt.progress(s.str());
+    last_line = Clock::now();
+  }
 
   const int nsteps = std::max(1, opt.steps);
   const long work_cap = opt.max_total_iterations > 0
@@ -212,6 +235,15 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       o.residual = cur.norm;
       o.reference = cur.ref;
       o.iterations = it;
+      if (opt.progress && it > 0 && since(last_line) > opt.progress_after) {
+        std::ostringstream s;
+        s.precision(4);
+        s << "  load factor " << lam << ", iteration " << it << ": residual " << cur.norm
+          << " (reference " << cur.ref << "), " << std::setprecision(3) << since(last_line)
+          << " s since the last line";
+        opt.progress(s.str());
+        last_line = Clock::now();
+      }
       if (cur.norm <= opt.tolerance * cur.ref + opt.absolute_tolerance) {
         o.converged = true;
         return o;
@@ -390,7 +422,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       report.status = RunStatus::kNotConverged;
       report.reason = StopReason::kLoadBelowTolerance;
       report.message = s.str();
-      return report;
+      return done();
     }
     if (o.converged) {
       if (const int q = flipped_point(dofs.expand(uf, lam1)); q != -1) {
@@ -440,6 +472,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         report.first_unstable_lambda = lambda;
       }
       if (on_step) on_step(sr);
+      last_line = Clock::now();  // the step's own line
       if (std::abs(lambda - next_nominal) < 1e-12) {
         cutbacks = 0;
         h = h_nom;
@@ -450,28 +483,28 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     }
     if (o.work_cap) {
       stop(StopReason::kWorkCap, "at the work cap", lam1, o.why);
-      return report;
+      return done();
     }
     if (++cutbacks > opt.max_cutbacks) {
       std::ostringstream s;
       s << "after " << opt.max_cutbacks << " cut-backs of the increment (last increment "
         << (lam1 - lambda) << ")";
       stop(StopReason::kCutbacks, s.str(), lam1, o.why);
-      return report;
+      return done();
     }
     if (0.5 * (lam1 - lambda) < opt.min_increment) {
       std::ostringstream s;
       s << "with the increment at its floor (" << (lam1 - lambda)
         << "; halving it would pass min_increment = " << opt.min_increment << ")";
       stop(StopReason::kIncrementFloor, s.str(), lam1, o.why);
-      return report;
+      return done();
     }
     // Half the increment that failed, not half of h: after a doubling, lam1 may have been
     // clipped at the nominal level, and h / 2 then retried the same increment from the same
     // state (session 31: 0.5 -> 1 failed twice, one cut-back and 36 iterations spent on it).
     h = 0.5 * (lam1 - lambda);
   }
-  return report;
+  return done();
 }
 
 }  // namespace knit::macro

@@ -123,7 +123,10 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
     }
   }
   // Symbolic analysis, once per run (the LDLT's only when the Cholesky needs a fallback).
-  if (supernodal_) supernodal_ = n_ > 0 && f_->cholesky.analyze(sparse_matrix_);
+  if (supernodal_ && n_ > 0 && !f_->cholesky.analyze(sparse_matrix_)) {
+    supernodal_ = false;
+    supernodal_failure_ = "the symbolic analysis: " + f_->cholesky.failure();
+  }
   if (!symmetric_)
     f_->sparse_lu.analyzePattern(sparse_matrix_);
   else if (!supernodal_)
@@ -300,6 +303,13 @@ Factorization ReducedTangent::factorize() {
         return from_pivots(f_->cholesky.pivots(), true, "supernodal Cholesky");
       }
       // Indefinite (or CHOLMOD failed): the LDLT below counts the negative pivots.
+      if (st == SupernodalCholesky::Status::kFailed) {
+        ++fallback_factorizations_;
+        if (supernodal_failure_.empty())
+          supernodal_failure_ = "a factorization: " + f_->cholesky.failure();
+      }
+    } else if (!supernodal_failure_.empty()) {
+      ++fallback_factorizations_;  // the analysis failed: every factorization is the LDLT's
     }
     analyze_ldlt();
     f_->sparse_ldlt.factorize(sparse_matrix_);

@@ -207,6 +207,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   // completed" and nothing else for one that ended with exit 1).
   if (!material_failure_.empty()) h5.set_attribute(".", "material_failure", material_failure_);
   if (!material_warning_.empty()) h5.set_attribute(".", "material_warning", material_warning_);
+  if (!solver_warning_.empty()) h5.set_attribute(".", "solver_warning", solver_warning_);
   if (!load_drops_.empty()) {
     std::string all;
     for (const std::string& d : load_drops_) all += (all.empty() ? "" : "\n") + d;
@@ -314,6 +315,7 @@ void ResultsWriter::finish(const RunReport& report) {
   if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
   if (!material_warning_.empty()) sum << material_warning_ << "\n";
   for (const std::string& d : load_drops_) sum << d << "\n";
+  if (!solver_warning_.empty()) sum << "solver: " << solver_warning_ << "\n";
   if (!nonfinite_output_.empty()) sum << "output failure: " << output_failure() << "\n";
   sum << "converged steps: " << report.converged_steps
       << "\nlast load factor: " << fmt(report.last_lambda) << "\n";

@@ -38,6 +38,8 @@ class ResultsWriter {
   /// Load drops (load_drop.hpp), a line each: CSV comments, summary.txt lines and the HDF5
   /// attribute "load_drops" (the lines joined by newlines).
   void set_load_drops(std::vector<std::string> d) { load_drops_ = std::move(d); }
+  /// RunResult::solver_warning: a summary.txt line and the HDF5 attribute "solver_warning".
+  void set_solver_warning(std::string w) { solver_warning_ = std::move(w); }
   /// Empty, or where the sampled output fields first held a non-finite number (the first
   /// field, step and point, and how many values in all): the quadrature points, which Newton
   /// checks, may never reach a strain where the material's stress overflows, the output grid
@@ -67,6 +69,7 @@ class ResultsWriter {
   std::string material_failure_;
   std::string material_warning_;
   std::vector<std::string> load_drops_;
+  std::string solver_warning_;
   std::string nonfinite_output_;
   long nonfinite_values_ = 0;
 };

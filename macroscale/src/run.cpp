@@ -109,6 +109,16 @@ std::string material_failure_message(const RunReport& report, long n) {
          "; results are not trustworthy";
 }
 
+std::string solver_fallback_message(const SolverStats& stats) {
+  if (stats.supernodal_failure.empty()) return {};
+  return "the supernodal Cholesky (CHOLMOD) failed in " + stats.supernodal_failure + "; " +
+         std::to_string(stats.fallback_factorizations) + " factorization" +
+         (stats.fallback_factorizations == 1 ? " was" : "s were") +
+         " made by Eigen's SimplicialLDLT instead (the same results, single-threaded and much "
+         "slower on large patches; " +
+         std::to_string(stats.unknowns) + " unknowns)";
+}
+
 std::string run_failure_message(const RunResult& r) {
   std::string m;
   const auto add = [&m](const std::string& part) {
@@ -139,7 +149,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   int outputs = 0;
   Eigen::VectorXd last_written;
   ShellModel::Evaluation audit;
-  res.report = solve_load_steps(m, p.dofs, p.fext, c.solver, [&](const StepResult& s) {
+  SolverOptions solver = c.solver;
+  if (opt.progress)  // long setups and slow iterations say so (newton.hpp)
+    solver.progress = [&opt](const std::string& line) { *opt.progress << line << std::endl; };
+  res.report = solve_load_steps(m, p.dofs, p.fext, solver, [&](const StepResult& s) {
     // Where the converged state lies in the material's data (one residual pass per step).
     if (c.material->begin_converged_audit()) {
       m.evaluate(s.u, false, audit);
@@ -189,6 +202,9 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   res.material_warning = c.material->warning();
   if (opt.warnings && !res.material_warning.empty())
     *opt.warnings << res.material_warning << std::endl;
+  res.solver_warning = solver_fallback_message(res.report.stats);
+  if (opt.warnings && !res.solver_warning.empty())
+    *opt.warnings << "warning: " << res.solver_warning << std::endl;
   for (const LoadDrop& d : find_load_drops(c, res.rows))
     res.load_drops.push_back(load_drop_message(d));
   if (opt.warnings)
@@ -208,6 +224,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     writer->set_material_warning(res.material_warning);
     writer->set_material_failure(failure);
     writer->set_load_drops(res.load_drops);
+    writer->set_solver_warning(res.solver_warning);
     // A stopped run still writes its last converged state.
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)

@@ -73,9 +73,33 @@ enum class Ordering {
   kAsIs,     ///< the matrix's own order, not postordered (a matrix permuted already)
 };
 
+namespace {
+/// CHOLMOD's status (cholmod_common::status) by name and in words; "" for OK and NOT_POSDEF.
+std::string status_text(int status) {
+  switch (status) {
+    case CHOLMOD_OK:
+    case CHOLMOD_NOT_POSDEF:
+      return {};
+    case CHOLMOD_NOT_INSTALLED:
+      return "CHOLMOD_NOT_INSTALLED: a method CHOLMOD was built without";
+    case CHOLMOD_OUT_OF_MEMORY:
+      return "CHOLMOD_OUT_OF_MEMORY: the factor does not fit in memory";
+    case CHOLMOD_TOO_LARGE:
+      return "CHOLMOD_TOO_LARGE: the factor's size overflows an int index";
+    case CHOLMOD_INVALID:
+      return "CHOLMOD_INVALID: invalid input";
+    case CHOLMOD_DSMALL:
+      return "CHOLMOD_DSMALL: a diagonal entry of the factor is tiny";
+    default:
+      return "CHOLMOD status " + std::to_string(status);
+  }
+}
+}  // namespace
+
 struct SupernodalCholesky::Impl {
   cholmod_common c{};
   cholmod_factor* L = nullptr;
+  std::string failure;  ///< status_text() of the last analyze or factorize
   explicit Impl(Ordering ordering) {
     cholmod_start(&c);
     c.supernodal = CHOLMOD_SUPERNODAL;
@@ -142,18 +166,31 @@ bool SupernodalCholesky::analyze(const Eigen::SparseMatrix<double>& lower) {
   if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
   cholmod_sparse A = view(lower);
   impl_->L = cholmod_analyze(&A, &impl_->c);
-  return impl_->L != nullptr && impl_->c.status == CHOLMOD_OK;
+  const bool ok = impl_->L != nullptr && impl_->c.status == CHOLMOD_OK;
+  impl_->failure = ok ? std::string() : status_text(impl_->c.status);
+  if (!ok && impl_->failure.empty()) impl_->failure = "the symbolic analysis failed";
+  return ok;
+}
+
+std::string SupernodalCholesky::failure() const {
+  return impl_->failure;
 }
 
 SupernodalCholesky::Status SupernodalCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
-  if (!impl_->L) return Status::kFailed;
+  if (!impl_->L) {
+    impl_->failure = "no symbolic analysis";
+    return Status::kFailed;
+  }
   serial_openmp_regions();
   serial_blas();
   cholmod_sparse A = view(lower);
   cholmod_factorize(&A, impl_->L, &impl_->c);
+  impl_->failure = status_text(impl_->c.status);
   if (impl_->c.status == CHOLMOD_NOT_POSDEF) return Status::kNotPositiveDefinite;
-  if (impl_->c.status != CHOLMOD_OK || !impl_->L->is_super || !impl_->L->is_ll)
+  if (impl_->c.status != CHOLMOD_OK || !impl_->L->is_super || !impl_->L->is_ll) {
+    if (impl_->failure.empty()) impl_->failure = "the factor is not a supernodal L L^T";
     return Status::kFailed;
+  }
   return Status::kOk;
 }
 
@@ -221,6 +258,9 @@ Eigen::VectorXd SupernodalCholesky::pivots() const {
 }
 Eigen::VectorXd SupernodalCholesky::solve(const Eigen::VectorXd& b) const {
   return Eigen::VectorXd::Constant(b.size(), std::numeric_limits<double>::quiet_NaN());
+}
+std::string SupernodalCholesky::failure() const {
+  return "this build has no CHOLMOD";
 }
 
 #endif

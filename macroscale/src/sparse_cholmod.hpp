@@ -49,6 +49,11 @@ class SupernodalCholesky {
   Eigen::VectorXd pivots() const;
   /// x = A^-1 b with the last successful factorization.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  /// Why the last analyze() or factorize() failed: CHOLMOD's status by name and in words
+  /// ("CHOLMOD_TOO_LARGE: the factor's size overflows an int index"), "" after a success or
+  /// an indefinite matrix (session 37: at 256 x 256 elements of degree 5 the shell fell back to
+  /// Eigen's SimplicialLDLT without a word, 37 s per iteration against 6.9 s at 192 x 192).
+  std::string failure() const;
 
  private:
   struct Impl;

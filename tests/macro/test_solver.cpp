@@ -730,3 +730,57 @@ TEST_CASE("a Newton step beyond the law's domain is shortened, on both paths", "
     CHECK(s * E / (1.0 - E / 0.3) == Approx(0.3).epsilon(1e-8));
   }
 }
+
+// Session 37 (a red team's 256 x 256 patch: nothing printed for 9.6 min; the supernodal
+// Cholesky fell back to the SimplicialLDLT without a word).
+TEST_CASE("long runs: the setup and slow iterations print progress lines, quick ones none",
+          "[unit]") {
+  json j = verification_case("sze_cantilever.json");
+  j["refinement"]["elements"] = {6, 1};
+  j["solver"]["steps"] = 2;
+  std::vector<std::string> lines;
+  const RunResult quiet = run(j, [&](Case& c) {
+    c.solver.linear_solver = LinearSolver::kSparse;
+    c.solver.progress = [&](const std::string& l) { lines.push_back(l); };
+  });
+  REQUIRE(quiet.report.status == RunStatus::kCompleted);
+  CHECK(lines.empty());  // nothing took 5 s
+  const RunResult loud = run(j, [&](Case& c) {
+    c.solver.linear_solver = LinearSolver::kSparse;
+    c.solver.progress = [&](const std::string& l) { lines.push_back(l); };
+    c.solver.progress_after = -1.0;  // every line
+  });
+  REQUIRE(loud.report.status == RunStatus::kCompleted);
+  REQUIRE(!lines.empty());
+  CHECK(lines.front().rfind(
+            "setup: " + std::to_string(loud.report.stats.unknowns) + " unknowns, " +
+                (ReducedTangent::supernodal_available() ? "supernodal Cholesky (ordering "
+                                                        : "sparse LDLT"),
+            0) == 0);
+  long iteration_lines = 0;
+  for (const auto& l : lines)
+    if (l.find(", iteration ") != std::string::npos && l.find(": residual ") != std::string::npos)
+      ++iteration_lines;
+  // A line at the start of every iteration after an attempt's first (the residual of the
+  // last iterate): one per Newton iteration, except after an attempt's last when that one
+  // ends on a round-off correction (at most one per step).
+  CHECK(iteration_lines <= loud.report.stats.iterations);
+  CHECK(iteration_lines >= loud.report.stats.iterations - long(loud.rows.size()));
+  // The supernodal path succeeded: no fallback, no warning.
+  CHECK(loud.report.stats.supernodal_failure.empty());
+  CHECK(loud.solver_warning.empty());
+}
+
+TEST_CASE("the supernodal Cholesky's failure is a warning naming CHOLMOD's status", "[unit]") {
+  SolverStats s;
+  CHECK(solver_fallback_message(s).empty());
+  s.supernodal_failure =
+      "a factorization: CHOLMOD_TOO_LARGE: the factor's size overflows an int index";
+  s.fallback_factorizations = 14;
+  s.unknowns = 135198;
+  CHECK(solver_fallback_message(s) ==
+        "the supernodal Cholesky (CHOLMOD) failed in a factorization: CHOLMOD_TOO_LARGE: the "
+        "factor's size overflows an int index; 14 factorizations were made by Eigen's "
+        "SimplicialLDLT instead (the same results, single-threaded and much slower on large "
+        "patches; 135198 unknowns)");
+}

@@ -77,6 +77,13 @@ struct SolverOptions {
   /// Sparse symmetric path: CHOLMOD's supernodal Cholesky while the tangent is positive
   /// definite (SimplicialLDLT otherwise); false: always SimplicialLDLT (to compare the paths).
   bool supernodal = true;
+  /// Progress of long runs (session 37's red team: a 256 x 256 patch printed nothing for 9.6
+  /// min): called with a line after a setup of more than `progress_after` seconds (unknowns,
+  /// factorization, seconds) and, within a step, for an iteration that ends more than
+  /// `progress_after` seconds after the last line (the iteration, residual, seconds). Empty: no
+  /// lines. The per-step lines are the StepCallback's.
+  std::function<void(const std::string&)> progress;
+  double progress_after = 5.0;
 };
 
 struct StepResult {
@@ -121,7 +128,10 @@ struct SolverStats {
   bool sparse = false, symmetric = false;
   bool supernodal = false;  ///< the sparse symmetric path tries the supernodal Cholesky
   std::string ordering;     ///< its fill-reducing ordering (ReducedTangent::ordering())
-  int threads = 1;          ///< assembly threads
+  /// ReducedTangent::supernodal_failure() and fallback_factorizations() at the end of the run.
+  std::string supernodal_failure;
+  long fallback_factorizations = 0;
+  int threads = 1;  ///< assembly threads
 };
 
 struct RunReport {

@@ -75,6 +75,11 @@ class ReducedTangent : public ElementTangentSink {
   /// SupernodalCholesky::fill_reducing_ordering takes the one with the fewest flops); empty on
   /// the other paths.
   const std::string& ordering() const { return ordering_; }
+  /// Why the supernodal Cholesky could not be used where it was wanted (the symbolic analysis
+  /// or a factorization failed in CHOLMOD, not an indefinite tangent): the first reason, ""
+  /// if none; and how many factorizations the SimplicialLDLT made instead.
+  const std::string& supernodal_failure() const { return supernodal_failure_; }
+  long fallback_factorizations() const { return fallback_factorizations_; }
   /// Whether the build has the supernodal Cholesky (CHOLMOD found at configure time).
   static bool supernodal_available();
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
@@ -139,6 +144,8 @@ class ReducedTangent : public ElementTangentSink {
   /// fill-reducing ordering); empty: the natural order.
   std::vector<int> perm_;
   std::string ordering_;
+  std::string supernodal_failure_;
+  long fallback_factorizations_ = 0;
   Eigen::MatrixXd dense_;
   Eigen::SparseMatrix<double> sparse_matrix_;
   struct Factors;  ///< the Eigen factorizations and the Cholesky (reduced_tangent.cpp)

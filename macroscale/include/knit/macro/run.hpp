@@ -98,6 +98,9 @@ struct RunResult {
   /// load_drop_message() of each reaction whose load falls between converged steps
   /// (load_drop.hpp): warnings, not failures (a buckling test may drop on purpose).
   std::vector<std::string> load_drops;
+  /// solver_fallback_message() of the run: the supernodal Cholesky failed where it was wanted
+  /// and Eigen's SimplicialLDLT factorized instead (slower); "" if not. A warning.
+  std::string solver_warning;
   /// Empty, or where the written output fields held a non-finite number (results_writer.hpp:
   /// the output grid reached a strain where the material's stress is not finite).
   std::string output_failure;
@@ -119,6 +122,10 @@ RunResult run_case(const Case& c, const RunOptions& options);
 /// "completed with N failed material evaluations; results are not trustworthy" (or
 /// "stopped ..." for a run that did not complete); empty if n == 0.
 std::string material_failure_message(const RunReport& report, long n);
+
+/// "the supernodal Cholesky (CHOLMOD) failed in <what>: <status>; N factorizations were made by
+/// Eigen's SimplicialLDLT instead ..." from the run's SolverStats; "" if it never failed.
+std::string solver_fallback_message(const SolverStats& stats);
 
 /// Why a run is not a plain success (RunResult::succeeded()): the stop message, the material's
 /// failures and the output failure, joined by "; "; empty if it succeeded.
