@@ -122,6 +122,8 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   stats.threads = model.assembly_threads();
   // Progress of long runs (SolverOptions::progress): the setup, then slow iterations.
   auto last_line = Clock::now();
+  std::string last_method;  // of the last factorization, for the progress lines
+  int last_negative_pivots = -1;
   if (opt.progress && stats.setup > opt.progress_after) {
     std::ostringstream s;
     s.precision(3);
@@ -239,8 +241,10 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         std::ostringstream s;
         s.precision(4);
         s << "  load factor " << lam << ", iteration " << it << ": residual " << cur.norm
-          << " (reference " << cur.ref << "), " << std::setprecision(3) << since(last_line)
-          << " s since the last line";
+          << " (reference " << cur.ref << "), last factorization " << last_method;
+        if (last_negative_pivots > 0)
+          s << " (indefinite: " << last_negative_pivots << " negative pivots)";
+        s << ", " << std::setprecision(3) << since(last_line) << " s since the last line";
         opt.progress(s.str());
         last_line = Clock::now();
       }
@@ -281,6 +285,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         return o;
       }
       o.negative_pivots = f.negative_pivots;
+      last_method = f.method, last_negative_pivots = f.negative_pivots;
       if (!du.allFinite()) {
         o.why = "the linear solve produced non-finite values";
         return o;

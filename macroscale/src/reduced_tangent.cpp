@@ -43,6 +43,7 @@ class PivotedSparseLU : public Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>
 template <typename Vec>
 Factorization from_pivots(const Vec& d, bool count_negative, const char* kind) {
   Factorization f;
+  f.method = kind;
   const double hi = d.size() ? d.cwiseAbs().maxCoeff() : 0.0;
   const double lo = d.size() ? d.cwiseAbs().minCoeff() : 0.0;
   f.pivot_ratio = hi > 0.0 ? lo / hi : 0.0;

@@ -765,6 +765,12 @@ TEST_CASE("long runs: the setup and slow iterations print progress lines, quick 
   // last iterate): one per Newton iteration, except after an attempt's last when that one
   // ends on a round-off correction (at most one per step).
   CHECK(iteration_lines <= loud.report.stats.iterations);
+  // Each names the factorization (the tangent is positive definite here).
+  for (const auto& l : lines)
+    if (l.find(", iteration ") != std::string::npos)
+      CHECK(l.find(ReducedTangent::supernodal_available()
+                       ? "last factorization supernodal Cholesky, "
+                       : "last factorization sparse LDLT, ") != std::string::npos);
   CHECK(iteration_lines >= loud.report.stats.iterations - long(loud.rows.size()));
   // The supernodal path succeeded: no fallback, no warning.
   CHECK(loud.report.stats.supernodal_failure.empty());

@@ -46,6 +46,9 @@ struct Factorization {
   /// tangent. -1 on the LU paths (not available).
   int negative_pivots = -1;
   double pivot_ratio = 0.0;  ///< min |pivot| / max |pivot|
+  /// Which factorization was made ("supernodal Cholesky", "sparse LDLT", ...): the sparse
+  /// LDLT on the supernodal path means an indefinite tangent (or a CHOLMOD failure).
+  const char* method = "";
 };
 
 class ReducedTangent : public ElementTangentSink {
