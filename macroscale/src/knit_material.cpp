@@ -260,8 +260,8 @@ void KnitMaterial::reset_stats() {
   audit_evaluations_ = 0;
   audit_outside_ = 0;
   for (int k = 0; k < 3; ++k) {
-    visited_[k] = std::numeric_limits<double>::infinity();
-    visited_[k + 3] = -std::numeric_limits<double>::infinity();
+    visited_[k] = audit_visited_[k] = std::numeric_limits<double>::infinity();
+    visited_[k + 3] = audit_visited_[k + 3] = -std::numeric_limits<double>::infinity();
   }
   std::lock_guard<std::mutex> lock(where_mutex_);
   where_.clear();
@@ -271,7 +271,7 @@ std::string KnitMaterial::warning() const {
   const long n = audit_evaluations_.load();
   if (n == 0) return {};
   const double share = static_cast<double>(audit_outside_.load()) / static_cast<double>(n);
-  if (!(share > kExtrapolatedWarning)) return {};
+  if (!(share > kExtrapolatedWarning)) return energy_ ? far_excursion_warning() : std::string();
   std::ostringstream os;
   os << std::setprecision(3) << "warning: " << 100.0 * share
      << " % of the material evaluations at converged states lie outside the database's data ("

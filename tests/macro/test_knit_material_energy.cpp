@@ -97,7 +97,8 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   CHECK(s.visited_max(2) == 0.3);
   const std::string rep = m.report();
   CHECK_THAT(rep, Catch::Contains("1 extrapolated") &&
-                      Catch::Contains("visited material-frame strain box: E11 [-0.2, 0.6]"));
+                      Catch::Contains("visited material-frame strain box (Newton's trial "
+                                      "iterates too): E11 [-0.2, 0.6]"));
   CHECK_THAT(rep, !Catch::Contains("at converged states"));  // no audit yet
   CHECK(m.warning().empty());                                // trial iterates alone never warn
   // The converged-state audit counts only what is evaluated between begin and end.
@@ -108,6 +109,10 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   m.evaluate({0.8, 0.0, 0.0}, p);  // after the audit: counted in the totals only
   CHECK(m.energy_stats().outside_box == 3);
   CHECK_THAT(m.report(), Catch::Contains("at converged states: 1 of 2 evaluations extrapolated"));
+  // ... and the strain box of the converged states alone (session 37), not the trial iterates'
+  // (E11 from -0.2, up to 0.8): the material frame is the case's here (alpha = 0).
+  CHECK_THAT(m.report(), Catch::Contains("%); their strain box E11 [0.1, 0.7], E22 [0, 0.1], "
+                                         "2E12 [0, 0]"));
   // More than 2 % of the converged states' evaluations outside the box: a warning (session 22:
   // a stretch of 10 times the specimen "completed" with 100 % outside and no warning).
   CHECK_THAT(m.warning(), Catch::StartsWith("warning: 50 % of the material evaluations at "
@@ -120,6 +125,20 @@ TEST_CASE("knit material, energy law: report counts extrapolation and the visite
   m.evaluate({0.9, 0.0, 0.0}, p);
   m.end_converged_audit();
   CHECK_THAT(m.warning(), Catch::StartsWith("warning: 3.92 % "));  // 2 of 51
+  // Session 37: one converged state far beyond the box (a clamped corner of a refined mesh)
+  // warns although its share is small: 1 of 1001 here, at E11 = 50.
+  m.reset_stats();
+  REQUIRE(m.begin_converged_audit());
+  for (int k = 0; k < 1000; ++k) m.evaluate({0.1, 0.1, 0.0}, p);
+  m.evaluate({0.44, 0.0, 0.0}, p);  // inside
+  m.end_converged_audit();
+  CHECK(m.warning().empty());
+  REQUIRE(m.begin_converged_audit());
+  m.evaluate({50.0, 0.0, 0.0}, p);
+  m.end_converged_audit();
+  CHECK_THAT(m.warning(), Catch::StartsWith("warning: converged states reach E11 = 50, beyond "
+                                            "the law's data box ["));
+  m.reset_stats();
   CHECK(m.failed_evaluations() == 0);
   const auto bad = m.evaluate({NAN, 0.0, 0.0}, p);
   CHECK(m.failed_evaluations() == 1);

@@ -204,6 +204,13 @@ class KnitMaterial : public Material {
   mutable std::atomic<long> audit_evaluations_{0}, audit_outside_{0};
   /// Visited box: min of (E11, E22, 2E12) in [0..2], max in [3..5].
   mutable std::array<std::atomic<double>, 6> visited_;
+  /// The same over the converged-state audit (session 37: the visited box above, Newton's trial
+  /// iterates included, read E11 = 4.3 / 12.9 / 43 for s312 refined to 32 / 64 / 128 elements,
+  /// which a red team took for the converged states; those reach E11 = 0.83 at 32 x 32).
+  mutable std::array<std::atomic<double>, 6> audit_visited_;
+  /// warning() below the share that warns: a converged state beyond the energy law's box by
+  /// more than the box's width in one component; "" if none.
+  std::string far_excursion_warning() const;
   spline::SplineSurface l_field_, a_field_;
   Source source_;
   std::vector<Bound> bound_;
