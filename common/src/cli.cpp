@@ -18,6 +18,7 @@
 #include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
+#include "knit/io/names.hpp"
 
 namespace knit::cli {
 
@@ -163,10 +164,10 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
   if (argc >= 2 && argv[1][0] != '-' && std::none_of(subs.begin(), subs.end(), [&](const auto& s) {
         return s.first->check_name(argv[1]);
       })) {
-    std::string names;
-    for (const auto& s : subs) names += (names.empty() ? "" : ", ") + s.first->get_name();
-    std::cerr << program << ": unknown subcommand '" << argv[1] << "' (subcommands: " << names
-              << "); run " << program << " --help\n";
+    std::vector<std::string> names;
+    for (const auto& s : subs) names.push_back(s.first->get_name());
+    std::cerr << program << ": unknown subcommand '" << argv[1]
+              << "' (subcommands: " << io::join_names(names) << "); run " << program << " --help\n";
     return kExitBadInput;
   }
   try {

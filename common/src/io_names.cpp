@@ -24,4 +24,10 @@ std::optional<std::string> output_name_problem(std::string_view name) {
   return std::nullopt;
 }
 
+std::string join_names(const std::vector<std::string>& names) {
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list;
+}
+
 }  // namespace knit::io

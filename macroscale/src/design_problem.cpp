@@ -12,6 +12,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/names.hpp"
 #include "knit/material/database.hpp"
 
 namespace knit::macro {
@@ -111,8 +112,7 @@ int find_name(const std::vector<std::string>& names, const json& j, const std::s
   const std::string n = j.is_string() ? j.get<std::string>() : "";
   const auto it = std::find(names.begin(), names.end(), n);
   if (it == names.end()) {
-    std::string list;
-    for (const auto& s : names) list += (list.empty() ? "" : ", ") + s;
+    const std::string list = io::join_names(names);
     throw InputError(file, p,
                      "\"" + n + "\" is not among the case's " + what + " (" +
                          (list.empty() ? "none" : list) + ")");
@@ -148,10 +148,9 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     keys.insert(keys.end(), extra.begin(), extra.end());
     for (auto it = j.begin(); it != j.end(); ++it)
       if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
-        std::string list;
-        for (const auto& key : keys) list += (list.empty() ? "" : ", ") + key;
-        throw InputError(file, p + "/" + io::json_pointer_escape(it.key()),
-                         "not used by a " + type + " term (its keys: " + list + ")");
+        throw InputError(
+            file, p + "/" + io::json_pointer_escape(it.key()),
+            "not used by a " + type + " term (its keys: " + io::join_names(keys) + ")");
       }
   }
   o.name = j.contains("name") && j.at("name").is_string() ? j.at("name").get<std::string>() : type;
@@ -394,10 +393,9 @@ DesignProblem load_design(const std::string& path) {
                        "must be an object of one value per design variable (by name)");
     for (auto it = t.begin(); it != t.end(); ++it)
       if (std::find(columns.begin(), columns.end(), it.key()) == columns.end()) {
-        std::string list;
-        for (const auto& c : columns) list += (list.empty() ? "" : ", ") + c;
-        throw InputError(path, "/twin/" + io::json_pointer_escape(it.key()),
-                         "names no design variable (the variables: " + list + ")");
+        throw InputError(
+            path, "/twin/" + io::json_pointer_escape(it.key()),
+            "names no design variable (the variables: " + io::join_names(columns) + ")");
       }
     for (std::size_t k = 0; k < columns.size(); ++k) {
       const std::string tp = "/twin/" + io::json_pointer_escape(columns[k]);

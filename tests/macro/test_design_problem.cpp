@@ -72,6 +72,16 @@ int run_design(const fs::path& file) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/// `knit-macro design FILE -o OUT`, its output in FILE with the extension .log: the exit code
+/// (-1 if it did not exit).
+int design_into(const fs::path& file, const fs::path& out) {
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " + file.string() +
+                          " -o " + out.string() + " > " +
+                          fs::path(file).replace_extension(".log").string() + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
 /// The design file `text`, written as kDir/name, is refused by load_design with an InputError
 /// naming the file and `ptr`, and by `knit-macro design --check` with exit 2.
 void expect_refused(const std::string& name, const std::string& text, const std::string& ptr) {
@@ -637,14 +647,9 @@ TEST_CASE("design: the final run names its case by the committed path", "[unit]"
                                 R"(, "objectives": )" + kObjs +
                                 R"(, "optimizer": {"max_iterations": 1}})");
   const fs::path out = kDir / "prov_out";
-  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
-                          (kDir / "prov.json").string() + " -o " + out.string() + " > " +
-                          (kDir / "prov.log").string() + " 2>&1";
-  const int st = std::system(cmd.c_str());
-  REQUIRE(WIFEXITED(st));
   // Session 34 (the design audit's mutant 98): one iteration does not meet these targets: the
   // iteration limit, exit 1 (docs/design.md), with every output written.
-  CHECK(WEXITSTATUS(st) == 1);
+  CHECK(design_into(kDir / "prov.json", out) == 1);
   REQUIRE(fs::exists(out / "run" / "load_strain.csv"));
   std::ifstream in(out / "run" / "load_strain.csv");
   std::string first;
@@ -675,11 +680,7 @@ TEST_CASE("design: case.json names a relative database by its absolute path", "[
                             "target": [0]}]})");
   const fs::path out = kDir / "relative_out" / "deeper" / "design";
   fs::remove_all(kDir / "relative_out");
-  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
-                          (kDir / "relative.json").string() + " -o " + out.string() + " > " +
-                          (kDir / "relative.log").string() + " 2>&1";
-  const int st = std::system(cmd.c_str());
-  CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));  // l on its upper bound: infeasible target
+  CHECK(design_into(kDir / "relative.json", out) == 0);  // l on its upper bound: infeasible
   REQUIRE(fs::exists(out / "case.json"));
   const std::string w = knit_test::read_text(out / "case.json");
   INFO(w);
@@ -771,12 +772,7 @@ TEST_CASE("design twin: knit-macro design writes the twin's targets and distance
                             "at_strain": [0.2]}],
             "twin": {"l": 5.5}})");
   const fs::path out = kDir / "twin_cli_out";
-  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
-                          (kDir / "twin_cli.json").string() + " -o " + out.string() + " > " +
-                          (kDir / "twin_cli.log").string() + " 2>&1";
-  const int st = std::system(cmd.c_str());
-  REQUIRE(WIFEXITED(st));
-  CHECK(WEXITSTATUS(st) == 0);
+  CHECK(design_into(kDir / "twin_cli.json", out) == 0);
   const std::string summary = knit_test::read_text(out / "summary.txt");
   INFO(summary);
   CHECK(summary.find("status: converged") != std::string::npos);

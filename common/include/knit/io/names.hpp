@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace knit::io {
 
@@ -18,5 +19,8 @@ inline constexpr std::size_t kMaxOutputNameLength = 64;
 
 /// Why `name` is not a valid output name, or nullopt if it is.
 std::optional<std::string> output_name_problem(std::string_view name);
+
+/// The names joined by ", " for a message ("design, knitmap, run"); "" for none.
+std::string join_names(const std::vector<std::string>& names);
 
 }  // namespace knit::io
