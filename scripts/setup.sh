@@ -10,6 +10,7 @@ PACKAGES=(
   nlohmann-json3-dev     # JSON input (3.11)
   libhdf5-dev            # material database and results (1.10)
   libsuitesparse-dev     # CHOLMOD: supernodal Cholesky of the shell tangent (5.12)
+  libmumps-seq-dev       # MUMPS: multifrontal LDLT of indefinite shell tangents (docs/solver.md)
   libopenblas0-pthread   # optimized BLAS behind CHOLMOD (docs/solver.md "Benchmark"): Debian's
                          # alternatives select it over ATLAS for libblas.so.3 (priority 100 vs 35)
   catch2                 # tests (2.13)

@@ -105,18 +105,21 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   const bool sparse = opt.linear_solver == LinearSolver::kSparse ||
                       (opt.linear_solver == LinearSolver::kAuto && n > opt.dense_limit);
   const auto t_setup = Clock::now();
-  ReducedTangent K(model, dofs, hyper && opt.symmetric, sparse, opt.supernodal);
+  ReducedTangent K(model, dofs, hyper && opt.symmetric, sparse, opt.supernodal, opt.multifrontal);
   stats.setup = since(t_setup);
   stats.unknowns = n;
   stats.stored_entries = K.stored_entries();
   stats.sparse = sparse;
   stats.symmetric = K.symmetric();
   stats.supernodal = K.supernodal();
+  stats.multifrontal = K.multifrontal();
   stats.ordering = K.ordering();
   // Every return: whether CHOLMOD failed where it was wanted (SolverStats).
   const auto done = [&]() -> RunReport& {
     stats.supernodal_failure = K.supernodal_failure();
     stats.fallback_factorizations = K.fallback_factorizations();
+    stats.multifrontal_factorizations = K.multifrontal_factorizations();
+    stats.multifrontal_failure = K.multifrontal_failure();
     return report;
   };
   stats.threads = model.assembly_threads();

@@ -11,6 +11,7 @@
 
 #include "knit/macro/thread_pool.hpp"
 #include "sparse_cholmod.hpp"
+#include "sparse_mumps.hpp"
 
 namespace knit::macro {
 
@@ -69,14 +70,19 @@ struct ReducedTangent::Factors {
   bool ldlt_analyzed = false;
   SupernodalCholesky cholesky;
   bool cholesky_active = false;  ///< the last factorization was the supernodal Cholesky
+  MultifrontalLDLT multifrontal;
+  bool multifrontal_analyzed = false;
+  bool multifrontal_active = false;  ///< the last factorization was the multifrontal LDLT
 };
 
 ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool symmetric, bool sparse,
-                               bool supernodal)
+                               bool supernodal, bool multifrontal)
     : n_(dofs.num_free()),
       symmetric_(symmetric),
       sparse_(sparse),
       supernodal_(symmetric && sparse && supernodal && SupernodalCholesky::available()),
+      multifrontal_(symmetric && sparse && supernodal && multifrontal &&
+                    MultifrontalLDLT::available()),
       threads_(m.assembly_threads()),
       f_(std::make_unique<Factors>()) {
   const int ne = m.num_elements();
@@ -223,6 +229,10 @@ bool ReducedTangent::supernodal_available() {
   return SupernodalCholesky::available();
 }
 
+bool ReducedTangent::multifrontal_available() {
+  return MultifrontalLDLT::available();
+}
+
 long ReducedTangent::stored_entries() const {
   return sparse_ ? static_cast<long>(sparse_matrix_.nonZeros()) : static_cast<long>(n_) * n_;
 }
@@ -297,6 +307,7 @@ Factorization ReducedTangent::factorize() {
   }
   if (symmetric_) {
     f_->cholesky_active = false;
+    f_->multifrontal_active = false;
     if (supernodal_) {
       const auto st = f_->cholesky.factorize(sparse_matrix_);
       if (st == SupernodalCholesky::Status::kOk) {
@@ -311,6 +322,10 @@ Factorization ReducedTangent::factorize() {
       }
     } else if (!supernodal_failure_.empty()) {
       ++fallback_factorizations_;  // the analysis failed: every factorization is the LDLT's
+    }
+    if (multifrontal_) {
+      Factorization f;
+      if (factorize_multifrontal(f)) return f;
     }
     analyze_ldlt();
     f_->sparse_ldlt.factorize(sparse_matrix_);
@@ -333,6 +348,39 @@ Factorization ReducedTangent::factorize() {
   return from_pivots(d, false, "sparse LU");
 }
 
+bool ReducedTangent::factorize_multifrontal(Factorization& f) {
+  MultifrontalLDLT& m = f_->multifrontal;
+  if (!f_->multifrontal_analyzed) {
+    f_->multifrontal_analyzed = true;
+    // The supernodal path's matrix is in its fill-reducing order already.
+    if (!m.analyze(sparse_matrix_, !perm_.empty())) {
+      multifrontal_ = false;
+      multifrontal_failure_ = "the symbolic analysis: " + m.failure();
+      return false;
+    }
+  }
+  const auto st = m.factorize(sparse_matrix_);
+  if (st == MultifrontalLDLT::Status::kFailed) {
+    // MUMPS failed (memory, workspace): this and every later factorization by the LDLT.
+    multifrontal_ = false;
+    multifrontal_failure_ = "a factorization: " + m.failure();
+    return false;
+  }
+  ++multifrontal_factorizations_;
+  f.method = "multifrontal LDLT";
+  f.negative_pivots = m.negative_pivots();
+  if (st == MultifrontalLDLT::Status::kSingular) {
+    f.pivot_ratio = 0.0;
+    f.why = "singular tangent stiffness (multifrontal LDLT: " + std::to_string(m.null_pivots()) +
+            " null pivots, |pivot| <= 1e-14 of the matrix's norm)";
+    return true;
+  }
+  f.pivot_ratio = 1.0;  // not available: no null pivot, so above the threshold
+  f.ok = true;
+  f_->multifrontal_active = true;
+  return true;
+}
+
 Eigen::VectorXd ReducedTangent::solve(const Eigen::VectorXd& b) const {
   if (n_ == 0) return Eigen::VectorXd(0);
   if (!sparse_)
@@ -349,6 +397,7 @@ Eigen::VectorXd ReducedTangent::solve(const Eigen::VectorXd& b) const {
 
 Eigen::VectorXd ReducedTangent::solve_stored(const Eigen::VectorXd& b) const {
   if (f_->cholesky_active) return f_->cholesky.solve(b);
+  if (f_->multifrontal_active) return f_->multifrontal.solve(b);
   return symmetric_ ? Eigen::VectorXd(f_->sparse_ldlt.solve(b))
                     : Eigen::VectorXd(f_->sparse_lu.solve(b));
 }

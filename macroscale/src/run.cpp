@@ -110,13 +110,23 @@ std::string material_failure_message(const RunReport& report, long n) {
 }
 
 std::string solver_fallback_message(const SolverStats& stats) {
-  if (stats.supernodal_failure.empty()) return {};
-  return "the supernodal Cholesky (CHOLMOD) failed in " + stats.supernodal_failure + "; " +
-         std::to_string(stats.fallback_factorizations) + " factorization" +
-         (stats.fallback_factorizations == 1 ? " was" : "s were") +
-         " made by Eigen's SimplicialLDLT instead (the same results, single-threaded and much "
-         "slower on large patches; " +
+  std::string m;
+  const bool mumps = stats.multifrontal && stats.multifrontal_failure.empty();
+  if (!stats.supernodal_failure.empty())
+    m = "the supernodal Cholesky (CHOLMOD) failed in " + stats.supernodal_failure + "; " +
+        std::to_string(stats.fallback_factorizations) + " factorization" +
+        (stats.fallback_factorizations == 1 ? " was" : "s were") + " made by " +
+        (mumps ? "MUMPS's multifrontal LDLT instead (the same results; "
+               : "Eigen's SimplicialLDLT instead (the same results, single-threaded and much "
+                 "slower on large patches; ") +
+        std::to_string(stats.unknowns) + " unknowns)";
+  if (!stats.multifrontal_failure.empty())
+    m += std::string(m.empty() ? "" : "; ") + "the multifrontal LDLT (MUMPS) failed in " +
+         stats.multifrontal_failure +
+         "; the indefinite tangents from there on were factorized by Eigen's SimplicialLDLT "
+         "(the same results, single-threaded and much slower on large patches; " +
          std::to_string(stats.unknowns) + " unknowns)";
+  return m;
 }
 
 std::string run_failure_message(const RunResult& r) {

@@ -1,6 +1,8 @@
 // CHOLMOD adapter (sparse_cholmod.hpp): the only file that includes CHOLMOD's headers.
 #include "sparse_cholmod.hpp"
 
+#include "blas_threads.hpp"
+
 #ifdef KNIT_HAVE_CHOLMOD
 #include <cholmod.h>
 #include <dlfcn.h>
@@ -27,22 +29,6 @@ void serial_openmp_regions() {
   static const auto set_levels =
       reinterpret_cast<SetLevels>(::dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
   if (set_levels) set_levels(0);
-}
-
-/// OpenBLAS (Debian's libopenblas0-pthread behind libblas.so.3, scripts/setup.sh) starts one
-/// thread per core for every BLAS call; beside the assembly threads and other processes on a
-/// 2-core machine its spinning threads cost more than they gave (a 1,440-unknown run: 27 % of
-/// the samples in the kernel's scheduler and sched_yield). One BLAS thread: the factorization
-/// runs on the calling thread. Looked up at run time: absent with another BLAS.
-void serial_blas() {
-  using SetThreads = void (*)(int);
-  static const auto set_threads =
-      reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
-  static const bool once = [] {
-    if (set_threads) set_threads(1);
-    return true;
-  }();
-  (void)once;
 }
 
 /// A view of Eigen's compressed lower triangle as a CHOLMOD matrix (no copy; stype -1: only

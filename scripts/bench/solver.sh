@@ -8,7 +8,10 @@
 #    (6,240 DOFs, 6,000 unknowns; <= 60 ms per iteration), with the time per Newton
 #    iteration split into assembly and solve, as wall and as CPU time (on a loaded machine
 #    the CPU figures of the one-thread runs are the cost); each also with the SimplicialLDLT
-#    instead of CHOLMOD's supernodal Cholesky.
+#    instead of CHOLMOD's supernodal Cholesky;
+#  * indefinite tangents (session 38): a square compressed past its limit point, p = 4, 32 x 32
+#    to 128 x 128 elements, the tangents the supernodal Cholesky refuses factorized by MUMPS's
+#    multifrontal LDLT and by Eigen's SimplicialLDLT (filter "bench: indefinite*", ~7 min).
 # Figures of 30 Nov 2026: docs/solver.md "Benchmark" (rounds 1-4). A solver change must leave the results
 # unchanged: run the same case before and after and compare the two results.h5 with
 # scripts/bench/compare_results.py (1e-8 relative).

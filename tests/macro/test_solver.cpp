@@ -179,6 +179,82 @@ TEST_CASE("LDLT inertia: a strip compressed past its limit point reports negativ
   CHECK(stability_summary(none) == "not available (no converged step)");
 }
 
+namespace {
+
+/// Only S11 = E11 (E = 1): no stiffness across the strip nor in shear, so a strip whose y is
+/// free has a singular tangent (null pivots) from the first iteration on.
+struct AxialOnly final : Material {
+  std::string name() const override { return "axial only"; }
+  bool hyperelastic() const override { return true; }
+  MaterialResponse evaluate(const Eigen::Vector3d& E, const MaterialPoint&) const override {
+    MaterialResponse r;
+    r.S.setZero();
+    r.C.setZero();
+    r.S(0) = E(0);
+    r.C(0, 0) = 1.0;
+    r.W = 0.5 * E(0) * E(0);
+    return r;
+  }
+};
+
+}  // namespace
+
+TEST_CASE(
+    "the multifrontal LDLT (MUMPS): the inertia of the dense LDLT, where the "
+    "SimplicialLDLT's fails",
+    "[unit]") {
+  // The supernodal Cholesky hands the tangents it refuses to MUMPS's multifrontal LDLT (when
+  // the build has it) or to the SimplicialLDLT (SolverOptions::multifrontal false). A 10 x 10
+  // square (SVK, nu = 0; 16 x 16 elements of degree 2, 611 unknowns) compressed uniformly
+  // past its limit point (s = 0.5): every state is homogeneous, so each step converges with
+  // no iteration, and the count of negative pivots is that of the converged state's tangent.
+  // The reference is the dense LDLT (Eigen's, with diagonal pivoting). At s = 0.5 the
+  // SimplicialLDLT (no pivoting) breaks down and the step keeps the previous step's count (124
+  // instead of 167: measured, not asserted).
+  const json j = knit::macro::test::compressed_square(2, 16);
+  const RunResult mf = run(j, [](Case& c) { c.solver.linear_solver = LinearSolver::kSparse; });
+  const RunResult dense = run(j, [](Case& c) { c.solver.linear_solver = LinearSolver::kDense; });
+  const RunResult simplicial = run(j, [](Case& c) {
+    c.solver.linear_solver = LinearSolver::kSparse;
+    c.solver.multifrontal = false;
+  });
+  for (const RunResult* x : {&mf, &dense, &simplicial}) {
+    INFO(x->report.message);
+    REQUIRE(x->report.status == RunStatus::kCompleted);
+    CHECK(x->report.stats.multifrontal_failure.empty());
+  }
+  const bool mumps =
+      ReducedTangent::multifrontal_available() && ReducedTangent::supernodal_available();
+  CHECK(mf.report.stats.multifrontal == mumps);
+  CHECK((mf.report.stats.multifrontal_factorizations > 0) == mumps);
+  CHECK_FALSE(simplicial.report.stats.multifrontal);
+  CHECK(simplicial.report.stats.multifrontal_factorizations == 0);
+  REQUIRE(mf.rows.size() == dense.rows.size());
+  for (size_t s = 0; s < dense.rows.size(); ++s) {
+    INFO("step " << s + 1 << ", load factor " << dense.rows[s].lambda);
+    if (mumps) CHECK(mf.rows[s].negative_pivots == dense.rows[s].negative_pivots);
+    CHECK(std::abs(mf.rows[s].reactions[0] - dense.rows[s].reactions[0]) <=
+          1e-8 * std::abs(dense.rows[s].reactions[0]));
+  }
+  // Stable up to s = 0.6 (load factor 0.8), then unstable in many modes.
+  CHECK(dense.rows.back().negative_pivots > 100);
+  // A singular tangent is named as such by either sparse LDLT (no pivot in y: the strip's y is
+  // free but at one corner, and the material has no stiffness across it).
+  json pull = strip(json::parse(R"({"edge": "u1", "fix": ["z"], "prescribe": {"x": 1.0}})"), false);
+  pull["refinement"] = json::parse(R"({"degree": 3, "elements": [6, 2]})");
+  for (const bool mf : {true, false}) {
+    const RunResult x = run(pull, [&](Case& c) {
+      c.solver.linear_solver = LinearSolver::kSparse;
+      c.solver.multifrontal = mf;
+      c.material = std::make_shared<AxialOnly>();
+    });
+    INFO(x.report.message);
+    CHECK(x.report.status == RunStatus::kNotConverged);
+    CHECK_THAT(x.report.message, Catch::Contains("singular tangent stiffness"));
+    if (mf && mumps) CHECK_THAT(x.report.message, Catch::Contains("multifrontal LDLT"));
+  }
+}
+
 TEST_CASE("energy line search: the full step first, backtracking decreases Pi", "[unit]") {
   // Sze cantilever at the full load from u = 0: the linear Newton step overshoots (tip
   // deflection ~130 for a length of 10), so Pi(1) > Pi(0) and the search must cut it.
@@ -777,7 +853,8 @@ TEST_CASE("long runs: the setup and slow iterations print progress lines, quick 
   CHECK(loud.solver_warning.empty());
 }
 
-TEST_CASE("the supernodal Cholesky's failure is a warning naming CHOLMOD's status", "[unit]") {
+TEST_CASE("the sparse factorizations' failures are warnings naming CHOLMOD's and MUMPS's status",
+          "[unit]") {
   SolverStats s;
   CHECK(solver_fallback_message(s).empty());
   s.supernodal_failure =
@@ -788,5 +865,20 @@ TEST_CASE("the supernodal Cholesky's failure is a warning naming CHOLMOD's statu
         "the supernodal Cholesky (CHOLMOD) failed in a factorization: CHOLMOD_TOO_LARGE: the "
         "factor's size overflows an int index; 14 factorizations were made by Eigen's "
         "SimplicialLDLT instead (the same results, single-threaded and much slower on large "
+        "patches; 135198 unknowns)");
+  // With MUMPS the refused factorizations went to its multifrontal LDLT; its own failure
+  // hands the rest to the SimplicialLDLT, and the warning says so.
+  s.multifrontal = true;
+  CHECK_THAT(solver_fallback_message(s),
+             Catch::EndsWith("14 factorizations were made by MUMPS's multifrontal LDLT instead "
+                             "(the same results; 135198 unknowns)"));
+  s.supernodal_failure.clear();
+  s.multifrontal_failure =
+      "a factorization: MUMPS error -13 (INFOG(2) = 5): a memory allocation "
+      "failed";
+  CHECK(solver_fallback_message(s) ==
+        "the multifrontal LDLT (MUMPS) failed in a factorization: MUMPS error -13 (INFOG(2) = "
+        "5): a memory allocation failed; the indefinite tangents from there on were factorized "
+        "by Eigen's SimplicialLDLT (the same results, single-threaded and much slower on large "
         "patches; 135198 unknowns)");
 }

@@ -11,16 +11,14 @@
 
 #include "knit/macro/case.hpp"
 #include "knit/macro/run.hpp"
+#include "verification_case.hpp"
 
 using namespace knit::macro;
 using nlohmann::json;
 
 namespace {
 
-json verification_case(const std::string& name) {
-  std::ifstream in(std::string(KNIT_SOURCE_DIR) + "/cases/verification/" + name);
-  return json::parse(in);
-}
+using knit::macro::test::verification_case;
 
 struct Timing {
   double wall = 0.0, cpu = 0.0;  ///< seconds; CPU time of the process (all threads)
@@ -28,11 +26,12 @@ struct Timing {
 };
 
 Timing time_case(const json& j, LinearSolver solver, bool symmetric, int threads,
-                 bool supernodal = true) {
+                 bool supernodal = true, bool multifrontal = true) {
   Case c = parse_case(j.dump(), "bench.json");
   c.solver.linear_solver = solver;
   c.solver.symmetric = symmetric;
   c.solver.supernodal = supernodal;
+  c.solver.multifrontal = multifrontal;
   c.threads = threads;
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();
@@ -122,4 +121,26 @@ TEST_CASE("bench: tensile p4 16x100 (6,240 DOFs)", "[.bench_solver]") {
   print("tensile p4 16x100 5 steps auto thr", time_case(j, LinearSolver::kAuto, true, 0));
   print("tensile p4 16x100 5 steps LU auto", time_case(j, LinearSolver::kAuto, false, 0));
   std::printf("solver target (~6,000 dofs): <= 60 ms per iteration\n");
+}
+
+TEST_CASE("bench: indefinite tangents, a square compressed past its limit point",
+          "[.bench_solver]") {
+  // compressed_square (verification_case.hpp): past the limit point the tangents are
+  // indefinite and the supernodal Cholesky hands them over: to MUMPS's multifrontal LDLT (default)
+  // or Eigen's SimplicialLDLT. Session 37's 256 x 256 patch: 340 s for one SimplicialLDLT against
+  // 10-20 s per supernodal Cholesky.
+  for (const int ne : {32, 64, 128}) {
+    const json j = knit::macro::test::compressed_square(4, ne);
+    for (const bool mf : {true, false}) {
+      const Timing t = time_case(j, LinearSolver::kSparse, true, 1, true, mf);
+      char label[80];
+      std::snprintf(label, sizeof label, "indefinite p4 %dx%d %s", ne, ne,
+                    mf ? "multifrontal" : "simplicial");
+      print(label, t);
+      std::printf(
+          "solver   %ld factorizations by the multifrontal LDLT, %d negative pivots at the "
+          "end\n",
+          t.report.stats.multifrontal_factorizations, t.report.max_negative_pivots);
+    }
+  }
 }

@@ -77,6 +77,10 @@ struct SolverOptions {
   /// Sparse symmetric path: CHOLMOD's supernodal Cholesky while the tangent is positive
   /// definite (SimplicialLDLT otherwise); false: always SimplicialLDLT (to compare the paths).
   bool supernodal = true;
+  /// Sparse symmetric path: the tangents the supernodal Cholesky refuses (indefinite) go to
+  /// MUMPS's multifrontal LDLT when the build has it; false: to the SimplicialLDLT (to compare
+  /// the paths).
+  bool multifrontal = true;
   /// Progress of long runs (session 37's red team: a 256 x 256 patch printed nothing for 9.6
   /// min): called with a line after a setup of more than `progress_after` seconds (unknowns,
   /// factorization, seconds) and, within a step, for an iteration that ends more than
@@ -131,6 +135,11 @@ struct SolverStats {
   /// ReducedTangent::supernodal_failure() and fallback_factorizations() at the end of the run.
   std::string supernodal_failure;
   long fallback_factorizations = 0;
+  /// Factorizations by MUMPS's multifrontal LDLT (the indefinite tangents of the supernodal
+  /// path), and why MUMPS failed ("" if it did not; the SimplicialLDLT took over from there).
+  bool multifrontal = false;  ///< the indefinite tangents go to MUMPS (when the run began)
+  long multifrontal_factorizations = 0;
+  std::string multifrontal_failure;
   int threads = 1;  ///< assembly threads
 };
 

@@ -61,9 +61,11 @@ class ReducedTangent : public ElementTangentSink {
   /// `symmetric`: assemble the lower triangle only and factorize by LDLT (the element
   /// tangents must be symmetric). `sparse`: sparse storage and factorization.
   /// `supernodal` (sparse symmetric only): try CHOLMOD's supernodal Cholesky first (ignored
-  /// when the build has no CHOLMOD).
+  /// when the build has no CHOLMOD); `multifrontal` (with `supernodal`): the tangents it
+  /// refuses go to MUMPS's multifrontal LDLT (ignored when the build has no MUMPS), else to the
+  /// SimplicialLDLT.
   ReducedTangent(const ShellModel& model, const DofMap& dofs, bool symmetric, bool sparse,
-                 bool supernodal = true);
+                 bool supernodal = true, bool multifrontal = true);
   ~ReducedTangent() override;
   ReducedTangent(const ReducedTangent&) = delete;
   ReducedTangent& operator=(const ReducedTangent&) = delete;
@@ -83,6 +85,15 @@ class ReducedTangent : public ElementTangentSink {
   /// if none; and how many factorizations the SimplicialLDLT made instead.
   const std::string& supernodal_failure() const { return supernodal_failure_; }
   long fallback_factorizations() const { return fallback_factorizations_; }
+  /// Whether the tangents the supernodal Cholesky refuses go to MUMPS's multifrontal LDLT
+  /// (the build has MUMPS, and it has not failed in this run), not to the SimplicialLDLT.
+  bool multifrontal() const { return multifrontal_; }
+  /// Why MUMPS failed in this run ("" if it did not); the SimplicialLDLT took over from there.
+  const std::string& multifrontal_failure() const { return multifrontal_failure_; }
+  /// Factorizations made by the multifrontal LDLT in this run.
+  long multifrontal_factorizations() const { return multifrontal_factorizations_; }
+  /// Whether the build has the multifrontal LDLT (MUMPS found at configure time).
+  static bool multifrontal_available();
   /// Whether the build has the supernodal Cholesky (CHOLMOD found at configure time).
   static bool supernodal_available();
   /// Stored entries of the reduced matrix (n^2 dense, the pattern's non-zeros sparse).
@@ -120,6 +131,10 @@ class ReducedTangent : public ElementTangentSink {
 
  private:
   void analyze_ldlt();  ///< symbolic analysis of the SimplicialLDLT (once, when first needed)
+  /// The multifrontal LDLT (MUMPS) of the assembled matrix, the symbolic analysis on first
+  /// need. False if MUMPS failed (multifrontal_failure_ says where; the SimplicialLDLT then
+  /// takes this and every later factorization), else `f` is the factorization's verdict.
+  bool factorize_multifrontal(Factorization& f);
   /// The compressed-column pattern of the reduced matrix and the scatter map, from the
   /// (stored) index g of every local DOF of every element (nd per element, -1 if constrained).
   void build_pattern(const std::vector<int>& g, int nd);
@@ -128,6 +143,9 @@ class ReducedTangent : public ElementTangentSink {
 
   int n_ = 0;
   bool symmetric_ = false, sparse_ = false, supernodal_ = false;
+  /// The indefinite tangents of the supernodal path go to MUMPS's multifrontal LDLT (while
+  /// it works) rather than to the SimplicialLDLT.
+  bool multifrontal_ = false;
   int block_ = 0;         ///< entries of one element tangent, (3 nloc)^2
   std::vector<int> map_;  ///< block_ entries per element: value index or -1 (construction only)
   int threads_ = 1;
@@ -148,6 +166,8 @@ class ReducedTangent : public ElementTangentSink {
   std::vector<int> perm_;
   std::string ordering_;
   std::string supernodal_failure_;
+  std::string multifrontal_failure_;
+  long multifrontal_factorizations_ = 0;
   long fallback_factorizations_ = 0;
   Eigen::MatrixXd dense_;
   Eigen::SparseMatrix<double> sparse_matrix_;
