@@ -207,8 +207,11 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
     throw InputError(ctx.file, p + "/database", db.string() + ": " + e.what());
   }
   // Every stored law must be usable (e.g. an E-surface folded by a damaged file): refused
-  // here, naming the database and the HDF5 group, before any work.
+  // here, naming the database and the HDF5 group, before any work. A loop length without a
+  // paper-law surface (a database fitted with the energy law only, session 38's red team: the
+  // empty optional was read) has nothing to check; the paper law refuses it in family().
   for (std::size_t k = 0; k < data.entries.size(); ++k) {
+    if (!data.entries[k].surface) continue;
     try {
       const material::ResponseSurface check(*data.entries[k].surface);
     } catch (const std::exception& e) {

@@ -157,7 +157,7 @@ std::string square_case(const std::string& material) {
      << material << R"(, "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
   return cs.str();
 }
-std::string db_file(const std::string& name, bool energy, int version) {
+std::string db_file(const std::string& name, bool energy, int version, bool surfaces = true) {
   const fs::path dir = fs::path(KNIT_BINARY_DIR) / "test_tmp";
   fs::create_directories(dir);
   const fs::path f = dir / name;
@@ -166,7 +166,7 @@ std::string db_file(const std::string& name, bool energy, int version) {
   for (double l : {4.5, 6.5}) {
     LoopLengthEntry e;
     e.loop_length = l;
-    e.surface = testing::make_test_surface(std::pow(4.5 / l, 2));
+    if (surfaces) e.surface = testing::make_test_surface(std::pow(4.5 / l, 2));
     db.entries.push_back(e);
   }
   if (energy) db.energy_law = testing::make_test_energy_law();
@@ -273,6 +273,15 @@ TEST_CASE("knit material: the case key /material/law", "[unit]") {
                         Catch::Contains("knit-meso fit " + v1 + " --law energy"));
   CHECK_THROWS_WITH(parse_case(square_case(material(with, "neo")), "c.json"),
                     Catch::Contains("c.json: /material/law"));
+  // A database fitted with the energy law only (`knit-meso fit RAW --law energy` of a sweep
+  // with "fit": false): no paper-law surface. Session 38's red team: the check of the
+  // surfaces read the empty optional (undefined behaviour; "degrees must be >= 1", exit 2).
+  const std::string energy_only =
+      db_file("law_energy_only.h5", true, kDatabaseFormatVersion, false);
+  CHECK(law_of(parse_case(square_case(material(energy_only, "")), "c.json")) == "energy");
+  CHECK_THROWS_WITH(parse_case(square_case(material(energy_only, "paper")), "c.json"),
+                    Catch::Contains("c.json: /material/database: ") &&
+                        Catch::Contains("has no fitted response surface"));
 }
 
 // Session 22: a knit case in other units ran with exit 0 (the database is in mm, N, MPa).
