@@ -247,8 +247,14 @@ void remove_stale_siblings(const fs::path& target) {
       const bool partial = std::string(tag) == ".partial-";
       // A partial directory has no manifest yet (written at commit): a copy of a finished
       // output under that name keeps its "for:" line and is not ours to remove (review).
-      if (partial ? m->for_name == name && !m->has_manifest : m->replaced_by_pid == pid)
-        remove_marked_tree(it->path());
+      // Killed within its commit (manifest written, not yet renamed) it has the manifest and
+      // the writer's "pid" line, which is the pid of its name; after the exchange of a
+      // replacement it holds the earlier output, marked "replaced by pid" (session 38's red
+      // team: a SIGINT in the commit's fsyncs left a 298 MB DIR.partial-<pid> for good).
+      const bool left_by_run =
+          m->replaced_by_pid == pid ||
+          (partial && m->for_name == name && (!m->has_manifest || m->writer_pid == pid));
+      if (left_by_run) remove_marked_tree(it->path());
     }
   }
 }
@@ -282,7 +288,8 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   // The first line names the writer (output_owner): only it replaces this output later.
   marker << "knitscale output" << (output_owner().empty() ? "" : ": " + output_owner()) << "\n"
          << Provenance::current().to_json_string() << "\n"
-         << "for: " << target_.filename().string() << "\n";
+         << "for: " << target_.filename().string() << "\n"
+         << "pid " << ::getpid() << "\n";
   if (!marker.flush()) {
     // The directory is ours, just created, and holds only this file: without its marker no
     // later run would remove it (session 34: a full disk left DIR.partial-<pid> for good).
@@ -379,6 +386,14 @@ void AtomicDirectory::commit() {
                         std::string(kOutputMarker) + " is missing or names another) while " +
                         "the run went on: left alone; the new output is kept in " + where);
     }
+    // So that the clean-up after a kill knows the earlier output for ours wherever the kill
+    // leaves it (DIR.partial-<pid> after the exchange, DIR.old-<pid> below): appended to a
+    // marker of ours only (an empty target has none), best effort (without it a killed run
+    // leaves the earlier output for the user).
+    if (read_output_marker(target_)) {
+      std::ofstream marker(target_ / kOutputMarker, std::ios::binary | std::ios::app);
+      marker << "replaced by pid " << ::getpid() << "\n";
+    }
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
       remove_old_output(partial_);  // now holds the old contents
     } else {
@@ -388,13 +403,6 @@ void AtomicDirectory::commit() {
       old += std::to_string(::getpid());
       if (fs::exists(fs::symlink_status(old, ec)))
         fail(old, "exists and is not ours to remove; rename or remove it");
-      // So that the clean-up after a kill knows this DIR.old-<pid> for ours: appended to a
-      // marker of ours only (an empty target has none), best effort (without it a killed run
-      // leaves DIR.old-<pid> for the user instead of putting it back).
-      if (read_output_marker(target_)) {
-        std::ofstream marker(target_ / kOutputMarker, std::ios::binary | std::ios::app);
-        marker << "replaced by pid " << ::getpid() << "\n";
-      }
       if (::rename(target_.c_str(), old.c_str()) != 0)
         fail(target_, "cannot move the previous output aside", errno);
       if (::rename(partial_.c_str(), target_.c_str()) != 0) {

@@ -112,6 +112,10 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
       char* end = nullptr;
       const long pid = std::strtol(line.c_str() + 16, &end, 10);
       if (end && *end == '\0' && pid > 0) m.replaced_by_pid = pid;
+    } else if (line.rfind("pid ", 0) == 0) {
+      char* end = nullptr;
+      const long pid = std::strtol(line.c_str() + 4, &end, 10);
+      if (end && *end == '\0' && pid > 0) m.writer_pid = pid;
     }
   }
   return m;

@@ -408,6 +408,15 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   make("out.partial-" + dead2, "knitscale output\n{}\nfor: out.partial-" + dead2 + "\nfile: x\n");
   make("out.old-" + dead2 + "1", "knitscale output\n");  // a marker of before session 29
   make("out.partial-999999997", complete_out);           // a copy of a finished output (review)
+  // Session 38: killed within the commit (the manifest written, not yet renamed: the writer's
+  // pid is the name's) -> removed; a copy of an output written by another pid -> kept; killed
+  // after the exchange of a replacement (the earlier output, "replaced by pid") -> removed.
+  const std::string dead3 = std::to_string(999999996), dead4 = std::to_string(999999995),
+                    dead5 = std::to_string(999999994);
+  make("out.partial-" + dead3, "knitscale output\n{}\nfor: out\npid " + dead3 + "\nfile: x\n");
+  make("out.partial-" + dead4, "knitscale output\n{}\nfor: out\npid 4242\nfile: x\n");
+  make("out.partial-" + dead5,
+       "knitscale output\n{}\nfor: out\npid 4242\nfile: x\nreplaced by pid " + dead5 + "\n");
   {
     knit::io::AtomicDirectory a(target);
     a.commit();
@@ -422,6 +431,12 @@ TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our st
   CHECK(slurp(d / ("out.partial-" + dead2) / "x") == "x");
   CHECK(slurp(d / ("out.old-" + dead2 + "1") / "x") == "x");
   CHECK(slurp(d / "out.partial-999999997" / "x") == "x");
+  CHECK_FALSE(fs::exists(d / ("out.partial-" + dead3)));
+  CHECK_FALSE(fs::exists(d / ("out.partial-" + dead5)));
+  CHECK(slurp(d / ("out.partial-" + dead4) / "x") == "x");
+  // The marker names its writer's pid.
+  CHECK_THAT(slurp(target / knit::io::kOutputMarker),
+             Catch::Contains("\nfor: out\npid " + std::to_string(::getpid()) + "\n"));
   // Killed between the two renames of a replacement without RENAME_EXCHANGE: no DIR, the
   // earlier output in DIR.old-<pid>. The next run puts it back, and a run that then fails
   // leaves it there (session 26: the clean-up deleted it).

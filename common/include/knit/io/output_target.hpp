@@ -53,6 +53,9 @@ struct OutputMarker {
   bool has_manifest = false;       ///< any "file:" line (a committed output of session >= 29)
   std::vector<std::string> files;  ///< the manifest, relative paths with '/'
   long replaced_by_pid = -1;       ///< -1 without that line
+  /// The "pid <pid>" line: the process that built the directory as DIR.partial-<pid> (-1
+  /// without it; markers before session 38).
+  long writer_pid = -1;
 };
 /// The marker of `dir`, read; nothing without a marker.
 std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);
