@@ -20,7 +20,7 @@ std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>&
     for (size_t k = 0; k + 1 < rows.size(); ++k) {
       const double f0 = rows[k].reactions[r], f1 = rows[k + 1].reactions[r];
       const double drop = std::abs(f0) - std::abs(f1);
-      if (!(drop > tolerance * max_load)) continue;
+      if (!(drop > tolerance * max_load) || !(drop > c.solver.absolute_tolerance)) continue;
       ++d.count;
       if (drop > d.largest) {
         d.largest = drop;

@@ -86,4 +86,9 @@ TEST_CASE("load drop: the threshold is relative to the largest load") {
   CHECK(find_load_drops(c, rows_of({100, 100 - 2.0 * tol * 101, 101}, {0, 0, 0})).size() == 1);
   // Loads that are zero throughout have no drop (no division by the largest load).
   CHECK(find_load_drops(c, rows_of({0, 0, 0}, {0, 0, 0})).empty());
+  // Round-off of a reaction that is zero (a free edge; session 38's red team): below the
+  // solve's absolute tolerance (1e-10 N) nothing is judged, above it the relative rule holds.
+  CHECK(c.solver.absolute_tolerance == 1e-10);
+  CHECK(find_load_drops(c, rows_of({-1.776e-15, 4.441e-16, 0}, {0, 0, 0})).empty());
+  CHECK(find_load_drops(c, rows_of({1e-9, 2e-9, 0.5e-9}, {0, 0, 0})).size() == 1);
 }

@@ -14,7 +14,10 @@
 
 namespace knit::macro {
 
-/// Relative threshold of a load drop: |F_k| - |F_k+1| > kLoadDropTolerance x max_j |F_j|.
+/// Relative threshold of a load drop: |F_k| - |F_k+1| > kLoadDropTolerance x max_j |F_j|, and
+/// more than the Newton solve's absolute residual tolerance (Case::solver.absolute_tolerance,
+/// N): a reaction is not known more closely than that (session 38's red team: a reaction of a
+/// free edge "fell" from -1.8e-15 to 4.4e-16 N, 75 % of its largest).
 inline constexpr double kLoadDropTolerance = 1e-6;
 
 /// The drops of one reaction: how many, and the largest (the steps on either side of it).
