@@ -106,7 +106,12 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
                   jobs[i].load_path.steps, r.attempts, r.message.c_str());
     }
   }
-  if (rep.wrote_database)
+  if (rep.wrote_database && rep.written != std::filesystem::path(output))
+    std::printf(
+        "database NOT replaced: the sweep failed, so %s (an earlier database) is kept as it was; "
+        "this sweep's database, with every case's status and message, is %s\n",
+        output.c_str(), rep.written.c_str());
+  else if (rep.wrote_database)
     std::printf("wrote %s\n", output.c_str());
   else
     std::printf("database NOT written: %s\n", rep.not_written.c_str());

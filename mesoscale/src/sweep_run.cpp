@@ -151,6 +151,13 @@ int default_threads(const MpiSession* mpi) {
 
 }  // namespace
 
+std::filesystem::path failed_database_path(const std::filesystem::path& output) {
+  std::filesystem::path p = output;
+  const std::string ext = output.extension().string();
+  p.replace_filename(output.stem().string() + ".failed" + ext);
+  return p;
+}
+
 SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathRunner& runner,
                       const MpiSession* mpi) {
   // Early check, before any case runs: a fit that cannot succeed with these paths and options
@@ -317,7 +324,18 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   }
   rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
   rep.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_sweep_database(opt.output, db, in, rep.results, rep);
+  // A sweep that fails (a paper path that did not complete, a fit that could not be made) does
+  // not replace a database already at the output: its own goes beside it, with its cases'
+  // status and messages for the diagnosis (fit's policy is the same: a failed fit writes
+  // nothing over its output).
+  rep.written = opt.output;
+  std::error_code ec;
+  if (!rep.ok() && std::filesystem::exists(opt.output, ec)) {
+    rep.written = failed_database_path(opt.output);
+    io::check_output_target(rep.written, io::OutputKind::kFile, "--output",
+                            material::kDatabaseFormatName);
+  }
+  write_sweep_database(rep.written, db, in, rep.results, rep);
   rep.wrote_database = true;
   if (opt.on_written) opt.on_written();
   if (!opt.keep_parts) store->remove();

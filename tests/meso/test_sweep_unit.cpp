@@ -955,6 +955,45 @@ TEST_CASE("sweep: a sweep in which no case converged leaves the output as it was
   CHECK_FALSE(std::filesystem::exists(out.string() + ".parts"));
 }
 
+TEST_CASE("sweep: a failing sweep keeps the database at the output and writes its own beside it",
+          "[unit]") {
+  // Session 38's red team: a sweep that failed (exit 1: a paper path did not converge, so the
+  // loop length was not fitted) replaced a working database with one knit-macro cannot use.
+  const auto dir = knit_test::scratch("sweep_unit_failing");
+  const auto out = dir / "db.h5";
+  const PathRunner failing = [](double l, const LoadPath& path) -> PathOutcome {
+    if (path.set == "paper" && path.kind == knit::material::PathKind::kShear)
+      throw std::runtime_error("the cell did not converge");
+    return synthetic_runner()(l, path);
+  };
+  CHECK(failed_database_path(out) == dir / "db.failed.h5");
+  CHECK(failed_database_path(dir / "db") == dir / "db.failed");
+  {  // No database at the output: the failing sweep's goes there (its status for the diagnosis).
+    const SweepReport r = run_sweep(synthetic_input(), quiet(out), failing);
+    CHECK_FALSE(r.ok());
+    CHECK(r.wrote_database);
+    CHECK(r.written == out);
+  }
+  const SweepReport good = run_sweep(synthetic_input(), quiet(out), synthetic_runner());
+  REQUIRE(good.ok());
+  const auto bytes = [](const std::filesystem::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    std::stringstream t;
+    t << in.rdbuf();
+    return t.str();
+  };
+  const std::string earlier = bytes(out);
+  const SweepReport r = run_sweep(synthetic_input(), quiet(out), failing);
+  CHECK_FALSE(r.ok());
+  CHECK(r.failed_cases() > 0);
+  CHECK(r.wrote_database);
+  CHECK(r.written == dir / "db.failed.h5");
+  CHECK(bytes(out) == earlier);
+  CHECK(knit::material::read_database(dir / "db.failed.h5", false).entries.size() == 2);
+  // A successful sweep replaces the output again.
+  CHECK(run_sweep(synthetic_input(), quiet(out), synthetic_runner()).written == out);
+}
+
 TEST_CASE("sweep synthetic runner: a loop length whose stand-in stress overflows is an input error",
           "[unit]") {
   // Before: a loop length of 1e-320 mm ran every case and failed at the database write (exit 1,

@@ -50,6 +50,10 @@ struct SweepReport {
   double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
   int threads = 1, ranks = 1;
   bool wrote_database = false;  ///< false on ranks other than 0
+  /// Where rank 0 wrote the database: the output, or, for a sweep that fails (ok() false)
+  /// while a database is at the output, beside it as failed_database_path(output) (session
+  /// 38's red team: a failed sweep replaced a working database with one knit-macro cannot use).
+  std::filesystem::path written;
   /// Why rank 0 did not write the database (empty: it did, or another rank): a sweep in which
   /// no case converged a single step stores nothing, and the output is left as it was.
   std::string not_written;
@@ -61,6 +65,10 @@ struct SweepReport {
   bool fits_ok() const;
   bool ok() const { return failed_cases() == 0 && fits_ok() && not_written.empty(); }
 };
+
+/// "DB.failed.h5" for "DB.h5" (the extension kept, ".failed" before it; "DB.failed" without
+/// one): where a failing sweep writes its database when one is at the output already.
+std::filesystem::path failed_database_path(const std::filesystem::path& output);
 
 /// True if this result makes the sweep fail (see SweepReport::failed_cases).
 bool fails_sweep(const JobResult& r);
