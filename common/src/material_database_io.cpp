@@ -85,9 +85,9 @@ std::string strip_file(const std::string& msg, const std::string& file) {
 
 void write_database(const std::filesystem::path& file, const Database& db,
                     const std::function<void(io::H5File&)>& extra) {
-  if (const auto bad = first_nonfinite_step(db))
+  if (const auto bad = first_unstorable_step(db))
     throw std::runtime_error(file.string() + ": database not written: " + *bad +
-                             " is marked converged (status 0) but is not finite");
+                             ", though marked converged (status 0)");
   io::AtomicFile out(file);
   const bool existed = std::filesystem::exists(file);
   try {
@@ -498,7 +498,7 @@ std::string raw_path_location(std::size_t k, std::size_t q) {
   return loop_group(k) + "/raw/" + path_group(q);
 }
 
-std::optional<std::string> first_nonfinite_step(const Database& db) {
+std::optional<std::string> first_unstorable_step(const Database& db) {
   for (std::size_t k = 0; k < db.entries.size(); ++k)
     for (std::size_t q = 0; q < db.entries[k].raw.size(); ++q) {
       const RawPath& r = db.entries[k].raw[q];
@@ -509,8 +509,15 @@ std::optional<std::string> first_nonfinite_step(const Database& db) {
                                    {"P", &r.P},
                                    {"E", &r.E},
                                    {"S", &r.S}})
-          if (i < m->rows() && !m->row(i).allFinite())
-            return raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1);
+          if (i < m->rows()) {
+            const std::string at =
+                raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1);
+            if (!m->row(i).allFinite()) return at + " is not finite";
+            const double bound = (*d == 'F' || *d == 'E') ? kMaxRawKinematic : kMaxRawStress;
+            if (m->row(i).cwiseAbs().maxCoeff() > bound)
+              return at + " holds |value| " + io::format_number(m->row(i).cwiseAbs().maxCoeff()) +
+                     " (F, E at most 1e3; P, S at most 1e9 MPa)";
+          }
       }
     }
   return std::nullopt;

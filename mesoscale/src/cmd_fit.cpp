@@ -55,6 +55,17 @@ static knit::cli::SubcommandRegistrar reg_fit(
         const knit::io::OutputLock lock(target);
         auto db = knit::material::read_database(o->db, true);
         const bool paper = o->law != "energy", energy = o->law != "paper";
+        // An options file the chosen law does not read is refused, not ignored unread (session
+        // 38's red team: `--law paper --energy-options /nonexistent.json` ended with exit 0;
+        // synth --no-fit refuses them the same way).
+        if (!paper && !o->options.empty())
+          throw knit::InputError(o->options, "--options",
+                                 "the paper law's fit options, but --law energy fits only the "
+                                 "energy law: leave --options out or fit the paper law too");
+        if (!energy && !o->energy_options.empty())
+          throw knit::InputError(o->energy_options, "--energy-options",
+                                 "the energy law's fit options, but --law paper fits only the "
+                                 "paper law: leave --energy-options out or fit the energy law too");
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()

@@ -59,21 +59,25 @@ static knit::cli::SubcommandRegistrar reg_synth(
         const knit::io::OutputLock lock(o->out);
         SyntheticOptions so;
         so.loop_lengths = o->loop_lengths;
+        // As the sweep's (sweep_input.cpp): at least 0.001 mm apart (session 38's red team:
+        // synth took 4.5 and 4.5001, which the sweep refuses).
         for (std::size_t k = 0; k < so.loop_lengths.size(); ++k)
           if (!(so.loop_lengths[k] > 0.0) ||
-              (k > 0 && !(so.loop_lengths[k] > so.loop_lengths[k - 1])))
-            throw knit::InputError("", "--loop-lengths", "must be positive and increasing");
+              (k > 0 && !(so.loop_lengths[k] >= so.loop_lengths[k - 1] + 1e-3)))
+            throw knit::InputError("", "--loop-lengths",
+                                   "must be positive and increase by at least 0.001 mm");
         so.paths = knit::material::default_load_paths(o->steps);
         if (!o->no_coverage)
           for (const auto& p : synthetic_coverage_paths(std::max(4, o->steps / 2)))
             so.paths.push_back(p);
         auto db = synthetic_database(so);
         // The stand-in's stiffness k = (4.5 / l)^2 overflows for a tiny l: its stresses were
-        // written as inf and NaN with exit 0 (session 21, --loop-lengths 1e-300).
-        if (const auto bad = knit::material::first_nonfinite_step(db))
+        // written as inf and NaN with exit 0 (session 21, --loop-lengths 1e-300), and beyond
+        // what the reader takes (session 38, --loop-lengths 0.0001: 1.4e9 MPa, exit 0).
+        if (const auto bad = knit::material::first_unstorable_step(db))
           throw knit::InputError("", "--loop-lengths",
-                                 "the stand-in law's stress is not finite (" + *bad +
-                                     "): its stiffness (4.5 / l)^2 MPa overflows; give loop "
+                                 "the stand-in law's stress cannot be stored (" + *bad +
+                                     "): its stiffness (4.5 / l)^2 MPa is too large; give loop "
                                      "lengths of a knit (a few mm)");
         int rc = knit::kExitOk;
         if (!o->no_fit) {

@@ -101,11 +101,11 @@ TEST_CASE("database: a converged step that is not finite is not written", "[unit
   write_database(file, db);
   const auto before = fs::file_size(file);
   db.entries[0].raw[3].S(2, 1) = std::nan("");  // step 3: status 1, not data
-  CHECK(!first_nonfinite_step(db));
+  CHECK(!first_unstorable_step(db));
   CHECK_NOTHROW(write_database(tmp("nonfinite_ok.h5"), db));
   db.entries[1].raw[3].S(1, 2) = std::numeric_limits<double>::infinity();  // step 2: converged
-  REQUIRE(first_nonfinite_step(db));
-  CHECK(*first_nonfinite_step(db) == "/loop_1/raw/path_03/S: step 2");
+  REQUIRE(first_unstorable_step(db));
+  CHECK(*first_unstorable_step(db) == "/loop_1/raw/path_03/S: step 2 is not finite");
   try {
     write_database(file, db);
     FAIL("written");
@@ -113,6 +113,14 @@ TEST_CASE("database: a converged step that is not finite is not written", "[unit
     CHECK(std::string(e.what()).find("/loop_1/raw/path_03/S: step 2") != std::string::npos);
   }
   CHECK(fs::file_size(file) == before);  // the earlier database is left as it was
+  // Finite but beyond the reader's bound (session 38: synth wrote 1.4e9 MPa with exit 0).
+  db.entries[1].raw[3].S(1, 2) = 1.5e9;
+  REQUIRE(first_unstorable_step(db));
+  CHECK_THAT(*first_unstorable_step(db),
+             Catch::StartsWith("/loop_1/raw/path_03/S: step 2 holds |value| 1500000000 "));
+  CHECK_THROWS(write_database(file, db));
+  db.entries[1].raw[3].S(1, 2) = 0.9e9;  // within the bound
+  CHECK_FALSE(first_unstorable_step(db));
   CHECK(read_database(file).entries[1].raw[3].S.allFinite());
 }
 

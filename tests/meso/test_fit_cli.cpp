@@ -213,4 +213,17 @@ TEST_CASE("knit-meso fit and synth: empty values, devices and unused options are
   CHECK(run("synth --no-fit --energy-options " + (dir / "missing.json").string() + " --out " +
             out.string()) == 2);
   CHECK_FALSE(fs::exists(out));
+  // synth: loop lengths the database cannot hold or the sweep refuses (session 38's red team:
+  // 0.0001 mm gave 1.4e9 MPa, which the reader refused as a damaged database; 4.5 and 4.5001).
+  CHECK(run("synth --no-fit --loop-lengths 0.0001 --out " + out.string()) == 2);
+  CHECK(run("synth --no-fit --loop-lengths 4.5,4.5001 --out " + out.string()) == 2);
+  CHECK_FALSE(fs::exists(out));
+  // fit: the options of the law it does not fit (session 38's red team: exit 0, unread).
+  const fs::path unused = dir / "cli_unused.h5";
+  fs::remove(unused);
+  CHECK(run("fit " + db.string() + " --law paper --energy-options " +
+            (dir / "missing.json").string() + " -o " + unused.string()) == 2);
+  CHECK(run("fit " + db.string() + " --law energy --options " + (dir / "missing.json").string() +
+            " -o " + unused.string()) == 2);
+  CHECK_FALSE(fs::exists(unused));
 }

@@ -163,17 +163,19 @@ const EnergyLawData& require_energy_law(const Database& db, const std::string& f
 /// HDF5 path of raw path q of loop length k ("/loop_k/raw/path_qq"), for messages.
 std::string raw_path_location(std::size_t k, std::size_t q);
 
-/// The first converged step (status 0) of db's raw data with a non-finite F, P, E or S, as
-/// "/loop_k/raw/path_qq/S: step s", or nothing. The reader refuses such a file; the writer
-/// refuses to write one (session 21: `knit-meso synth --loop-lengths 1e-300` wrote inf and NaN
-/// stresses with exit 0).
-std::optional<std::string> first_nonfinite_step(const Database& db);
+/// The first converged step (status 0) of db's raw data that the reader would refuse: a
+/// non-finite F, P, E or S, or a value beyond kMaxRawKinematic (F, E) or kMaxRawStress (P, S),
+/// as "/loop_k/raw/path_qq/S: step s is not finite" or "... holds |value| 1.2e9 (F, E at most
+/// 1e3; P, S at most 1e9 MPa)"; nothing if there is none. The writer refuses to write such a
+/// database (session 21: `knit-meso synth --loop-lengths 1e-300` wrote inf and NaN stresses
+/// with exit 0; session 38: `--loop-lengths 0.0001` wrote 1.4e9 MPa, which the reader refused).
+std::optional<std::string> first_unstorable_step(const Database& db);
 
 /// Provenance of this build, now.
 Provenance current_provenance();
 
 /// Writes atomically (temporary file next to `file`, then rename). Throws std::runtime_error,
-/// and writes nothing, when a converged step is not finite (first_nonfinite_step). `extra`,
+/// and writes nothing, when a converged step cannot be stored (first_unstorable_step). `extra`,
 /// when given, adds to the open file before it is closed and renamed (the sweep's
 /// /sweep/report; `knit-meso fit` copies the input's objects the Database does not hold), so
 /// one temporary and one rename make the whole file (session 26: the sweep wrote the database
