@@ -23,9 +23,10 @@ std::string job_file(int index) {
   return b;
 }
 
-// Every record ends with a digest line over the record text before it (64-bit FNV-1a,
-// fingerprint() of input.hpp): a record edited by hand or damaged on disk is refused on
-// --resume, naming the file and the record.
+// Every record ends with a digest line over the record text before it (fingerprint() of
+// input.hpp: a 64-bit FNV-1a variant whose offset basis lacks the standard's last digit, kept
+// for the checkpoints of earlier versions; docs/sweep.md): a record edited by hand or damaged
+// on disk is refused on --resume, naming the file and the record.
 constexpr const char* kDigestTag = "digest fnv1a64 ";
 
 std::string slurp(const fs::path& p) {

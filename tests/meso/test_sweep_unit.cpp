@@ -283,6 +283,11 @@ TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {
   const auto c = parse_sweep_input(R"({"loop_lengths": [4.5], "steps": 19})", "c");
   CHECK(a.job_definition() == b.job_definition());
   CHECK(fingerprint(a.job_definition()) != fingerprint(c.job_definition()));
+  // The digest is a pinned FNV-1a 64 variant (offset basis 1469598103934665603; the standard's
+  // gives af63dc4c8601ec8c for "a"): earlier versions' checkpoints were written with it
+  // (docs/sweep.md; session 38's red team found the slip).
+  CHECK(fingerprint("") == "14650fb0739d0383");
+  CHECK(fingerprint("a") == "44bd8ad473cd9906");
   CHECK_FALSE(b.fit);
   // explicit paths
   const auto e = parse_sweep_input(

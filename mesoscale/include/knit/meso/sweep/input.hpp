@@ -82,7 +82,8 @@ SweepInput load_sweep_input(const std::filesystem::path& file);
 /// The same from JSON text (`file` names it in errors).
 SweepInput parse_sweep_input(const std::string& text, const std::string& file);
 
-/// 64-bit FNV-1a hash as 16 hex digits (fingerprint of a job definition).
+/// A 64-bit FNV-1a variant (offset basis 1469598103934665603, not the standard's
+/// 14695981039346656037; docs/sweep.md) as 16 hex digits (fingerprint of a job definition).
 std::string fingerprint(const std::string& text);
 
 }  // namespace knit::meso::sweep
