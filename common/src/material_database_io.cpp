@@ -144,6 +144,9 @@ void write_database(const std::filesystem::path& file, const Database& db,
                      "holdout (never fitted: checks of the law)");
     H5Group yarn = f.create_group("/yarn");
     for (const auto& [k, v] : db.yarn) yarn.set_attribute(".", k, v);
+    // Attributes cannot carry attributes: a group's "units" names those of its attributes
+    // (session 38's red team: only the root's global "units" covered them).
+    yarn.set_attribute(".", "units", "lengths (diameter, ...) mm, moduli and stresses MPa");
     f.write("/loop_lengths", db.loop_lengths());
     f.set_attribute("/loop_lengths", "units", "mm");
     const StrainDomain dom = db.domain();
@@ -153,6 +156,7 @@ void write_database(const std::filesystem::path& file, const Database& db,
     dg.set_attribute(".", "E22_min", dom.E22_min);
     dg.set_attribute(".", "E22_max", dom.E22_max);
     dg.set_attribute(".", "E12_max", dom.E12_max);
+    dg.set_attribute(".", "units", "Green-Lagrange strains (1); E12 the tensor shear strain");
     for (std::size_t k = 0; k < db.entries.size(); ++k) {
       const LoopLengthEntry& e = db.entries[k];
       H5Group g = f.create_group(loop_group(k));
@@ -161,6 +165,7 @@ void write_database(const std::filesystem::path& file, const Database& db,
       g.set_attribute(".", "course_height", e.cell.course_height);
       g.set_attribute(".", "thickness", e.cell.thickness);
       g.set_attribute(".", "fitted", e.surface ? 1 : 0);
+      g.set_attribute(".", "units", "loop_length, wale_width, course_height, thickness: mm");
       H5Group raw = g.create_group("raw");
       raw.set_attribute(".", "paths", static_cast<int>(e.raw.size()));
       for (std::size_t q = 0; q < e.raw.size(); ++q) {
@@ -192,6 +197,7 @@ void write_database(const std::filesystem::path& file, const Database& db,
         d.write("rms", e.diagnostics.rms);
         d.write("max", e.diagnostics.max);
         d.set_attribute(".", "components", "E1, E2, S1, S2, S12");
+        d.set_attribute(".", "units", "rms and max: E1, E2 strain (1); S1, S2, S12 MPa");
         d.set_attribute(".", "max_relative", e.diagnostics.max_relative);
         d.set_attribute(".", "points_used", e.diagnostics.points_used);
         d.set_attribute(".", "points_skipped", e.diagnostics.points_skipped);
@@ -300,6 +306,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     db.sweep_input = f.attribute_string("/sweep", "input_json");
     require_group("/yarn");
     for (const auto& n : f.attribute_names("/yarn")) {
+      if (n == "units") continue;  // the text naming the others' units (since session 38)
       db.yarn[n] = f.attribute_double("/yarn", n);
       if (!std::isfinite(db.yarn[n]))
         throw InputError(fname, "/yarn", "attribute " + n + " is not finite");

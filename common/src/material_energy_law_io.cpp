@@ -122,6 +122,14 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
                   "largest (max - min) of a stress component over the fit data of the loop length");
   d.write("holdout_rms", dg.holdout_rms);
   d.write("holdout_max", dg.holdout_max);
+  // Units of every dataset and attribute that has one (session 38's red team: only the root's
+  // global "units" covered these).
+  d.set_attribute("loop_length", "units", "mm");
+  d.set_attribute("stress_range", "units", "MPa");
+  d.set_attribute("holdout_rms", "units", "MPa");
+  d.set_attribute("holdout_max", "units", "MPa");
+  d.set_attribute(".", "units",
+                  "min_eigenvalue: MPa; holdout_max_relative: fraction of the stress range");
   d.set_attribute(".", "holdout_points", dg.holdout_points);
   d.set_attribute(".", "holdout_within_5_percent", dg.holdout_within_5_percent);
   d.set_attribute(".", "holdout_max_relative", dg.holdout_max_relative);

@@ -158,6 +158,7 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
                     "(/energy_law) fits the converged steps of every path whose set is not "
                     "\"holdout\", up to where the cell gave way (/energy_law/diagnostics)");
     g.write("case_seconds", seconds);
+    g.set_attribute("case_seconds", "units", "s");
     g.write_strings("case_messages", messages);
     g.write("residual_S", residual);
     g.set_attribute("residual_S", "columns",
