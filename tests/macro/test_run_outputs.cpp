@@ -129,6 +129,11 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
     r = macro((d / "fail.json").string() + " --output " + (d / dir).string());
     CHECK(r.rc == 1);
     CHECK(fs::exists(d / dir / "summary.txt"));
+    // No VTU, so no results.pvd (it was an empty collection; session 38's red team).
+    CHECK_FALSE(fs::exists(d / dir / "results.pvd"));
+    std::ifstream sum_in(d / dir / "summary.txt");
+    CHECK(knit_test::contains(std::string((std::istreambuf_iterator<char>(sum_in)), {}),
+                              "vtk: none (no step converged, so no results.pvd)"));
   }
   fs::remove_all(d);
 }
