@@ -65,8 +65,11 @@ CLI::Validator number(double lo, double hi, Ends ends) {
         const bool decimal = text.find_first_of("xXpP \t\n") == std::string::npos;
         if (text.empty() || end == text.c_str() || *end != '\0' || !decimal)
           return "must be a number " + range + ", got \"" + text + "\"";
+        // (session 38's red team: "must be a finite number >= 0 and finite" for --mu nan)
         if (!std::isfinite(v) || errno == ERANGE)
-          return "must be a finite number " + range + ", got " + text;
+          return (range.find("finite") == std::string::npos ? "must be a finite number "
+                                                            : "must be ") +
+                 range + ", got " + text;
         if ((lo_open ? !(v > lo) : !(v >= lo)) || (hi_open ? !(v < hi) : !(v <= hi)))
           return "must be " + range + ", got " + text;
         return {};

@@ -72,7 +72,8 @@ int run(const Options& o) {
   if (!(o.loop_length > 0)) throw knit::InputError("", "--loop-length", "must be positive");
   const bool bi = !o.biaxial.empty(), sh = !std::isnan(o.shear), un = !o.uniaxial.empty();
   if (int(bi) + int(sh) + int(un) != 1)
-    throw knit::InputError("", "", "give exactly one of --biaxial, --shear or --uniaxial");
+    throw knit::InputError("", "--biaxial, --shear, --uniaxial",
+                           "give exactly one of them (the load path)");
   if (bi && o.biaxial.size() != 2) throw knit::InputError("", "--biaxial", "needs EPS11 EPS22");
   if (o.steps < 1) throw knit::InputError("", "--steps", "must be >= 1");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");

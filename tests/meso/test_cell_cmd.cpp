@@ -145,7 +145,11 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"cell --loop-length 4.5 --diameter -0.38", "--diameter", "> 0"},
       {"path --loop-length 4.5 --shear 5 --penalty -5", "--penalty", "> 0"},
       {"path --loop-length 4.5 --shear 5 --mu -1", "--mu", ">= 0"},
-      {"path --loop-length 4.5 --shear 5 --mu nan", "--mu", ">= 0"},
+      // (session 38's red team: "must be a finite number >= 0 and finite (at most 1e300)")
+      {"path --loop-length 4.5 --shear 5 --mu nan", "--mu",
+       "must be >= 0 and finite (at most 1e300), got nan"},
+      // (session 38's red team: "<input>: give exactly one of ...", a file that does not exist)
+      {"path --loop-length 4.5", "--biaxial, --shear, --uniaxial", ": give exactly one of them"},
       {"path --loop-length 4.5 --shear nan", "--shear", "in (-80, 80)"},
       {"path --loop-length 4.5 --biaxial nan 0", "--biaxial", "in (-1, 10]"},
       {"path --loop-length 4.5 --uniaxial 1 nan", "--uniaxial", "in (-0.5, 10]"},
@@ -183,6 +187,7 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
     INFO(log);
     CHECK(log.find(b.option) != std::string::npos);
     CHECK(log.find(b.range) != std::string::npos);
+    CHECK(log.find("<input>") == std::string::npos);  // no file was given
     CHECK_FALSE(fs::exists(out));
   }
 }
