@@ -16,6 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 constexpr const char* kManifest = "manifest.json";
+/// Written once the database is in place (CheckpointStore::mark_written).
+constexpr const char* kWritten = "database_written";
 
 std::string job_file(int index) {
   char b[32];
@@ -44,7 +46,7 @@ bool is_store_file(std::string name) {
     if (tmp == std::string::npos) return false;
     name = name.substr(1, tmp - 1);
   }
-  if (name == kManifest) return true;
+  if (name == kManifest || name == kWritten) return true;
   // job_%05d.txt: at least 5 digits (index 100000 has 6)
   if (name.size() < 13 || name.rfind("job_", 0) != 0 ||
       name.compare(name.size() - 4, 4, ".txt") != 0)
@@ -86,7 +88,7 @@ bool holds_job_records(const fs::path& dir) {
   for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
        it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name[0] != '.' && name != kManifest && is_store_file(name)) return true;
+    if (name[0] != '.' && name != kManifest && name != kWritten && is_store_file(name)) return true;
   }
   return false;
 }
@@ -120,6 +122,13 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
         throw InputError(dir_.string(), "", "cannot discard the empty checkpoint directory");
       resume = false;
     }
+  }
+  // Left by a sweep that wrote its database and was stopped while it removed them: nothing of
+  // an unfinished sweep to keep (--resume still takes them: every case is in them).
+  if (!resume && fs::exists(dir_ / kWritten, ec)) {
+    remove();
+    if (fs::exists(fs::symlink_status(dir_, ec)))
+      throw InputError(dir_.string(), "", "cannot discard the finished sweep's checkpoints");
   }
   if (fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
@@ -227,6 +236,10 @@ std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& 
 
 void CheckpointStore::store(const JobResult& r) const {
   io::write_file_atomically(dir_ / job_file(r.index), seal_record(serialize(r), fingerprint_));
+}
+
+void CheckpointStore::mark_written() const {
+  std::ofstream(dir_ / kWritten) << "the database of these checkpoints was written\n";
 }
 
 void CheckpointStore::remove() const {

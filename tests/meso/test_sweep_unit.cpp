@@ -774,6 +774,19 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                     Catch::Contains("checkpoints of an unfinished sweep exist"));
   CHECK_THROWS_WITH(CheckpointStore(out, R"({"other": 1})", n, true, false),
                     Catch::Contains("different sweep input"));
+  // Marked written (a sweep stopped after its database was in place, while it removed them;
+  // session 38's red team: the next sweep said "checkpoints of an unfinished sweep exist"):
+  // --resume takes them, a plain sweep discards them.
+  CheckpointStore(out, in.job_definition(), n, true, false).mark_written();
+  CHECK(CheckpointStore(out, in.job_definition(), n, true, false)
+            .load_finished(make_jobs(in))
+            .size() == 1);
+  CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, false, false));
+  CHECK(fs::exists(parts / "manifest.json"));  // the new sweep's
+  CHECK_FALSE(fs::exists(parts / "database_written"));
+  CHECK(CheckpointStore(out, in.job_definition(), n, true, false)
+            .load_finished(make_jobs(in))
+            .empty());
 }
 
 TEST_CASE(

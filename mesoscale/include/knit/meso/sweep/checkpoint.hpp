@@ -46,6 +46,12 @@ class CheckpointStore {
   void store(const JobResult& r) const;
   /// Removes the directory (after the database is in place).
   void remove() const;
+  /// Marks the checkpoints as those of a sweep whose database is in place (the file
+  /// "database_written"), before remove(): a stop in between leaves checkpoints that the next
+  /// sweep without --resume discards instead of refusing them as an unfinished sweep's
+  /// (session 38's red team); --resume still takes them. Not for --keep-parts (kept on
+  /// purpose: a later sweep without --resume refuses them as before).
+  void mark_written() const;
 
  private:
   std::filesystem::path dir_;
