@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/knit_material.hpp"
@@ -81,9 +82,10 @@ Basis2 read_basis(const nlohmann::json& j, const std::string& p, const CaseConte
       const auto& pb = dir == 0 ? ctx.patch->basis_u() : ctx.patch->basis_v();
       if (std::abs(basis.lo() - pb.lo()) > 1e-12 || std::abs(basis.hi() - pb.hi()) > 1e-12)
         throw InputError(ctx.file, kp,
-                         "the field's domain [" + std::to_string(basis.lo()) + ", " +
-                             std::to_string(basis.hi()) + "] differs from the patch's [" +
-                             std::to_string(pb.lo()) + ", " + std::to_string(pb.hi()) + "]");
+                         "the field's domain [" + io::format_number(basis.lo()) + ", " +
+                             io::format_number(basis.hi()) + "] differs from the patch's [" +
+                             io::format_number(pb.lo()) + ", " + io::format_number(pb.hi()) +
+                             "]");  // (std::to_string wrote a knot of 1e308 with 300 digits)
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {

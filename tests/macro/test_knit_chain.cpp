@@ -168,7 +168,14 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
       load(
           head +
           R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 2, 2], "knots_v": [0, 1], "values": [5, 5]}})"),
-      Catch::Contains("/material/stitch_value/knots_u: the field's domain"));
+      Catch::Contains("/material/stitch_value/knots_u: the field's domain [0, 2] differs from "
+                      "the patch's [0, 1]"));
+  // Printed in full, not as std::to_string's 300 digits (session 38's red team).
+  CHECK_THROWS_WITH(
+      load(
+          head +
+          R"("stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1e308, 1e308], "knots_v": [0, 1], "values": [5, 5]}})"),
+      Catch::Contains("the field's domain [0, 1e+308] differs"));
   CHECK_THROWS_WITH(
       load(
           head +
