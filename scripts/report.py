@@ -895,16 +895,50 @@ class Report:
 TWIN_TOLERANCE = 0.005
 
 
-def twin_verdict(summ):
+def declared_twins(out):
+    """{design: {variable: value}} of the design inputs of the run ($(OUT)/design/inputs/*.json
+    with a "twin"): what each design was asked to recover, independent of its outputs."""
+    twins = {}
+    for p in sorted(glob.glob(os.path.join(out, "design", "inputs", "*.json"))):
+        try:
+            with open(p) as f:
+                j = json.load(f)
+        except (OSError, ValueError):
+            continue
+        if isinstance(j, dict) and isinstance(j.get("twin"), dict):
+            twins[os.path.basename(p)[:-5]] = j["twin"]
+    return twins
+
+
+def design_exit_code(out, name):
+    """The exit code in $(OUT)/design/NAME.status, or None (missing or unreadable)."""
+    try:
+        with open(os.path.join(out, "design", name + ".status")) as f:
+            return json.load(f).get("exit_code")
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
+def twin_verdict(summ, declared=None, exit_code=0):
     """(ok, text) of a design's twin lines in summary.txt ({key: value}, design.read_summary),
     or None for a design without a twin: 'twin NAME: V (recovered X, off by P % of the
     bounds)'. A twin line that cannot be read, or a design whose status is not converged, does
-    not recover."""
+    not recover. `declared`: the twin of the design's input ({variable: value}); then a design
+    with no twin line (no output), another twin value (a stale summary) or a twin variable
+    missing does not recover either (session 38's red team: a deleted design output dropped
+    out of the count, and a summary of another twin passed). `exit_code`: the design's, from
+    its status file (None: unknown); anything but 0 does not recover."""
     rows = [(k[len("twin "):], v) for k, v in summ.items()
             if k.startswith("twin ") and not k.startswith("twin target ")]
-    if not rows:
+    if not rows and not declared:
         return None
-    parts, ok = [], summ.get("status") == "converged"
+    parts, ok = [], summ.get("status") == "converged" and exit_code == 0
+    if declared:
+        written = {n for n, _ in rows}
+        for name in sorted(set(declared) - written):
+            parts.append(f"{name}: declared (twin {declared[name]}) but not in the summary "
+                         f"({'no output' if not summ else 'no twin line'})")
+            ok = False
     number = r"(\S+)"
     for name, value in rows:
         # The distance is recomputed from the twin and the variable's own line ('variable
@@ -928,8 +962,16 @@ def twin_verdict(summ):
         off = 100 * abs(end - twin) / (hi - lo)
         ok = ok and off <= 100 * TWIN_TOLERANCE
         parts.append(f"{name} {end:.6g} (twin {twin:g}, off by {off:.2g} % of [{lo:g}, {hi:g}])")
+        if declared is not None:
+            want = declared.get(name)
+            if not isinstance(want, (int, float)) or abs(float(want) - twin) > 1e-12 * max(
+                    1.0, abs(twin)):
+                ok = False
+                parts.append(f"{name}: the input's twin is {want}, not {twin:g} (a stale summary)")
     if summ.get("status") != "converged":
         parts.append(f"status {summ.get('status', 'missing')}")
+    if exit_code != 0:
+        parts.append(f"exit {exit_code if exit_code is not None else 'unknown'}")
     return ok, "; ".join(parts)
 
 
@@ -937,7 +979,9 @@ def design_section(out):
     """Inverse design (issue 13, docs/design.md): each example's status, objective before and
     after and its figure, from $(OUT)/design/NAME.status and NAME/summary.txt."""
     L = ["## Inverse design (knit-macro design)\n"]
-    names = sorted(os.path.basename(p)[:-7] for p in glob.glob(os.path.join(out, "design", "*.status")))
+    twins = declared_twins(out)
+    names = sorted({os.path.basename(p)[:-7]
+                    for p in glob.glob(os.path.join(out, "design", "*.status"))} | set(twins))
     if not names:
         L.append("No design example was run (`make -f scripts/pipeline.mk designs`).\n")
         return L
@@ -964,7 +1008,8 @@ def design_section(out):
         L.append(f"| {n} | {md(status)} | {md(summ.get('J_initial', '-'))} | "
                  f"{md(summ.get('J_final', '-'))} | {summ.get('iterations', '-')} | "
                  f"{summ.get('evaluations', '-')} | "
-                 f"{fmt((st or {}).get('seconds', float('nan')), 1)} | {md(twin_cell(summ))} |")
+                 f"{fmt((st or {}).get('seconds', float('nan')), 1)} | "
+                 f"{md(twin_cell(summ, twins.get(n), None if st is None else exit_code))} |")
         fig = f"design_{n}.png"
         if os.path.exists(os.path.join(out, "figures", fig)):
             figs.append(fig)
@@ -974,17 +1019,20 @@ def design_section(out):
     return L
 
 
-def twin_cell(summ):
+def twin_cell(summ, declared=None, exit_code=0):
     """The design table's twin column: '-' without a twin, else the verdict and the numbers."""
-    t = twin_verdict(summ)
+    t = twin_verdict(summ, declared, exit_code)
     return "-" if t is None else f"{verdict(t[0])}: {t[1]}"
 
 
 def twin_counts(out):
     """(recovered, twins) over the designs of $(OUT)/design that have a twin."""
-    got = [twin_verdict(read_design_summary(os.path.join(out, "design", os.path.basename(p)[:-7],
-                                                         "summary.txt")))
-           for p in glob.glob(os.path.join(out, "design", "*.status"))]
+    twins = declared_twins(out)
+    names = ({os.path.basename(p)[:-7] for p in glob.glob(os.path.join(out, "design", "*.status"))}
+             | set(twins))
+    got = [twin_verdict(read_design_summary(os.path.join(out, "design", n, "summary.txt")),
+                        twins.get(n), design_exit_code(out, n))
+           for n in sorted(names)]
     got = [t for t in got if t is not None]
     return sum(1 for ok, _ in got if ok), len(got)
 

@@ -28,12 +28,20 @@ final run: completed
 """
 
 
-def write_design(out, name, text):
+def write_design(out, name, text, exit_code=0, twin=None):
     os.makedirs(os.path.join(out, "design", name), exist_ok=True)
     with open(os.path.join(out, "design", name + ".status"), "w") as f:
-        f.write('{"design": "%s", "exit_code": 0, "seconds": 0.1}\n' % name)
+        f.write('{"design": "%s", "exit_code": %d, "seconds": 0.1}\n' % (name, exit_code))
+    if twin is not None:
+        write_input(out, name, twin)
     with open(os.path.join(out, "design", name, "summary.txt"), "w") as f:
         f.write(text)
+
+
+def write_input(out, name, twin):
+    os.makedirs(os.path.join(out, "design", "inputs"), exist_ok=True)
+    with open(os.path.join(out, "design", "inputs", name + ".json"), "w") as f:
+        f.write('{"case": "c.json", "variables": [], "objectives": [], "twin": %s}\n' % twin)
 
 
 def main():
@@ -72,6 +80,27 @@ def main():
           table)
         c("| plain |" in table and table.split("| plain |")[1].split("\n")[0].rstrip().endswith(
             "| - |"), "the table: no twin, no verdict", table)
+    # Session 38's red team: the verdict came from the summaries alone.
+    recovered = SUMMARY.format(status="converged", end="6", got="6")
+    with tempfile.TemporaryDirectory(prefix="design_twin_test_") as out:
+        write_design(out, "good", recovered, twin='{"l": 6.0}')
+        c(report.twin_counts(out) == (1, 1), "declared and recovered: 1 of 1",
+          repr(report.twin_counts(out)))
+        write_input(out, "gone", '{"l": 6.0}')  # declared, its output deleted
+        c(report.twin_counts(out) == (1, 2), "a declared twin without output counts, not "
+          "recovered: 1 of 2", repr(report.twin_counts(out)))
+        table = "\n".join(report.design_section(out))
+        c("| gone |" in table and "declared (twin 6.0) but not in the summary (no output)"
+          in table, "the table names the declared twin without output", table)
+        write_design(out, "failed", recovered, exit_code=1, twin='{"l": 6.0}')
+        c(report.twin_counts(out) == (1, 3), "exit code 1: not recovered",
+          repr(report.twin_counts(out)))
+        write_design(out, "stale", recovered, twin='{"l": 5.0}')
+        c(report.twin_counts(out) == (1, 4), "a summary of another twin (stale): not recovered",
+          repr(report.twin_counts(out)))
+        table = "\n".join(report.design_section(out))
+        c("the input's twin is 5.0, not 6 (a stale summary)" in table and "exit 1" in table,
+          "the table says why", table)
     return c.exit_code()
 
 
