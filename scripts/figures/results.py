@@ -8,6 +8,7 @@ results.h5 when it holds the step and from the VTU file otherwise.
 import json
 import math
 import os
+import re
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -67,6 +68,16 @@ class Result:
             if made_for and made_for[0] != name:
                 self.problem = (f"{self.dir} holds the output written for {made_for[0]}, not "
                                 f"for {name}")
+        if self.ok and not self.problem:
+            # The CSV's first line names the case it was written for (session 38's red team:
+            # conv7c_p7h4's load_strain.csv copied into conv7c_p5h1 was judged as its own).
+            csv_path = os.path.join(self.dir, "load_strain.csv")
+            with open(csv_path, errors="replace") as f:
+                first = f.readline()
+            m = re.match(r"# knit-macro results of (.*?) \(knitscale ", first)
+            if m and os.path.basename(m.group(1)) != name + ".json":
+                self.problem = (f"{csv_path} holds the results of {os.path.basename(m.group(1))}, "
+                                f"not of {name}.json")
         self.csv = {}
         if self.ok:
             try:

@@ -800,6 +800,12 @@ def unusable_result_failures(tmp):
     r = Result(res, "a")
     if not r.completed or r.problem:
         out.append(f"unusable results: a good result is not completed ({r.problem})")
+    with open(os.path.join(res, "a", "load_strain.csv"), "w") as f:  # its own CSV line: taken
+        f.write("# knit-macro results of /x/cases/a.json (knitscale 0.1.0, git 0)\n"
+                "step,strain,load_N\n1,0.1,2.0\n")
+    r = Result(res, "a")
+    if not r.completed or r.problem:
+        out.append(f"unusable results: a CSV naming its own case is not taken ({r.problem})")
     variants = {
         "a truncated status file": (lambda d: open(os.path.join(res, "a.status"), "w").write(
             '{"case": "a", "exit_co'), "a.status is unreadable"),
@@ -810,6 +816,10 @@ def unusable_result_failures(tmp):
         "another case's output": (lambda d: open(os.path.join(d, ".knitscale-output"), "w").write(
             "knitscale output: knit-macro run\n{}\nfor: b\n"),
             "holds the output written for b, not for a"),
+        # session 38's red team: another case's CSV copied in was judged as this case's
+        "another case's CSV": (lambda d: open(os.path.join(d, "load_strain.csv"), "w").write(
+            "# knit-macro results of /x/cases/b.json (knitscale 0.1.0, git 0)\n"
+            "step,strain,load_N\n1,0.1,2.0\n"), "holds the results of b.json, not of a.json"),
     }
     for what, (damage, needle) in variants.items():
         damage(fresh("a"))
