@@ -745,6 +745,10 @@ class Report:
         twins_ok, twins = twin_counts(self.out)
         if twins:
             law_text += f"; inverse design: {twins_ok} of {twins} twin experiments recovered"
+        n_failed_figs = sum(1 for p in glob.glob(os.path.join(self.out, "figures", "*.png"))
+                            if figure_failed(p))
+        if n_failed_figs:
+            law_text += f"; {n_failed_figs} figure script(s) FAILED (placeholders)"
         L.append(f"**Summary:** {npass} of {npass + nfail} checks of the paper's statements pass, "
                  f"{nfail} fail ({ninfo} listed with our numbers only, the paper giving none); "
                  f"{ndone} of {len(names)} cases completed; material database: "
@@ -840,11 +844,21 @@ class Report:
         figs = sorted(glob.glob(os.path.join(self.out, "figures", "*.png")))
         if cells != "yes":
             L.append("Fig. 5 (unit cells) is missing: this build has no `knit-meso cell`.\n")
+        failed_figs = []
         for p in figs:
             base = os.path.basename(p)
             if base == SENSITIVITY_FIGURE or base.startswith("design_"):
                 continue  # shown in its own section
-            L.append(f"### {base[:-4]}\n\n![{base}](figures/{base})\n")
+            L.append(f"### {base[:-4]}\n")
+            if figure_failed(p):  # session 38's red team: embedded as if drawn
+                failed_figs.append(base[:-4])
+                L.append(f"**The figure script failed**: this is its placeholder (log: "
+                         f"logs/figures/{base[:-4]}.log).\n")
+            L.append(f"![{base}](figures/{base})\n")
+        if failed_figs:
+            at = next(i for i, l in enumerate(L) if l.startswith("## Figures"))
+            L.insert(at + 1, f"**{len(failed_figs)} figure script(s) failed** (placeholders "
+                             f"below): {', '.join(failed_figs)}.\n")
         with open(os.path.join(self.out, "report.md.tmp"), "w") as f:
             f.write("\n".join(L) + "\n")
         os.replace(os.path.join(self.out, "report.md.tmp"), os.path.join(self.out, "report.md"))
@@ -1035,6 +1049,15 @@ def twin_counts(out):
            for n in sorted(names)]
     got = [t for t in got if t is not None]
     return sum(1 for ok, _ in got if ok), len(got)
+
+
+def figure_failed(path):
+    """Whether a figure is the placeholder of a figure script that failed: scripts/figures/
+    batch.py dates those 1970 (mtime 0) so that the next run draws them again."""
+    try:
+        return os.path.getmtime(path) < 86400
+    except OSError:
+        return False
 
 
 def md(text):

@@ -901,6 +901,23 @@ def main():
             failures.append(f"summary line: '{summary}' not in the report")
         if "Not yet measured" not in text:
             failures.append("no sensitivity table: the report must say 'Not yet measured'")
+        # A figure script that failed leaves a placeholder dated 1970 (batch.py): the report
+        # says so in its summary and above the figure (session 38's red team: embedded as if
+        # drawn); a drawn figure gets no such note.
+        figs = os.path.join(tmp, "figures")
+        os.makedirs(figs, exist_ok=True)
+        for name, failed in (("fig_drawn", False), ("fig_failed", True)):
+            with open(os.path.join(figs, name + ".png"), "wb") as f:
+                f.write(b"png")
+            if failed:
+                os.utime(os.path.join(figs, name + ".png"), (0, 0))
+        rep.write(os.path.join(tmp, "no-database.h5"), "")
+        text = open(os.path.join(tmp, "report.md")).read()
+        if ("1 figure script(s) FAILED (placeholders)" not in text
+                or "**1 figure script(s) failed** (placeholders below): fig_failed." not in text
+                or text.count("**The figure script failed**") != 1):
+            failures.append("a failed figure's placeholder is not named in the report")
+        shutil.rmtree(figs)
         # -- variants: the known defect fails exactly the checks that read it ------------------
         failed_somewhere = set()
         for name, (mutate, must_fail, exact) in VARIANTS.items():
