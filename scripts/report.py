@@ -363,8 +363,9 @@ def small_strain_text(db_path):
 class Data:
     """The pipeline's results, loaded on demand: curves and fields by case name."""
 
-    def __init__(self, res_dir):
+    def __init__(self, res_dir, db_date=None):
         self.res_dir = res_dir
+        self.db_date = db_date  # the database's date_utc: results of another one are stale
         self.cache = {}
         self.read = set()      # names read since the last take_read() (checks() attributes them)
         self.read_fields = set()  # ... of those, the names whose fields were read
@@ -416,6 +417,13 @@ class Data:
             return f"exit code {ex} although its summary says it completed"
         if ex == 0 and stopped:
             return "exit code 0 although its summary says it stopped"
+        # Results of another database (session 38's red team: results older than the database
+        # were judged as its own): knit-macro run records the date_utc of the database it read.
+        if self.db_date is not None:
+            used = r.database_date()
+            if used is not None and used != self.db_date:
+                return (f"its results were computed with the database written {used}; the "
+                        f"database is of {self.db_date} (stale: rerun the case)")
         for s in r.steps():  # step_0010's fields copied into step_0020 were judged at 30 %
             lf, csv_lf = r.load_factor_of_step(s), r.csv_load_factor(s)
             if lf is not None and csv_lf is not None and abs(lf - csv_lf) > 1e-9 * max(1.0, abs(csv_lf)):
@@ -682,11 +690,25 @@ def case_names(cases_dir, res_dir):
     return sorted(names)
 
 
+def database_date(db_path):
+    """The database file's date_utc attribute (when it was written), or None (no database, no
+    attribute, unreadable)."""
+    if not db_path:
+        return None
+    try:
+        import h5py
+        with h5py.File(db_path, "r") as f:
+            d = f.attrs.get("date_utc")
+        return None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
+    except (OSError, KeyError, ValueError):
+        return None
+
+
 class Report:
-    def __init__(self, out_dir, sensitivity=None, cases_dir=CASES_DIR):
+    def __init__(self, out_dir, sensitivity=None, cases_dir=CASES_DIR, database=None):
         self.out = out_dir
         self.res_dir = os.path.join(out_dir, "results")
-        self.data = Data(self.res_dir)
+        self.data = Data(self.res_dir, database_date(database))
         self.sensitivity = sensitivity
         self.names = case_names(cases_dir, self.res_dir)
         self.rows = []
@@ -1079,7 +1101,7 @@ def main():
         print(f"report: error: --cases-dir {a.cases_dir}: holds no case file (*.json)",
               file=sys.stderr)
         sys.exit(2)
-    rep = Report(a.out_dir, a.sensitivity, a.cases_dir)
+    rep = Report(a.out_dir, a.sensitivity, a.cases_dir, a.database)
     if not any(rep.r(n).ok for n in rep.names):
         # Nothing to judge: a report of 0 passes would read as a result (session 30: exit 0).
         print(f"report: error: {rep.res_dir}: no case of {a.cases_dir} has a result "

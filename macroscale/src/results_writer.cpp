@@ -203,6 +203,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "units", "mm, N, MPa");
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
+  for (const auto& [k, v] : case_.material->data_provenance()) h5.set_attribute(".", k, v);
   // A run whose material failed says so in every output (session 37: results.h5 read "status
   // completed" and nothing else for one that ended with exit 1).
   if (!material_failure_.empty()) h5.set_attribute(".", "material_failure", material_failure_);

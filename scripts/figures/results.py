@@ -108,6 +108,18 @@ class Result:
     def seconds(self):
         return self.status.get("seconds", float("nan"))
 
+    def database_date(self):
+        """results.h5's material_database_date_utc (the date_utc of the database the run read,
+        since session 38), or None."""
+        p = os.path.join(self.dir, "results.h5")
+        try:
+            import h5py
+            with h5py.File(p, "r") as f:
+                d = f.attrs.get("material_database_date_utc")
+        except (OSError, KeyError, ValueError):
+            return None
+        return None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
+
     def summary(self):
         p = os.path.join(self.dir, "summary.txt")
         return open(p).read().strip() if os.path.exists(p) else ""

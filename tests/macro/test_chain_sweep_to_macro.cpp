@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "knit/io/hdf5.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -82,5 +84,15 @@ TEST_CASE("reduced sweep database drives a knit-macro tensile case", "[case][cha
   }
   CHECK(std::stod(rows.back()[strain]) == Approx(0.10).epsilon(1e-9));
   CHECK(std::stod(rows.back()[cy]) == Approx(2.5).epsilon(1e-6));
+  // results.h5 names the database and when it was written (session 38: the report refuses
+  // results of another database by this date).
+  {
+    const auto h5 = knit::io::H5File::open_read(out / "results.h5");
+    const auto dbf = knit::io::H5File::open_read(db);
+    CHECK(h5.attribute_string(".", "material_database") == db.string());
+    CHECK(!dbf.attribute_string(".", "date_utc").empty());
+    CHECK(h5.attribute_string(".", "material_database_date_utc") ==
+          dbf.attribute_string(".", "date_utc"));
+  }
   fs::remove_all(dir);
 }

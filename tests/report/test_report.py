@@ -821,6 +821,19 @@ def unusable_result_failures(tmp):
             "# knit-macro results of /x/cases/b.json (knitscale 0.1.0, git 0)\n"
             "step,strain,load_N\n1,0.1,2.0\n"), "holds the results of b.json, not of a.json"),
     }
+    # Results of another database (session 38's red team): results.h5 names the date_utc of
+    # the database the run read; another date than the database's is a defect of the run.
+    import h5py
+    fresh("a")
+    with h5py.File(os.path.join(res, "a", "results.h5"), "w") as h:
+        h.attrs["material_database_date_utc"] = "2026-12-01T10:00:00Z"
+    with open(os.path.join(res, "a", "summary.txt"), "w") as f:
+        f.write("status: completed\n")
+    same = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    other = report.Data(res, "2026-12-05T12:00:00Z").run_defect("a")
+    unknown = report.Data(res, None).run_defect("a")
+    if same is not None or unknown is not None or other is None or "stale" not in other:
+        out.append(f"stale results: same date {same!r}, another {other!r}, no date {unknown!r}")
     for what, (damage, needle) in variants.items():
         damage(fresh("a"))
         try:

@@ -75,6 +75,7 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
 struct KnitMaterialSource {
   std::string file, stitch_pointer = "/material/stitch_value",
                     angle_pointer = "/material/knitting_angle", database;
+  std::string database_date_utc;  ///< the database file's date_utc attribute ("" if none)
 };
 
 class KnitMaterial : public Material {
@@ -119,6 +120,11 @@ class KnitMaterial : public Material {
   std::string warning() const override;
   /// The database's units.
   std::string required_units() const override { return "mm, N, MPa"; }
+  /// material_database (the file) and material_database_date_utc (when it was written).
+  std::vector<std::pair<std::string, std::string>> data_provenance() const override {
+    return {{"material_database", source_.database},
+            {"material_database_date_utc", source_.database_date_utc}};
+  }
   static constexpr double kExtrapolatedWarning = 0.02;
 
   double stitch_value(const Eigen::Vector2d& theta) const;

@@ -92,6 +92,12 @@ class Material {
   /// The units a case with this material must be in (its data's, e.g. "mm, N, MPa"), or
   /// empty: any consistent units (the case's `units` is then informational).
   virtual std::string required_units() const { return {}; }
+
+  /// Where the material's data come from, as (name, value) attributes of results.h5 (the
+  /// knit material: its database's file and when that file was written), so that results of
+  /// another database are told from this one's (session 38's red team: the report judged
+  /// results older than the database). Empty by default.
+  virtual std::vector<std::pair<std::string, std::string>> data_provenance() const { return {}; }
 };
 
 }  // namespace knit::macro
