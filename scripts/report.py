@@ -841,7 +841,10 @@ class Report:
             st = (f"not taken: {md(r.problem)}" if r.problem else "completed" if r.completed else
                   ("no status file" if r.ok else "no result (no status file)") if not r.status
                   else f"stopped (exit {ex})" if r.ok and stopped
-                  else f"ended in error (exit {ex})" if r.ok else f"failed (exit {ex})")
+                  else f"ended in error (exit {ex})" if r.ok
+                  # (session 38's red team: a deleted result of exit 0 read "failed (exit 0)")
+                  else f"result missing (its status says exit {ex})" if ex == 0
+                  else f"failed (exit {ex})")
             steps = len(r.csv.get("step", [])) if r.ok else 0
             fe = r.strain()[-1] if r.ok and steps else float("nan")
             fl = r.load()[-1] if r.ok and steps else float("nan")

@@ -931,6 +931,16 @@ def main():
                 or text.count("**The figure script failed**") != 1):
             failures.append("a failed figure's placeholder is not named in the report")
         shutil.rmtree(figs)
+        # A result deleted after a run of exit 0 is "result missing", not "failed (exit 0)"
+        # (session 38's red team).
+        victim = sorted(n for n in rep.names if rep.r(n).completed)[0]
+        shutil.rmtree(os.path.join(tmp, "results", victim))
+        rep2 = report.Report(tmp)
+        rep2.checks()
+        rep2.write(os.path.join(tmp, "no-database.h5"), "")
+        text = open(os.path.join(tmp, "report.md")).read()
+        if f"| {victim} | result missing (its status says exit 0) |" not in text:
+            failures.append(f"a deleted result of exit 0 is not 'result missing' ({victim})")
         # -- variants: the known defect fails exactly the checks that read it ------------------
         failed_somewhere = set()
         for name, (mutate, must_fail, exact) in VARIANTS.items():
