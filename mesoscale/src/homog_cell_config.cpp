@@ -105,6 +105,14 @@ std::optional<CellOptionError> CellOptions::validate() const {
   // without force, so the cell has no contact at all.
   if (std::isfinite(p.g0) && std::isfinite(section.d) && section.d > 0 && p.g0 >= section.d) {
     std::ostringstream m;
+    // The default allowance with a thin yarn: named at the yarn the user set (session 38's red
+    // team: "/contact/allowance ... got 0.14" for a file without that key).
+    if (p.g0 == contact::PenaltyLaw{}.g0) {
+      m << "must be larger than the contact allowance /contact/allowance, whose default is " << p.g0
+        << " mm, got " << section.d
+        << " (give /contact/allowance below the diameter with a thinner yarn)";
+      return CellOptionError{"/yarn/d", m.str()};
+    }
     m << "must be smaller than the yarn diameter /yarn/d = " << section.d << " mm, got " << p.g0
       << " (an allowance of a whole diameter lets yarns pass through each other without force)";
     return CellOptionError{"/contact/allowance", m.str()};

@@ -154,6 +154,17 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
   CHECK(allowance_pointer == "/contact/allowance");
   CHECK_NOTHROW(read_cell_options(
       write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.3}, "contact": {"allowance": 0.29}})")));
+  // A thin yarn with the default allowance (0.14 mm) is named at /yarn/d, the key the user set
+  // (session 38's red team: "/contact/allowance ... got 0.14" for a file without that key).
+  try {
+    read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.1}})"));
+    FAIL("d = 0.1 with the default allowance accepted");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/yarn/d");
+    CHECK(std::string(e.what()).find("whose default is 0.14 mm, got 0.1") != std::string::npos);
+  }
+  CHECK_NOTHROW(read_cell_options(
+      write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.1}, "contact": {"allowance": 0.05}})")));
   // A real number beyond the reader's 1e300 said "must be > 0, got 1e+308".
   try {
     read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e308}})"));
