@@ -81,8 +81,9 @@ ReducedTangent::ReducedTangent(const ShellModel& m, const DofMap& dofs, bool sym
       symmetric_(symmetric),
       sparse_(sparse),
       supernodal_(symmetric && sparse && supernodal && SupernodalCholesky::available()),
-      multifrontal_(symmetric && sparse && supernodal && multifrontal &&
-                    MultifrontalLDLT::available()),
+      // Behind the supernodal Cholesky only (a build without CHOLMOD keeps the SimplicialLDLT
+      // throughout, as docs/solver.md says).
+      multifrontal_(supernodal_ && multifrontal && MultifrontalLDLT::available()),
       threads_(m.assembly_threads()),
       f_(std::make_unique<Factors>()) {
   const int ne = m.num_elements();
@@ -356,14 +357,17 @@ bool ReducedTangent::factorize_multifrontal(Factorization& f) {
     if (!m.analyze(sparse_matrix_, !perm_.empty())) {
       multifrontal_ = false;
       multifrontal_failure_ = "the symbolic analysis: " + m.failure();
+      m.release();
       return false;
     }
   }
   const auto st = m.factorize(sparse_matrix_);
   if (st == MultifrontalLDLT::Status::kFailed) {
-    // MUMPS failed (memory, workspace): this and every later factorization by the LDLT.
+    // MUMPS failed (memory, workspace): this and every later factorization by the LDLT, with
+    // MUMPS's memory freed first.
     multifrontal_ = false;
     multifrontal_failure_ = "a factorization: " + m.failure();
+    m.release();
     return false;
   }
   ++multifrontal_factorizations_;
@@ -371,8 +375,11 @@ bool ReducedTangent::factorize_multifrontal(Factorization& f) {
   f.negative_pivots = m.negative_pivots();
   if (st == MultifrontalLDLT::Status::kSingular) {
     f.pivot_ratio = 0.0;
-    f.why = "singular tangent stiffness (multifrontal LDLT: " + std::to_string(m.null_pivots()) +
-            " null pivots, |pivot| <= 1e-14 of the matrix's norm)";
+    f.why =
+        m.null_pivots() < 0
+            ? "singular tangent stiffness (multifrontal LDLT: numerically singular)"
+            : "singular tangent stiffness (multifrontal LDLT: " + std::to_string(m.null_pivots()) +
+                  " null pivots, |pivot| <= 1e-14 of the matrix's norm)";
     return true;
   }
   f.pivot_ratio = 1.0;  // not available: no null pivot, so above the threshold

@@ -68,7 +68,8 @@ bool workspace_error(int code) {
 struct MultifrontalLDLT::Impl {
   DMUMPS_STRUC_C id{};
   std::vector<int> irn, jcn, perm;  ///< 1-based coordinates of the lower triangle; identity
-  bool analyzed = false, factorized = false;
+  bool initialized = false, analyzed = false, factorized = false;
+  int null_pivots = 0;  ///< of the last factorization; -1: numerically singular (error -10)
   std::string failure;
   Impl() {
     id.par = 1;                 // the host works (the sequential library has no other)
@@ -76,6 +77,8 @@ struct MultifrontalLDLT::Impl {
     id.comm_fortran = -987654;  // USE_COMM_WORLD (the sequential library's dummy MPI)
     id.job = -1;
     dmumps_c(&id);
+    initialized = id.infog[0] >= 0;
+    if (!initialized) failure = "the initialization: " + error_text(id.infog[0], id.infog[1]);
     id.icntl[icntl(1)] = -1;  // no error, diagnostic or global output
     id.icntl[icntl(2)] = -1;
     id.icntl[icntl(3)] = -1;
@@ -86,7 +89,8 @@ struct MultifrontalLDLT::Impl {
     id.cntl[2] = kNullPivot;  // CNTL(3)
   }
   ~Impl() {
-    id.job = -2;
+    if (!initialized) return;
+    id.job = -2;  // frees MUMPS's factors and workspace
     dmumps_c(&id);
   }
 };
@@ -95,11 +99,19 @@ bool MultifrontalLDLT::available() {
   return true;
 }
 
-MultifrontalLDLT::MultifrontalLDLT() : impl_(std::make_unique<Impl>()) {}
+// The MUMPS instance is made on first need (a ReducedTangent whose tangents stay positive
+// definite never starts one) and released by release().
+MultifrontalLDLT::MultifrontalLDLT() = default;
 MultifrontalLDLT::~MultifrontalLDLT() = default;
 
+void MultifrontalLDLT::release() {
+  impl_.reset();
+}
+
 bool MultifrontalLDLT::analyze(const Eigen::SparseMatrix<double>& lower, bool own_order) {
+  if (!impl_) impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
+  if (!m.initialized) return false;
   const int n = static_cast<int>(lower.cols());
   m.irn.resize(static_cast<size_t>(lower.nonZeros()));
   m.jcn.resize(m.irn.size());
@@ -126,12 +138,12 @@ bool MultifrontalLDLT::analyze(const Eigen::SparseMatrix<double>& lower, bool ow
 }
 
 MultifrontalLDLT::Status MultifrontalLDLT::factorize(const Eigen::SparseMatrix<double>& lower) {
-  Impl& m = *impl_;
-  m.factorized = false;
-  if (!m.analyzed) {
-    m.failure = "no symbolic analysis";
+  if (!impl_ || !impl_->analyzed) {
+    if (impl_) impl_->failure = "no symbolic analysis";
     return Status::kFailed;
   }
+  Impl& m = *impl_;
+  m.factorized = false;
   serial_blas();
   m.id.a = const_cast<double*>(lower.valuePtr());
   m.id.job = 2;
@@ -143,6 +155,7 @@ MultifrontalLDLT::Status MultifrontalLDLT::factorize(const Eigen::SparseMatrix<d
   }
   if (m.id.infog[0] == -10) {
     m.failure.clear();
+    m.null_pivots = -1;
     return Status::kSingular;
   }
   if (m.id.infog[0] < 0) {
@@ -151,24 +164,25 @@ MultifrontalLDLT::Status MultifrontalLDLT::factorize(const Eigen::SparseMatrix<d
   }
   m.failure.clear();
   m.factorized = true;
-  return m.id.infog[27] > 0 ? Status::kSingular : Status::kOk;
+  m.null_pivots = m.id.infog[27];
+  return m.null_pivots > 0 ? Status::kSingular : Status::kOk;
 }
 
 int MultifrontalLDLT::negative_pivots() const {
-  return impl_->id.infog[11];
+  return impl_ && impl_->factorized ? impl_->id.infog[11] : -1;
 }
 
 int MultifrontalLDLT::null_pivots() const {
-  return impl_->id.infog[27];
+  return impl_ ? impl_->null_pivots : 0;
 }
 
 Eigen::VectorXd MultifrontalLDLT::solve(const Eigen::VectorXd& b) const {
-  Impl& m = *impl_;
   Eigen::VectorXd x = b;
-  if (!m.factorized) {
+  if (!impl_ || !impl_->factorized) {
     x.setConstant(std::numeric_limits<double>::quiet_NaN());
     return x;
   }
+  Impl& m = *impl_;
   m.id.rhs = x.data();
   m.id.nrhs = 1;
   m.id.lrhs = m.id.n;
@@ -179,7 +193,7 @@ Eigen::VectorXd MultifrontalLDLT::solve(const Eigen::VectorXd& b) const {
 }
 
 std::string MultifrontalLDLT::failure() const {
-  return impl_->failure;
+  return impl_ ? impl_->failure : std::string();
 }
 
 #else  // without MUMPS: never used (available() is false)
@@ -190,6 +204,7 @@ bool MultifrontalLDLT::available() {
 }
 MultifrontalLDLT::MultifrontalLDLT() = default;
 MultifrontalLDLT::~MultifrontalLDLT() = default;
+void MultifrontalLDLT::release() {}
 bool MultifrontalLDLT::analyze(const Eigen::SparseMatrix<double>&, bool) {
   return false;
 }

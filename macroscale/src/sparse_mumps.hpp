@@ -50,8 +50,12 @@ class MultifrontalLDLT {
   /// The number of negative eigenvalues of D, which by Sylvester's law of inertia is that of
   /// the matrix (MUMPS's INFOG(12)); null pivots are not counted.
   int negative_pivots() const;
-  /// The number of null pivots of the last factorization (INFOG(28)).
+  /// The number of null pivots of the last factorization (INFOG(28)); -1 when MUMPS found the
+  /// matrix numerically singular without counting them (its error -10).
   int null_pivots() const;
+  /// Frees the MUMPS instance with its factors and workspace (after a failure, so that the
+  /// factorization taking over has the memory); a later analyze() starts a new one.
+  void release();
   /// x = A^-1 b with the last successful factorization (NaN after a failure).
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   /// Why the last analyze() or factorize() failed ("MUMPS error -9 (INFO(2) = ...): the

@@ -13,13 +13,16 @@
 //   symmetric (a hyperelastic material: C = d2W/dE2, the shell tangent is a Hessian):
 //     only the lower triangle is assembled; dense LDLT (diagonal pivoting), sparse: the
 //     supernodal Cholesky L L^T of CHOLMOD (sparse_cholmod.hpp; ordering by CHOLMOD, AMD or
-//     METIS) while the tangent is positive definite, Eigen's SimplicialLDLT (AMD ordering)
-//     when it is not (the Cholesky stops at the first non-positive pivot) or without CHOLMOD. The
+//     METIS) while the tangent is positive definite; when it is not (the Cholesky stops at the
+//     first non-positive pivot) MUMPS's multifrontal LDLT with 1 x 1 and 2 x 2 pivots
+//     (sparse_mumps.hpp; since session 38), or without MUMPS, or once it failed in a run,
+//     Eigen's SimplicialLDLT (AMD ordering), which is also the path without CHOLMOD. The
 //     inertia of the reduced tangent is the number of negative entries of D (Sylvester's law of
 //     inertia: P K P^T = L D L^T is a congruence): a negative count means the equilibrium is
 //     unstable (past a limit or bifurcation point).
 // Singularity is detected from the factorization's pivots (min |pivot| / max |pivot| below
-// kSingularPivotRatio), not from a condition estimate (which cost 11 % of a run).
+// kSingularPivotRatio; MUMPS: a null pivot, |pivot| <= 1e-14 of the scaled matrix's norm), not
+// from a condition estimate (which cost 11 % of a run).
 #pragma once
 
 #include <Eigen/Core>
