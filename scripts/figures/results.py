@@ -72,8 +72,11 @@ class Result:
             # The CSV's first line names the case it was written for (session 38's red team:
             # conv7c_p7h4's load_strain.csv copied into conv7c_p5h1 was judged as its own).
             csv_path = os.path.join(self.dir, "load_strain.csv")
-            with open(csv_path, errors="replace") as f:
-                first = f.readline()
+            try:
+                with open(csv_path, errors="replace") as f:
+                    first = f.readline()
+            except OSError:
+                first = ""  # read_csv below says why it cannot be read
             m = re.match(r"# knit-macro results of (.*?) \(knitscale ", first)
             if m and os.path.basename(m.group(1)) != name + ".json":
                 self.problem = (f"{csv_path} holds the results of {os.path.basename(m.group(1))}, "
@@ -116,9 +119,10 @@ class Result:
             import h5py
             with h5py.File(p, "r") as f:
                 d = f.attrs.get("material_database_date_utc")
-        except (OSError, KeyError, ValueError):
+        except (OSError, KeyError, ValueError, ImportError):
             return None
-        return None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
+        d = None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
+        return d or None  # "": the database had no date_utc
 
     def summary(self):
         p = os.path.join(self.dir, "summary.txt")
