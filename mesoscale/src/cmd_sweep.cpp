@@ -154,11 +154,12 @@ int run(const Cli& c) {
       explain_interrupt(c);
       // From here on the database is complete (session 36's red team: a stop while the
       // checkpoints were removed advised --resume, which then refused what was left).
-      o.on_written = [&c] {
+      o.on_written = [&c](const std::filesystem::path& written) {
+        // (a failing sweep's is DB.failed.h5, beside the earlier database it kept)
         knit::cli::on_interrupt_say(
             "knit-meso sweep: interrupted after the database was "
             "written: " +
-            c.output + " is complete; what is left of its checkpoints in " + c.output +
+            written.string() + " is complete; what is left of its checkpoints in " + c.output +
             ".parts is no longer needed");
       };
     }

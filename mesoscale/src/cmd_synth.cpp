@@ -63,7 +63,7 @@ static knit::cli::SubcommandRegistrar reg_synth(
         // synth took 4.5 and 4.5001, which the sweep refuses).
         for (std::size_t k = 0; k < so.loop_lengths.size(); ++k)
           if (!(so.loop_lengths[k] > 0.0) ||
-              (k > 0 && !(so.loop_lengths[k] >= so.loop_lengths[k - 1] + 1e-3)))
+              (k > 0 && !(so.loop_lengths[k] >= so.loop_lengths[k - 1] + 1e-3 - 1e-9)))
             throw knit::InputError("", "--loop-lengths",
                                    "must be positive and increase by at least 0.001 mm");
         so.paths = knit::material::default_load_paths(o->steps);

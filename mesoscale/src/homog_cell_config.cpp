@@ -108,8 +108,8 @@ std::optional<CellOptionError> CellOptions::validate() const {
     // The default allowance with a thin yarn: named at the yarn the user set (session 38's red
     // team: "/contact/allowance ... got 0.14" for a file without that key).
     if (p.g0 == contact::PenaltyLaw{}.g0) {
-      m << "must be larger than the contact allowance /contact/allowance, whose default is " << p.g0
-        << " mm, got " << section.d
+      m << "must be larger than the contact allowance /contact/allowance = " << p.g0
+        << " mm (its default when the file does not set it), got " << section.d
         << " (give /contact/allowance below the diameter with a thinner yarn)";
       return CellOptionError{"/yarn/d", m.str()};
     }

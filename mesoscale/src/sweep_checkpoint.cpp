@@ -130,6 +130,9 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     if (fs::exists(fs::symlink_status(dir_, ec)))
       throw InputError(dir_.string(), "", "cannot discard the finished sweep's checkpoints");
   }
+  // Resumed, they are this run's again: the mark goes (a --keep-parts resume keeps them on
+  // purpose, and a later plain sweep must then refuse them, not discard them).
+  if (resume) fs::remove(dir_ / kWritten, ec);
   if (fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
       throw InputError(dir_.string(), "",
@@ -253,8 +256,13 @@ void CheckpointStore::remove() const {
        it.increment(ec))
     if (is_store_file(it->path().filename().string()) && it->is_regular_file(ec))
       ours.push_back(it->path());
-  std::stable_partition(ours.begin(), ours.end(),
-                        [](const fs::path& p) { return p.filename() != kManifest; });
+  // The job files first, then the "database_written" mark (a stop before it leaves a store
+  // the next sweep still discards as finished), the manifest last.
+  const auto rank = [](const fs::path& p) {
+    return p.filename() == kManifest ? 2 : p.filename() == kWritten ? 1 : 0;
+  };
+  std::stable_sort(ours.begin(), ours.end(),
+                   [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });
   for (const auto& p : ours) fs::remove(p, ec);
   fs::remove(dir_, ec);  // fails (and keeps it) unless empty
 }

@@ -190,7 +190,8 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
   // after 4.500000"); printed in full.
   constexpr double kMinLoopLengthSpacing = 1e-3;
   for (std::size_t k = 1; k < in.loop_lengths.size(); ++k)
-    if (!(in.loop_lengths[k] >= in.loop_lengths[k - 1] + kMinLoopLengthSpacing))
+    // (1e-9 mm of slack: 4.001 after 4 is 0.001 apart, though not in binary floating point)
+    if (!(in.loop_lengths[k] >= in.loop_lengths[k - 1] + kMinLoopLengthSpacing - 1e-9))
       throw InputError(file, io::json_pointer_append("/loop_lengths", k),
                        "loop lengths must increase by at least 0.001 mm, got " +
                            shortest(in.loop_lengths[k]) + " after " +

@@ -337,7 +337,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   }
   write_sweep_database(rep.written, db, in, rep.results, rep);
   rep.wrote_database = true;
-  if (opt.on_written) opt.on_written();
+  if (opt.on_written) opt.on_written(rep.written);
   // (--keep-parts: kept on purpose, so not marked: a later sweep without --resume refuses them)
   if (!opt.keep_parts) {
     store->mark_written();

@@ -161,7 +161,8 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
     FAIL("d = 0.1 with the default allowance accepted");
   } catch (const knit::InputError& e) {
     CHECK(e.pointer() == "/yarn/d");
-    CHECK(std::string(e.what()).find("whose default is 0.14 mm, got 0.1") != std::string::npos);
+    CHECK(std::string(e.what()).find("/contact/allowance = 0.14 mm (its default when the file "
+                                     "does not set it), got 0.1") != std::string::npos);
   }
   CHECK_NOTHROW(read_cell_options(
       write_tmp("cell_cfg_max.json", R"({"yarn": {"d": 0.1}, "contact": {"allowance": 0.05}})")));

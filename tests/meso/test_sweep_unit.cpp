@@ -183,6 +183,11 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
   CHECK_THROWS_WITH(parse_sweep_input(R"({"loop_lengths": [4.5, 4.500000000000001]})", "t.json"),
                     "t.json: /loop_lengths/1: loop lengths must increase by at least 0.001 mm, "
                     "got 4.500000000000001 after 4.5");
+  // Exactly 0.001 mm apart is enough, though not in binary (the review of session 38: 4.001
+  // and 4.002 were refused).
+  for (const char* pair : {"[4.001, 4.002]", "[4.009, 4.01]", "[4, 4.001]"})
+    CHECK_NOTHROW(parse_sweep_input(std::string(R"({"loop_lengths": )") + pair + "}", "t.json"));
+  CHECK_THROWS(parse_sweep_input(R"({"loop_lengths": [4, 4.000999]})", "t.json"));
   CHECK_NOTHROW(parse_sweep_input(R"({"loop_lengths": [4.5, 4.501]})", "t.json"));
   // Paths that end at the reference state carry no data (session 36's red team: a paper
   // biaxial path to (0, 0) folded the surface after the whole sweep).
@@ -776,11 +781,17 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                     Catch::Contains("different sweep input"));
   // Marked written (a sweep stopped after its database was in place, while it removed them;
   // session 38's red team: the next sweep said "checkpoints of an unfinished sweep exist"):
-  // --resume takes them, a plain sweep discards them.
+  // --resume takes them (and drops the mark: they are that run's again, and a --keep-parts
+  // resume keeps them on purpose), a plain sweep discards them.
   CheckpointStore(out, in.job_definition(), n, true, false).mark_written();
+  CHECK(fs::exists(parts / "database_written"));
   CHECK(CheckpointStore(out, in.job_definition(), n, true, false)
             .load_finished(make_jobs(in))
             .size() == 1);
+  CHECK_FALSE(fs::exists(parts / "database_written"));
+  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, false),
+                    Catch::Contains("checkpoints of an unfinished sweep exist"));
+  CheckpointStore(out, in.job_definition(), n, true, false).mark_written();
   CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, false, false));
   CHECK(fs::exists(parts / "manifest.json"));  // the new sweep's
   CHECK_FALSE(fs::exists(parts / "database_written"));
@@ -800,7 +811,8 @@ TEST_CASE(
   const auto in = synthetic_input();
   auto o = quiet(dir / "db.h5");
   int calls = 0;
-  o.on_written = [&] {
+  o.on_written = [&](const std::filesystem::path& written) {
+    CHECK(written == dir / "db.h5");
     ++calls;
     CHECK(fs::exists(dir / "db.h5"));
     CHECK(fs::exists(CheckpointStore::parts_dir(dir / "db.h5") / "manifest.json"));

@@ -37,7 +37,9 @@ struct SweepOptions {
   std::FILE* log = stdout;       ///< summary, time per case (nullptr: silent)
   /// Called once the database is in place, before the checkpoints are removed (the command
   /// changes what an interrupt from then on says: the database is complete).
-  std::function<void()> on_written;
+  /// Its argument: the file written (the output, or DB.failed.h5 beside it for a failing
+  /// sweep: SweepReport::written).
+  std::function<void(const std::filesystem::path&)> on_written;
 };
 
 struct SweepReport {
