@@ -1,6 +1,7 @@
 // HDF5 reading and writing of the material database (layout: schemas/database.layout.json,
 // docs/database.md). HDF5 is reached only through knit/io/hdf5.hpp.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -16,6 +17,25 @@
 namespace knit::material {
 
 namespace {
+
+/// The raw arrays of a path by name, for the per-step checks of the reader and the writer.
+std::array<std::pair<const char*, const RowMatrixX*>, 4> raw_arrays(const RawPath& r) {
+  return {{{"F", &r.F}, {"P", &r.P}, {"E", &r.E}, {"S", &r.S}}};
+}
+
+/// Why row s of raw array `d` ("F", "P", "E" or "S") is no converged state of a textile cell,
+/// in the words both the reader and the writer use: "not finite", "holds |value| X (F, E at
+/// most 1e3; P, S at most 1e9 MPa)" (deformation gradients and strains beyond
+/// kMaxRawKinematic, stresses beyond kMaxRawStress: session 29, 1e308 made the paper fit's rms
+/// inf), or "" when it is one.
+std::string raw_step_problem(const char* d, const RowMatrixX& m, Eigen::Index s) {
+  if (!m.row(s).allFinite()) return "not finite";
+  const double bound = (*d == 'F' || *d == 'E') ? kMaxRawKinematic : kMaxRawStress;
+  const double v = m.row(s).cwiseAbs().maxCoeff();
+  if (v > bound)
+    return "holds |value| " + io::format_number(v) + " (F, E at most 1e3; P, S at most 1e9 MPa)";
+  return {};
+}
 
 using io::H5File;
 using io::H5Group;
@@ -406,23 +426,16 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                                "step " + std::to_string(s + 1) + ": status " + std::to_string(st) +
                                    " (0 converged, 1 did not converge, 2 not reached)");
             if (st != 0) continue;
-            for (const auto& [d, m] : {std::pair<const char*, const RowMatrixX*>{"F", &r.F},
-                                       {"P", &r.P},
-                                       {"E", &r.E},
-                                       {"S", &r.S}}) {
-              if (!m->row(s).allFinite())
+            for (const auto& [d, m] : raw_arrays(r)) {
+              const std::string why = raw_step_problem(d, *m, s);
+              if (why == "not finite")
                 throw InputError(fname, p + "/" + d,
                                  "step " + std::to_string(s + 1) +
                                      " is marked converged (status 0) but is not finite");
-              // Deformation gradients and strains beyond 1e3, stresses beyond 1e9 MPa are no
-              // state of a textile cell (session 29: 1e308 made the paper fit's rms inf).
-              const double bound = (*d == 'F' || *d == 'E') ? kMaxRawKinematic : kMaxRawStress;
-              if (m->row(s).cwiseAbs().maxCoeff() > bound)
-                throw InputError(fname, p + "/" + d,
-                                 "step " + std::to_string(s + 1) + " holds |value| " +
-                                     io::format_number(m->row(s).cwiseAbs().maxCoeff()) +
-                                     " (F, E at most 1e3; P, S at most 1e9 MPa): a damaged "
-                                     "database");
+              if (!why.empty())
+                throw InputError(
+                    fname, p + "/" + d,
+                    "step " + std::to_string(s + 1) + " " + why + ": a damaged database");
             }
           }
           e.raw.push_back(std::move(r));
@@ -512,18 +525,12 @@ std::optional<std::string> first_unstorable_step(const Database& db) {
       for (std::size_t s = 0; s < r.status.size(); ++s) {
         if (r.status[s] != 0) continue;
         const auto i = static_cast<Eigen::Index>(s);
-        for (const auto& [d, m] : {std::pair<const char*, const RowMatrixX*>{"F", &r.F},
-                                   {"P", &r.P},
-                                   {"E", &r.E},
-                                   {"S", &r.S}})
+        for (const auto& [d, m] : raw_arrays(r))
           if (i < m->rows()) {
-            const std::string at =
-                raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1);
-            if (!m->row(i).allFinite()) return at + " is not finite";
-            const double bound = (*d == 'F' || *d == 'E') ? kMaxRawKinematic : kMaxRawStress;
-            if (m->row(i).cwiseAbs().maxCoeff() > bound)
-              return at + " holds |value| " + io::format_number(m->row(i).cwiseAbs().maxCoeff()) +
-                     " (F, E at most 1e3; P, S at most 1e9 MPa)";
+            const std::string why = raw_step_problem(d, *m, i);
+            if (!why.empty())
+              return raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1) + " " +
+                     (why == "not finite" ? "is not finite" : why);
           }
       }
     }
