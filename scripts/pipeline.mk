@@ -331,7 +331,8 @@ $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scri
   $(FIGPY)/energy_law.py \
   $(FIGPY)/results.py $(FIGPY)/sensitivity.py $(wildcard $(SENSITIVITY))
 	@$(PY) $(ROOT)/scripts/report.py --out-dir $(OUT) --database $(DB) --cells "$(HAVE_CELL)" \
-	  --sensitivity "$(SENSITIVITY)" --cases-dir $(CASEDIR) > $(LOGS)/report.log 2>&1 \
+	  --sensitivity "$(SENSITIVITY)" --cases-dir $(CASEDIR) \
+	  --expect-figures "$(notdir $(FIGURES) $(DESIGN_FIGURES))" > $(LOGS)/report.log 2>&1 \
 	  || { cat $(LOGS)/report.log; exit 1; }
 	@echo "report: $@"
 

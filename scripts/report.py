@@ -722,6 +722,9 @@ class Report:
         self.sensitivity = sensitivity
         self.names = case_names(cases_dir, self.res_dir)
         self.rows = []
+        # The figures the pipeline draws (--expect-figures): a missing one is named (session
+        # 38's red team: a deleted figure dropped its section without a word).
+        self.expected_figures = []
 
     def r(self, name):
         return self.data.r(name)
@@ -781,6 +784,10 @@ class Report:
                             if figure_failed(p))
         if n_failed_figs:
             law_text += f"; {n_failed_figs} figure script(s) FAILED (placeholders)"
+        missing_figs = [n for n in self.expected_figures
+                        if not os.path.exists(os.path.join(self.out, "figures", n))]
+        if missing_figs:
+            law_text += f"; {len(missing_figs)} figure(s) MISSING"
         L.append(f"**Summary:** {npass} of {npass + nfail} checks of the paper's statements pass, "
                  f"{nfail} fail ({ninfo} listed with our numbers only, the paper giving none); "
                  f"{ndone} of {len(names)} cases completed; material database: "
@@ -895,6 +902,10 @@ class Report:
             at = next(i for i, l in enumerate(L) if l.startswith("## Figures"))
             L.insert(at + 1, f"**{len(failed_figs)} figure script(s) failed** (placeholders "
                              f"below): {', '.join(failed_figs)}.\n")
+        if missing_figs:
+            at = next(i for i, l in enumerate(L) if l.startswith("## Figures"))
+            L.insert(at + 1, f"**{len(missing_figs)} figure(s) missing** (drawn by the pipeline, "
+                             f"not in figures/): {', '.join(n[:-4] for n in missing_figs)}.\n")
         with open(os.path.join(self.out, "report.md.tmp"), "w") as f:
             f.write("\n".join(L) + "\n")
         os.replace(os.path.join(self.out, "report.md.tmp"), os.path.join(self.out, "report.md"))
@@ -1109,6 +1120,9 @@ def main():
     ap.add_argument("--cells", default="")
     ap.add_argument("--sensitivity", default="",
                     help="sensitivity table (CSV: parameter,value,observable,result)")
+    ap.add_argument("--expect-figures", default="",
+                    help="the figures the pipeline draws (file names, blank-separated): a "
+                         "missing one is named in the report")
     ap.add_argument("--cases-dir", default=CASES_DIR,
                     help="the case files the pipeline runs (default: the checkout's cases/paper)")
     a = ap.parse_args()
@@ -1117,6 +1131,7 @@ def main():
               file=sys.stderr)
         sys.exit(2)
     rep = Report(a.out_dir, a.sensitivity, a.cases_dir, a.database)
+    rep.expected_figures = a.expect_figures.split()
     if not any(rep.r(n).ok for n in rep.names):
         # Nothing to judge: a report of 0 passes would read as a result (session 30: exit 0).
         print(f"report: error: {rep.res_dir}: no case of {a.cases_dir} has a result "

@@ -942,6 +942,16 @@ def main():
                 or "**1 figure script(s) failed** (placeholders below): fig_failed." not in text
                 or text.count("**The figure script failed**") != 1):
             failures.append("a failed figure's placeholder is not named in the report")
+        # A figure the pipeline draws that is not there is named (session 38's red team: its
+        # section vanished without a word).
+        rep.expected_figures = ["fig_drawn.png", "fig_failed.png", "fig_gone.png"]
+        rep.write(os.path.join(tmp, "no-database.h5"), "")
+        text = open(os.path.join(tmp, "report.md")).read()
+        if ("1 figure(s) MISSING" not in text
+                or "**1 figure(s) missing** (drawn by the pipeline, not in figures/): fig_gone."
+                not in text):
+            failures.append("a missing figure is not named in the report")
+        rep.expected_figures = []
         shutil.rmtree(figs)
         # A result deleted after a run of exit 0 is "result missing", not "failed (exit 0)"
         # (session 38's red team).
