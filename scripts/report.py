@@ -33,7 +33,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from results import Result  # noqa: E402
+from results import Result, root_text_attribute  # noqa: E402
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
 from design import read_summary as read_design_summary  # noqa: E402
 
@@ -702,16 +702,7 @@ def case_names(cases_dir, res_dir):
 def database_date(db_path):
     """The database file's date_utc attribute (when it was written), or None (no database, no
     attribute, unreadable)."""
-    if not db_path:
-        return None
-    try:
-        import h5py
-        with h5py.File(db_path, "r") as f:
-            d = f.attrs.get("date_utc")
-        d = None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
-        return d or None  # "" (a database without the attribute): no date
-    except (OSError, KeyError, ValueError, ImportError):
-        return None
+    return root_text_attribute(db_path, "date_utc") if db_path else None
 
 
 class Report:

@@ -321,6 +321,8 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     db.provenance.software_version = f.attribute_string(".", "software_version");
     db.provenance.git_revision = f.attribute_string(".", "git_revision");
     db.provenance.created = f.attribute_string(".", "created");
+    if (f.has_attribute(".", "date_utc"))
+      db.provenance.date_utc = f.attribute_string(".", "date_utc");
     db.generator = f.attribute_string(".", "generator");
     require_group("/sweep");
     db.sweep_input = f.attribute_string("/sweep", "input_json");

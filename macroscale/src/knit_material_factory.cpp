@@ -22,7 +22,6 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/csv.hpp"
-#include "knit/io/hdf5.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/knit_material.hpp"
@@ -246,15 +245,9 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   src.stitch_pointer = p + "/stitch_value";
   src.angle_pointer = p + "/knitting_angle";
   src.database = db.string();
-  // When the database file was written (its date_utc, io::write_provenance): results.h5 keeps
-  // it, and the report refuses results of another database (session 38's red team).
-  try {
-    const auto h = io::H5File::open_read(db);
-    if (h.has_attribute(".", "date_utc"))
-      src.database_date_utc = h.attribute_string(".", "date_utc");
-  } catch (const std::exception&) {
-    // read_database read it a moment ago; a file without the attribute (older) has no date
-  }
+  // When the database file was written: results.h5 keeps it, and the report refuses results
+  // of another database (session 38's red team).
+  src.database_date_utc = data.provenance.date_utc;
   if (m.at("stitch_value").is_number()) {
     // A constant: name the value itself rather than a control value.
     const double v = m.at("stitch_value").get<double>();

@@ -39,6 +39,19 @@ def read_vtu(path):
     return pts, fields
 
 
+def root_text_attribute(path, name):
+    """The text of the root attribute `name` of the HDF5 file `path` (bytes decoded), or None:
+    no file, no attribute, an empty one, unreadable, or no h5py."""
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            d = f.attrs.get(name)
+    except (OSError, KeyError, ValueError, ImportError):
+        return None
+    d = None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
+    return d or None
+
+
 class Result:
     """One case's output directory plus the pipeline's status file next to it."""
 
@@ -114,15 +127,8 @@ class Result:
     def database_date(self):
         """results.h5's material_database_date_utc (the date_utc of the database the run read,
         since session 38), or None."""
-        p = os.path.join(self.dir, "results.h5")
-        try:
-            import h5py
-            with h5py.File(p, "r") as f:
-                d = f.attrs.get("material_database_date_utc")
-        except (OSError, KeyError, ValueError, ImportError):
-            return None
-        d = None if d is None else (d.decode() if isinstance(d, bytes) else str(d))
-        return d or None  # "": the database had no date_utc
+        return root_text_attribute(os.path.join(self.dir, "results.h5"),
+                                   "material_database_date_utc")
 
     def summary(self):
         p = os.path.join(self.dir, "summary.txt")

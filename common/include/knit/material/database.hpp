@@ -135,6 +135,10 @@ struct Provenance {
   /// The file the database was made from, as given (the sweep's input, the database a fit
   /// read; "" for synth): the root attribute `input` (session 37: it was "" for every file).
   std::string input;
+  /// When the file was written: the root attribute `date_utc` (io::write_provenance; "" for a
+  /// file without it). Read only: a writer stamps its own time. knit-macro run keeps it in
+  /// results.h5, so that the report tells results of another database (session 38).
+  std::string date_utc;
 };
 
 struct Database {
