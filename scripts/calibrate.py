@@ -94,7 +94,7 @@ def run_path(binary, work, p, loop, axis, steps):
               f"  {last[:90]}", file=sys.stderr)
         if r.returncode not in (0, 1) or not os.path.exists(csv_path):
             raise RuntimeError(f"knit-meso failed ({' '.join(cmd)}):\n{r.stdout}")
-    e, s, lat = ("E11", "S11", "E22") if axis == 0 else ("E22", "S22", "E11")
+    e, s, lat = ("E11", "S11_MPa", "E22") if axis == 0 else ("E22", "S22_MPa", "E11")
     with open(csv_path) as f:
         return [(float(row[e]), float(row[s]), float(row[lat])) for row in csv.DictReader(f)]
 

@@ -800,9 +800,7 @@ class Report:
                      "surfaces.\n")
         L.append(f"- file: `{db_path}`; generator attribute: `{generator}`; loop lengths: "
                  f"{', '.join(f'{x:g}' for x in loops)} mm")
-        L.append(f"- time to build it: {fmt(db_seconds, 1)} s (paper: ~30 min per loop length, "
-                 f"i.e. ~{30 * max(1, len(loops))} min for {max(1, len(loops))} loop lengths, on "
-                 "6 cores)\n")
+        L.append(database_time_line(db_seconds, loops) + "\n")
         if law:
             L.append("## Material law (issue 11's acceptance)\n")
             L.append("The energy-based law's fit against the cell data and the held-out cell runs "
@@ -1076,6 +1074,18 @@ def twin_cell(summ, declared=None, exit_code=0):
     """The design table's twin column: '-' without a twin, else the verdict and the numbers."""
     t = twin_verdict(summ, declared, exit_code)
     return "-" if t is None else f"{verdict(t[0])}: {t[1]}"
+
+
+def database_time_line(db_seconds, loops):
+    """The database section's line on its build time: the paper's ~30 min per loop length
+    only beside a database whose loop lengths were read (session 38's red team: with
+    database.h5 missing it said "~30 min for 1 loop lengths")."""
+    if not loops:
+        return (f"- time to build it: {fmt(db_seconds, 1)} s (no loop lengths read: the "
+                "database is missing or unreadable, see above)")
+    n = len(loops)
+    return (f"- time to build it: {fmt(db_seconds, 1)} s (paper: ~30 min per loop length, "
+            f"i.e. ~{30 * n} min for {n} loop length{'s' if n != 1 else ''}, on 6 cores)")
 
 
 def twin_counts(out):

@@ -251,12 +251,54 @@ std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size
   return {line, col};
 }
 
+/// `s` with every byte that is not part of a well-formed UTF-8 sequence (RFC 3629: no overlong
+/// forms, no surrogates, nothing above U+10FFFF) written as \xHH. nlohmann's parse errors quote
+/// the bytes last read; from a Latin-1 or binary file they were raw and garbled the terminal.
+std::string printable_utf8(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    unsigned lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+    if (b < 0x80)
+      n = 1;
+    else if (b >= 0xC2 && b <= 0xDF)
+      n = 2;
+    else if (b >= 0xE0 && b <= 0xEF) {
+      n = 3;
+      if (b == 0xE0) lo = 0xA0;
+      if (b == 0xED) hi = 0x9F;
+    } else if (b >= 0xF0 && b <= 0xF4) {
+      n = 4;
+      if (b == 0xF0) lo = 0x90;
+      if (b == 0xF4) hi = 0x8F;
+    }
+    bool ok = n > 0 && i + n <= s.size();
+    for (std::size_t k = 1; ok && k < n; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + k]);
+      ok = k == 1 ? (c >= lo && c <= hi) : (c >= 0x80 && c <= 0xBF);
+    }
+    if (ok) {
+      out.append(s.substr(i, n));
+      i += n;
+    } else {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      out += "\\x";
+      out += kHex[b >> 4];
+      out += kHex[b & 15];
+      ++i;
+    }
+  }
+  return out;
+}
+
 [[noreturn]] void fail_at(std::string_view text, const std::string& source, std::size_t at,
                           const std::string& what) {
   const auto [line, col] = line_column(text, at);
   throw knit::InputError(source, "",
                          "invalid JSON at line " + std::to_string(line) + ", column " +
-                             std::to_string(col) + ": " + what);
+                             std::to_string(col) + ": " + printable_utf8(what));
 }
 
 /// Refuses nesting deeper than kMaxJsonDepth before anything recursive (the line scanner, the
@@ -312,7 +354,7 @@ nlohmann::json parse_json(std::string_view text, const std::string& source) {
                                  std::to_string(b.line) + ", column " + std::to_string(b.column) +
                                  ")");
     }
-    throw knit::InputError(source, "", std::string("invalid JSON: ") + e.what());
+    throw knit::InputError(source, "", "invalid JSON: " + printable_utf8(e.what()));
   }
   // nlohmann keeps the last of duplicate keys silently; a case file with a key twice is
   // almost certainly a mistake.

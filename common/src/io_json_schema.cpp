@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,28 @@
 namespace knit::io {
 
 using nlohmann::json;
+
+bool json_is_integer(const json& v) {
+  if (v.is_number_integer()) return true;
+  if (!v.is_number_float()) return false;
+  const double d = v.get<double>();
+  return std::isfinite(d) && std::floor(d) == d;
+}
+
+long long json_integer_saturated(const json& v) {
+  constexpr long long kMax = std::numeric_limits<long long>::max();
+  constexpr long long kMin = std::numeric_limits<long long>::min();
+  if (v.is_number_unsigned()) {
+    const auto u = v.get<unsigned long long>();
+    return u > static_cast<unsigned long long>(kMax) ? kMax : static_cast<long long>(u);
+  }
+  if (v.is_number_integer()) return v.get<long long>();
+  const double d = v.get<double>();
+  // 2^63 is exact in a double; every double below it converts exactly (it has no fraction).
+  if (d >= 9223372036854775808.0) return kMax;
+  if (d < -9223372036854775808.0) return kMin;
+  return static_cast<long long>(d);
+}
 
 namespace {
 
@@ -70,19 +93,12 @@ std::string join_values(const json& values) {
   return s;
 }
 
-bool is_integer_value(const json& v) {
-  if (v.is_number_integer()) return true;
-  if (!v.is_number_float()) return false;
-  const double d = v.get<double>();
-  return std::isfinite(d) && std::floor(d) == d;
-}
-
 bool has_type(const json& v, const std::string& t) {
   if (t == "object") return v.is_object();
   if (t == "array") return v.is_array();
   if (t == "string") return v.is_string();
   if (t == "number") return v.is_number();
-  if (t == "integer") return is_integer_value(v);
+  if (t == "integer") return json_is_integer(v);
   if (t == "boolean") return v.is_boolean();
   if (t == "null") return v.is_null();
   return false;

@@ -89,8 +89,8 @@ class Reader {
     return x;
   }
   int integer(const json& j, const std::string& ptr, int lo, int hi) const {
-    if (!j.is_number_integer()) fail(ptr, "must be an integer, got " + j.dump());
-    const long long v = j.get<long long>();
+    if (!io::json_is_integer(j)) fail(ptr, "must be an integer, got " + j.dump());
+    const long long v = io::json_integer_saturated(j);
     if (v < lo || v > hi)
       fail(ptr,
            "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + j.dump());

@@ -68,12 +68,12 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
     throw InputError(file, p + "/indices", "must be a non-empty array of control-value indices");
   for (std::size_t k = 0; k < idx.size(); ++k) {
     const std::string ip = p + "/indices/" + std::to_string(k);
-    if (!idx[k].is_number_integer() || idx[k].get<long>() < 0 ||
-        idx[k].get<long>() >= static_cast<long>(vals.size()))
+    if (!io::json_is_integer(idx[k]) || io::json_integer_saturated(idx[k]) < 0 ||
+        io::json_integer_saturated(idx[k]) >= static_cast<long long>(vals.size()))
       throw InputError(file, ip,
                        "must be the index of one of the " + std::to_string(vals.size()) +
                            " control values of the case's /material/" + field);
-    v.indices.push_back(idx[k].get<int>());
+    v.indices.push_back(static_cast<int>(io::json_integer_saturated(idx[k])));
   }
   v.lower = number(j.at("lower"), file, p + "/lower");
   v.upper = number(j.at("upper"), file, p + "/upper");

@@ -111,14 +111,22 @@ std::string material_failure_message(const RunReport& report, long n) {
 
 std::string solver_fallback_message(const SolverStats& stats) {
   std::string m;
+  // Who made the factorizations CHOLMOD refused: MUMPS; the SimplicialLDLT without MUMPS; both
+  // when MUMPS failed after it had made some (the counts do not split them: session 38 credited
+  // them all to the SimplicialLDLT).
   const bool mumps = stats.multifrontal && stats.multifrontal_failure.empty();
+  const bool both = stats.multifrontal && !stats.multifrontal_failure.empty() &&
+                    stats.multifrontal_factorizations > 0;
   if (!stats.supernodal_failure.empty())
     m = "the supernodal Cholesky (CHOLMOD) failed in " + stats.supernodal_failure + "; " +
         std::to_string(stats.fallback_factorizations) + " factorization" +
         (stats.fallback_factorizations == 1 ? " was" : "s were") + " made by " +
-        (mumps ? "MUMPS's multifrontal LDLT instead (the same results; "
-               : "Eigen's SimplicialLDLT instead (the same results, single-threaded and much "
-                 "slower on large patches; ") +
+        (mumps  ? "MUMPS's multifrontal LDLT instead (the same results; "
+         : both ? "MUMPS's multifrontal LDLT and, once it had failed, by Eigen's SimplicialLDLT "
+                  "instead (the same results, the latter single-threaded and much slower on "
+                  "large patches; "
+                : "Eigen's SimplicialLDLT instead (the same results, single-threaded and much "
+                  "slower on large patches; ") +
         std::to_string(stats.unknowns) + " unknowns)";
   if (!stats.multifrontal_failure.empty())
     m += std::string(m.empty() ? "" : "; ") + "the multifrontal LDLT (MUMPS) failed in " +

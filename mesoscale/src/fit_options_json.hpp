@@ -6,6 +6,7 @@
 #include <string>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/json_input.hpp"
 
 namespace knit::meso::fit {
 
@@ -16,12 +17,11 @@ inline void read_int_option(const nlohmann::json& j, const char* key, const std:
   if (!j.contains(key)) return;
   const nlohmann::json& x = j[key];
   const std::string p = pointer + "/" + key;
-  if (!x.is_number_integer()) throw InputError(file, p, "must be an integer");
-  if (x.is_number_unsigned()
-          ? x.get<unsigned long long>() > 2147483647ull
-          : (x.get<long long>() < -2147483648ll || x.get<long long>() > 2147483647ll))
+  if (!io::json_is_integer(x)) throw InputError(file, p, "must be an integer");
+  const long long i = io::json_integer_saturated(x);
+  if (i < -2147483648ll || i > 2147483647ll)
     throw InputError(file, p, "must fit a 32-bit integer, got " + x.dump());
-  v = x.get<int>();
+  v = static_cast<int>(i);
 }
 
 /// j[key] into v if present: a number (JSON has no NaN or infinity; 1e400 fails the parse).

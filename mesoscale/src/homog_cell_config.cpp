@@ -53,11 +53,9 @@ struct Reader {
     if (!j.contains(key)) return;
     const json& x = j[key];
     const std::string p = ptr + "/" + key;
-    if (!x.is_number_integer()) fail(p, "must be an integer");
+    if (!io::json_is_integer(x)) fail(p, "must be an integer");
     // Range before narrowing: get<int>() of 4294967297 gave 1 (issue 14).
-    const long long i = x.is_number_unsigned() && x.get<unsigned long long>() > 1ull << 62
-                            ? 1ll << 62
-                            : x.get<long long>();
+    const long long i = io::json_integer_saturated(x);
     if (i < lo) fail(p, "must be >= " + std::to_string(lo) + ", got " + std::to_string(i));
     if (i > hi) fail(p, "must be <= " + std::to_string(hi) + ", got " + x.dump());
     v = static_cast<int>(i);

@@ -58,7 +58,10 @@ PathResult run_path(PeriodicCell& cell, const PathSpec& path,
 }
 
 std::string csv_header() {
-  return "step,lambda,F11,F12,F21,F22,P11,P12,P21,P22,E11,E22,E12,S11,S22,S12,S21,"
+  // Units in the column names, as knit-macro's load_strain.csv has them (F and E are
+  // dimensionless; session 38's red team: P and S had no unit).
+  return "step,lambda,F11,F12,F21,F22,P11_MPa,P12_MPa,P21_MPa,P22_MPa,E11,E22,E12,S11_MPa,"
+         "S22_MPa,S12_MPa,S21_MPa,"
          "newton_iterations,cutbacks,seconds,active_contacts,min_gap_mm,dissipation_Nmm,"
          "imbalance_N\n";
 }

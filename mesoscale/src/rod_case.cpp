@@ -69,9 +69,9 @@ struct Reader {
     return v;
   }
   int integer(const json& j, const std::string& ptr, int lo) const {
-    if (!j.is_number_integer())
+    if (!io::json_is_integer(j))
       fail(ptr, "must be an integer, got " + (j.is_number() ? j.dump() : kind(j)));
-    const long long v = j.get<long long>();
+    const long long v = io::json_integer_saturated(j);
     // The upper bound is part of the message (session 25: 1000001 was refused as "must be an
     // integer >= 1"); schemas/rod.schema.json states it too.
     constexpr long long kMax = 1000000;

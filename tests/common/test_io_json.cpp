@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -482,4 +483,54 @@ TEST_CASE("schema patterns run in linear time without recursion", "[unit][io][js
   CHECK_THROWS_AS(knit::io::Pattern("[a"), std::invalid_argument);
   CHECK_THROWS_AS(knit::io::JsonSchema(json::parse(R"x({"pattern": "(?<n>a)"})x"), "t"),
                   std::logic_error);
+}
+
+TEST_CASE("a parse error quotes the bytes that are not UTF-8 in hexadecimal", "[unit][io][json]") {
+  // "caf\xE9" is Latin-1; nlohmann's message quotes the bytes it last read, raw until session
+  // 39. Well-formed UTF-8 (the e-acute of a UTF-8 file) stays as it is.
+  auto message = [](const std::string& text) {
+    try {
+      knit::io::parse_json(text, "t.json");
+    } catch (const knit::InputError& e) {
+      return e.message();
+    }
+    return std::string("no exception");
+  };
+  const std::string latin1 = message("{\"name\": \"caf\xE9\"}");
+  CHECK_THAT(latin1, Catch::StartsWith("invalid JSON at line 1, column "));
+  CHECK_THAT(latin1, Catch::Contains("caf\\xE9"));
+  for (unsigned char c : latin1) CHECK(c < 0x80);
+  // A well-formed two-byte sequence before the error is kept; a stray continuation byte,
+  // an overlong form (C0 AF) and a surrogate (ED A0 80) are not well-formed.
+  CHECK_THAT(message("[\"\xC3\xA9\n\"]"), Catch::Contains("\"\xC3\xA9<U+000A>"));
+  CHECK_THAT(message("[\"\x80\"]"), Catch::Contains("\\x80"));
+  // nlohmann stops at the first byte that cannot continue a sequence and quotes what it read.
+  CHECK_THAT(message("[\"\xC0\xAF\"]"), Catch::EndsWith("last read: '\"\\xC0'"));
+  CHECK_THAT(message("[\"\xED\xA0\x80\"]"), Catch::EndsWith("last read: '\"\\xED\\xA0'"));
+}
+
+TEST_CASE("json_is_integer is JSON Schema's integer, and its value saturates", "[unit][io][json]") {
+  using knit::io::json_integer_saturated;
+  using knit::io::json_is_integer;
+  CHECK(json_is_integer(json(2)));
+  CHECK(json_is_integer(json(2.0)));
+  CHECK(json_is_integer(json(-3.0)));
+  CHECK(json_is_integer(json(1e300)));
+  CHECK_FALSE(json_is_integer(json(2.5)));
+  CHECK_FALSE(json_is_integer(json("2")));
+  CHECK_FALSE(json_is_integer(json(true)));
+  CHECK_FALSE(json_is_integer(json(nullptr)));
+  CHECK(json_integer_saturated(json(2.0)) == 2);
+  CHECK(json_integer_saturated(json(-7)) == -7);
+  CHECK(json_integer_saturated(json(4294967297.0)) == 4294967297ll);
+  CHECK(json_integer_saturated(json(1e300)) == std::numeric_limits<long long>::max());
+  CHECK(json_integer_saturated(json(-1e300)) == std::numeric_limits<long long>::min());
+  CHECK(json_integer_saturated(json(18446744073709551615ull)) ==
+        std::numeric_limits<long long>::max());
+  CHECK(json_integer_saturated(json(9223372036854775807ll)) ==
+        std::numeric_limits<long long>::max());
+  // The schema validator uses the same predicate: 2.0 is an integer there too.
+  const auto schema = knit::io::JsonSchema(json::parse(R"({"type": "integer"})"), "int");
+  CHECK(schema.errors(json(2.0)).empty());
+  CHECK_FALSE(schema.errors(json(2.5)).empty());
 }

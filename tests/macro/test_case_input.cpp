@@ -1215,3 +1215,19 @@ TEST_CASE("a knit field degree of 1e10 is an input error before any int conversi
         "bad.json: /material/stitch_value/degrees/0: must be at most 15, got 10000000000.0");
   fs::remove_all(dir);
 }
+
+TEST_CASE("an integer written as 2.0 is the integer 2, as the case schema says", "[unit]") {
+  // Session 38's red team: the schema accepted "steps": 2.0 (JSON Schema's integer is a number
+  // with no fraction) and the case reader refused it.
+  json j = verification_case("tensile_svk.json");
+  j["solver"]["steps"] = 2.0;
+  j["solver"]["max_iterations"] = 30.0;
+  CHECK(error_of(j).empty());
+  const Case c = parse_case(j.dump(), "ok.json");
+  CHECK(c.solver.steps == 2);
+  CHECK(c.solver.max_iterations == 30);
+  j["solver"]["steps"] = 2.5;
+  CHECK_THAT(error_of(j), Catch::StartsWith("bad.json: /solver/steps: must be "));
+  j["solver"]["steps"] = 1e300;  // saturated, not narrowed: refused by its range
+  CHECK(error_of(j) == "bad.json: /solver/steps: must lie in [1, 100000], got 1e+300");
+}

@@ -881,4 +881,19 @@ TEST_CASE("the sparse factorizations' failures are warnings naming CHOLMOD's and
         "5): a memory allocation failed; the indefinite tangents from there on were factorized "
         "by Eigen's SimplicialLDLT (the same results, single-threaded and much slower on large "
         "patches; 135198 unknowns)");
+  // Both failed: CHOLMOD's refused factorizations went to MUMPS until it failed, then to the
+  // SimplicialLDLT; the warning credits both (session 38 credited them all to the latter).
+  // With MUMPS failed before its first factorization, all of them are the SimplicialLDLT's.
+  s.supernodal_failure = "a factorization: CHOLMOD_OUT_OF_MEMORY";
+  s.multifrontal_factorizations = 3;
+  CHECK_THAT(solver_fallback_message(s),
+             Catch::StartsWith("the supernodal Cholesky (CHOLMOD) failed in a factorization: "
+                               "CHOLMOD_OUT_OF_MEMORY; 14 factorizations were made by MUMPS's "
+                               "multifrontal LDLT and, once it had failed, by Eigen's "
+                               "SimplicialLDLT instead ("));
+  s.multifrontal_factorizations = 0;
+  CHECK_THAT(solver_fallback_message(s),
+             Catch::StartsWith("the supernodal Cholesky (CHOLMOD) failed in a factorization: "
+                               "CHOLMOD_OUT_OF_MEMORY; 14 factorizations were made by Eigen's "
+                               "SimplicialLDLT instead ("));
 }

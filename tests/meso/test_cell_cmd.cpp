@@ -78,8 +78,9 @@ TEST_CASE("knit-meso path: shear CSV rows and VTP files", "[unit]") {
       M << std::stod(r[col(a)]), std::stod(r[col(b)]), std::stod(r[col(c)]), std::stod(r[col(d)]);
       return M;
     };
-    const Eigen::Matrix2d F = m2("F11", "F12", "F21", "F22"), P = m2("P11", "P12", "P21", "P22"),
-                          S = m2("S11", "S12", "S21", "S22");
+    const Eigen::Matrix2d F = m2("F11", "F12", "F21", "F22"),
+                          P = m2("P11_MPa", "P12_MPa", "P21_MPa", "P22_MPa"),
+                          S = m2("S11_MPa", "S12_MPa", "S21_MPa", "S22_MPa");
     INFO("step " << k << ": P =\n" << P << "\nF S =\n" << F * S);
     CHECK((F * S - P).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + P.cwiseAbs().maxCoeff()));
     if (k == 3) CHECK(std::abs(P(0, 1) - P(1, 0)) > 0.05);
@@ -103,9 +104,9 @@ TEST_CASE("knit-meso path --uniaxial: the lateral stress vanishes at every step"
   for (int k = 1; k <= 3; ++k) {
     const auto& r = rows[k + 1];
     INFO("step " << k);
-    CHECK(std::abs(std::stod(r[col("S11")])) <= 1e-4);
+    CHECK(std::abs(std::stod(r[col("S11_MPa")])) <= 1e-4);
     CHECK(std::stod(r[col("E11")]) < 0);
-    CHECK(std::stod(r[col("S22")]) > 0);
+    CHECK(std::stod(r[col("S22_MPa")]) > 0);
     CHECK(std::abs(std::stod(r[col("E12")])) < 1e-12);
   }
   CHECK(std::stod(rows[4][col("E22")]) == Approx(0.1).margin(1e-12));

@@ -223,6 +223,13 @@ TEST_CASE("energy fit: a floor or weights large enough to overflow are refused",
                     Catch::StartsWith("o.json: /floor: floor must be <= 1000 MPa"));
   CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube_weight": -1})", "o.json"),
                     Catch::StartsWith("o.json: /tube_weight: "));
+  // An integer option written as 12.0 is the integer 12, as JSON Schema counts it (session 39:
+  // the sweep input's schema accepted it and the reader refused it); 12.5 and 2^31 are refused.
+  CHECK(EnergyFitOptions::from_json(R"({"s_spans": 12.0})", "o.json").s_spans == 12);
+  CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"s_spans": 12.5})", "o.json"),
+                    "o.json: /s_spans: must be an integer");
+  CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"s_spans": 2147483648.0})", "o.json"),
+                    "o.json: /s_spans: must fit a 32-bit integer, got 2147483648.0");
 }
 
 TEST_CASE("energy fit: the monotonicity bound of the data", "[unit]") {

@@ -1036,6 +1036,15 @@ def main():
             failures.append("reaches: compression to -14.1 % not recognised")
         if abs(rc.stretch_bound(0.3) - 0.345) > 1e-12 or abs(rc.stretch_bound(0.2) - 0.22) > 1e-12:
             failures.append("kinematic bound")
+        # The database's build time: the paper's ~30 min only beside loop lengths read.
+        line = report.database_time_line(None, [])
+        if "30 min" in line or "missing or unreadable" not in line:
+            failures.append(f"database time without a database: {line!r}")
+        line = report.database_time_line(91.0, [4.5, 5.0, 5.5, 6.0, 6.5])
+        if "~150 min for 5 loop lengths" not in line or "91" not in line:
+            failures.append(f"database time of five loop lengths: {line!r}")
+        if "for 1 loop length," not in report.database_time_line(3.0, [4.5]):
+            failures.append("database time of one loop length: not singular")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     for f in failures:

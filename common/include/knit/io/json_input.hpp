@@ -131,6 +131,17 @@ std::string unknown_key_note(const std::string& key, const std::vector<std::stri
 /// four readers appended the raw key, "/material/x/y" for the key "x/y"). The case, material,
 /// design and fit-option readers name the member's pointer; the rod and cell readers word it
 /// as their schemas do (the object's pointer, the key quoted).
+/// JSON Schema's "integer": a number with no fraction, 2 as well as 2.0 (draft 2020-12, section
+/// 6.1.1 of the validation vocabulary). The schema validator and every hand-written reader of an
+/// integer use this one predicate (session 38: the readers refused "steps": 2.0, which the
+/// schemas accept).
+bool json_is_integer(const nlohmann::json& j);
+/// The value of a json_is_integer number as a long long, saturated at the type's limits
+/// (18446744073709551615 and 1e300 give LLONG_MAX), so that a range check on the result
+/// refuses what lies beyond and never narrows silently (get<int>() of 4294967297 gave 1: issue
+/// 14). Precondition: json_is_integer(j).
+long long json_integer_saturated(const nlohmann::json& j);
+
 struct UnknownKey {
   std::string key;
   std::string pointer;
