@@ -8,8 +8,8 @@ readers, the library ParaView is built on, and checks what a ParaView user would
   .pvd         well-formed XML, a VTKFile of type Collection with at least one DataSet, strictly
                increasing timesteps, every referenced file present (and checked as above).
 
-Needs VTK's Python module: Debian's python3-vtk9 (`apt-get install python3-vtk9`, ~250 MB with
-its Qt dependencies; not part of scripts/setup.sh). Session 26 found no problem in the main
+Needs VTK's Python module: Debian's python3-vtk9 (`apt-get install python3-vtk9`, ~300 MB with
+its Qt dependencies; scripts/test.sh installs it through scripts/setup.sh, the main job does not). Session 26 found no problem in the main
 job's 139 VTU/VTP files and 22 collections (VTK 9.1).
 
 Usage: /usr/bin/python3 scripts/vtk_check.py out/results out/design out/cells

@@ -3,8 +3,8 @@
 then only our own parser had read them): a shell run's VTU files and collection, a unit-cell
 path's and a rod's VTP files pass; a truncated file, a collection naming a missing file, a
 non-finite value, an array with the wrong number of tuples and an empty directory are each
-refused by name. Skipped (exit 77) without Debian's python3-vtk9, which scripts/setup.sh does
-not install. Run by CTest (tests/CMakeLists.txt, label report) with /usr/bin/python3;
+refused by name. Skipped (exit 77) without Debian's python3-vtk9, which scripts/test.sh installs
+(KNIT_SETUP_TESTS=1 scripts/setup.sh) since session 39. Run by CTest (tests/CMakeLists.txt, label report) with /usr/bin/python3;
 KNIT_BIN_DIR names the directory of knit-macro and knit-meso.
 """
 import os
