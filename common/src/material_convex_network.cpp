@@ -420,14 +420,20 @@ std::vector<double> NetworkLawData::theta_row(Eigen::Index j) const {
 std::vector<double> NetworkLawData::theta_at(double l, int derivative) const {
   const auto n = static_cast<Eigen::Index>(l_knots.size());
   std::vector<double> out(static_cast<std::size_t>(shape.size()), 0.0);
-  if (n == 1 || l <= l_knots.front() || l >= l_knots.back()) {
+  // Beyond the knots theta is constant (derivative 0). At the end knots themselves the
+  // derivative is the one-sided one of the span inside: it was 0 there until session 39, so a
+  // design that reached the database's first or last loop length saw dJ/dl = 0 and stopped at
+  // the bound ("infeasible target") where the target lay inside.
+  const bool at_end = n > 1 && (l == l_knots.front() || l == l_knots.back());
+  if (n == 1 || l < l_knots.front() || l > l_knots.back() || (at_end && derivative == 0)) {
     if (derivative != 0) return out;
     const Eigen::Index j = (n == 1 || l <= l_knots.front()) ? 0 : n - 1;
     for (int k = 0; k < shape.size(); ++k) out[static_cast<std::size_t>(k)] = theta(j, k);
     return out;
   }
+  // l in [l_j, l_j+1); the last knot belongs to the last span.
   const auto it = std::upper_bound(l_knots.begin(), l_knots.end(), l);
-  const auto j = static_cast<Eigen::Index>(it - l_knots.begin()) - 1;  // l in [l_j, l_j+1)
+  const auto j = std::min(static_cast<Eigen::Index>(it - l_knots.begin()) - 1, n - 2);
   const double dl = l_knots[static_cast<std::size_t>(j + 1)] - l_knots[static_cast<std::size_t>(j)];
   const double t = (l - l_knots[static_cast<std::size_t>(j)]) / dl;
   for (int k = 0; k < shape.size(); ++k)

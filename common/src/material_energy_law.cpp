@@ -131,6 +131,10 @@ EnergyLaw::EnergyLaw(EnergyLawData d) : d_(std::move(d)) {
 }
 
 Eigen::VectorXd EnergyLaw::l_basis(double l, int derivative) const {
+  // Clamped beyond the knots: the law is constant in l there, so its l-derivatives are 0 (the
+  // basis' derivative at the end knot is the one-sided one of the span inside).
+  if (derivative > 0 && (l < lb_.lo() || l > lb_.hi()))
+    return Eigen::VectorXd::Zero(lb_.eval_all(lb_.lo(), 0).size());
   return lb_.eval_all(std::clamp(l, lb_.lo(), lb_.hi()), derivative);
 }
 
@@ -156,13 +160,28 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
       const std::vector<double> theta_j = d.network.theta_row(s.j);
       net_ = NetworkLawAt(d.network.shape, theta_j);
       lanes_ = NetworkLanesAt(d.network.shape, theta_j);
+      const auto& knots = d.network.l_knots;
       if (s.inside && (s.t > 0.0 || with_l_derivative)) {
         const std::vector<double> theta_next = d.network.theta_row(s.j + 1);
         net_next_ = NetworkLawAt(d.network.shape, theta_next);
         if (s.t > 0.0) lanes_ = NetworkLanesAt(d.network.shape, theta_j, theta_next, s.t);
         has_next_ = true;
-        dl_span_ = d.network.l_knots[static_cast<std::size_t>(s.j + 1)] -
-                   d.network.l_knots[static_cast<std::size_t>(s.j)];
+        dl_span_ = knots[static_cast<std::size_t>(s.j + 1)] - knots[static_cast<std::size_t>(s.j)];
+      } else if (with_l_derivative && knots.size() > 1 &&
+                 (l == knots.front() || l == knots.back())) {
+        // At an end knot: the one-sided derivative of the span inside (session 39: it was 0,
+        // and a design stopped at the database's first or last loop length).
+        const auto n = static_cast<Eigen::Index>(knots.size());
+        if (l == knots.front()) {  // net_ is knot 0's law
+          net_next_ = NetworkLawAt(d.network.shape, d.network.theta_row(1));
+          has_next_ = true;
+          dl_span_ = knots[1] - knots[0];
+        } else {  // net_ is the last knot's law
+          net_prev_ = NetworkLawAt(d.network.shape, d.network.theta_row(n - 2));
+          has_prev_ = true;
+          dl_span_ =
+              knots[static_cast<std::size_t>(n - 1)] - knots[static_cast<std::size_t>(n - 2)];
+        }
       }
       return;
     }
@@ -273,9 +292,13 @@ EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
 Eigen::Vector3d EnergyLawAt::dS_dl(const Eigen::Vector3d& e) const {
   if (network_) {
     if (!with_l_derivative_) throw std::logic_error("EnergyLawAt: built without the l-derivative");
-    if (energy_blend_)  // dW/dl = (W_j+1 - W_j) / dl in the span; 0 outside the knots
-      return has_next_ ? Eigen::Vector3d((net_next_.evaluate(e).S - net_.evaluate(e).S) / dl_span_)
-                       : Eigen::Vector3d::Zero();
+    if (energy_blend_) {  // dW/dl = (W_j+1 - W_j) / dl in the span; 0 beyond the end knots
+      if (has_next_)
+        return Eigen::Vector3d((net_next_.evaluate(e).S - net_.evaluate(e).S) / dl_span_);
+      if (has_prev_)
+        return Eigen::Vector3d((net_.evaluate(e).S - net_prev_.evaluate(e).S) / dl_span_);
+      return Eigen::Vector3d::Zero();
+    }
     return (net_hi_.evaluate(e).S - net_lo_.evaluate(e).S) / (2.0 * net_h_);
   }
   if (dpoly_.empty()) throw std::logic_error("EnergyLawAt: built without the l-derivative");

@@ -310,3 +310,35 @@ TEST_CASE("energy law: validation refuses bad data", "[unit]") {
   CHECK_THROWS_AS(validate(bad([](auto& d) { d.directions.d(0, 0) = 2.0; })),
                   std::invalid_argument);
 }
+
+TEST_CASE("energy law: at the end knots dS/dl is the one-sided slope of the span inside",
+          "[unit]") {
+  // Session 39's fresh-user walkthrough: dS/dl was 0 at the first and last loop length of the
+  // network law (either interpolation), so a design that reached the database's range ended
+  // there with dJ/dl = 0 and "infeasible target" although the target lay inside. At l = 4.5
+  // the forward difference, at l = 6.5 the backward one; beyond the knots the law is clamped
+  // (constant in l), and dS/dl is 0 there.
+  const int kind = GENERATE(0, 1, 2);
+  const EnergyLaw law(law_of_kind(kind));
+  std::mt19937 gen(21);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  const double h = 1e-6;
+  double smallest = 1e300;
+  for (const auto& [l, dir] : {std::pair{4.5, 1.0}, std::pair{6.5, -1.0}}) {
+    // The one-sided difference of second order, (-3 S(l) + 4 S(l + h) - S(l + 2h)) / 2h.
+    const EnergyLawAt at = law.at(l, true), here = law.at(l), in1 = law.at(l + dir * h),
+                      in2 = law.at(l + 2 * dir * h);
+    for (int k = 0; k < 100; ++k) {
+      const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+      const Eigen::Vector3d fd =
+          dir * (-3 * here.evaluate(e).S + 4 * in1.evaluate(e).S - in2.evaluate(e).S) / (2 * h);
+      const Eigen::Vector3d dS = at.dS_dl(e);
+      INFO("kind " << kind << ", l = " << l << ": dS/dl = " << dS.transpose() << ", FD "
+                   << fd.transpose());
+      REQUIRE((fd - dS).norm() <= 1e-5 * (1 + fd.norm()));
+      smallest = std::min(smallest, fd.norm());
+    }
+    CHECK(law.at(l - dir * 0.5, true).dS_dl(Eigen::Vector3d(0.1, 0.2, 0.05)).norm() == 0.0);
+  }
+  CHECK(smallest > 1e-6);  // the slope is not 0 there, so the check above can fail
+}

@@ -2,7 +2,8 @@
 // scaled by (4.5/l)^2 at each loop length), written to the build's test_tmp directory; with
 // the synthetic stand-in's cell parameters (mesoscale/src/fit_synthetic.cpp) unless
 // with_cells is false; with_energy adds the energy-based law of test_energy_util.hpp
-// (4.5-6.5 mm), which the knit material then uses by default.
+// (4.5-6.5 mm), which the knit material then uses by default: the ridge family, or with
+// energy_network the network family (knots 4.5, 5.5, 6.5 mm).
 #pragma once
 
 #include <cmath>
@@ -26,7 +27,8 @@ inline double synth_course_height(double l) {
 
 inline std::string write_knit_test_database(const std::string& name,
                                             const std::vector<double>& loop_lengths,
-                                            bool with_cells = true, bool with_energy = false) {
+                                            bool with_cells = true, bool with_energy = false,
+                                            bool energy_network = false) {
   const std::filesystem::path dir = std::filesystem::path(KNIT_BINARY_DIR) / "test_tmp";
   std::filesystem::create_directories(dir);
   const std::filesystem::path f = dir / name;
@@ -40,7 +42,9 @@ inline std::string write_knit_test_database(const std::string& name,
     e.surface = material::testing::make_test_surface(std::pow(4.5 / l, 2));
     db.entries.push_back(e);
   }
-  if (with_energy) db.energy_law = material::testing::make_test_energy_law();
+  if (with_energy)
+    db.energy_law = energy_network ? material::testing::make_test_network_law()
+                                   : material::testing::make_test_energy_law();
   material::write_database(f, db);
   return f.string();
 }

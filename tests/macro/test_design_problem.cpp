@@ -29,16 +29,19 @@ void write(const fs::path& f, const std::string& text) {
   std::ofstream(f) << text;
 }
 
-/// A wale-wise tensile case with a designable l field (two control values across u).
-void write_case() {
-  const std::string db =
-      knit::testing::write_knit_test_database("design_problem_db.h5", {4.5, 5.5, 6.5});
-  write(kDir / "case.json", R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1],
+/// A wale-wise tensile case with a designable l field (two control values across u), written
+/// as kDir/file; on the paper law's test database, or with `network` on one whose default law
+/// is the energy law's network family.
+void write_case(bool network = false, const std::string& file = "case.json") {
+  const std::string db = knit::testing::write_knit_test_database(
+      network ? "design_problem_net_db.h5" : "design_problem_db.h5", {4.5, 5.5, 6.5}, true, network,
+      network);
+  write(kDir / file, R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1],
       "knots_v": [0, 0, 1, 1],
       "control_points": [[0, 0, 0], [20, 0, 0], [0, 20, 0], [20, 20, 0]], "thickness": 0.76},
     "refinement": {"degree": 2, "elements": [1, 1]},
     "material": {"type": "knit", "database": ")" +
-                                db + R"(",
+                         db + R"(",
       "stitch_value": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
                        "values": [5.0, 5.0]},
       "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1],
@@ -781,4 +784,42 @@ TEST_CASE("design twin: knit-macro design writes the twin's targets and distance
   CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5]") != std::string::npos);
   CHECK(summary.find("twin l: 5.5 (recovered 5.5, off by ") != std::string::npos);
   fs::remove_all(out);
+}
+
+TEST_CASE("design twin: a design started on the database's first or last loop length leaves it",
+          "[case]") {
+  // Session 39's fresh-user walkthrough: the network law's dS/dl was 0 at the database's first
+  // and last loop length, so a design started there (or stepping onto it) saw dJ/dl = 0 and
+  // ended on the bound as "infeasible target" although the target lay inside. Now dJ/dl there
+  // is the one-sided derivative from inside (equal to the one-sided difference of J), and a
+  // twin 0.3 mm inside is recovered by either optimizer. (The test network's reactions are not
+  // monotone in l over the whole range, so the twins lie near the bound they start from.)
+  write_case(true, "case_net.json");
+  for (const auto& [twin, start] : {std::pair{6.2, 6.5}, std::pair{4.8, 4.5}}) {
+    write(kDir / "twin_net.json",
+          R"({"case": "case_net.json", "variables": [{"name": "l", "field": "stitch_value",
+              "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+              "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2]}],
+              "twin": {"l": )" +
+              std::to_string(twin) + "}}");
+    DesignProblem d = load_design((kDir / "twin_net.json").string());
+    REQUIRE(set_twin_targets(d).empty());
+    const DesignEvaluation e = evaluate_design(d, {start});
+    const double h = start < 5.5 ? 1e-5 : -1e-5;  // inwards
+    const double J1 = evaluate_design(d, {start + h}, false).J,
+                 J2 = evaluate_design(d, {start + 2 * h}, false).J;
+    const double fd = (-3 * e.J + 4 * J1 - J2) / (2 * h);
+    INFO("start " << start << ": J = " << e.J << ", dJ/dl = " << e.gradient(0) << ", FD " << fd);
+    CHECK(e.gradient(0) == Approx(fd).epsilon(1e-4));
+    CHECK(std::abs(fd) > 1e-3 * e.J);
+    for (const auto method :
+         {DesignOptimizerSpec::Method::kCeres, DesignOptimizerSpec::Method::kProjectedGradient}) {
+      DesignProblem p = d;
+      p.variables[0].initial = start;
+      p.optimizer.method = method;
+      const DesignResult r = optimize_design(p);
+      INFO("recovered l = " << r.x[0] << ", status " << to_string(r.status));
+      CHECK(std::abs(r.x[0] - twin) < 1e-3);
+    }
+  }
 }

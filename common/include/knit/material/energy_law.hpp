@@ -146,8 +146,11 @@ class EnergyLawAt {
   /// t W_j+1 in lanes_); dS/dl = (S_j+1 - S_j) / dl_span_.
   bool energy_blend_ = false;
   NetworkLawAt net_next_;
+  /// At the last knot (with the l-derivative only): knot n-2's law, for the one-sided
+  /// derivative (S_n-1 - S_n-2) / dl_span_.
+  NetworkLawAt net_prev_;
   double dl_span_ = 0.0;
-  bool has_next_ = false;
+  bool has_next_ = false, has_prev_ = false;
 };
 
 /// The family over l: validated data and the l-basis.
