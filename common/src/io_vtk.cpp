@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
@@ -229,9 +230,12 @@ void data_section(XmlOut& x, const char* tag, const std::vector<VtkField>& field
 std::string header(const char* type, const std::string& comment) {
   std::string s = "<?xml version=\"1.0\"?>\n";
   if (!comment.empty()) {
-    std::string c = comment;  // "--" is not allowed inside XML comments
+    // "--" is not allowed inside an XML comment. It is written "-\u002d", which a JSON
+    // comment (the provenance, where "--" only occurs inside strings: "--output") reads back
+    // as "--"; session 39's walkthrough found "- -output", which no JSON reader restores.
+    std::string c = comment;
     for (std::size_t p = c.find("--"); p != std::string::npos; p = c.find("--", p))
-      c.replace(p, 2, "- -");
+      c.replace(p, 2, "-\\u002d");
     s += "<!-- " + c + " -->\n";
   }
   s += std::string("<VTKFile type=\"") + type +
@@ -338,8 +342,21 @@ void PvdCollection::write() const {
   s +=
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
   char buf[40];
-  for (const auto& e : entries_) {
-    std::snprintf(buf, sizeof buf, "%.16g", e.time);
+  double prev_time = 0.0, prev_written = 0.0;
+  const auto sign = [](double x) { return (x > 0) - (x < 0); };
+  for (std::size_t k = 0; k < entries_.size(); ++k) {
+    const auto& e = entries_[k];
+    // 15 significant digits, so that an accumulated load factor reads 0.5, not
+    // 0.4999999999999999 (session 39's walkthrough); 17 (exact) when the 15 digits would not
+    // keep this time's order with the one before (equal, or crossed).
+    std::snprintf(buf, sizeof buf, "%.15g", e.time);
+    double written = std::strtod(buf, nullptr);
+    if (k > 0 && sign(written - prev_written) != sign(e.time - prev_time)) {
+      std::snprintf(buf, sizeof buf, "%.17g", e.time);
+      written = e.time;
+    }
+    prev_time = e.time;
+    prev_written = written;
     s += std::string("    <DataSet timestep=\"") + buf + "\" group=\"\" part=\"" +
          std::to_string(e.part) + "\" file=\"" + xml_escape(e.file) + "\"/>\n";
   }

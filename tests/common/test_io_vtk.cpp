@@ -2,12 +2,15 @@
 // their structure checked — element nesting, counts, array sizes and values — not their text.
 #include <unistd.h>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -214,8 +217,18 @@ TEST_CASE("VTU surface grid: structure, counts and values parse back", "[unit][i
 
   for (auto enc : {VtkEncoding::Ascii, VtkEncoding::Base64}) {
     const fs::path file = scratch(enc == VtkEncoding::Ascii ? "grid_ascii.vtu" : "grid_b64.vtu");
-    write_vtu(file, mesh, enc, "provenance: {\"x\": \"a--b\"}");
-    auto root = parse_file(file);
+    write_vtu(file, mesh, enc, "provenance: {\"x\": \"a--b---c\"}");
+    auto root = parse_file(file);  // refuses "--" inside a comment
+    {
+      // The provenance JSON reads back exactly (session 39: "--output" was written "- -output").
+      std::ifstream in(file);
+      const std::string text((std::istreambuf_iterator<char>(in)), {});
+      const auto a = text.find("<!-- provenance: "), b = text.find(" -->");
+      REQUIRE(a != std::string::npos);
+      REQUIRE(b != std::string::npos);
+      const std::string json_text = text.substr(a + 17, b - a - 17);
+      CHECK(nlohmann::json::parse(json_text).at("x") == "a--b---c");
+    }
     CHECK(root->tag == "VTKFile");
     CHECK(root->attr.at("type") == "UnstructuredGrid");
     CHECK(root->attr.at("byte_order") == "LittleEndian");
@@ -375,4 +388,19 @@ TEST_CASE("PVD collection lists time steps with relative file names", "[unit][io
   CHECK(fs::exists(dir / sets[2]->attr.at("file")));
   CHECK(sets[3]->attr.at("file") == "bare.vtu");
   CHECK(sets[3]->attr.at("part") == "1");
+  // Accumulated load factors read as the user wrote them (session 39: a load factor 0.5 was
+  // written 0.4999999999999999; here 0.7 - 0.2, which %.16g wrote so), and times closer than
+  // 15 digits keep their order: exact there.
+  PvdCollection noise(dir / "noise.pvd");
+  const double t1 = 0.7 - 0.2, t2 = 0.7, t3 = std::nextafter(0.7, 1.0),
+               t4 = std::nextafter(t3, 1.0);
+  for (double t : {t1, t2, t3, t4}) noise.add(t, "bare.vtu");
+  noise.write();
+  const auto noise_root = parse_file(dir / "noise.pvd");  // owns the nodes
+  const auto ns = noise_root->child("Collection").all("DataSet");
+  REQUIRE(ns.size() == 4);
+  CHECK(ns[0]->attr.at("timestep") == "0.5");
+  CHECK(ns[1]->attr.at("timestep") == "0.7");
+  CHECK(std::stod(ns[2]->attr.at("timestep")) == t3);
+  CHECK(std::stod(ns[3]->attr.at("timestep")) == t4);
 }

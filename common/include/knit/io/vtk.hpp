@@ -12,7 +12,7 @@
 //   "radius" array first in a PolylineSet so that the Tube filter ("Vary Radius: By Absolute
 //   Scalar") draws yarns with their radius.
 // * `comment` (e.g. Provenance::to_json_string()) is written as an XML comment after the
-//   header line.
+//   header line, each "--" (not allowed there) as "-\u002d", which JSON reads back as "--".
 #pragma once
 
 #include <Eigen/Core>
