@@ -13,6 +13,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/macro/knitmap.hpp"
 
@@ -33,9 +34,13 @@ knit::cli::SubcommandRegistrar reg(
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->case_file, "case file (JSON, knit material, planar patch)")
           ->required();
-      sub.add_option("-o,--output,--out", o->output, "output directory");
+      // The defaults in the help (session 39's walkthrough: neither was stated).
+      sub.add_option("-o,--output,--out", o->output,
+                     "output directory (default: the case file's name without its extension + "
+                     "\"_knitmap\", in the current directory)");
       sub.add_option("--angle-tolerance", o->angle_tolerance,
-                     "largest deviation of the course direction from its mean (deg)")
+                     "largest deviation of the course direction from its mean (deg; default " +
+                         knit::io::format_number(o->angle_tolerance) + ")")
           // A finite angle in (0, 180]: CLI::PositiveNumber let "nan" through, which passed
           // every patch (session 21).
           ->check(knit::cli::number(0, 180, knit::cli::Ends::kOpenLow));

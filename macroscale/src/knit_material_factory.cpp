@@ -105,6 +105,11 @@ void check_angle(double a, const std::string& p, const CaseContext& ctx, bool de
     m << "a knitting angle must lie in " << (deg ? "[-360, 360] deg" : "[-2 pi, 2 pi] rad")
       << ", got " << (deg ? a * 180.0 / std::numbers::pi : a)
       << " (a larger angle is the same course direction as one inside)";
+    // An angle meant in degrees (session 39's walkthrough: "values": [30] with no unit).
+    if (!deg && std::abs(a) <= 360.0)
+      m << "; if it is in degrees, give the spline field \"unit\": \"deg\" (a constant angle as "
+           "{\"degrees\": [0, 0], \"knots_u\": [0, 1], \"knots_v\": [0, 1], \"values\": ["
+        << a << "], \"unit\": \"deg\"})";
     throw InputError(ctx.file, p, m.str());
   }
 }

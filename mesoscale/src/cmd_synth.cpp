@@ -35,14 +35,17 @@ struct SynthCli {
 static knit::cli::SubcommandRegistrar reg_synth(
     "synth",
     "Write a SYNTHETIC material database (a stand-in for the mesoscale sweep: a known "
-    "orthotropic stiffening law on the default load paths), fitted unless --no-fit",
+    "orthotropic stiffening law on the default load paths, not a knit: in tension about 8 "
+    "times softer than a swept database), fitted unless --no-fit",
     [](CLI::App& sub) {
       auto o = std::make_shared<SynthCli>();
       sub.add_option("-o,--output,--out", o->out, "output database (.h5)")->required();
-      sub.add_option("--loop-lengths", o->loop_lengths, "loop lengths in mm (increasing)")
+      // The defaults in the help (session 39's walkthrough: neither was stated).
+      sub.add_option("--loop-lengths", o->loop_lengths,
+                     "loop lengths in mm (increasing; default 4.5,5,5.5,6,6.5)")
           ->delimiter(',')
           ->check(knit::cli::number(0, 50, knit::cli::Ends::kOpenLow));
-      sub.add_option("--steps", o->steps, "load steps per path")
+      sub.add_option("--steps", o->steps, "load steps per path (default 20)")
           ->check(knit::cli::integer(4, 1000));
       auto* fo = sub.add_option("--fit-options", o->fit_options, "fit options (JSON file)");
       auto* eo = sub.add_option("--energy-options", o->energy_options,

@@ -284,6 +284,7 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     }
   }
   if (j.contains("energy_fit")) {
+    in.energy_fit_given = true;
     const auto& f = j.at("energy_fit");
     if (f.is_boolean())
       in.energy_fit = f.get<bool>();

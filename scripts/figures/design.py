@@ -66,6 +66,15 @@ def field_grid(spec, n=81):
     return u, v, Bv @ C @ Bu.T, C, scale
 
 
+def field_unit(name, scale):
+    """The unit of a designed field's values as the case gives them (field_grid's values are
+    not converted): mm for the stitch value, the angle field's own "unit" (scale pi/180: deg)
+    for the knitting angle. Session 39's walkthrough: a field in degrees was labelled rad."""
+    if name == "stitch_value":
+        return "mm"
+    return "deg" if scale != 1.0 else "rad"
+
+
 def read_summary(path):
     """summary.txt of a design -> {key: text} of its 'key: value' lines ({} when missing)."""
     out = {}
@@ -169,7 +178,7 @@ def main():
     ax.grid(True, which="both", alpha=0.3)
     for i, (name, (u, v, F, C, scale)) in enumerate(fields):
         ax = axes[0][i + 1]
-        unit = "mm" if name == "stitch_value" else "rad"
+        unit = field_unit(name, scale)
         im = ax.imshow(F, origin="lower", extent=(u[0], u[-1], v[0], v[-1]), aspect="equal", cmap="viridis")
         fig.colorbar(im, ax=ax, label=("l" if name == "stitch_value" else "alpha") + f" ({unit})")
         ax.set_xlabel("theta1 (u)")

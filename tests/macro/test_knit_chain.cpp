@@ -195,6 +195,14 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
       head +
       R"("stitch_value": 5, "knitting_angle": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [-360, 360], "unit": "deg"}})"));
   CHECK_NOTHROW(load(head + R"("stitch_value": 5, "knitting_angle": -6.28})"));
+  // An angle that reads as degrees says how to write it in degrees (session 39).
+  CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": 30})"),
+                    Catch::EndsWith("; if it is in degrees, give the spline field \"unit\": "
+                                    "\"deg\" (a constant angle as {\"degrees\": [0, 0], "
+                                    "\"knots_u\": [0, 1], \"knots_v\": [0, 1], \"values\": "
+                                    "[30], \"unit\": \"deg\"}) (line 2)"));
+  CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": 1e308})"),
+                    !Catch::Contains("if it is in degrees"));
   CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "colour": 1})"),
                     Catch::Contains("/material/colour: unknown key"));
   // The material readers suggest a close key, as every reader does (io::unknown_key_note).

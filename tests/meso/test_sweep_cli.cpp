@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "../output_test_util.hpp"
+#include "knit/meso/sweep/input.hpp"
 #include "knit/meso/sweep/mpi.hpp"
 #include "test_sweep_util.hpp"
 
@@ -221,4 +222,28 @@ TEST_CASE(
   // Once the cause is gone, --resume writes the database from the checkpoints.
   CHECK(shell(sweep + " --resume 2>&1") == 0);
   CHECK_FALSE(fs::exists(parts));
+}
+
+TEST_CASE("knit-meso sweep: a sweep input without energy_fit is told it got the code's defaults",
+          "[case]") {
+  // Session 39's fresh-user walkthrough: the code's energy-fit defaults are not the default
+  // sweep's, and a sweep input without "energy_fit" got them without a word. The input's
+  // flag, and the run's note (with the options given: no note).
+  const SweepScratch s = sweep_scratch("sweep_energy_fit_note");
+  std::string text = knit_test::synthetic_sweep_json();
+  CHECK(knit::meso::sweep::parse_sweep_input(text, "s.json").energy_fit_given);
+  const auto at = text.find(",\n  \"energy_fit\"");
+  REQUIRE(at != std::string::npos);
+  text = text.substr(0, at) + "}";
+  CHECK_FALSE(knit::meso::sweep::parse_sweep_input(text, "s.json").energy_fit_given);
+  knit_test::write_text(s.dir / "bare.json", text);
+  const fs::path log = s.dir / "bare.log", log2 = s.dir / "given.log";
+  REQUIRE(shell(kExe + " sweep " + (s.dir / "bare.json").string() + " --output " +
+                (s.dir / "bare.h5").string() + " --no-progress > " + log.string() + " 2>&1") == 0);
+  CHECK_THAT(knit_test::read_text(log),
+             Catch::Contains("note: the sweep input has no \"energy_fit\", so the energy law was "
+                             "fitted with the code's defaults"));
+  REQUIRE(shell(kExe + " sweep " + (s.dir / "s.json").string() + " --output " + s.db.string() +
+                " --no-progress > " + log2.string() + " 2>&1") == 0);
+  CHECK_THAT(knit_test::read_text(log2), !Catch::Contains("note: the sweep input has no"));
 }

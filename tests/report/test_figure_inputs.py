@@ -117,6 +117,19 @@ def main():
                     if m.group(1) != "tmp":
                         direct.append(f"{name}: savefig({m.group(1)}")
     c(not direct, "no figure script saves straight to its output: %s" % direct)
+    # design.py labels a designed angle field in its own unit (session 39: degrees said rad).
+    sys.path.insert(0, FIG)
+    import design  # noqa: E402
+    import math
+    spec = {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1], "values": [30],
+            "unit": "deg"}
+    scale = design.field_grid(spec, n=3)[4]
+    c(design.field_unit("knitting_angle", scale) == "deg", "an angle field in deg is labelled deg")
+    spec["unit"] = "rad"
+    c(design.field_unit("knitting_angle", design.field_grid(spec, n=3)[4]) == "rad",
+      "an angle field in rad is labelled rad")
+    c(design.field_unit("stitch_value", 1.0) == "mm", "the stitch value is labelled mm")
+    c(abs(scale - math.pi / 180) < 1e-15, "field_grid's scale of a deg field is pi / 180")
     return c.exit_code()
 
 

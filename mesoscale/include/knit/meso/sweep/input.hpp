@@ -70,6 +70,9 @@ struct SweepInput {
   /// input key "energy_fit": false | {options of knit/meso/fit/energy_fit.hpp}.
   bool energy_fit = true;
   fit::EnergyFitOptions energy_fit_options;
+  /// Whether the input gave "energy_fit" options (the run's report says when the code's
+  /// defaults were used: they are not the default sweep's, which hold the fit within 4.5 %).
+  bool energy_fit_given = false;
 
   /// Canonical JSON of everything that determines the job results (loop lengths, paths,
   /// runner, cell, retry) -- not the fit options: a resumed sweep may refit differently.
