@@ -133,6 +133,20 @@ knit::cli::SubcommandRegistrar reg(
         for (std::size_t k = 0; k < r.terms0.size(); ++k)
           sum << "term " << r.terms0[k].first << ": " << r.terms0[k].second << " -> "
               << (k < r.terms.size() ? r.terms[k].second : r.terms0[k].second) << "\n";
+        // What the design reached beside what was asked (session 39's walkthrough: only J was
+        // given, and the load had to be read from run/load_strain.csv or worked out from J).
+        for (std::size_t k = 0; k < d.objectives.size() && k < r.reached.size(); ++k) {
+          const auto& o = d.objectives[k];
+          if (r.reached[k].empty()) continue;
+          const bool reaction = o.kind == knit::macro::DesignObjective::Kind::kReaction;
+          sum << "reached " << o.name << ":";
+          for (double v : r.reached[k]) sum << " " << v;
+          sum << " " << (reaction ? "N" : "mm") << " (target";
+          for (double t : o.target) sum << " " << t;
+          sum << "; at strain";
+          for (double e : o.at_strain) sum << " " << e;
+          sum << ")\n";
+        }
         for (std::size_t k = 0; k < d.variables.size(); ++k)
           sum << "variable " << header[4 + k] << ": " << d.variables[k].initial << " -> " << r.x[k]
               << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "]\n";

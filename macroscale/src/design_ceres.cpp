@@ -54,6 +54,7 @@ struct Tracker {
       res->J = last.J;
       res->x = x;
       res->terms = last.terms;
+      res->reached = last.reached;
     }
     return last;
   }

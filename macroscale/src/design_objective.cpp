@@ -101,7 +101,9 @@ DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<doubl
     return out;
   }
   Residuals res;
-  for (const auto& o : d.objectives) {
+  out.reached.resize(d.objectives.size());
+  for (std::size_t oi = 0; oi < d.objectives.size(); ++oi) {
+    const DesignObjective& o = d.objectives[oi];
     const std::size_t first = res.r.size();
     const double w = std::sqrt(o.weight);
     if (o.kind == DesignObjective::Kind::kReactionLinearity) {
@@ -122,12 +124,14 @@ DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<doubl
           const Sensitive q =
               s.reaction(L, d.c.output.reactions[static_cast<std::size_t>(o.reaction)]);
           res.add(w * (q.value - o.target[k]), w * to_variables(d, q.d));
+          out.reached[oi].push_back(q.value);
           break;
         }
         case DesignObjective::Kind::kDisplacement: {
           const Sensitive q = s.displacement(
               L, d.c.output.points[static_cast<std::size_t>(o.point)].at, o.component);
           res.add(w * (q.value - o.target[k]), w * to_variables(d, q.d));
+          out.reached[oi].push_back(q.value);
           break;
         }
         case DesignObjective::Kind::kStrainVariance:

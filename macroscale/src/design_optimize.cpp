@@ -171,6 +171,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
   }
   res.J = cur.J;
   res.terms = cur.terms;
+  res.reached = cur.reached;
   classify_result(d, opt, converged ? SolverEnd::kConverged : SolverEnd::kIterationLimit, res);
   return res;
 }

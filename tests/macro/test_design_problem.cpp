@@ -1,6 +1,7 @@
 // The design file (schemas/design.schema.json): a valid file loads; an unknown objective, a
 // variable outside the field, bounds outside the database's range and an empty objective list
 // are JSON-pointer errors, and `knit-macro design` exits with 2 for them.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -783,6 +784,56 @@ TEST_CASE("design twin: knit-macro design writes the twin's targets and distance
   // The case's l is 5.0, the twin 5.5: the design moves there.
   CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5]") != std::string::npos);
   CHECK(summary.find("twin l: 5.5 (recovered 5.5, off by ") != std::string::npos);
+  // What the design reached, beside its target (session 39): the twin's load, in N.
+  const auto number_after = [&](const std::string& key) {
+    const auto at = summary.find(key);
+    REQUIRE(at != std::string::npos);
+    return std::stod(summary.substr(at + key.size()));
+  };
+  const double target = number_after("twin target load: ");
+  const double reached = number_after("reached load: ");
+  CHECK(target > 0.0);
+  CHECK(reached == Approx(target).epsilon(1e-5));
+  fs::remove_all(out);
+}
+
+TEST_CASE("design: summary.txt gives what the design reached, the final run's own values",
+          "[case]") {
+  // Session 39's walkthrough: only J was given. A target out of reach (1e6 N): the design ends
+  // on a bound, and what it reached is the final run's load at that strain (its last row: 0.2
+  // is the case's end), not the target.
+  write_case();
+  write(kDir / "reach.json",
+        R"({"case": "case.json",
+            "variables": [{"name": "l", "field": "stitch_value", "indices": [0, 1],
+                           "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "name": "load", "reaction": "fy",
+                            "at_strain": [0.2], "target": [1e6]}]})");
+  const fs::path out = kDir / "reach_out";
+  CHECK(design_into(kDir / "reach.json", out) == 0);
+  const std::string summary = knit_test::read_text(out / "summary.txt");
+  INFO(summary);
+  const auto at = summary.find("reached load: ");
+  REQUIRE(at != std::string::npos);
+  const double reached = std::stod(summary.substr(at + 14));
+  CHECK(summary.find(" N (target 1e+06; at strain 0.2)") != std::string::npos);
+  CHECK(reached > 0.0);
+  CHECK(reached < 1e5);
+  std::istringstream csv(knit_test::read_text(out / "run" / "load_strain.csv"));
+  std::string line, header, last;
+  while (std::getline(csv, line))
+    if (!line.empty() && line[0] != '#') (header.empty() ? header : last) = line;
+  std::vector<std::string> names, values;
+  for (auto [text, into] : {std::pair{&header, &names}, std::pair{&last, &values}}) {
+    std::istringstream cells(*text);
+    for (std::string c; std::getline(cells, c, ',');) into->push_back(c);
+  }
+  const auto col = std::find(names.begin(), names.end(), "fy_N");
+  REQUIRE(col != names.end());
+  REQUIRE(values.size() == names.size());
+  CHECK(reached == Approx(std::stod(values[std::size_t(col - names.begin())])).epsilon(1e-5));
+  CHECK(summary.find(" N (target ") != std::string::npos);
+  CHECK(summary.find("; at strain 0.2)") != std::string::npos);
   fs::remove_all(out);
 }
 

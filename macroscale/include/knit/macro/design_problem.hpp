@@ -107,6 +107,9 @@ struct DesignEvaluation {
   std::string message;
   double J = 0.0;
   std::vector<std::pair<std::string, double>> terms;  ///< per objective (name, sum r^2)
+  /// Per objective: the reaction (N) or displacement (mm) reached at each of its at_strain
+  /// levels; empty for the other kinds (what summary.txt reports beside the targets).
+  std::vector<std::vector<double>> reached;
   Eigen::VectorXd residuals;
   Eigen::MatrixXd jacobian;  ///< dr/dx (residuals x variables); empty without gradient
   Eigen::VectorXd gradient;  ///< dJ/dx = 2 jacobian^T r
@@ -156,6 +159,7 @@ struct DesignResult {
   std::vector<double> x;  ///< the best design found (inside the bounds)
   double J = 0.0, J0 = 0.0;
   std::vector<std::pair<std::string, double>> terms0, terms;  ///< at the start and the best
+  std::vector<std::vector<double>> reached;  ///< DesignEvaluation::reached of the best design
   std::vector<DesignIteration> history;
   int evaluations = 0;  ///< objective evaluations (each one forward run)
   /// Wall seconds over all evaluations: forward solves, and the sensitivities (gradients).

@@ -127,8 +127,9 @@ std::string material_failure_message(const RunReport& report, long n);
 /// Eigen's SimplicialLDLT instead ..." from the run's SolverStats; "" if it never failed.
 std::string solver_fallback_message(const SolverStats& stats);
 
-/// Why a run is not a plain success (RunResult::succeeded()): the stop message, the material's
-/// failures and the output failure, joined by "; "; empty if it succeeded.
+/// Why a run is not a plain success (RunResult::succeeded()): the stop message (with what to
+/// change when Newton gave up), the material's failures and the output failure, joined by "; ";
+/// empty if it succeeded.
 std::string run_failure_message(const RunResult& r);
 
 }  // namespace knit::macro
