@@ -599,6 +599,7 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   ctx.file = file;
   ctx.pointer = "/material";
   ctx.patch = &c.surface;
+  ctx.thickness = c.thickness;
   c.material = make_material(root.at("material"), ctx);
   // A material with data in fixed units (the knit database: mm, N, MPa): a case declaring other
   // units would run with its numbers read as those (session 22).

@@ -226,6 +226,21 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
                        db.string() + ": /loop_" + std::to_string(k) + "/fit: " + e.what());
     }
   }
+  // The database's stresses are per its cell's thickness t = 2d (eq. 8's volume w c t): a
+  // shell of another thickness scales every force by the ratio (session 39's walkthrough: a
+  // 0.30 mm yarn's database, t = 0.60 mm, under a case copied with 0.76 mm gave 27 % more load
+  // with exit 0). Databases without cell parameters (thickness 0) cannot say.
+  for (std::size_t k = 0; k < data.entries.size() && ctx.thickness > 0.0; ++k) {
+    const double t = data.entries[k].cell.thickness;
+    if (t > 0.0 && std::abs(ctx.thickness - t) > 1e-6 * t) {
+      std::ostringstream os;
+      os << "the shell's thickness " << ctx.thickness << " mm is not the database's cell "
+         << "thickness t = 2d = " << t << " mm (" << db.string() << ", /loop_" << k
+         << "@thickness), per which its stresses are homogenized: every force would be "
+         << ctx.thickness / t << " times the fabric's; set /geometry/thickness to " << t;
+      throw InputError(ctx.file, "/geometry/thickness", os.str());
+    }
+  }
   {
     // A homogenized fabric spans many stitches: a patch smaller than one loop of the database
     // is a case in other units (a 50 mm patch written in metres ran with exit 0, session 22).

@@ -21,6 +21,7 @@
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
 #include "knit/material/database.hpp"
+#include "knit_test_database.hpp"
 #include "verification_case.hpp"
 
 using namespace knit::macro;
@@ -1233,4 +1234,29 @@ TEST_CASE("an integer written as 2.0 is the integer 2, as the case schema says",
   CHECK_THAT(error_of(j), Catch::StartsWith("bad.json: /solver/steps: must be "));
   j["solver"]["steps"] = 1e300;  // saturated, not narrowed: refused by its range
   CHECK(error_of(j) == "bad.json: /solver/steps: must lie in [1, 100000], got 1e+300");
+}
+
+TEST_CASE("a knit case whose thickness is not the database's cell thickness is refused", "[unit]") {
+  // The database's stresses are per its cell's thickness t = 2d; another shell thickness
+  // scales every force by the ratio (session 39's walkthrough: a 0.30 mm yarn's database under
+  // a case copied with 0.76 mm gave 27 % more load, exit 0). The test database's cells have
+  // t = 0.76 mm.
+  const std::string db = knit::testing::write_knit_test_database("thickness_db.h5", {4.5, 6.5});
+  json j = verification_case("tensile_svk.json");
+  j["material"] = {{"type", "knit"}, {"database", db}, {"stitch_value", 5.0}};
+  REQUIRE(j["geometry"]["thickness"] == 0.76);
+  CHECK(error_of(j).empty());
+  j["geometry"]["thickness"] = 0.6;
+  CHECK(error_of(j) ==
+        "bad.json: /geometry/thickness: the shell's thickness 0.6 mm is not the "
+        "database's cell thickness t = 2d = 0.76 mm (" +
+            db +
+            ", /loop_0@thickness), per which its stresses are homogenized: every "
+            "force would be 0.789474 times the fabric's; set /geometry/thickness "
+            "to 0.76");
+  // A database without cell parameters (thickness 0) cannot say: accepted.
+  const std::string bare =
+      knit::testing::write_knit_test_database("thickness_bare_db.h5", {4.5, 6.5}, false);
+  j["material"]["database"] = bare;
+  CHECK(error_of(j).empty());
 }

@@ -18,6 +18,9 @@ struct CaseContext {
   std::string pointer;  ///< JSON pointer of the material object
   /// The refined patch (parameter domain). Valid only during make_material: copy what you need.
   const spline::SplineSurface* patch = nullptr;
+  /// The shell's thickness (/geometry/thickness, mm; 0 = unknown): a knit database's stresses
+  /// are per its cell's thickness t = 2d, which the case must use.
+  double thickness = 0.0;
 };
 
 std::unique_ptr<Material> make_material(const nlohmann::json& material, const CaseContext& ctx);
