@@ -12,14 +12,23 @@ std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>&
   if (!c.output.applied || rows.size() < 2) return drops;
   for (size_t r = 0; r < c.output.reactions.size(); ++r) {
     if (c.output.reactions[r].component != c.output.applied->component) continue;
-    double max_load = 0.0;
-    for (const StepRow& row : rows) max_load = std::max(max_load, std::abs(row.reactions[r]));
+    // The load's direction: the sign of its largest value. A drop is a fall of the load along
+    // it, F_k - F_k+1 times that sign: the magnitude |F_k| - |F_k+1| took a change of sign for
+    // a rise (session 39's walkthrough: 0.146 -> -0.530 N was not named, and -0.508 -> 0.148 N
+    // was called a fall "from -0.5077 to 0.1477").
+    double max_load = 0.0, sign = 0.0;
+    for (const StepRow& row : rows)
+      if (std::abs(row.reactions[r]) > max_load) {
+        max_load = std::abs(row.reactions[r]);
+        sign = row.reactions[r] > 0.0 ? 1.0 : -1.0;
+      }
     LoadDrop d;
     d.reaction = c.output.reactions[r].name;
     d.max_load = max_load;
+    d.direction = sign;
     for (size_t k = 0; k + 1 < rows.size(); ++k) {
       const double f0 = rows[k].reactions[r], f1 = rows[k + 1].reactions[r];
-      const double drop = std::abs(f0) - std::abs(f1);
+      const double drop = sign * (f0 - f1);
       if (!(drop > tolerance * max_load) || !(drop > c.solver.absolute_tolerance)) continue;
       ++d.count;
       if (drop > d.largest) {
@@ -38,7 +47,9 @@ std::string load_drop_message(const LoadDrop& d, double tolerance) {
   std::ostringstream m;
   m.precision(4);
   m << "load drop: reaction '" << d.reaction << "' falls from " << d.from_load << " to "
-    << d.to_load << " N (" << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load
+    << d.to_load << " N (by " << d.largest << " N";
+  if (d.direction < 0.0) m << " along its largest load, " << -d.max_load << " N";
+  m << "; " << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load
     << " N) between step " << d.from_step << " (strain " << d.from_strain << ") and step "
     << d.to_step << " (strain " << d.to_strain << ") while the applied displacement grows";
   if (d.count > 1) m << "; " << d.count << " drops in all";

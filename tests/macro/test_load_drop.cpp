@@ -69,6 +69,27 @@ TEST_CASE("load drop: the magnitude along the pull counts, lateral reactions do 
   CHECK(find_load_drops(c, rows_of({-1, -2, -4}, {0, 0, 0})).empty());
   // Negative and shrinking: a drop.
   CHECK(find_load_drops(c, rows_of({-1, -4, -2}, {0, 0, 0})).size() == 1);
+  // A change of sign is judged along the load's direction (the sign of its largest value), not
+  // by magnitude (session 39's walkthrough: 0.146 -> -0.530 -> -0.508 -> 0.148 N named the
+  // last step a fall "from -0.5077 to 0.1477" and missed nothing else; by magnitude a sign
+  // flip through a smaller value hides a drop).
+  {
+    const auto d = find_load_drops(c, rows_of({0.146, -0.530, -0.508, 0.148}, {0, 0, 0, 0}));
+    REQUIRE(d.size() == 1);
+    CHECK(d[0].direction == -1.0);
+    CHECK(d[0].count == 2);  // -0.530 -> -0.508 and -0.508 -> 0.148 fall along -x
+    CHECK(d[0].from_load == -0.508);
+    CHECK(d[0].to_load == 0.148);
+    CHECK(d[0].largest == Approx(0.656).epsilon(1e-12));
+    const std::string m = knit::macro::load_drop_message(d[0]);
+    CHECK(m.find("falls from -0.508 to 0.148 N (by 0.656 N along its largest load, -0.53 N; ") !=
+          std::string::npos);
+    // A positive load through zero: 2 -> -1 is a drop of 3 although |F| falls by 1 only.
+    const auto e = find_load_drops(c, rows_of({1, 2, -1, 3}, {0, 0, 0, 0}));
+    REQUIRE(e.size() == 1);
+    CHECK(e[0].largest == Approx(3.0).epsilon(1e-12));
+    CHECK(e[0].count == 1);
+  }
   // The lateral reaction falls (Poisson contraction relaxing): not a load drop.
   CHECK(find_load_drops(c, rows_of({1, 2, 3}, {5, 1, 0})).empty());
   // Without an applied displacement (force control) nothing is judged.

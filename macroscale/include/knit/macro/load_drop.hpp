@@ -14,7 +14,9 @@
 
 namespace knit::macro {
 
-/// Relative threshold of a load drop: |F_k| - |F_k+1| > kLoadDropTolerance x max_j |F_j|, and
+/// Relative threshold of a load drop: s (F_k - F_k+1) > kLoadDropTolerance x max_j |F_j|, s the
+/// sign of the load of largest magnitude (the direction the test pulls it; a reaction at the
+/// held edge is negative), and
 /// more than the Newton solve's absolute residual tolerance (Case::solver.absolute_tolerance,
 /// N): a reaction is not known more closely than that (session 38's red team: a reaction of a
 /// free edge "fell" from -1.8e-15 to 4.4e-16 N, 75 % of its largest).
@@ -22,10 +24,11 @@ inline constexpr double kLoadDropTolerance = 1e-6;
 
 /// The drops of one reaction: how many, and the largest (the steps on either side of it).
 struct LoadDrop {
-  std::string reaction;   ///< the name in output.reactions
-  int count = 0;          ///< consecutive-step decrements above the threshold
-  double largest = 0.0;   ///< |F_from| - |F_to| of the largest (N)
-  double max_load = 0.0;  ///< max_j |F_j| over the run (N)
+  std::string reaction;    ///< the name in output.reactions
+  int count = 0;           ///< consecutive-step decrements above the threshold
+  double largest = 0.0;    ///< s (F_from - F_to) of the largest (N)
+  double max_load = 0.0;   ///< max_j |F_j| over the run (N)
+  double direction = 0.0;  ///< s: the sign of the load of largest magnitude
   int from_step = 0, to_step = 0;
   double from_load = 0.0, to_load = 0.0;      ///< F at those steps (N)
   double from_strain = 0.0, to_strain = 0.0;  ///< the applied strain at those steps
