@@ -45,6 +45,14 @@ material::Database assemble_database(const SweepInput& in, const std::vector<Job
   db.provenance.input = in.file;
   db.generator = in.runner == RunnerKind::kCell ? "sweep" : "sweep (synthetic runner)";
   db.sweep_input = in.json;
+  if (!in.cell_file.empty()) {
+    // The cell parameters inline, not the name of their file (session 39's walkthrough: the
+    // database kept "cell": "myyarn.json", so neither its allowance, loop shape nor contact
+    // law was in the file, and the stored input could not be run anywhere else).
+    nlohmann::json j = nlohmann::json::parse(in.json);
+    j["cell"] = nlohmann::json::parse(in.cell_json);
+    db.sweep_input = j.dump(2);
+  }
   const nlohmann::json cell = nlohmann::json::parse(in.cell_json);
   // The cell's defaults (docs/unit-cell.md) where the input says nothing.
   const double d = cell_value(cell, "yarn", "d", 0.38);

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "../output_test_util.hpp"
+#include "knit/material/database.hpp"
 #include "knit/meso/sweep/input.hpp"
 #include "knit/meso/sweep/mpi.hpp"
 #include "test_sweep_util.hpp"
@@ -246,4 +247,30 @@ TEST_CASE("knit-meso sweep: a sweep input without energy_fit is told it got the 
   REQUIRE(shell(kExe + " sweep " + (s.dir / "s.json").string() + " --output " + s.db.string() +
                 " --no-progress > " + log2.string() + " 2>&1") == 0);
   CHECK_THAT(knit_test::read_text(log2), !Catch::Contains("note: the sweep input has no"));
+}
+
+TEST_CASE("knit-meso sweep: the database keeps a cell parameter file's contents, not its name",
+          "[case]") {
+  // Session 39's walkthrough: /sweep's stored input said "cell": "myyarn.json"; the allowance,
+  // loop shape and contact law were nowhere in the database, and the stored input could not be
+  // run from another directory. Now the cell object is inline, and the stored input is a sweep
+  // input that reads anywhere.
+  const SweepScratch s = sweep_scratch("sweep_cell_file");
+  const std::string cell = R"({"yarn": {"d": 0.3}, "contact": {"allowance": 0.11, "mu": 0.25}})";
+  knit_test::write_text(s.dir / "myyarn.json", cell);
+  std::string text = knit_test::synthetic_sweep_json();
+  text.insert(text.rfind('}'), R"(, "cell": "myyarn.json")");
+  knit_test::write_text(s.dir / "s.json", text);
+  REQUIRE(shell(kExe + " sweep " + (s.dir / "s.json").string() + " --output " + s.db.string() +
+                " --no-progress > " + (s.dir / "log.txt").string() + " 2>&1") == 0);
+  const auto db = knit::material::read_database(s.db, false);
+  const auto stored = nlohmann::json::parse(db.sweep_input);
+  CHECK(stored.at("cell") == nlohmann::json::parse(cell));
+  CHECK(db.yarn.at("diameter") == 0.3);
+  // Read from a directory without myyarn.json: the stored input is complete.
+  const fs::path elsewhere = knit_test::scratch("sweep_cell_file_elsewhere");
+  const auto again =
+      knit::meso::sweep::parse_sweep_input(db.sweep_input, (elsewhere / "stored.json").string());
+  CHECK(nlohmann::json::parse(again.cell_json) == nlohmann::json::parse(cell));
+  CHECK(again.cell_file.empty());
 }
