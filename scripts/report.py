@@ -361,6 +361,13 @@ def held_out_text(db_path):
                        "the database has no energy law or no held-out path")
 
 
+def uniaxial_text(db_path):
+    """The law along the cell's uniaxial-stress paths (scripts/law_uniaxial.py)."""
+    import law_uniaxial as m
+    return beside_text("Uniaxial tension", lambda: m.summary(m.uniaxial_ratios(db_path)),
+                       "the database has no energy law")
+
+
 def small_strain_text(db_path):
     """The law over the cell at small strains (scripts/law_small_strain.py)."""
     import law_small_strain as m
@@ -780,7 +787,8 @@ class Report:
         if missing_figs:
             law_text += f"; {len(missing_figs)} figure(s) MISSING"
         L.append(f"**Summary:** {npass} of {npass + nfail} checks of the paper's statements pass, "
-                 f"{nfail} fail ({ninfo} listed with our numbers only, the paper giving none); "
+                 f"{nfail} fail, and {ninfo} more are listed with our numbers only (the paper "
+                 "giving none); "
                  f"{ndone} of {len(names)} cases completed; material database: "
                  f"{'SYNTHETIC stand-in' if mode == 'synth' or generator == 'synth' else 'mesoscale sweep'}"
                  f"{law_text}.\n")
@@ -814,6 +822,7 @@ class Report:
             L.append(held_out_text(db_path))
             L.append(near_visited_text(db_path, os.path.join(self.out, "results")))
             L.append(small_strain_text(db_path))
+            L.append(uniaxial_text(db_path))
         L.append("## Statements of the paper against our numbers\n")
         L.append("Each check is a function of the loaded results (scripts/report_checks.py; "
                  "thresholds and their reasons in docs/reproduction.md). Curves are compared at "
@@ -992,10 +1001,11 @@ def twin_verdict(summ, declared=None, exit_code=0):
     number = r"(\S+)"
     for name, value in rows:
         # The distance is recomputed from the twin and the variable's own line ('variable
-        # NAME: START -> END in [LO, HI]'), not taken from the summary's "off by".
+        # NAME: START -> END in [LO, HI] UNIT', the unit since session 39), not taken from the
+        # summary's "off by".
         m = re.match(r"^%s \(recovered %s, off by \S+ %% of the bounds\)$" % (number, number),
                      value)
-        v = re.match(r"^\S+ -> %s in \[%s, %s\]$" % (number, number, number),
+        v = re.match(r"^\S+ -> %s in \[%s, %s\](?: (?:mm|deg|rad))?$" % (number, number, number),
                      summ.get("variable " + name, ""))
         try:
             twin, got = (float(x) for x in m.groups()) if m else (None, None)

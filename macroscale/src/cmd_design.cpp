@@ -149,7 +149,8 @@ knit::cli::SubcommandRegistrar reg(
         }
         for (std::size_t k = 0; k < d.variables.size(); ++k)
           sum << "variable " << header[4 + k] << ": " << d.variables[k].initial << " -> " << r.x[k]
-              << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "]\n";
+              << " in [" << d.variables[k].lower << ", " << d.variables[k].upper << "] "
+              << d.variables[k].unit << "\n";
         // A twin experiment: its targets and how far the design ends from the twin, per
         // variable in % of its bound interval (docs/design.md, "Twin experiments").
         for (std::size_t k = 0; k < d.objectives.size() && !d.twin.empty(); ++k)

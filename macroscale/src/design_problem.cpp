@@ -91,6 +91,7 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
     }
   } else {
     const bool deg = f.contains("unit") && f.at("unit") == "deg";
+    v.unit = deg ? "deg" : "rad";
     const double lim = deg ? 180.0 : std::numbers::pi;
     if (v.lower < -lim || v.upper > lim)
       throw InputError(file, p + (v.lower < -lim ? "/lower" : "/upper"),

@@ -111,6 +111,9 @@ TEST_CASE("design file: a valid file loads", "[unit]") {
   REQUIRE(d.variables.size() == 2);
   CHECK(d.variables[0].indices == std::vector<int>{0, 1});
   CHECK(d.variables[0].initial == 5.0);
+  // The units summary.txt gives each variable (session 39): mm, and the angle field's deg.
+  CHECK(d.variables[0].unit == "mm");
+  CHECK(d.variables[1].unit == "deg");
   CHECK(d.expanded().size() == 3);
   REQUIRE(d.objectives.size() == 3);
   CHECK(d.objectives[0].kind == DesignObjective::Kind::kReaction);
@@ -782,7 +785,7 @@ TEST_CASE("design twin: knit-macro design writes the twin's targets and distance
   CHECK(summary.find("status: converged") != std::string::npos);
   CHECK(summary.find("twin target load: ") != std::string::npos);
   // The case's l is 5.0, the twin 5.5: the design moves there.
-  CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5]") != std::string::npos);
+  CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5] mm\n") != std::string::npos);
   CHECK(summary.find("twin l: 5.5 (recovered 5.5, off by ") != std::string::npos);
   // What the design reached, beside its target (session 39): the twin's load, in N.
   const auto number_after = [&](const std::string& key) {

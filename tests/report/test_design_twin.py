@@ -21,7 +21,7 @@ import report  # noqa: E402
 SUMMARY = """status: {status}
 J_initial: 122.66
 J_final: 2.97785e-23
-variable l: 5.5 -> {end} in [4.5, 6.5]
+variable l: 5.5 -> {end} in [4.5, 6.5] mm
 twin target load_at_20: 48.0437
 twin l: 6 (recovered {got}, off by 0 % of the bounds)
 final run: completed

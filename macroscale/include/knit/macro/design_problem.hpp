@@ -18,7 +18,8 @@ struct DesignVariableSpec {
   DesignVariable::Field field = DesignVariable::Field::kStitchValue;
   std::vector<int> indices;  ///< control values moved together (a symmetry tie)
   double lower = 0.0, upper = 0.0;
-  double initial = 0.0;  ///< the case's value at these indices
+  double initial = 0.0;     ///< the case's value at these indices
+  std::string unit = "mm";  ///< of its values and bounds: mm, or the angle field's deg / rad
 };
 
 struct DesignObjective {

@@ -1,0 +1,81 @@
+#!/usr/bin/python3
+"""scripts/law_uniaxial.py (session 39): the energy law along the cell's uniaxial-stress paths.
+
+A hand-made database of one loop length (5 mm) whose law is S = 2 (E11, E22, 2 E12) (a network
+with all parameters 0 and a floor of 2 MPa). A uniaxial wale path (axis 1) whose cell carries
+S22 = 0.4, 1.0 and 4.0 MPa at E22 = 0.1, 0.25, 0.5 with E11 = -0.05, -0.1, -0.2 and S11 = 0:
+the law's axial stress is 0.2, 0.5, 1.0 MPa, so the ratios are 0.5, 0.5, 0.25 and the lateral
+shares |2 E11| / S22 0.25, 0.2, 0.1; the first state (0.4 MPa, 10 % of the path's largest
+4.0) is kept at the default share and dropped at 0.2. A biaxial path and a held-out uniaxial
+course path with the same stresses must not count as the wale's. Also the sentence, a database
+without a law and the command line's refusal of a bad --min-share.
+Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+
+from checklist import Checklist  # tests/report/checklist.py, beside this file
+from fixtures import linear_network_law, raw_path, script_refuses  # tests/report/fixtures.py
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, "scripts", "law_uniaxial.py")
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import law_uniaxial as lu  # noqa: E402
+
+E = [[-0.05, 0.1, 0], [-0.1, 0.25, 0], [-0.2, 0.5, 0]]
+S = [[0, 0.4, 0], [0, 1.0, 0], [0, 4.0, 0]]
+
+
+def write_db(path, law=True):
+    with h5py.File(path, "w") as f:
+        f["loop_lengths"] = [5.0]
+        if law:
+            linear_network_law(f, 2.0)
+        g = raw_path(f, "path_0", "coverage", E, S)
+        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
+        raw_path(f, "path_1", "coverage", E, [[9, 9, 0]] * 3)  # biaxial-like: not counted
+        g = raw_path(f, "path_2", "holdout", [[0.3, 0, 0]], [[0.1, 0, 0]])
+        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 0
+
+
+def main():
+    c = Checklist()
+    with tempfile.TemporaryDirectory(prefix="law_uniaxial_test_") as tmp:
+        db = os.path.join(tmp, "db.h5")
+        write_db(db)
+        rows = lu.uniaxial_ratios(db)
+        wale = [r for r in rows if r["axis"] == "wale"]
+        r = wale[0] if wale else {}
+        c(r.get("n") == 3, "the three wale states (10 %% of the largest kept): %s" % rows)
+        c(abs(r.get("median", 0) - 0.5) < 1e-12, "median ratio 0.5 (got %s)" % r.get("median"))
+        c(abs(r.get("largest", 0) - 0.25) < 1e-12 and abs(r.get("at", 0) - 0.5) < 1e-12,
+          "farthest from 1: 0.25 at E22 = 0.5 (got %s at %s)" % (r.get("largest"), r.get("at")))
+        c(abs(r.get("lateral", 0) - 0.25) < 1e-12,
+          "largest lateral share |2 E11| / S22 = 0.25 (got %s)" % r.get("lateral"))
+        course = [r for r in rows if r["axis"] == "course"]
+        c(len(course) == 1 and abs(course[0]["median"] - 6.0) < 1e-12,
+          "the course path (held out, still the cell's uniaxial states): ratio 0.6 / 0.1 = 6: %s"
+          % course)
+        rows = lu.uniaxial_ratios(db, 0.2)
+        wale = [r for r in rows if r["axis"] == "wale"]
+        c(wale and wale[0]["n"] == 2 and abs(wale[0]["lateral"] - 0.2) < 1e-12,
+          "--min-share 0.2 drops the first state (0.4 of 4 MPa): %s" % rows)
+        text = lu.summary(lu.uniaxial_ratios(db))
+        c("5 mm wale: 0.50 (farthest from 1: 0.25 at E = 0.500; lateral 25 %)" in text,
+          "the sentence gives the wale row: %s" % text)
+        bare = os.path.join(tmp, "bare.h5")
+        write_db(bare, law=False)
+        c(lu.uniaxial_ratios(bare) == [], "no law: no rows")
+        out = subprocess.run([sys.executable, SCRIPT, db], capture_output=True, text=True)
+        c(out.returncode == 0 and "Uniaxial tension" in out.stdout, "the command line prints it")
+        script_refuses(c, SCRIPT, [db, "--min-share", "-1"], "--min-share", "a negative share")
+        script_refuses(c, SCRIPT, [bare], "no /energy_law", "a database without a law")
+    return c.exit_code()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
