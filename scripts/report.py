@@ -880,6 +880,7 @@ class Report:
         if failed:
             L.append("")
         L.extend(design_section(self.out))
+        L.extend(knitmap_section(self.out))
         L.append("## Figures\n")
         figs = sorted(glob.glob(os.path.join(self.out, "figures", "*.png")))
         if cells != "yes":
@@ -889,7 +890,7 @@ class Report:
         failed_figs = [os.path.basename(p)[:-4] for p in figs if figure_failed(p)]
         for p in figs:
             base = os.path.basename(p)
-            if base == SENSITIVITY_FIGURE or base.startswith("design_"):
+            if base == SENSITIVITY_FIGURE or base.startswith(("design_", "knitmap_")):
                 continue  # shown in its own section
             L.append(f"### {base[:-4]}\n")
             if figure_failed(p):  # session 38's red team: embedded as if drawn
@@ -1072,6 +1073,49 @@ def design_section(out):
                  f"{fmt((st or {}).get('seconds', float('nan')), 1)} | "
                  f"{md(twin_cell(summ, twins.get(n), None if st is None else exit_code))} |")
         fig = f"design_{n}.png"
+        if os.path.exists(os.path.join(out, "figures", fig)):
+            figs.append(fig)
+    L.append("")
+    for fig in figs:
+        L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
+    return L
+
+
+def knitmap_section(out):
+    """The knitting maps (docs/design.md, "The knitting map"; session 39: drawn by the main job,
+    before only by `make ... knitmaps`): per planar paper case, the totals of its summary.txt
+    ($(OUT)/knitmap/NAME/) and its figure; warnings named."""
+    L = ["## Knitting maps (knit-macro knitmap)\n"]
+    names = sorted(os.path.basename(os.path.dirname(p))
+                   for p in glob.glob(os.path.join(out, "knitmap", "*", "summary.txt")))
+    if not names:
+        L.append("No knitting map was made (`make -f scripts/pipeline.mk knitmaps`).\n")
+        return L
+    L.append("Course by course and needle by needle, the loop length of each stitch of the "
+             "planar paper cases (`knit-macro knitmap` with the pipeline's database; "
+             "knitmap.csv and courses.csv in knitmap/NAME/).\n")
+    L.append("| case | stitches | needles | courses | yarn [m] | l [mm] | warnings |")
+    L.append("|---|---|---|---|---|---|---|")
+    figs = []
+    for n in names:
+        summ = read_design_summary(os.path.join(out, "knitmap", n, "summary.txt"))
+        try:
+            yarn = f"{float(summ.get('yarn_length_mm', 'nan')) / 1000:.2f}"
+            lo, hi = (float(summ.get(k, "nan")) for k in ("loop_length_min_mm",
+                                                           "loop_length_max_mm"))
+            lrange = f"{lo:.2f}-{hi:.2f}"
+        except ValueError:
+            yarn, lrange = "?", "?"
+        try:  # every warning line (read_design_summary keeps the first of a key)
+            with open(os.path.join(out, "knitmap", n, "summary.txt")) as f:
+                warnings = [line[len("warning:"):].strip() for line in f
+                            if line.startswith("warning:")]
+        except OSError:
+            warnings = []
+        L.append(f"| {n} | {summ.get('stitches', '?')} | {summ.get('needles', '?')} | "
+                 f"{summ.get('courses', '?')} | {yarn} | {lrange} | "
+                 f"{md('; '.join(warnings)) if warnings else '-'} |")
+        fig = f"knitmap_{n}.png"
         if os.path.exists(os.path.join(out, "figures", fig)):
             figs.append(fig)
     L.append("")

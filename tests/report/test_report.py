@@ -1036,6 +1036,19 @@ def main():
             failures.append("reaches: compression to -14.1 % not recognised")
         if abs(rc.stretch_bound(0.3) - 0.345) > 1e-12 or abs(rc.stretch_bound(0.2) - 0.22) > 1e-12:
             failures.append("kinematic bound")
+        # The knitting maps' section (session 39): totals and every warning of each summary.
+        km = os.path.join(tmp, "km_out")
+        text = "\n".join(report.knitmap_section(km))
+        if "No knitting map was made" not in text:
+            failures.append("knitmap section without maps: " + text[:200])
+        os.makedirs(os.path.join(km, "knitmap", "patch"))
+        with open(os.path.join(km, "knitmap", "patch", "summary.txt"), "w") as f:
+            f.write("# provenance: {}\nstitches: 1547\nyarn_length_mm: 8306.5\nneedles: 40\n"
+                    "courses: 41\nloop_length_min_mm: 4.5177\nloop_length_max_mm: 6.4432\n"
+                    "warning: first one\nwarning: second one\n")
+        text = "\n".join(report.knitmap_section(km))
+        if "| patch | 1547 | 40 | 41 | 8.31 | 4.52-6.44 | first one; second one |" not in text:
+            failures.append("knitmap section row: " + text[-300:])
         # The database's build time: the paper's ~30 min only beside loop lengths read.
         line = report.database_time_line(None, [])
         if "30 min" in line or "missing or unreadable" not in line:
