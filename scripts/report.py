@@ -1055,7 +1055,6 @@ def design_section(out):
     L.append("| example | status | J before | J after | iterations | evaluations | wall [s] | "
              "twin recovered |")
     L.append("|---|---|---|---|---|---|---|---|")
-    figs = []
     for n in names:
         try:
             with open(os.path.join(out, "design", n + ".status")) as f:
@@ -1072,12 +1071,16 @@ def design_section(out):
                  f"{summ.get('evaluations', '-')} | "
                  f"{fmt((st or {}).get('seconds', float('nan')), 1)} | "
                  f"{md(twin_cell(summ, twins.get(n), None if st is None else exit_code))} |")
-        fig = f"design_{n}.png"
+    return L + section_figures(out, [f"design_{n}.png" for n in names])
+
+
+def section_figures(out, names):
+    """A section's figures that exist in OUT/figures, each under its own heading, after an
+    empty line that ends the section's table."""
+    L = [""]
+    for fig in names:
         if os.path.exists(os.path.join(out, "figures", fig)):
-            figs.append(fig)
-    L.append("")
-    for fig in figs:
-        L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
+            L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
     return L
 
 
@@ -1096,7 +1099,6 @@ def knitmap_section(out):
              "knitmap.csv and courses.csv in knitmap/NAME/).\n")
     L.append("| case | stitches | needles | courses | yarn [m] | l [mm] | warnings |")
     L.append("|---|---|---|---|---|---|---|")
-    figs = []
     for n in names:
         summ = read_design_summary(os.path.join(out, "knitmap", n, "summary.txt"))
         try:
@@ -1115,13 +1117,7 @@ def knitmap_section(out):
         L.append(f"| {n} | {summ.get('stitches', '?')} | {summ.get('needles', '?')} | "
                  f"{summ.get('courses', '?')} | {yarn} | {lrange} | "
                  f"{md('; '.join(warnings)) if warnings else '-'} |")
-        fig = f"knitmap_{n}.png"
-        if os.path.exists(os.path.join(out, "figures", fig)):
-            figs.append(fig)
-    L.append("")
-    for fig in figs:
-        L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
-    return L
+    return L + section_figures(out, [f"knitmap_{n}.png" for n in names])
 
 
 def twin_cell(summ, declared=None, exit_code=0):
