@@ -150,7 +150,9 @@ def main():
             g = f["fields"][last]
             nu, nv = int(g.attrs["grid_u"]), int(g.attrs["grid_v"])
             E = np.array(g[a.section]).reshape(nv, nu)  # u fastest
-            section = (np.linspace(0, 1, nu), E[nv // 2])
+            # The step drawn is the run's last output step: its load factor goes in the title
+            # (session 39's walkthrough: a design at 10 % strain was drawn at 30 % unsaid).
+            section = (np.linspace(0, 1, nu), E[nv // 2], float(g.attrs.get("load_factor", np.nan)))
     npan = 1 + len(fields) + (curve is not None) + (section is not None)
     fig, axes = plt.subplots(1, npan, figsize=(4.2 * npan, 3.8), squeeze=False)
     ax = axes[0][0]
@@ -229,7 +231,7 @@ def main():
         k += 1
     if section is not None:
         ax = axes[0][k]
-        u, E = section
+        u, E, load_factor = section
         ax.plot(u, E, "-", label="final run")
         if any(o.get("type") == "strain_variance" and o.get("component") == a.section
                for o in objectives or []):  # the objective's ideal: a uniform strain
@@ -238,7 +240,8 @@ def main():
             ax.legend(fontsize=7)
         ax.set_xlabel("theta1 (u) at v = 0.5")
         ax.set_ylabel(a.section + " [-]")
-        ax.set_title(f"final run: {a.section} along the section\n(std {np.std(E):.2g})", fontsize=10)
+        ax.set_title(f"final run: {a.section} along the section at load factor {load_factor:.3g}\n"
+                     f"(the run's last output step; std {np.std(E):.2g})", fontsize=9)
         ax.grid(True, alpha=0.3)
     if a.title:
         fig.suptitle(a.title)
