@@ -465,8 +465,15 @@ ResponseEvaluation ResponseSurface::evaluate(const Eigen::Vector3d& E) const {
 
   const Eigen::Vector2d Et = E.head<2>();
   const double rE2 = Et.squaredNorm();
-  if (rE2 == 0.0) {
+  // The unloaded state, up to round-off: the initial tangent C0, inside the data. Its direction
+  // is noise there (session 39's walkthrough: a paper-law run's extrapolation report listed
+  // (E11, E22) = (-3.6e-16, 2.7e-16) as "biaxial compression (linear initial law)", and the
+  // tangent of such a state switched between C0 and the compression law's Kc by the sign of
+  // the round-off).
+  constexpr double kOriginRadius = 1e-12;
+  if (rE2 <= kOriginRadius * kOriginRadius) {
     out.C.topLeftCorner<2, 2>() = C0_.topLeftCorner<2, 2>();
+    out.S.head<2>() = C0_.topLeftCorner<2, 2>() * Et;
     return out;
   }
   // The angle psi of (E11, E22) unwrapped around the fan's range, its distance beta beyond the

@@ -63,6 +63,20 @@ TEST_CASE("response surface: origin is stress free with a finite initial stiffne
   CHECK(ev2.S.norm() < 1e-8);
   CHECK((ev2.C - ev.C).norm() < 0.1);
   CHECK(rs.evaluate({0, 0, -0.2}).S(2) == Approx(-rs.evaluate({0, 0, 0.2}).S(2)));
+  // Round-off around the origin in any direction, biaxial compression's included, is the
+  // unloaded state: C0, inside the data, S = C0 E (session 39: (-3.6e-16, 2.7e-16) was flagged
+  // "biaxial compression" and took the compression law's tangent).
+  for (const Eigen::Vector3d& e :
+       {Eigen::Vector3d(-3.6e-16, 2.7e-16, 0.0), Eigen::Vector3d(-1e-13, -1e-13, 0.0),
+        Eigen::Vector3d(4e-13, -5e-13, 0.0)}) {
+    const auto r = rs.evaluate(e);
+    INFO("E = " << e.transpose());
+    CHECK(r.flags == kInside);
+    CHECK((r.C - ev.C).norm() == 0.0);
+    CHECK((r.S.head<2>() - ev.C.topLeftCorner<2, 2>() * e.head<2>()).norm() == 0.0);
+  }
+  // ... and a strain of 1e-9 in biaxial compression is the compression law's again.
+  CHECK((rs.evaluate({-1e-9, -1e-9, 0.0}).flags & kCompression) != 0);
 }
 
 TEST_CASE("response surface: bad data are refused with a reason", "[unit]") {
