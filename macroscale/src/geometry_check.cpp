@@ -163,4 +163,39 @@ std::optional<AreaQuadratureDefect> area_quadrature_defect(const spline::SplineS
   return std::nullopt;
 }
 
+std::string symmetry_plane_problem(const spline::SplineSurface& surface,
+                                   const std::vector<int>& row0, const std::vector<int>& row1,
+                                   int component) {
+  const Eigen::MatrixXd& P = surface.control_points();
+  const char* axis = component == 0 ? "x" : component == 1 ? "y" : "z";
+  std::ostringstream m;
+  m.precision(6);
+  double lo = P(row0.front(), component), hi = lo;
+  for (int a : row0) {
+    lo = std::min(lo, P(a, component));
+    hi = std::max(hi, P(a, component));
+  }
+  if (hi - lo > kSymmetryTolerance * patch_size(surface)) {
+    m << "the edge does not lie in a plane of normal " << axis << ": its control points' " << axis
+      << " run from " << lo << " to " << hi << " mm (a symmetry plane of normal " << axis
+      << " needs " << axis << " constant along the edge; check the edge and the plane's normal)";
+    return m.str();
+  }
+  for (std::size_t k = 0; k < row0.size() && k < row1.size(); ++k) {
+    const Eigen::Vector3d d = (P.row(row1[k]) - P.row(row0[k])).transpose();
+    Eigen::Vector3d along = d;
+    along(component) = 0.0;
+    if (along.norm() > kSymmetryTolerance * d.norm()) {
+      m << "the surface does not cross the plane of normal " << axis
+        << " at a right angle along the edge: at its control point " << k + 1 << " of "
+        << row0.size() << " the next row is offset by (" << d(0) << ", " << d(1) << ", " << d(2)
+        << ") mm, not along " << axis
+        << " (a symmetry plane needs the surface to leave it along its normal; check the edge "
+           "and the plane's normal)";
+      return m.str();
+    }
+  }
+  return "";
+}
+
 }  // namespace knit::macro

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "knit/core/errors.hpp"
+#include "knit/macro/geometry_check.hpp"
 #include "knit/macro/load_drop.hpp"
 #include "results_writer.hpp"
 
@@ -49,6 +50,9 @@ Problem setup_problem(const Case& c) {
           for (int i = 0; i < 3; ++i) con.tie(3 * row1[k] + i, 3 * row0[k] + i);
       if (bc.symmetry >=
           0) {  // u_s = 0 on the edge, the cross-edge slope stays normal to the plane
+        if (const std::string why = symmetry_plane_problem(c.surface, row0, row1, bc.symmetry);
+            !why.empty())
+          throw InputError(c.file, bc.pointer + "/symmetry", why);
         for (size_t k = 0; k < row0.size(); ++k)
           for (int i = 0; i < 3; ++i) {
             if (i == bc.symmetry)

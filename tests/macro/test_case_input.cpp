@@ -1260,3 +1260,25 @@ TEST_CASE("a knit case whose thickness is not the database's cell thickness is r
   j["material"]["database"] = bare;
   CHECK(error_of(j).empty());
 }
+
+TEST_CASE(
+    "a symmetry condition on an edge that is not in its plane, or not crossed at a right "
+    "angle, is refused",
+    "[unit]") {
+  // Session 39's walkthrough: the planes y and z swapped on a quarter cylinder ran with exit 0
+  // (radius 19.19-20.03 mm where the symmetric answer is 18.58 everywhere). The quarter
+  // Scordelis-Lo roof: u1 lies in the plane x = 25, v0 is the crown, crossed by the plane y = 0.
+  const json base = verification_case("scordelis_lo_quarter.json");
+  CHECK(error_of(base).empty());
+  json j = base;
+  j["boundary_conditions"][1]["symmetry"] = "y";  // u1 is the plane x = 25, not y = const
+  CHECK_THAT(error_of(j),
+             Catch::StartsWith("bad.json: /boundary_conditions/1/symmetry: the edge does not lie "
+                               "in a plane of normal y: its control points' y run from "));
+  j = base;
+  j["boundary_conditions"][2]["symmetry"] = "z";  // the crown's z is constant, but the roof
+                                                  // leaves it along y, not z
+  CHECK_THAT(error_of(j), Catch::StartsWith("bad.json: /boundary_conditions/2/symmetry: the "
+                                            "surface does not cross the plane of normal z at a "
+                                            "right angle along the edge"));
+}

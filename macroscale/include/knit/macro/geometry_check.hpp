@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "knit/spline/surface.hpp"
 
@@ -64,5 +65,18 @@ struct AreaQuadratureDefect {
 /// The first element whose area the shell's quadrature misses by more than
 /// kMaxAreaQuadratureError, or nothing.
 std::optional<AreaQuadratureDefect> area_quadrature_defect(const spline::SplineSurface& surface);
+
+/// Why an edge cannot carry a symmetry condition of plane normal `component` (0, 1, 2 = x, y,
+/// z), or "": the edge row's control points `row0` must lie in one plane x_component = const
+/// (within kSymmetryTolerance of the patch's size), and the surface must cross it at a right
+/// angle, the second row `row1` offset from the edge row along the normal only (within
+/// kSymmetryTolerance of that offset). The condition holds u_component = 0 on the edge and ties
+/// the other components of the second row to the edge row, which keeps a symmetric state only
+/// under both (session 39's walkthrough: planes y and z swapped on a quarter cylinder ran with
+/// exit 0, the radius varying 19.19-20.03 mm where it is 18.58 everywhere).
+inline constexpr double kSymmetryTolerance = 1e-6;
+std::string symmetry_plane_problem(const spline::SplineSurface& surface,
+                                   const std::vector<int>& row0, const std::vector<int>& row1,
+                                   int component);
 
 }  // namespace knit::macro
