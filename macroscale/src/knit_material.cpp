@@ -307,7 +307,10 @@ std::string KnitMaterial::report() const {
     os << "\n  at converged states: " << k << " of " << n << " evaluations extrapolated ("
        << std::setprecision(4) << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)";
   }
-  os << "\n  first locations (theta1, theta2; material strains E_course, E_wale, 2E_cw):";
+  // Every evaluation, Newton's trial iterates too (session 39's walkthrough read them as
+  // converged states).
+  os << "\n  first locations (Newton's trial iterates too; theta1, theta2; material strains "
+        "E_course, E_wale, 2E_cw):";
   for (const auto& w : s.first)
     os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();
   return os.str();

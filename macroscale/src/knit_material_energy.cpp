@@ -182,7 +182,10 @@ std::string KnitMaterial::energy_report() const {
      << s.visited_max(1) << "], 2E12 [" << s.visited_min(2) << ", " << s.visited_max(2) << "]";
   const Stats st = stats();
   if (!st.first.empty()) {
-    os << "\n  first locations outside the box (theta1, theta2; E_course, E_wale, 2E_cw):";
+    // Every evaluation, Newton's trial iterates too (session 39's walkthrough read an iterate's
+    // E = 111 as a state the fabric reached).
+    os << "\n  first locations outside the box (Newton's trial iterates too; theta1, theta2; "
+          "E_course, E_wale, 2E_cw):";
     for (const auto& w : st.first)
       os << "\n    (" << w.theta(0) << ", " << w.theta(1) << "): " << w.E_material.transpose();
   }

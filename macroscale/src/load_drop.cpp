@@ -30,7 +30,7 @@ std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>&
       const double f0 = rows[k].reactions[r], f1 = rows[k + 1].reactions[r];
       const double drop = sign * (f0 - f1);
       if (!(drop > tolerance * max_load) || !(drop > c.solver.absolute_tolerance)) continue;
-      ++d.count;
+      if (++d.count == 1) d.first_from_step = rows[k].step, d.first_to_step = rows[k + 1].step;
       if (drop > d.largest) {
         d.largest = drop;
         d.from_step = rows[k].step, d.to_step = rows[k + 1].step;
@@ -52,7 +52,11 @@ std::string load_drop_message(const LoadDrop& d, double tolerance) {
   m << "; " << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load
     << " N) between step " << d.from_step << " (strain " << d.from_strain << ") and step "
     << d.to_step << " (strain " << d.to_strain << ") while the applied displacement grows";
-  if (d.count > 1) m << "; " << d.count << " drops in all";
+  // Which drop is named (session 39's walkthrough had to read the header to learn it is the
+  // largest), and where the first one was.
+  if (d.count > 1)
+    m << "; the largest of " << d.count << " drops in all, the first between step "
+      << d.first_from_step << " and step " << d.first_to_step;
   m << " (threshold " << tolerance
     << " x the largest load). A tensile test's load does not fall: a snap of the material "
        "law or a lost stability (summary.txt's stability line tells the second)";

@@ -316,7 +316,8 @@ void ResultsWriter::finish(const RunReport& report) {
   sum << "status: " << (report.status == RunStatus::kCompleted ? "completed" : "stopped") << "\n";
   if (!material_failure_.empty()) sum << "material failures: " << material_failure_ << "\n";
   if (!material_warning_.empty()) sum << material_warning_ << "\n";
-  for (const std::string& d : load_drops_) sum << d << "\n";
+  // "warning: " as on stderr (session 39's walkthrough: a grep for warnings missed them here).
+  for (const std::string& d : load_drops_) sum << "warning: " << d << "\n";
   if (!solver_warning_.empty()) sum << "solver: " << solver_warning_ << "\n";
   if (!nonfinite_output_.empty()) sum << "output failure: " << output_failure() << "\n";
   if (case_.output.vtk && pvd_.size() == 0)

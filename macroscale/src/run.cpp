@@ -151,7 +151,8 @@ std::string run_failure_message(const RunResult& r) {
   // What to change when Newton gave up (session 39's walkthrough: the paper's law stopped a
   // run at 1.6 % strain with "no convergence in 25 iterations" and no hint).
   if (r.report.reason == StopReason::kCutbacks || r.report.reason == StopReason::kIncrementFloor)
-    add("to get further: more load steps (/solver/steps) or cut-backs (/solver/max_cutbacks); "
+    add("to get further: more Newton iterations per step (/solver/max_iterations), more load "
+        "steps (/solver/steps) or cut-backs (/solver/max_cutbacks); "
         "a material law evaluated far outside its data also stops Newton (summary.txt's "
         "\"material report\" counts the extrapolated evaluations: the paper's law extrapolates "
         "beyond its 13 load paths, the default energy law holds over the whole strain box)");

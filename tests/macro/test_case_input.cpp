@@ -538,8 +538,9 @@ TEST_CASE("knit-macro run: a failing step stops the run and keeps the converged 
   CHECK(log.find("failed after 1 cut-backs") != std::string::npos);
   CHECK(log.find("6 converged steps kept, last lambda = 0.6") != std::string::npos);
   // And what to change (session 39).
-  CHECK(log.find("6 converged steps kept, last lambda = 0.6; to get further: more load steps "
-                 "(/solver/steps) or cut-backs (/solver/max_cutbacks)") != std::string::npos);
+  CHECK(log.find("6 converged steps kept, last lambda = 0.6; to get further: more Newton "
+                 "iterations per step (/solver/max_iterations), more load steps (/solver/steps) "
+                 "or cut-backs (/solver/max_cutbacks)") != std::string::npos);
   REQUIRE(fs::exists(d / "out" / "load_strain.csv"));
   const std::string csv = slurp(d / "out" / "load_strain.csv");
   CHECK(csv.find("# run stopped early") != std::string::npos);

@@ -60,7 +60,8 @@ TEST_CASE("load drop: a monotone tensile curve has none, a snap is found with it
   const std::string m = knit::macro::load_drop_message(d[0]);
   CHECK(m.find("'jaw' falls from 17.1 to 5.7 N") != std::string::npos);
   CHECK(m.find("between step 3") != std::string::npos);
-  CHECK(m.find("2 drops in all") != std::string::npos);
+  CHECK(m.find("; the largest of 2 drops in all, the first between step 3 and step 4") !=
+        std::string::npos);
 }
 
 TEST_CASE("load drop: the magnitude along the pull counts, lateral reactions do not") {
@@ -84,6 +85,11 @@ TEST_CASE("load drop: the magnitude along the pull counts, lateral reactions do 
     const std::string m = knit::macro::load_drop_message(d[0]);
     CHECK(m.find("falls from -0.508 to 0.148 N (by 0.656 N along its largest load, -0.53 N; ") !=
           std::string::npos);
+    // The largest is named as such, and the first drop (-0.530 -> -0.508) is located too.
+    CHECK(d[0].first_from_step == d[0].from_step - 1);
+    CHECK(m.find("the largest of 2 drops in all, the first between step " +
+                 std::to_string(d[0].from_step - 1) + " and step " +
+                 std::to_string(d[0].from_step)) != std::string::npos);
     // A positive load through zero: 2 -> -1 is a drop of 3 although |F| falls by 1 only.
     const auto e = find_load_drops(c, rows_of({1, 2, -1, 3}, {0, 0, 0, 0}));
     REQUIRE(e.size() == 1);

@@ -24,14 +24,15 @@ inline constexpr double kLoadDropTolerance = 1e-6;
 
 /// The drops of one reaction: how many, and the largest (the steps on either side of it).
 struct LoadDrop {
-  std::string reaction;    ///< the name in output.reactions
-  int count = 0;           ///< consecutive-step decrements above the threshold
-  double largest = 0.0;    ///< s (F_from - F_to) of the largest (N)
-  double max_load = 0.0;   ///< max_j |F_j| over the run (N)
-  double direction = 0.0;  ///< s: the sign of the load of largest magnitude
-  int from_step = 0, to_step = 0;
-  double from_load = 0.0, to_load = 0.0;      ///< F at those steps (N)
-  double from_strain = 0.0, to_strain = 0.0;  ///< the applied strain at those steps
+  std::string reaction;                        ///< the name in output.reactions
+  int count = 0;                               ///< consecutive-step decrements above the threshold
+  double largest = 0.0;                        ///< s (F_from - F_to) of the largest (N)
+  double max_load = 0.0;                       ///< max_j |F_j| over the run (N)
+  double direction = 0.0;                      ///< s: the sign of the load of largest magnitude
+  int from_step = 0, to_step = 0;              ///< of the largest drop
+  int first_from_step = 0, first_to_step = 0;  ///< of the first drop (count > 1)
+  double from_load = 0.0, to_load = 0.0;       ///< F at those steps (N)
+  double from_strain = 0.0, to_strain = 0.0;   ///< the applied strain at those steps
 };
 
 /// The load drops of a run's rows: only for a case with output.applied_displacement, and only
