@@ -319,6 +319,7 @@ void ResultsWriter::finish(const RunReport& report) {
   // "warning: " as on stderr (session 39's walkthrough: a grep for warnings missed them here).
   for (const std::string& d : load_drops_) sum << "warning: " << d << "\n";
   if (!solver_warning_.empty()) sum << "solver: " << solver_warning_ << "\n";
+  for (const std::string& w : input_warnings_) sum << "warning: " << w << "\n";
   if (!nonfinite_output_.empty()) sum << "output failure: " << output_failure() << "\n";
   if (case_.output.vtk && pvd_.size() == 0)
     sum << "vtk: none (no step converged, so no results.pvd)\n";

@@ -40,6 +40,8 @@ class ResultsWriter {
   void set_load_drops(std::vector<std::string> d) { load_drops_ = std::move(d); }
   /// RunResult::solver_warning: a summary.txt line and the HDF5 attribute "solver_warning".
   void set_solver_warning(std::string w) { solver_warning_ = std::move(w); }
+  /// RunResult::input_warnings: "warning: " lines of summary.txt.
+  void set_input_warnings(std::vector<std::string> w) { input_warnings_ = std::move(w); }
   /// Empty, or where the sampled output fields first held a non-finite number (the first
   /// field, step and point, and how many values in all): the quadrature points, which Newton
   /// checks, may never reach a strain where the material's stress overflows, the output grid
@@ -70,6 +72,7 @@ class ResultsWriter {
   std::string material_warning_;
   std::vector<std::string> load_drops_;
   std::string solver_warning_;
+  std::vector<std::string> input_warnings_;
   std::string nonfinite_output_;
   long nonfinite_values_ = 0;
 };

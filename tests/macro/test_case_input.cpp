@@ -1283,3 +1283,21 @@ TEST_CASE(
                                             "surface does not cross the plane of normal z at a "
                                             "right angle along the edge"));
 }
+
+TEST_CASE("a load on held degrees of freedom only is named as a warning", "[unit]") {
+  // Session 39's walkthrough: an edge load on the fixed jaw ran with exit 0; the supports took
+  // it, and the held edge's reaction then "dropped", which the load-drop warning blamed on the
+  // material law. The tensile case holds v0 in x, y, z and v1 in x, z (y prescribed).
+  json j = verification_case("tensile_svk.json");
+  j["loads"] = json::parse(R"([{"type": "edge", "edge": "v0", "force_per_length": [1, 0, 0]},
+                               {"type": "edge", "edge": "v1", "force_per_length": [0, 0, 1]},
+                               {"type": "edge", "edge": "u0", "force_per_length": [1, 0, 0]}])");
+  const Problem p = setup_problem(parse_case(j.dump(), "held.json"));
+  REQUIRE(p.warnings.size() == 2);  // v0 in x and v1 in z: held; u0 (a free edge) is not
+  CHECK_THAT(p.warnings[0], Catch::StartsWith("/loads/0: the load acts on held degrees of "
+                                              "freedom only"));
+  CHECK_THAT(p.warnings[1], Catch::StartsWith("/loads/1: "));
+  // The free edge's load reaches the patch: no warning for it, nor for the case without loads.
+  CHECK(setup_problem(parse_case(verification_case("tensile_svk.json").dump(), "ok.json"))
+            .warnings.empty());
+}

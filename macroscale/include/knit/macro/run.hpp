@@ -34,6 +34,9 @@ struct Problem {
   std::unique_ptr<ShellModel> model;
   DofMap dofs;
   Eigen::VectorXd fext;  ///< dead loads at load factor 1
+  /// Input that runs but is very likely not what was meant, each "POINTER: what" (a load on
+  /// held degrees of freedom only); run_case reports them as warnings.
+  std::vector<std::string> warnings;
 };
 
 /// Builds the model, constraints and loads. Throws knit::InputError for a degenerate geometry
@@ -98,6 +101,8 @@ struct RunResult {
   /// load_drop_message() of each reaction whose load falls between converged steps
   /// (load_drop.hpp): warnings, not failures (a buckling test may drop on purpose).
   std::vector<std::string> load_drops;
+  /// Problem::warnings of the case (input that runs but is likely not what was meant).
+  std::vector<std::string> input_warnings;
   /// solver_fallback_message() of the run: the supernodal Cholesky failed where it was wanted
   /// and Eigen's SimplicialLDLT factorized instead (slower); "" if not. A warning.
   std::string solver_warning;
