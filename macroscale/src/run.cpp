@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <ostream>
+#include <sstream>
 
 #include "knit/core/errors.hpp"
 #include "knit/macro/geometry_check.hpp"
@@ -25,7 +26,45 @@ Problem setup_problem(const Case& c) {
   const ShellModel& m = *p.model;
   const int nu = c.surface.size_u(), nv = c.surface.size_v();
   Constraints con(m.num_dofs());
-  for (const BoundaryCondition& bc : c.bcs) {
+  // Which entry held each DOF, and how: a conflict names both entries and the control point's
+  // place (session 39's walkthrough: "DOF 168 (control point 56, component x) is prescribed
+  // twice" named neither the other entry nor a point the user can see).
+  struct Holder {
+    int bc = -1;
+    double value = 0.0;
+    const char* how = "";
+  };
+  std::vector<Holder> holder(static_cast<std::size_t>(m.num_dofs()));
+  const auto where = [&](int dof) {
+    std::ostringstream s;
+    s.precision(6);
+    const auto X = c.surface.control_points().row(dof / 3);
+    s << "component "
+      << "xyz"[dof % 3] << " of control point " << dof / 3 << " of the analysis "
+      << "net, at (" << X(0) << ", " << X(1) << ", " << X(2) << ") mm";
+    return s.str();
+  };
+  for (std::size_t bi = 0; bi < c.bcs.size(); ++bi) {
+    const BoundaryCondition& bc = c.bcs[bi];
+    const auto hold = [&](int dof, double value, const char* how) {
+      const Holder& h = holder[static_cast<std::size_t>(dof)];
+      if (h.bc >= 0 && std::abs(h.value - value) > 1e-14 * (1.0 + std::abs(value))) {
+        const auto what = [](const char* verb, double v) {
+          std::ostringstream w;
+          w << verb;
+          if (std::string(verb).find("symmetry") == std::string::npos) w << " (" << v << " mm)";
+          return w.str();
+        };
+        std::ostringstream s;
+        s << where(dof) << ", is " << what(how, value) << " here and " << what(h.how, h.value)
+          << (h.bc == static_cast<int>(bi) ? std::string(" by the same entry")
+                                           : " by " + c.bcs[static_cast<std::size_t>(h.bc)].pointer)
+          << ": a displacement takes one value; change one of the two";
+        throw InputError(c.file, bc.pointer, s.str());
+      }
+      con.prescribe(dof, value);
+      holder[static_cast<std::size_t>(dof)] = {static_cast<int>(bi), value, how};
+    };
     try {
       std::vector<int> row0, row1;
       switch (bc.target) {
@@ -42,8 +81,8 @@ Problem setup_problem(const Case& c) {
       }
       for (int a : row0)
         for (int i = 0; i < 3; ++i) {
-          if (bc.fix[i]) con.fix(3 * a + i);
-          if (bc.prescribe[i]) con.prescribe(3 * a + i, *bc.prescribe[i]);
+          if (bc.fix[i]) hold(3 * a + i, 0.0, "fixed");
+          if (bc.prescribe[i]) hold(3 * a + i, *bc.prescribe[i], "prescribed");
         }
       if (bc.clamp)  // zero rotation: the second row moves with the edge row
         for (size_t k = 0; k < row0.size(); ++k)
@@ -56,7 +95,7 @@ Problem setup_problem(const Case& c) {
         for (size_t k = 0; k < row0.size(); ++k)
           for (int i = 0; i < 3; ++i) {
             if (i == bc.symmetry)
-              con.fix(3 * row0[k] + i);
+              hold(3 * row0[k] + i, 0.0, "held at 0 by the symmetry plane");
             else
               con.tie(3 * row1[k] + i, 3 * row0[k] + i);
           }
@@ -68,7 +107,13 @@ Problem setup_problem(const Case& c) {
   try {
     p.dofs = DofMap(con);
   } catch (const ConstraintConflict& e) {
-    throw InputError(c.file, "/boundary_conditions", e.what());
+    const Holder& h = holder[static_cast<std::size_t>(e.dof())];
+    throw InputError(c.file, "/boundary_conditions",
+                     std::string(e.what()) + " (" + where(e.dof()) +
+                         (h.bc >= 0 ? ", " + std::string(h.how) + " by " +
+                                          c.bcs[static_cast<std::size_t>(h.bc)].pointer
+                                    : std::string()) +
+                         "; a clamp or symmetry condition ties it to the edge row)");
   }
   if (const auto mode = p.dofs.unconstrained_rigid_mode(c.surface.control_points()))
     throw InputError(c.file, "/boundary_conditions",

@@ -1301,3 +1301,24 @@ TEST_CASE("a load on held degrees of freedom only is named as a warning", "[unit
   CHECK(setup_problem(parse_case(verification_case("tensile_svk.json").dump(), "ok.json"))
             .warnings.empty());
 }
+
+TEST_CASE("contradictory boundary conditions name both entries and the control point's place",
+          "[unit]") {
+  // Session 39's walkthrough: "DOF 168 (control point 56, component x) is prescribed twice with
+  // different values" named neither the other entry nor a point the user can see. The tensile
+  // case: v1 (y = 50) prescribes y = 15; a corner entry fixing y at u1v1 contradicts it.
+  json j = verification_case("tensile_svk.json");
+  j["boundary_conditions"].push_back(json::parse(R"({"corner": "u1v1", "fix": ["y"]})"));
+  const std::string e = error_of(j);
+  CHECK_THAT(e, Catch::StartsWith("bad.json: /boundary_conditions/2: component y of control "
+                                  "point "));
+  CHECK_THAT(e, Catch::Contains(", 50, 0) mm, is fixed (0 mm) here and prescribed (15 mm) by "
+                                "/boundary_conditions/1: a displacement takes one value; change "
+                                "one of the two"));
+  // Within one entry: a symmetry plane's zero against the entry's own prescribed value.
+  j = verification_case("tensile_svk.json");
+  j["boundary_conditions"][1] =
+      json::parse(R"({"edge": "v1", "prescribe": {"y": 15.0}, "symmetry": "y"})");
+  CHECK_THAT(error_of(j), Catch::Contains("is held at 0 by the symmetry plane here and prescribed "
+                                          "(15 mm) by the same entry"));
+}
