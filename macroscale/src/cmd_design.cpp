@@ -60,7 +60,7 @@ knit::cli::SubcommandRegistrar reg(
                     << " control values";
           for (int i : v.indices) std::cout << " " << i;
           std::cout << ", initial " << v.initial << ", bounds [" << v.lower << ", " << v.upper
-                    << "]\n";
+                    << "] " << v.unit << "\n";
         }
         for (const auto& ob : d.objectives)
           std::cout << "objective " << ob.name << ": weight " << ob.weight << ", "

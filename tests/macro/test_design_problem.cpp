@@ -126,6 +126,10 @@ TEST_CASE("design file: a valid file loads", "[unit]") {
   CHECK(d.objectives[2].point == 0);
   CHECK(d.smoothness == 0.01);
   CHECK(run_design(kDir / "ok.json") == 0);
+  // --check prints each variable's bounds with their unit (session 39: the angle's had none).
+  const std::string log = knit_test::read_text(kDir / "cmd.log");
+  CHECK(log.find("initial 5, bounds [4.5, 6.5] mm\n") != std::string::npos);
+  CHECK(log.find(", bounds [-45, 45] deg\n") != std::string::npos);
 }
 
 // Session 24: the output target was checked only when the results were written, after the
