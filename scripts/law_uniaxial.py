@@ -52,8 +52,12 @@ def uniaxial_ratios(db_path, min_share=MIN_SHARE):
                 S = np.vstack([p[2] for p in paths]) if paths else np.zeros((0, 3))
                 if not len(e):
                     continue
-                top = max(float(p[2][:, axis].max(initial=0.0)) for p in paths)
-                keep = S[:, axis] >= min_share * top if top > 0 else np.zeros(len(S), bool)
+                # Each path's own largest axial stress sets its cut (the session's review: the
+                # largest over all the axis' paths was taken).
+                keep = np.concatenate([
+                    p[2][:, axis] >= min_share * p[2][:, axis].max(initial=0.0)
+                    if p[2][:, axis].max(initial=0.0) > 0 else np.zeros(len(p[2]), bool)
+                    for p in paths])
                 row = {"l": float(l), "axis": AXES[axis], "n": int(keep.sum())}
                 if keep.any():
                     law = law or load_law(f["energy_law"], l)

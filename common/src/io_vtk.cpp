@@ -342,21 +342,25 @@ void PvdCollection::write() const {
   s +=
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
   char buf[40];
-  double prev_time = 0.0, prev_written = 0.0;
+  // 15 significant digits, so that an accumulated load factor reads 0.5, not
+  // 0.4999999999999999 (session 39's walkthrough); 17 (exact) for both times of a neighbouring
+  // pair whose order the 15 digits would not keep (equal, or crossed). An exact time then lies
+  // within half a 15-digit step of its rounded value, so it keeps its order with a rounded
+  // neighbour too (the session's review: one pass fixed only the later time of such a pair).
   const auto sign = [](double x) { return (x > 0) - (x < 0); };
-  for (std::size_t k = 0; k < entries_.size(); ++k) {
+  const std::size_t n = entries_.size();
+  std::vector<double> rounded(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    std::snprintf(buf, sizeof buf, "%.15g", entries_[k].time);
+    rounded[k] = std::strtod(buf, nullptr);
+  }
+  std::vector<bool> exact(n, false);
+  for (std::size_t k = 1; k < n; ++k)
+    if (sign(rounded[k] - rounded[k - 1]) != sign(entries_[k].time - entries_[k - 1].time))
+      exact[k] = exact[k - 1] = true;
+  for (std::size_t k = 0; k < n; ++k) {
     const auto& e = entries_[k];
-    // 15 significant digits, so that an accumulated load factor reads 0.5, not
-    // 0.4999999999999999 (session 39's walkthrough); 17 (exact) when the 15 digits would not
-    // keep this time's order with the one before (equal, or crossed).
-    std::snprintf(buf, sizeof buf, "%.15g", e.time);
-    double written = std::strtod(buf, nullptr);
-    if (k > 0 && sign(written - prev_written) != sign(e.time - prev_time)) {
-      std::snprintf(buf, sizeof buf, "%.17g", e.time);
-      written = e.time;
-    }
-    prev_time = e.time;
-    prev_written = written;
+    std::snprintf(buf, sizeof buf, exact[k] ? "%.17g" : "%.15g", e.time);
     s += std::string("    <DataSet timestep=\"") + buf + "\" group=\"\" part=\"" +
          std::to_string(e.part) + "\" file=\"" + xml_escape(e.file) + "\"/>\n";
   }

@@ -12,7 +12,7 @@ namespace knit::macro {
 Constraints::Constraints(int n) : n_(n), value_(n) {}
 
 void Constraints::prescribe(int dof, double value) {
-  if (value_[dof] && std::abs(*value_[dof] - value) > 1e-14 * (1.0 + std::abs(value)))
+  if (value_[dof] && values_conflict(*value_[dof], value))
     throw ConstraintConflict(dof, "DOF " + std::to_string(dof) + " (control point " +
                                       std::to_string(dof / 3) + ", component " + "xyz"[dof % 3] +
                                       ") is prescribed twice with different values");
@@ -43,7 +43,7 @@ DofMap::DofMap(const Constraints& c)
   for (int d = 0; d < c.n_; ++d) {
     if (!c.value_[d]) continue;
     auto& g = gv[root_[d]];
-    if (g && std::abs(*g - *c.value_[d]) > 1e-14 * (1.0 + std::abs(*g)))
+    if (g && values_conflict(*c.value_[d], *g))
       throw ConstraintConflict(d, "DOF " + std::to_string(d) + " (control point " +
                                       std::to_string(d / 3) + ", component " + "xyz"[d % 3] +
                                       ") is tied to a DOF with a different prescribed value");

@@ -175,7 +175,7 @@ std::string symmetry_plane_problem(const spline::SplineSurface& surface,
     lo = std::min(lo, P(a, component));
     hi = std::max(hi, P(a, component));
   }
-  if (hi - lo > kSymmetryTolerance * patch_size(surface)) {
+  if (hi - lo > kSymmetryPlaneTolerance * patch_size(surface)) {
     m << "the edge does not lie in a plane of normal " << axis << ": its control points' " << axis
       << " run from " << lo << " to " << hi << " mm (a symmetry plane of normal " << axis
       << " needs " << axis << " constant along the edge; check the edge and the plane's normal)";
@@ -185,13 +185,13 @@ std::string symmetry_plane_problem(const spline::SplineSurface& surface,
     const Eigen::Vector3d d = (P.row(row1[k]) - P.row(row0[k])).transpose();
     Eigen::Vector3d along = d;
     along(component) = 0.0;
-    if (along.norm() > kSymmetryTolerance * d.norm()) {
-      m << "the surface does not cross the plane of normal " << axis
-        << " at a right angle along the edge: at its control point " << k + 1 << " of "
-        << row0.size() << " the next row is offset by (" << d(0) << ", " << d(1) << ", " << d(2)
+    if (along.norm() > kSymmetryAngleTolerance * d.norm()) {
+      m << "the control net does not leave the plane of normal " << axis
+        << " along that normal: at the edge's control point " << k + 1 << " of " << row0.size()
+        << " the next row is offset by (" << d(0) << ", " << d(1) << ", " << d(2)
         << ") mm, not along " << axis
-        << " (a symmetry plane needs the surface to leave it along its normal; check the edge "
-           "and the plane's normal)";
+        << " (the condition ties control points, so the net's second row must lie on the "
+           "plane's normal; check the edge and the plane's normal)";
       return m.str();
     }
   }

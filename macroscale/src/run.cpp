@@ -48,7 +48,7 @@ Problem setup_problem(const Case& c) {
     const BoundaryCondition& bc = c.bcs[bi];
     const auto hold = [&](int dof, double value, const char* how) {
       const Holder& h = holder[static_cast<std::size_t>(dof)];
-      if (h.bc >= 0 && std::abs(h.value - value) > 1e-14 * (1.0 + std::abs(value))) {
+      if (h.bc >= 0 && values_conflict(h.value, value)) {
         const auto what = [](const char* verb, double v) {
           std::ostringstream w;
           w << verb;

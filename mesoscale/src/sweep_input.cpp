@@ -284,8 +284,9 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     }
   }
   if (j.contains("energy_fit")) {
-    in.energy_fit_given = true;
     const auto& f = j.at("energy_fit");
+    // {} fits with the code's defaults too (the session's review).
+    in.energy_fit_given = f.is_object() && !f.empty();
     if (f.is_boolean())
       in.energy_fit = f.get<bool>();
     else

@@ -400,7 +400,19 @@ TEST_CASE("PVD collection lists time steps with relative file names", "[unit][io
   const auto ns = noise_root->child("Collection").all("DataSet");
   REQUIRE(ns.size() == 4);
   CHECK(ns[0]->attr.at("timestep") == "0.5");
-  CHECK(ns[1]->attr.at("timestep") == "0.7");
+  CHECK(std::stod(ns[1]->attr.at("timestep")) == t2);  // exact: 15 digits join it with t3
   CHECK(std::stod(ns[2]->attr.at("timestep")) == t3);
   CHECK(std::stod(ns[3]->attr.at("timestep")) == t4);
+  // Approached from below, the earlier time rounds up onto the later one: both exact (the
+  // session's review: "0.7" then "0.69999999999999996", equal once read).
+  PvdCollection below(dir / "below.pvd");
+  const double b1 = std::nextafter(0.7, 0.0), b2 = 0.7;
+  below.add(b1, "bare.vtu");
+  below.add(b2, "bare.vtu");
+  below.write();
+  const auto below_root = parse_file(dir / "below.pvd");
+  const auto bs = below_root->child("Collection").all("DataSet");
+  REQUIRE(bs.size() == 2);
+  CHECK(std::stod(bs[0]->attr.at("timestep")) == b1);
+  CHECK(std::stod(bs[1]->attr.at("timestep")) == b2);
 }

@@ -237,6 +237,10 @@ TEST_CASE("knit-meso sweep: a sweep input without energy_fit is told it got the 
   REQUIRE(at != std::string::npos);
   text = text.substr(0, at) + "}";
   CHECK_FALSE(knit::meso::sweep::parse_sweep_input(text, "s.json").energy_fit_given);
+  // {} fits with the code's defaults as well (the schema allows false or an object).
+  CHECK_FALSE(knit::meso::sweep::parse_sweep_input(
+                  text.substr(0, text.size() - 1) + R"(, "energy_fit": {}})", "s.json")
+                  .energy_fit_given);
   knit_test::write_text(s.dir / "bare.json", text);
   const fs::path log = s.dir / "bare.log", log2 = s.dir / "given.log";
   REQUIRE(shell(kExe + " sweep " + (s.dir / "bare.json").string() + " --output " +

@@ -6,7 +6,8 @@ with all parameters 0 and a floor of 2 MPa). A uniaxial wale path (axis 1) whose
 S22 = 0.4, 1.0 and 4.0 MPa at E22 = 0.1, 0.25, 0.5 with E11 = -0.05, -0.1, -0.2 and S11 = 0:
 the law's axial stress is 0.2, 0.5, 1.0 MPa, so the ratios are 0.5, 0.5, 0.25 and the lateral
 shares |2 E11| / S22 0.25, 0.2, 0.1; the first state (0.4 MPa, 10 % of the path's largest
-4.0) is kept at the default share and dropped at 0.2. A biaxial path and a held-out uniaxial
+4.0) is kept at the default share and dropped at 0.2. A second wale path of small stresses is
+cut by its own largest, not by the first path's. A biaxial path and a held-out uniaxial
 course path with the same stresses must not count as the wale's. Also the sentence, a database
 without a law and the command line's refusal of a bad --min-share.
 Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
@@ -38,6 +39,12 @@ def write_db(path, law=True):
         g = raw_path(f, "path_0", "coverage", E, S)
         g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
         raw_path(f, "path_1", "coverage", E, [[9, 9, 0]] * 3)  # biaxial-like: not counted
+        # A second uniaxial wale path of small stresses, cut by its own largest (0.4 MPa), not
+        # by path_0's 4 MPa: its states of 0.05 and 0.4 MPa are kept (0.02 is below 10 %), with
+        # ratios 0.1 / 0.05 = 2 and 0.2 / 0.4 = 0.5 and lateral shares 0.04 / 0.05 = 0.8, 0.25.
+        g = raw_path(f, "path_3", "coverage", [[-0.01, 0.02, 0], [-0.02, 0.05, 0], [-0.05, 0.1, 0]],
+                     [[0, 0.02, 0], [0, 0.05, 0], [0, 0.4, 0]])
+        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
         g = raw_path(f, "path_2", "holdout", [[0.3, 0, 0]], [[0.1, 0, 0]])
         g.attrs["kind"], g.attrs["axis"] = "uniaxial", 0
 
@@ -50,22 +57,24 @@ def main():
         rows = lu.uniaxial_ratios(db)
         wale = [r for r in rows if r["axis"] == "wale"]
         r = wale[0] if wale else {}
-        c(r.get("n") == 3, "the three wale states (10 %% of the largest kept): %s" % rows)
-        c(abs(r.get("median", 0) - 0.5) < 1e-12, "median ratio 0.5 (got %s)" % r.get("median"))
-        c(abs(r.get("largest", 0) - 0.25) < 1e-12 and abs(r.get("at", 0) - 0.5) < 1e-12,
-          "farthest from 1: 0.25 at E22 = 0.5 (got %s at %s)" % (r.get("largest"), r.get("at")))
-        c(abs(r.get("lateral", 0) - 0.25) < 1e-12,
-          "largest lateral share |2 E11| / S22 = 0.25 (got %s)" % r.get("lateral"))
+        c(r.get("n") == 5, "the wale states, each path cut at 10 %% of its own largest: 3 + 2 "
+          "(with path_0's largest for both: 3): %s" % rows)
+        c(abs(r.get("median", 0) - 0.5) < 1e-12, "median of 0.5, 0.5, 0.25, 2, 0.5: 0.5 (got %s)"
+          % r.get("median"))
+        c(abs(r.get("largest", 0) - 2.0) < 1e-12 and abs(r.get("at", 0) - 0.05) < 1e-12,
+          "farthest from 1: 2 at E22 = 0.05 (got %s at %s)" % (r.get("largest"), r.get("at")))
+        c(abs(r.get("lateral", 0) - 0.8) < 1e-12,
+          "largest lateral share |2 E11| / S22 = 0.8 (got %s)" % r.get("lateral"))
         course = [r for r in rows if r["axis"] == "course"]
         c(len(course) == 1 and abs(course[0]["median"] - 6.0) < 1e-12,
           "the course path (held out, still the cell's uniaxial states): ratio 0.6 / 0.1 = 6: %s"
           % course)
         rows = lu.uniaxial_ratios(db, 0.2)
         wale = [r for r in rows if r["axis"] == "wale"]
-        c(wale and wale[0]["n"] == 2 and abs(wale[0]["lateral"] - 0.2) < 1e-12,
-          "--min-share 0.2 drops the first state (0.4 of 4 MPa): %s" % rows)
+        c(wale and wale[0]["n"] == 3 and abs(wale[0]["lateral"] - 0.25) < 1e-12,
+          "--min-share 0.2 drops 0.4 of 4 MPa and 0.05 of 0.4 MPa: %s" % rows)
         text = lu.summary(lu.uniaxial_ratios(db))
-        c("5 mm wale: 0.50 (farthest from 1: 0.25 at E = 0.500; lateral 25 %)" in text,
+        c("5 mm wale: 0.50 (farthest from 1: 2.00 at E = 0.050; lateral 80 %)" in text,
           "the sentence gives the wale row: %s" % text)
         bare = os.path.join(tmp, "bare.h5")
         write_db(bare, law=False)

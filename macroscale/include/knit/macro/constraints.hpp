@@ -7,6 +7,8 @@
 // reduced residual Z^T r, reduced tangent Z^T K Z (scatter-add through free_index).
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 #include <optional>
 #include <stdexcept>
@@ -14,6 +16,12 @@
 #include <vector>
 
 namespace knit::macro {
+
+/// Whether two prescribed values of one DOF conflict: they differ by more than round-off,
+/// 1e-14 (1 + |b|) mm. One rule for Constraints, DofMap and the case loader's message.
+inline bool values_conflict(double a, double b) {
+  return std::abs(a - b) > 1e-14 * (1.0 + std::abs(b));
+}
 
 class Constraints {
  public:
