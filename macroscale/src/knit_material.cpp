@@ -259,6 +259,7 @@ void KnitMaterial::reset_stats() {
   failed_ = 0;
   audit_evaluations_ = 0;
   audit_outside_ = 0;
+  for (int k = 0; k < 2; ++k) step_start_[k] = last_step_[k] = 0;
   for (int k = 0; k < 3; ++k) {
     visited_[k] = audit_visited_[k] = std::numeric_limits<double>::infinity();
     visited_[k + 3] = audit_visited_[k + 3] = -std::numeric_limits<double>::infinity();
@@ -267,14 +268,28 @@ void KnitMaterial::reset_stats() {
   where_.clear();
 }
 
+std::string KnitMaterial::last_step_share() const {
+  const long n = last_step_[0].load();
+  if (n <= 0) return {};
+  std::ostringstream os;
+  os << std::setprecision(3) << " (at the last converged step: "
+     << 100.0 * static_cast<double>(last_step_[1].load()) / static_cast<double>(n) << " %)";
+  return os.str();
+}
+
 std::string KnitMaterial::warning() const {
   const long n = audit_evaluations_.load();
   if (n == 0) return {};
   const double share = static_cast<double>(audit_outside_.load()) / static_cast<double>(n);
-  if (!(share > kExtrapolatedWarning)) return energy_ ? far_excursion_warning() : std::string();
+  const long n_last = last_step_[0].load();
+  const double last =
+      n_last > 0 ? static_cast<double>(last_step_[1].load()) / static_cast<double>(n_last) : 0.0;
+  if (!(share > kExtrapolatedWarning) && !(last > kExtrapolatedWarning))
+    return energy_ ? far_excursion_warning() : std::string();
   std::ostringstream os;
   os << std::setprecision(3) << "warning: " << 100.0 * share
-     << " % of the material evaluations at converged states lie outside the database's data ("
+     << " % of the material evaluations at converged states" << last_step_share()
+     << " lie outside the database's data ("
      << (energy_ ? "its strain box, in the material report"
                  : "beyond the fan of load paths, the last load step or the shear data, or in "
                    "biaxial compression")
@@ -305,7 +320,8 @@ std::string KnitMaterial::report() const {
   if (const long n = audit_evaluations_.load(); n > 0) {
     const long k = audit_outside_.load();
     os << "\n  at converged states: " << k << " of " << n << " evaluations extrapolated ("
-       << std::setprecision(4) << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)";
+       << std::setprecision(4) << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)"
+       << last_step_share();
   }
   // Every evaluation, Newton's trial iterates too (session 39's walkthrough read them as
   // converged states).

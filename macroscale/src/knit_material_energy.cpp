@@ -172,9 +172,9 @@ std::string KnitMaterial::energy_report() const {
   if (const long n = audit_evaluations_.load(); n > 0) {
     const long k = audit_outside_.load();
     os << "\n  at converged states: " << k << " of " << n << " evaluations extrapolated ("
-       << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %); their strain box E11 ["
-       << audit_visited_[0].load() << ", " << audit_visited_[3].load() << "], E22 ["
-       << audit_visited_[1].load() << ", " << audit_visited_[4].load() << "], 2E12 ["
+       << 100.0 * static_cast<double>(k) / static_cast<double>(n) << " %)" << last_step_share()
+       << "; their strain box E11 [" << audit_visited_[0].load() << ", " << audit_visited_[3].load()
+       << "], E22 [" << audit_visited_[1].load() << ", " << audit_visited_[4].load() << "], 2E12 ["
        << audit_visited_[2].load() << ", " << audit_visited_[5].load() << "]";
   }
   os << "\n  visited material-frame strain box (Newton's trial iterates too): E11 ["
