@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace knit_test {
 
@@ -87,6 +88,21 @@ class LockHolder {
 
 inline bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
+}
+
+/// The rows of a CSV file as text cells, its '#' comment lines and empty lines left out (the
+/// header is the first row): load_strain.csv, history.csv, path.csv.
+inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& f) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(f);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
 }
 
 inline std::string read_text(const std::filesystem::path& p) {

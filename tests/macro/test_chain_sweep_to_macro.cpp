@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../output_test_util.hpp"
 #include "knit/io/hdf5.hpp"
 
 namespace fs = std::filesystem;
@@ -22,21 +23,6 @@ namespace {
 int run(const std::string& cmd) {
   const int rc = std::system((cmd + " > /dev/null 2>&1").c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::vector<std::vector<std::string>> read_csv(const fs::path& f) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(f);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
 }
 
 }  // namespace
@@ -65,7 +51,7 @@ TEST_CASE("reduced sweep database drives a knit-macro tensile case", "[case][cha
   REQUIRE(run((bin / "knit-macro").string() + " run " + case_file.string() + " --output " +
               out.string()) == 0);
 
-  const auto rows = read_csv(out / "load_strain.csv");
+  const auto rows = knit_test::read_csv(out / "load_strain.csv");
   REQUIRE(rows.size() >= 1 + 4);  // header and one row per converged step
   const auto& header = rows.front();
   auto col = [&](const std::string& name) {

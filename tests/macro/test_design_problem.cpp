@@ -69,6 +69,14 @@ const std::string kObjs =
         {"type": "displacement", "point": "mid", "component": "y", "at_strain": [0.2],
          "target": [2.0]}])";
 
+/// The number after `key` in `text` (a summary.txt line "key: number ..."); a failed REQUIRE when
+/// the key is missing.
+double number_after(const std::string& text, const std::string& key) {
+  const auto at = text.find(key);
+  REQUIRE(at != std::string::npos);
+  return std::stod(text.substr(at + key.size()));
+}
+
 int run_design(const fs::path& file) {
   const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " + file.string() +
                           " --check > " + (kDir / "cmd.log").string() + " 2>&1";
@@ -792,13 +800,8 @@ TEST_CASE("design twin: knit-macro design writes the twin's targets and distance
   CHECK(summary.find("variable l: 5 -> 5.5 in [4.5, 6.5] mm\n") != std::string::npos);
   CHECK(summary.find("twin l: 5.5 (recovered 5.5, off by ") != std::string::npos);
   // What the design reached, beside its target (session 39): the twin's load, in N.
-  const auto number_after = [&](const std::string& key) {
-    const auto at = summary.find(key);
-    REQUIRE(at != std::string::npos);
-    return std::stod(summary.substr(at + key.size()));
-  };
-  const double target = number_after("twin target load: ");
-  const double reached = number_after("reached load: ");
+  const double target = number_after(summary, "twin target load: ");
+  const double reached = number_after(summary, "reached load: ");
   CHECK(target > 0.0);
   CHECK(reached == Approx(target).epsilon(1e-5));
   fs::remove_all(out);
@@ -820,21 +823,13 @@ TEST_CASE("design: summary.txt gives what the design reached, the final run's ow
   CHECK(design_into(kDir / "reach.json", out) == 0);
   const std::string summary = knit_test::read_text(out / "summary.txt");
   INFO(summary);
-  const auto at = summary.find("reached load: ");
-  REQUIRE(at != std::string::npos);
-  const double reached = std::stod(summary.substr(at + 14));
+  const double reached = number_after(summary, "reached load: ");
   CHECK(summary.find(" N (target 1e+06; at strain 0.2)") != std::string::npos);
   CHECK(reached > 0.0);
   CHECK(reached < 1e5);
-  std::istringstream csv(knit_test::read_text(out / "run" / "load_strain.csv"));
-  std::string line, header, last;
-  while (std::getline(csv, line))
-    if (!line.empty() && line[0] != '#') (header.empty() ? header : last) = line;
-  std::vector<std::string> names, values;
-  for (auto [text, into] : {std::pair{&header, &names}, std::pair{&last, &values}}) {
-    std::istringstream cells(*text);
-    for (std::string c; std::getline(cells, c, ',');) into->push_back(c);
-  }
+  const auto rows = knit_test::read_csv(out / "run" / "load_strain.csv");
+  REQUIRE(rows.size() >= 2);
+  const std::vector<std::string>&names = rows.front(), &values = rows.back();
   const auto col = std::find(names.begin(), names.end(), "fy_N");
   REQUIRE(col != names.end());
   REQUIRE(values.size() == names.size());
