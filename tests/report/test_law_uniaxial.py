@@ -10,6 +10,13 @@ shares |2 E11| / S22 0.25, 0.2, 0.1; the first state (0.4 MPa, 10 % of the path'
 cut by its own largest, not by the first path's. A biaxial path and a held-out uniaxial
 course path with the same stresses must not count as the wale's. Also the sentence, a database
 without a law and the command line's refusal of a bad --min-share.
+
+The law's own uniaxial response (session 40): with S = 2 e the lateral stress vanishes at a
+lateral strain of 0, so the own ratios are the ratios above. A coupled law S = Q e, Q = L L^T =
+[[2, 1, 0], [1, 2, 0], [0, 0, 0]], contracts to E11 = -E22 / 2 and carries S22 = 1.5 E22 there:
+own ratios 0.15 / 0.4, 0.375 / 1, 0.75 / 4 = 0.375, 0.375, 0.1875 (at the cell's states the
+law gives 0.375, 0.4, 0.2). With Q = [[1, 2, 0], [2, 5, 0], [0, 0, 0]] the zero lies
+at E11 = -2 E22, outside the bracket (E > -0.5) for E22 = 0.4: that state is counted missing.
 Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
 """
 import os
@@ -18,6 +25,7 @@ import sys
 import tempfile
 
 import h5py
+import numpy as np
 
 from checklist import Checklist  # tests/report/checklist.py, beside this file
 from fixtures import linear_network_law, raw_path, script_refuses  # tests/report/fixtures.py
@@ -29,6 +37,19 @@ import law_uniaxial as lu  # noqa: E402
 
 E = [[-0.05, 0.1, 0], [-0.1, 0.25, 0], [-0.2, 0.5, 0]]
 S = [[0, 0.4, 0], [0, 1.0, 0], [0, 4.0, 0]]
+
+
+def coupled_db(path, L, E_path, S_path):
+    """One loop length, the law S = L L^T e (floor 0), one uniaxial wale path."""
+    with h5py.File(path, "w") as f:
+        f["loop_lengths"] = [5.0]
+        law = linear_network_law(f, 0.0)
+        theta = np.zeros((1, 20))
+        theta[0, 11:] = np.array(L, float).ravel()  # the last 9 parameters: L, row by row
+        del law["theta"]
+        law["theta"] = theta
+        g = raw_path(f, "path_0", "coverage", E_path, S_path)
+        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
 
 
 def write_db(path, law=True):
@@ -69,6 +90,31 @@ def main():
         c(len(course) == 1 and abs(course[0]["median"] - 6.0) < 1e-12,
           "the course path (held out, still the cell's uniaxial states): ratio 0.6 / 0.1 = 6: %s"
           % course)
+        c(abs(r.get("own_median", 0) - 0.5) < 1e-12 and abs(r.get("own_largest", 0) - 2.0) < 1e-12
+          and abs(r.get("own_lateral", 1)) < 1e-12 and r.get("own_missing") == 0,
+          "S = 2 e: the law's own uniaxial states have lateral strain 0 and the same ratios: %s" % r)
+        coupled = os.path.join(tmp, "coupled.h5")
+        s2 = 0.5 ** 0.5
+        coupled_db(coupled, [[2 ** 0.5, 0, 0], [s2, 1.5 ** 0.5, 0], [0, 0, 0]], E, S)
+        r = lu.uniaxial_ratios(coupled)
+        r = r[0] if r else {}
+        c(abs(r.get("own_median", 0) - 0.375) < 1e-9 and abs(r.get("own_largest", 0) - 0.1875)
+          < 1e-9 and abs(r.get("own_at", 0) - 0.5) < 1e-12
+          and abs(r.get("own_lateral", 0) + 0.25) < 1e-9 and abs(r.get("cell_lateral", 0) + 0.2)
+          < 1e-12, "coupled law: own ratios 0.375, 0.375, 0.1875, farthest at E22 = 0.5 with "
+          "E11 = -0.25 (cell -0.2): %s" % r)
+        c(abs(r.get("largest", 0) - 0.2) < 1e-9 and abs(r.get("lateral", 0) - 0.05) < 1e-9,
+          "coupled law at the cell's states (not its own): S22 = E11 + 2 E22 = 0.15, 0.4, 0.8 "
+          "over 0.4, 1, 4, farthest 0.2; S11 = 2 E11 + E22 = 0, 0.05, 0.1, largest share 0.05: %s"
+          % r)
+        steep = os.path.join(tmp, "steep.h5")
+        coupled_db(steep, [[1, 0, 0], [2, 1, 0], [0, 0, 0]],
+                   [[-0.2, 0.1, 0], [-0.4, 0.2, 0], [-0.6, 0.4, 0]], S)
+        r = lu.uniaxial_ratios(steep)
+        r = r[0] if r else {}
+        c(r.get("own_missing") == 1 and abs(r.get("own_median", 0) - 0.225) < 1e-9,
+          "E11 = -2 E22 leaves the bracket at E22 = 0.4: 1 missing, median of 0.25 and 0.2: %s" % r)
+        c("1 without a zero" in lu.summary([r]), "the sentence says so: %s" % lu.summary([r]))
         rows = lu.uniaxial_ratios(db, 0.2)
         wale = [r for r in rows if r["axis"] == "wale"]
         c(wale and wale[0]["n"] == 3 and abs(wale[0]["lateral"] - 0.25) < 1e-12,
