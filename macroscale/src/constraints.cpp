@@ -38,15 +38,25 @@ DofMap::DofMap(const Constraints& c)
     if (ra != rb) root_[std::max(ra, rb)] = std::min(ra, rb);
   }
   for (int d = 0; d < c.n_; ++d) root_[d] = find(root_, d);
-  // Group values: a group is constrained if any member is.
+  // Group values: a group is constrained if any member is. The member that gave the group its
+  // value is kept to name both sides of a conflict (session 40: only the second was named).
   std::vector<std::optional<double>> gv(c.n_);
+  std::vector<int> source(c.n_, -1);
+  const auto name = [](int d) {
+    return "DOF " + std::to_string(d) + " (control point " + std::to_string(d / 3) +
+           ", component " + "xyz"[d % 3] + ")";
+  };
   for (int d = 0; d < c.n_; ++d) {
     if (!c.value_[d]) continue;
-    auto& g = gv[root_[d]];
-    if (g && values_conflict(*c.value_[d], *g))
-      throw ConstraintConflict(d, "DOF " + std::to_string(d) + " (control point " +
-                                      std::to_string(d / 3) + ", component " + "xyz"[d % 3] +
-                                      ") is tied to a DOF with a different prescribed value");
+    const int r = root_[d];
+    auto& g = gv[r];
+    if (g && values_conflict(*c.value_[d], *g)) {
+      std::ostringstream s;
+      s << name(d) << ", prescribed " << *c.value_[d] << ", is tied to " << name(source[r])
+        << ", prescribed " << *g << ": a tied group takes one value";
+      throw ConstraintConflict(d, s.str(), source[r]);
+    }
+    if (!g) source[r] = d;
     g = c.value_[d];
   }
   std::vector<int> group_index(c.n_, -1);

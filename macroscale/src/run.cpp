@@ -107,13 +107,18 @@ Problem setup_problem(const Case& c) {
   try {
     p.dofs = DofMap(con);
   } catch (const ConstraintConflict& e) {
-    const Holder& h = holder[static_cast<std::size_t>(e.dof())];
+    // Both members of the tied group, each with its place and the entry that holds it.
+    const auto held = [&](int dof) {
+      const Holder& h = holder[static_cast<std::size_t>(dof)];
+      return where(dof) + (h.bc >= 0 ? ", " + std::string(h.how) + " by " +
+                                           c.bcs[static_cast<std::size_t>(h.bc)].pointer
+                                     : std::string());
+    };
     throw InputError(c.file, "/boundary_conditions",
-                     std::string(e.what()) + " (" + where(e.dof()) +
-                         (h.bc >= 0 ? ", " + std::string(h.how) + " by " +
-                                          c.bcs[static_cast<std::size_t>(h.bc)].pointer
-                                    : std::string()) +
-                         "; a clamp or symmetry condition ties it to the edge row)");
+                     std::string(e.what()) + " (" + held(e.dof()) +
+                         (e.other() >= 0 ? "; the other: " + held(e.other()) : std::string()) +
+                         "; a clamp or symmetry condition ties the edge's second row to its "
+                         "first)");
   }
   if (const auto mode = p.dofs.unconstrained_rigid_mode(c.surface.control_points()))
     throw InputError(c.file, "/boundary_conditions",

@@ -1328,3 +1328,20 @@ TEST_CASE("contradictory boundary conditions name both entries and the control p
   CHECK_THAT(error_of(j), Catch::Contains("is held at 0 by the symmetry plane here and prescribed "
                                           "(15 mm) by the same entry"));
 }
+
+TEST_CASE("a tied group's conflict names both members and their entries", "[unit]") {
+  // Session 40 (left open in session 39): a clamp ties an edge's second row to its first; a
+  // value held on the second row that differs from the first row's named only one of the two.
+  // The tensile case's upper jaw (v1, y = 50) is prescribed y = 15 and clamped; a corner pad at
+  // u0v0 of radius 45 mm fixes y on the second row's point at (0, 40) but not on the jaw itself.
+  json j = verification_case("tensile_svk.json");
+  j["boundary_conditions"].push_back(
+      json::parse(R"({"corner": "u0v0", "radius": 45, "fix": ["y"]})"));
+  const std::string e = error_of(j);
+  CHECK_THAT(e, Catch::StartsWith("bad.json: /boundary_conditions: "));
+  CHECK_THAT(e, Catch::Contains(", prescribed 15, is tied to "));
+  CHECK_THAT(e, Catch::Contains(", prescribed 0: a tied group takes one value"));
+  CHECK_THAT(e, Catch::Contains("at (0, 50, 0) mm, prescribed by /boundary_conditions/1; the "
+                                "other: component y of control point "));
+  CHECK_THAT(e, Catch::Contains("at (0, 40, 0) mm, fixed by /boundary_conditions/2;"));
+}

@@ -43,11 +43,15 @@ class Constraints {
 /// Thrown by DofMap for contradictory constraints; names the DOF.
 class ConstraintConflict : public std::runtime_error {
  public:
-  ConstraintConflict(int dof, const std::string& what) : std::runtime_error(what), dof_(dof) {}
+  ConstraintConflict(int dof, const std::string& what, int other = -1)
+      : std::runtime_error(what), dof_(dof), other_(other) {}
   int dof() const { return dof_; }
+  /// The DOF whose prescribed value the group already held (a tied group's conflict), else -1.
+  int other() const { return other_; }
 
  private:
   int dof_;
+  int other_;
 };
 
 class DofMap {
