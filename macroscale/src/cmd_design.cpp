@@ -79,6 +79,11 @@ knit::cli::SubcommandRegistrar reg(
           std::cout << " (the reaction and displacement terms' targets come from its run)\n";
         }
         if (o->check) return knit::kExitOk;
+        // The output directory (and its lock) before any work (session 40's data-safety red
+        // team: taken after the optimization, a second design into the same directory started
+        // meanwhile was silently replaced, and a run into it failed the design after all its
+        // work). Until commit() only DIR.partial-<pid> exists; a failure removes it.
+        knit::io::AtomicDirectory out(dir);
         // The twin's targets: the case solved at the twin's values (not for --check).
         if (const std::string why = knit::macro::set_twin_targets(d); !why.empty()) {
           std::cerr << "knit-macro design: " << o->file << ": " << why << "\n";
@@ -92,7 +97,6 @@ knit::cli::SubcommandRegistrar reg(
           std::cout << "status: failed\n";
           return knit::kExitFailure;
         }
-        knit::io::AtomicDirectory out(dir);
         std::vector<std::string> header = {"iteration", "J", "gradient_norm", "seconds"};
         for (std::size_t k = 0; k < d.variables.size(); ++k) header.push_back(column_name(d, k));
         knit::io::CsvWriter csv(out / "history.csv", header);

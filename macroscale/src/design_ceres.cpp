@@ -55,6 +55,7 @@ struct Tracker {
       res->x = x;
       res->terms = last.terms;
       res->reached = last.reached;
+      res->gradient = last.gradient;
     }
     return last;
   }
@@ -177,6 +178,8 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
                   res);
   if (res.message.empty() && summary.termination_type != ceres::CONVERGENCE)
     res.message = summary.message;
+  else if (res.status != DesignStatus::kConverged && !failed)  // why it stopped (session 40)
+    res.message += (res.message.empty() ? "" : "; ") + ("Ceres: " + summary.message);
   return res;
 }
 

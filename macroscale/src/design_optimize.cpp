@@ -37,6 +37,35 @@ std::string to_string(DesignStatus s) {
   return "failed";
 }
 
+DesignStop design_stop(const DesignProblem& d, const std::vector<double>& x,
+                       const Eigen::VectorXd& g, double J) {
+  if (g.size() != static_cast<Eigen::Index>(d.variables.size()) || x.size() != d.variables.size() ||
+      !(J > 0.0) || !g.allFinite())
+    return DesignStop::kUnknown;
+  double largest = 0.0, inward = 0.0, outward = 0.0;
+  for (std::size_t i = 0; i < d.variables.size(); ++i) {
+    const auto& v = d.variables[i];
+    const double range = v.upper - v.lower, tol = 1e-6 * range;
+    const double gi = g(static_cast<Eigen::Index>(i)), si = std::abs(gi) * range;
+    largest = std::max(largest, si);
+    // Descent moves x_i along -g_i: out of the bounds at the lower bound when g_i > 0.
+    const bool out = (x[i] <= v.lower + tol && gi > 0.0) || (x[i] >= v.upper - tol && gi < 0.0);
+    if (out) {
+      outward = std::max(outward, si);
+      continue;
+    }
+    // The first-order decrease of J that the room left in the descent direction allows (a
+    // variable creeping towards its bound has little: design example (b)'s l6 at 6.494 of 6.5).
+    const double room = gi > 0.0 ? x[i] - v.lower : v.upper - x[i];
+    inward = std::max(inward, std::abs(gi) * std::max(0.0, room));
+  }
+  if (largest <= 1e-9 * J) return DesignStop::kStationary;
+  if (inward > 1e-2 * J) return DesignStop::kNotStationary;
+  // Any gradient out of the bounds above the stationary level: the bound holds the design
+  // (an unreachable target's J can be large and flat, design_terms' 1e8 with |dJ/dl| 2e5).
+  return outward > 1e-9 * J ? DesignStop::kPushesOut : DesignStop::kInside;
+}
+
 void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverEnd end,
                      DesignResult& r) {
   if (end == SolverEnd::kFailed) r.status = DesignStatus::kFailed;
@@ -72,14 +101,49 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
                 "met%s)",
                 Jo, J0o > 0 ? Jo / J0o : 0.0, opt.feasible,
                 Jo != r.J ? "; the smoothness penalty left out" : "");
-  r.status = on_bound ? DesignStatus::kInfeasible : DesignStatus::kTargetNotMet;
+  // Session 40: "on a bound" alone is not infeasibility; the gradient there says which stop
+  // this is (design_stop).
+  const DesignStop stop = design_stop(d, r.x, r.gradient, r.J);
+  r.status = on_bound && (stop == DesignStop::kPushesOut || stop == DesignStop::kUnknown)
+                 ? DesignStatus::kInfeasible
+                 : DesignStatus::kTargetNotMet;
   char tol[64];
   std::snprintf(tol, sizeof tol, "%g", opt.function_tolerance);
-  r.message = (r.message.empty() ? "" : r.message + "; ") + std::string(buf) +
-              (on_bound ? ", with a variable on a bound: the targets lie outside the bounds"
-                        : std::string(", inside the bounds: a local minimum of J, or a stop by "
-                                      "the function tolerance (") +
-                              tol + ")");
+  std::string why;
+  switch (stop) {
+    case DesignStop::kStationary:
+      why =
+          ": the gradient of J vanishes at this design (|dJ/dx| x interval <= 1e-9 J), a "
+          "stationary point where descent cannot start, not a minimum; a knitting angle of 0 "
+          "or +-90 deg is one (the material is symmetric about it, so J is even in alpha "
+          "there): start the variables from other values";
+      break;
+    case DesignStop::kNotStationary:
+      why =
+          ": the optimizer stopped where J still decreases inside the bounds (|dJ/dx| x the "
+          "room to the bound it moves towards > 1e-2 J): raise max_iterations, lower "
+          "function_tolerance (" +
+          std::string(tol) + ") or start from other values";
+      break;
+    case DesignStop::kPushesOut:
+      why =
+          ", with a variable on a bound whose gradient points out of the bounds: the targets "
+          "lie outside the bounds";
+      break;
+    case DesignStop::kUnknown:
+    case DesignStop::kInside:
+      if (stop == DesignStop::kUnknown && on_bound) {
+        why = ", with a variable on a bound: the targets lie outside the bounds";
+        break;
+      }
+      why = on_bound ? std::string(": a local minimum of J; no gradient points out of the bounds")
+                     : std::string(
+                           ", inside the bounds: a local minimum of J, or a stop by "
+                           "the function tolerance (") +
+                           tol + ")";
+      break;
+  }
+  r.message = (r.message.empty() ? "" : r.message + "; ") + std::string(buf) + why;
 }
 
 DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& options) {
@@ -172,6 +236,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
   res.J = cur.J;
   res.terms = cur.terms;
   res.reached = cur.reached;
+  res.gradient = cur.gradient;
   classify_result(d, opt, converged ? SolverEnd::kConverged : SolverEnd::kIterationLimit, res);
   return res;
 }

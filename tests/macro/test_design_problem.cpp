@@ -619,6 +619,47 @@ TEST_CASE("design status: a variable on either bound makes a stop an infeasible 
   }
 }
 
+// Session 40's walkthrough: an alpha design started at alpha = 0 (J even in alpha, gradient
+// 6e-17) and a stop with |dJ/dl| = 794 pointing into the bounds were both "infeasible target:
+// the targets lie outside the bounds". With the best design's gradient the stop is told apart:
+// infeasible only where a variable on a bound has a gradient pointing out of the bounds.
+TEST_CASE("design status: the gradient on the bounds decides an infeasible target", "[unit]") {
+  const DesignProblem d = one_variable_design(0.0);  // l in [4.5, 6.5]: interval 2 mm
+  const OptimizeOptions opt;
+  struct Row {
+    double x, g;
+    DesignStatus status;
+    const char* says;
+  };
+  for (const Row& row : {
+           Row{4.5, 6e-17, DesignStatus::kTargetNotMet, "the gradient of J vanishes"},
+           Row{4.5, 1.0, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           Row{6.5, -1.0, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           Row{6.5, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{4.5, -1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{5.5, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{5.5, 1e-4, DesignStatus::kTargetNotMet, "inside the bounds: a local minimum"},
+           // Creeping towards a bound 0.001 mm away (example (b)'s l6): little room, no stop.
+           Row{6.499, -1.0, DesignStatus::kTargetNotMet, "inside the bounds: a local minimum"},
+           Row{6.499, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{4.5, -1e-4, DesignStatus::kTargetNotMet, "a local minimum of J; no gradient"},
+           Row{4.5, 1e-4, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           Row{4.5, 1e-10, DesignStatus::kTargetNotMet, "the gradient of J vanishes"},
+       }) {
+    INFO("x = " << row.x << ", dJ/dx = " << row.g);
+    DesignResult r;
+    r.x = {row.x};
+    r.gradient = Eigen::VectorXd::Constant(1, row.g);
+    r.terms0 = {{"load", 10.0}};
+    r.J0 = 10.0;
+    r.terms = {{"load", 1.0}};
+    r.J = 1.0;  // |g| x 2 mm (interval) or x the room against 1e-2 J = 0.01 and 1e-9 J
+    classify_result(d, opt, SolverEnd::kConverged, r);
+    CHECK(r.status == row.status);
+    CHECK_THAT(r.message, Catch::Contains(row.says));
+  }
+}
+
 // Session 23 made a final run that is not a plain success end `knit-macro design` with exit 1;
 // session 24 moved that decision out of the command so that it is tested.
 TEST_CASE("design: the exit code is the optimizer's status and the final run's", "[unit]") {

@@ -161,6 +161,7 @@ struct DesignResult {
   double J = 0.0, J0 = 0.0;
   std::vector<std::pair<std::string, double>> terms0, terms;  ///< at the start and the best
   std::vector<std::vector<double>> reached;  ///< DesignEvaluation::reached of the best design
+  Eigen::VectorXd gradient;  ///< dJ/dx at the best design (empty if none was evaluated)
   std::vector<DesignIteration> history;
   int evaluations = 0;  ///< objective evaluations (each one forward run)
   /// Wall seconds over all evaluations: forward solves, and the sensitivities (gradients).
@@ -179,6 +180,24 @@ enum class SolverEnd { kConverged, kIterationLimit, kFailed };
 /// after the first evaluation said "iteration limit"); the best design so far is kept.
 void classify_result(const DesignProblem& d, const OptimizeOptions& options, SolverEnd end,
                      DesignResult& r);
+/// Where a stop inside or on the bounds stands (session 40's walkthrough: an alpha design
+/// started at alpha = 0, where J is even in alpha and its gradient 6e-17, was called "infeasible
+/// target: the targets lie outside the bounds"; a stop with |dJ/dl| = 794 N^2/mm pointing into
+/// the bounds was called the same). With s_i = |dJ/dx_i| (upper_i - lower_i), the first-order
+/// change of J over variable i's whole interval, and the projected gradient (a component on a
+/// bound that points out of the bounds counts 0):
+///  * kStationary: every s_i <= 1e-9 J: the gradient vanishes (a symmetry point, not a descent's
+///    minimum);
+///  * kNotStationary: a variable whose gradient does not point out of the bounds has
+///    |dJ/dx_i| times the room left towards the bound it descends to > 1e-2 J: J still
+///    decreases inside the bounds;
+///  * kPushesOut: otherwise, with a variable on a bound whose gradient points out of the bounds
+///    by s_i > 1e-9 J: the bounds keep the targets out of reach;
+///  * kInside: otherwise (a minimum inside the bounds as far as the gradient tells);
+///  * kUnknown: no gradient of the best design (classify_result then goes by the bounds alone).
+enum class DesignStop { kStationary, kNotStationary, kPushesOut, kInside, kUnknown };
+DesignStop design_stop(const DesignProblem& d, const std::vector<double>& x,
+                       const Eigen::VectorXd& gradient, double J);
 
 struct RunResult;  // knit/macro/run.hpp
 /// What `knit-macro design` ends with, once its outputs are written: exit code 0 and no reason
