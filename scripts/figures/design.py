@@ -9,9 +9,11 @@ the designed case's stitch-value field l and knitting-angle field alpha (case.js
 parameter domain, with the profile at mid-height when a field varies; the final run's
 load-strain curve (run/load_strain.csv: the reaction an objective names, else the first) with
 the objectives drawn on it: a `reaction` objective's targets as points, a `reaction_linearity`
-objective's straight line through the origin and the curve at its last strain; with --section,
-that strain component of the final run along the central section v = 0.5 (run/results.h5, last
-step). The objectives are read from the design file
+objective's straight line through the origin and the curve at its last strain; `displacement`
+objectives' targets and the values reached (summary.txt) in a panel of their own; with
+--section, that strain component of the final run along the central section v = 0.5
+(run/results.h5, last step), with the targets of `target_strain` objectives of that component
+whose region holds the section. The objectives are read from the design file
 (--design; by default the pipeline's DIR/../inputs/NAME.json when it exists). Writes
 DIR_design.png (beside DIR) unless --out is given. The pipeline calls it (make -f scripts/pipeline.mk
 designs); the C++ command never needs python.
@@ -89,6 +91,21 @@ def read_summary(path):
     return out
 
 
+def reached_values(summary, name):
+    """The values an objective reached and their unit, from summary.txt's 'reached NAME: v1 v2
+    ... UNIT (target ...; at strain ...)' line (read_summary's dict); None when there is none
+    (only reaction and displacement objectives have one)."""
+    line = summary.get("reached " + str(name))
+    if not line:
+        return None
+    words = line.split("(")[0].split()
+    try:
+        values = [float(w) for w in words[:-1]]
+    except ValueError:
+        return None
+    return (values, words[-1]) if values and len(words) > 1 else None
+
+
 def design_file(a):
     """The design file whose objectives are drawn: --design, else the pipeline's
     OUT/design/inputs/NAME.json beside DIR = OUT/design/NAME (None when there is none)."""
@@ -153,7 +170,19 @@ def main():
             # The step drawn is the run's last output step: its load factor goes in the title
             # (session 39's walkthrough: a design at 10 % strain was drawn at 30 % unsaid).
             section = (np.linspace(0, 1, nu), E[nv // 2], float(g.attrs.get("load_factor", np.nan)))
-    npan = 1 + len(fields) + (curve is not None) + (section is not None)
+    # Displacement objectives (session 40's walkthrough: the figure drew none): their targets
+    # and what the final design reached, from summary.txt's 'reached' lines.
+    moved = []
+    for o in objectives or []:
+        if o.get("type") != "displacement":
+            continue
+        tag = o.get("name", o.get("type"))
+        at = np.atleast_1d(np.array(o.get("at_strain", []), float))
+        got = reached_values(summary, tag)
+        target = o.get("target", [])
+        if len(at) and (got is not None or len(target) == len(at)):
+            moved.append((tag, o.get("component", ""), at, target, got))
+    npan = 1 + len(fields) + (curve is not None) + (section is not None) + bool(moved)
     fig, axes = plt.subplots(1, npan, figsize=(4.2 * npan, 3.8), squeeze=False)
     ax = axes[0][0]
     J = np.maximum(np.atleast_1d(h["J"]), 1e-300)
@@ -229,10 +258,36 @@ def main():
         ax.legend(fontsize=7)
         ax.grid(True, alpha=0.3)
         k += 1
+    if moved:
+        ax = axes[0][k]
+        for tag, comp, at, target, got in moved:
+            if len(target) == len(at):
+                ax.plot(100 * at, target, "D", ms=8, mfc="none", mec="tab:red", mew=1.6, zorder=3,
+                        label=f"target of {tag} ({comp})")
+            if got is not None and len(got[0]) == len(at):
+                ax.plot(100 * at, got[0], "o", ms=6, label=f"{tag} reached ({got[1]})")
+        ax.set_xlabel("applied strain (%)")
+        ax.set_ylabel("displacement (mm)")
+        ax.set_title("displacement objectives:\ntargets and the final design (summary.txt)",
+                     fontsize=9)
+        ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+        k += 1
     if section is not None:
         ax = axes[0][k]
         u, E, load_factor = section
         ax.plot(u, E, "-", label="final run")
+        # target_strain objectives of this component whose region holds the section v = 0.5:
+        # each target over its region's u interval (session 40's walkthrough: not drawn).
+        for o in objectives or []:
+            reg = o.get("region", {})
+            if (o.get("type") != "target_strain" or o.get("component") != a.section
+                    or not reg or not reg["v"][0] <= 0.5 <= reg["v"][1]):
+                continue
+            for x, t in zip(np.atleast_1d(o.get("at_strain", [])), o.get("target", [])):
+                ax.plot(reg["u"], [t, t], color="tab:red", ls="--", lw=1.4,
+                        label=f"target of {o.get('name', o['type'])}: {t:.3g} at {100 * x:.3g} %")
+            ax.legend(fontsize=7)
         if any(o.get("type") == "strain_variance" and o.get("component") == a.section
                for o in objectives or []):  # the objective's ideal: a uniform strain
             ax.axhline(np.mean(E), color="tab:red", ls="--", lw=1,

@@ -130,6 +130,15 @@ def main():
       "an angle field in rad is labelled rad")
     c(design.field_unit("stitch_value", 1.0) == "mm", "the stitch value is labelled mm")
     c(abs(scale - math.pi / 180) < 1e-15, "field_grid's scale of a deg field is pi / 180")
+    # design.py draws displacement objectives from summary.txt's 'reached' lines (session 40).
+    summ = {"reached pull": "5.11828 21.6887 N (target 10 100; at strain 0.1 0.2)",
+            "reached center_ux": "4.17938 mm (target 4; at strain 0.2)", "reached bad": "x mm"}
+    c(design.reached_values(summ, "pull") == ([5.11828, 21.6887], "N"),
+      "two values and the unit N: %s" % (design.reached_values(summ, "pull"),))
+    c(design.reached_values(summ, "center_ux") == ([4.17938], "mm"),
+      "one value in mm: %s" % (design.reached_values(summ, "center_ux"),))
+    c(design.reached_values(summ, "bad") is None and design.reached_values(summ, "none") is None,
+      "a line without numbers and a missing line give None")
     return c.exit_code()
 
 
