@@ -101,10 +101,23 @@ Basis2 read_basis(const nlohmann::json& j, const std::string& p, const CaseConte
 void check_angle(double a, const std::string& p, const CaseContext& ctx, bool deg) {
   constexpr double kTurn = 2.0 * std::numbers::pi;
   if (!(std::abs(a) <= kTurn)) {
+    // Printed with as many digits as it takes to differ from the bound printed alike (session
+    // 40's red team: 2 pi + 1e-12 read "must lie in [-2 pi, 2 pi] rad, got 6.28319").
+    const double shown = deg ? a * 180.0 / std::numbers::pi : a, bound = deg ? 360.0 : kTurn;
+    std::string got;
+    for (int digits = 6; digits <= 17; ++digits) {
+      std::ostringstream v, b;
+      v.precision(digits);
+      b.precision(digits);
+      v << std::abs(shown);
+      b << bound;
+      got = v.str();
+      if (got != b.str()) break;
+    }
+    if (shown < 0.0) got = "-" + got;
     std::ostringstream m;
     m << "a knitting angle must lie in " << (deg ? "[-360, 360] deg" : "[-2 pi, 2 pi] rad")
-      << ", got " << (deg ? a * 180.0 / std::numbers::pi : a)
-      << " (a larger angle is the same course direction as one inside)";
+      << ", got " << got << " (a larger angle is the same course direction as one inside)";
     // An angle meant in degrees (session 39's walkthrough: "values": [30] with no unit).
     if (!deg && std::abs(a) <= 360.0)
       m << "; if it is in degrees, give the spline field \"unit\": \"deg\" (a constant angle as "

@@ -195,6 +195,14 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
       head +
       R"("stitch_value": 5, "knitting_angle": {"degrees": [1, 0], "knots_u": [0, 0, 1, 1], "knots_v": [0, 1], "values": [-360, 360], "unit": "deg"}})"));
   CHECK_NOTHROW(load(head + R"("stitch_value": 5, "knitting_angle": -6.28})"));
+  // Just outside, printed with the digits that show it (session 40's red team: "got 6.28319").
+  CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": 6.283185307181})"),
+                    Catch::Contains("[-2 pi, 2 pi] rad, got 6.283185307181 "));
+  CHECK_THROWS_WITH(
+      load(
+          head +
+          R"("stitch_value": 5, "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1], "values": [360.0000001], "unit": "deg"}})"),
+      Catch::Contains("[-360, 360] deg, got 360.0000001 "));
   // An angle that reads as degrees says how to write it in degrees (session 39).
   CHECK_THROWS_WITH(load(head + R"("stitch_value": 5, "knitting_angle": 30})"),
                     Catch::EndsWith("; if it is in degrees, give the spline field \"unit\": "
