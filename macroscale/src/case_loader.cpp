@@ -400,8 +400,7 @@ void read_solver(const Reader& r, const json& root, Case& c) {
   const json& s = root.at("solver");
   r.keys(s, "/solver",
          {"steps", "tolerance", "absolute_tolerance", "max_iterations", "max_cutbacks",
-          "divergence_factor", "line_search", "line_search_first", "threads",
-          "thickness_integration", "description"});
+          "line_search", "line_search_first", "threads", "thickness_integration", "description"});
   SolverOptions& o = c.solver;
   if (s.contains("steps")) o.steps = r.integer(s.at("steps"), "/solver/steps", 1, 100000);
   // Upper bounds (session 21, found by fuzzing: a tolerance of 1e308 accepted every first
@@ -422,13 +421,6 @@ void read_solver(const Reader& r, const json& root, Case& c) {
     o.max_iterations = r.integer(s.at("max_iterations"), "/solver/max_iterations", 1, 1000);
   if (s.contains("max_cutbacks"))
     o.max_cutbacks = r.integer(s.at("max_cutbacks"), "/solver/max_cutbacks", 0, 40);
-  if (s.contains("divergence_factor")) {
-    o.divergence_factor = r.positive(s.at("divergence_factor"), "/solver/divergence_factor");
-    if (!(o.divergence_factor > 1.0))
-      r.fail("/solver/divergence_factor",
-             "must be > 1 (a residual growth that ends a Newton attempt), got " +
-                 s.at("divergence_factor").dump());
-  }
   if (s.contains("line_search"))
     o.line_search = r.boolean(s.at("line_search"), "/solver/line_search");
   if (s.contains("line_search_first"))

@@ -54,13 +54,6 @@ struct SolverOptions {
       1e-8;                 ///< ||du|| / ||u|| accepted when the residual is at round-off
   int max_iterations = 25;  ///< Newton iterations per step
   int max_cutbacks = 8;     ///< halvings of the increment within one nominal step
-  /// A Newton attempt whose residual passes this many times its start (the larger of its first
-  /// residual and reference force) has diverged and ends; the step's next attempt takes over.
-  /// 1e30 (session 40): the 26 paper cases' residuals grow at most 3.4-fold within an attempt,
-  /// the Sze cantilever's 6.3e3-fold, a 64 x 64, p = 2 patch pulled 30 % in one step 2.2e20-fold
-  /// and still converges (a guard at 1e10 made it slower: 5.1 s against 3.3 s); at p = 5 the
-  /// residual passed 1e87-fold and the attempt never recovered.
-  double divergence_factor = 1e30;
   /// Floor of the load increment (in load factor): a step that would need a smaller one stops
   /// the run.
   double min_increment = 1e-9;
