@@ -142,10 +142,30 @@ knit::cli::SubcommandRegistrar reg(
         for (std::size_t k = 0; k < d.objectives.size() && k < r.reached.size(); ++k) {
           const auto& o = d.objectives[k];
           if (r.reached[k].empty()) continue;
-          const bool reaction = o.kind == knit::macro::DesignObjective::Kind::kReaction;
+          using Kind = knit::macro::DesignObjective::Kind;
+          const std::string comp = std::string("E") + (o.component == 0   ? "11"
+                                                       : o.component == 1 ? "22"
+                                                                          : "12");
           sum << "reached " << o.name << ":";
           for (double v : r.reached[k]) sum << " " << v;
-          sum << " " << (reaction ? "N" : "mm") << " (target";
+          // The unit slot (scripts/figures/design.py reads the word before the parenthesis):
+          // N, mm, or the strain component (session 40: the strain objectives had no line).
+          switch (o.kind) {
+            case Kind::kReaction:
+              sum << " N (target";
+              break;
+            case Kind::kDisplacement:
+              sum << " mm (target";
+              break;
+            case Kind::kTargetStrain:
+              sum << " " << comp << " (the mean over the region's samples; target";
+              break;
+            default:
+              sum << " " << comp
+                  << "_std (the standard deviation over the region's samples; a "
+                     "uniform strain has 0";
+              break;
+          }
           for (double t : o.target) sum << " " << t;
           sum << "; at strain";
           for (double e : o.at_strain) sum << " " << e;

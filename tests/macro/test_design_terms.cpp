@@ -690,3 +690,38 @@ TEST_CASE("knit-macro design: case.json and summary.txt hold the best design", "
     CHECK(after_arrow(summary, "term " + name + ":") == Approx(value).epsilon(1e-5));
   fs::remove_all(out);
 }
+
+// Session 40's walkthrough: summary.txt gave the reaction and displacement reached but nothing
+// for the strain objectives (the region means had to be worked out from results.h5). What the
+// evaluation reports for them follows from its residuals: target_strain's are sqrt(w/n) (E_i -
+// target), so the mean over the samples is target + mean(r_i) / sqrt(w/n); strain_variance's
+// are sqrt(w/n) (E_i - mean), so the standard deviation over the samples is sqrt(term / w).
+TEST_CASE("design terms: the strain objectives report their region's mean and spread", "[unit]") {
+  const std::string c = write_case(false);
+  const DesignProblem d = problem(c, "reached_strain.json", R"([
+      {"type": "strain_variance", "component": "E22", "region": {"u": [0, 1], "v": [0.5, 0.5]},
+       "samples": [5, 1], "at_strain": [0.1, 0.2], "weight": 1000},
+      {"type": "target_strain", "component": "E11", "region": {"u": [0.2, 0.8], "v": [0.2, 0.8]},
+       "samples": [4, 3], "at_strain": [0.1, 0.2], "target": [0.01, -0.02], "weight": 100}])",
+                                  0.0, kStitchVars);
+  const DesignEvaluation e = evaluate_design(d, {5.0, 5.5, 6.2}, false);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.reached.size() == 2);
+  REQUIRE(e.reached[0].size() == 2);
+  REQUIRE(e.reached[1].size() == 2);
+  const double wv = std::sqrt(1000.0 / 5.0), wt = std::sqrt(100.0 / 12.0);
+  Eigen::Index i = 0;
+  for (int k = 0; k < 2; ++k) {  // strain_variance: residuals 0-4 and 5-9
+    const double ss = e.residuals.segment(i, 5).squaredNorm();
+    i += 5;
+    CHECK(e.reached[0][static_cast<std::size_t>(k)] == Approx(std::sqrt(ss / (wv * wv) / 5.0)));
+    CHECK(e.reached[0][static_cast<std::size_t>(k)] > 0.0);  // l graded: E22 is not uniform
+  }
+  const double targets[2] = {0.01, -0.02};
+  for (int k = 0; k < 2; ++k) {  // target_strain: residuals 10-21 and 22-33
+    const double mean = targets[k] + e.residuals.segment(i, 12).mean() / wt;
+    i += 12;
+    CHECK(e.reached[1][static_cast<std::size_t>(k)] == Approx(mean).epsilon(1e-12));
+  }
+  CHECK(i == e.residuals.size());
+}

@@ -108,8 +108,10 @@ struct DesignEvaluation {
   std::string message;
   double J = 0.0;
   std::vector<std::pair<std::string, double>> terms;  ///< per objective (name, sum r^2)
-  /// Per objective: the reaction (N) or displacement (mm) reached at each of its at_strain
-  /// levels; empty for the other kinds (what summary.txt reports beside the targets).
+  /// Per objective, at each of its at_strain levels: the reaction (N) or displacement (mm)
+  /// reached, the mean of the strain over the samples (target_strain) or its standard
+  /// deviation there (strain_variance; session 40); empty for reaction_linearity (what
+  /// summary.txt reports beside the targets).
   std::vector<std::vector<double>> reached;
   Eigen::VectorXd residuals;
   Eigen::MatrixXd jacobian;  ///< dr/dx (residuals x variables); empty without gradient
