@@ -191,6 +191,8 @@ knit::cli::SubcommandRegistrar reg(
         }
         const std::string run_failure = knit::macro::run_failure_message(run);
         sum << "final run: " << (run.succeeded() ? "completed" : run_failure) << "\n";
+        for (const std::string& n : knit::macro::final_run_step_notes(d))
+          sum << "note: " << n << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());
         out.commit();
         for (const auto& h : r.history)

@@ -1,6 +1,7 @@
 // The design objective as residuals with their Jacobian (knit/macro/design_problem.hpp).
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/design_sensitivity.hpp"
@@ -195,6 +196,44 @@ DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<doubl
       out.message = "a residual is not finite";
     }
   return out;
+}
+
+std::vector<std::string> final_run_step_notes(const DesignProblem& d) {
+  std::vector<std::string> notes;
+  if (!d.c.output.applied || d.c.output.applied->value == 0.0) return notes;
+  const double L = d.c.output.applied->gauge_length, delta = d.c.output.applied->value;
+  const int steps = std::max(1, d.c.solver.steps), every = std::max(1, d.c.output.every);
+  const double per_step = std::abs(delta) / L / steps;  // strain of one nominal step
+  std::vector<double> seen;
+  for (const auto& o : d.objectives)
+    for (double e : o.at_strain) {
+      if (std::find(seen.begin(), seen.end(), e) != seen.end()) continue;
+      seen.push_back(e);
+      const double k = e * L / delta * steps;  // the step index at this strain
+      const double nearest = std::round(k);
+      std::ostringstream s;
+      s.precision(6);
+      if (std::abs(k - nearest) > 1e-9 * std::max(1.0, std::abs(k))) {
+        const double below = std::floor(k) * per_step, above = std::ceil(k) * per_step;
+        s << "the final run (run/) has no step at strain " << e << " of " << o.name << ": its "
+          << steps << " steps lie every " << per_step << " of strain (nearest " << below << " and "
+          << above << "); what the design reached there was solved at " << e << " itself";
+        const double lambda = e * L / delta;  // the smallest step count with a step there
+        for (int q = 1; q <= 1000; ++q)
+          if (std::abs(lambda * q - std::round(lambda * q)) <= 1e-9 * q) {
+            s << "; a step count (/solver/steps of the case) that is a multiple of " << q
+              << " has one";
+            break;
+          }
+        notes.push_back(s.str());
+      } else if (static_cast<long>(nearest) % every != 0 && static_cast<long>(nearest) != steps) {
+        s << "the final run (run/) writes its fields only every " << every
+          << " steps and at the last (/output/every): none at strain " << e << " of " << o.name
+          << " (step " << static_cast<long>(nearest) << "; its row is in run/load_strain.csv)";
+        notes.push_back(s.str());
+      }
+    }
+  return notes;
 }
 
 }  // namespace knit::macro

@@ -725,3 +725,33 @@ TEST_CASE("design terms: the strain objectives report their region's mean and sp
   }
   CHECK(i == e.residuals.size());
 }
+
+// Session 40's walkthrough: a target at 20 % with steps of 1.5 % had no row or field in the
+// final run (run/), unsaid. write_case: 2 steps to 4 mm over a gauge length of 20 mm (steps at
+// strains 0.1 and 0.2).
+TEST_CASE("design: the final run's missing steps at an objective's strain are noted", "[unit]") {
+  const std::string c = write_case(false);
+  const std::string reaction =
+      R"([{"type": "reaction", "name": "fy_at", "reaction": "fy", "at_strain": [%], "target": [#]}])";
+  const auto objectives = [&](const std::string& at, const std::string& t) {
+    std::string o = reaction;
+    o.replace(o.find('%'), 1, at);
+    o.replace(o.find('#'), 1, t);
+    return o;
+  };
+  DesignProblem d = problem(c, "steps_on.json", objectives("0.1, 0.2", "1, 2"), 0.0, kStitchVars);
+  CHECK(final_run_step_notes(d).empty());
+  d = problem(c, "steps_off.json", objectives("0.15, 0.2", "1, 2"), 0.0, kStitchVars);
+  auto notes = final_run_step_notes(d);
+  REQUIRE(notes.size() == 1);
+  CHECK_THAT(notes[0], Catch::StartsWith("the final run (run/) has no step at strain 0.15 of "
+                                         "fy_at: its 2 steps lie every 0.1 of strain (nearest "
+                                         "0.1 and 0.2)"));
+  CHECK_THAT(notes[0], Catch::EndsWith("a multiple of 4 has one"));  // 0.15 = 3/4 of 0.2
+  d = problem(c, "steps_every.json", objectives("0.1, 0.2", "1, 2"), 0.0, kStitchVars);
+  d.c.output.every = 2;  // fields at step 2 (every 2nd, also the last), not at step 1
+  notes = final_run_step_notes(d);
+  REQUIRE(notes.size() == 1);
+  CHECK_THAT(notes[0], Catch::Contains("writes its fields only every 2 steps and at the last "
+                                       "(/output/every): none at strain 0.1 of fy_at (step 1;"));
+}

@@ -220,5 +220,11 @@ namespace knit::macro {
 /// The case text with the variables at x and the database path made absolute, so that the
 /// file runs as is with `knit-macro run` from any directory.
 std::string design_case_text(const DesignProblem& d, const std::vector<double>& x);
+/// Where the final run (run/, the case's own load steps) has no state at an objective's strain
+/// (session 40's walkthrough: a target at 20 % with steps of 1.5 % had no row or field there):
+/// one note per such strain, naming the objective, the nearest steps and how to get one (a
+/// step count); and where the step exists but /output/every writes no fields at it. The
+/// values the design reached are solved at the objective's strain itself either way.
+std::vector<std::string> final_run_step_notes(const DesignProblem& d);
 
 }  // namespace knit::macro
