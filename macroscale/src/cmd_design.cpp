@@ -46,7 +46,14 @@ knit::cli::SubcommandRegistrar reg(
     "design", "Inverse design of the stitch-value and knitting-angle fields (--check: validate)",
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
-      sub.add_option("design", o->file, "design file (JSON)")->required();
+      // What a design file holds, in the help (session 40's walkthrough: the objective types
+      // were only in docs/design.md).
+      sub.add_option("design", o->file,
+                     "design file (JSON, schemas/design.schema.json; docs/design.md): a knit case, "
+                     "variables (stitch_value or knitting_angle control values with bounds), "
+                     "objectives (reaction, displacement, strain_variance, target_strain, "
+                     "reaction_linearity; at applied strains) and a smoothness penalty")
+          ->required();
       sub.add_flag("--check", o->check, "read and check the design file, print the problem");
       sub.add_option("-o,--output,--out", o->output, "output directory");
       return [o]() -> int {

@@ -473,6 +473,19 @@ TEST_CASE("knit-macro --help and run --help state the exit codes and units", "[u
     CHECK(help.find("2 bad command line or input") != std::string::npos);
     CHECK(help.find("Units: mm, N, MPa.") != std::string::npos);
   }
+  // design --help names every objective type of the schema (session 40's walkthrough: they
+  // were only in docs/design.md).
+  const std::string line = std::string(KNIT_BIN_DIR) + "/knit-macro design --help > " +
+                           (d / "help.txt").string() + " 2>&1";
+  CHECK(std::system(line.c_str()) == 0);
+  const std::string help = slurp(d / "help.txt");
+  const json schema = json::parse(slurp(fs::path(KNIT_SOURCE_DIR) / "schemas/design.schema.json"));
+  const json& kinds = schema["properties"]["objectives"]["items"]["properties"]["type"]["enum"];
+  REQUIRE(kinds.size() == 5);
+  for (const auto& k : kinds) {
+    INFO(k.get<std::string>());
+    CHECK(help.find(k.get<std::string>()) != std::string::npos);
+  }
   fs::remove_all(d);
 }
 
