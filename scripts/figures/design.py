@@ -77,6 +77,19 @@ def field_unit(name, scale):
     return "deg" if scale != 1.0 else "rad"
 
 
+def colour_limits(F, flat=1e-6, span=0.01):
+    """(vmin, vmax, uniform) of a designed field's map. A field whose values differ by at most
+    `flat` x their size (or 1) is uniform: drawn in one colour on a scale of +-`span` x its
+    value (session 40's walkthrough: l = 5.982232096 +- 1e-11 was drawn as a full gradient, its
+    colour bar read 0.6 ... 2.0 mm under an offset 'le-11+5.98' that ran into the title)."""
+    lo, hi = float(np.nanmin(F)), float(np.nanmax(F))
+    size = max(abs(lo), abs(hi), 1.0)
+    if hi - lo > flat * size:
+        return lo, hi, False
+    mid = 0.5 * (lo + hi)
+    return mid - span * size, mid + span * size, True
+
+
 def read_summary(path):
     """summary.txt of a design -> {key: text} of its 'key: value' lines ({} when missing)."""
     out = {}
@@ -210,12 +223,17 @@ def main():
     for i, (name, (u, v, F, C, scale)) in enumerate(fields):
         ax = axes[0][i + 1]
         unit = field_unit(name, scale)
-        im = ax.imshow(F, origin="lower", extent=(u[0], u[-1], v[0], v[-1]), aspect="equal", cmap="viridis")
-        fig.colorbar(im, ax=ax, label=("l" if name == "stitch_value" else "alpha") + f" ({unit})")
+        vmin, vmax, uniform = colour_limits(F)
+        im = ax.imshow(F, origin="lower", extent=(u[0], u[-1], v[0], v[-1]), aspect="equal",
+                       cmap="viridis", vmin=vmin, vmax=vmax)
+        cb = fig.colorbar(im, ax=ax, label=("l" if name == "stitch_value" else "alpha") + f" ({unit})")
+        cb.formatter.set_useOffset(False)
+        cb.update_ticks()
         ax.set_xlabel("theta1 (u)")
         ax.set_ylabel("theta2 (v)")
-        ax.set_title(f"designed {name}")
-        if C.shape[1] > 1:  # the profile along u at mid-height, in an inset with its own axis
+        ax.set_title(f"designed {name}" + (f": uniform {0.5 * (vmin + vmax):.6g} {unit}"
+                                           if uniform else ""), fontsize=11 if not uniform else 9)
+        if C.shape[1] > 1 and not uniform:  # the profile along u at mid-height, in an inset
             # (until session 25 it was drawn over the map in the map's coordinates, where it
             # read as a line of the domain at theta2 ~ 0.2)
             prof = F[F.shape[0] // 2]
@@ -224,7 +242,8 @@ def main():
             ins.set_facecolor((1, 1, 1, 0.85))
             ins.set_title(f"along v = 0.5: {prof.min():.3g} ... {prof.max():.3g} {unit}",
                           fontsize=6, pad=2)
-            ins.tick_params(labelsize=5, pad=1, length=2)
+            ins.tick_params(labelsize=6, pad=1, length=2)
+            ins.ticklabel_format(axis="y", useOffset=False)
             ins.margins(x=0)
     k = 1 + len(fields)
     if curve is not None:
@@ -293,6 +312,10 @@ def main():
             ax.axhline(np.mean(E), color="tab:red", ls="--", lw=1,
                        label=f"uniform (strain_variance target): mean {np.mean(E):.3g}")
             ax.legend(fontsize=7)
+        lo, hi, flat = colour_limits(E, span=0.01)
+        if flat:  # a uniform strain: no offset axis of round-off (session 40's walkthrough)
+            ax.set_ylim(lo, hi)
+        ax.ticklabel_format(axis="y", useOffset=False)
         ax.set_xlabel("theta1 (u) at v = 0.5")
         ax.set_ylabel(a.section + " [-]")
         ax.set_title(f"final run: {a.section} along the section at load factor {load_factor:.3g}\n"

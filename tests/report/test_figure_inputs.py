@@ -139,6 +139,15 @@ def main():
       "one value in mm: %s" % (design.reached_values(summ, "center_ux"),))
     c(design.reached_values(summ, "bad") is None and design.reached_values(summ, "none") is None,
       "a line without numbers and a missing line give None")
+    # A field uniform to round-off is drawn in one colour around its value (session 40).
+    import numpy as np
+    lo, hi, uniform = design.colour_limits(np.array([[5.982232096, 5.982232096 + 1e-11]]))
+    c(uniform and abs(lo - (5.982232096 - 0.01 * 5.982232096)) < 1e-9 and lo < 5.98 < 6.0 < hi,
+      "l = 5.98 +- 1e-11: uniform, scale 5.98 +- 1 %%: %s" % ((lo, hi, uniform),))
+    lo, hi, uniform = design.colour_limits(np.array([[4.5, 6.5]]))
+    c(not uniform and (lo, hi) == (4.5, 6.5), "a graded field keeps its range: %s" % ((lo, hi),))
+    lo, hi, uniform = design.colour_limits(np.zeros((2, 2)))
+    c(uniform and (lo, hi) == (-0.01, 0.01), "alpha = 0: +-0.01 around 0: %s" % ((lo, hi),))
     return c.exit_code()
 
 
