@@ -155,10 +155,20 @@ int run(const Options& o) {
       pvd.emplace_back(double(k), name);
     }
   });
+  const int n = static_cast<int>(res.steps.size()) - 1;
+  // A path with no converged load step writes nothing and leaves an earlier output in place,
+  // as knit-macro run does (session 40's data-safety red team: `--biaxial 9 9` replaced a
+  // complete earlier path by its reference state alone).
+  if (!res.completed && n <= 0) {
+    std::fprintf(stderr,
+                 "knit-meso path: %s; no load step converged: nothing written; the earlier "
+                 "outputs in %s, if any, are left as they were\n",
+                 res.message.c_str(), o.out.c_str());
+    return knit::kExitFailure;
+  }
   knit::meso::cell::write_text_atomic((dir / "path.csv").string(), csv);
   if (!o.no_vtp) knit::meso::cell::write_pvd((dir / "yarn.pvd").string(), pvd);
   dir.commit();  // a run that stopped early keeps its converged steps (exit 1)
-  const int n = static_cast<int>(res.steps.size()) - 1;
   std::printf(
       "%s: %d steps in %.3f s (%.4f s/step, %.1f Newton iterations/step), "
       "equilibration %.3f s -> %s/path.csv\n",

@@ -272,3 +272,35 @@ TEST_CASE("knit-meso path: a step that does not converge is reported on stderr",
   fs::remove_all(out);
   fs::remove(err);
 }
+
+// Session 40's data-safety red team: a path whose first step does not converge replaced a
+// complete earlier output in the same place by its reference state alone (exit 1). Now it
+// writes nothing, as knit-macro run does, and the earlier output stays as it was.
+TEST_CASE("knit-meso path: no converged step leaves an earlier output as it was", "[unit]") {
+  const std::string out = std::string(KNIT_BINARY_DIR) + "/test_cell_cmd_keeps_earlier";
+  fs::remove_all(out);
+  const std::string exe = "timeout 60 " + std::string(KNIT_BIN_DIR) + "/knit-meso path ";
+  const std::string err = out + "_stderr.txt";
+  REQUIRE(std::system((exe + "--loop-length 5 --biaxial 0.01 0.01 --steps 1 --no-vtp --out " + out +
+                       " > /dev/null 2>&1")
+                          .c_str()) == 0);
+  const auto slurp = [](const std::string& f) {
+    std::ifstream in(f);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  const std::string before = slurp(out + "/path.csv");
+  REQUIRE(before.find("\n1,") != std::string::npos);  // the earlier output's step 1
+  // A biaxial stretch of 9 (E = 40): the yarns sink into each other in the first step.
+  const int rc = std::system((exe + "--loop-length 5 --biaxial 9 9 --steps 2 --no-vtp --out " +
+                              out + " > /dev/null 2> " + err)
+                                 .c_str());
+  REQUIRE(WIFEXITED(rc));
+  CHECK(WEXITSTATUS(rc) == 1);
+  CHECK(slurp(err).find("no load step converged: nothing written; the earlier outputs in " + out +
+                        ", if any, are left as they were") != std::string::npos);
+  CHECK(slurp(out + "/path.csv") == before);
+  fs::remove_all(out);
+  fs::remove(err);
+}
