@@ -19,6 +19,11 @@
 namespace knit::macro {
 
 namespace {
+/// The largest ratio of two NURBS weights of a case (a geometry check, session 40).
+constexpr double kMaxWeightRatio = 1e6;
+}  // namespace
+
+namespace {
 
 /// Upper bounds of the solver's tolerances (schemas/case.schema.json "maximum"): relative to the
 /// load, and in N.
@@ -209,6 +214,21 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
       if (!(wv[a] > 0.0))
         r.fail("/geometry/weights/" + std::to_string(a), "weights must be positive");
       w(a) = wv[a];
+    }
+    // Weights orders of magnitude apart (session 40's red team: a weight of 1e-320 beside 1 was
+    // reported at /geometry/control_points as a degenerate Jacobian, "coincident or collinear
+    // control points?"). Far beyond what the quadrature check below accepts (1, 1, 1, 10 on
+    // one element already fails it), so no geometry it passes is refused here.
+    const Eigen::Index lo = [&] {
+      Eigen::Index i = 0;
+      w.minCoeff(&i);
+      return i;
+    }();
+    if (w.maxCoeff() > kMaxWeightRatio * w(lo)) {
+      std::ostringstream m;
+      m << "the weights must lie within a factor of " << kMaxWeightRatio
+        << " of each other; this one is " << w(lo) << " beside a largest of " << w.maxCoeff();
+      r.fail("/geometry/weights/" + std::to_string(lo), m.str());
     }
   }
   c.thickness = r.positive(g.at("thickness"), "/geometry/thickness");

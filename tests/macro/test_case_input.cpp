@@ -843,6 +843,11 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
                           0) == 0);
   j["geometry"]["weights"] = {1, 1, 1, 3};  // 2.5e-6 off: accepted
   CHECK(error_of(j).empty());
+  // Session 40's red team: a weight of 1e-320 was blamed on the control points.
+  j["geometry"]["weights"] = {1, 1, 1e-320, 1};
+  CHECK_THAT(error_of(j), Catch::StartsWith("w.json: /geometry/weights/2: the weights must lie "
+                                            "within a factor of 1e+06 of each other; this one is "
+                                            "9.99989e-321 beside a largest of 1"));
   j["geometry"]["weights"] = {1, 1, 1, 10};
   j["refinement"]["elements"] = {4, 4};  // 4.2e-6 off: accepted
   CHECK(error_of(j).empty());
