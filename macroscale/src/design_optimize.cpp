@@ -59,7 +59,15 @@ DesignStop design_stop(const DesignProblem& d, const std::vector<double>& x,
     const double room = gi > 0.0 ? x[i] - v.lower : v.upper - x[i];
     inward = std::max(inward, std::abs(gi) * std::max(0.0, room));
   }
-  if (largest <= 1e-9 * J) return DesignStop::kStationary;
+  // A vanishing gradient where the design never moved: descent could not start (the review of
+  // session 40: at a minimum the optimizer reached, the gradient vanishes as well, and that is
+  // no "stationary start").
+  bool moved = false;
+  for (std::size_t i = 0; i < d.variables.size(); ++i) {
+    const auto& v = d.variables[i];
+    moved = moved || std::abs(x[i] - v.initial) > 1e-9 * (v.upper - v.lower);
+  }
+  if (largest <= 1e-9 * J && !moved) return DesignStop::kStationary;
   if (inward > 1e-2 * J) return DesignStop::kNotStationary;
   // Any gradient out of the bounds above the stationary level: the bound holds the design
   // (an unreachable target's J can be large and flat, design_terms' 1e8 with |dJ/dl| 2e5).
@@ -113,10 +121,11 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
   switch (stop) {
     case DesignStop::kStationary:
       why =
-          ": the gradient of J vanishes at this design (|dJ/dx| x interval <= 1e-9 J), a "
-          "stationary point where descent cannot start, not a minimum; a knitting angle of 0 "
-          "or +-90 deg is one (the material is symmetric about it, so J is even in alpha "
-          "there): start the variables from other values";
+          ": the gradient of J vanishes at the start, which the optimizer never left (|dJ/dx| "
+          "x interval <= 1e-9 J): J does not change with the variables there to first order, "
+          "a symmetry point (a knitting angle of 0 or +-90 deg: the material is symmetric "
+          "about it, so J is even in alpha) or objectives that do not depend on them; start "
+          "the variables from other values or check what the objectives measure";
       break;
     case DesignStop::kNotStationary:
       why =
@@ -138,8 +147,8 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
       }
       why = on_bound ? std::string(": a local minimum of J; no gradient points out of the bounds")
                      : std::string(
-                           ", inside the bounds: a local minimum of J, or a stop by "
-                           "the function tolerance (") +
+                           ", inside the bounds (or against a bound not quite reached): a "
+                           "local minimum of J, or a stop by the function tolerance (") +
                            tol + ")";
       break;
   }

@@ -624,29 +624,39 @@ TEST_CASE("design status: a variable on either bound makes a stop an infeasible 
 // the targets lie outside the bounds". With the best design's gradient the stop is told apart:
 // infeasible only where a variable on a bound has a gradient pointing out of the bounds.
 TEST_CASE("design status: the gradient on the bounds decides an infeasible target", "[unit]") {
-  const DesignProblem d = one_variable_design(0.0);  // l in [4.5, 6.5]: interval 2 mm
-  const OptimizeOptions opt;
+  // l in [4.5, 6.5]: interval 2 mm. `start` is the variable's initial value: a vanishing
+  // gradient is a stationary start only where the design never left it (the session's review:
+  // at a minimum the optimizer reached, two reaction targets 44 and 52 N met by 48 N, the
+  // gradient vanishes too, and that is a local minimum).
   struct Row {
-    double x, g;
+    double x, g, start;
     DesignStatus status;
     const char* says;
   };
+  constexpr const char* kMinimum = "a local minimum of J, or a stop by the function tolerance";
   for (const Row& row : {
-           Row{4.5, 6e-17, DesignStatus::kTargetNotMet, "the gradient of J vanishes"},
-           Row{4.5, 1.0, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
-           Row{6.5, -1.0, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
-           Row{6.5, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
-           Row{4.5, -1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
-           Row{5.5, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
-           Row{5.5, 1e-4, DesignStatus::kTargetNotMet, "inside the bounds: a local minimum"},
+           Row{4.5, 6e-17, 4.5, DesignStatus::kTargetNotMet,
+               "the gradient of J vanishes at the start"},
+           Row{4.5, 1e-10, 4.5, DesignStatus::kTargetNotMet,
+               "the gradient of J vanishes at the start"},
+           Row{5.0, 1e-12, 5.5, DesignStatus::kTargetNotMet, kMinimum},  // moved: a minimum
+           Row{4.5, 1e-12, 5.5, DesignStatus::kTargetNotMet, "a local minimum of J; no gradient"},
+           Row{4.5, 1.0, 5.5, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           Row{6.5, -1.0, 5.5, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           Row{6.5, 1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{4.5, -1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{5.5, 1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{5.5, 1e-4, 5.5, DesignStatus::kTargetNotMet, kMinimum},
            // Creeping towards a bound 0.001 mm away (example (b)'s l6): little room, no stop.
-           Row{6.499, -1.0, DesignStatus::kTargetNotMet, "inside the bounds: a local minimum"},
-           Row{6.499, 1.0, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
-           Row{4.5, -1e-4, DesignStatus::kTargetNotMet, "a local minimum of J; no gradient"},
-           Row{4.5, 1e-4, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
-           Row{4.5, 1e-10, DesignStatus::kTargetNotMet, "the gradient of J vanishes"},
+           Row{6.499, -1.0, 5.5, DesignStatus::kTargetNotMet, kMinimum},
+           Row{6.499, 1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
+           Row{4.5, -1e-4, 5.5, DesignStatus::kTargetNotMet, "a local minimum of J; no gradient"},
+           Row{4.5, 1e-4, 5.5, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
        }) {
-    INFO("x = " << row.x << ", dJ/dx = " << row.g);
+    INFO("x = " << row.x << ", dJ/dx = " << row.g << ", start " << row.start);
+    DesignProblem d = one_variable_design(0.0);
+    d.variables[0].initial = row.start;
+    const OptimizeOptions opt;
     DesignResult r;
     r.x = {row.x};
     r.gradient = Eigen::VectorXd::Constant(1, row.g);
@@ -859,7 +869,10 @@ TEST_CASE("design: summary.txt gives what the design reached, the final run's ow
             "variables": [{"name": "l", "field": "stitch_value", "indices": [0, 1],
                            "lower": 4.5, "upper": 6.5}],
             "objectives": [{"type": "reaction", "name": "load", "reaction": "fy",
-                            "at_strain": [0.2], "target": [1e6]}]})");
+                            "at_strain": [0.2], "target": [1e6]},
+                           {"type": "target_strain", "name": "mean22", "component": "E22",
+                            "region": {"u": [0.2, 0.8], "v": [0.2, 0.8]},
+                            "at_strain": [0.15], "target": [0.1], "weight": 1e-6}]})");
   const fs::path out = kDir / "reach_out";
   CHECK(design_into(kDir / "reach.json", out) == 0);
   const std::string summary = knit_test::read_text(out / "summary.txt");
@@ -877,6 +890,14 @@ TEST_CASE("design: summary.txt gives what the design reached, the final run's ow
   CHECK(reached == Approx(std::stod(values[std::size_t(col - names.begin())])).epsilon(1e-5));
   CHECK(summary.find(" N (target ") != std::string::npos);
   CHECK(summary.find("; at strain 0.2)") != std::string::npos);
+  // Session 40: a strain objective's line with its component in the unit slot, Ceres' reason
+  // for a stop that is not converged, and a note for a strain with no step of the final run.
+  CHECK(number_after(summary, "reached mean22: ") > 0.0);
+  CHECK(summary.find(" E22 (the mean over the region's samples; target 0.1; at strain 0.15)") !=
+        std::string::npos);
+  CHECK(summary.find("; Ceres: ") != std::string::npos);
+  CHECK(summary.find("\nnote: the final run (run/) has no step at strain 0.15 of mean22") !=
+        std::string::npos);
   fs::remove_all(out);
 }
 

@@ -188,8 +188,9 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& options, Sol
 /// the bounds was called the same). With s_i = |dJ/dx_i| (upper_i - lower_i), the first-order
 /// change of J over variable i's whole interval, and the projected gradient (a component on a
 /// bound that points out of the bounds counts 0):
-///  * kStationary: every s_i <= 1e-9 J: the gradient vanishes (a symmetry point, not a descent's
-///    minimum);
+///  * kStationary: every s_i <= 1e-9 J at a design that never left the start: the gradient
+///    vanishes there (a symmetry point, or objectives that do not depend on the variables);
+///    where the optimizer moved, a vanishing gradient is a minimum (kInside);
 ///  * kNotStationary: a variable whose gradient does not point out of the bounds has
 ///    |dJ/dx_i| times the room left towards the bound it descends to > 1e-2 J: J still
 ///    decreases inside the bounds;
