@@ -203,7 +203,7 @@ std::vector<std::string> final_run_step_notes(const DesignProblem& d) {
   if (!d.c.output.applied || d.c.output.applied->value == 0.0) return notes;
   const double L = d.c.output.applied->gauge_length, delta = d.c.output.applied->value;
   const int steps = std::max(1, d.c.solver.steps), every = std::max(1, d.c.output.every);
-  const double per_step = std::abs(delta) / L / steps;  // strain of one nominal step
+  const double per_step = delta / L / steps;  // strain of one nominal step, with its sign
   std::vector<double> seen;
   for (const auto& o : d.objectives)
     for (double e : o.at_strain) {
@@ -227,9 +227,13 @@ std::vector<std::string> final_run_step_notes(const DesignProblem& d) {
           }
         notes.push_back(s.str());
       } else if (static_cast<long>(nearest) % every != 0 && static_cast<long>(nearest) != steps) {
+        // Counted in nominal steps: a cut-back adds converged sub-steps and moves the count of
+        // /output/every (the session's review), so the note says which count it assumes.
         s << "the final run (run/) writes its fields only every " << every
-          << " steps and at the last (/output/every): none at strain " << e << " of " << o.name
-          << " (step " << static_cast<long>(nearest) << "; its row is in run/load_strain.csv)";
+          << " converged steps and at the last (/output/every): strain " << e << " of " << o.name
+          << " is its nominal step " << static_cast<long>(nearest)
+          << ", which gets none unless a cut-back shifted the count; its row is in "
+             "run/load_strain.csv";
         notes.push_back(s.str());
       }
     }

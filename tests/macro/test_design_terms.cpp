@@ -748,10 +748,19 @@ TEST_CASE("design: the final run's missing steps at an objective's strain are no
                                          "fy_at: its 2 steps lie every 0.1 of strain (nearest "
                                          "0.1 and 0.2)"));
   CHECK_THAT(notes[0], Catch::EndsWith("a multiple of 4 has one"));  // 0.15 = 3/4 of 0.2
+  // A pull towards -y (the session's review: the nearest steps were printed without their
+  // sign): steps at strains -0.1 and -0.2.
+  const std::string cneg = write_case_variant("neg_case.json", R"("y": 4.0)", R"("y": -4.0)");
+  d = problem(cneg, "steps_neg.json", objectives("-0.15", "1"), 0.0, kStitchVars);
+  notes = final_run_step_notes(d);
+  REQUIRE(notes.size() == 1);
+  CHECK_THAT(notes[0], Catch::Contains("no step at strain -0.15 of fy_at: its 2 steps lie every "
+                                       "-0.1 of strain (nearest -0.1 and -0.2)"));
   d = problem(c, "steps_every.json", objectives("0.1, 0.2", "1, 2"), 0.0, kStitchVars);
   d.c.output.every = 2;  // fields at step 2 (every 2nd, also the last), not at step 1
   notes = final_run_step_notes(d);
   REQUIRE(notes.size() == 1);
-  CHECK_THAT(notes[0], Catch::Contains("writes its fields only every 2 steps and at the last "
-                                       "(/output/every): none at strain 0.1 of fy_at (step 1;"));
+  CHECK_THAT(notes[0], Catch::Contains("writes its fields only every 2 converged steps and at the "
+                                       "last (/output/every): strain 0.1 of fy_at is its nominal "
+                                       "step 1, which gets none"));
 }
