@@ -217,18 +217,24 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
     }
     // Weights orders of magnitude apart (session 40's red team: a weight of 1e-320 beside 1 was
     // reported at /geometry/control_points as a degenerate Jacobian, "coincident or collinear
-    // control points?"). Far beyond what the quadrature check below accepts (1, 1, 1, 10 on
-    // one element already fails it), so no geometry it passes is refused here.
-    const Eigen::Index lo = [&] {
-      Eigen::Index i = 0;
-      w.minCoeff(&i);
-      return i;
-    }();
-    if (w.maxCoeff() > kMaxWeightRatio * w(lo)) {
+    // control points?"). Named at the weight farthest from the median in log (the review: the
+    // smallest blamed an ordinary 1 beside a 1e6).
+    if (w.maxCoeff() > kMaxWeightRatio * w.minCoeff()) {
+      std::vector<double> logs(wv.size());
+      for (std::size_t a = 0; a < wv.size(); ++a) logs[a] = std::log(wv[a]);
+      std::vector<double> sorted = logs;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      const double median = sorted[sorted.size() / 2];
+      std::size_t far = 0;
+      for (std::size_t a = 1; a < logs.size(); ++a)
+        if (std::abs(logs[a] - median) > std::abs(logs[far] - median)) far = a;
       std::ostringstream m;
+      m.precision(10);
       m << "the weights must lie within a factor of " << kMaxWeightRatio
-        << " of each other; this one is " << w(lo) << " beside a largest of " << w.maxCoeff();
-      r.fail("/geometry/weights/" + std::to_string(lo), m.str());
+        << " of each other; they range from " << w.minCoeff() << " to " << w.maxCoeff()
+        << ", and this one, " << wv[far] << ", lies farthest from their median "
+        << std::exp(median);
+      r.fail("/geometry/weights/" + std::to_string(far), m.str());
     }
   }
   c.thickness = r.positive(g.at("thickness"), "/geometry/thickness");
@@ -593,11 +599,23 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   read_geometry(r, root, c);
   // A zero or flipped Jacobian anywhere (corners and edges included) is bad input, refused
   // before any work (knit/macro/geometry_check.hpp).
+  // With NURBS weights that differ, the weights bend the map as well (the session's review:
+  // weights 1, 1, 1e5, 1 were blamed on "coincident or collinear control points?" alone).
+  const auto weights_note = [&]() -> std::string {
+    if (!c.input_surface.rational()) return {};
+    const Eigen::VectorXd& wt = c.input_surface.weights();
+    if (wt.maxCoeff() <= wt.minCoeff()) return {};
+    std::ostringstream m;
+    m.precision(6);
+    m << "; or the NURBS weights (/geometry/weights, from " << wt.minCoeff() << " to "
+      << wt.maxCoeff() << "): weights far apart degenerate the map as well";
+    return m.str();
+  };
   if (const auto bad = find_geometry_defect(c.surface))
-    r.fail("/geometry/control_points", bad->message);
+    r.fail("/geometry/control_points", bad->message + weights_note());
   if (const auto bad =
           find_geometry_defect(c.input_surface, dense_samples_per_span(c.input_surface)))
-    r.fail("/geometry/control_points", bad->message);
+    r.fail("/geometry/control_points", bad->message + weights_note());
   // The shell's quadrature must integrate at least the area of every element (session 28: NURBS
   // weights 1, 1, 1, 10 on the one-element tensile patch, the same flat square, gave 23 % more
   // jaw force with the area integrated 0.5 % off; weights up to 1e4 ran with exit 0, results

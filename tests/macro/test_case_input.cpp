@@ -846,8 +846,19 @@ TEST_CASE("a surface whose area the shell's quadrature misses is refused at load
   // Session 40's red team: a weight of 1e-320 was blamed on the control points.
   j["geometry"]["weights"] = {1, 1, 1e-320, 1};
   CHECK_THAT(error_of(j), Catch::StartsWith("w.json: /geometry/weights/2: the weights must lie "
-                                            "within a factor of 1e+06 of each other; this one is "
-                                            "9.99989e-321 beside a largest of 1"));
+                                            "within a factor of 1000000 of each other; they range "
+                                            "from 9.999888672e-321 to 1, and this one, "
+                                            "9.999888672e-321, lies farthest from their median 1"));
+  // The outlier is named, not the smallest (the session's review: 1, 1, 1.0000001e6, 1 blamed
+  // weight 0, an ordinary 1, "beside a largest of 1e+06").
+  j["geometry"]["weights"] = {1, 1, 1.0000001e6, 1};
+  CHECK_THAT(error_of(j), Catch::StartsWith("w.json: /geometry/weights/2: "));
+  CHECK_THAT(error_of(j), Catch::Contains("this one, 1000000.1, lies farthest"));
+  // Below the ratio, a degenerate map names the weights beside the control points.
+  j["geometry"]["weights"] = {1, 1, 1e5, 1};
+  CHECK_THAT(error_of(j), Catch::StartsWith("w.json: /geometry/control_points: "));
+  CHECK_THAT(error_of(j), Catch::Contains("; or the NURBS weights (/geometry/weights, from 1 to "
+                                          "100000): weights far apart degenerate the map as well"));
   j["geometry"]["weights"] = {1, 1, 1, 10};
   j["refinement"]["elements"] = {4, 4};  // 4.2e-6 off: accepted
   CHECK(error_of(j).empty());
