@@ -61,10 +61,13 @@ def own_uniaxial(law, e_axial, axis):
     ok = (stress(lo)[..., 1 - axis] <= 0.0) & (stress(hi)[..., 1 - axis] >= 0.0)
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
-        up = stress(mid)[..., 1 - axis] > 0.0
+        s_mid = stress(mid)[..., 1 - axis]
+        ok &= np.isfinite(s_mid)  # a non-finite stress on the way: that state is missing
+        up = s_mid > 0.0
         hi, lo = np.where(up, mid, hi), np.where(up, lo, mid)
     lateral = 0.5 * (lo + hi)
     axial = stress(lateral)[..., axis]
+    ok &= np.isfinite(axial)
     return np.where(ok, lateral, np.nan), np.where(ok, axial, np.nan)
 
 

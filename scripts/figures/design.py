@@ -298,6 +298,7 @@ def main():
         ax.plot(u, E, "-", label="final run")
         # target_strain objectives of this component whose region holds the section v = 0.5:
         # each target over its region's u interval (session 40's walkthrough: not drawn).
+        drawn = []
         for o in objectives or []:
             reg = o.get("region", {})
             if (o.get("type") != "target_strain" or o.get("component") != a.section
@@ -306,6 +307,7 @@ def main():
             for x, t in zip(np.atleast_1d(o.get("at_strain", [])), o.get("target", [])):
                 ax.plot(reg["u"], [t, t], color="tab:red", ls="--", lw=1.4,
                         label=f"target of {o.get('name', o['type'])}: {t:.3g} at {100 * x:.3g} %")
+                drawn.append(t)
             ax.legend(fontsize=7)
         if any(o.get("type") == "strain_variance" and o.get("component") == a.section
                for o in objectives or []):  # the objective's ideal: a uniform strain
@@ -313,8 +315,11 @@ def main():
                        label=f"uniform (strain_variance target): mean {np.mean(E):.3g}")
             ax.legend(fontsize=7)
         lo, hi, flat = colour_limits(E, span=0.01)
-        if flat:  # a uniform strain: no offset axis of round-off (session 40's walkthrough)
-            ax.set_ylim(lo, hi)
+        if flat:  # a uniform strain: no offset axis of round-off (session 40's walkthrough),
+            # with the targets drawn kept in view (the session's review: they were clipped)
+            lo, hi = min([lo] + drawn), max([hi] + drawn)
+            pad = 0.05 * (hi - lo)
+            ax.set_ylim(lo - pad, hi + pad)
         ax.ticklabel_format(axis="y", useOffset=False)
         ax.set_xlabel("theta1 (u) at v = 0.5")
         ax.set_ylabel(a.section + " [-]")

@@ -115,6 +115,22 @@ def main():
         c(r.get("own_missing") == 1 and abs(r.get("own_median", 0) - 0.225) < 1e-9,
           "E11 = -2 E22 leaves the bracket at E22 = 0.4: 1 missing, median of 0.25 and 0.2: %s" % r)
         c("1 without a zero" in lu.summary([r]), "the sentence says so: %s" % lu.summary([r]))
+        # A law whose stress is not finite on the bisection's way (its first midpoint, lateral
+        # strain 0.5): that state is missing, not taken for a stress <= 0 (the session's review).
+        class Holed:
+            def eval(self, e):
+                S = 2.0 * np.asarray(e, float)
+                S[np.abs(e[..., 0] - 0.5) < 0.05] = np.nan
+                return None, S
+        lat, ax = lu.own_uniaxial(Holed(), [0.1, 0.2], 1)
+        c(np.isnan(lat).all() and np.isnan(ax).all(),
+          "a non-finite stress at a midpoint makes the state missing: %s, %s" % (lat, ax))
+        class Whole:
+            def eval(self, e):
+                return None, 2.0 * np.asarray(e, float)
+        lat, ax = lu.own_uniaxial(Whole(), [0.1, 0.2], 1)
+        c(np.allclose(lat, 0.0, atol=1e-15) and np.allclose(ax, [0.2, 0.4]),
+          "the same law without the hole: lateral 0, axial 2 E22: %s, %s" % (lat, ax))
         rows = lu.uniaxial_ratios(db, 0.2)
         wale = [r for r in rows if r["axis"] == "wale"]
         c(wale and wale[0]["n"] == 3 and abs(wale[0]["lateral"] - 0.25) < 1e-12,
