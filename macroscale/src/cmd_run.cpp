@@ -49,7 +49,12 @@ knit::cli::SubcommandRegistrar reg(
         if (!r.succeeded()) {
           std::cerr << "knit-macro run: " << o->case_file << ": "
                     << knit::macro::run_failure_message(r)
-                    << (r.wrote_outputs ? "; outputs in " + ro.output_dir.string() : "") << "\n";
+                    << (r.wrote_outputs ? "; outputs in " + ro.output_dir.string() : "")
+                    << (r.wrote_outputs && r.replaced_earlier
+                            ? " (they replace the earlier outputs there: a stopped run keeps its "
+                              "converged steps)"
+                            : "")
+                    << "\n";
           return knit::kExitFailure;
         }
         std::cout << "wrote " << ro.output_dir.string() << "\n";

@@ -333,6 +333,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
       writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
     writer->finish(res.report);
     res.wrote_outputs = true;
+    res.replaced_earlier = had_output;
     res.output_failure = writer->output_failure();
   }
   return res;

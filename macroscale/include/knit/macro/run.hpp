@@ -112,6 +112,10 @@ struct RunResult {
   /// False when the run wrote no output directory (none asked for, or a run without a
   /// converged step that left an earlier output in place).
   bool wrote_outputs = false;
+  /// The outputs written replaced an earlier output of the same directory (what a stopped
+  /// run's message says: session 40's red team found a complete earlier output replaced by a
+  /// stopped run's, unsaid).
+  bool replaced_earlier = false;
   /// Plain success: every step converged, the material never failed and every output value is
   /// finite.
   bool succeeded() const {
