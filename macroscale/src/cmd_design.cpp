@@ -150,9 +150,7 @@ knit::cli::SubcommandRegistrar reg(
           const auto& o = d.objectives[k];
           if (r.reached[k].empty()) continue;
           using Kind = knit::macro::DesignObjective::Kind;
-          const std::string comp = std::string("E") + (o.component == 0   ? "11"
-                                                       : o.component == 1 ? "22"
-                                                                          : "12");
+          const std::string& comp = o.component_name();
           sum << "reached " << o.name << ":";
           for (double v : r.reached[k]) sum << " " << v;
           // The unit slot (scripts/figures/design.py reads the word before the parenthesis):

@@ -43,11 +43,16 @@ DesignStop design_stop(const DesignProblem& d, const std::vector<double>& x,
       !(J > 0.0) || !g.allFinite())
     return DesignStop::kUnknown;
   double largest = 0.0, inward = 0.0, outward = 0.0;
+  // A vanishing gradient where the design never moved: descent could not start (the review of
+  // session 40: at a minimum the optimizer reached, the gradient vanishes as well, and that is
+  // no "stationary start").
+  bool moved = false;
   for (std::size_t i = 0; i < d.variables.size(); ++i) {
     const auto& v = d.variables[i];
     const double range = v.upper - v.lower, tol = 1e-6 * range;
     const double gi = g(static_cast<Eigen::Index>(i)), si = std::abs(gi) * range;
     largest = std::max(largest, si);
+    moved = moved || std::abs(x[i] - v.initial) > 1e-9 * range;
     // Descent moves x_i along -g_i: out of the bounds at the lower bound when g_i > 0.
     const bool out = (x[i] <= v.lower + tol && gi > 0.0) || (x[i] >= v.upper - tol && gi < 0.0);
     if (out) {
@@ -58,14 +63,6 @@ DesignStop design_stop(const DesignProblem& d, const std::vector<double>& x,
     // variable creeping towards its bound has little: design example (b)'s l6 at 6.494 of 6.5).
     const double room = gi > 0.0 ? x[i] - v.lower : v.upper - x[i];
     inward = std::max(inward, std::abs(gi) * std::max(0.0, room));
-  }
-  // A vanishing gradient where the design never moved: descent could not start (the review of
-  // session 40: at a minimum the optimizer reached, the gradient vanishes as well, and that is
-  // no "stationary start").
-  bool moved = false;
-  for (std::size_t i = 0; i < d.variables.size(); ++i) {
-    const auto& v = d.variables[i];
-    moved = moved || std::abs(x[i] - v.initial) > 1e-9 * (v.upper - v.lower);
   }
   if (largest <= 1e-9 * J && !moved) return DesignStop::kStationary;
   if (inward > 1e-2 * J) return DesignStop::kNotStationary;

@@ -18,6 +18,19 @@
 namespace knit::macro {
 
 namespace {
+/// The component names of an objective kind, in the order of DesignObjective::component.
+const std::vector<std::string>& component_names(DesignObjective::Kind kind) {
+  static const std::vector<std::string> displacement = {"x", "y", "z"};
+  static const std::vector<std::string> strain = {"E11", "E22", "E12"};
+  return kind == DesignObjective::Kind::kDisplacement ? displacement : strain;
+}
+}  // namespace
+
+const std::string& DesignObjective::component_name() const {
+  return component_names(kind).at(static_cast<std::size_t>(component));
+}
+
+namespace {
 
 using nlohmann::json;
 
@@ -218,9 +231,7 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
   if (!j.contains("component")) throw InputError(file, p, "missing required key \"component\"");
   const std::string comp =
       j.at("component").is_string() ? j.at("component").get<std::string>() : "";
-  const std::vector<std::string> allowed = o.kind == DesignObjective::Kind::kDisplacement
-                                               ? std::vector<std::string>{"x", "y", "z"}
-                                               : std::vector<std::string>{"E11", "E22", "E12"};
+  const std::vector<std::string>& allowed = component_names(o.kind);
   const auto ci = std::find(allowed.begin(), allowed.end(), comp);
   if (ci == allowed.end())
     throw InputError(file, p + "/component",

@@ -39,6 +39,13 @@ E = [[-0.05, 0.1, 0], [-0.1, 0.25, 0], [-0.2, 0.5, 0]]
 S = [[0, 0.4, 0], [0, 1.0, 0], [0, 4.0, 0]]
 
 
+def uniaxial_path(*args, axis):
+    """raw_path(*args) marked as a uniaxial-stress path along `axis` (0 course, 1 wale)."""
+    g = raw_path(*args)
+    g.attrs["kind"], g.attrs["axis"] = "uniaxial", axis
+    return g
+
+
 def coupled_db(path, L, E_path, S_path):
     """One loop length, the law S = L L^T e (floor 0), one uniaxial wale path."""
     with h5py.File(path, "w") as f:
@@ -48,8 +55,7 @@ def coupled_db(path, L, E_path, S_path):
         theta[0, 11:] = np.array(L, float).ravel()  # the last 9 parameters: L, row by row
         del law["theta"]
         law["theta"] = theta
-        g = raw_path(f, "path_0", "coverage", E_path, S_path)
-        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
+        uniaxial_path(f, "path_0", "coverage", E_path, S_path, axis=1)
 
 
 def write_db(path, law=True):
@@ -57,17 +63,14 @@ def write_db(path, law=True):
         f["loop_lengths"] = [5.0]
         if law:
             linear_network_law(f, 2.0)
-        g = raw_path(f, "path_0", "coverage", E, S)
-        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
+        uniaxial_path(f, "path_0", "coverage", E, S, axis=1)
         raw_path(f, "path_1", "coverage", E, [[9, 9, 0]] * 3)  # biaxial-like: not counted
         # A second uniaxial wale path of small stresses, cut by its own largest (0.4 MPa), not
         # by path_0's 4 MPa: its states of 0.05 and 0.4 MPa are kept (0.02 is below 10 %), with
         # ratios 0.1 / 0.05 = 2 and 0.2 / 0.4 = 0.5 and lateral shares 0.04 / 0.05 = 0.8, 0.25.
-        g = raw_path(f, "path_3", "coverage", [[-0.01, 0.02, 0], [-0.02, 0.05, 0], [-0.05, 0.1, 0]],
-                     [[0, 0.02, 0], [0, 0.05, 0], [0, 0.4, 0]])
-        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 1
-        g = raw_path(f, "path_2", "holdout", [[0.3, 0, 0]], [[0.1, 0, 0]])
-        g.attrs["kind"], g.attrs["axis"] = "uniaxial", 0
+        uniaxial_path(f, "path_3", "coverage", [[-0.01, 0.02, 0], [-0.02, 0.05, 0], [-0.05, 0.1, 0]],
+                      [[0, 0.02, 0], [0, 0.05, 0], [0, 0.4, 0]], axis=1)
+        uniaxial_path(f, "path_2", "holdout", [[0.3, 0, 0]], [[0.1, 0, 0]], axis=0)
 
 
 def main():

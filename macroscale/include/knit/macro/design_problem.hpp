@@ -31,6 +31,8 @@ struct DesignObjective {
   int reaction = -1;  ///< index into the case's output.reactions
   int point = -1;     ///< index into the case's output.points
   int component = 0;  ///< x, y, z (displacement) or E11, E22, E12 (strain terms)
+  /// The component's name as the design file writes it ("x" ... or "E11" ...).
+  const std::string& component_name() const;
   Eigen::Vector2d u_range = {0, 1}, v_range = {0, 1};
   /// Strain terms: sample points per direction (a uniform grid over the region; a direction
   /// whose range is a single value -- a section -- has one).
