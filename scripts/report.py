@@ -879,6 +879,7 @@ class Report:
             L.append(f"- `{n}`: {summ} (log: logs/{n}.log)")
         if failed:
             L.append("")
+        L.extend(run_warnings(names, self.r))
         L.extend(design_section(self.out))
         L.extend(knitmap_section(self.out))
         L.append("## Figures\n")
@@ -1035,6 +1036,21 @@ def twin_verdict(summ, declared=None, exit_code=0):
     if exit_code != 0:
         parts.append(f"exit {exit_code if exit_code is not None else 'unknown'}")
     return ok, "; ".join(parts)
+
+
+def run_warnings(names, result):
+    """The `warning:` lines of each run's summary.txt (knit-macro's: the law's own uniaxial
+    response against the cell's, extrapolation, load drops, the solver's fallback), one item
+    each, under the runs' table (session 41: the uniaxial one was in the logs only)."""
+    rows = []
+    for n in names:
+        for line in result(n).summary().splitlines():
+            if line.startswith("warning:"):
+                rows.append(f"- `{n}`: {md(line[len('warning:'):].strip())}")
+    if not rows:
+        return ["No run warned (`warning:` lines of summary.txt).\n"]
+    return (["Warnings of the runs (the `warning:` lines of their summary.txt, not judged; "
+             "docs/case-format.md):\n"] + rows + [""])
 
 
 def design_section(out):

@@ -9,6 +9,8 @@ namespace knit::material::detail {
 
 namespace {
 
+constexpr const char* kUniaxialAxes[2] = {"course", "wale"};
+
 std::vector<double> to_vec(const Eigen::VectorXd& v) {
   return {v.data(), v.data() + v.size()};
 }
@@ -137,6 +139,34 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
   d.set_attribute(".", "points_skipped", dg.points_skipped);
   d.set_attribute(".", "min_eigenvalue", dg.min_eigenvalue);
   d.set_attribute(".", "options_json", dg.options_json);
+  // The law's own uniaxial response beside the cell's (session 41; uniaxial_curve.hpp): one
+  // dataset per loop length (row k of loop_length) and axis with such a path.
+  bool any_curve = false;
+  for (const auto& p : dg.per_loop)
+    for (const auto& c : p.uniaxial) any_curve = any_curve || !c.empty();
+  if (any_curve) {
+    io::H5Group u = d.create_group("uniaxial");
+    for (Eigen::Index k = 0; k < n; ++k)
+      for (int ax = 0; ax < 2; ++ax) {
+        const UniaxialCurve& c =
+            dg.per_loop[static_cast<std::size_t>(k)].uniaxial[static_cast<std::size_t>(ax)];
+        if (c.empty()) continue;
+        RowMatrixX m(static_cast<Eigen::Index>(c.strain.size()), 3);
+        for (Eigen::Index i = 0; i < m.rows(); ++i)
+          m.row(i) << c.strain[static_cast<std::size_t>(i)], c.cell[static_cast<std::size_t>(i)],
+              c.law[static_cast<std::size_t>(i)];
+        const std::string name = kUniaxialAxes[ax] + std::string("_") + std::to_string(k);
+        u.write(name, m);
+      }
+    u.set_attribute(".", "columns",
+                    "E_axial (Green-Lagrange), S_cell (MPa), S_law (MPa; NaN: no state of the "
+                    "law there)");
+    u.set_attribute(".", "definition",
+                    "dataset AXIS_K: the cell's uniaxial-stress path along AXIS (course: E11, "
+                    "wale: E22) at loop length row K of loop_length, its converged steps; "
+                    "S_law is the law's axial stress at the same axial strain where the law's "
+                    "lateral stress vanishes (E12 = 0)");
+  }
 }
 
 void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLawData& law,
@@ -293,6 +323,31 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
       if (!std::isfinite(v))
         throw InputError(file, d, "attribute " + std::string(name) + " is not finite");
     dg.options_json = root.attribute_string(d, "options_json");
+    // Optional (session 41): older files have no uniaxial curves.
+    if (root.exists(d + "/uniaxial")) {
+      for (std::size_t k = 0; k < n; ++k)
+        for (int ax = 0; ax < 2; ++ax) {
+          const std::string name =
+              d + "/uniaxial/" + kUniaxialAxes[ax] + std::string("_") + std::to_string(k);
+          if (!root.exists(name)) continue;
+          where = name;
+          const RowMatrixX m = root.read_matrix(name);
+          if (m.rows() < 1 || m.cols() != 3)
+            throw InputError(file, name,
+                             "needs one row per step and 3 columns (E_axial, S_cell, "
+                             "S_law)");
+          UniaxialCurve& c = dg.per_loop[k].uniaxial[static_cast<std::size_t>(ax)];
+          for (Eigen::Index i = 0; i < m.rows(); ++i) {
+            // The law's stress may be NaN (no state of the law there), the cell's may not.
+            if (!std::isfinite(m(i, 0)) || !std::isfinite(m(i, 1)) || std::isinf(m(i, 2)))
+              throw InputError(file, name, "row " + std::to_string(i) + " is not finite");
+            c.strain.push_back(m(i, 0));
+            c.cell.push_back(m(i, 1));
+            c.law.push_back(m(i, 2));
+          }
+        }
+      where = d;
+    }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

@@ -284,8 +284,14 @@ std::string KnitMaterial::warning() const {
   const long n_last = last_step_[0].load();
   const double last =
       n_last > 0 ? static_cast<double>(last_step_[1].load()) / static_cast<double>(n_last) : 0.0;
+  // The law's own uniaxial response against the cell's, after the extrapolation's warning.
+  const std::string uniaxial = energy_ ? uniaxial_warning() : std::string();
+  auto with_uniaxial = [&uniaxial](std::string w) {
+    if (!uniaxial.empty()) w += (w.empty() ? "" : "\n") + uniaxial;
+    return w;
+  };
   if (!(share > kExtrapolatedWarning) && !(last > kExtrapolatedWarning))
-    return energy_ ? far_excursion_warning() : std::string();
+    return with_uniaxial(energy_ ? far_excursion_warning() : std::string());
   std::ostringstream os;
   os << std::setprecision(3) << "warning: " << 100.0 * share
      << " % of the material evaluations at converged states" << last_step_share()
@@ -297,7 +303,7 @@ std::string KnitMaterial::warning() const {
      << (energy_ ? "the law's convex extension"
                  : "the response surfaces' extension (eq. 17) and the linear initial law")
      << ", not from cell runs (docs/database.md)";
-  return os.str();
+  return with_uniaxial(os.str());
 }
 
 std::string KnitMaterial::report() const {

@@ -142,6 +142,64 @@ std::string KnitMaterial::far_excursion_warning() const {
   return {};
 }
 
+std::string KnitMaterial::uniaxial_warning() const {
+  const auto& curves = source_.uniaxial;
+  if (curves.empty() || audit_evaluations_.load() == 0) return {};
+  // The loop lengths the case's law is made of: knot k where some point's l lies strictly
+  // between knots k - 1 and k + 1 (the energy law between two knots is their convex
+  // combination, docs/database.md "Interpolation in l"), by more than round-off (1e-6 mm: the
+  // discontinuous cases' l = 6.5 mm side gave the 6 mm knot a weight of 1e-8); every knot
+  // without bound points.
+  const std::size_t m = curves.size();
+  std::vector<bool> used(m, bound_.empty());
+  for (std::size_t k = 0; k < m; ++k) {
+    const double below = k > 0 ? curves[k - 1].first : -HUGE_VAL;
+    const double above = k + 1 < m ? curves[k + 1].first : HUGE_VAL;
+    for (const Bound& b : bound_)
+      if (b.l > below + 1e-6 && b.l < above - 1e-6) {
+        used[k] = true;
+        break;
+      }
+  }
+  static const char* axis_name[2] = {"course (E11)", "wale (E22)"};
+  static const char* component[2] = {"E11", "E22"};
+  std::ostringstream os;
+  os << std::setprecision(3);
+  for (int ax = 0; ax < 2; ++ax) {
+    // The axial strain the converged states reached along this axis (material frame).
+    const double reached = audit_visited_[static_cast<std::size_t>(ax) + 3].load();
+    if (!(reached > 0.0)) continue;
+    std::ostringstream at;
+    at << std::setprecision(3);
+    int worse = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+      if (!used[k]) continue;
+      const material::UniaxialDeviation d =
+          material::uniaxial_deviation(curves[k].second[static_cast<std::size_t>(ax)], reached);
+      if (d.states == 0 || !(d.deviation > source_.uniaxial_tolerance)) continue;
+      at << (worse++ ? "; " : "") << "at l = " << curves[k].first << " mm ";
+      if (std::isfinite(d.ratio))
+        at << d.ratio << " times the cell's stress";
+      else
+        at << "no uniaxial state of the law";
+      at << " (" << component[ax] << " = " << d.strain << ")";
+    }
+    if (worse == 0) continue;
+    if (!os.str().empty()) os << "\n";
+    os << "warning: in uniaxial tension along the " << axis_name[ax]
+       << " the material law departs from its unit cell by more than "
+       << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer
+       << ") at the strains this run's converged states reached (" << component[ax] << " up to "
+       << reached << "): " << at.str()
+       << ". Where the fabric is in uniaxial tension that way, the run's stresses are off by "
+          "that factor ("
+       << (source_.database.empty() ? std::string("the database") : source_.database)
+       << ", /energy_law/diagnostics/uniaxial; docs/database.md, \"The law's own uniaxial "
+          "response\")";
+  }
+  return os.str();
+}
+
 KnitMaterial::EnergyStats KnitMaterial::energy_stats() const {
   EnergyStats s;
   s.evaluations = evaluations_.load();

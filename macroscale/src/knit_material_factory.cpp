@@ -6,7 +6,9 @@
 //     "stitch_value": 5.5 | {field},              // l(theta1, theta2), mm
 //     "knitting_angle": 0.0 | {field} | {"align_with": [vx, vy, vz], "degrees": [pu, pv],
 //                                         "knots_u": [...], "knots_v": [...]},
-//     "law": "energy" | "paper"    // default: "energy" when the database has it, else "paper"
+//     "law": "energy" | "paper",   // default: "energy" when the database has it, else "paper"
+//     "uniaxial_tolerance": 0.25   // energy law: warn where its own uniaxial response departs
+//                                  // from the cell's by more than this (KnitMaterial::warning())
 //   }
 //   {field} = {"degrees": [pu, pv], "knots_u": [...], "knots_v": [...], "values": [...],
 //              "unit": "rad" | "deg" (knitting angle only)}
@@ -185,7 +187,8 @@ spline::SplineSurface read_field(const nlohmann::json& j, const std::string& p,
 std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const CaseContext& ctx) {
   const std::string& p = ctx.pointer;
   check_keys(m, p, ctx,
-             {"type", "database", "stitch_value", "knitting_angle", "law", "description"});
+             {"type", "database", "stitch_value", "knitting_angle", "law", "description",
+              "uniaxial_tolerance"});
   for (const char* k : {"database", "stitch_value"})
     if (!m.contains(k))
       throw InputError(ctx.file, p, std::string("missing required key \"") + k + "\"");
@@ -281,6 +284,21 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // When the database file was written: results.h5 keeps it, and the report refuses results
   // of another database (session 38's red team).
   src.database_date_utc = data.provenance.date_utc;
+  // The law's own uniaxial response beside the cell's (session 41): warned about after a run
+  // where it departs by more than /material/uniaxial_tolerance (KnitMaterial::warning()).
+  if (energy)
+    for (const auto& pl : data.energy_diagnostics.per_loop)
+      if (!pl.uniaxial[0].empty() || !pl.uniaxial[1].empty())
+        src.uniaxial.emplace_back(pl.loop_length, pl.uniaxial);
+  src.uniaxial_tolerance_pointer = p + "/uniaxial_tolerance";
+  if (m.contains("uniaxial_tolerance")) {
+    const auto& v = m.at("uniaxial_tolerance");
+    if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
+      throw InputError(ctx.file, p + "/uniaxial_tolerance",
+                       "must be a positive number (the largest |law / cell - 1| of the law's "
+                       "own uniaxial stress tolerated without a warning; default 0.25)");
+    src.uniaxial_tolerance = v.get<double>();
+  }
   if (m.at("stitch_value").is_number()) {
     // A constant: name the value itself rather than a control value.
     const double v = m.at("stitch_value").get<double>();

@@ -650,23 +650,21 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       // The end is the last converged step (session 33, a helper's audit: the last step, so a
       // path that stopped where the cell jammed had no end ratio and the report said "no
       // path" for its axis).
-      double smax = 0.0;
-      int end = -1;
-      for (int s = 0; s < r.steps(); ++s)
-        if (r.status[static_cast<std::size_t>(s)] == 0) {
-          smax = std::max(smax, std::abs(r.S(s, ax)));
-          end = s;
-        }
+      // A second path along the same axis (an extra input) counts in uniaxial_max_relative;
+      // the curve kept is the last one's.
+      material::UniaxialCurve& c = pl.uniaxial[static_cast<std::size_t>(ax)];
+      c = {};
       for (int s = 0; s < r.steps(); ++s) {
-        if (r.status[static_cast<std::size_t>(s)] != 0 || !(smax > 0.0)) continue;
-        const double law_s = uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax));
-        const double ratio = law_s / r.S(s, ax);
-        if (std::abs(r.S(s, ax)) >= 0.1 * smax)
-          pl.uniaxial_max_relative = std::isfinite(ratio)
-                                         ? std::max(pl.uniaxial_max_relative, std::abs(ratio - 1.0))
-                                         : std::numeric_limits<double>::infinity();
-        if (s == end) pl.uniaxial_end_ratio(ax) = ratio;
+        if (r.status[static_cast<std::size_t>(s)] != 0) continue;
+        c.strain.push_back(r.E(s, ax));
+        c.cell.push_back(r.S(s, ax));
+        c.law.push_back(uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax)));
       }
+      if (std::none_of(c.cell.begin(), c.cell.end(), [](double v) { return v != 0.0; })) continue;
+      pl.uniaxial_end_ratio(ax) = c.law.back() / c.cell.back();
+      const material::UniaxialDeviation d =
+          material::uniaxial_deviation(c, std::numeric_limits<double>::infinity());
+      if (d.states > 0) pl.uniaxial_max_relative = std::max(pl.uniaxial_max_relative, d.deviation);
     }
     if (pl.stress_range > 0) {
       std::vector<Eigen::Vector3d> e{Eigen::Vector3d::Zero()}, S{Eigen::Vector3d::Zero()};

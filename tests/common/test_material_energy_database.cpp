@@ -44,6 +44,8 @@ Database db_with_law() {
     p.max_relative = 0.3;
     p.rms_relative = 0.15;
     p.monotonicity_bound = 0.01 * l;
+    if (l == 6.5)  // a wale-wise uniaxial curve at 6.5 mm only, its last law state missing
+      p.uniaxial[1] = {{0.1, 0.2, 0.3}, {0.5, 1.0, 2.0}, {0.6, 2.5, std::nan("")}};
     dg.per_loop.push_back(p);
   }
   dg.holdout_points = 21;
@@ -135,6 +137,61 @@ TEST_CASE("database: diagnostics written before the monotonicity bound still loa
   REQUIRE(back.energy_diagnostics.per_loop.size() == 2);
   CHECK(std::isnan(back.energy_diagnostics.per_loop[0].monotonicity_bound));
   CHECK(back.energy_diagnostics.per_loop[1].stress_range == 2.0);
+}
+
+TEST_CASE("database: the law's own uniaxial curves round trip, older files load without them",
+          "[unit]") {
+  // Session 41: knit-macro warns from them (KnitMaterial::warning()).
+  const auto file = tmp("energy_uniaxial.h5");
+  const Database db = db_with_law();
+  write_database(file, db);
+  const Database back = read_database(file, false);
+  const auto& pl = back.energy_diagnostics.per_loop;
+  REQUIRE(pl.size() == 2);
+  CHECK(pl[0].uniaxial[0].empty());
+  CHECK(pl[0].uniaxial[1].empty());
+  CHECK(pl[1].uniaxial[0].empty());
+  const UniaxialCurve& c = pl[1].uniaxial[1];
+  CHECK(c.strain == std::vector<double>{0.1, 0.2, 0.3});
+  CHECK(c.cell == std::vector<double>{0.5, 1.0, 2.0});
+  REQUIRE(c.law.size() == 3);
+  CHECK(c.law[0] == 0.6);
+  CHECK(c.law[1] == 2.5);
+  CHECK(std::isnan(c.law[2]));  // no state of the law there: kept as NaN
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    CHECK(f.exists("/energy_law/diagnostics/uniaxial/wale_1"));
+    CHECK_FALSE(f.exists("/energy_law/diagnostics/uniaxial/course_1"));
+    f.remove("/energy_law/diagnostics/uniaxial");  // as written before session 41
+  }
+  const Database old = read_database(file, false);
+  CHECK(old.energy_diagnostics.per_loop[1].uniaxial[1].empty());
+  // A malformed curve is refused with its HDF5 path: two columns, a non-finite cell stress, an
+  // infinite law stress.
+  const std::string w = "/energy_law/diagnostics/uniaxial/wale_1";
+  auto refused = [&](const RowMatrixX& m) {
+    write_database(file, db);
+    {
+      auto f = knit::io::H5File::open_rw(file);
+      f.write(w, m);
+    }
+    try {
+      read_database(file);
+    } catch (const knit::InputError& e) {
+      return e.pointer() + ": " + e.message();
+    }
+    return std::string("no error");
+  };
+  RowMatrixX m(3, 3);
+  m << 0.1, 0.5, 0.6, 0.2, 1.0, 2.5, 0.3, 2.0, 3.0;
+  CHECK(refused(m) == "no error");
+  CHECK(refused(m.leftCols(2)) ==
+        w + ": needs one row per step and 3 columns (E_axial, S_cell, S_law)");
+  m(1, 1) = std::nan("");
+  CHECK(refused(m) == w + ": row 1 is not finite");
+  m(1, 1) = 1.0;
+  m(2, 2) = std::numeric_limits<double>::infinity();
+  CHECK(refused(m) == w + ": row 2 is not finite");
 }
 
 TEST_CASE("database v1: loads, and asking it for the energy law names file and path", "[unit]") {

@@ -275,6 +275,21 @@ TEST_CASE("knit material: the case key /material/law", "[unit]") {
                         Catch::Contains("knit-meso fit " + v1 + " --law energy"));
   CHECK_THROWS_WITH(parse_case(square_case(material(with, "neo")), "c.json"),
                     Catch::Contains("c.json: /material/law"));
+  // /material/uniaxial_tolerance (session 41): 0.25 by default, positive.
+  auto source_of = [](const Case& c) {
+    return dynamic_cast<const KnitMaterial&>(*c.material).source();
+  };
+  auto tolerance = [&](const std::string& v) {
+    std::string m = material(with, "");
+    m.insert(m.size() - 1, R"(, "uniaxial_tolerance": )" + v);
+    return square_case(m);
+  };
+  CHECK(source_of(parse_case(square_case(material(with, "")), "c.json")).uniaxial_tolerance ==
+        0.25);
+  CHECK(source_of(parse_case(tolerance("0.5"), "c.json")).uniaxial_tolerance == 0.5);
+  for (const char* bad : {"0", "-0.1", "\"large\""})
+    CHECK_THROWS_WITH(parse_case(tolerance(bad), "c.json"),
+                      Catch::Contains("c.json: /material/uniaxial_tolerance"));
   // A database fitted with the energy law only (`knit-meso fit RAW --law energy` of a sweep
   // with "fit": false): no paper-law surface. Session 38's red team: the check of the
   // surfaces read the empty optional (undefined behaviour; "degrees must be >= 1", exit 2).
@@ -352,4 +367,75 @@ TEST_CASE("knit material, energy law: bound points on graded l and alpha fields"
     CHECK((m.dS_dl(E, bound, 1e-6) - d_ref).norm() <= 1e-12 * (1 + d_ref.norm()));
     CHECK((m.dS_dl(E, unbound, 1e-6) - d_ref).norm() <= 1e-12 * (1 + d_ref.norm()));
   }
+}
+
+TEST_CASE("knit material, energy law: a warning where the law's own uniaxial response departs",
+          "[unit]") {
+  // Session 41: at 6.5 mm the default law carries 2.6 times the cell's uniaxial wale-wise
+  // stress; a run stretched that way said nothing. Curves at 4.5, 5.5 and 6.5 mm: the law is
+  // exact at 4.5 mm, 1.2 times the cell (wale) at 5.5 mm, 2 times (wale) and 0.5 times (course)
+  // at 6.5 mm from E = 0.2 on.
+  using Curves = std::array<UniaxialCurve, 2>;
+  const UniaxialCurve exact{{0.1, 0.2, 0.3}, {1.0, 2.0, 3.0}, {1.0, 2.0, 3.0}};
+  const UniaxialCurve stiff12{{0.1, 0.2, 0.3}, {1.0, 2.0, 3.0}, {1.2, 2.4, 3.6}};
+  const UniaxialCurve stiff2{{0.1, 0.2, 0.3}, {1.0, 2.0, 3.0}, {1.0, 4.0, 6.0}};
+  const UniaxialCurve soft{{0.1, 0.2, 0.3}, {1.0, 2.0, 3.0}, {1.0, 1.0, 1.5}};
+  KnitMaterialSource src;
+  src.database = "db.h5";
+  src.uniaxial = {
+      {4.5, Curves{exact, exact}}, {5.5, Curves{exact, stiff12}}, {6.5, Curves{soft, stiff2}}};
+  auto run = [&](double l0, double l1, const Eigen::Vector3d& E, double tolerance = 0.25) {
+    KnitMaterialSource s = src;
+    s.uniaxial_tolerance = tolerance;
+    KnitMaterial m(nullptr, std::make_shared<const EnergyLaw>(testing::make_test_energy_law()),
+                   make_scalar_field(knit::testing::graded_stitch_value(l0, l1)),
+                   make_scalar_field(ScalarFieldSpec::constant(0.0)), s);
+    // The field's ends and a point 30 % of the way (l0 + 0.3 (l1 - l0)).
+    const std::vector<Eigen::Vector2d> pts = {{0.0, 0.5}, {0.3, 0.5}, {1.0, 0.5}};
+    m.bind_points(pts);
+    MaterialPoint p;
+    p.point_id = 0;
+    p.theta = pts[0];
+    m.evaluate(E, p);  // a trial iterate: not what the run reached
+    REQUIRE(m.begin_converged_audit());
+    m.evaluate(0.5 * E, p);
+    m.end_converged_audit();
+    return m.warning();
+  };
+  // Graded 4.5 ... 6.5 mm, the converged states up to E22 = 0.25: the 6.5 mm wale curve
+  // departs by 100 % at E22 = 0.2 (the 5.5 mm one by 20 %, within the tolerance).
+  const Eigen::Vector3d wale(0.0, 0.5, 0.0);
+  CHECK(run(4.5, 6.5, wale) ==
+        "warning: in uniaxial tension along the wale (E22) the material law departs from its "
+        "unit cell by more than 25 % (/material/uniaxial_tolerance) at the strains this run's "
+        "converged states reached (E22 up to 0.25): at l = 6.5 mm 2 times the cell's stress "
+        "(E22 = 0.2). Where the fabric is in uniaxial tension that way, the run's stresses are "
+        "off by that factor (db.h5, /energy_law/diagnostics/uniaxial; docs/database.md, \"The "
+        "law's own uniaxial response\")");
+  // A tolerance of 10 % names 5.5 mm as well; 150 % names nothing.
+  CHECK_THAT(run(4.5, 6.5, wale, 0.1),
+             Catch::Contains("more than 10 %") &&
+                 Catch::Contains("at l = 5.5 mm 1.2 times the cell's stress (E22 = 0.1); at l = "
+                                 "6.5 mm 2 times"));
+  CHECK(run(4.5, 6.5, wale, 1.5).empty());
+  // Up to E22 = 0.15 only the first state is compared, where every law is within 25 %.
+  CHECK(run(4.5, 6.5, Eigen::Vector3d(0.0, 0.3, 0.0)).empty());
+  // Only the loop lengths the case uses: 4.5 ... 5 mm mixes the 4.5 and 5.5 mm laws.
+  CHECK(run(4.5, 5.0, wale).empty());
+  CHECK_THAT(run(4.5, 5.0, wale, 0.1), Catch::Contains("at l = 5.5 mm"));
+  // Course-wise at 6.5 mm: 0.5 times the cell; the wale is compressed there (nothing to say).
+  CHECK_THAT(run(6.5, 6.5, Eigen::Vector3d(0.5, -0.2, 0.0)),
+             Catch::StartsWith("warning: in uniaxial tension along the course (E11)") &&
+                 Catch::Contains("at l = 6.5 mm 0.5 times the cell's stress (E11 = 0.2)") &&
+                 !Catch::Contains("wale (E22)"));
+  // A constant 6.5 mm uses the 6.5 mm law alone: the 5.5 mm one is not named at 10 %.
+  CHECK_THAT(run(6.5, 6.5, wale, 0.1),
+             Catch::Contains("at l = 6.5 mm") && !Catch::Contains("5.5 mm"));
+  // Both directions stretched: two lines.
+  CHECK_THAT(run(6.5, 6.5, Eigen::Vector3d(0.5, 0.5, 0.0)),
+             Catch::Contains("course (E11)") && Catch::Contains("\nwarning: in uniaxial tension "
+                                                                "along the wale (E22)"));
+  // No curves (a database written before session 41): no warning.
+  src.uniaxial.clear();
+  CHECK(run(4.5, 6.5, wale).empty());
 }

@@ -488,6 +488,20 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
     CHECK(dg.per_loop[1].uniaxial_end_ratio(1) == Approx(1.0 / scale).epsilon(1e-6));
     CHECK(dg.per_loop[1].uniaxial_max_relative == Approx(1.0 - 1.0 / scale).margin(1e-6));
     CHECK(std::isnan(dg.per_loop[1].uniaxial_end_ratio(0)));
+    // The curve stored for knit-macro (session 41): the path's steps, the law's own stress
+    // beside the cell's; no course-wise curve, none at the other loop length.
+    const material::UniaxialCurve& c = dg.per_loop[1].uniaxial[1];
+    REQUIRE(c.strain.size() == static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      CHECK(c.strain[i] == r.E(k, 1));
+      CHECK(c.cell[i] == r.S(k, 1));
+      CHECK(c.law[i] == Approx(c.cell[i] / scale).epsilon(1e-6));
+    }
+    CHECK(dg.per_loop[1].uniaxial[0].empty());
+    CHECK(dg.per_loop[0].uniaxial[1].empty());
+    // The stopped path's curve holds its converged steps only.
+    CHECK(stopped.per_loop[1].uniaxial[1].strain.size() == static_cast<std::size_t>(n - 1));
     // The report says so for the course (no course-wise path here) instead of "nan".
     EnergyFitSummary with = s;
     with.diagnostics = dg;

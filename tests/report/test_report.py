@@ -1036,6 +1036,23 @@ def main():
             failures.append("reaches: compression to -14.1 % not recognised")
         if abs(rc.stretch_bound(0.3) - 0.345) > 1e-12 or abs(rc.stretch_bound(0.2) - 0.22) > 1e-12:
             failures.append("kinematic bound")
+        # The runs' warnings (session 41): every `warning:` line of a summary, under its name.
+        runs = {"a": "status: completed\nwarning: in uniaxial tension along the wale\n"
+                     "warning: load drop: x | y\n", "b": "status: completed\n"}
+
+        class _Summary:
+            def __init__(self, text):
+                self.text = text
+
+            def summary(self):
+                return self.text
+        text = "\n".join(report.run_warnings(sorted(runs), lambda n: _Summary(runs[n])))
+        if ("- `a`: in uniaxial tension along the wale" not in text
+                or "- `a`: load drop: x \\| y" not in text or "`b`" in text):
+            failures.append("run warnings: " + text[-300:])
+        text = "\n".join(report.run_warnings(["b"], lambda n: _Summary(runs[n])))
+        if "No run warned" not in text:
+            failures.append("run warnings without any: " + text)
         # The knitting maps' section (session 39): totals and every warning of each summary.
         km = os.path.join(tmp, "km_out")
         text = "\n".join(report.knitmap_section(km))

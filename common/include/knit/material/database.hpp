@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -26,6 +27,7 @@
 #include "knit/material/load_paths.hpp"
 #include "knit/material/loop_length_family.hpp"
 #include "knit/material/response_surface.hpp"
+#include "knit/material/uniaxial_curve.hpp"
 
 namespace knit::io {
 class H5File;  // knit/io/hdf5.hpp
@@ -113,8 +115,12 @@ struct EnergyFitDiagnostics {
     /// stored.
     Eigen::Vector2d uniaxial_end_ratio = Eigen::Vector2d::Constant(std::nan(""));
     /// Largest |law / cell - 1| of that axial stress over the steps whose cell stress is at
-    /// least 10 % of the path's largest. Printed, not stored.
+    /// least 10 % of the path's largest, both axes. Printed, not stored.
     double uniaxial_max_relative = 0.0;
+    /// Those paths step by step, course (0) and wale (1): the cell's axial strain and stress
+    /// and the law's own axial stress (uniaxial_curve.hpp); empty without such a path. Stored
+    /// in /energy_law/diagnostics/uniaxial (session 41; absent from older files).
+    std::array<UniaxialCurve, 2> uniaxial;
   };
   std::vector<PerLoop> per_loop;
   int holdout_points = 0;

@@ -45,6 +45,7 @@
 #include "knit/macro/material_factory.hpp"
 #include "knit/material/energy_law.hpp"
 #include "knit/material/loop_length_family.hpp"
+#include "knit/material/uniaxial_curve.hpp"
 #include "knit/spline/surface.hpp"
 
 namespace knit::macro {
@@ -76,6 +77,13 @@ struct KnitMaterialSource {
   std::string file, stitch_pointer = "/material/stitch_value",
                     angle_pointer = "/material/knitting_angle", database;
   std::string database_date_utc;  ///< the database file's date_utc attribute ("" if none)
+  /// The energy law's own uniaxial response beside the cell's, per loop length of the
+  /// database (/energy_law/diagnostics/uniaxial, session 41; empty for older files or the
+  /// paper's law), and the largest |law / cell - 1| tolerated without a warning at the strains
+  /// a run reaches (/material/uniaxial_tolerance; KnitMaterial::warning()).
+  std::vector<std::pair<double, std::array<material::UniaxialCurve, 2>>> uniaxial;
+  double uniaxial_tolerance = 0.25;
+  std::string uniaxial_tolerance_pointer = "/material/uniaxial_tolerance";
 };
 
 class KnitMaterial : public Material {
@@ -127,6 +135,8 @@ class KnitMaterial : public Material {
   /// specimen's length ran to "completed" with 100 % of them outside and no word of it but the
   /// figure inside the material report.
   std::string warning() const override;
+  /// Where the fields came from, and the law's uniaxial curves with their tolerance.
+  const Source& source() const { return source_; }
   /// The database's units.
   std::string required_units() const override { return "mm, N, MPa"; }
   /// material_database (the file) and material_database_date_utc (when it was written).
@@ -230,6 +240,10 @@ class KnitMaterial : public Material {
   /// warning() below the share that warns: a converged state beyond the energy law's box by
   /// more than the box's width in one component; "" if none.
   std::string far_excursion_warning() const;
+  /// warning(), the energy law: where the law's own uniaxial response departs from the cell's
+  /// by more than source_.uniaxial_tolerance at the axial strains the converged states reached
+  /// and the loop lengths the case uses; "" if nowhere (or no curves).
+  std::string uniaxial_warning() const;
   spline::SplineSurface l_field_, a_field_;
   Source source_;
   std::vector<Bound> bound_;
