@@ -325,6 +325,25 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
     dg.options_json = root.attribute_string(d, "options_json");
     // Optional (session 41): older files have no uniaxial curves.
     if (root.exists(d + "/uniaxial")) {
+      // Every dataset is one this reader knows (session 41's review: "wale_9" of a five-knot
+      // file and misspelt names were passed over), and the loop lengths increase (the knots'
+      // neighbours decide which curves a case's l uses).
+      for (const std::string& child : root.children(d + "/uniaxial")) {
+        bool known = false;
+        for (std::size_t k = 0; k < n && !known; ++k)
+          for (const char* axis : kUniaxialAxes)
+            known = known || child == std::string(axis) + "_" + std::to_string(k);
+        if (!known)
+          throw InputError(file, d + "/uniaxial/" + child,
+                           "not a curve of this file: the datasets are course_<k> and wale_<k> "
+                           "for k = 0 ... " +
+                               std::to_string(n > 0 ? n - 1 : 0) + " (the rows of loop_length)");
+      }
+      for (std::size_t k = 1; k < n; ++k)
+        if (!(l[k] > l[k - 1]))
+          throw InputError(file, d + "/loop_length",
+                           "must increase (entry " + std::to_string(k) + ") where curves in " + d +
+                               "/uniaxial refer to its rows");
       for (std::size_t k = 0; k < n; ++k)
         for (int ax = 0; ax < 2; ++ax) {
           const std::string name =
@@ -341,6 +360,10 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
             // The law's stress may be NaN (no state of the law there), the cell's may not.
             if (!std::isfinite(m(i, 0)) || !std::isfinite(m(i, 1)) || std::isinf(m(i, 2)))
               throw InputError(file, name, "row " + std::to_string(i) + " is not finite");
+            if (i > 0 && !(m(i, 0) > m(i - 1, 0)))
+              throw InputError(file, name,
+                               "row " + std::to_string(i) +
+                                   ": the axial strain must increase from step to step");
             c.strain.push_back(m(i, 0));
             c.cell.push_back(m(i, 1));
             c.law.push_back(m(i, 2));

@@ -98,6 +98,7 @@ KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> fam
       a_field_(std::move(knitting_angle)),
       source_(std::move(source)) {
   if (!family_ && !energy_) throw std::invalid_argument("knit material: no database");
+  uniaxial_reached_ = std::make_unique<std::atomic<double>[]>(2 * source_.uniaxial.size());
   if (l_field_.dim() != 1 || a_field_.dim() != 1)
     throw std::invalid_argument("knit material: the fields must be scalar");
   reset_stats();
@@ -203,12 +204,13 @@ MaterialResponse KnitMaterial::evaluate(const Eigen::Vector3d& E,
                                         const MaterialPoint& where) const {
   if (where.point_id >= 0 && where.point_id < static_cast<int>(bound_.size())) {
     const Bound& b = bound_[where.point_id];
-    if (b.ea) return evaluate_energy(E, *b.ea, b.TE, where.theta);
+    if (b.ea) return evaluate_energy(E, *b.ea, b.TE, where.theta, b.l);
     return evaluate_at(E, *b.rs, b.alpha, b.TE, b.TSinv, where.theta);
   }
   if (energy_) {
-    const auto ea = energy_at(stitch_value(where.theta));
-    return evaluate_energy(E, *ea, mech::T_E(knitting_angle(where.theta)), where.theta);
+    const double l = stitch_value(where.theta);
+    const auto ea = energy_at(l);
+    return evaluate_energy(E, *ea, mech::T_E(knitting_angle(where.theta)), where.theta, l);
   }
   const auto rs = surface_at(stitch_value(where.theta));
   const double a = knitting_angle(where.theta);
@@ -264,6 +266,8 @@ void KnitMaterial::reset_stats() {
     visited_[k] = audit_visited_[k] = std::numeric_limits<double>::infinity();
     visited_[k + 3] = audit_visited_[k + 3] = -std::numeric_limits<double>::infinity();
   }
+  for (std::size_t k = 0; k < 2 * source_.uniaxial.size(); ++k)
+    uniaxial_reached_[k] = -std::numeric_limits<double>::infinity();
   std::lock_guard<std::mutex> lock(where_mutex_);
   where_.clear();
 }

@@ -81,10 +81,23 @@ Eigen::Vector3d KnitMaterial::dS_dl(const Eigen::Vector3d& E, const MaterialPoin
   return TE.transpose() * law->dS_dl(TE * E);
 }
 
+template <class F>
+void KnitMaterial::for_uniaxial_knots(double l, F&& f) const {
+  const auto& curves = source_.uniaxial;
+  const std::size_t m = curves.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    const double below = k > 0 ? curves[k - 1].first : -HUGE_VAL;
+    const double above = k + 1 < m ? curves[k + 1].first : HUGE_VAL;
+    // By more than round-off: the discontinuous cases' l = 6.5 mm side gave the 6 mm knot a
+    // weight of 1e-8.
+    if (l > below + 1e-6 && l < above - 1e-6) f(k);
+  }
+}
+
 MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,
                                                const material::EnergyLawAt& law,
                                                const Eigen::Matrix3d& TE,
-                                               const Eigen::Vector2d& theta) const {
+                                               const Eigen::Vector2d& theta, double l) const {
   MaterialResponse out;
   evaluations_.fetch_add(1, std::memory_order_relaxed);
   // W(E) = W_hat(T_E E): S = T_E^T S_hat, C = T_E^T C_hat T_E (T_E^T = T^-1, eq. 22).
@@ -111,6 +124,13 @@ MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,
       atomic_min(audit_visited_[k], Ehat(k));
       atomic_max(audit_visited_[k + 3], Ehat(k));
     }
+    // The strains each knot's law saw (uniaxial_warning(); session 41's review: one largest
+    // strain of the whole patch named the 6.5 mm knot of s321, whose points stay below
+    // E11 = 0.07, for the 4.5 mm region's 0.385).
+    for_uniaxial_knots(l, [&](std::size_t k) {
+      atomic_max(uniaxial_reached_[2 * k], Ehat(0));
+      atomic_max(uniaxial_reached_[2 * k + 1], Ehat(1));
+    });
   }
   const material::EnergyResponse r = law.evaluate(Ehat);
   out.W = r.W;
@@ -145,54 +165,37 @@ std::string KnitMaterial::far_excursion_warning() const {
 std::string KnitMaterial::uniaxial_warning() const {
   const auto& curves = source_.uniaxial;
   if (curves.empty() || audit_evaluations_.load() == 0) return {};
-  // The loop lengths the case's law is made of: knot k where some point's l lies strictly
-  // between knots k - 1 and k + 1 (the energy law between two knots is their convex
-  // combination, docs/database.md "Interpolation in l"), by more than round-off (1e-6 mm: the
-  // discontinuous cases' l = 6.5 mm side gave the 6 mm knot a weight of 1e-8); every knot
-  // without bound points.
-  const std::size_t m = curves.size();
-  std::vector<bool> used(m, bound_.empty());
-  for (std::size_t k = 0; k < m; ++k) {
-    const double below = k > 0 ? curves[k - 1].first : -HUGE_VAL;
-    const double above = k + 1 < m ? curves[k + 1].first : HUGE_VAL;
-    for (const Bound& b : bound_)
-      if (b.l > below + 1e-6 && b.l < above - 1e-6) {
-        used[k] = true;
-        break;
-      }
-  }
   static const char* axis_name[2] = {"course (E11)", "wale (E22)"};
   static const char* component[2] = {"E11", "E22"};
   std::ostringstream os;
   os << std::setprecision(3);
-  for (int ax = 0; ax < 2; ++ax) {
-    // The axial strain the converged states reached along this axis (material frame).
-    const double reached = audit_visited_[static_cast<std::size_t>(ax) + 3].load();
-    if (!(reached > 0.0)) continue;
+  for (std::size_t ax = 0; ax < 2; ++ax) {
     std::ostringstream at;
     at << std::setprecision(3);
     int worse = 0;
-    for (std::size_t k = 0; k < m; ++k) {
-      if (!used[k]) continue;
+    for (std::size_t k = 0; k < curves.size(); ++k) {
+      // The axial strain the converged states reached with this knot's law (material frame);
+      // -inf where no point uses the knot, <= 0 where nothing is stretched that way.
+      const double reached = uniaxial_reached_[2 * k + ax].load();
+      if (!(reached > 0.0)) continue;
       const material::UniaxialDeviation d =
-          material::uniaxial_deviation(curves[k].second[static_cast<std::size_t>(ax)], reached);
+          material::uniaxial_deviation(curves[k].second[ax], reached);
       if (d.states == 0 || !(d.deviation > source_.uniaxial_tolerance)) continue;
       at << (worse++ ? "; " : "") << "at l = " << curves[k].first << " mm ";
       if (std::isfinite(d.ratio))
-        at << d.ratio << " times the cell's stress";
+        at << d.ratio << " times";
       else
         at << "no uniaxial state of the law";
-      at << " (" << component[ax] << " = " << d.strain << ")";
+      at << " (at " << component[ax] << " = " << d.strain << "; reached " << reached << ")";
     }
     if (worse == 0) continue;
     if (!os.str().empty()) os << "\n";
-    os << "warning: in uniaxial tension along the " << axis_name[ax]
-       << " the material law departs from its unit cell by more than "
-       << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer
-       << ") at the strains this run's converged states reached (" << component[ax] << " up to "
-       << reached << "): " << at.str()
-       << ". Where the fabric is in uniaxial tension that way, the run's stresses are off by "
-          "that factor ("
+    os << "warning: where the fabric is stretched uniaxially along the " << axis_name[ax]
+       << ", the material law may be off by up to about these factors of its unit cell's stress "
+          "(more than "
+       << 100.0 * source_.uniaxial_tolerance << " % off, " << source_.uniaxial_tolerance_pointer
+       << "), at the strains this run's converged states reached with each loop length: "
+       << at.str() << " ("
        << (source_.database.empty() ? std::string("the database") : source_.database)
        << ", /energy_law/diagnostics/uniaxial; docs/database.md, \"The law's own uniaxial "
           "response\")";
@@ -238,6 +241,16 @@ std::string KnitMaterial::energy_report() const {
   os << "\n  visited material-frame strain box (Newton's trial iterates too): E11 ["
      << s.visited_min(0) << ", " << s.visited_max(0) << "], E22 [" << s.visited_min(1) << ", "
      << s.visited_max(1) << "], 2E12 [" << s.visited_min(2) << ", " << s.visited_max(2) << "]";
+  // Whether the law's own uniaxial response was checked (session 41's review: a database
+  // without the curves said nothing, which read as "checked, fine").
+  if (source_.uniaxial.empty())
+    os << "\n  uniaxial check: not available (the database has no "
+          "/energy_law/diagnostics/uniaxial: fitted before session 41; `knit-meso fit DB --law "
+          "energy --energy-options OPTS` with its options adds it)";
+  else
+    os << "\n  uniaxial check: the law's own uniaxial response against the cell's, tolerance "
+       << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer
+       << "); a departure beyond it is a warning";
   const Stats st = stats();
   if (!st.first.empty()) {
     // Every evaluation, Newton's trial iterates too (session 39's walkthrough read an iterate's

@@ -286,12 +286,25 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   src.database_date_utc = data.provenance.date_utc;
   // The law's own uniaxial response beside the cell's (session 41): warned about after a run
   // where it departs by more than /material/uniaxial_tolerance (KnitMaterial::warning()).
-  if (energy)
-    for (const auto& pl : data.energy_diagnostics.per_loop)
-      if (!pl.uniaxial[0].empty() || !pl.uniaxial[1].empty())
-        src.uniaxial.emplace_back(pl.loop_length, pl.uniaxial);
+  // Every loop length of the diagnostics, those without a curve too: the knots' neighbours
+  // decide which laws a point's l uses (session 41's review: a loop length left out made a
+  // 5.2 mm case name the 6 mm law).
+  if (energy) {
+    const auto& per_loop = data.energy_diagnostics.per_loop;
+    const bool any = std::any_of(per_loop.begin(), per_loop.end(), [](const auto& pl) {
+      return !pl.uniaxial[0].empty() || !pl.uniaxial[1].empty();
+    });
+    if (any)
+      for (const auto& pl : per_loop) src.uniaxial.emplace_back(pl.loop_length, pl.uniaxial);
+  }
   src.uniaxial_tolerance_pointer = p + "/uniaxial_tolerance";
   if (m.contains("uniaxial_tolerance")) {
+    // Refused rather than passed over (session 41's review): the paper's law has no curves.
+    if (!energy)
+      throw InputError(ctx.file, p + "/uniaxial_tolerance",
+                       "applies to the energy law only (its uniaxial curves); the case uses the "
+                       "paper's law: remove the key, or set " +
+                           p + "/law to \"energy\"");
     const auto& v = m.at("uniaxial_tolerance");
     if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
       throw InputError(ctx.file, p + "/uniaxial_tolerance",

@@ -650,21 +650,28 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       // The end is the last converged step (session 33, a helper's audit: the last step, so a
       // path that stopped where the cell jammed had no end ratio and the report said "no
       // path" for its axis).
-      // A second path along the same axis (an extra input) counts in uniaxial_max_relative;
-      // the curve kept is the last one's.
-      material::UniaxialCurve& c = pl.uniaxial[static_cast<std::size_t>(ax)];
-      c = {};
+      // A second path along the same axis (an extra input): both count in
+      // uniaxial_max_relative, and the curve kept is the one that departs more.
+      material::UniaxialCurve c;
       for (int s = 0; s < r.steps(); ++s) {
-        if (r.status[static_cast<std::size_t>(s)] != 0) continue;
+        // Converged steps whose axial strain increases (the reader refuses a curve that does
+        // not; the prescribed axial strain of a uniaxial path always does).
+        if (r.status[static_cast<std::size_t>(s)] != 0 ||
+            (!c.strain.empty() && !(r.E(s, ax) > c.strain.back())))
+          continue;
         c.strain.push_back(r.E(s, ax));
         c.cell.push_back(r.S(s, ax));
         c.law.push_back(uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax)));
       }
       if (std::none_of(c.cell.begin(), c.cell.end(), [](double v) { return v != 0.0; })) continue;
-      pl.uniaxial_end_ratio(ax) = c.law.back() / c.cell.back();
-      const material::UniaxialDeviation d =
-          material::uniaxial_deviation(c, std::numeric_limits<double>::infinity());
+      const double inf = std::numeric_limits<double>::infinity();
+      const material::UniaxialDeviation d = material::uniaxial_deviation(c, inf);
       if (d.states > 0) pl.uniaxial_max_relative = std::max(pl.uniaxial_max_relative, d.deviation);
+      material::UniaxialCurve& kept = pl.uniaxial[static_cast<std::size_t>(ax)];
+      if (kept.empty() || d.deviation > material::uniaxial_deviation(kept, inf).deviation) {
+        pl.uniaxial_end_ratio(ax) = c.law.back() / c.cell.back();
+        kept = std::move(c);
+      }
     }
     if (pl.stress_range > 0) {
       std::vector<Eigen::Vector3d> e{Eigen::Vector3d::Zero()}, S{Eigen::Vector3d::Zero()};

@@ -192,6 +192,35 @@ TEST_CASE("database: the law's own uniaxial curves round trip, older files load 
   m(1, 1) = 1.0;
   m(2, 2) = std::numeric_limits<double>::infinity();
   CHECK(refused(m) == w + ": row 2 is not finite");
+  m(2, 2) = 3.0;
+  m(2, 0) = 0.2;  // the axial strain of the last step equals the one before
+  CHECK(refused(m) == w + ": row 2: the axial strain must increase from step to step");
+  // Session 41's review: a curve of a row the file does not have and a misspelt name were
+  // passed over; loop lengths that do not increase misplace the knots' neighbours.
+  auto refused_edit = [&](const std::function<void(knit::io::H5File&)>& edit) {
+    write_database(file, db);
+    {
+      auto f = knit::io::H5File::open_rw(file);
+      edit(f);
+    }
+    try {
+      read_database(file);
+    } catch (const knit::InputError& e) {
+      return e.pointer() + ": " + e.message();
+    }
+    return std::string("no error");
+  };
+  const std::string u = "/energy_law/diagnostics/uniaxial";
+  CHECK(refused_edit([&](knit::io::H5File& f) { f.write(u + "/wale_2", m); }) ==
+        u + "/wale_2: not a curve of this file: the datasets are course_<k> and wale_<k> for k = "
+            "0 ... 1 (the rows of loop_length)");
+  CHECK_THAT(refused_edit([&](knit::io::H5File& f) { f.write(u + "/wales_1", m); }),
+             Catch::StartsWith(u + "/wales_1: not a curve of this file"));
+  CHECK(refused_edit([&](knit::io::H5File& f) {
+          f.write("/energy_law/diagnostics/loop_length", std::vector<double>{6.5, 4.5});
+        }) ==
+        "/energy_law/diagnostics/loop_length: must increase (entry 1) where curves in "
+        "/energy_law/diagnostics/uniaxial refer to its rows");
 }
 
 TEST_CASE("database v1: loads, and asking it for the energy law names file and path", "[unit]") {

@@ -290,6 +290,14 @@ TEST_CASE("knit material: the case key /material/law", "[unit]") {
   for (const char* bad : {"0", "-0.1", "\"large\""})
     CHECK_THROWS_WITH(parse_case(tolerance(bad), "c.json"),
                       Catch::Contains("c.json: /material/uniaxial_tolerance"));
+  // With the paper's law it would be passed over: refused (session 41's review).
+  {
+    std::string m = material(with, "paper");
+    m.insert(m.size() - 1, R"(, "uniaxial_tolerance": 0.5)");
+    CHECK_THROWS_WITH(parse_case(square_case(m), "c.json"),
+                      Catch::Contains("c.json: /material/uniaxial_tolerance: applies to the "
+                                      "energy law only"));
+  }
   // A database fitted with the energy law only (`knit-meso fit RAW --law energy` of a sweep
   // with "fit": false): no paper-law surface. Session 38's red team: the check of the
   // surfaces read the empty optional (undefined behaviour; "degrees must be >= 1", exit 2).
@@ -384,58 +392,91 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   src.database = "db.h5";
   src.uniaxial = {
       {4.5, Curves{exact, exact}}, {5.5, Curves{exact, stiff12}}, {6.5, Curves{soft, stiff2}}};
-  auto run = [&](double l0, double l1, const Eigen::Vector3d& E, double tolerance = 0.25) {
+  // The field's ends and a point 30 % of the way (l0 + 0.3 (l1 - l0)), each with its strain
+  // at the converged state (material frame: alpha = 0).
+  auto run = [&](double l0, double l1, const std::array<Eigen::Vector3d, 3>& E,
+                 double tolerance = 0.25) {
     KnitMaterialSource s = src;
     s.uniaxial_tolerance = tolerance;
     KnitMaterial m(nullptr, std::make_shared<const EnergyLaw>(testing::make_test_energy_law()),
                    make_scalar_field(knit::testing::graded_stitch_value(l0, l1)),
                    make_scalar_field(ScalarFieldSpec::constant(0.0)), s);
-    // The field's ends and a point 30 % of the way (l0 + 0.3 (l1 - l0)).
     const std::vector<Eigen::Vector2d> pts = {{0.0, 0.5}, {0.3, 0.5}, {1.0, 0.5}};
     m.bind_points(pts);
     MaterialPoint p;
-    p.point_id = 0;
-    p.theta = pts[0];
-    m.evaluate(E, p);  // a trial iterate: not what the run reached
+    for (int i = 0; i < 3; ++i) {
+      p.point_id = i;
+      p.theta = pts[static_cast<std::size_t>(i)];
+      m.evaluate(2.0 * E[static_cast<std::size_t>(i)], p);  // a trial iterate: not reached
+    }
     REQUIRE(m.begin_converged_audit());
-    m.evaluate(0.5 * E, p);
+    for (int i = 0; i < 3; ++i) {
+      p.point_id = i;
+      p.theta = pts[static_cast<std::size_t>(i)];
+      m.evaluate(E[static_cast<std::size_t>(i)], p);
+    }
     m.end_converged_audit();
     return m.warning();
   };
-  // Graded 4.5 ... 6.5 mm, the converged states up to E22 = 0.25: the 6.5 mm wale curve
-  // departs by 100 % at E22 = 0.2 (the 5.5 mm one by 20 %, within the tolerance).
-  const Eigen::Vector3d wale(0.0, 0.5, 0.0);
-  CHECK(run(4.5, 6.5, wale) ==
-        "warning: in uniaxial tension along the wale (E22) the material law departs from its "
-        "unit cell by more than 25 % (/material/uniaxial_tolerance) at the strains this run's "
-        "converged states reached (E22 up to 0.25): at l = 6.5 mm 2 times the cell's stress "
-        "(E22 = 0.2). Where the fabric is in uniaxial tension that way, the run's stresses are "
-        "off by that factor (db.h5, /energy_law/diagnostics/uniaxial; docs/database.md, \"The "
-        "law's own uniaxial response\")");
+  auto all = [](const Eigen::Vector3d& E) { return std::array<Eigen::Vector3d, 3>{E, E, E}; };
+  // Graded 4.5 ... 6.5 mm, the converged states at E22 = 0.25: the 6.5 mm wale curve departs
+  // by 100 % from E22 = 0.2 on (the 5.5 mm one by 20 %, within the tolerance).
+  const Eigen::Vector3d wale(0.0, 0.25, 0.0);
+  CHECK(run(4.5, 6.5, all(wale)) ==
+        "warning: where the fabric is stretched uniaxially along the wale (E22), the material "
+        "law may be off by up to about these factors of its unit cell's stress (more than 25 % "
+        "off, /material/uniaxial_tolerance), at the strains this run's converged states "
+        "reached with each loop length: at l = 6.5 mm 2 times (at E22 = 0.2; reached 0.25) "
+        "(db.h5, /energy_law/diagnostics/uniaxial; docs/database.md, \"The law's own uniaxial "
+        "response\")");
   // A tolerance of 10 % names 5.5 mm as well; 150 % names nothing.
-  CHECK_THAT(run(4.5, 6.5, wale, 0.1),
-             Catch::Contains("more than 10 %") &&
-                 Catch::Contains("at l = 5.5 mm 1.2 times the cell's stress (E22 = 0.1); at l = "
+  CHECK_THAT(run(4.5, 6.5, all(wale), 0.1),
+             Catch::Contains("more than 10 % off") &&
+                 Catch::Contains("at l = 5.5 mm 1.2 times (at E22 = 0.1; reached 0.25); at l = "
                                  "6.5 mm 2 times"));
-  CHECK(run(4.5, 6.5, wale, 1.5).empty());
-  // Up to E22 = 0.15 only the first state is compared, where every law is within 25 %.
-  CHECK(run(4.5, 6.5, Eigen::Vector3d(0.0, 0.3, 0.0)).empty());
+  CHECK(run(4.5, 6.5, all(wale), 1.5).empty());
+  // Up to E22 = 0.1 only the first state is compared, where every law is within 25 %; up to
+  // 0.15 the curves interpolated there are compared too (6.5 mm: 2.5 / 1.5).
+  CHECK(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.1, 0.0))).empty());
+  CHECK_THAT(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.15, 0.0))),
+             Catch::Contains("at l = 6.5 mm 1.67 times (at E22 = 0.15; reached 0.15)"));
+  // The strain each knot's law saw (session 41's review): the 4.5 mm end stretched to 0.25,
+  // the point at 5.1 mm and the 6.5 mm end to 0.1 only, so the 6.5 mm law is not named.
+  const Eigen::Vector3d low(0.0, 0.1, 0.0);
+  CHECK(run(4.5, 6.5, {wale, low, low}).empty());
+  CHECK_THAT(run(4.5, 6.5, {low, low, wale}), Catch::Contains("at l = 6.5 mm 2 times"));
   // Only the loop lengths the case uses: 4.5 ... 5 mm mixes the 4.5 and 5.5 mm laws.
-  CHECK(run(4.5, 5.0, wale).empty());
-  CHECK_THAT(run(4.5, 5.0, wale, 0.1), Catch::Contains("at l = 5.5 mm"));
-  // Course-wise at 6.5 mm: 0.5 times the cell; the wale is compressed there (nothing to say).
-  CHECK_THAT(run(6.5, 6.5, Eigen::Vector3d(0.5, -0.2, 0.0)),
-             Catch::StartsWith("warning: in uniaxial tension along the course (E11)") &&
-                 Catch::Contains("at l = 6.5 mm 0.5 times the cell's stress (E11 = 0.2)") &&
-                 !Catch::Contains("wale (E22)"));
+  CHECK(run(4.5, 5.0, all(wale)).empty());
+  CHECK_THAT(run(4.5, 5.0, all(wale), 0.1), Catch::Contains("at l = 5.5 mm"));
   // A constant 6.5 mm uses the 6.5 mm law alone: the 5.5 mm one is not named at 10 %.
-  CHECK_THAT(run(6.5, 6.5, wale, 0.1),
+  CHECK_THAT(run(6.5, 6.5, all(wale), 0.1),
              Catch::Contains("at l = 6.5 mm") && !Catch::Contains("5.5 mm"));
+  // Course-wise at 6.5 mm: 0.5 times the cell; the wale is compressed there (nothing to say).
+  CHECK_THAT(run(6.5, 6.5, all(Eigen::Vector3d(0.25, -0.1, 0.0))),
+             Catch::StartsWith("warning: where the fabric is stretched uniaxially along the "
+                               "course (E11)") &&
+                 Catch::Contains("at l = 6.5 mm 0.5 times (at E11 = 0.2; reached 0.25)") &&
+                 !Catch::Contains("wale (E22)"));
   // Both directions stretched: two lines.
-  CHECK_THAT(run(6.5, 6.5, Eigen::Vector3d(0.5, 0.5, 0.0)),
-             Catch::Contains("course (E11)") && Catch::Contains("\nwarning: in uniaxial tension "
-                                                                "along the wale (E22)"));
-  // No curves (a database written before session 41): no warning.
+  CHECK_THAT(run(6.5, 6.5, all(Eigen::Vector3d(0.25, 0.25, 0.0))),
+             Catch::Contains("course (E11)") &&
+                 Catch::Contains("\nwarning: where the fabric is stretched uniaxially along the "
+                                 "wale (E22)"));
+  // The material report says whether the check was made (a database without the curves said
+  // nothing, which read as "checked, fine").
+  auto report_of = [&]() {
+    KnitMaterial m(nullptr, std::make_shared<const EnergyLaw>(testing::make_test_energy_law()),
+                   make_scalar_field(ScalarFieldSpec::constant(5.0)),
+                   make_scalar_field(ScalarFieldSpec::constant(0.0)), src);
+    m.evaluate(Eigen::Vector3d(0.1, 0.1, 0.0), at(0.5, 0.5));
+    return m.report();
+  };
+  CHECK_THAT(report_of(), Catch::Contains("\n  uniaxial check: the law's own uniaxial response "
+                                          "against the cell's, tolerance 25 % "
+                                          "(/material/uniaxial_tolerance)"));
+  // No curves (a database written before session 41): no warning, and the report says so.
   src.uniaxial.clear();
-  CHECK(run(4.5, 6.5, wale).empty());
+  CHECK(run(4.5, 6.5, all(wale)).empty());
+  CHECK_THAT(report_of(), Catch::Contains("\n  uniaxial check: not available (the database has "
+                                          "no /energy_law/diagnostics/uniaxial"));
 }

@@ -36,8 +36,10 @@ struct UniaxialDeviation {
 };
 
 /// The largest |law / cell - 1| over the curve's states with an axial strain of at most
-/// `max_strain` and a cell stress of at least `min_share` times the path's largest |S| (over
-/// every state of the curve). states == 0 when none qualifies.
+/// `max_strain` (the strains increase along the curve; where max_strain lies between two
+/// states, the curve interpolated linearly there is one more state) and a cell stress of at
+/// least `min_share` times the largest |S_cell| of those states. states == 0 when none
+/// qualifies.
 UniaxialDeviation uniaxial_deviation(const UniaxialCurve& c, double max_strain,
                                      double min_share = kUniaxialMinShare);
 

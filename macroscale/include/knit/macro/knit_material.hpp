@@ -208,7 +208,8 @@ class KnitMaterial : public Material {
 
   std::shared_ptr<const material::EnergyLawAt> energy_at(double l) const;
   MaterialResponse evaluate_energy(const Eigen::Vector3d& E, const material::EnergyLawAt& law,
-                                   const Eigen::Matrix3d& TE, const Eigen::Vector2d& theta) const;
+                                   const Eigen::Matrix3d& TE, const Eigen::Vector2d& theta,
+                                   double l) const;
   std::string energy_report() const;
   double l_min() const;
   double l_max() const;
@@ -244,6 +245,14 @@ class KnitMaterial : public Material {
   /// by more than source_.uniaxial_tolerance at the axial strains the converged states reached
   /// and the loop lengths the case uses; "" if nowhere (or no curves).
   std::string uniaxial_warning() const;
+  /// The knots of source_.uniaxial whose law enters the law at l: knot k when l lies strictly
+  /// (by more than 1e-6 mm) between knots k - 1 and k + 1 (the energy law between two knots is
+  /// their convex combination); calls f(k) for each.
+  template <class F>
+  void for_uniaxial_knots(double l, F&& f) const;
+  /// Per knot of source_.uniaxial, the largest material-frame E11 (2 k) and E22 (2 k + 1) of
+  /// the audited (converged) evaluations whose law uses that knot; -inf before any.
+  std::unique_ptr<std::atomic<double>[]> uniaxial_reached_;
   spline::SplineSurface l_field_, a_field_;
   Source source_;
   std::vector<Bound> bound_;
