@@ -51,6 +51,12 @@ knit::cli::SubcommandRegistrar reg(
             rod::load_rod_case(o->file);  // InputError -> exit 2, nothing written
         rod::check_output_size(c, cap);
         const rod::CasePathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
+        if (!rep.written) {
+          std::cerr << "knit-meso rod: " << rep.message
+                    << "; no load increment converged: nothing written; the earlier outputs in "
+                    << out.string() << ", if any, are left as they were\n";
+          return knit::kExitFailure;
+        }
         std::cout << "rod: " << rep.message << "; lambda = " << rep.lambda_reached << ", "
                   << rep.increments << " increments, " << rep.cutbacks << " cut-backs, "
                   << rep.total_iterations << " Newton iterations; outputs in " << out.string()

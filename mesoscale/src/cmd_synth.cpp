@@ -9,6 +9,7 @@
 //   knit-meso synth --out synthetic.h5
 //   knit-meso synth --out db.h5 --loop-lengths 4.5,5.5,6.5 --steps 20 --fit-options fit.json
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -16,6 +17,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
@@ -83,6 +85,7 @@ static knit::cli::SubcommandRegistrar reg_synth(
                                      "): its stiffness (4.5 / l)^2 MPa is too large; give loop "
                                      "lengths of a knit (a few mm)");
         int rc = knit::kExitOk;
+        std::string first_failure;
         if (!o->no_fit) {
           const FitOptions fo =
               o->fit_options.empty()
@@ -92,8 +95,14 @@ static knit::cli::SubcommandRegistrar reg_synth(
           const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
-          for (const auto& f : fits)
-            if (!f.ok()) rc = knit::kExitFailure;
+          for (std::size_t k = 0; k < fits.size(); ++k)
+            if (!fits[k].ok()) {
+              rc = knit::kExitFailure;
+              if (first_failure.empty())
+                first_failure =
+                    "the paper law at l = " + knit::io::format_number(db.entries[k].loop_length) +
+                    " mm: " + fits[k].reason;
+            }
           // The synthetic law is exactly a sum of ridge functions of the default directions
           // (knit/meso/fit/synthetic.hpp), so the stand-in fits the ridge family unless the
           // options say otherwise (the network's fit costs seconds for nothing here).
@@ -103,7 +112,22 @@ static knit::cli::SubcommandRegistrar reg_synth(
             eo = EnergyFitOptions::from_json(read_text_file(o->energy_options), o->energy_options);
           const auto es = fit_energy_database(db, eo);
           std::cout << energy_fit_report(es);
-          if (!es.ok()) rc = knit::kExitFailure;
+          if (!es.ok()) {
+            rc = knit::kExitFailure;
+            if (first_failure.empty()) first_failure = "the energy law: " + es.reason;
+          }
+        }
+        // A fit that failed writes nothing, as knit-meso fit (session 41's red team: synth
+        // replaced a good database by one whose loop length held raw data only, exit 1).
+        if (rc != knit::kExitOk) {
+          const bool existed = std::filesystem::exists(o->out);
+          std::cout << "database NOT written: a fit failed; " << o->out
+                    << (existed ? " is left as it was\n" : " was not created\n");
+          std::cout.flush();
+          std::cerr << "knit-meso synth: error: " << first_failure << "; " << o->out
+                    << (existed ? " is left as it was" : " was not created")
+                    << " (the fit's report is on stdout; --no-fit writes the raw data alone)\n";
+          return rc;
         }
         knit::material::write_database(o->out, db);
         std::cout << "wrote " << o->out << " (synthetic stand-in, generator = \"synth\")\n";

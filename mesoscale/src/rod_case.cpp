@@ -437,6 +437,12 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
         record(step, lambda, xs);
         if (log) *log << "step " << step << ": lambda = " << lambda << "\n";
       });
+  // No load increment converged: nothing to write (the partial directory is removed with
+  // `dir`), an earlier output stays as it was.
+  if (!rep.completed && rows.size() <= 1) {
+    rep.written = false;
+    return rep;
+  }
   // Newton iterations per target step (cut-back sub-increments summed).
   std::vector<int> iters(rows.size(), 0);
   {

@@ -177,6 +177,30 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   CHECK(bytes(clean) == clean_before);
 }
 
+// Session 41's red team: a synth whose fit failed replaced a good database by one whose loop
+// length held raw data only (exit 1). It now writes nothing, as fit does.
+TEST_CASE("knit-meso synth: a fit that fails writes nothing", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_synth_fails.h5", opts = dir / "cli_synth_fails.json";
+  fs::remove(db);
+  REQUIRE(run("synth --steps 4 --loop-lengths 4.5 --out " + db.string()) == 0);
+  const std::string before = bytes(db);
+  // One iteration from the fitted initial stiffness: the E-surface is not invertible.
+  std::ofstream(opts) << R"({"max_iterations": 1, "initial_stiffness": "fit"})";
+  const std::string failing = "synth --steps 4 --loop-lengths 4.5 --fit-options " + opts.string();
+  std::string err;
+  CHECK(run_with_stderr(failing + " --out " + db.string(), dir / "cli_synth_fails.err", err) == 1);
+  CHECK(bytes(db) == before);
+  CHECK_THAT(err, Catch::StartsWith("knit-meso synth: error: the paper law at l = 4.5 mm: ") &&
+                      Catch::Contains(db.string() + " is left as it was"));
+  const fs::path fresh = dir / "cli_synth_fails_new.h5";
+  fs::remove(fresh);
+  CHECK(run_with_stderr(failing + " --out " + fresh.string(), dir / "cli_synth_fails.err", err) ==
+        1);
+  CHECK_FALSE(fs::exists(fresh));
+  CHECK_THAT(err, Catch::Contains(fresh.string() + " was not created"));
+}
+
 // Session 21: the stand-in's stiffness (4.5 / l)^2 overflows for l = 1e-300, and `synth
 // --no-fit` wrote inf and NaN stresses with exit 0. Now refused (exit 2), nothing written.
 TEST_CASE("knit-meso synth: loop lengths whose stresses are not finite are refused", "[unit]") {

@@ -1,5 +1,6 @@
 // The rod driver: every case in cases/rod/ runs and is compared with its reference numbers;
 // bad input gives exit code 2, a JSON-pointer message and no output.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -353,4 +354,42 @@ TEST_CASE("rod case: a reversed end moment stops at the work cap, outputs of con
   CHECK((msg.find("work cap: ") != std::string::npos ||
          msg.find("step floor: ") != std::string::npos));
   CHECK(fs::exists(out / "load_displacement.csv"));  // step 0 and any converged steps
+}
+
+TEST_CASE("rod case: without a converged increment nothing is written, an earlier output stays",
+          "[unit]") {
+  // Session 41's red team: elastica.json with E = 1e-300 (no increment converges) replaced a
+  // complete earlier output by the reference state alone (exit 1), where knit-meso path and
+  // knit-macro run leave it as it was.
+  const fs::path out = kTmp / "no_increment_out";
+  fs::remove_all(out);
+  REQUIRE(run("rod " + (kCases / "elastica.json").string() + " -q -o " + out.string()) == 0);
+  const auto files = [&] {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const std::vector<std::string> before = files();
+  REQUIRE(before.size() > 3);
+  std::ifstream in(kCases / "elastica.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const auto at = text.find("\"E\": ");
+  REQUIRE(at != std::string::npos);
+  text.replace(at, text.find_first_of(",}", at) - at, "\"E\": 1e-300");
+  const fs::path f = kTmp / "no_increment.json";
+  write(f, text);
+  std::string msg;
+  CHECK(run("rod " + f.string() + " -q -o " + out.string(), &msg) == 1);
+  CHECK_THAT(msg, Catch::Contains("no load increment converged: nothing written; the earlier "
+                                  "outputs in " +
+                                  out.string() + ", if any, are left as they were"));
+  CHECK(files() == before);
+  // Into a new directory: nothing is created.
+  const fs::path fresh = kTmp / "no_increment_new";
+  fs::remove_all(fresh);
+  CHECK(run("rod " + f.string() + " -q -o " + fresh.string(), &msg) == 1);
+  CHECK_FALSE(fs::exists(fresh));
 }
