@@ -11,7 +11,6 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
-#include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
@@ -76,14 +75,8 @@ static knit::cli::SubcommandRegistrar reg_fit(
                                     : FitOptions::from_json(read_text_file(o->options), o->options);
           const auto fits = fit_paper_law(db, fo);
           print_fit_summaries(std::cout, db, fits);
-          for (std::size_t k = 0; k < fits.size(); ++k)
-            if (!fits[k].ok()) {
-              rc = knit::kExitFailure;
-              if (first_failure.empty())
-                first_failure =
-                    "the paper law at l = " + knit::io::format_number(db.entries[k].loop_length) +
-                    " mm: " + fits[k].reason;
-            }
+          first_failure = knit::meso::fit::first_fit_failure(db, fits);
+          if (!first_failure.empty()) rc = knit::kExitFailure;
         }
         if (energy) {
           EnergyFitOptions eo = o->energy_options.empty()

@@ -17,7 +17,6 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
-#include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
@@ -95,14 +94,8 @@ static knit::cli::SubcommandRegistrar reg_synth(
           const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
-          for (std::size_t k = 0; k < fits.size(); ++k)
-            if (!fits[k].ok()) {
-              rc = knit::kExitFailure;
-              if (first_failure.empty())
-                first_failure =
-                    "the paper law at l = " + knit::io::format_number(db.entries[k].loop_length) +
-                    " mm: " + fits[k].reason;
-            }
+          first_failure = knit::meso::fit::first_fit_failure(db, fits);
+          if (!first_failure.empty()) rc = knit::kExitFailure;
           // The synthetic law is exactly a sum of ridge functions of the default directions
           // (knit/meso/fit/synthetic.hpp), so the stand-in fits the ridge family unless the
           // options say otherwise (the network's fit costs seconds for nothing here).

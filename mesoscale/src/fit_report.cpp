@@ -1,10 +1,19 @@
 #include <algorithm>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/input_file.hpp"
 #include "knit/meso/fit/report.hpp"
 
 namespace knit::meso::fit {
+
+std::string first_fit_failure(const material::Database& db, const std::vector<FitSummary>& fits) {
+  for (std::size_t k = 0; k < fits.size() && k < db.entries.size(); ++k)
+    if (!fits[k].ok())
+      return "the paper law at l = " + io::format_number(db.entries[k].loop_length) +
+             " mm: " + fits[k].reason;
+  return {};
+}
 
 void print_fit_summaries(std::ostream& os, const material::Database& db,
                          const std::vector<FitSummary>& fits) {

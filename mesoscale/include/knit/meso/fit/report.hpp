@@ -13,6 +13,10 @@ namespace knit::meso::fit {
 void print_fit_summaries(std::ostream& os, const material::Database& db,
                          const std::vector<FitSummary>& fits);
 
+/// "the paper law at l = L mm: REASON" of the first loop length whose fit failed; "" if none
+/// (the stderr line of knit-meso fit and synth, which then write nothing).
+std::string first_fit_failure(const material::Database& db, const std::vector<FitSummary>& fits);
+
 /// Fits the paper's law (eq. 17) of every loop length from the raw paths of the "paper" set
 /// only (the coverage and held-out paths are the energy law's), and stores it in db.
 std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& options);
