@@ -62,6 +62,14 @@ std::vector<std::vector<double>> read_csv(const fs::path& f,
   return rows;
 }
 
+/// The text of cases/rod/NAME.
+std::string case_text(const std::string& name) {
+  std::ifstream in(kCases / name);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 void write(const fs::path& f, const std::string& text) {
   fs::create_directories(f.parent_path());
   std::ofstream(f) << text;
@@ -115,10 +123,7 @@ TEST_CASE("rod case: every case file in cases/rod runs to lambda = 1", "[case]")
 // Session 28: one element of degree 3 gave the elastica's tip deflection with the wrong sign
 // (-0.40 mm for 6.70 mm) and one of degree 2 gave 0.0022 mm, both with exit 0 and no word.
 TEST_CASE("rod case: a mesh too coarse for the case is reported by the bisection check", "[case]") {
-  std::ifstream in(kCases / "elastica.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text = case_text("elastica.json");
   const std::string mesh = R"("degree": 4, "elements": 8)";
   const auto at = text.find(mesh);
   REQUIRE(at != std::string::npos);
@@ -336,10 +341,7 @@ TEST_CASE("rod case: a reversed end moment stops at the work cap, outputs of con
           "[unit]") {
   // Issue 14: rollup.json with its end moment reversed and ten times larger sub-stepped
   // forever. The load stepping now stops at its floor or work cap (exit 1) and says which.
-  std::ifstream in(kCases / "rollup.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text = case_text("rollup.json");
   const std::string m = "-2.4674011002723395e-3";
   const auto at = text.find(m);
   REQUIRE(at != std::string::npos);
@@ -372,10 +374,7 @@ TEST_CASE("rod case: without a converged increment nothing is written, an earlie
   };
   const std::vector<std::string> before = files();
   REQUIRE(before.size() > 3);
-  std::ifstream in(kCases / "elastica.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text = case_text("elastica.json");
   const auto at = text.find("\"E\": ");
   REQUIRE(at != std::string::npos);
   text.replace(at, text.find_first_of(",}", at) - at, "\"E\": 1e-300");
@@ -392,4 +391,39 @@ TEST_CASE("rod case: without a converged increment nothing is written, an earlie
   fs::remove_all(fresh);
   CHECK(run("rod " + f.string() + " -q -o " + fresh.string(), &msg) == 1);
   CHECK_FALSE(fs::exists(fresh));
+}
+
+TEST_CASE("rod case: a prescribed end rotation of a full turn rolls the rod up", "[unit]") {
+  // Session 41's red team: the check that the loads are resolved looked at lambda = 1 only,
+  // where a prescribed rotation of 2 pi is the identity, and refused this case (naming
+  // /steps/tolerance). Rolled up by the end's rotation, the tip is back on the axis at
+  // -u = L (1 - sin t / t) = 10 mm, w = L (1 - cos t) / t = 0 (t = 2 pi), as under the moment.
+  std::string text = case_text("rollup.json");
+  const std::string end =
+      R"("end": { "position": "free", "rotation": "free", "moment": [0, -2.4674011002723395e-3, 0] })";
+  const auto at = text.find(end);
+  REQUIRE(at != std::string::npos);
+  text.replace(
+      at, end.size(),
+      R"("end": {"position": "free", "rotation": "fixed", "rotation_vector": [0, -6.283185307179586, 0]})");
+  const fs::path f = kTmp / "turn.json", out = kTmp / "turn_out";
+  fs::remove_all(out);
+  write(f, text);
+  std::string msg;
+  const int rc = run("rod " + f.string() + " -q -o " + out.string(), &msg);
+  INFO(msg);
+  REQUIRE(rc == 0);
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "load_displacement.csv", &header);
+  REQUIRE(!rows.empty());
+  REQUIRE(header.size() >= 6);
+  CHECK(header[3] == "tip_ux");
+  CHECK(rows.back()[1] == 1.0);
+  CHECK(rows.back()[3] == Approx(-10.0).margin(1e-3));
+  CHECK(rows.back()[5] == Approx(0.0).margin(1e-3));
+  // Half way (lambda = 0.5, t = pi): -u = L, w = 2 L / pi.
+  const auto& half = rows[rows.size() / 2];
+  REQUIRE(half[1] == Approx(0.5));
+  CHECK(half[3] == Approx(-10.0).margin(1e-3));
+  CHECK(half[5] == Approx(20.0 / M_PI).margin(1e-3));
 }
