@@ -295,8 +295,10 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       throw InputError(
           fname, "",
           "the file was written with checksums but its structure checksum is gone: it was "
-          "opened for writing after it was written (h5py's \"r+\" and \"a\" modes drop it even "
-          "without a change), so a change to its law or data cannot be ruled out; use the "
+          "changed after it was written (opened for writing: h5py's \"r+\" and \"a\" modes "
+          "drop the checksum even without a change), or it was cut short or extended (a copy "
+          "interrupted, bytes appended), so a change to its law or data cannot be ruled out; use "
+          "the "
           "database as knit-meso wrote it (a copy made with cp keeps the checksum), or write a "
           "new one (knit-meso sweep, or knit-meso fit from the original)");
     db.format_version = f.attribute_int(".", "format_version");

@@ -86,9 +86,22 @@ int run(const Options& o) {
   if (o.k_T) co.contact.friction.k_T = *o.k_T;
   // The same checks as the cell parameter file (CellOptions::validate names the field): a flag
   // the parser let through is still refused here, never replaced by a default.
-  if (const auto bad = co.validate())
+  if (const auto bad = co.validate()) {
+    // A value a flag set is named by its flag (session 41's red team: "<input>:
+    // /contact/allowance" for --allowance without a --config file).
+    const std::pair<const char*, bool> flags[] = {{"/analysis/elements", o.elements.has_value()},
+                                                  {"/contact/penalty", o.k_N.has_value()},
+                                                  {"/contact/allowance", o.g0.has_value()},
+                                                  {"/contact/delta", o.delta.has_value()},
+                                                  {"/contact/mu", o.mu.has_value()},
+                                                  {"/contact/stick_penalty", o.k_T.has_value()}};
+    const char* names[] = {"--elements", "--penalty", "--allowance", "--delta", "--mu", "--stick"};
+    for (std::size_t i = 0; i < std::size(flags); ++i)
+      if (flags[i].second && bad->pointer == flags[i].first)
+        throw knit::InputError("", names[i], bad->message);
     throw knit::InputError(o.config.empty() ? "" : o.config, bad->pointer,
                            bad->message + " (command-line flags override the file)");
+  }
   PathSpec p;
   p.steps = o.steps;
   if (bi) {

@@ -510,8 +510,17 @@ TEST_CASE("database: a database of ours without its structure checksum is refuse
   CHECK(where == file.string());
   CHECK(pointer.empty());
   CHECK_THAT(message, Catch::StartsWith("the file was written with checksums but its structure "
-                                        "checksum is gone: it was opened for writing after it "
-                                        "was written"));
+                                        "checksum is gone: it was changed after it was written "
+                                        "(opened for writing"));
+  // Bytes appended (or a copy cut short) lose the trailer too, and the message does not claim
+  // the file was opened for writing alone (session 41's red team).
+  const fs::path longer = written_test_database("db_appended.h5");
+  std::ofstream(longer, std::ios::binary | std::ios::app) << "0123456789";
+  const auto [where2, pointer2, message2] = database_error_of(longer);
+  CHECK(where2 == longer.string());
+  CHECK_THAT(message2, Catch::StartsWith("the file was written with checksums but its structure "
+                                         "checksum is gone") &&
+                           Catch::Contains("or it was cut short or extended"));
 }
 
 TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",

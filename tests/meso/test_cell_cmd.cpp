@@ -179,6 +179,10 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"cell --loop-length 5 --diameter 1e308", "--diameter", "could not match"},
       {"path --loop-length 2.5 --shear 5", "--loop-length", "no cell geometry for 2.5 mm"},
       {"cell --loop-length 4.5 --config ''", "--config", "must not be empty"},
+      // Session 41's red team: a flag's value refused by the cell's own checks was named
+      // "<input>: /contact/allowance", a file that was never given.
+      {"path --loop-length 4.5 --allowance 0.38 --biaxial 0.1 0 --steps 1",
+       "--allowance: ", "must be smaller than the yarn diameter"},
   };
   for (const Bad& b : bad) {
     INFO(b.args);
