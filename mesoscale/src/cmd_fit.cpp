@@ -6,6 +6,7 @@
 //   knit-meso fit db.h5                       # both laws
 //   knit-meso fit db.h5 --law energy --energy-options energy.json -o refit.h5
 //   knit-meso fit db.h5 --law paper --options fit.json
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -98,10 +99,13 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // input would lose its consistent state (found with a stress of 1e308 MPa in the raw
         // data). The target is left as it was.
         if (rc != knit::kExitOk) {
-          std::cout << "database NOT written: a fit failed; " << target << " is left as it was\n";
+          // (session 41: "left as it was" of an -o file that did not exist)
+          const char* state =
+              std::filesystem::exists(target) ? " is left as it was" : " was not created";
+          std::cout << "database NOT written: a fit failed; " << target << state << "\n";
           std::cout.flush();
-          std::cerr << "knit-meso fit: error: " << first_failure << "; " << target
-                    << " is left as it was (the fit's report is on stdout)\n";
+          std::cerr << "knit-meso fit: error: " << first_failure << "; " << target << state
+                    << " (the fit's report is on stdout)\n";
           return rc;
         }
         db.provenance = knit::material::current_provenance();

@@ -511,6 +511,22 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
   }
 }
 
+TEST_CASE("energy fit: a law that misses its data by more than their range fails", "[unit]") {
+  // Session 41's red team: network_iterations 5 with a floor of 1000 MPa was written with a
+  // largest error of 25,214 % of the stress range, exit 0.
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 6);
+  const EnergyFitSummary bad =
+      fit_energy_law(db, EnergyFitOptions::from_json(R"({"family": "ridge", "floor": 1000})"));
+  CHECK(bad.status == FitStatus::kSolverFailed);
+  CHECK_THAT(bad.reason, Catch::StartsWith("the law misses its own fit data by up to ") &&
+                             Catch::Contains("more than the whole range"));
+  // The same family with its own floor fits (within a few % of the range).
+  const EnergyFitSummary good =
+      fit_energy_law(db, EnergyFitOptions::from_json(R"({"family": "ridge"})"));
+  REQUIRE(good.ok());
+  for (const auto& p : good.diagnostics.per_loop) CHECK(p.max_relative < kMaxFitErrorRelative);
+}
+
 TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
   SECTION("non-finite data in a converged step") {
     Database db = synthetic_coverage_db({4.5, 6.5}, 4);
