@@ -256,6 +256,41 @@ std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File
   return copied;
 }
 
+std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5File& to) {
+  std::vector<std::string> out;
+  // Groups a refit rewrites: the energy law and each loop length's fitted surfaces.
+  auto rewritten = [](const std::string& path) {
+    if (path == "/energy_law") return true;
+    const std::string fit = "/fit";
+    return path.rfind("/loop_", 0) == 0 && path.size() > fit.size() &&
+           path.compare(path.size() - fit.size(), fit.size(), fit) == 0 &&
+           path.find('/', 1) == path.size() - fit.size();
+  };
+  auto attributes = [&](const std::string& path) {
+    const std::vector<std::string> have = to.attribute_names(path);
+    for (const std::string& a : from.attribute_names(path))
+      if (std::find(have.begin(), have.end(), a) == have.end()) out.push_back(path + "@" + a);
+  };
+  std::function<void(const std::string&)> walk = [&](const std::string& group) {
+    attributes(group);
+    for (const std::string& name : from.children(group)) {
+      const std::string path = (group == "/" ? "" : group) + "/" + name;
+      if (rewritten(path)) continue;
+      if (!to.exists(path)) {
+        out.push_back(path);
+      } else if (from.is_group(path) && to.is_group(path)) {
+        walk(path);
+      } else if (from.is_dataset(path) && to.is_dataset(path)) {
+        attributes(path);
+      } else {
+        out.push_back(path);  // a group where a dataset is written, or the reverse
+      }
+    }
+  };
+  walk("/");
+  return out;
+}
+
 std::runtime_error database_not_written(const std::filesystem::path& target, bool existed,
                                         const std::filesystem::path& temp,
                                         const std::exception& e) {

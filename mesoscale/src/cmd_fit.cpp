@@ -112,17 +112,42 @@ static knit::cli::SubcommandRegistrar reg_fit(
         db.provenance.input = o->db;  // the database the laws were refitted from
         // What the Database does not hold (the sweep's /sweep/report, groups a user added)
         // comes along from the input, in the same atomic write.
-        std::vector<std::string> carried;
-        knit::material::write_database(target, db, [&](knit::io::H5File& f) {
-          const auto src = knit::io::H5File::open_read(o->db);
-          carried = knit::material::carry_over_unwritten(
-              src, f,
-              "the laws were refitted by knit-meso fit (" + db.provenance.created +
-                  "); fit_status and case_in_fit describe the sweep's own fit");
-        });
+        std::vector<std::string> carried, lost;
+        std::error_code ec;
+        const bool in_place = std::filesystem::equivalent(target, o->db, ec);
+        try {
+          knit::material::write_database(target, db, [&](knit::io::H5File& f) {
+            const auto src = knit::io::H5File::open_read(o->db);
+            carried = knit::material::carry_over_unwritten(
+                src, f,
+                "the laws were refitted by knit-meso fit (" + db.provenance.created +
+                    "); fit_status and case_in_fit describe the sweep's own fit");
+            // What neither the Database nor the carry-over holds (session 41's red team: a file
+            // without checksums lost a user's items inside /loop_0 with exit 0): an in-place
+            // refit is abandoned, the input left as it was.
+            lost = knit::material::items_not_carried(src, f);
+            if (in_place && !lost.empty()) throw std::runtime_error("items not carried over");
+          });
+        } catch (const std::exception&) {
+          if (!in_place || lost.empty()) throw;
+          std::string list;
+          for (std::size_t i = 0; i < lost.size() && i < 5; ++i) list += (i ? ", " : "") + lost[i];
+          if (lost.size() > 5) list += ", ... (" + std::to_string(lost.size()) + " in all)";
+          throw knit::InputError(o->db, lost.front(),
+                                 "holds items that knit-meso does not write (" + list +
+                                     "): a refit in place would lose them; nothing was written. "
+                                     "Write the refit to another file with -o OUT, or move them "
+                                     "out of the database first");
+        }
         if (!carried.empty()) {
           std::cout << "kept from " << o->db << ":";
           for (const auto& c : carried) std::cout << " " << c;
+          std::cout << "\n";
+        }
+        if (!lost.empty()) {
+          std::cout << "not carried over from " << o->db << " (items knit-meso does not write; "
+                    << o->db << " keeps them):";
+          for (const auto& c : lost) std::cout << " " << c;
           std::cout << "\n";
         }
         return rc;

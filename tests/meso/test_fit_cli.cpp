@@ -177,6 +177,44 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   CHECK(bytes(clean) == clean_before);
 }
 
+// Session 41's red team: an in-place fit of a database without checksums dropped a user's items
+// inside the groups knit-meso writes (an attribute of /, of /loop_0, a dataset /loop_0/user_ds)
+// with exit 0. Such a refit is now refused, the file left as it was; with -o the items stay in
+// the input and the output says which were not carried over.
+TEST_CASE("knit-meso fit: items it does not write are never lost in place", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_fit_items.h5", out = dir / "cli_fit_items_out.h5";
+  fs::remove(out);
+  REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  REQUIRE(run("fit " + db.string() + " --law paper") == 0);  // nothing foreign: in place
+  {
+    auto f = knit::io::H5File::open_rw(db);
+    f.set_attribute("/", "user_note", std::string("mine"));
+    f.set_attribute("/loop_0", "user_note", std::string("mine too"));
+    f.write("/loop_0/user_ds", std::vector<double>{1.0, 2.0, 3.0});
+  }
+  const std::string before = bytes(db);
+  std::string err;
+  CHECK(run_with_stderr("fit " + db.string() + " --law paper", dir / "cli_fit_items.err", err) ==
+        2);
+  CHECK(bytes(db) == before);
+  CHECK_THAT(err, Catch::Contains(db.string() + ": /@user_note: holds items that knit-meso does "
+                                                "not write (/@user_note, /loop_0@user_note, "
+                                                "/loop_0/user_ds): a refit in place would lose "
+                                                "them; nothing was written"));
+  // Into another file: written, the input keeps them, and the items are named.
+  const fs::path log = dir / "cli_fit_items.out";
+  const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-meso fit " + db.string() +
+                          " --law paper -o " + out.string() + " > " + log.string() + " 2>&1";
+  CHECK(std::system(cmd.c_str()) == 0);
+  CHECK(bytes(db) == before);
+  std::ifstream in(log);
+  const std::string text(std::istreambuf_iterator<char>(in), {});
+  CHECK_THAT(text, Catch::Contains("not carried over from " + db.string()) &&
+                       Catch::Contains(" /@user_note /loop_0@user_note /loop_0/user_ds"));
+  CHECK_FALSE(knit::io::H5File::open_read(out).exists("/loop_0/user_ds"));
+}
+
 // Session 41's red team: a synth whose fit failed replaced a good database by one whose loop
 // length held raw data only (exit 1). It now writes nothing, as fit does.
 TEST_CASE("knit-meso synth: a fit that fails writes nothing", "[unit]") {
