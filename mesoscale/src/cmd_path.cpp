@@ -15,6 +15,7 @@
 //   neighbours, radius array) and DIR/yarn.pvd; prints the time per step and the Newton iterations.
 // Example: knit-meso path --loop-length 4.5 --biaxial 0.3 0 --steps 20 --out path45
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,6 +27,7 @@
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/cell/geometry.hpp"
 #include "knit/meso/cell/output.hpp"
 #include "knit/meso/homog/cell_config.hpp"
@@ -51,7 +53,11 @@ struct Options {
   double k_N_arg = 0, g0_arg = 0, delta_arg = 0, mu_arg = 0, k_T_arg = 0;
   bool no_vtp = false;
   std::string config;
+  std::string max_output_size;  ///< --max-output-size ("" = the default cap)
 };
+
+/// The default cap of --max-output-size, as knit-meso rod's and knit-macro run's: 2 GB.
+constexpr std::uint64_t kDefaultMaxOutputBytes = 2'000'000'000;
 
 void write_step_vtp(knit::meso::homog::PeriodicCell& cell, const std::string& file) {
   using knit::meso::cell::Polyline;
@@ -152,6 +158,29 @@ int run(const Options& o) {
   }();
   PeriodicCell& cell = *cell_ptr;
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
+  // The outputs' size, estimated before the run from one VTP of the reference state (session
+  // 41's red team: --steps 100000 started writing about 5.9 GB without a word; knit-meso rod
+  // and knit-macro run have the same cap).
+  const std::uint64_t cap = o.max_output_size.empty()
+                                ? kDefaultMaxOutputBytes
+                                : knit::io::parse_size(o.max_output_size, "--max-output-size");
+  if (cap > 0) {
+    std::uint64_t per_step = 200;  // a CSV row
+    if (!o.no_vtp) {
+      const std::string probe = (dir / "yarn_probe.vtp").string();
+      write_step_vtp(cell, probe);
+      per_step += std::filesystem::file_size(probe);
+      std::filesystem::remove(probe);
+    }
+    const std::uint64_t est = per_step * (static_cast<std::uint64_t>(p.steps) + 1);
+    if (est > cap)
+      throw knit::InputError(
+          "", "--steps",
+          "the estimated output size " + knit::io::format_bytes(est) + " (" +
+              std::to_string(p.steps + 1) + " steps of " + knit::io::format_bytes(per_step) +
+              ") exceeds the cap of " + knit::io::format_bytes(cap) +
+              ": use fewer --steps, --no-vtp, or raise the cap with --max-output-size");
+  }
   std::string csv = csv_header();
   std::vector<std::pair<double, std::string>> pvd;
   const PathResult res = run_path(cell, p, [&](int k, const StepResult& r) {
@@ -237,6 +266,9 @@ knit::cli::SubcommandRegistrar reg(
       auto* kt = sub.add_option("--stick", o->k_T_arg, "stick penalty k_T (MPa)")
                      ->check(number(0, finite, Ends::kOpenLow));
       sub.add_flag("--no-vtp", o->no_vtp, "skip the per-step VTP files");
+      sub.add_option("--max-output-size", o->max_output_size,
+                     "refuse the path before the run if its outputs are estimated above this "
+                     "size (default 2GB; e.g. 500MB, 10GB; 0 = no cap)");
       sub.add_option("--config", o->config,
                      "JSON cell parameters (schemas/cell.schema.json); flags override it");
       return [o, ne, kn, g0, dl, mu, kt]() {

@@ -183,6 +183,13 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       // "<input>: /contact/allowance", a file that was never given.
       {"path --loop-length 4.5 --allowance 0.38 --biaxial 0.1 0 --steps 1",
        "--allowance: ", "must be smaller than the yarn diameter"},
+      // Session 41's red team: --steps 100000 started writing about 6 GB without a word.
+      {"path --loop-length 4.5 --shear 5 --steps 100000", "--steps",
+       "(100001 steps of 59.7 kB) exceeds the cap of 2 GB"},
+      {"path --loop-length 4.5 --shear 5 --steps 20 --max-output-size 1MB", "--steps",
+       "exceeds the cap of 1 MB"},
+      {"path --loop-length 4.5 --shear 5 --steps 20 --no-vtp --max-output-size 1kB", "--steps",
+       "(21 steps of 200 bytes) exceeds the cap of 1 kB"},
   };
   for (const Bad& b : bad) {
     INFO(b.args);
