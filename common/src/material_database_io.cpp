@@ -256,11 +256,14 @@ std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File
   return copied;
 }
 
-std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5File& to) {
+std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5File& to,
+                                           bool energy_refit, bool paper_refit) {
   std::vector<std::string> out;
-  // Groups a refit rewrites: the energy law and each loop length's fitted surfaces.
-  auto rewritten = [](const std::string& path) {
-    if (path == "/energy_law") return true;
+  // Groups the refit rewrote: the energy law, each loop length's fitted surfaces (session 41's
+  // review: skipped whatever --law said, so --law paper lost a user's items in /energy_law).
+  auto rewritten = [&](const std::string& path) {
+    if (path == "/energy_law") return energy_refit;
+    if (!paper_refit) return false;
     const std::string fit = "/fit";
     return path.rfind("/loop_", 0) == 0 && path.size() > fit.size() &&
            path.compare(path.size() - fit.size(), fit.size(), fit) == 0 &&

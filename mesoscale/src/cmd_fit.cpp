@@ -125,7 +125,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
             // What neither the Database nor the carry-over holds (session 41's red team: a file
             // without checksums lost a user's items inside /loop_0 with exit 0): an in-place
             // refit is abandoned, the input left as it was.
-            lost = knit::material::items_not_carried(src, f);
+            lost = knit::material::items_not_carried(src, f, energy, paper);
             if (in_place && !lost.empty()) throw std::runtime_error("items not carried over");
           });
         } catch (const std::exception&) {

@@ -52,9 +52,11 @@ knit::cli::SubcommandRegistrar reg(
         rod::check_output_size(c, cap);
         const rod::CasePathReport rep = rod::run_rod_case(c, out, o->quiet ? nullptr : &std::cout);
         if (!rep.written) {
+          // (session 41's review: "no load increment converged" where sub-increments had)
           std::cerr << "knit-meso rod: " << rep.message
-                    << "; no load increment converged: nothing written; the earlier outputs in "
-                    << out.string() << ", if any, are left as they were\n";
+                    << "; no load step completed (lambda reached " << rep.lambda_reached
+                    << "): nothing written; the earlier outputs in " << out.string()
+                    << ", if any, are left as they were\n";
           return knit::kExitFailure;
         }
         std::cout << "rod: " << rep.message << "; lambda = " << rep.lambda_reached << ", "

@@ -663,15 +663,10 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       // The end is the last converged step (session 33, a helper's audit: the last step, so a
       // path that stopped where the cell jammed had no end ratio and the report said "no
       // path" for its axis).
-      // A second path along the same axis (an extra input): both count in
-      // uniaxial_max_relative, and the curve kept is the one that departs more.
+      // Every converged step: the law's own axial stress beside the cell's.
       material::UniaxialCurve c;
       for (int s = 0; s < r.steps(); ++s) {
-        // Converged steps whose axial strain increases (the reader refuses a curve that does
-        // not; the prescribed axial strain of a uniaxial path always does).
-        if (r.status[static_cast<std::size_t>(s)] != 0 ||
-            (!c.strain.empty() && !(r.E(s, ax) > c.strain.back())))
-          continue;
+        if (r.status[static_cast<std::size_t>(s)] != 0) continue;
         c.strain.push_back(r.E(s, ax));
         c.cell.push_back(r.S(s, ax));
         c.law.push_back(uniaxial_axial_stress(at, ax, r.E(s, ax), r.E(s, 1 - ax)));
@@ -680,11 +675,25 @@ EnergyFitDiagnostics diagnose_energy_law(const EnergyLawData& law, const Databas
       const double inf = std::numeric_limits<double>::infinity();
       const material::UniaxialDeviation d = material::uniaxial_deviation(c, inf);
       if (d.states > 0) pl.uniaxial_max_relative = std::max(pl.uniaxial_max_relative, d.deviation);
+      pl.uniaxial_end_ratio(ax) = c.law.back() / c.cell.back();
+      // The curve stored for knit-macro's warning: a tension path's (prescribed axial strain
+      // > 0), its steps in increasing strain (the reader refuses others). Of two such paths
+      // along one axis (an extra input) the one that departs more is kept; a compression path
+      // is not stored (session 41's review: a path to E = -0.2 became a one-state curve that
+      // replaced the tension curve and turned the wale-wise warning off).
+      if (!(r.path.target(0) > 0.0)) continue;
+      material::UniaxialCurve t;
+      for (std::size_t i = 0; i < c.strain.size(); ++i)
+        if (c.strain[i] > 0.0 && (t.strain.empty() || c.strain[i] > t.strain.back())) {
+          t.strain.push_back(c.strain[i]);
+          t.cell.push_back(c.cell[i]);
+          t.law.push_back(c.law[i]);
+        }
+      if (t.empty()) continue;
       material::UniaxialCurve& kept = pl.uniaxial[static_cast<std::size_t>(ax)];
-      if (kept.empty() || d.deviation > material::uniaxial_deviation(kept, inf).deviation) {
-        pl.uniaxial_end_ratio(ax) = c.law.back() / c.cell.back();
-        kept = std::move(c);
-      }
+      if (kept.empty() || material::uniaxial_deviation(t, inf).deviation >
+                              material::uniaxial_deviation(kept, inf).deviation)
+        kept = std::move(t);
     }
     if (pl.stress_range > 0) {
       std::vector<Eigen::Vector3d> e{Eigen::Vector3d::Zero()}, S{Eigen::Vector3d::Zero()};

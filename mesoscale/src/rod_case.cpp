@@ -444,8 +444,8 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
         record(step, lambda, xs);
         if (log) *log << "step " << step << ": lambda = " << lambda << "\n";
       });
-  // No load increment converged: nothing to write (the partial directory is removed with
-  // `dir`), an earlier output stays as it was.
+  // No load step completed: nothing to write but the reference state (the partial directory is
+  // removed with `dir`), an earlier output stays as it was.
   if (!rep.completed && rows.size() <= 1) {
     rep.written = false;
     return rep;

@@ -213,6 +213,22 @@ TEST_CASE("knit-meso fit: items it does not write are never lost in place", "[un
   CHECK_THAT(text, Catch::Contains("not carried over from " + db.string()) &&
                        Catch::Contains(" /@user_note /loop_0@user_note /loop_0/user_ds"));
   CHECK_FALSE(knit::io::H5File::open_read(out).exists("/loop_0/user_ds"));
+  // Inside the law that is not refitted, items are the user's too (session 41's review: every
+  // /energy_law and /loop_k/fit item was passed over whatever --law said): --law paper keeps
+  // /energy_law and rewrites /loop_k/fit.
+  const fs::path full = dir / "cli_fit_items_full.h5";
+  REQUIRE(run("synth --steps 6 --loop-lengths 4.5,6.5 --out " + full.string()) == 0);
+  {
+    auto f = knit::io::H5File::open_rw(full);
+    f.set_attribute("/energy_law", "user_note", std::string("mine"));
+    f.set_attribute("/loop_0/fit", "user_note", std::string("an earlier fit's"));
+  }
+  const std::string full_before = bytes(full);
+  CHECK(run_with_stderr("fit " + full.string() + " --law paper", dir / "cli_fit_items.err", err) ==
+        2);
+  CHECK(bytes(full) == full_before);
+  CHECK_THAT(err,
+             Catch::Contains("holds items that knit-meso does not write (/energy_law@user_note)"));
 }
 
 // Session 41's red team: a synth whose fit failed replaced a good database by one whose loop

@@ -458,6 +458,7 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
   for (const double scale : {1.0, 1.5}) {
     const int n = 5;
     material::RawPath r = zero_path(material::PathKind::kUniaxial, "coverage", n, 1);
+    r.path.target << 0.05 * n, 0.0;  // wale-wise tension to E22 = 0.25
     double lateral = 0.0;
     for (int k = 0; k < n; ++k) {
       const double e2 = 0.05 * (k + 1);
@@ -502,6 +503,22 @@ TEST_CASE("energy fit: the uniaxial-stress diagnostic compares the law driven li
     CHECK(dg.per_loop[0].uniaxial[1].empty());
     // The stopped path's curve holds its converged steps only.
     CHECK(stopped.per_loop[1].uniaxial[1].strain.size() == static_cast<std::size_t>(n - 1));
+    // A compression path along the same axis (to E22 = -0.2, its law 3 times the cell) counts
+    // in the largest departure but is not stored: it replaced the tension curve (session 41's
+    // review), which turned the wale-wise warning off.
+    db.entries[1].raw.push_back(r);
+    material::RawPath q = zero_path(material::PathKind::kUniaxial, "coverage", 4, 1);
+    q.path.target << -0.2, 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const double e2 = -0.05 * (k + 1);
+      q.E.row(k) << 0.0, e2, 0.0;
+      q.S.row(k) << 0.0, uniaxial_axial_stress(at, 1, e2, 0.0) / 3.0, 0.0;
+    }
+    db.entries[1].raw.push_back(q);
+    const auto both = diagnose_energy_law(s.law, db);
+    db.entries[1].raw.resize(db.entries[1].raw.size() - 2);
+    CHECK(both.per_loop[1].uniaxial[1].strain == c.strain);
+    CHECK(both.per_loop[1].uniaxial_max_relative == Approx(2.0).epsilon(1e-6));
     // The report says so for the course (no course-wise path here) instead of "nan".
     EnergyFitSummary with = s;
     with.diagnostics = dg;

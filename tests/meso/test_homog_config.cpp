@@ -12,7 +12,11 @@ using namespace knit::meso::homog;
 
 namespace {
 std::string write_tmp(const std::string& name, const std::string& text) {
-  const std::string path = std::string(KNIT_BINARY_DIR) + "/" + name;
+  // Appended piece by piece: GCC 12's -Warray-bounds misfires on the chained operator+ here
+  // (a false positive that comes and goes with the unity group's other code).
+  std::string path = KNIT_BINARY_DIR;
+  path += "/";
+  path += name;
   std::ofstream(path) << text;
   return path;
 }

@@ -382,8 +382,8 @@ TEST_CASE("rod case: without a converged increment nothing is written, an earlie
   write(f, text);
   std::string msg;
   CHECK(run("rod " + f.string() + " -q -o " + out.string(), &msg) == 1);
-  CHECK_THAT(msg, Catch::Contains("no load increment converged: nothing written; the earlier "
-                                  "outputs in " +
+  CHECK_THAT(msg, Catch::Contains("no load step completed (lambda reached 0): nothing written; the "
+                                  "earlier outputs in " +
                                   out.string() + ", if any, are left as they were"));
   CHECK(files() == before);
   // Into a new directory: nothing is created.

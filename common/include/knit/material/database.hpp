@@ -202,11 +202,13 @@ std::vector<std::string> carry_over_unwritten(const io::H5File& from, io::H5File
                                               const std::string& refit_note);
 
 /// What `from` holds that `to` does not, after carry_over_unwritten: HDF5 paths of objects
-/// ("/loop_0/user_ds") and attributes ("/loop_0@note") anywhere but inside the groups a refit
-/// rewrites (/energy_law, /loop_<k>/fit: an earlier fit's items there are replaced by design).
-/// knit-meso fit refuses an in-place refit that would drop such items (session 41's red team:
-/// a file without checksums lost a user's attributes and datasets inside /loop_0 with exit 0).
-std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5File& to);
+/// ("/loop_0/user_ds") and attributes ("/loop_0@note") anywhere but inside the groups the refit
+/// rewrote (/energy_law when `energy_refit`, each /loop_<k>/fit when `paper_refit`: an earlier
+/// fit's items there are replaced by design). knit-meso fit refuses an in-place refit that would
+/// drop such items (session 41's red team: a file without checksums lost a user's attributes
+/// and datasets inside /loop_0 with exit 0).
+std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5File& to,
+                                           bool energy_refit, bool paper_refit);
 
 /// The error of a database write into the temporary `temp` of `target` that failed with `e`
 /// (a full file system, say): "TARGET: database not written (the earlier file is left as it

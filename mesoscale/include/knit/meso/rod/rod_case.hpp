@@ -44,9 +44,10 @@ struct RodCase {
 /// stopped early).
 struct CasePathReport : PathReport {
   std::optional<ResolutionCheck> resolution;
-  /// False when no load increment converged: nothing was written, and an earlier output in the
-  /// directory is left as it was (session 41's red team: it was replaced by the reference
-  /// state alone; knit-meso path and knit-macro run do the same).
+  /// False when no load step completed (none of the path's target steps; cut-back
+  /// sub-increments may have converged short of the first): nothing was written, and an earlier
+  /// output in the directory is left as it was (session 41's red team: it was replaced by the
+  /// reference state alone; knit-meso path and knit-macro run do the same).
   bool written = true;
 };
 
