@@ -99,9 +99,20 @@ def placeholder(out, title, message):
     save(fig, out)
 
 
+UNIAXIAL_WARNING = "warning: where the fabric is stretched uniaxially"
+
+
+def uniaxial_warned(summary):
+    """True when a run's summary.txt carries knit-macro's warning that the law's own uniaxial
+    response departs from the unit cell's (session 41: the load-strain figures mark such runs,
+    so that the reader of the curves sees it where the curves are)."""
+    return any(line.startswith(UNIAXIAL_WARNING) for line in summary.splitlines())
+
+
 def cmd_load(a):
     fig, ax = plt.subplots(figsize=(6, 4.2))
     drawn = 0
+    warned = 0
     study = any(n.startswith(("conv", "mesh")) for n in a.cases)  # legend by mesh
     for name in a.cases:
         r = Result(a.results, name)
@@ -109,6 +120,9 @@ def cmd_load(a):
             continue
         eps, f = r.strain(), r.load()
         lab = label_of(name, r.case, study) + ("" if r.completed else " (stopped early)")
+        if uniaxial_warned(r.summary()):
+            lab += " *"
+            warned += 1
         ax.plot(100 * eps, f, "-" if r.completed else "--", marker=".", ms=3, label=lab)
         drawn += 1
     if drawn == 0:
@@ -120,6 +134,11 @@ def cmd_load(a):
     ax.set_title(a.title, fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    if warned:
+        # Below the axis label (the saved figure's tight box takes it in).
+        ax.text(0.0, -0.16, "* knit-macro warns: the law's own uniaxial stress departs from the "
+                "unit cell's there (the report's warnings; docs/database.md)", fontsize=6.5,
+                color="0.3", ha="left", va="top", transform=ax.transAxes)
     save(fig, a.out)
 
 
