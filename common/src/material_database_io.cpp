@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -531,6 +532,29 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                                   db.energy_law->l_max < db.entries.back().loop_length))
         throw InputError(fname, detail::kEnergyLawGroup,
                          "the law's loop-length range does not cover /loop_lengths");
+      // The uniaxial curves' rows are the database's loop lengths (session 42: knit-macro
+      // takes a case's l between two rows as the laws it uses; a row at 7 mm of a 4.5-6.5 mm
+      // database was read).
+      const auto& pl = db.energy_diagnostics.per_loop;
+      const bool curves = std::any_of(pl.begin(), pl.end(), [](const auto& p) {
+        return !p.uniaxial[0].empty() || !p.uniaxial[1].empty();
+      });
+      for (std::size_t k = 0; curves && k < std::max(pl.size(), db.entries.size()); ++k) {
+        std::ostringstream os;
+        os << std::setprecision(10);
+        if (pl.size() != db.entries.size()) {
+          os << "has " << pl.size() << " rows and /loop_lengths " << db.entries.size();
+        } else {
+          const double want = db.entries[k].loop_length;
+          if (std::abs(pl[k].loop_length - want) <= 1e-9 * std::max(1.0, want)) continue;
+          os << "entry " << k << " (" << pl[k].loop_length
+             << " mm) is not the database's loop length /loop_lengths[" << k << "] = " << want
+             << " mm";
+        }
+        os << ", where curves in /energy_law/diagnostics/uniaxial refer to its rows";
+        throw InputError(fname, std::string(detail::kEnergyLawGroup) + "/diagnostics/loop_length",
+                         os.str());
+      }
     }
     // Written by an older build: the file stays version 1 in memory until it is rewritten.
     return db;

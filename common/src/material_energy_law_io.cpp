@@ -1,5 +1,9 @@
 // HDF5 reading and writing of the energy-based law (layout: schemas/database.layout.json,
 // docs/database.md "The energy-based law").
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 #include "knit/core/errors.hpp"
@@ -344,6 +348,26 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
           throw InputError(file, d + "/loop_length",
                            "must increase (entry " + std::to_string(k) + ") where curves in " + d +
                                "/uniaxial refer to its rows");
+      // The rows are the network's knots (session 42): knit-macro takes a case's l between two
+      // rows as the knots whose laws it uses, so rows off the knots would warn about laws the
+      // case never evaluates. (The rows against the database's loop lengths, every family:
+      // read_database.)
+      if (law.family == EnergyFamily::kNetwork) {
+        const auto& knots = law.network.l_knots;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (knots.size() == n && std::abs(l[k] - knots[k]) <= 1e-9 * std::max(1.0, knots[k]))
+            continue;
+          std::ostringstream os;
+          os << std::setprecision(10) << "entry " << k << " (" << l[k]
+             << " mm) is not the law's loop length " << g << "/l_knots[" << k << "]";
+          if (k < knots.size())
+            os << " = " << knots[k] << " mm";
+          else
+            os << " (it has " << knots.size() << " knots)";
+          os << ", where curves in " << d << "/uniaxial refer to its rows";
+          throw InputError(file, d + "/loop_length", os.str());
+        }
+      }
       for (std::size_t k = 0; k < n; ++k)
         for (int ax = 0; ax < 2; ++ax) {
           const std::string name =

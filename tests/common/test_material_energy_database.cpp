@@ -59,6 +59,17 @@ Database db_with_law() {
   dg.options_json = "{\"smoothing\": 1}";
   return db;
 }
+/// The test network law (knots 4.5, 5.5, 6.5 mm) in place of the ridge law, with the
+/// database's loop lengths and the diagnostics' rows at its knots (the 4.5 mm entry and row
+/// repeated at 5.5 mm), as the fit writes them.
+void set_network_law(Database& db) {
+  db.energy_law = testing::make_test_network_law();
+  auto& pl = db.energy_diagnostics.per_loop;
+  pl.insert(pl.begin() + 1, pl[0]);
+  pl[1].loop_length = 5.5;
+  db.entries.insert(db.entries.begin() + 1, db.entries[0]);
+  db.entries[1].loop_length = 5.5;
+}
 }  // namespace
 
 TEST_CASE("database v2: the energy law round trip", "[unit]") {
@@ -211,6 +222,35 @@ TEST_CASE("database: the law's own uniaxial curves round trip, older files load 
         }) ==
         "/energy_law/diagnostics/loop_length: must increase (entry 1) where curves in "
         "/energy_law/diagnostics/uniaxial refer to its rows");
+  // Session 42: the rows are the database's loop lengths (4.5 and 6.5 mm here) and, for the
+  // network, its knots; a row off them is refused.
+  CHECK(refused_edit([&](knit::io::H5File& f) {
+          f.write("/energy_law/diagnostics/loop_length", std::vector<double>{4.5, 7.0});
+        }) ==
+        "/energy_law/diagnostics/loop_length: entry 1 (7 mm) is not the database's loop length "
+        "/loop_lengths[1] = 6.5 mm, where curves in /energy_law/diagnostics/uniaxial refer to "
+        "its rows");
+  Database extra_row = db;  // a third row of diagnostics for two loop lengths
+  extra_row.energy_diagnostics.per_loop.push_back(extra_row.energy_diagnostics.per_loop[1]);
+  extra_row.energy_diagnostics.per_loop[2].loop_length = 7.0;
+  write_database(file, extra_row);
+  CHECK_THROWS_WITH(read_database(file),
+                    file.string() +
+                        ": /energy_law/diagnostics/loop_length: has 3 rows and /loop_lengths 2, "
+                        "where curves in /energy_law/diagnostics/uniaxial refer to its rows");
+  Database net = db;
+  set_network_law(net);  // knots 4.5, 5.5, 6.5
+  write_database(file, net);
+  CHECK(read_database(file).energy_diagnostics.per_loop[2].uniaxial[1].strain.size() == 3);
+  {
+    auto f = knit::io::H5File::open_rw(file);
+    f.write("/energy_law/diagnostics/loop_length", std::vector<double>{4.5, 5.25, 6.5});
+  }
+  CHECK_THROWS_WITH(read_database(file),
+                    file.string() +
+                        ": /energy_law/diagnostics/loop_length: entry 1 (5.25 mm) is not the "
+                        "law's loop length /energy_law/l_knots[1] = 5.5 mm, where curves in "
+                        "/energy_law/diagnostics/uniaxial refer to its rows");
 }
 
 TEST_CASE("database v1: loads, and asking it for the energy law names file and path", "[unit]") {
@@ -332,7 +372,7 @@ TEST_CASE("database: non-finite energy-law diagnostics are refused with their HD
 TEST_CASE("database v3: the network law round trip", "[unit]") {
   const auto file = tmp("network_roundtrip.h5");
   Database db = db_with_law();
-  db.energy_law = testing::make_test_network_law();
+  set_network_law(db);
   db.energy_law->network.shape.stiff1 = 1;  // stiffening units (session 11) round-trip too
   db.energy_law->network.shape.stiff2 = 2;
   db.energy_law->network.shape.outer = 1;  // and the exponential outer function (session 15)
@@ -376,7 +416,7 @@ namespace {
 template <class Edit>
 Database write_network_db_then(const std::string& file, Edit edit) {
   Database db = db_with_law();
-  db.energy_law = testing::make_test_network_law();
+  set_network_law(db);
   write_database(file, db);
   auto f = knit::io::H5File::open_rw(file);
   edit(f);
@@ -434,7 +474,7 @@ TEST_CASE("database v3: the outer function's parameters without its kind are ref
   for (const bool exp : {true, false}) {
     const auto file = tmp(exp ? "network_outer_gone_exp.h5" : "network_outer_gone_none.h5");
     Database db = db_with_law();
-    db.energy_law = testing::make_test_network_law();
+    set_network_law(db);
     if (exp) {
       db.energy_law->network.shape.outer = 1;
       db.energy_law->network.shape.outer_scale = 0.3;
@@ -459,7 +499,7 @@ TEST_CASE("database v3: the outer function's parameters without its kind are ref
 
 TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit]") {
   Database db = db_with_law();
-  db.energy_law = testing::make_test_network_law();
+  set_network_law(db);
   const auto good = tmp("network_good.h5");
   write_database(good, db);
   const auto bad = tmp("network_bad.h5");

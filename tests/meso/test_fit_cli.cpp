@@ -1,5 +1,7 @@
 // knit-meso synth / fit from the command line: a raw-only synthetic database is refitted in
 // place; bad options are input errors (exit 2) naming the file and the field.
+#include <sys/wait.h>
+
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -202,6 +204,16 @@ TEST_CASE("knit-meso fit: items it does not write are never lost in place", "[un
                                                 "not write (/@user_note, /loop_0@user_note, "
                                                 "/loop_0/user_ds): a refit in place would lose "
                                                 "them; nothing was written"));
+  {  // Refused before the fit (session 42: after it, 45 s later on the default database): the
+     // fit's report is not on stdout.
+    const fs::path refused_out = dir / "cli_fit_items_refused.out";
+    const std::string c = std::string(KNIT_BIN_DIR) + "/knit-meso fit " + db.string() +
+                          " --law paper > " + refused_out.string() + " 2>/dev/null";
+    CHECK(WEXITSTATUS(std::system(c.c_str())) == 2);
+    std::ifstream in(refused_out);
+    CHECK(std::string(std::istreambuf_iterator<char>(in), {}).empty());
+    CHECK(bytes(db) == before);
+  }
   // Into another file: written, the input keeps them, and the items are named.
   const fs::path log = dir / "cli_fit_items.out";
   const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-meso fit " + db.string() +
