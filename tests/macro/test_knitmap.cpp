@@ -491,6 +491,48 @@ TEST_CASE("knitmap: a waist narrower than a stitch is refused, a narrow tip is l
   CHECK_THAT(v.warnings.back(), Catch::Contains("left out"));
 }
 
+// Session 42's red team: on an arch (quadratic edges through (0, 0), (25, 60), (50, 0) and 10
+// mm higher) with the knitting angle turning against the arch's u direction, so that the
+// courses run along x, the course lines below the arch's top cross the boundary four times,
+// and each course was laid across its whole chord: 727 of 1,098 stitches outside the fabric,
+// exit 0 with a warning. The lower edge is x = 50 u, y = 120 u (1 - u): its direction is
+// atan(2.4 (1 - 2u)), and the angle field is minus that, piecewise linear in 64 spans (within
+// 0.03 deg of it, inside the default tolerance of 2 deg).
+TEST_CASE("knitmap: a course line that leaves the patch and comes back is refused", "[case]") {
+  const std::string db = database();
+  std::ostringstream angle;
+  angle.precision(17);
+  angle << R"({"degrees": [1, 0], "knots_v": [0, 1], "unit": "rad", "knots_u": [0)";
+  for (int i = 0; i <= 64; ++i) angle << ", " << i / 64.0;
+  angle << R"(, 1], "values": [)";
+  for (int i = 0; i <= 64; ++i) angle << (i ? ", " : "") << -std::atan(2.4 * (1 - i / 32.0));
+  angle << "]}";
+  const std::string m = knit_material(db, "5.0", angle.str());
+  const std::string arch = write_case("arch.json", R"({"geometry": {"degrees": [2, 1],
+      "knots_u": [0, 0, 0, 1, 1, 1], "knots_v": [0, 0, 1, 1],
+      "control_points": [[0, 0, 0], [25, 60, 0], [50, 0, 0], [0, 10, 0], [25, 70, 0],
+                         [50, 10, 0]], "thickness": 0.76},
+    "refinement": {"degree": 2, "elements": [1, 1]}, "material": )" +
+                                                       m + R"(,
+    "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "v0", "fix": ["x", "y"]}],
+    "output": {"vtk": false, "hdf5": false}})");
+  try {
+    const auto in = load_knitmap_input(arch);
+    (void)make_knitmap(in.c, in.cells);
+    FAIL("no error");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == arch);
+    CHECK(e.pointer() == "/geometry");
+    CHECK_THAT(e.message(), Catch::Contains("crosses its boundary 4 times") &&
+                                Catch::Contains("not convex along its courses") &&
+                                Catch::Contains("map the pieces as separate cases"));
+  }
+  const fs::path out = kDir / "arch_out";
+  fs::remove_all(out);
+  CHECK(run_knitmap(arch + " --output " + out.string()) == 2);
+  CHECK(!fs::exists(out));
+}
+
 TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothing", "[case]") {
   const std::string db = database();
   auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr,
