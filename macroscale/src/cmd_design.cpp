@@ -26,6 +26,7 @@
 #include "knit/io/output_target.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/run.hpp"
+#include "results_writer.hpp"
 
 // A named namespace per command: the cmd_*.cpp files share one unity translation unit
 // (docs/build.md), and each defines its own Options, run and reg.
@@ -38,7 +39,7 @@ std::string column_name(const knit::macro::DesignProblem& d, std::size_t k) {
 }
 
 struct Options {
-  std::string file, output;
+  std::string file, output, max_output_size;
   bool check = false;
 };
 
@@ -56,7 +57,13 @@ knit::cli::SubcommandRegistrar reg(
           ->required();
       sub.add_flag("--check", o->check, "read and check the design file, print the problem");
       sub.add_option("-o,--output,--out", o->output, "output directory");
+      sub.add_option("--max-output-size", o->max_output_size,
+                     "refuse a design whose final run's outputs (run/) are estimated larger "
+                     "(default 2G; 0: no cap), as knit-macro run does");
       return [o]() -> int {
+        knit::macro::RunOptions ro;
+        if (!o->max_output_size.empty())
+          ro.max_output_bytes = knit::io::parse_size(o->max_output_size, "--max-output-size");
         auto d = knit::macro::load_design(o->file);
         std::cout << "design: " << o->file << "\ncase: " << d.case_file << "\n";
         for (const auto& v : d.variables) {
@@ -79,6 +86,11 @@ knit::cli::SubcommandRegistrar reg(
         // it was checked only when the results were written, after minutes of optimizing).
         knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
                                       o->output.empty() ? "output directory" : "--output");
+        // The final run's outputs against the cap, before the optimization and by --check
+        // (session 42's red team: the final run refused them after the whole optimization,
+        // naming DIR/case.json, which was never written, and an option design did not have).
+        // The case's output settings are the final run's: the design changes its fields only.
+        knit::macro::check_output_size(d.c, ro);
         if (!d.twin.empty()) {
           std::cout << "twin:";
           for (std::size_t k = 0; k < d.variables.size(); ++k)
@@ -97,7 +109,15 @@ knit::cli::SubcommandRegistrar reg(
           std::cout << "status: failed\n";
           return knit::kExitFailure;
         }
-        const auto r = knit::macro::optimize_design(d);
+        // Each accepted iteration as it comes (session 42's red team: printed after the
+        // optimization, so an interrupted design left not even the header in a log file).
+        knit::macro::OptimizeOptions oo;
+        oo.on_iteration = [](const knit::macro::DesignIteration& h) {
+          std::cout << "iteration " << h.iteration << ": J = " << h.J
+                    << ", |dJ/dp| = " << h.gradient_norm << ", " << h.seconds << " s" << std::endl;
+        };
+        std::cout.flush();
+        const auto r = knit::macro::optimize_design(d, oo);
         using knit::macro::DesignStatus;
         if (r.status == DesignStatus::kFailed && r.evaluations <= 1) {
           std::cerr << "knit-macro design: " << o->file << ": " << r.message << "\n";
@@ -120,7 +140,6 @@ knit::cli::SubcommandRegistrar reg(
         // provenance named a directory that no longer exists; session 27). Relative paths in
         // the case resolve alike: both directories have the same parent.
         const auto best = knit::macro::parse_case(case_text, (dir / "case.json").string());
-        knit::macro::RunOptions ro;
         ro.output_dir = out / "run";
         const auto run = knit::macro::run_case(best, ro);
         std::ostringstream sum;
@@ -200,8 +219,6 @@ knit::cli::SubcommandRegistrar reg(
           sum << "note: " << n << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());
         out.commit();
-        for (const auto& h : r.history)
-          std::cout << "iteration " << h.iteration << ": J = " << h.J << "\n";
         std::cout << sum.str() << "wrote " << dir.string() << "\n";
         const auto verdict = knit::macro::design_verdict(r, run);
         if (verdict.exit_code != knit::kExitOk)

@@ -16,7 +16,9 @@
 #include <ceres/ceres.h>
 
 #include <chrono>
+#include <functional>
 #include <limits>
+#include <utility>
 
 #include "knit/macro/design_problem.hpp"
 
@@ -86,8 +88,9 @@ class DesignCost : public ceres::CostFunction {
 
 class History : public ceres::IterationCallback {
  public:
-  History(DesignResult& r, Tracker& t, const std::vector<double>& x, Clock::time_point t0)
-      : r_(r), t_(t), x_(x), t0_(t0) {}
+  History(DesignResult& r, Tracker& t, const std::vector<double>& x, Clock::time_point t0,
+          std::function<void(const DesignIteration&)> on_iteration)
+      : r_(r), t_(t), x_(x), t0_(t0), on_iteration_(std::move(on_iteration)) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     // A rejected step leaves x where it was (its cost is the trial's): not a history point.
     if (s.iteration > 0 && !s.step_is_successful) return ceres::SOLVER_CONTINUE;
@@ -105,6 +108,7 @@ class History : public ceres::IterationCallback {
     h.seconds = std::chrono::duration<double>(Clock::now() - t0_).count();
     h.x = x_;
     r_.history.push_back(h);
+    if (on_iteration_) on_iteration_(h);
     return ceres::SOLVER_CONTINUE;
   }
 
@@ -113,6 +117,7 @@ class History : public ceres::IterationCallback {
   Tracker& t_;
   const std::vector<double>& x_;
   Clock::time_point t0_;
+  std::function<void(const DesignIteration&)> on_iteration_;
 };
 
 }  // namespace
@@ -156,7 +161,7 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.minimizer_progress_to_stdout = false;
   o.num_threads = 1;
   o.update_state_every_iteration = true;
-  History history(res, t, x, t0);
+  History history(res, t, x, t0, opt.on_iteration);
   o.callbacks.push_back(&history);
   ceres::Solver::Summary summary;
   ceres::Solve(o, &problem, &summary);

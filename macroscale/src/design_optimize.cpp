@@ -189,6 +189,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
     h.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     h.x = res.x;
     res.history.push_back(h);
+    if (opt.on_iteration) opt.on_iteration(h);
   };
   record(0);
   // Step in "interval units": x_i -= s * range_i^2 * g_i / max_j |range_j g_j|.

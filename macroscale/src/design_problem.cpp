@@ -4,6 +4,7 @@
 #include "knit/macro/design_problem.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -273,6 +274,13 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     o.samples_u = static_cast<int>(n[0]);
     o.samples_v = static_cast<int>(n[1]);
   }
+  // The variance of one sample is 0 whatever the design (session 42's red team: "converged" at
+  // J = 0 after 0 iterations).
+  if (o.kind == DesignObjective::Kind::kStrainVariance && o.samples_u * o.samples_v < 2)
+    throw InputError(file, j.contains("samples") ? p + "/samples" : p + "/region",
+                     "a strain_variance term needs at least 2 samples (its variance over one "
+                     "sample is 0 for every design): give its region an extent and more than "
+                     "one sample along it");
 }
 
 /// The control grid of a field of the case (u fastest): nu = knots_u - degree_u - 1.
@@ -381,6 +389,19 @@ DesignProblem load_design(const std::string& path) {
     // objective's, with exit 0).
     {
       const std::string column = v.name.empty() ? "x" + std::to_string(k) : v.name;
+      // The schema's pattern for names, here so that it comes before the twin's and the
+      // objectives' checks that use the columns (session 42's red team: "a,b" was reported as
+      // a twin naming no variable, "the variables: a,b").
+      const bool identifier = !column.empty() &&
+                              !std::isdigit(static_cast<unsigned char>(column[0])) &&
+                              std::all_of(column.begin(), column.end(), [](char ch) {
+                                return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                              });
+      if (!identifier)
+        throw InputError(path, p + "/name",
+                         "\"" + column +
+                             "\" is not a name: letters, digits and _, not starting with a "
+                             "digit (it is a column of history.csv)");
       const std::vector<std::string> reserved = {"iteration", "J", "gradient_norm", "seconds"};
       if (std::find(reserved.begin(), reserved.end(), column) != reserved.end())
         throw InputError(path, p + "/name",

@@ -164,6 +164,34 @@ TEST_CASE("design: an output directory that is not ours is refused before any wo
   fs::remove_all(user);
 }
 
+// Session 42's red team: the final run refused its outputs' size after the whole optimization,
+// naming DIR/case.json (never written) and advising --max-output-size, which design did not
+// have. Now before any work and by --check, naming the design's case; the option raises the cap.
+TEST_CASE("design: the final run's output size is checked before any work", "[unit]") {
+  write_case();
+  write(kDir / "ok.json", design(kVars, kObjs));
+  const fs::path out = kDir / "size_out";
+  fs::remove_all(out);
+  const std::string log = (kDir / "size.log").string();
+  auto run = [&](const std::string& args) {
+    const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro design " +
+                            (kDir / "ok.json").string() + " -o " + out.string() + args + " > " +
+                            log + " 2>&1";
+    const int st = std::system(cmd.c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  };
+  for (const std::string check : {" --check", ""}) {
+    INFO("knit-macro design" << check);
+    CHECK(run(check + " --max-output-size 1k") == 2);
+    const std::string text = knit_test::read_text(log);
+    CHECK(text.find((kDir / "case.json").string() + ": /output/grid: the estimated output size") !=
+          std::string::npos);
+    CHECK(text.find("iteration") == std::string::npos);  // no optimization reported
+    CHECK_FALSE(fs::exists(out));
+  }
+  CHECK(run(" --check --max-output-size 10G") == 0);
+}
+
 TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]") {
   write_case();
   const auto expect = expect_refused;
@@ -296,6 +324,16 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
                          "region": {"u": [0, 1], "v": [0.5, 0.5]}, "samples": [5, 7]}])"),
          "/objectives/0/samples/1");
+  // Session 42's red team: a variance over one sample is 0 for every design ("converged" at
+  // J = 0): refused, at the samples given or at a point region.
+  expect("variance_one_sample.json",
+         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                         "region": {"u": [0, 1], "v": [0.5, 0.5]}, "samples": [1, 1]}])"),
+         "/objectives/0/samples");
+  expect("variance_point.json",
+         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                         "region": {"u": [0.5, 0.5], "v": [0.5, 0.5]}}])"),
+         "/objectives/0/region");
   // Session 34 (the design audit's mutants 76 to 82): each check of the loader, off alone,
   // survived (`--check` exited 0): equal bounds, an upper bound beyond the database's 6.5, an
   // angle bound below -180 deg, tied control values that differ in the case (5.0 and 5.6 in
@@ -826,6 +864,14 @@ TEST_CASE("design twin: bad twins are JSON-pointer errors and exit 2", "[unit]")
          R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
               "region": {"u": [0, 1], "v": [0.4, 0.6]}}])",
          R"({"l": 5, "x1": 0})", "/twin");
+  // A variable name that is not a name is reported as such, not as a twin naming no variable
+  // (session 42's red team: "a,b" with a twin {"l": ...} gave "/twin/l: names no design
+  // variable (the variables: a,b)").
+  expect_refused("twin_bad_name.json",
+                 R"({"case": "case.json", "variables": [{"name": "a,b", "field": "stitch_value",
+                     "indices": [0], "lower": 4.5, "upper": 6.5}], "objectives": )" +
+                     reaction + R"(, "twin": {"l": 5}})",
+                 "/variables/0/name");
   // Without a twin a reaction term still needs its target (the schema no longer requires it).
   write(kDir / "no_target.json",
         R"({"case": "case.json", "variables": )" + vars + R"(, "objectives": )" + reaction + "}");

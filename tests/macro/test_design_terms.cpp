@@ -604,9 +604,13 @@ TEST_CASE("design optimizer (projected gradient): no descent step found is a sto
   d.objectives[0].target = {e.residuals(0) + eps};
   OptimizeOptions opt;
   opt.x_tolerance = 0.0;
+  int seen = 0;  // the history rows handed out as recorded (session 42)
+  opt.on_iteration = [&seen](const DesignIteration&) { ++seen; };
   const DesignResult r = optimize_design(d, opt);
   INFO("status " << to_string(r.status) << ", " << r.message << ", J " << r.J0 << " -> " << r.J
                  << ", evaluations " << r.evaluations);
+  CHECK(seen == static_cast<int>(r.history.size()));
+  CHECK(seen >= 1);
   CHECK(r.evaluations == 1 + 30);
   CHECK(r.x == std::vector<double>{5.6});
   CHECK(r.message.find("no descent step found") != std::string::npos);
@@ -626,9 +630,21 @@ TEST_CASE("design optimizer (Ceres): a target beyond the upper bounds ends on th
       {"field": "stitch_value", "indices": [1], "lower": 4.6, "upper": 6.4},
       {"field": "stitch_value", "indices": [2], "lower": 4.6, "upper": 6.4}])");
   d.optimizer.max_iterations = 10;
-  const DesignResult r = optimize_design(d);
+  // Each history row is handed out as it is recorded (session 42: knit-macro design prints them
+  // while it optimizes).
+  std::vector<DesignIteration> seen;
+  OptimizeOptions opt;
+  opt.on_iteration = [&seen](const DesignIteration& h) { seen.push_back(h); };
+  const DesignResult r = optimize_design(d, opt);
   INFO("status " << to_string(r.status) << ", l = " << r.x[0] << ", " << r.x[1] << ", " << r.x[2]
                  << ", J " << r.J0 << " -> " << r.J);
+  REQUIRE(seen.size() == r.history.size());
+  REQUIRE(seen.size() >= 2);
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    CHECK(seen[k].iteration == r.history[k].iteration);
+    CHECK(seen[k].J == r.history[k].J);
+    CHECK(seen[k].x == r.history[k].x);
+  }
   CHECK(r.status == DesignStatus::kInfeasible);
   for (double l : r.x) CHECK(l == Approx(6.4).epsilon(1e-9));
   for (const auto& h : r.history)

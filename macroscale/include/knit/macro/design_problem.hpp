@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -149,6 +150,10 @@ struct OptimizeOptions {
   double function_tolerance = 1e-6;
   /// J / J0 below which a converged design counts as meeting its targets.
   double feasible = 1e-6;
+  /// Called with each history row as it is recorded (knit-macro design prints it: progress
+  /// while it optimizes; session 42's red team: the rows were printed after the optimization,
+  /// and an interrupted design left nothing).
+  std::function<void(const struct DesignIteration&)> on_iteration;
 };
 enum class DesignStatus { kConverged, kIterationLimit, kInfeasible, kTargetNotMet, kFailed };
 /// "converged", "iteration limit", "infeasible target", "target not met", "failed".
