@@ -16,6 +16,7 @@
 #include <ceres/ceres.h>
 
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <utility>
@@ -27,6 +28,9 @@ namespace knit::macro {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// Ceres' gradient tolerance, on J / J0 (optimize_design_ceres scales the residuals).
+constexpr double kGradientTolerance = 1e-12;
 
 /// Shared between the cost function and the iteration callback: the last evaluation (Ceres
 /// asks for the Jacobian at an accepted point it evaluated before: the cached evaluation
@@ -65,7 +69,10 @@ struct Tracker {
 
 class DesignCost : public ceres::CostFunction {
  public:
-  DesignCost(Tracker& t, int residuals, int variables) : t_(t), n_(variables) {
+  /// `scale` multiplies the residuals (and their Jacobian): 1 / sqrt(J0), so that Ceres sees
+  /// J / J0 (below, optimize_design_ceres).
+  DesignCost(Tracker& t, int residuals, int variables, double scale)
+      : t_(t), n_(variables), scale_(scale) {
     set_num_residuals(residuals);
     mutable_parameter_block_sizes()->push_back(variables);
   }
@@ -74,29 +81,30 @@ class DesignCost : public ceres::CostFunction {
     const std::vector<double> x(parameters[0], parameters[0] + n_);
     const DesignEvaluation& e = t_.evaluate(x);
     if (e.status != RunStatus::kCompleted || e.residuals.size() != num_residuals()) return false;
-    for (int i = 0; i < num_residuals(); ++i) residuals[i] = e.residuals(i);
+    for (int i = 0; i < num_residuals(); ++i) residuals[i] = scale_ * e.residuals(i);
     if (jacobians && jacobians[0])
       for (int i = 0; i < num_residuals(); ++i)
-        for (int k = 0; k < n_; ++k) jacobians[0][i * n_ + k] = e.jacobian(i, k);
+        for (int k = 0; k < n_; ++k) jacobians[0][i * n_ + k] = scale_ * e.jacobian(i, k);
     return true;
   }
 
  private:
   Tracker& t_;
   int n_;
+  double scale_;
 };
 
 class History : public ceres::IterationCallback {
  public:
   History(DesignResult& r, Tracker& t, const std::vector<double>& x, Clock::time_point t0,
-          std::function<void(const DesignIteration&)> on_iteration)
-      : r_(r), t_(t), x_(x), t0_(t0), on_iteration_(std::move(on_iteration)) {}
+          double scale, std::function<void(const DesignIteration&)> on_iteration)
+      : r_(r), t_(t), x_(x), t0_(t0), scale_(scale), on_iteration_(std::move(on_iteration)) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     // A rejected step leaves x where it was (its cost is the trial's): not a history point.
     if (s.iteration > 0 && !s.step_is_successful) return ceres::SOLVER_CONTINUE;
     DesignIteration h;
     h.iteration = s.iteration;
-    h.J = 2.0 * s.cost;  // Ceres' cost is (1/2) sum r^2
+    h.J = 2.0 * s.cost / (scale_ * scale_);  // Ceres' cost is (1/2) sum (scale r)^2
     // |dJ/dp| (DesignEvaluation::gradient) at the accepted design, as the projected-gradient method
     // reports it (session 37's red team: Ceres' gradient_norm of a bounded problem is |x - P(x -
     // g)|, the step to the bounds' projection, so 2 x it read 2.0 at l = 5.5 with upper bound 6.5
@@ -117,6 +125,7 @@ class History : public ceres::IterationCallback {
   Tracker& t_;
   const std::vector<double>& x_;
   Clock::time_point t0_;
+  double scale_;
   std::function<void(const DesignIteration&)> on_iteration_;
 };
 
@@ -143,8 +152,14 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   res.terms0 = e0.terms;
   const int n = static_cast<int>(x.size());
   ceres::Problem problem;
-  problem.AddResidualBlock(new DesignCost(t, static_cast<int>(e0.residuals.size()), n), nullptr,
-                           x.data());
+  // Ceres sees J / J0 (session 42's red team): its tolerances are absolute in places (the
+  // gradient's; and a bounded problem measures the gradient as |x - P(x - g)|, which is 0 in
+  // floating point once g is below the round-off of x), so a design whose weights were scaled
+  // by 1e-16 stopped at its start, 'target not met', where the same design with weight 1
+  // converged. Scaled, every weight gives the same steps.
+  const double scale = e0.J > 0.0 && std::isfinite(e0.J) ? 1.0 / std::sqrt(e0.J) : 1.0;
+  problem.AddResidualBlock(new DesignCost(t, static_cast<int>(e0.residuals.size()), n, scale),
+                           nullptr, x.data());
   for (int i = 0; i < n; ++i) {
     problem.SetParameterLowerBound(x.data(), i, d.variables[static_cast<std::size_t>(i)].lower);
     problem.SetParameterUpperBound(x.data(), i, d.variables[static_cast<std::size_t>(i)].upper);
@@ -156,12 +171,13 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.max_num_iterations = opt.max_iterations;
   o.parameter_tolerance = opt.x_tolerance;
   o.function_tolerance = opt.function_tolerance;  // relative change of J
-  o.gradient_tolerance = 1e-12;
+  // Of J / J0 (the residuals' scale above).
+  o.gradient_tolerance = kGradientTolerance;
   o.logging_type = ceres::SILENT;
   o.minimizer_progress_to_stdout = false;
   o.num_threads = 1;
   o.update_state_every_iteration = true;
-  History history(res, t, x, t0, opt.on_iteration);
+  History history(res, t, x, t0, scale, opt.on_iteration);
   o.callbacks.push_back(&history);
   ceres::Solver::Summary summary;
   ceres::Solve(o, &problem, &summary);

@@ -340,6 +340,39 @@ TEST_CASE("design optimizer (Ceres): a twin experiment recovers a linear l gradi
   CHECK(r.J < 1e-6 * r.J0);
 }
 
+// Session 42's red team: scaling every weight by 1e-16 stopped the Ceres design at its start
+// ('target not met': Ceres' gradient tolerance is absolute, and a bounded problem measures the
+// gradient as |x - P(x - g)|, 0 in floating point once g is below x's round-off), where the same
+// design with weight 1 converged. Ceres now sees J / J0: every weight gives the same design.
+TEST_CASE("design optimizer (Ceres): the design does not depend on the weights' scale", "[case]") {
+  const std::string c = write_case(false);
+  const std::string var =
+      R"([{"field": "stitch_value", "indices": [0], "lower": 4.6, "upper": 6.4}])";
+  DesignProblem probe = problem(c, "scale_probe.json", R"([{"type": "reaction", "reaction":
+      "fy", "at_strain": [0.2], "target": [0]}])",
+                                0.0, var);
+  const DesignEvaluation at = evaluate_design(probe, {5.6}, false);  // R(l0 = 5.6)
+  REQUIRE(at.status == RunStatus::kCompleted);
+  std::vector<double> first;
+  for (const char* w : {"1", "1e-16", "1e8"}) {
+    INFO("weight " << w);
+    std::ostringstream obj;
+    obj.precision(17);
+    obj << R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.2], "weight": )" << w
+        << R"(, "target": [)" << at.residuals(0) << "]}]";
+    const DesignProblem d = problem(c, "scale.json", obj.str(), 0.0, var);
+    const DesignResult r = optimize_design(d);
+    INFO("status " << to_string(r.status) << ", " << r.message << ", l0 = " << r.x[0] << ", J "
+                   << r.J0 << " -> " << r.J);
+    CHECK(r.status == DesignStatus::kConverged);
+    CHECK(std::abs(r.x[0] - 5.6) < 1e-3);
+    if (first.empty())
+      first = r.x;
+    else
+      CHECK(std::abs(r.x[0] - first[0]) < 1e-6);
+  }
+}
+
 TEST_CASE("design optimizer: an infeasible target ends with its status and the best design",
           "[case]") {
   const std::string c = write_case(false);
