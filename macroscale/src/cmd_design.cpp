@@ -24,6 +24,7 @@
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
+#include "knit/io/provenance.hpp"
 #include "knit/macro/design_problem.hpp"
 #include "knit/macro/run.hpp"
 #include "results_writer.hpp"
@@ -127,6 +128,19 @@ knit::cli::SubcommandRegistrar reg(
         std::vector<std::string> header = {"iteration", "J", "gradient_norm", "seconds"};
         for (std::size_t k = 0; k < d.variables.size(); ++k) header.push_back(column_name(d, k));
         knit::io::CsvWriter csv(out / "history.csv", header);
+        // Provenance and units, as knitmap.csv and load_strain.csv have them (session 42's red
+        // team: none here).
+        csv.add_comment("provenance: " + knit::io::Provenance::current(o->file).to_json_string());
+        {
+          std::string units =
+              "units: J the sum of the weighted squared residuals (a reaction's in N^2, a "
+              "displacement's in mm^2, a strain's dimensionless, each times its weight; "
+              "docs/design.md); gradient_norm |dJ/dp| in J per unit of the variables; seconds "
+              "s (wall time since the start);";
+          for (std::size_t k = 0; k < d.variables.size(); ++k)
+            units += " " + column_name(d, k) + " " + d.variables[k].unit;
+          csv.add_comment(units);
+        }
         for (const auto& h : r.history) {
           std::vector<knit::io::CsvCell> row = {h.iteration, h.J, h.gradient_norm, h.seconds};
           for (double x : h.x) row.emplace_back(x);

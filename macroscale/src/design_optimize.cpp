@@ -195,6 +195,10 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
   // Step in "interval units": x_i -= s * range_i^2 * g_i / max_j |range_j g_j|.
   double s = 0.1;
   bool converged = false;
+  // Why the method stopped, for the message of a design that stops short of its targets
+  // (session 42's red team: it said only "raise max_iterations" at iteration 53 of 200).
+  std::string stop;
+  char buf[200];
   for (int it = 1; it <= opt.max_iterations; ++it) {
     double gmax = 0.0;
     for (std::size_t i = 0; i < n; ++i)
@@ -202,6 +206,7 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
                                      cur.gradient(static_cast<Eigen::Index>(i))));
     if (gmax == 0.0) {
       converged = true;
+      stop = "the gradient of J vanished";
       break;
     }
     bool accepted = false, moved = false;
@@ -217,13 +222,24 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
       }
       if (largest <= opt.x_tolerance) {
         converged = true;
+        std::snprintf(buf, sizeof buf,
+                      "its step fell to %.3g of a variable's interval, below x_tolerance %g, "
+                      "after %d halving(s) in iteration %d",
+                      largest, opt.x_tolerance, trial, it);
+        stop = buf;
         break;
       }
       moved = true;
       const DesignEvaluation e = evaluate_design(d, xt);
       count(e);
       if (e.status == RunStatus::kCompleted && e.J <= cur.J + 1e-4 * dir_dot) {
-        if (cur.J - e.J <= opt.function_tolerance * cur.J) converged = true;
+        if (cur.J - e.J <= opt.function_tolerance * cur.J) {
+          converged = true;
+          std::snprintf(buf, sizeof buf,
+                        "J fell by %.3g of itself in iteration %d, below function_tolerance %g",
+                        cur.J > 0.0 ? (cur.J - e.J) / cur.J : 0.0, it, opt.function_tolerance);
+          stop = buf;
+        }
         res.x = xt;
         cur = e;
         accepted = true;
@@ -232,7 +248,9 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
         s *= 0.5;
       }
     }
-    record(it);
+    // A row per accepted step, as Ceres' history has (session 42's red team: a stop by the
+    // step's size repeated the last row).
+    if (accepted) record(it);
     if (converged) break;
     if (!accepted) {
       if (moved) res.message = "no descent step found (the best design is kept)";
@@ -245,6 +263,8 @@ DesignResult optimize_design_projected(const DesignProblem& d, const OptimizeOpt
   res.reached = cur.reached;
   res.gradient = cur.gradient;
   classify_result(d, opt, converged ? SolverEnd::kConverged : SolverEnd::kIterationLimit, res);
+  if (res.status != DesignStatus::kConverged && !stop.empty())
+    res.message += (res.message.empty() ? "" : "; ") + ("projected gradient: " + stop);
   return res;
 }
 

@@ -185,16 +185,30 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
   // exit 1 naming neither file nor field; 1e-8 of a 20 % case still solves, 1e-10 does not).
   const double end = c.output.applied->value / c.output.applied->gauge_length;
   constexpr double kMinLoadFraction = 1e-6;
+  // A case whose applied displacement is 0 has no strain to design at (session 42's red team:
+  // "must lie between 0 ... and 0").
+  if (!(end != 0.0))
+    throw InputError(file, p + "/at_strain",
+                     "the case applies no displacement (output.applied_displacement: " +
+                         fmt(c.output.applied->value) +
+                         " mm): a design evaluates its objectives at applied strains, so the "
+                         "case must load its patch");
   for (std::size_t k = 0; k < o.at_strain.size(); ++k) {
     const double lambda = o.at_strain[k] / end;
     if (!(std::isfinite(lambda) && lambda >= kMinLoadFraction && lambda <= 1.0 + 1e-12))
       throw InputError(
           file, p + "/at_strain/" + std::to_string(k),
-          "must lie between " + fmt(kMinLoadFraction * end) +
-              " (1e-6 of the end: smaller is the unloaded state to the solver) and " + fmt(end) +
-              ", the case's applied strain at its end (output.applied_displacement: " +
-              fmt(c.output.applied->value) + " mm over the gauge length " +
-              fmt(c.output.applied->gauge_length) + " mm), got " + fmt(o.at_strain[k]));
+          // In compression the end is the smaller bound (session 42's red team: "between -1e-07
+          // and -0.1").
+          "must lie between " + fmt(end < 0.0 ? end : kMinLoadFraction * end) +
+              (end < 0.0 ? " and " + fmt(kMinLoadFraction * end) +
+                               " (the case's applied strain at its end, and 1e-6 of it: closer "
+                               "to 0 is the unloaded state to the solver)"
+                         : " (1e-6 of the end: smaller is the unloaded state to the solver) and " +
+                               fmt(end) + ", the case's applied strain at its end") +
+              " (output.applied_displacement: " + fmt(c.output.applied->value) +
+              " mm over the gauge length " + fmt(c.output.applied->gauge_length) + " mm), got " +
+              fmt(o.at_strain[k]));
   }
   const bool targets = o.kind != DesignObjective::Kind::kStrainVariance &&
                        o.kind != DesignObjective::Kind::kReactionLinearity;

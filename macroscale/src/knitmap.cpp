@@ -420,14 +420,17 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
 std::string knitmap_summary(const KnitMap& map) {
   std::ostringstream os;
   os.precision(10);
+  // Angles within 1e-9 deg of 0 are 0 (session 42's red team: 4.599205532e-16 and -6.9e-15 of
+  // round-off for courses along x).
+  auto angle = [](double deg) { return std::abs(deg) < 1e-9 ? 0.0 : deg; };
   os << "stitches: " << map.stitches.size() << "\n"
      << "yarn_length_mm: " << map.yarn_length << "\n"
      << "needles: " << map.needles << "\n"
      << "courses: " << map.courses.size() << "\n"
      << "loop_length_min_mm: " << map.l_min << "\n"
      << "loop_length_max_mm: " << map.l_max << "\n"
-     << "course_direction_deg: " << map.course_direction_deg << "\n"
-     << "course_direction_spread_deg: " << map.angle_spread_deg << "\n"
+     << "course_direction_deg: " << angle(map.course_direction_deg) << "\n"
+     << "course_direction_spread_deg: " << angle(map.angle_spread_deg) << "\n"
      << "max_course_height_mismatch: " << map.max_height_mismatch << "\n";
   for (const auto& w : map.warnings) os << "warning: " << w << "\n";
   return os.str();

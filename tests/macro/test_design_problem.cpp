@@ -235,6 +235,27 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0],
                             "target": [1]}])"),
          "/objectives/0/at_strain/0");
+  // Session 42's red team: a case that applies no displacement gave "must lie between 0 ...
+  // and 0", and one in compression its bounds reversed ("between -1e-07 and -0.1").
+  for (const auto& [y, want] :
+       {std::pair{"0.0", "/objectives/0/at_strain: the case applies no displacement"},
+        std::pair{"-4.0", "/objectives/0/at_strain/0: must lie between -0.2 and -2e-07"}}) {
+    INFO("prescribed y " << y);
+    std::string text = knit_test::read_text(kDir / "case.json");
+    const std::string from = "\"y\": 4.0";
+    text.replace(text.find(from), from.size(), "\"y\": " + std::string(y));
+    write(kDir / "case_end.json", text);
+    std::string d = design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1],
+                                       "target": [1]}])");
+    d.replace(d.find("case.json"), 9, "case_end.json");
+    write(kDir / "end.json", d);
+    try {
+      (void)load_design((kDir / "end.json").string());
+      FAIL_CHECK("no error");
+    } catch (const knit::InputError& e) {
+      CHECK_THAT(e.pointer() + ": " + e.message(), Catch::StartsWith(want));
+    }
+  }
   // Session 36's red team: two objectives of one name (given, or the type by default) were
   // reported as two indistinguishable lines of summary.txt.
   expect("same_name.json",
@@ -459,6 +480,12 @@ TEST_CASE("design optimizer: a twin experiment recovers a uniform stitch value",
     CHECK(l.message.find("inside the bounds") != std::string::npos);
     CHECK(l.history.size() < r.history.size());
     CHECK(l.history.back().J <= l.history.front().J);
+    // Which tolerance stopped it (session 42's red team: the projected gradient gave no reason)
+    // and no repeated history row.
+    CHECK(l.message.find(method == DesignOptimizerSpec::Method::kCeres
+                             ? "Ceres: "
+                             : "projected gradient: J fell by ") != std::string::npos);
+    for (std::size_t k = 1; k < l.history.size(); ++k) CHECK(l.history[k].x != l.history[k - 1].x);
     // Targets no single l meets (the 10 % load of l = 5.0, the 20 % load of l = 6.0): the
     // least-squares optimum lies between them, inside the bounds, with J > 0.
     DesignProblem torn = twin;
@@ -509,6 +536,20 @@ TEST_CASE("design optimizer (projected gradient): steps double and the tolerance
   CHECK(r.history[2].x[0] == Approx(5.4).epsilon(1e-12));
   CHECK(r.history[3].x[0] == Approx(5.0).epsilon(1e-12));
   CHECK(r.status == DesignStatus::kConverged);
+  // A row per accepted step (session 42's red team: the stop by the step's size repeated the
+  // last row).
+  for (std::size_t k = 1; k < r.history.size(); ++k) CHECK(r.history[k].x != r.history[k - 1].x);
+  // A stop by the step's size says so when the target is not met: with x_tolerance 0.15 the
+  // first trial (10 % of the interval) is already below it.
+  OptimizeOptions coarse;
+  coarse.x_tolerance = 0.15;
+  const DesignResult c = optimize_design(d, coarse);
+  INFO("x tolerance 0.15: " << c.message);
+  CHECK(c.status == DesignStatus::kTargetNotMet);
+  CHECK(c.history.size() == 1);
+  CHECK(c.message.find("projected gradient: its step fell to 0.1 of a variable's interval, "
+                       "below x_tolerance 0.15, after 0 halving(s) in iteration 1") !=
+        std::string::npos);
   // The first step lowers J by 29 % of J (3.044 -> 2.164): a function tolerance of 0.35 stops
   // there, with the target not met. Measured against the J after the step (0.35 x 2.164 =
   // 0.757) or as an absolute (0.35), the same decrease of 0.880 would not stop it.

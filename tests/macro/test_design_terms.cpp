@@ -719,7 +719,13 @@ TEST_CASE("knit-macro design: case.json and summary.txt hold the best design", "
     CHECK(x[k] ==
           Approx(after_arrow(summary, "variable x" + std::to_string(k) + ":")).margin(1e-5));
   // The last history row: iteration, J, gradient norm, seconds, x0, x1, x2.
-  std::istringstream history(knit_test::read_text(out / "history.csv"));
+  const std::string history_text = knit_test::read_text(out / "history.csv");
+  // Provenance and units (session 42's red team: none).
+  CHECK(history_text.rfind("# provenance: {", 0) == 0);
+  CHECK(history_text.find("\n# units: J the sum of the weighted squared residuals") !=
+        std::string::npos);
+  CHECK(history_text.find("; x0 mm x1 mm x2 mm\n") != std::string::npos);
+  std::istringstream history(history_text);
   std::string line, last;
   while (std::getline(history, line))
     if (!line.empty() && line[0] != '#') last = line;

@@ -739,3 +739,16 @@ TEST_CASE("knitmap: --angle-tolerance sets the course direction's tolerance", "[
                     " --angle-tolerance 2.9") == 2);
   CHECK(!fs::exists(kDir / "tol6_narrow"));
 }
+
+// Session 42's red team: summary.txt gave the course direction of courses along x as
+// 4.599205532e-16 deg (and its spread as 5e-14): round-off below 1e-9 deg is printed as 0.
+TEST_CASE("knitmap: summary.txt prints round-off angles as 0", "[unit]") {
+  KnitMap m;
+  m.course_direction_deg = 4.599205532e-16;
+  m.angle_spread_deg = 5.054698275e-14;
+  const std::string s = knitmap_summary(m);
+  CHECK(s.find("\ncourse_direction_deg: 0\n") != std::string::npos);
+  CHECK(s.find("\ncourse_direction_spread_deg: 0\n") != std::string::npos);
+  m.course_direction_deg = -0.2642998643;  // a real angle stays
+  CHECK(knitmap_summary(m).find("\ncourse_direction_deg: -0.2642998643\n") != std::string::npos);
+}
