@@ -254,6 +254,15 @@ TEST_CASE("rod case: the output size is estimated and capped before the run", "[
   INFO(msg);
   CHECK(msg.find("many_steps.json: /steps/count: the estimated output size") != std::string::npos);
   CHECK_FALSE(fs::exists(kTmp / "many_steps"));
+  // A cap that even the reference state and one step pass names the mesh's output, not the
+  // steps (session 42).
+  CHECK(run("rod " + (kCases / "elastica.json").string() + " -q --max-output-size 1k -o " +
+                (kTmp / "tiny_cap").string(),
+            &msg) == 2);
+  INFO(msg);
+  CHECK(msg.find("elastica.json: /output/samples_per_element: the estimated output size") !=
+        std::string::npos);
+  CHECK_FALSE(fs::exists(kTmp / "tiny_cap"));
 }
 
 TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output", "[case]") {
