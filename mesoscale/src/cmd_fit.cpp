@@ -23,6 +23,8 @@
 #include "knit/meso/fit/report.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 
+// A named namespace: the cmd_*.cpp files share one unity translation unit (docs/build.md).
+namespace knit::meso::cmd_fit {
 namespace {
 
 [[noreturn]] void refuse_in_place(const std::string& db, const std::vector<std::string>& lost) {
@@ -53,15 +55,22 @@ std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
     }
   } remove{scratch};
   std::vector<std::string> lost;
-  knit::material::write_database(scratch, db, [&](knit::io::H5File& f) {
-    const auto src = knit::io::H5File::open_read(input);
-    knit::material::carry_over_unwritten(src, f, "check");
-    lost = knit::material::items_not_carried(src, f, energy, paper);
-  });
+  try {
+    knit::material::write_database(scratch, db, [&](knit::io::H5File& f) {
+      const auto src = knit::io::H5File::open_read(input);
+      knit::material::carry_over_unwritten(src, f, "check");
+      lost = knit::material::items_not_carried(src, f, energy, paper);
+    });
+  } catch (const std::exception&) {
+    // A scratch file that cannot be written (a full temporary directory) does not stop the
+    // refit: the same check after its write still keeps the input as it was.
+    return {};
+  }
   return lost;
 }
 
 }  // namespace
+}  // namespace knit::meso::cmd_fit
 
 static knit::cli::SubcommandRegistrar reg_fit(
     "fit",
@@ -115,8 +124,10 @@ static knit::cli::SubcommandRegistrar reg_fit(
         {
           std::error_code ec;
           if (std::filesystem::equivalent(target, o->db, ec))
-            if (const auto lost = items_lost_by_refit(db, o->db, energy, paper); !lost.empty())
-              refuse_in_place(o->db, lost);
+            if (const auto lost =
+                    knit::meso::cmd_fit::items_lost_by_refit(db, o->db, energy, paper);
+                !lost.empty())
+              knit::meso::cmd_fit::refuse_in_place(o->db, lost);
         }
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
@@ -182,7 +193,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
           });
         } catch (const std::exception&) {
           if (!in_place || lost.empty()) throw;
-          refuse_in_place(o->db, lost);
+          knit::meso::cmd_fit::refuse_in_place(o->db, lost);
         }
         if (!carried.empty()) {
           std::cout << "kept from " << o->db << ":";
