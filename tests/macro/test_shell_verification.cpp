@@ -96,6 +96,10 @@ TEST_CASE("Sze, Liu & Lo (2004) cantilever subjected to end shear force", "[veri
     tip.emplace_back(s.lambda, model.displacement(s.u, Eigen::Vector2d(1.0, 0.5)));
   });
   REQUIRE(rep.status == RunStatus::kCompleted);
+  // The nominal steps end on their load factors exactly (session 42's red team: the tenth of
+  // ten steps ended at 0.9 + 0.1 = 0.9999999999999999).
+  REQUIRE(tip.size() == 10);
+  for (std::size_t k = 0; k < tip.size(); ++k) CHECK(tip[k].first == 0.1 * double(k + 1));
   // Both reference rows are compared (session 39's audit: a load factor that missed 0.5 or 1.0
   // by round-off skipped its checks without a word).
   int checked = 0;
