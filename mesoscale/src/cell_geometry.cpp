@@ -39,6 +39,17 @@ CellDimensions cell_dimensions(double l) {
   return d;
 }
 
+std::string loop_length_range_warning(double l) {
+  if (l >= kPublishedLoopLengthMin - 1e-12 && l <= kPublishedLoopLengthMax + 1e-12) return {};
+  std::ostringstream os;
+  os << "warning: loop length " << l << " mm lies outside the cells with published wale width "
+     << "and course height (" << kPublishedLoopLengthMin << " and " << kPublishedLoopLengthMax
+     << " mm; docs/unit-cell.md): w and c are extrapolated (w = " << cell_dimensions(l).w
+     << " mm, c = " << cell_dimensions(l).c
+     << " mm), and the cell has not been compared with any knit there";
+  return os.str();
+}
+
 Eigen::Vector3d LoopShape::point(double s, int k) const {
   const double a = 2 * kPi * s, b = 4 * kPi * s;
   switch (k) {

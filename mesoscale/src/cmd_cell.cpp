@@ -131,6 +131,9 @@ int run(const Options& o) {
   j["crossings_with_next_course"] = xs;
   write_text_atomic((dir / "cell.json").string(), j.dump(2) + "\n");
   dir.commit();
+  // (session 42's metamorphic red team: loop lengths up to 50 mm were accepted without a word)
+  if (const std::string w = loop_length_range_warning(g.dim.loop_length); !w.empty())
+    std::cerr << "knit-meso cell: " << w << "\n";
   std::cout << "cell l=" << g.dim.loop_length << " mm: w=" << g.dim.w << " c=" << g.dim.c
             << " h=" << g.shape.h << " measured l=" << g.measured_length
             << " min clearance=" << cl.clearance << " mm -> " << o.out << "/cell.{vtp,json}\n";

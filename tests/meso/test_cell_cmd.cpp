@@ -11,7 +11,9 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+
 #include <vector>
+#include "knit/meso/cell/geometry.hpp"
 
 namespace fs = std::filesystem;
 
@@ -312,6 +314,41 @@ TEST_CASE("knit-meso path: no converged step leaves an earlier output as it was"
   CHECK(slurp(err).find("no load step converged: nothing written; the earlier outputs in " + out +
                         ", if any, are left as they were") != std::string::npos);
   CHECK(slurp(out + "/path.csv") == before);
+  fs::remove_all(out);
+  fs::remove(err);
+}
+
+// Session 42's metamorphic red team: 8 analysis-curve elements gave an equibiaxial S11 52 %
+// above 64 elements', and loop lengths outside the published cells (12 mm) ran, both with exit
+// 0 and no word. Both warn on stderr now (the run goes on); the defaults warn of nothing.
+TEST_CASE("knit-meso path and cell warn of a coarse mesh and an extrapolated loop", "[unit]") {
+  const std::string out = std::string(KNIT_BINARY_DIR) + "/test_cell_cmd_warn";
+  const std::string err = out + "_stderr.txt";
+  auto stderr_of = [&](const std::string& args) {
+    fs::remove_all(out);
+    const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-meso " + args + " --out " + out +
+                            " > /dev/null 2> " + err;
+    const int rc = std::system(cmd.c_str());
+    CHECK((WIFEXITED(rc) && WEXITSTATUS(rc) == 0));
+    std::ifstream in(err);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  const std::string path = "path --biaxial 0.01 0.01 --steps 1 --no-vtp";
+  CHECK(stderr_of(path + " --loop-length 5").empty());
+  const std::string coarse = stderr_of(path + " --loop-length 5 --elements 8");
+  CHECK(coarse.find("knit-meso path: warning: 8 analysis-curve elements, fewer than the default "
+                    "32: the stresses are not mesh-converged") != std::string::npos);
+  const std::string long_loop = stderr_of(path + " --loop-length 7");
+  CHECK(long_loop.find("knit-meso path: warning: loop length 7 mm lies outside the cells with "
+                       "published wale width and course height (4.5 and 6.5 mm") !=
+        std::string::npos);
+  CHECK(stderr_of("cell --loop-length 6.5").empty());
+  CHECK(stderr_of("cell --loop-length 7").find("knit-meso cell: warning: loop length 7 mm") !=
+        std::string::npos);
+  CHECK(knit::meso::cell::loop_length_range_warning(4.5).empty());
+  CHECK_FALSE(knit::meso::cell::loop_length_range_warning(4.49).empty());
   fs::remove_all(out);
   fs::remove(err);
 }

@@ -44,6 +44,15 @@ struct CellDimensions {
 /// Throws std::invalid_argument for l <= 0.
 CellDimensions cell_dimensions(double loop_length);
 
+/// The loop lengths whose w and c are published (the paper's cells, notes.md); between them
+/// cell_dimensions interpolates, outside it extrapolates.
+inline constexpr double kPublishedLoopLengthMin = 4.5, kPublishedLoopLengthMax = 6.5;
+
+/// A warning for a loop length outside [kPublishedLoopLengthMin, kPublishedLoopLengthMax]
+/// (session 42's metamorphic red team: 12 mm ran without a word, its wale stress 1.6 times the
+/// 4.5 mm cell's); empty inside.
+std::string loop_length_range_warning(double loop_length);
+
 /// Parameters of the closed-form loop.
 struct LoopShape {
   double w = 1.26, h = 1.49, d = 0.38, gamma = 0.25;
