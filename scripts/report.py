@@ -440,6 +440,19 @@ class Data:
             if used is not None and used != self.db_date:
                 return (f"its results were computed with the database written {used}; the "
                         f"database is of {self.db_date} (stale: rerun the case)")
+        # Results that do not say which database they read (no material_database_date_utc:
+        # written before session 38, or changed since) are not judged as this database's
+        # (session 42's red team: with the attribute deleted, a stale run passed).
+        if self.db_date is not None and r.database_date() is None and \
+                r.case.get("material", {}).get("type") == "knit":
+            return ("its results.h5 does not say which database it read (no "
+                    "material_database_date_utc: written before session 38, without results.h5, "
+                    "or changed since; rerun the case)")
+        # The run's own outputs against each other (session 42's red team: a doubled strain
+        # column, another step's fields, a summary of fewer steps than the CSV).
+        why = r.consistency_defect()
+        if why:
+            return why
         for s in r.steps():  # step_0010's fields copied into step_0020 were judged at 30 %
             lf, csv_lf = r.load_factor_of_step(s), r.csv_load_factor(s)
             if lf is not None and csv_lf is not None and abs(lf - csv_lf) > 1e-9 * max(1.0, abs(csv_lf)):

@@ -134,6 +134,83 @@ class Result:
         p = os.path.join(self.dir, "summary.txt")
         return open(p).read().strip() if os.path.exists(p) else ""
 
+    def consistency_defect(self):
+        """Why this run's outputs disagree with each other, or None (session 42's red team: a
+        strain column doubled was judged at 60 %, fields of step 10 copied with step 20's load
+        factor left in place were judged at 30 %, and a summary of 12 steps beside 20 CSV rows
+        passed). Checks, where the columns and the case say: strain = applied displacement /
+        gauge length and the applied displacement proportional to the load factor, row by row;
+        summary.txt's converged steps and last load factor equal the CSV's; and at every output
+        step in results.h5 the displacement of the applied edge equals the CSV's applied
+        displacement (knit-macro prescribes it there)."""
+        c = self.csv
+        lf, d, e = c.get("load_factor"), c.get("applied_displacement_mm"), c.get("strain")
+        ad = self.case.get("output", {}).get("applied_displacement") or {}
+        if lf is not None and d is not None and e is not None and len(lf):
+            L = ad.get("gauge_length")
+            if isinstance(L, (int, float)) and L > 0:
+                bad = np.abs(e - d / L) > 1e-9 * np.maximum(1.0, np.abs(e)) + 1e-12
+                if bad.any():
+                    i = int(np.argmax(bad))
+                    return (f"load_strain.csv row {i + 1}: strain {e[i]:.9g} is not the applied "
+                            f"displacement {d[i]:.9g} mm over the gauge length {L:g} mm")
+            if lf[-1] != 0:
+                D = d[-1] / lf[-1]
+                bad = np.abs(d - D * lf) > 1e-9 * max(1.0, abs(D))
+                if bad.any():
+                    i = int(np.argmax(bad))
+                    return (f"load_strain.csv row {i + 1}: applied displacement {d[i]:.9g} mm at "
+                            f"load factor {lf[i]:.9g} is not proportional to the last row's "
+                            f"{d[-1]:.9g} mm at {lf[-1]:.9g}")
+        summ = self.summary()
+        m = re.search(r"^converged steps: (\d+)$", summ, re.M)
+        rows = len(c.get("step", []))
+        if m and rows and int(m.group(1)) != rows:
+            return (f"summary.txt says {m.group(1)} converged steps, load_strain.csv has "
+                    f"{rows} rows")
+        m = re.search(r"^last load factor: (\S+)$", summ, re.M)
+        if m and lf is not None and len(lf):
+            try:
+                last = float(m.group(1))
+            except ValueError:
+                last = float("nan")
+            if not abs(last - lf[-1]) <= 1e-6 * max(1.0, abs(lf[-1])):
+                return (f"summary.txt says last load factor {m.group(1)}, load_strain.csv "
+                        f"{lf[-1]:.9g}")
+        return self._edge_displacement_defect(ad, d)
+
+    def _edge_displacement_defect(self, ad, d):
+        edge, comp = ad.get("edge"), "xyz".find(str(ad.get("component", "")))
+        path = os.path.join(self.dir, "results.h5")
+        steps = self.csv.get("step")
+        if edge not in ("u0", "u1", "v0", "v1") or comp < 0 or d is None or steps is None \
+                or not os.path.exists(path):
+            return None
+        try:
+            import h5py
+        except ImportError:
+            return None
+        by_step = dict(zip(steps.astype(int), d))
+        scale = max(1.0, float(np.max(np.abs(d)))) if len(d) else 1.0
+        try:
+            with h5py.File(path, "r") as f:
+                for k, g in f.get("fields", {}).items():
+                    s = int(k.split("_")[-1])
+                    if s not in by_step or "displacement" not in g:
+                        continue
+                    nu, nv = int(g.attrs["grid_u"]), int(g.attrs["grid_v"])
+                    u = np.array(g["displacement"], dtype=float).reshape(nv, nu, 3)[..., comp]
+                    line = {"u0": u[:, 0], "u1": u[:, -1], "v0": u[0, :], "v1": u[-1, :]}[edge]
+                    off = float(np.max(np.abs(line - by_step[s])))
+                    if not off <= 1e-6 * scale:
+                        return (f"results.h5 {k}: the displacement of edge {edge} along "
+                                f"{ad.get('component')} is up to {off:.3g} mm off the "
+                                f"applied displacement {by_step[s]:.9g} mm of load_strain.csv "
+                                f"for that step (its fields are not of that load)")
+        except (OSError, KeyError, ValueError):
+            return None  # unreadable: the checks that read the fields say so
+        return None
+
     # -- load-strain curve --------------------------------------------------------------------
     def strain(self):
         return np.concatenate([[0.0], self.csv.get("strain", np.array([]))])

@@ -897,6 +897,71 @@ def held_out_agreement_failures(tmp):
     return out
 
 
+def consistency_failures(tmp):
+    """A run's outputs that disagree with each other are a defect of the run (session 42's red
+    team: a doubled strain column was judged at 60 %, step 10's fields copied into step 20 with
+    its load factor left were judged at 30 %, a summary of 12 steps beside 20 CSV rows passed,
+    and results.h5 without the database's date passed as this database's)."""
+    import h5py
+    sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
+    from results import Result
+    out = []
+    res = os.path.join(tmp, "consistency")
+
+    def fresh(strain_scale=1.0, steps_line=2, last_lf="1", field_scale=1.0, date=True):
+        shutil.rmtree(res, ignore_errors=True)
+        d = os.path.join(res, "a")
+        os.makedirs(d)
+        with open(os.path.join(d, "load_strain.csv"), "w") as f:  # 2 mm over L = 20 mm at lf 1
+            f.write("step,load_factor,applied_displacement_mm,strain,load_N\n"
+                    f"1,0.5,1,{0.05 * strain_scale},2.0\n2,1,2,{0.1 * strain_scale},5.0\n")
+        with open(os.path.join(d, "case.json"), "w") as f:
+            json.dump({"material": {"type": "knit"}, "output": {"grid": [3, 3],
+                       "applied_displacement": {"edge": "v1", "component": "y",
+                                                "gauge_length": 20}}}, f)
+        with open(os.path.join(d, "summary.txt"), "w") as f:
+            f.write(f"status: completed\nconverged steps: {steps_line}\n"
+                    f"last load factor: {last_lf}\n")
+        with open(os.path.join(res, "a.status"), "w") as f:
+            json.dump({"case": "a", "exit_code": 0, "seconds": 0.1}, f)
+        with h5py.File(os.path.join(d, "results.h5"), "w") as h:
+            if date:
+                h.attrs["material_database_date_utc"] = "2026-12-01T10:00:00Z"
+            g = h.create_group("fields/step_0002")
+            g.attrs["grid_u"], g.attrs["grid_v"], g.attrs["load_factor"] = 3, 3, 1.0
+            u = np.zeros((3, 3, 3))
+            u[:, :, 1] = np.linspace(0.0, 2.0, 3)[:, None] * field_scale  # v1 (last row): 2 mm
+            g["displacement"] = u.reshape(-1, 3)
+            g["x"] = u.reshape(-1, 3)
+        return Result(res, "a")
+
+    if fresh().consistency_defect() is not None:
+        out.append(f"consistency: a consistent run has a defect: {fresh().consistency_defect()!r}")
+    for what, kw, needle in [
+            ("a doubled strain column", dict(strain_scale=2.0),
+             "strain 0.1 is not the applied displacement 1 mm over the gauge length 20 mm"),
+            ("a summary of fewer steps", dict(steps_line=1),
+             "summary.txt says 1 converged steps, load_strain.csv has 2 rows"),
+            ("a summary of another last load factor", dict(last_lf="0.6"),
+             "summary.txt says last load factor 0.6"),
+            ("fields of half the load", dict(field_scale=0.5),
+             "the displacement of edge v1 along y is up to 1 mm off the applied displacement 2 mm")]:
+        why = fresh(**kw).consistency_defect()
+        if why is None or needle not in why:
+            out.append(f"consistency, {what}: {why!r}")
+    fresh(date=False)
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is None or "does not say which database it read" not in why:
+        out.append(f"consistency, results without the database's date: {why!r}")
+    if report.Data(res, None).run_defect("a") is not None:  # no database date to compare with
+        out.append("consistency: a run without a date is a defect without a database date")
+    fresh()
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is not None:
+        out.append(f"consistency: a consistent run with its database's date: {why!r}")
+    return out
+
+
 def main():
     failures = []
     tmp = tempfile.mkdtemp(prefix="knit_report_test_")
@@ -1028,6 +1093,7 @@ def main():
         failures.extend(held_out_reference_failures(tmp))
         failures.extend(held_out_agreement_failures(tmp))
         failures.extend(unusable_result_failures(tmp))
+        failures.extend(consistency_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
