@@ -334,6 +334,7 @@ $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scri
   $(FIGPY)/results.py $(FIGPY)/sensitivity.py $(wildcard $(SENSITIVITY))
 	@$(PY) $(ROOT)/scripts/report.py --out-dir $(OUT) --database $(DB) --cells "$(HAVE_CELL)" \
 	  --sensitivity "$(SENSITIVITY)" --cases-dir $(CASEDIR) \
+	  --expect-designs "$(DESIGNS)" --designs-dir $(ROOT)/cases/design \
 	  --expect-figures "$(notdir $(FIGURES) $(DESIGN_FIGURES) $(KNITMAP_FIGURES))" > $(LOGS)/report.log 2>&1 \
 	  || { cat $(LOGS)/report.log; exit 1; }
 	@echo "report: $@"

@@ -5,6 +5,7 @@ vtk/step_NNNN.vtu (the deformed mid-surface sampled on an n_u x n_v grid of para
 u index fastest) and results.h5 (the same fields under fields/step_NNNN). Fields are read from
 results.h5 when it holds the step and from the VTU file otherwise.
 """
+import base64
 import json
 import math
 import os
@@ -26,14 +27,40 @@ def read_csv(path):
     return {h: data[:, k] for k, h in enumerate(head)}
 
 
+def _data_array(da, header_type):
+    """The values of a VTU DataArray: ASCII, or inline binary as knit-macro writes it (base64 of
+    the byte count, UInt64 or UInt32 per the file's header_type, and the data, encoded together;
+    session 42's red team: only ASCII was read, and the report's fallback to the VTU files
+    failed with 54 kB of base64 in its message)."""
+    fmt = da.get("format", "ascii")
+    if fmt == "ascii":
+        return np.array(da.text.split(), dtype=float)
+    if fmt != "binary":
+        raise ValueError(f"DataArray {da.get('Name')!r}: format {fmt!r} is not read")
+    dtype = {"Float64": "<f8", "Float32": "<f4", "Int32": "<i4", "Int64": "<i8",
+             "UInt8": "u1", "UInt32": "<u4", "UInt64": "<u8"}.get(da.get("type"))
+    if dtype is None:
+        raise ValueError(f"DataArray {da.get('Name')!r}: type {da.get('type')!r} is not read")
+    raw = base64.b64decode("".join((da.text or "").split()))
+    hs = 8 if header_type == "UInt64" else 4
+    n = int(np.frombuffer(raw[:hs], dtype="<u8" if hs == 8 else "<u4")[0])
+    if len(raw) < hs + n:
+        raise ValueError(f"DataArray {da.get('Name')!r}: {len(raw) - hs} bytes, not {n}")
+    return np.frombuffer(raw[hs:hs + n], dtype=dtype).astype(float)
+
+
 def read_vtu(path):
-    """ASCII VTU of the shell writer -> (points (n,3), {name: (n,) or (n,3)})."""
+    """VTU of the shell writer (ASCII or inline binary) -> (points (n,3), {name: (n,) or
+    (n,3)})."""
     root = ET.parse(path).getroot()
+    if root.get("compressor"):
+        raise ValueError(f"{path}: compressed VTU ({root.get('compressor')}) is not read")
+    ht = root.get("header_type", "UInt32")
     piece = root.find("./UnstructuredGrid/Piece")
-    pts = np.array(piece.find("./Points/DataArray").text.split(), dtype=float).reshape(-1, 3)
+    pts = _data_array(piece.find("./Points/DataArray"), ht).reshape(-1, 3)
     fields = {}
     for da in piece.findall("./PointData/DataArray"):
-        v = np.array(da.text.split(), dtype=float)
+        v = _data_array(da, ht)
         nc = int(da.get("NumberOfComponents", "1"))
         fields[da.get("Name")] = v.reshape(-1, nc) if nc > 1 else v
     return pts, fields

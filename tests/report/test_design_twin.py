@@ -101,6 +101,26 @@ def main():
         table = "\n".join(report.design_section(out))
         c("the input's twin is 5.0, not 6 (a stale summary)" in table and "exit 1" in table,
           "the table says why", table)
+    # Session 42's red team: with $(OUT)/design deleted (its inputs too) the twin verdict
+    # dropped out of the summary without a FAIL. An expected design (--expect-designs) takes its
+    # twin from --designs-dir.
+    with tempfile.TemporaryDirectory(prefix="design_twin_test_") as out:
+        src = os.path.join(out, "src")
+        os.makedirs(src)
+        with open(os.path.join(src, "wanted.json"), "w") as f:
+            f.write('{"twin": {"l": 6.0}}')
+        c(report.twin_counts(out) == (0, 0), "nothing expected, nothing there: 0 of 0",
+          repr(report.twin_counts(out)))
+        report.EXPECTED_DESIGNS, report.DESIGNS_DIR = ["wanted"], src
+        try:
+            c(report.twin_counts(out) == (0, 1), "an expected twin without any output: 0 of 1",
+              repr(report.twin_counts(out)))
+            table = "\n".join(report.design_section(out))
+            c("| wanted |" in table and "no status file" in table
+              and "declared (twin 6.0) but not in the summary (no output)" in table,
+              "the table names the expected design without output", table)
+        finally:
+            report.EXPECTED_DESIGNS, report.DESIGNS_DIR = [], None
     return c.exit_code()
 
 

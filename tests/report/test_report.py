@@ -959,6 +959,13 @@ def consistency_failures(tmp):
     why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
     if why is not None:
         out.append(f"consistency: a consistent run with its database's date: {why!r}")
+    # The summary's count of completed cases leaves a defective run out ("26 of 26 cases
+    # completed" beside a run whose every check FAILed).
+    if report.completed_runs(["a"], report.Data(res, "2026-12-01T10:00:00Z")) != ["a"]:
+        out.append("consistency: a consistent run is not counted as completed")
+    fresh(strain_scale=2.0)
+    if report.completed_runs(["a"], report.Data(res, "2026-12-01T10:00:00Z")) != []:
+        out.append("consistency: a defective run is counted as completed")
     return out
 
 

@@ -74,6 +74,24 @@ def main():
               f"{os.path.basename(d)}: every {ext} file and the collection read cleanly",
               r.stdout[-400:] + r.stderr[-400:])
 
+        # The report's own VTU reader (scripts/figures/results.py, its fallback when results.h5
+        # is missing) reads knit-macro's inline binary VTU files as results.h5 holds the same
+        # fields (session 42's red team: only ASCII was read, and the fallback failed with 54 kB
+        # of base64 in the report).
+        sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
+        import numpy as np
+        from results import _fields_from_h5, read_vtu
+        vtus = sorted(os.path.join(dp, n) for dp, _, ns in os.walk(shell) for n in ns
+                      if n.endswith(".vtu"))
+        same = bool(vtus)
+        for v in vtus:
+            step = int(os.path.splitext(os.path.basename(v))[0].split("_")[-1])
+            pts, f = read_vtu(v)
+            h = _fields_from_h5(os.path.join(shell, "results.h5"), step)
+            same = same and h is not None and np.array_equal(pts, h[0]) and all(
+                np.array_equal(f[k], h[1][k]) for k in h[1] if k in f) and "E11" in f
+        c(same, f"the report's VTU reader gives results.h5's fields ({len(vtus)} VTU files)")
+
         # Damage, one kind per copy; each is refused with the file's name.
         def damaged(name, edit):
             d = os.path.join(tmp, name)
