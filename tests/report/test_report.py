@@ -1139,6 +1139,12 @@ def main():
         text = "\n".join(report.knitmap_section(km))
         if "| patch | 1547 | 40 | 41 | 8.31 | 4.52-6.44 | first one; second one |" not in text:
             failures.append("knitmap section row: " + text[-300:])
+        # A value beside its bound prints the digits that tell it from the bound (session 42's
+        # red team: "largest 2.0 %" FAILed against "<= 2 %").
+        for v, b, want in ((2.0004, 2.0, "2.0004"), (1.9996, 2.0, "1.9996"), (2.0, 2.0, "2.0"),
+                           (11.7, 5.0, "11.7")):
+            if report.beside_bound(v, b) != want:
+                failures.append(f"beside_bound({v}, {b}) = {report.beside_bound(v, b)!r}")
         # The database's build time: the paper's ~30 min only beside loop lengths read.
         line = report.database_time_line(None, [])
         if "30 min" in line or "missing or unreadable" not in line:
