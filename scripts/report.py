@@ -115,6 +115,8 @@ def beside_bound(value, bound, nd=1):
     while nd < 8 and value != bound and float(text) == bound:
         nd += 1
         text = f"{value:.{nd}f}"
+    if value != bound and float(text) == bound:  # within round-off of it: every digit
+        text = repr(float(value))
     return text
 
 
@@ -249,7 +251,7 @@ def law_checks(db_path, extrapolations):
                  f"<= {100 * LAW_BOUND:g} %, every loop length", per_l + pct(mx) + floor + short
                  + fit_note,
                  whole and fit_agree and all(math.isfinite(x) and x <= LAW_BOUND for x in mx)))
-    held = (f"{h_in} of {h_n} (largest {beside_bound(100 * h_max, 5.0)} %)" if h_n
+    held = (f"{h_in} of {h_n} (largest {beside_bound(100 * h_max, 100 * LAW_BOUND)} %)" if h_n
             else "none in the database")
     held += ("; runs not countable (no raw paths)" if h_runs is None else
              f" in {h_runs} held-out runs")
@@ -458,8 +460,9 @@ class Data:
         if self.db_date is not None and r.database_date() is None and \
                 r.case.get("material", {}).get("type") == "knit":
             return ("its results.h5 does not say which database it read (no "
-                    "material_database_date_utc: written before session 38, without results.h5, "
-                    "or changed since; rerun the case)")
+                    "material_database_date_utc: written before session 38, changed since, or "
+                    "no results.h5, which the report needs for a knit run: rerun the case with "
+                    "/output/hdf5 true, the default)")
         # The run's own outputs against each other (session 42's red team: a doubled strain
         # column, another step's fields, a summary of fewer steps than the CSV).
         why = r.consistency_defect()
@@ -1004,7 +1007,8 @@ DESIGNS_DIR = None
 def declared_twins(out):
     """{design: {variable: value}} of the design inputs of the run ($(OUT)/design/inputs/*.json
     with a "twin"): what each design was asked to recover, independent of its outputs; for an
-    expected design (EXPECTED_DESIGNS) without its input there, its file in DESIGNS_DIR."""
+    expected design (EXPECTED_DESIGNS), its file in DESIGNS_DIR too, whose twin counts unless
+    the run's own input declares one."""
     twins = {}
     paths = [os.path.join(DESIGNS_DIR, n + ".json") for n in EXPECTED_DESIGNS] if DESIGNS_DIR \
         else []

@@ -97,14 +97,16 @@ class DesignCost : public ceres::CostFunction {
 class History : public ceres::IterationCallback {
  public:
   History(DesignResult& r, Tracker& t, const std::vector<double>& x, Clock::time_point t0,
-          double scale, std::function<void(const DesignIteration&)> on_iteration)
-      : r_(r), t_(t), x_(x), t0_(t0), scale_(scale), on_iteration_(std::move(on_iteration)) {}
+          double j0, std::function<void(const DesignIteration&)> on_iteration)
+      : r_(r), t_(t), x_(x), t0_(t0), j0_(j0), on_iteration_(std::move(on_iteration)) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     // A rejected step leaves x where it was (its cost is the trial's): not a history point.
     if (s.iteration > 0 && !s.step_is_successful) return ceres::SOLVER_CONTINUE;
     DesignIteration h;
     h.iteration = s.iteration;
-    h.J = 2.0 * s.cost / (scale_ * scale_);  // Ceres' cost is (1/2) sum (scale r)^2
+    // Ceres' cost is (1/2) sum (scale r)^2 = J / (2 J0): J = 2 cost J0 (not / scale^2, which
+    // overflows for a J0 below 1e-308; the review of session 42).
+    h.J = 2.0 * s.cost * j0_;
     // |dJ/dp| (DesignEvaluation::gradient) at the accepted design, as the projected-gradient method
     // reports it (session 37's red team: Ceres' gradient_norm of a bounded problem is |x - P(x -
     // g)|, the step to the bounds' projection, so 2 x it read 2.0 at l = 5.5 with upper bound 6.5
@@ -125,7 +127,7 @@ class History : public ceres::IterationCallback {
   Tracker& t_;
   const std::vector<double>& x_;
   Clock::time_point t0_;
-  double scale_;
+  double j0_;  ///< J0, or 1 where the residuals are not scaled
   std::function<void(const DesignIteration&)> on_iteration_;
 };
 
@@ -177,7 +179,7 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
   o.minimizer_progress_to_stdout = false;
   o.num_threads = 1;
   o.update_state_every_iteration = true;
-  History history(res, t, x, t0, scale, opt.on_iteration);
+  History history(res, t, x, t0, scale == 1.0 ? 1.0 : e0.J, opt.on_iteration);
   o.callbacks.push_back(&history);
   ceres::Solver::Summary summary;
   ceres::Solve(o, &problem, &summary);

@@ -286,8 +286,12 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
         // team: 727 of an arch's 1,098 stitches, exit 0 with a warning). A gap narrower than
         // half a stitch (a shallow notch, a boundary's round-off) is knitted over; a wider one
         // is refused, as the pieces between courses are (rule 3).
+        // The pairs (cr[2k], cr[2k+1]) are inside; with an odd count (the line through a
+        // boundary vertex that is a local extremum, counted once) they are not pairs, and the
+        // chord is taken whole (the review of session 42: the fabric beside such a vertex was
+        // taken for a gap).
         double gap = 0.0, gap_at = 0.0;
-        for (std::size_t i = 1; i + 1 < cr.size(); i += 2)
+        for (std::size_t i = 1; cr.size() % 2 == 0 && i + 1 < cr.size(); i += 2)
           if (cr[i + 1] - cr[i] > gap) {
             gap = cr[i + 1] - cr[i];
             gap_at = 0.5 * (cr[i] + cr[i + 1]);

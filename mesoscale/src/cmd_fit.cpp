@@ -45,8 +45,12 @@ namespace {
 std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
                                              const std::string& input, bool energy, bool paper) {
   namespace fs = std::filesystem;
-  const fs::path scratch =
-      fs::temp_directory_path() / ("knit-meso-fit-check-" + std::to_string(::getpid()) + ".h5");
+  // No usable temporary directory (TMPDIR not a directory): no pre-check (the review of session
+  // 42: temp_directory_path() threw, and ended the refit it should spare).
+  std::error_code tmp_ec;
+  const fs::path tmp = fs::temp_directory_path(tmp_ec);
+  if (tmp_ec) return {};
+  const fs::path scratch = tmp / ("knit-meso-fit-check-" + std::to_string(::getpid()) + ".h5");
   struct Remove {
     fs::path p;
     ~Remove() {

@@ -908,17 +908,21 @@ def consistency_failures(tmp):
     out = []
     res = os.path.join(tmp, "consistency")
 
-    def fresh(strain_scale=1.0, steps_line=2, last_lf="1", field_scale=1.0, date=True):
+    def fresh(strain_scale=1.0, steps_line=2, last_lf="1", field_scale=1.0, date=True,
+              corner=False, d1="1", strain1=None, rows=True):
         shutil.rmtree(res, ignore_errors=True)
         d = os.path.join(res, "a")
         os.makedirs(d)
         with open(os.path.join(d, "load_strain.csv"), "w") as f:  # 2 mm over L = 20 mm at lf 1
-            f.write("step,load_factor,applied_displacement_mm,strain,load_N\n"
-                    f"1,0.5,1,{0.05 * strain_scale},2.0\n2,1,2,{0.1 * strain_scale},5.0\n")
+            f.write("step,load_factor,applied_displacement_mm,strain,load_N\n")
+            if rows:
+                e1 = 0.05 * strain_scale if strain1 is None else strain1
+                f.write(f"1,0.5,{d1},{e1},2.0\n2,1,2,{0.1 * strain_scale},5.0\n")
         with open(os.path.join(d, "case.json"), "w") as f:
             json.dump({"material": {"type": "knit"}, "output": {"grid": [3, 3],
-                       "applied_displacement": {"edge": "v1", "component": "y",
-                                                "gauge_length": 20}}}, f)
+                       "applied_displacement": {"corner" if corner else "edge":
+                                                "u1v1" if corner else "v1",
+                                                "component": "y", "gauge_length": 20}}}, f)
         with open(os.path.join(d, "summary.txt"), "w") as f:
             f.write(f"status: completed\nconverged steps: {steps_line}\n"
                     f"last load factor: {last_lf}\n")
@@ -935,6 +939,8 @@ def consistency_failures(tmp):
             g["x"] = u.reshape(-1, 3)
         return Result(res, "a")
 
+    if fresh(corner=True).consistency_defect() is not None:
+        out.append("consistency: a consistent corner-loaded run has a defect")
     if fresh().consistency_defect() is not None:
         out.append(f"consistency: a consistent run has a defect: {fresh().consistency_defect()!r}")
     for what, kw, needle in [
@@ -945,7 +951,15 @@ def consistency_failures(tmp):
             ("a summary of another last load factor", dict(last_lf="0.6"),
              "summary.txt says last load factor 0.6"),
             ("fields of half the load", dict(field_scale=0.5),
-             "the displacement of edge v1 along y is up to 1 mm off the applied displacement 2 mm")]:
+             "the displacement of v1 along y is up to 1 mm off the applied displacement 2 mm"),
+            # the review of session 42: corners, proportionality, NaN and an empty CSV
+            ("a corner's fields of half the load", dict(field_scale=0.5, corner=True),
+             "the displacement of u1v1 along y is up to 1 mm off the applied displacement 2 mm"),
+            ("a displacement not proportional to the load factor", dict(d1="1.5", strain1=0.075),
+             "applied displacement 1.5 mm at load factor 0.5 is not proportional"),
+            ("a NaN strain", dict(strain1=float("nan")), "holds a non-finite"),
+            ("a summary of steps beside an empty CSV", dict(rows=False),
+             "summary.txt says 2 converged steps, load_strain.csv has 0 rows")]:
         why = fresh(**kw).consistency_defect()
         if why is None or needle not in why:
             out.append(f"consistency, {what}: {why!r}")
@@ -1142,7 +1156,7 @@ def main():
         # A value beside its bound prints the digits that tell it from the bound (session 42's
         # red team: "largest 2.0 %" FAILed against "<= 2 %").
         for v, b, want in ((2.0004, 2.0, "2.0004"), (1.9996, 2.0, "1.9996"), (2.0, 2.0, "2.0"),
-                           (11.7, 5.0, "11.7")):
+                           (11.7, 5.0, "11.7"), (5.000000000000001, 5.0, "5.000000000000001")):
             if report.beside_bound(v, b) != want:
                 failures.append(f"beside_bound({v}, {b}) = {report.beside_bound(v, b)!r}")
         # The database's build time: the paper's ~30 min only beside loop lengths read.
