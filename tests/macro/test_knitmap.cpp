@@ -89,6 +89,18 @@ KnitMap map_of(const std::string& name, const std::string& text) {
   const auto in = load_knitmap_input(write_case(name, text));
   return make_knitmap(in.c, in.cells);
 }
+/// The InputError that reading and mapping the case file `file` ends with (a failed check when
+/// it maps without one).
+knit::InputError map_error(const std::string& file) {
+  try {
+    const auto in = load_knitmap_input(file);
+    (void)make_knitmap(in.c, in.cells);
+  } catch (const knit::InputError& e) {
+    return e;
+  }
+  FAIL("no error: " << file);
+  return knit::InputError("", "", "");
+}
 
 int run_knitmap(const std::string& args) {
   const std::string cmd = std::string(KNIT_BIN_DIR) + "/knit-macro knitmap " + args + " > " +
@@ -469,15 +481,10 @@ TEST_CASE("knitmap: a waist narrower than a stitch is refused, a narrow tip is l
     INFO(name);
     const std::string hourglass =
         write_case(std::string(name) + ".json", tapered_case(m, {0, 0.5 * H, H}, {25, -24.9, 25}));
-    try {
-      const auto in = load_knitmap_input(hourglass);
-      (void)make_knitmap(in.c, in.cells);
-      FAIL("no error");
-    } catch (const knit::InputError& e) {
-      CHECK(e.pointer() == "/geometry");
-      CHECK_THAT(e.what(), Catch::Contains("fall apart into pieces"));
-      CHECK_THAT(e.what(), Catch::Contains(gap));
-    }
+    const knit::InputError e = map_error(hourglass);
+    CHECK(e.pointer() == "/geometry");
+    CHECK_THAT(e.what(), Catch::Contains("fall apart into pieces"));
+    CHECK_THAT(e.what(), Catch::Contains(gap));
     const fs::path out = kDir / (std::string(name) + "_out");
     fs::remove_all(out);
     CHECK(run_knitmap(hourglass + " --output " + out.string()) == 2);
@@ -516,17 +523,12 @@ TEST_CASE("knitmap: a course line that leaves the patch and comes back is refuse
                                                        m + R"(,
     "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "v0", "fix": ["x", "y"]}],
     "output": {"vtk": false, "hdf5": false}})");
-  try {
-    const auto in = load_knitmap_input(arch);
-    (void)make_knitmap(in.c, in.cells);
-    FAIL("no error");
-  } catch (const knit::InputError& e) {
-    CHECK(e.file() == arch);
-    CHECK(e.pointer() == "/geometry");
-    CHECK_THAT(e.message(), Catch::Contains("crosses its boundary 4 times") &&
-                                Catch::Contains("not convex along its courses") &&
-                                Catch::Contains("map the pieces as separate cases"));
-  }
+  const knit::InputError e = map_error(arch);
+  CHECK(e.file() == arch);
+  CHECK(e.pointer() == "/geometry");
+  CHECK_THAT(e.message(), Catch::Contains("crosses its boundary 4 times") &&
+                              Catch::Contains("not convex along its courses") &&
+                              Catch::Contains("map the pieces as separate cases"));
   const fs::path out = kDir / "arch_out";
   fs::remove_all(out);
   CHECK(run_knitmap(arch + " --output " + out.string()) == 2);
@@ -539,14 +541,9 @@ TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothin
                     const std::string& args = "") {
     INFO(name);
     const std::string file = write_case(name, text);
-    try {
-      const auto in = load_knitmap_input(file);
-      (void)make_knitmap(in.c, in.cells);
-      FAIL("no error");
-    } catch (const knit::InputError& e) {
-      CHECK(e.pointer() == ptr);
-      CHECK(std::string(e.what()).find(ptr) != std::string::npos);
-    }
+    const knit::InputError e = map_error(file);
+    CHECK(e.pointer() == ptr);
+    CHECK(std::string(e.what()).find(ptr) != std::string::npos);
     const fs::path out = kDir / (name + "_out");
     fs::remove_all(out);
     CHECK(run_knitmap(file + " --output " + out.string() + args) == 2);
