@@ -44,6 +44,7 @@ struct StepOutcome {
   double residual = 0.0;
   double reference = 0.0;    ///< the reference force of the last convergence test
   int negative_pivots = -2;  ///< -2: no factorization in this step
+  int determinant_sign = 0;  ///< of that factorization; 0: none in this step
   std::string why;
 };
 
@@ -84,7 +85,18 @@ std::string stability_summary(const RunReport& r) {
   if (r.converged_steps == 0) {
     o << "not available (no converged step)";
   } else if (r.max_negative_pivots < 0) {
-    o << "not available (unsymmetric tangent, LU factorization)";
+    // The LU path: no inertia, only the sign of det K (an odd number of negative real
+    // eigenvalues when negative; a pair of them, or a complex pair, leaves it positive).
+    o << "unsymmetric tangent (LU factorization: no inertia, only the sign of det K): ";
+    if (r.first_negative_determinant_step < 0)
+      o << "det K > 0 at every converged step (no odd number of negative real eigenvalues; an "
+           "even number would not show)";
+    else
+      o << "det K < 0 from step " << r.first_negative_determinant_step << " (load factor "
+        << r.first_negative_determinant_lambda << "), at " << r.negative_determinant_steps << " of "
+        << r.converged_steps
+        << " converged steps: an odd number of negative real eigenvalues of the reduced tangent "
+           "(loss of stability: a limit or bifurcation point was passed)";
   } else if (r.first_unstable_step < 0) {
     o << "the tangent was positive definite at every converged step (0 negative pivots)";
   } else {
@@ -152,7 +164,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
   Eigen::VectorXd ufree = Eigen::VectorXd::Zero(n);
   double lambda = 0.0, h = h_nom, lambda_prev = 0.0;
   Eigen::VectorXd ufree_prev = ufree;
-  int cutbacks = 0, step = 0, last_negative = -1;
+  int cutbacks = 0, step = 0, last_negative = -1, last_sign = 0;
   ShellModel::Evaluation ev, trial;
 
   // The state (residual, reference force, potential) at u = expand(uf, lam) from an evaluation
@@ -288,6 +300,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         return o;
       }
       o.negative_pivots = f.negative_pivots;
+      o.determinant_sign = f.determinant_sign;
       last_method = f.method, last_negative_pivots = f.negative_pivots;
       if (!du.allFinite()) {
         o.why = "the linear solve produced non-finite values";
@@ -445,14 +458,17 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
     }
     if (o.converged) {
       folds.accept();
-      if (o.negative_pivots == -2 && K.symmetric()) {
-        // No factorization in this step (converged at once): the inertia at this state (its
-        // tangent is assembled already when the step's first evaluation was here).
+      if (o.determinant_sign == 0 && o.negative_pivots == -2) {
+        // No factorization in this step (converged at once): the inertia (the LU: the sign of
+        // the determinant) at this state (its tangent is assembled already when the step's
+        // first evaluation was here).
         if (ev_u.size() == 0 || ev_u != dofs.expand(uf, lam1)) tangent(uf, lam1);
         const Factorization f = K.factorize();
         o.negative_pivots = f.ok ? f.negative_pivots : last_negative;
+        o.determinant_sign = f.ok ? f.determinant_sign : last_sign;
       }
       if (o.negative_pivots != -2) last_negative = o.negative_pivots;
+      if (o.determinant_sign != 0) last_sign = o.determinant_sign;
       lambda_prev = lambda;
       ufree_prev = ufree;
       lambda = lam1;
@@ -464,6 +480,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       sr.iterations = o.iterations;
       sr.residual = o.residual;
       sr.negative_pivots = last_negative;
+      sr.determinant_sign = last_sign;
       sr.u = dofs.expand(ufree, lambda);
       // The internal forces at the converged state: usually evaluated there already.
       if (trial_u.size() > 0 && trial_u == sr.u && trial.ok)
@@ -482,6 +499,13 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       if (last_negative > 0 && report.first_unstable_step < 0) {
         report.first_unstable_step = step;
         report.first_unstable_lambda = lambda;
+      }
+      if (last_sign < 0) {
+        ++report.negative_determinant_steps;
+        if (report.first_negative_determinant_step < 0) {
+          report.first_negative_determinant_step = step;
+          report.first_negative_determinant_lambda = lambda;
+        }
       }
       if (on_step) on_step(sr);
       last_line = Clock::now();  // the step's own line

@@ -48,7 +48,10 @@ Factorization from_pivots(const Vec& d, bool count_negative, const char* kind) {
   const double hi = d.size() ? d.cwiseAbs().maxCoeff() : 0.0;
   const double lo = d.size() ? d.cwiseAbs().minCoeff() : 0.0;
   f.pivot_ratio = hi > 0.0 ? lo / hi : 0.0;
-  if (count_negative) f.negative_pivots = static_cast<int>((d.array() < 0.0).count());
+  if (count_negative) {
+    f.negative_pivots = static_cast<int>((d.array() < 0.0).count());
+    f.determinant_sign = f.negative_pivots % 2 ? -1 : 1;  // det K = det D (Sylvester)
+  }
   if (!(f.pivot_ratio > ReducedTangent::kSingularPivotRatio) || !d.allFinite()) {
     std::ostringstream o;
     o << "singular tangent stiffness (" << kind << ": smallest / largest pivot " << f.pivot_ratio
@@ -295,12 +298,20 @@ Factorization ReducedTangent::factorize() {
     Factorization f;
     f.ok = true;
     f.negative_pivots = symmetric_ ? 0 : -1;
+    f.determinant_sign = 1;  // the empty product
     f.pivot_ratio = 1.0;
     return f;
   }
   if (!sparse_ && !symmetric_) {
     f_->dense_lu.compute(dense_);
-    return from_pivots(f_->dense_lu.matrixLU().diagonal(), false, "dense LU");
+    Factorization f = from_pivots(f_->dense_lu.matrixLU().diagonal(), false, "dense LU");
+    if (f.ok) {
+      // det K = det(P^-1) prod u_jj (P A = L U, L unit lower triangular).
+      int sign = f_->dense_lu.permutationP().determinant() > 0 ? 1 : -1;
+      for (double u : f_->dense_lu.matrixLU().diagonal()) sign = u < 0.0 ? -sign : sign;
+      f.determinant_sign = sign;
+    }
+    return f;
   }
   if (!sparse_) {
     f_->dense_ldlt.compute(dense_);
@@ -346,7 +357,10 @@ Factorization ReducedTangent::factorize() {
   }
   const auto [lo, hi] = f_->sparse_lu.pivot_range();
   Eigen::Vector2d d(lo, hi);
-  return from_pivots(d, false, "sparse LU");
+  Factorization f = from_pivots(d, false, "sparse LU");
+  // Eigen's signDeterminant: the signs of U's diagonal and of both permutations.
+  if (f.ok) f.determinant_sign = f_->sparse_lu.signDeterminant() < 0.0 ? -1 : 1;
+  return f;
 }
 
 bool ReducedTangent::factorize_multifrontal(Factorization& f) {
@@ -373,6 +387,7 @@ bool ReducedTangent::factorize_multifrontal(Factorization& f) {
   ++multifrontal_factorizations_;
   f.method = "multifrontal LDLT";
   f.negative_pivots = m.negative_pivots();
+  if (f.negative_pivots >= 0) f.determinant_sign = f.negative_pivots % 2 ? -1 : 1;
   if (st == MultifrontalLDLT::Status::kSingular) {
     f.pivot_ratio = 0.0;
     f.why =

@@ -78,7 +78,8 @@ std::string result_unit(const std::string& name) {
                                                               {"iterations", "1"},
                                                               {"residual", "N"},
                                                               {"seconds", "s"},
-                                                              {"negative_pivots", "1"}};
+                                                              {"negative_pivots", "1"},
+                                                              {"determinant_sign", "1"}};
   for (const auto& [n, u] : units)
     if (name == n) return u;
   return "";
@@ -237,6 +238,8 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   Eigen::VectorXi neg(n);
   for (int k = 0; k < n; ++k) neg(k) = rows_[k].negative_pivots;
   h5.write("steps/negative_pivots", neg);
+  for (int k = 0; k < n; ++k) neg(k) = rows_[k].determinant_sign;
+  h5.write("steps/determinant_sign", neg);
   for (size_t c = 0; c < case_.output.reactions.size(); ++c) {
     Eigen::VectorXd f(n);
     for (int k = 0; k < n; ++k) f(k) = rows_[k].reactions[c];
@@ -248,7 +251,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
     h5.write("steps/points/" + case_.output.points[c].name, d);
   }
   for (const char* name : {"step", "load_factor", "applied_displacement", "strain", "iterations",
-                           "residual", "seconds", "negative_pivots"})
+                           "residual", "seconds", "negative_pivots", "determinant_sign"})
     if (h5.exists(std::string("steps/") + name))
       h5.set_attribute(std::string("steps/") + name, "units", result_unit(name));
   for (const ReactionOutput& r : case_.output.reactions)
@@ -290,7 +293,8 @@ void ResultsWriter::finish(const RunReport& report) {
   for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + "_N");
   for (const OutputPoint& p : case_.output.points)
     header.insert(header.end(), {p.name + "_ux_mm", p.name + "_uy_mm", p.name + "_uz_mm"});
-  header.insert(header.end(), {"iterations", "residual", "seconds", "negative_pivots"});
+  header.insert(header.end(),
+                {"iterations", "residual", "seconds", "negative_pivots", "determinant_sign"});
   io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
   csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
                   ", git " + git_revision() + ")");
@@ -305,7 +309,8 @@ void ResultsWriter::finish(const RunReport& report) {
     if (case_.output.applied) row.insert(row.end(), {r.applied, r.strain});
     for (double f : r.reactions) row.emplace_back(f);
     for (const auto& d : r.points) row.insert(row.end(), {d(0), d(1), d(2)});
-    row.insert(row.end(), {r.iterations, r.residual, r.seconds, r.negative_pivots});
+    row.insert(row.end(),
+               {r.iterations, r.residual, r.seconds, r.negative_pivots, r.determinant_sign});
     csv.add_row(row);
   }
   csv.commit();

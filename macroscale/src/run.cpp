@@ -274,6 +274,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     row.residual = s.residual;
     row.seconds = s.seconds;
     row.negative_pivots = s.negative_pivots;
+    row.determinant_sign = s.determinant_sign;
     res.rows.push_back(row);
     res.u = s.u;
     if (opt.progress) {
@@ -285,6 +286,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
       if (s.negative_pivots > 0 && len > 0 && len < int(sizeof line))
         std::snprintf(line + len, sizeof line - len, "  UNSTABLE: %d negative pivots",
                       s.negative_pivots);
+      else if (s.negative_pivots < 0 && s.determinant_sign < 0 && len > 0 && len < int(sizeof line))
+        std::snprintf(line + len, sizeof line - len, "  UNSTABLE: det K < 0 (LU)");
       *opt.progress << line << std::endl;
     }
     if (writer) {
@@ -310,7 +313,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     res.load_drops.push_back(load_drop_message(d));
   if (opt.warnings)
     for (const std::string& w : res.load_drops) *opt.warnings << "warning: " << w << std::endl;
-  if (opt.progress && res.report.first_unstable_step > 0)
+  if (opt.progress &&
+      (res.report.first_unstable_step > 0 || res.report.first_negative_determinant_step > 0))
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;
   // A run in which no load step converged does not replace an earlier output of the same
   // directory with its empty one (session 26, found by a helper's audit: a rerun that failed

@@ -665,20 +665,60 @@ TEST_CASE("stability: a run that passes a softening window and stiffens again", 
   for (std::string line; std::getline(lines, line);)
     if (line.find("UNSTABLE: ") != std::string::npos) ++flagged;
   CHECK(flagged == 3);
-  // The same run on the LU path has no inertia: -1 everywhere, nothing flagged, and the
-  // summary says why.
-  Case lu = c;
+  // The sign of det K on the symmetric path is (-1)^(negative pivots).
+  for (const StepRow& row : r.rows)
+    CHECK(row.determinant_sign == (row.negative_pivots % 2 ? -1 : 1));
+  // The LU path has no inertia (-1 everywhere) but the sign of det K, from the LU's own
+  // pivots and permutations. Here the window has 2 unstable modes (above), which a sign
+  // cannot see; with one element along the strip it has one. The same matrices (the
+  // material is symmetric): det K < 0 on the LU path exactly where the LDLT counts an odd
+  // number of negative pivots; those steps are flagged, and the summary says what the sign
+  // can and cannot tell.
+  const Case one = [&] {
+    json j = strip(bc, true);
+    j["refinement"]["elements"] = {1, 1};
+    Case x = parse_case(j.dump(), "wavy_one_element.json");
+    x.material = std::make_shared<Wavy>();
+    return x;
+  }();
+  o.progress = nullptr;
+  const RunResult r1 = run_case(one, o);
+  REQUIRE(r1.report.status == RunStatus::kCompleted);
+  Case lu = one;
   lu.solver.symmetric = false;
   std::ostringstream lu_log;
   o.progress = &lu_log;
   const RunResult u = run_case(lu, o);
   REQUIRE(u.report.status == RunStatus::kCompleted);
-  for (const StepRow& row : u.rows) CHECK(row.negative_pivots == -1);
+  REQUIRE(u.rows.size() == r1.rows.size());
+  std::vector<int> odd;
+  for (size_t k = 0; k < u.rows.size(); ++k) {
+    CHECK(u.rows[k].negative_pivots == -1);
+    CHECK(u.rows[k].determinant_sign == (r1.rows[k].negative_pivots % 2 ? -1 : 1));
+    if (u.rows[k].determinant_sign < 0) odd.push_back(u.rows[k].step);
+  }
+  REQUIRE_FALSE(odd.empty());
+  // The sparse LU (Eigen's signDeterminant, with its row and column permutations) agrees.
+  Case sparse_lu = lu;
+  sparse_lu.solver.linear_solver = LinearSolver::kSparse;
+  o.progress = nullptr;
+  const RunResult su = run_case(sparse_lu, o);
+  REQUIRE(su.rows.size() == u.rows.size());
+  for (size_t k = 0; k < u.rows.size(); ++k)
+    CHECK(su.rows[k].determinant_sign == u.rows[k].determinant_sign);
   CHECK(u.report.max_negative_pivots == -1);
   CHECK(u.report.first_unstable_step == -1);
-  CHECK(lu_log.str().find("UNSTABLE") == std::string::npos);
+  CHECK(u.report.first_negative_determinant_step == odd.front());
+  CHECK(u.report.negative_determinant_steps == int(odd.size()));
+  int lu_flagged = 0;
+  std::istringstream lu_lines(lu_log.str());
+  for (std::string line; std::getline(lu_lines, line);)
+    if (line.find("UNSTABLE: det K < 0") != std::string::npos) ++lu_flagged;
+  CHECK(lu_flagged == int(odd.size()));
   CHECK_THAT(stability_summary(u.report),
-             Catch::StartsWith("not available (unsymmetric tangent, LU factorization)"));
+             Catch::StartsWith("unsymmetric tangent (LU factorization: no inertia, only the sign "
+                               "of det K): det K < 0 from step " +
+                               std::to_string(odd.front())));
 }
 
 TEST_CASE("stability: a patch with no free DOF has 0 negative pivots, or none on the LU path",
@@ -693,9 +733,14 @@ TEST_CASE("stability: a patch with no free DOF has 0 negative pivots, or none on
   REQUIRE(r.report.status == RunStatus::kCompleted);
   CHECK(r.report.stats.unknowns == 0);
   for (const StepRow& row : r.rows) CHECK(row.negative_pivots == 0);
+  for (const StepRow& row : r.rows) CHECK(row.determinant_sign == 1);
   const RunResult u = run(j, [](Case& c) { c.solver.symmetric = false; });
   REQUIRE(u.report.status == RunStatus::kCompleted);
-  for (const StepRow& row : u.rows) CHECK(row.negative_pivots == -1);
+  for (const StepRow& row : u.rows) {
+    CHECK(row.negative_pivots == -1);
+    CHECK(row.determinant_sign == 1);  // det of the 0 x 0 matrix
+  }
+  CHECK_THAT(stability_summary(u.report), Catch::Contains("det K > 0 at every converged step"));
 }
 
 namespace {

@@ -100,6 +100,9 @@ struct StepResult {
   /// this step (the number of unstable modes; > 0 past a limit or bifurcation point), -1 on
   /// the LU path (unsymmetric material: not available).
   int negative_pivots = -1;
+  /// Sign of det of the reduced tangent at that iterate (Factorization::determinant_sign):
+  /// +1 or -1; 0 before any factorization. The LU path's stability indicator.
+  int determinant_sign = 0;
   Eigen::VectorXd u;     ///< full displacement vector
   Eigen::VectorXd fint;  ///< internal forces (reactions on constrained DOFs)
 };
@@ -154,6 +157,11 @@ struct RunReport {
   int first_unstable_step = -1;
   double first_unstable_lambda = 0.0;
   int max_negative_pivots = -1;
+  /// The sign of det K (both paths; the LU path's only indicator): the first converged step
+  /// with det K < 0 (-1 if none), its load factor, and how many converged steps had it.
+  int first_negative_determinant_step = -1;
+  double first_negative_determinant_lambda = 0.0;
+  int negative_determinant_steps = 0;
   SolverStats stats;
 };
 
@@ -186,8 +194,9 @@ EnergyLineSearch energy_line_search(const std::function<std::optional<double>(do
 bool at_round_off_floor(double r, double ref, double du_rel, double r2, const SolverOptions& opt);
 
 /// One line on the stability of a run for summaries: "tangent positive definite at every
-/// converged step", "unstable from step N (load factor x): k negative pivots at most", or
-/// "not available (unsymmetric tangent, LU)".
+/// converged step", "unstable from step N (load factor x): k negative pivots at most", or on
+/// the LU path "unsymmetric tangent (LU factorization: ...): det K > 0 at every converged step
+/// ..." / "det K < 0 from step N ...".
 std::string stability_summary(const RunReport& report);
 
 }  // namespace knit::macro

@@ -48,6 +48,11 @@ struct Factorization {
   /// Number of negative pivots of D (LDLT): the number of negative eigenvalues of the reduced
   /// tangent. -1 on the LU paths (not available).
   int negative_pivots = -1;
+  /// Sign of the determinant of the reduced tangent (+1 or -1; 0 when singular). On the LDLT
+  /// paths (-1)^negative_pivots; on the LU paths the product of the signs of U's diagonal and
+  /// of the permutations: det K < 0 means an odd number of negative real eigenvalues, the one
+  /// stability indicator an LU gives (it cannot tell 0 from 2 negative eigenvalues).
+  int determinant_sign = 0;
   double pivot_ratio = 0.0;  ///< min |pivot| / max |pivot|
   /// Which factorization was made ("supernodal Cholesky", "sparse LDLT", ...): the sparse
   /// LDLT on the supernodal path means an indefinite tangent (or a CHOLMOD failure).

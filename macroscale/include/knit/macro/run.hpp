@@ -54,6 +54,7 @@ struct StepRow {
   int iterations = 0;
   double residual = 0.0, seconds = 0.0;
   int negative_pivots = -1;  ///< of the reduced tangent (StepResult), -1 if not available
+  int determinant_sign = 0;  ///< sign of det of the reduced tangent (StepResult)
 };
 
 /// The control points a reaction output sums over: the first `rows` rows of its edge, or its
