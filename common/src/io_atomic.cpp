@@ -270,7 +270,8 @@ void remove_old_output(const fs::path& old) {
 
 }  // namespace
 
-AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::string_view option)
+AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::string_view option,
+                                 std::string input)
     : target_(prepare_target(std::move(target), option)), lock_(target_), on_abandon_(on_abandon) {
   // Under the lock: nobody else writes this target now. Clean up after killed runs (which may
   // put an earlier output back in place), then check again what the target holds.
@@ -287,7 +288,7 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   std::ofstream marker(partial_ / kOutputMarker, std::ios::binary);
   // The first line names the writer (output_owner): only it replaces this output later.
   marker << "knitscale output" << (output_owner().empty() ? "" : ": " + output_owner()) << "\n"
-         << Provenance::current().to_json_string() << "\n"
+         << Provenance::current(input).to_json_string() << "\n"
          << "for: " << target_.filename().string() << "\n"
          << "pid " << ::getpid() << "\n";
   if (!marker.flush()) {

@@ -364,9 +364,12 @@ nlohmann::json parse_json(std::string_view text, const std::string& source) {
   scan.value("");
   if (!scan.duplicates.empty()) {
     const auto& d = scan.duplicates.front();
+    // Both on one line: "(line 43, twice)", not "(lines 43 and 43)" (session 43's walkthrough).
     throw knit::InputError(source, d.pointer,
-                           "duplicate key (lines " + std::to_string(d.first_line) + " and " +
-                               std::to_string(d.second_line) + ")");
+                           d.first_line == d.second_line
+                               ? "duplicate key (line " + std::to_string(d.first_line) + ", twice)"
+                               : "duplicate key (lines " + std::to_string(d.first_line) + " and " +
+                                     std::to_string(d.second_line) + ")");
   }
   return j;
 }

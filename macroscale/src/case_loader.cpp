@@ -1,6 +1,7 @@
 // Case JSON -> Case (case.hpp). Every check names the file and the JSON pointer; unknown keys
 // are errors at every level (the same rules as schemas/case.schema.json).
 #include <algorithm>
+#include <cctype>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -250,7 +251,9 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
     r.fail("/geometry/thickness",
            "the thickness must lie in " +
                relative_range(kMinThicknessPerSize, kMaxThicknessPerSize, size) + ", got " +
-               g.at("thickness").dump());
+               g.at("thickness").dump() +
+               "; are the control points and the thickness in the same length unit (mm for a "
+               "knit case)?");
   c.surface = c.input_surface;
   if (root.contains("refinement")) {
     const json& rf = root.at("refinement");
@@ -641,8 +644,16 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   c.material = make_material(root.at("material"), ctx);
   // A material with data in fixed units (the knit database: mm, N, MPa): a case declaring other
   // units would run with its numbers read as those (session 22).
+  // Compared without blanks ("mm,N,MPa" and "mm, N, MPa " are the same units: session 43's
+  // walkthrough had them refused); the symbols themselves are case-sensitive (mN, MN).
+  const auto no_blanks = [](std::string u) {
+    u.erase(std::remove_if(u.begin(), u.end(), [](unsigned char ch) { return std::isspace(ch); }),
+            u.end());
+    return u;
+  };
   if (const std::string units = c.material->required_units();
-      !units.empty() && root.contains("units") && root.at("units").get<std::string>() != units)
+      !units.empty() && root.contains("units") &&
+      no_blanks(root.at("units").get<std::string>()) != no_blanks(units))
     r.fail("/units", "a " + c.material->name() + " case is in \"" + units +
                          "\" (its material database's units), got " + root.at("units").dump());
   read_bcs(r, root, c);

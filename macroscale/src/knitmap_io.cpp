@@ -35,7 +35,8 @@ KnitMapInput load_knitmap_input(const std::string& case_file) {
 }
 
 void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir) {
-  io::AtomicDirectory out(dir);
+  io::AtomicDirectory out(dir, io::AtomicDirectory::OnAbandon::Remove, "output directory",
+                          in.c.file);
   const std::string prov = "provenance: " + io::Provenance::current(in.c.file).to_json_string();
   {
     io::CsvWriter csv(out / "knitmap.csv", {"course", "needle", "l_mm", "x_mm", "y_mm"});

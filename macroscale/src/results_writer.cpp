@@ -40,7 +40,10 @@ void write_text(const fs::path& file, const std::string& text) {
 }  // namespace
 
 ResultsWriter::ResultsWriter(const Case& c, const ShellModel& m, fs::path dir)
-    : case_(c), model_(m), dir_(std::move(dir)), pvd_(dir_.path() / "results.pvd") {
+    : case_(c),
+      model_(m),
+      dir_(std::move(dir), io::AtomicDirectory::OnAbandon::Remove, "output directory", c.file),
+      pvd_(dir_.path() / "results.pvd") {
   if (c.output.vtk) fs::create_directories(dir_.path() / "vtk");
   write_text(dir_.path() / "case.json", c.text);
 }

@@ -424,7 +424,9 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
                             std::ostream* log) {
   const RodSystem& sys = c.system;
   const std::string provenance = io::Provenance::current(c.file).to_json_string();
-  io::AtomicDirectory dir(outdir);  // OUT.partial-<pid>, renamed onto OUT by commit()
+  // OUT.partial-<pid>, renamed onto OUT by commit()
+  io::AtomicDirectory dir(outdir, io::AtomicDirectory::OnAbandon::Remove, "output directory",
+                          c.file);
 
   std::vector<std::string> header{"step", "lambda", "iterations"};
   for (const auto& p : c.points)

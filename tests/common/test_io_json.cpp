@@ -363,6 +363,13 @@ TEST_CASE("duplicate keys are input errors", "[unit][io][json]") {
     CHECK(e.pointer() == "/a/x");
     CHECK(e.message() == "duplicate key (lines 1 and 3)");
   }
+  try {
+    knit::io::parse_json("{\"a\": 1, \"b\": 2, \"a\": 3}", "one_line.json");
+    FAIL("no exception");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/a");
+    CHECK(e.message() == "duplicate key (line 1, twice)");
+  }
   CHECK_NOTHROW(
       knit::io::parse_json(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "t"));
 }

@@ -246,6 +246,10 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     CHECK(error_of(j).rfind("bad.json: /geometry/thickness: the thickness must lie in "
                             "[0.00707107, 70.7107] mm",
                             0) == 0);
+    // Session 43's walkthrough: a case in metres with its thickness in mm met this refusal
+    // first; it asks about the units.
+    CHECK_THAT(error_of(j), Catch::EndsWith("are the control points and the thickness in the "
+                                            "same length unit (mm for a knit case)?"));
   }
   for (const double t : {7.1e-3, 70.7}) {
     json j = base;

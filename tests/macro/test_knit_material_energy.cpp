@@ -320,6 +320,14 @@ TEST_CASE("knit material: a case in other units is refused", "[unit]") {
   nlohmann::json j = nlohmann::json::parse(mm);
   j["units"] = "mm, N, MPa";
   CHECK_NOTHROW(parse_case(j.dump(), "c.json"));
+  // Blanks do not count (session 43's walkthrough); the symbols do.
+  for (const char* same : {"mm,N,MPa", " mm, N, MPa ", "mm,  N,\tMPa"}) {
+    j["units"] = same;
+    CHECK_NOTHROW(parse_case(j.dump(), "c.json"));
+  }
+  j["units"] = "mm, N, mPa";
+  CHECK_THROWS_WITH(parse_case(j.dump(), "c.json"),
+                    Catch::StartsWith("c.json: /units: a knit case is in \"mm, N, MPa\""));
   j["units"] = "m, N, Pa";
   CHECK_THROWS_WITH(parse_case(j.dump(), "c.json"),
                     Catch::StartsWith("c.json: /units: a knit case is in \"mm, N, MPa\""));

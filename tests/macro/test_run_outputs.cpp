@@ -78,6 +78,13 @@ TEST_CASE("knit-macro run never deletes files it did not write", "[unit][outputs
   REQUIRE(macro(c + " --output " + (d / "empty").string()).rc == 0);
   CHECK(fs::exists(d / "empty" / "load_strain.csv"));
   CHECK(fs::exists(d / "empty" / ".knitscale-output"));
+  {  // The marker's provenance names the case (session 43's walkthrough: "input": "").
+    std::ifstream in(d / "empty" / ".knitscale-output");
+    std::string first, prov;
+    std::getline(in, first);
+    std::getline(in, prov);
+    CHECK(nlohmann::json::parse(prov).at("input") == c);
+  }
   REQUIRE(macro(c + " --output " + (d / "empty").string()).rc == 0);
   CHECK(fs::exists(d / "empty" / "load_strain.csv"));
   for (const auto& e : fs::directory_iterator(d))  // no partial, old or lock files left

@@ -88,9 +88,10 @@ class AtomicDirectory {
   /// of DIR, takes the lock (InputError naming the holder's pid while another process holds
   /// it), removes the stale "DIR.partial-<pid>" and "DIR.old-<pid>" directories of dead
   /// processes (only those holding the marker), then creates the partial directory with the
-  /// marker in it.
+  /// marker in it. `input`: the input file the output is made from, for the marker's provenance
+  /// (empty for a command without one).
   explicit AtomicDirectory(std::filesystem::path target, OnAbandon on_abandon = OnAbandon::Remove,
-                           std::string_view option = "output directory");
+                           std::string_view option = "output directory", std::string input = {});
   AtomicDirectory(AtomicDirectory&& o) noexcept;
   AtomicDirectory& operator=(AtomicDirectory&&) = delete;
   AtomicDirectory(const AtomicDirectory&) = delete;
