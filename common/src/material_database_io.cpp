@@ -309,6 +309,20 @@ std::runtime_error database_not_written(const std::filesystem::path& target, boo
       (existed ? "the earlier file is left as it was" : "no file was created") + "): " + why);
 }
 
+namespace {
+/// True if a dataset below `group` (recursively) carries a checksum of ours (has_checksum): a
+/// file written since the checksums exist. /loop_lengths first (every database has it).
+bool any_checksum(const H5Group& f, const std::string& group) {
+  if (group == "/" && f.has_checksum("/loop_lengths")) return true;
+  for (const std::string& name : f.children(group)) {
+    const std::string path = (group == "/" ? "" : group) + "/" + name;
+    if (f.is_dataset(path) ? f.has_checksum(path) : f.is_group(path) && any_checksum(f, path))
+      return true;
+  }
+  return false;
+}
+}  // namespace
+
 Database read_database(const std::filesystem::path& file, bool with_raw) {
   const std::string fname = file.string();
   std::string where;  // HDF5 path being read, for messages
@@ -329,8 +343,11 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     // writing after it was written (session 36: h5py "r+" scaled /energy_law/theta by 1.5,
     // HDF5 recomputed the Fletcher32 sums and dropped the trailer, and knit-macro ran the
     // edited law as an old, unverifiable file with exit 0: 27,148 N instead of 84.6 N).
-    // Only files written before the checksums existed are read unverified.
-    if (!f.structure_sealed() && f.has_checksum("/loop_lengths"))
+    // Only files written before the checksums existed are read unverified: no dataset of the
+    // file carries a checksum (session 43's red team: /loop_lengths re-created without one by
+    // h5py's delete-and-create let the file pass as old, with /energy_law/theta scaled by 1.5
+    // and its Fletcher32 sums recomputed: 27,148 N instead of 84.6 N, exit 0 again).
+    if (!f.structure_sealed() && any_checksum(f, "/"))
       throw InputError(
           fname, "",
           "the file was written with checksums but its structure checksum is gone: it was "

@@ -521,6 +521,25 @@ TEST_CASE("database: a database of ours without its structure checksum is refuse
   CHECK_THAT(message2, Catch::StartsWith("the file was written with checksums but its structure "
                                          "checksum is gone") &&
                            Catch::Contains("or it was cut short or extended"));
+  // Session 43's red team: /loop_lengths deleted and written again without a checksum (h5py's
+  // delete-and-create) made the file pass as one written before the checksums; every other
+  // dataset still has its own, and the file is refused.
+  const fs::path recreated = written_test_database("db_recreated.h5");
+  {
+    H5File f = H5File::open_rw(recreated);
+    const std::vector<double> l = f.read_doubles("/loop_lengths");
+    f.remove("/loop_lengths");
+    knit::io::H5WriteOptions plain;
+    plain.checksum = false;
+    f.write("/loop_lengths", l, plain);
+    f.close();
+  }
+  strip_trailer(recreated);
+  CHECK_FALSE(H5File::open_read(recreated).has_checksum("/loop_lengths"));
+  const auto [where3, pointer3, message3] = database_error_of(recreated);
+  CHECK(where3 == recreated.string());
+  CHECK_THAT(message3, Catch::StartsWith("the file was written with checksums but its structure "
+                                         "checksum is gone"));
 }
 
 TEST_CASE("database: one flipped sign bit in /loop_0/fit/S_ctrl is refused, naming it",
