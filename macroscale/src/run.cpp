@@ -223,11 +223,61 @@ std::string run_failure_message(const RunResult& r) {
         "a material law evaluated far outside its data also stops Newton (summary.txt's "
         "\"material report\" counts the extrapolated evaluations: the paper's law extrapolates "
         "beyond its 13 load paths, the default energy law holds over the whole strain box)");
+  // The LU path (a material without strain energy: the paper's law): more steps do not pass a
+  // limit point of the law itself (session 43's walkthrough: an off-axis fabric stopped at
+  // 0.4 % strain, and at 1.6 % with 200 steps and 50 iterations).
+  if ((r.report.reason == StopReason::kCutbacks ||
+       r.report.reason == StopReason::kIncrementFloor) &&
+      r.report.converged_steps > 0 && r.report.max_negative_pivots < 0) {
+    std::ostringstream o;
+    o << "the tangent is unsymmetric (a material without strain energy, such as the paper's "
+         "law: /material/law), and such a law can stop Newton where no smaller step helps";
+    if (r.report.first_negative_determinant_step > 0)
+      o << " (det K < 0 from step " << r.report.first_negative_determinant_step
+        << ": a limit point was passed)";
+    o << "; the energy law (/material/law \"energy\") has a strain energy and a symmetric "
+         "tangent";
+    add(o.str());
+  }
   add(material_failure_message(r.report, r.failed_material_evaluations));
   add(r.output_failure);
   if (m.empty() && !r.succeeded()) m = "the run did not complete";
   return m;
 }
+
+namespace {
+
+/// A warning when the applied displacement moved the patch without straining it (session 43's
+/// walkthrough: a tensile test without the support opposite the moving jaw translated as a rigid
+/// body, with a jaw force of 1e-14 N, strain 0.2 in the CSV and exit 0): the largest membrane
+/// strain and curvature change times half the thickness on a 9 x 9 grid of the last converged
+/// state, against 1e-8 of the applied strain. Empty when the case applies no displacement or
+/// the patch is strained.
+std::string unstrained_warning(const Case& c, const ShellModel& m, const RunResult& res) {
+  if (!c.output.applied || res.rows.empty() || res.u.size() == 0) return {};
+  const double applied = res.rows.back().strain;
+  if (!(std::abs(applied) > 1e-9)) return {};
+  constexpr int kGrid = 9;
+  double largest = 0.0;
+  for (int i = 0; i < kGrid; ++i)
+    for (int j = 0; j < kGrid; ++j) {
+      const ShellSample s =
+          m.sample(res.u, Eigen::Vector2d(double(i) / (kGrid - 1), double(j) / (kGrid - 1)));
+      largest = std::max(
+          {largest, s.E.cwiseAbs().maxCoeff(), 0.5 * c.thickness * s.kappa.cwiseAbs().maxCoeff()});
+    }
+  if (largest > 1e-8 * std::abs(applied)) return {};
+  std::ostringstream o;
+  o.precision(3);
+  o << "the patch is not strained (largest strain " << largest << " on a " << kGrid << " x "
+    << kGrid << " grid of the last converged step) although the applied displacement reached "
+    << res.rows.back().applied << " mm (strain " << applied
+    << "): it moved as a rigid body, and the reactions are round-off. Is the edge opposite the "
+       "moving one held (/boundary_conditions)?";
+  return o.str();
+}
+
+}  // namespace
 
 RunResult run_case(const Case& c, const RunOptions& opt) {
   if (!opt.output_dir.empty()) check_output_size(c, opt);  // before any work or file
@@ -313,6 +363,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     res.load_drops.push_back(load_drop_message(d));
   if (opt.warnings)
     for (const std::string& w : res.load_drops) *opt.warnings << "warning: " << w << std::endl;
+  if (std::string w = unstrained_warning(c, m, res); !w.empty()) {
+    if (opt.warnings) *opt.warnings << "warning: " << w << std::endl;
+    res.input_warnings.push_back(std::move(w));
+  }
   if (opt.progress &&
       (res.report.first_unstable_step > 0 || res.report.first_negative_determinant_step > 0))
     *opt.progress << "stability: " << stability_summary(res.report) << std::endl;

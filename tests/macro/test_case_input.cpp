@@ -1086,6 +1086,22 @@ TEST_CASE("why a run is not a plain success: every reason, joined", "[unit]") {
   r.failed_material_evaluations = 0;
   r.output_failure.clear();
   CHECK(run_failure_message(r) == "the run did not complete");  // never empty on a failure
+  // Newton gave up on the LU path (session 43's walkthrough: the paper's law on an off-axis
+  // fabric stopped at 0.4 % strain, and more steps did not help): the hint names the law.
+  r.report.reason = StopReason::kCutbacks;
+  r.report.converged_steps = 3;
+  r.report.max_negative_pivots = 0;  // the LDLT path: no such hint
+  CHECK(run_failure_message(r).find("unsymmetric") == std::string::npos);
+  r.report.max_negative_pivots = -1;  // the LU path
+  CHECK_THAT(run_failure_message(r),
+             Catch::Contains("the tangent is unsymmetric (a material without strain energy, such "
+                             "as the paper's law: /material/law)") &&
+                 !Catch::Contains("det K < 0"));
+  r.report.first_negative_determinant_step = 2;
+  CHECK_THAT(run_failure_message(r),
+             Catch::Contains("(det K < 0 from step 2: a limit point was passed)") &&
+                 Catch::EndsWith("the energy law (/material/law \"energy\") has a strain energy "
+                                 "and a symmetric tangent"));
 }
 
 TEST_CASE("a folded database surface is refused at load, naming the database and HDF5 group",

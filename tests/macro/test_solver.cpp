@@ -942,3 +942,32 @@ TEST_CASE("the sparse factorizations' failures are warnings naming CHOLMOD's and
                                "CHOLMOD_OUT_OF_MEMORY; 14 factorizations were made by Eigen's "
                                "SimplicialLDLT instead ("));
 }
+
+// Session 43's walkthrough: a tensile test without the support opposite the moving jaw moved as
+// a rigid body (jaw force 1e-14 N, strain 0.2 in the CSV) and ended with exit 0 in silence.
+TEST_CASE("a tensile test whose patch moves as a rigid body warns", "[unit]") {
+  json j = verification_case("tensile_svk.json");
+  j["solver"]["steps"] = 2;
+  j["output"]["grid"] = {5, 5};
+  std::ostringstream warnings;
+  RunOptions o;
+  o.warnings = &warnings;
+  const RunResult held = run_case(parse_case(j.dump(), "tensile.json"), o);
+  REQUIRE(held.report.status == RunStatus::kCompleted);
+  CHECK(warnings.str().find("not strained") == std::string::npos);
+  for (const std::string& w : held.input_warnings)
+    CHECK(w.find("not strained") == std::string::npos);
+  // Without the fixed jaw (edge v0): the moving jaw carries the patch along.
+  j["boundary_conditions"].erase(0);
+  const RunResult loose = run_case(parse_case(j.dump(), "tensile.json"), o);
+  REQUIRE(loose.report.status == RunStatus::kCompleted);
+  CHECK(std::abs(loose.rows.back().reactions[0]) < 1e-9);  // the jaw force is round-off
+  CHECK(loose.rows.back().strain == Approx(0.3));
+  REQUIRE(loose.input_warnings.size() == 1);
+  CHECK_THAT(
+      loose.input_warnings[0],
+      Catch::StartsWith("the patch is not strained (largest strain ") &&
+          Catch::Contains("although the applied displacement reached 15 mm (strain 0.3)") &&
+          Catch::EndsWith("Is the edge opposite the moving one held (/boundary_conditions)?"));
+  CHECK_THAT(warnings.str(), Catch::Contains("warning: the patch is not strained"));
+}
