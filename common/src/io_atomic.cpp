@@ -109,6 +109,40 @@ void remove_stale_temporaries(const fs::path& target) {
 
 // ---- AtomicFile -----------------------------------------------------------------------------
 
+namespace {
+// The temporaries of AtomicFiles not yet committed, for unlink_live_temporaries() in a signal
+// handler: a slot is claimed, its path copied, then marked ready; the handler reads ready
+// slots only, and a release clears ready before the claim.
+constexpr int kLiveSlots = 16;
+constexpr std::size_t kLivePathMax = 4096;
+char g_live_path[kLiveSlots][kLivePathMax];
+std::atomic<bool> g_live_claimed[kLiveSlots];
+std::atomic<bool> g_live_ready[kLiveSlots];
+
+int register_live(const fs::path& p) {
+  const std::string& s = p.native();
+  if (s.size() + 1 > kLivePathMax) return -1;
+  for (int i = 0; i < kLiveSlots; ++i) {
+    if (g_live_claimed[i].exchange(true)) continue;
+    std::memcpy(g_live_path[i], s.c_str(), s.size() + 1);
+    g_live_ready[i].store(true);
+    return i;
+  }
+  return -1;  // more than kLiveSlots at once: left for the next run's clean-up
+}
+
+void release_live(int slot) {
+  if (slot < 0) return;
+  g_live_ready[slot].store(false);
+  g_live_claimed[slot].store(false);
+}
+}  // namespace
+
+void unlink_live_temporaries() noexcept {
+  for (int i = 0; i < kLiveSlots; ++i)
+    if (g_live_ready[i].load()) ::unlink(g_live_path[i]);
+}
+
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   if (!target_.has_filename()) fail(target_, "not a file name");
   const fs::path dir = parent_or_dot(target_);
@@ -123,18 +157,22 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   name += std::to_string(g_counter++);
   temp_ = dir / name;
   remove_stale_temporaries(target_);
+  live_slot_ = register_live(temp_);
 }
 
 AtomicFile::AtomicFile(AtomicFile&& o) noexcept
     : target_(std::move(o.target_)),
       temp_(std::move(o.temp_)),
       stream_(std::move(o.stream_)),
-      committed_(o.committed_) {
+      committed_(o.committed_),
+      live_slot_(o.live_slot_) {
   o.temp_.clear();
   o.committed_ = true;
+  o.live_slot_ = -1;
 }
 
 AtomicFile::~AtomicFile() {
+  release_live(live_slot_);
   if (committed_ || temp_.empty()) return;
   if (stream_.is_open()) stream_.close();
   std::error_code ec;
@@ -164,6 +202,8 @@ void AtomicFile::commit() {
   if (::rename(temp_.c_str(), target_.c_str()) != 0)
     fail(target_, "cannot rename temporary", errno);
   committed_ = true;
+  release_live(live_slot_);  // renamed: a signal from here on must not unlink a new temporary
+  live_slot_ = -1;
   fsync_path(parent_or_dot(target_), true);  // best effort: makes the rename durable
 }
 

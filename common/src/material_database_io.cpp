@@ -424,6 +424,14 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
       require_group(g + "/raw");
       if (with_raw) {
         const int np = f.attribute_int(g + "/raw", "paths");
+        // The count must be the groups' (session 43's red team: paths = 7 on an unchecked
+        // file refitted the law on 7 of its 50 paths with exit 0).
+        const std::size_t groups = f.children(g + "/raw").size();
+        if (np < 0 || static_cast<std::size_t>(np) != groups)
+          throw InputError(fname, g + "/raw",
+                           "attribute paths is " + std::to_string(np) + " but the group holds " +
+                               std::to_string(groups) +
+                               " paths: the file was changed after it was written");
         for (int q = 0; q < np; ++q) {
           const std::string p = g + "/raw/" + path_group(static_cast<std::size_t>(q));
           where = p;

@@ -178,7 +178,14 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
   const std::string g = kEnergyLawGroup;
   std::string where = g;
   try {
-    // Format version 2 has no "family" attribute: its laws are ridge laws.
+    // Format version 2 has no "family" attribute: its laws are ridge laws. Version 3 always
+    // names it (session 43's red team: a version-3 file without it was read as a ridge law and
+    // refused at /energy_law/directions, "dataset missing").
+    if (!root.has_attribute(g, "family") && root.has_attribute(".", "format_version") &&
+        root.attribute_int(".", "format_version") >= 3)
+      throw InputError(file, g,
+                       "attribute family missing (a format-version-3 database names its energy "
+                       "law's family, \"network\" or \"ridge\")");
     const std::string family =
         root.has_attribute(g, "family") ? root.attribute_string(g, "family") : "ridge";
     if (family != "ridge" && family != "network")

@@ -124,12 +124,19 @@ std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int ste
     }
     // A path that ends where it starts carries no data (session 36's red team: a paper
     // biaxial path to (0, 0) passed the early checks and folded the surface after the sweep).
+    // Nor does one that ends within round-off of it (session 43's red team: a shear path to
+    // 1e-300 deg gave a shear curve of noise and "fit ok"): its end must reach
+    // StrainBox::kMinExtent (the shear angle in radians, the box's own smallest side).
     const bool gradient = p.kind == material::PathKind::kGradient;
-    if (gradient ? p.H.isZero(0.0) : p.target.isZero(0.0))
-      throw InputError(file, io::json_pointer_append(pointer, i),
-                       std::string("the path ends at the reference state (") +
-                           (gradient ? "H = 0" : "a zero end strain") +
-                           "): it carries no data; give it a nonzero end");
+    const double reach = gradient ? p.H.cwiseAbs().maxCoeff() : p.target.cwiseAbs().maxCoeff();
+    if (!(reach >= material::StrainBox::kMinExtent)) {
+      std::ostringstream o;
+      o << "the path ends " << (reach == 0.0 ? "at" : "within round-off of")
+        << " the reference state (" << (gradient ? "largest |H| " : "largest end strain ") << reach
+        << ", below " << material::StrainBox::kMinExtent
+        << "): it carries no data; give it an end of at least that size";
+      throw InputError(file, io::json_pointer_append(pointer, i), o.str());
+    }
     out.push_back(p);
   }
   return out;
@@ -206,6 +213,16 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     const double e_min = lp.value("e_min", material::kDefaultFanEMin);
     const double g_max = lp.value("gamma_max_deg", 40.0) * kPi / 180.0;
     if (!(e_min < e_max)) throw InputError(file, "/load_paths/e_min", "must be smaller than e_max");
+    // Ends that carry data (session 43's red team: gamma_max_deg 1e-300 gave a shear curve of
+    // noise and "fit ok"; the box has the same floor).
+    const double m = material::StrainBox::kMinExtent;
+    if (!(e_max >= m))
+      throw InputError(file, "/load_paths/e_max",
+                       "must be >= " + io::format_number(m) + " (the fan's end strain)");
+    if (!(g_max >= m))
+      throw InputError(file, "/load_paths/gamma_max_deg",
+                       "must be >= " + io::format_number(m * 180.0 / kPi) + " deg (" +
+                           io::format_number(m) + " rad: the shear path's end)");
     const auto all = material::default_load_paths(steps, e_max, e_min, g_max);
     if (lp.contains("select")) {
       for (int id : lp.at("select").get<std::vector<int>>()) {

@@ -1,5 +1,6 @@
 // Atomic files/directories, CSV writer and provenance records.
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <catch2/catch.hpp>
 #include <filesystem>
@@ -12,6 +13,7 @@
 
 #include "../output_test_util.hpp"
 #include "knit/core/build_info.hpp"
+#include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
@@ -750,4 +752,42 @@ TEST_CASE("Output sizes: parsed from the command line, printed in decimal units"
   CHECK(knit::io::format_bytes(7'800'000'000u) == "7.8 GB");
   CHECK(knit::io::format_bytes(350'000'000u) == "350 MB");
   CHECK(knit::io::format_bytes(999u) == "999 bytes");
+}
+
+TEST_CASE("a signal that ends the program unlinks the temporaries not yet committed",
+          "[unit][io][atomic]") {
+  // Session 43's red team: SIGINT or SIGTERM while a database was written left its half-written
+  // ".DB.h5.tmp-<pid>-<n>" beside the target until the next run into it.
+  const fs::path d = scratch("live_tmp");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  {  // In this process: the uncommitted temporary goes, a committed target stays.
+    knit::io::AtomicFile done(d / "done.txt");
+    done.stream() << "kept";
+    done.commit();
+    knit::io::AtomicFile open(d / "open.txt");
+    open.stream() << "half" << std::flush;
+    REQUIRE(fs::exists(open.temp_path()));
+    knit::io::unlink_live_temporaries();
+    CHECK_FALSE(fs::exists(open.temp_path()));
+    CHECK(slurp(d / "done.txt") == "kept");
+  }
+  // A program interrupted while it writes (the CLI's handler, then the signal's default).
+  for (const int sig : {SIGINT, SIGTERM}) {
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      knit::cli::on_interrupt_say("interrupted (test)");
+      knit::io::AtomicFile f(d / "db.h5");
+      f.stream() << "partial" << std::flush;
+      ::raise(sig);
+      ::_exit(3);  // not reached: the handler ends the process by the signal
+    }
+    int status = 0;
+    REQUIRE(::waitpid(child, &status, 0) == child);
+    CHECK(WIFSIGNALED(status));
+    CHECK(WTERMSIG(status) == sig);
+  }
+  CHECK(entries(d) == 1);  // done.txt only: no ".db.h5.tmp-<pid>-<n>", no ".open.txt.tmp-..."
+  fs::remove_all(d);
 }

@@ -306,6 +306,23 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
                       Catch::StartsWith(bad.string() + ": /loop_0/raw/path_00: F, P must be "
                                                        "steps x 4 and E, S steps x 3"));
   }
+  SECTION("a path count that is not the raw group's") {
+    // Session 43's red team: /loop_0/raw@paths = 7 refitted the law on 7 of 50 paths, exit 0.
+    const auto bad = tmp("paths_count.h5");
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    int groups = 0;
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      groups = static_cast<int>(f.children("/loop_0/raw").size());
+      REQUIRE(groups >= 2);
+      f.set_attribute("/loop_0/raw", "paths", groups - 1);
+    }
+    CHECK_THROWS_WITH(read_database(bad), bad.string() + ": /loop_0/raw: attribute paths is " +
+                                              std::to_string(groups - 1) + " but the group holds " +
+                                              std::to_string(groups) +
+                                              " paths: the file was changed after it was written");
+    CHECK_NOTHROW(read_database(bad, false));  // the law alone (knit-macro) does not read raw
+  }
   SECTION("non-finite fit diagnostics") {
     // Session 33 (a helper's audit): NaN in /loop_0/fit/diagnostics went through `knit-meso
     // fit` into the refitted file with exit 0; h5py's edits drop the checksum trailer, so the

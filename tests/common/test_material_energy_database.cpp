@@ -522,6 +522,14 @@ TEST_CASE("database v3: a bad network law is refused with its HDF5 path", "[unit
     CHECK_THROWS_WITH(read_database(bad), Catch::Contains("network_bad.h5: /energy_law: ") &&
                                               Catch::Contains("family is \"spline3d\""));
   }
+  SECTION("a missing family (session 43's red team: read as a ridge law, 'directions missing')") {
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      f.remove_attribute("/energy_law", "family");
+    }
+    CHECK_THROWS_WITH(read_database(bad),
+                      Catch::Contains("network_bad.h5: /energy_law: attribute family missing"));
+  }
   SECTION("a missing dataset") {
     {
       auto f = knit::io::H5File::open_rw(bad);

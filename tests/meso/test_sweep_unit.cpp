@@ -203,6 +203,32 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
                           "t.json"),
         Catch::StartsWith("t.json: /load_paths/extra/0: the path ends at the reference state"));
   }
+  // Nor within round-off of it (session 43's red team: a shear path to 1e-300 deg gave a shear
+  // curve of noise and "fit ok"); ends of 1e-3 (the box's floor) and more are data.
+  for (const char* path : {R"({"kind": "biaxial", "E11": 1e-300, "E22": 1e-300})",
+                           R"({"kind": "shear", "gamma_deg": 1e-6})",
+                           R"({"kind": "uniaxial", "axis": "course", "E": -9e-4})",
+                           R"({"kind": "gradient", "H": [[1e-5, 0], [0, 0]]})"}) {
+    INFO(path);
+    CHECK_THROWS_WITH(
+        parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": {"preset": )"
+                                      R"("default", "extra": [)") +
+                              path + "]}}",
+                          "t.json"),
+        Catch::StartsWith("t.json: /load_paths/extra/0: the path ends within round-off of the "
+                          "reference state") &&
+            Catch::Contains("below 0.001"));
+  }
+  for (const char* path :
+       {R"({"kind": "biaxial", "E11": 1e-3, "E22": 0})", R"({"kind": "shear", "gamma_deg": 0.1})"})
+    CHECK_NOTHROW(parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": )"
+                                                R"({"preset": "default", "extra": [)") +
+                                        path + "]}}",
+                                    "t.json"));
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
+                   R"("gamma_max_deg": 1e-300}})") == "/load_paths/gamma_max_deg");
+  CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
+                   R"("e_max": 1e-6}})") == "/load_paths/e_max");
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "steps": 0})") == "/steps");
   // unknown keys: reported on the object that holds them, naming the key
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "stepz": 3})") == "|stepz");

@@ -57,7 +57,15 @@ class AtomicFile {
   std::filesystem::path target_, temp_;
   std::ofstream stream_;
   bool committed_ = false;
+  int live_slot_ = -1;  ///< the temporary's slot for unlink_live_temporaries(); -1: none
 };
+
+/// Unlinks the temporaries of this process's AtomicFiles that are not committed (async-signal-
+/// safe: ::unlink over a fixed table; at most 16 at once are tracked, the rest are left for the
+/// next run's clean-up). For a handler that ends the program on a signal (knit::cli's): an
+/// interrupted database write left its half-written ".DB.h5.tmp-<pid>-<n>" beside the target
+/// until the next run into it (session 43's red team).
+void unlink_live_temporaries() noexcept;
 
 /// Writes `content` to `target` atomically.
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
