@@ -192,15 +192,18 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
   // Paths that end at the reference state carry no data (session 36's red team: a paper
   // biaxial path to (0, 0) folded the surface after the whole sweep).
   // (A shear path of 0 deg is the schema's: gamma_deg > 0.)
+  const auto with_extra = [](const char* path) {
+    return parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": {"preset": )"
+                                         R"("default", "extra": [)") +
+                                 path + "]}}",
+                             "t.json");
+  };
   for (const char* path : {R"({"kind": "biaxial", "E11": 0, "E22": 0})",
                            R"({"kind": "uniaxial", "axis": "wale", "E": 0})",
                            R"({"kind": "gradient", "H": [[0, 0], [0, 0]]})"}) {
     INFO(path);
     CHECK_THROWS_WITH(
-        parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": {"preset": )"
-                                      R"("default", "extra": [)") +
-                              path + "]}}",
-                          "t.json"),
+        with_extra(path),
         Catch::StartsWith("t.json: /load_paths/extra/0: the path ends at the reference state"));
   }
   // Nor within round-off of it (session 43's red team: a shear path to 1e-300 deg gave a shear
@@ -210,21 +213,14 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
                            R"({"kind": "uniaxial", "axis": "course", "E": -9e-4})",
                            R"({"kind": "gradient", "H": [[1e-5, 0], [0, 0]]})"}) {
     INFO(path);
-    CHECK_THROWS_WITH(
-        parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": {"preset": )"
-                                      R"("default", "extra": [)") +
-                              path + "]}}",
-                          "t.json"),
-        Catch::StartsWith("t.json: /load_paths/extra/0: the path ends within round-off of the "
-                          "reference state") &&
-            Catch::Contains("below 0.001"));
+    CHECK_THROWS_WITH(with_extra(path),
+                      Catch::StartsWith("t.json: /load_paths/extra/0: the path ends within "
+                                        "round-off of the reference state") &&
+                          Catch::Contains("below 0.001"));
   }
   for (const char* path :
        {R"({"kind": "biaxial", "E11": 1e-3, "E22": 0})", R"({"kind": "shear", "gamma_deg": 0.1})"})
-    CHECK_NOTHROW(parse_sweep_input(std::string(R"({"loop_lengths": [4.5], "load_paths": )"
-                                                R"({"preset": "default", "extra": [)") +
-                                        path + "]}}",
-                                    "t.json"));
+    CHECK_NOTHROW(with_extra(path));
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
                    R"("gamma_max_deg": 1e-300}})") == "/load_paths/gamma_max_deg");
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
