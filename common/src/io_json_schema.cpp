@@ -371,7 +371,9 @@ struct JsonSchema::Impl {
   void array(const json& s, const json& v, const std::string& ptr, int depth, Errs& out) const {
     const std::size_t n = v.size();
     if (auto it = s.find("minItems"); it != s.end() && n < it->get<std::size_t>())
-      add(out, ptr, "must have at least " + short_dump(*it) + " items, got " + std::to_string(n));
+      add(out, ptr,
+          "must have at least " + short_dump(*it) + (*it == 1 ? " item" : " items") + ", got " +
+              std::to_string(n));
     if (auto it = s.find("maxItems"); it != s.end() && n > it->get<std::size_t>())
       add(out, ptr, "must have at most " + short_dump(*it) + " items, got " + std::to_string(n));
     if (auto it = s.find("uniqueItems"); it != s.end() && it->is_boolean() && it->get<bool>()) {
@@ -528,8 +530,18 @@ struct JsonSchema::Impl {
     // An unknown key counts at the key's own depth: an object with a misspelt key, against
     // "false or an object", is reported as the unknown key, not as "must be false".
     auto depth_of = [](const Err& e) { return pointer_depth(e.at.empty() ? e.pointer : e.at); };
+    // A branch that rejects the value's type loses to one of its type (session 43's red team:
+    // "load_paths": [] said "must be an object, got an array", where a list of at least one
+    // path is allowed).
+    auto wrong_type = [&](const Errs& e) {
+      return e.size() == 1 && e[0].pointer == ptr && !e[0].expected_type.empty();
+    };
     std::size_t best = 0;
     for (std::size_t i = 1; i < results.size(); ++i) {
+      if (wrong_type(results[i]) != wrong_type(results[best])) {
+        if (wrong_type(results[best])) best = i;
+        continue;
+      }
       const std::size_t di = depth_of(results[i].front());
       const std::size_t db = depth_of(results[best].front());
       if (di > db || (di == db && results[i].size() < results[best].size())) best = i;

@@ -161,6 +161,8 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
               c.law[static_cast<std::size_t>(i)];
         const std::string name = kUniaxialAxes[ax] + std::string("_") + std::to_string(k);
         u.write(name, m);
+        // Per dataset too, as every other dataset of ours (session 43's walkthrough).
+        u.set_attribute(name, "units", "E_axial 1, S_cell MPa, S_law MPa");
       }
     u.set_attribute(".", "columns",
                     "E_axial (Green-Lagrange), S_cell (MPa), S_law (MPa; NaN: no state of the "

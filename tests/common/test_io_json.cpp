@@ -179,7 +179,7 @@ TEST_CASE("schema validator: objects, arrays, $ref", "[unit][io][json][schema]")
   CHECK(first_error(with("/material", json::object())) == "/material: missing required key \"E\"");
 
   CHECK(first_error(with("/boundary_conditions", json::array())) ==
-        "/boundary_conditions: must have at least 1 items, got 0");
+        "/boundary_conditions: must have at least 1 item, got 0");
   CHECK(first_error(with("/boundary_conditions", json::parse(R"([{"edge":"u0"},{"edge":"u0"},
     {"edge":"u0"},{"edge":"u0"},{"edge":"u0"}])"))) ==
         "/boundary_conditions: must have at most 4 items, got 5");
@@ -247,6 +247,17 @@ TEST_CASE("schema validator: oneOf/anyOf report the relevant branch, if/then/els
   CHECK_THAT(misspelt[0].message, Catch::Contains("unknown key \"tubee\""));
   CHECK(false_or_object.errors(json(true)).size() == 1);
   CHECK(false_or_object.errors(json(false)).empty());
+  // "an object or a non-empty list" (the sweep input's load_paths): an empty list is told its
+  // own error, not the object's type (session 43's red team: "must be an object, got an
+  // array", where lists are allowed).
+  const knit::io::JsonSchema object_or_list(
+      json::parse(R"({"oneOf": [{"type": "object"}, {"type": "array", "minItems": 1}]})"), "t");
+  const auto empty_list = object_or_list.errors(json::array());
+  REQUIRE(empty_list.size() == 1);
+  CHECK(empty_list[0].message == "must have at least 1 item, got 0");
+  CHECK(object_or_list.errors(json::parse("[1]")).empty());
+  CHECK_THAT(object_or_list.errors(json("x")).at(0).message,
+             Catch::StartsWith("must be an object or an array"));
   // oneOf matching twice.
   json both =
       knit::io::JsonSchema(json::parse(R"({"oneOf": [{"type": "number"}, {"minimum": 0}]})"), "t")

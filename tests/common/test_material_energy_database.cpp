@@ -172,6 +172,8 @@ TEST_CASE("database: the law's own uniaxial curves round trip, older files load 
   {
     auto f = knit::io::H5File::open_rw(file);
     CHECK(f.exists("/energy_law/diagnostics/uniaxial/wale_1"));
+    CHECK(f.attribute_string("/energy_law/diagnostics/uniaxial/wale_1", "units") ==
+          "E_axial 1, S_cell MPa, S_law MPa");
     CHECK_FALSE(f.exists("/energy_law/diagnostics/uniaxial/course_1"));
     f.remove("/energy_law/diagnostics/uniaxial");  // as written before session 41
   }
