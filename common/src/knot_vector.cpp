@@ -56,6 +56,15 @@ void validate_knots(const std::vector<double>& U, int p, int n_ctrl, bool requir
               (end ? "at an end" : "inside the domain") + " for degree " + std::to_string(p));
     i = j;
   }
+  // The count before the clamping (session 43's red team: a knot vector one short was told
+  // it is "not clamped at its end").
+  if (n_ctrl >= 0 && n != n_ctrl)
+    throw KnotVectorError(
+        KnotError::kCountMismatch,
+        std::to_string(m) + " knots of degree " + std::to_string(p) + " define " +
+            std::to_string(n) + " basis functions, but " + std::to_string(n_ctrl) +
+            " control points were given (knots must number control points + degree + 1 = " +
+            std::to_string(n_ctrl + p + 1) + ")");
   if (require_clamped) {
     for (int i = 1; i <= p; ++i) {
       if (U[i] != U[0])
@@ -68,13 +77,6 @@ void validate_knots(const std::vector<double>& U, int p, int n_ctrl, bool requir
                                   std::to_string(p + 1) + " knots must be equal");
     }
   }
-  if (n_ctrl >= 0 && n != n_ctrl)
-    throw KnotVectorError(
-        KnotError::kCountMismatch,
-        std::to_string(m) + " knots of degree " + std::to_string(p) + " define " +
-            std::to_string(n) + " basis functions, but " + std::to_string(n_ctrl) +
-            " control points were given (knots must number control points + degree + 1 = " +
-            std::to_string(n_ctrl + p + 1) + ")");
 }
 
 int find_span(int n, int p, double u, const std::vector<double>& U) {

@@ -76,6 +76,9 @@ TEST_CASE("knot error: empty domain", "[unit][spline][knots]") {
 
 TEST_CASE("knot error: count mismatch with the control points", "[unit][spline][knots]") {
   CHECK(code_of({0, 0, 0, 1, 1, 1}, 2, 4) == code(KnotError::kCountMismatch));
+  // A clamped vector with its last knot cut off is told its count, not "not clamped at its
+  // end" (session 43's red team, a database's knots 14 instead of 15).
+  CHECK(code_of({0, 0, 0, 0.5, 1, 1}, 2, 4) == code(KnotError::kCountMismatch));
   const BSplineBasis b(2, {0, 0, 0, 1, 1, 1});
   try {
     SplineCurve c(b, Eigen::MatrixXd::Zero(4, 2));
