@@ -111,21 +111,28 @@ void remove_stale_temporaries(const fs::path& target) {
 
 namespace {
 // The temporaries of AtomicFiles not yet committed, for unlink_live_temporaries() in a signal
-// handler: a slot is claimed, its path copied, then marked ready; the handler reads ready
-// slots only, and a release clears ready before the claim.
+// handler. A slot is claimed, its generation made odd, its path copied, the generation made
+// even again; a release makes it odd (and never even again until the next path is in). The
+// handler copies a slot's path while its generation is even and unlinks the copy only if the
+// generation is still the same: a path that another thread released or rewrote meanwhile is
+// skipped, never a torn mix of two (session 43's review).
 constexpr int kLiveSlots = 16;
 constexpr std::size_t kLivePathMax = 4096;
 char g_live_path[kLiveSlots][kLivePathMax];
 std::atomic<bool> g_live_claimed[kLiveSlots];
-std::atomic<bool> g_live_ready[kLiveSlots];
+std::atomic<unsigned> g_live_generation[kLiveSlots];  // even: the path is ours and complete
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<unsigned>::is_always_lock_free,
+              "the signal handler reads these: they must be lock-free");
 
 int register_live(const fs::path& p) {
   const std::string& s = p.native();
   if (s.size() + 1 > kLivePathMax) return -1;
   for (int i = 0; i < kLiveSlots; ++i) {
     if (g_live_claimed[i].exchange(true)) continue;
+    // Released slots are odd already; a slot never used is 0 (even, but with an empty path).
+    if (g_live_generation[i].load() % 2 == 0) g_live_generation[i].fetch_add(1);
     std::memcpy(g_live_path[i], s.c_str(), s.size() + 1);
-    g_live_ready[i].store(true);
+    g_live_generation[i].fetch_add(1);  // even: complete
     return i;
   }
   return -1;  // more than kLiveSlots at once: left for the next run's clean-up
@@ -133,14 +140,20 @@ int register_live(const fs::path& p) {
 
 void release_live(int slot) {
   if (slot < 0) return;
-  g_live_ready[slot].store(false);
+  g_live_generation[slot].fetch_add(1);  // odd: not a live temporary
   g_live_claimed[slot].store(false);
 }
 }  // namespace
 
 void unlink_live_temporaries() noexcept {
-  for (int i = 0; i < kLiveSlots; ++i)
-    if (g_live_ready[i].load()) ::unlink(g_live_path[i]);
+  char path[kLivePathMax];
+  for (int i = 0; i < kLiveSlots; ++i) {
+    const unsigned g = g_live_generation[i].load();
+    if (g == 0 || g % 2 != 0) continue;  // never used, or released / being written
+    std::memcpy(path, g_live_path[i], kLivePathMax);
+    path[kLivePathMax - 1] = '\0';
+    if (g_live_generation[i].load() == g) ::unlink(path);
+  }
 }
 
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {

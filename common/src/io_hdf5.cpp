@@ -376,6 +376,23 @@ bool H5Group::is_dataset(const std::string& path) const {
   return exists(path) && object_type(id_.get(), h5name(path)) == H5O_TYPE_DATASET;
 }
 
+bool H5Group::any_checksum() const {
+  silence_hdf5();
+  bool found = false;
+  const H5O_iterate_t op = [](hid_t obj, const char* name, const H5O_info_t* info,
+                              void* data) -> herr_t {
+    if (info->type != H5O_TYPE_DATASET) return 0;
+    H5Handle ds(H5Dopen2(obj, name, H5P_DEFAULT));
+    if (ds.valid() && (has_filter(ds.get(), H5Z_FILTER_FLETCHER32) || read_digest(ds.get()))) {
+      *static_cast<bool*>(data) = true;
+      return 1;  // found: stop the visit
+    }
+    return 0;
+  };
+  H5Ovisit2(id_.get(), H5_INDEX_NAME, H5_ITER_NATIVE, op, &found, H5O_INFO_BASIC);
+  return found;
+}
+
 bool H5Group::has_checksum(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) return false;
@@ -434,6 +451,14 @@ void H5Group::remove(const std::string& path) {
   silence_hdf5();
   if (!exists(path)) fail(path, "object missing");
   if (H5Ldelete(id_.get(), h5name(path).c_str(), H5P_DEFAULT) < 0) fail(path, "cannot remove");
+}
+
+void H5Group::hard_link(const std::string& existing, const std::string& name) {
+  silence_hdf5();
+  if (!exists(existing)) fail(existing, "object missing");
+  if (H5Lcreate_hard(id_.get(), h5name(existing).c_str(), id_.get(), h5name(name).c_str(),
+                     H5P_DEFAULT, H5P_DEFAULT) < 0)
+    fail(name, "cannot create a hard link to " + existing);
 }
 
 // ---- datasets -------------------------------------------------------------------------------

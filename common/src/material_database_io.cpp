@@ -309,20 +309,6 @@ std::runtime_error database_not_written(const std::filesystem::path& target, boo
       (existed ? "the earlier file is left as it was" : "no file was created") + "): " + why);
 }
 
-namespace {
-/// True if a dataset below `group` (recursively) carries a checksum of ours (has_checksum): a
-/// file written since the checksums exist. /loop_lengths first (every database has it).
-bool any_checksum(const H5Group& f, const std::string& group) {
-  if (group == "/" && f.has_checksum("/loop_lengths")) return true;
-  for (const std::string& name : f.children(group)) {
-    const std::string path = (group == "/" ? "" : group) + "/" + name;
-    if (f.is_dataset(path) ? f.has_checksum(path) : f.is_group(path) && any_checksum(f, path))
-      return true;
-  }
-  return false;
-}
-}  // namespace
-
 Database read_database(const std::filesystem::path& file, bool with_raw) {
   const std::string fname = file.string();
   std::string where;  // HDF5 path being read, for messages
@@ -347,7 +333,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     // file carries a checksum (session 43's red team: /loop_lengths re-created without one by
     // h5py's delete-and-create let the file pass as old, with /energy_law/theta scaled by 1.5
     // and its Fletcher32 sums recomputed: 27,148 N instead of 84.6 N, exit 0 again).
-    if (!f.structure_sealed() && any_checksum(f, "/"))
+    if (!f.structure_sealed() && (f.has_checksum("/loop_lengths") || f.any_checksum()))
       throw InputError(
           fname, "",
           "the file was written with checksums but its structure checksum is gone: it was "

@@ -88,9 +88,14 @@ std::string stability_summary(const RunReport& r) {
     // The LU path: no inertia, only the sign of det K (an odd number of negative real
     // eigenvalues when negative; a pair of them, or a complex pair, leaves it positive).
     o << "unsymmetric tangent (LU factorization: no inertia, only the sign of det K): ";
-    if (r.first_negative_determinant_step < 0)
+    if (r.first_negative_determinant_step < 0 && r.unknown_determinant_steps == 0)
       o << "det K > 0 at every converged step (no odd number of negative real eigenvalues; an "
            "even number would not show)";
+    else if (r.first_negative_determinant_step < 0)
+      o << "det K > 0 at every converged step where it is known (unknown at "
+        << r.unknown_determinant_steps << " of " << r.converged_steps
+        << ": a singular tangent there); an even number of negative real eigenvalues would not "
+           "show";
     else
       o << "det K < 0 from step " << r.first_negative_determinant_step << " (load factor "
         << r.first_negative_determinant_lambda << "), at " << r.negative_determinant_steps << " of "
@@ -465,10 +470,12 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         if (ev_u.size() == 0 || ev_u != dofs.expand(uf, lam1)) tangent(uf, lam1);
         const Factorization f = K.factorize();
         o.negative_pivots = f.ok ? f.negative_pivots : last_negative;
-        o.determinant_sign = f.ok ? f.determinant_sign : last_sign;
+        // A singular tangent at the converged state (a limit point): the sign is not known
+        // there, and not the last step's (session 43's review).
+        o.determinant_sign = f.ok ? f.determinant_sign : 0;
       }
       if (o.negative_pivots != -2) last_negative = o.negative_pivots;
-      if (o.determinant_sign != 0) last_sign = o.determinant_sign;
+      last_sign = o.determinant_sign;
       lambda_prev = lambda;
       ufree_prev = ufree;
       lambda = lam1;
@@ -500,6 +507,7 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
         report.first_unstable_step = step;
         report.first_unstable_lambda = lambda;
       }
+      if (last_sign == 0) ++report.unknown_determinant_steps;
       if (last_sign < 0) {
         ++report.negative_determinant_steps;
         if (report.first_negative_determinant_step < 0) {

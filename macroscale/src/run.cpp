@@ -233,10 +233,9 @@ std::string run_failure_message(const RunResult& r) {
     o << "the tangent is unsymmetric (a material without strain energy, such as the paper's "
          "law: /material/law), and such a law can stop Newton where no smaller step helps";
     if (r.report.first_negative_determinant_step > 0)
-      o << " (det K < 0 from step " << r.report.first_negative_determinant_step
-        << ": a limit point was passed)";
-    o << "; the energy law (/material/law \"energy\") has a strain energy and a symmetric "
-         "tangent";
+      o << " (det K < 0 from step " << r.report.first_negative_determinant_step << ")";
+    o << "; the energy law (/material/law \"energy\", when the database has one) has a strain "
+         "energy and a symmetric tangent";
     add(o.str());
   }
   add(material_failure_message(r.report, r.failed_material_evaluations));

@@ -86,7 +86,8 @@ int run(const Options& o) {
       throw knit::InputError("", "--loop-length", msg);
     }
   }();
-  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
+  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out",
+                                o.config);
 
   std::vector<Polyline> lines;
   int image = 0;

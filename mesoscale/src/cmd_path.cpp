@@ -168,7 +168,8 @@ int run(const Options& o) {
                  "%d: the stresses are not mesh-converged (docs/unit-cell.md, \"Convergence "
                  "study\": at 16 elements S is 5-20 %% above 64 elements', at 8 up to 52 %%)\n",
                  co.elements, CellOptions{}.elements);
-  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out");
+  knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out",
+                                o.config);
   // The outputs' size, estimated before the run from one VTP of the reference state (session
   // 41's red team: --steps 100000 started writing about 5.9 GB without a word; knit-meso rod
   // and knit-macro run have the same cap).

@@ -132,9 +132,15 @@ std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int ste
     if (!(reach >= material::StrainBox::kMinExtent)) {
       std::ostringstream o;
       o << "the path ends " << (reach == 0.0 ? "at" : "within round-off of")
-        << " the reference state (" << (gradient ? "largest |H| " : "largest end strain ") << reach
-        << ", below " << material::StrainBox::kMinExtent
-        << "): it carries no data; give it an end of at least that size";
+        << " the reference state (";
+      if (p.kind == material::PathKind::kShear)  // given in degrees (session 43's review)
+        o << "shear angle " << reach * 180.0 / kPi << " deg, below "
+          << material::StrainBox::kMinExtent * 180.0 / kPi
+          << " deg = " << material::StrainBox::kMinExtent << " rad";
+      else
+        o << (gradient ? "largest |H| " : "largest end strain ") << reach << ", below "
+          << material::StrainBox::kMinExtent;
+      o << "): it carries no data; give it an end of at least that size";
       throw InputError(file, io::json_pointer_append(pointer, i), o.str());
     }
     out.push_back(p);

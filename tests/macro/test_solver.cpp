@@ -971,3 +971,21 @@ TEST_CASE("a tensile test whose patch moves as a rigid body warns", "[unit]") {
           Catch::EndsWith("Is the edge opposite the moving one held (/boundary_conditions)?"));
   CHECK_THAT(warnings.str(), Catch::Contains("warning: the patch is not strained"));
 }
+
+// Session 43's review: a converged step whose tangent is singular there has no known sign; the
+// summary must not claim "det K > 0 at every converged step" then.
+TEST_CASE("stability summary on the LU path: an unknown sign is not a positive one", "[unit]") {
+  RunReport r;
+  r.converged_steps = 5;
+  r.max_negative_pivots = -1;  // the LU path
+  CHECK_THAT(stability_summary(r), Catch::Contains("det K > 0 at every converged step (no odd"));
+  r.unknown_determinant_steps = 1;
+  CHECK_THAT(stability_summary(r),
+             Catch::Contains("det K > 0 at every converged step where it is known (unknown at 1 "
+                             "of 5: a singular tangent there)"));
+  r.first_negative_determinant_step = 3;
+  r.first_negative_determinant_lambda = 0.6;
+  r.negative_determinant_steps = 2;
+  CHECK_THAT(stability_summary(r), Catch::Contains("det K < 0 from step 3 (load factor 0.6), at 2 "
+                                                   "of 5 converged steps"));
+}

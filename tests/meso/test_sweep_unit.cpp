@@ -216,11 +216,13 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
     CHECK_THROWS_WITH(with_extra(path),
                       Catch::StartsWith("t.json: /load_paths/extra/0: the path ends within "
                                         "round-off of the reference state") &&
-                          Catch::Contains("below 0.001"));
+                          Catch::Contains("0.001"));
   }
   for (const char* path :
        {R"({"kind": "biaxial", "E11": 1e-3, "E22": 0})", R"({"kind": "shear", "gamma_deg": 0.1})"})
     CHECK_NOTHROW(with_extra(path));
+  CHECK_THROWS_WITH(with_extra(R"({"kind": "shear", "gamma_deg": 0.05})"),
+                    Catch::Contains("(shear angle 0.05 deg, below 0.0572958 deg = 0.001 rad)"));
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
                    R"("gamma_max_deg": 1e-300}})") == "/load_paths/gamma_max_deg");
   CHECK(pointer_of(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"

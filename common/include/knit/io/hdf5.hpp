@@ -131,10 +131,16 @@ class H5Group {
   /// True if the dataset at path carries a checksum of ours: the Fletcher32 filter or the
   /// digest attribute "knit_fnv1a64" (every dataset written since the checksums exist).
   bool has_checksum(const std::string& path) const;
+  /// True if any dataset at or below this group carries a checksum of ours (has_checksum).
+  /// Every object is visited once (H5Ovisit), so a file whose hard links form a cycle ends too
+  /// (session 43's review: a recursive walk of children() never did).
+  bool any_checksum() const;
   /// Names of the direct children (groups and datasets) of the group at path, sorted by name.
   std::vector<std::string> children(const std::string& path = ".") const;
   /// Removes the link at path (the space is not reclaimed by HDF5; fine for our sizes).
   void remove(const std::string& path);
+  /// A second name (a hard link) `name` for the existing object at `existing`.
+  void hard_link(const std::string& existing, const std::string& name);
 
   // ---- datasets ----------------------------------------------------------------------------
   /// Raw writers: data in row-major (C) order with the given shape (rank 0..N).

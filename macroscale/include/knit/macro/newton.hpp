@@ -162,6 +162,8 @@ struct RunReport {
   int first_negative_determinant_step = -1;
   double first_negative_determinant_lambda = 0.0;
   int negative_determinant_steps = 0;
+  /// Converged steps whose tangent could not be factorized there (singular): sign unknown (0).
+  int unknown_determinant_steps = 0;
   SolverStats stats;
 };
 
