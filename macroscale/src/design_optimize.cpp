@@ -112,8 +112,9 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
   r.status = on_bound && (stop == DesignStop::kPushesOut || stop == DesignStop::kUnknown)
                  ? DesignStatus::kInfeasible
                  : DesignStatus::kTargetNotMet;
-  char tol[64];
+  char tol[64], xtol[64];
   std::snprintf(tol, sizeof tol, "%g", opt.function_tolerance);
+  std::snprintf(xtol, sizeof xtol, "%g", opt.x_tolerance);
   std::string why;
   switch (stop) {
     case DesignStop::kStationary:
@@ -129,7 +130,9 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
           ": the optimizer stopped where J still decreases inside the bounds (|dJ/dx| x the "
           "room to the bound it moves towards > 1e-2 J): raise max_iterations, lower "
           "function_tolerance (" +
-          std::string(tol) + ") or start from other values";
+          std::string(tol) + ") or x_tolerance (" + std::string(xtol) +
+          ": the smallest step, a fraction of each variable's interval; /optimizer) or start "
+          "from other values";
       break;
     case DesignStop::kPushesOut:
       why =
@@ -156,6 +159,7 @@ DesignResult optimize_design(const DesignProblem& d, const OptimizeOptions& opti
   OptimizeOptions o = options;
   o.max_iterations = d.optimizer.max_iterations;
   o.function_tolerance = d.optimizer.function_tolerance;
+  if (d.optimizer.x_tolerance) o.x_tolerance = *d.optimizer.x_tolerance;
   return d.optimizer.method == DesignOptimizerSpec::Method::kCeres
              ? optimize_design_ceres(d, o)
              : optimize_design_projected(d, o);

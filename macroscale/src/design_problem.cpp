@@ -334,6 +334,13 @@ void read_optimizer(const json& j, const std::string& file, DesignOptimizerSpec&
                        "must be a fraction of J in (0, 1), e.g. 1e-6");
     o.function_tolerance = t;
   }
+  if (j.contains("x_tolerance")) {
+    const double t = number(j.at("x_tolerance"), file, "/optimizer/x_tolerance");
+    if (!(t >= 1e-14 && t < 1))
+      throw InputError(file, "/optimizer/x_tolerance",
+                       "must be a fraction of a variable's interval in [1e-14, 1), e.g. 1e-6");
+    o.x_tolerance = t;
+  }
 }
 
 }  // namespace

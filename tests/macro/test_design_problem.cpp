@@ -387,6 +387,19 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
              R"(, "optimizer": {"function_tolerance": 0}})",
          "/optimizer/function_tolerance");
+  for (const char* t : {"0", "1e-15", "1"})
+    expect(std::string("x_tolerance_") + t + ".json",
+           R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
+               R"(, "optimizer": {"x_tolerance": )" + t + "}}",
+           "/optimizer/x_tolerance");
+  {  // Since session 43 the design file sets it (Ceres' parameter_tolerance).
+    write(kDir / "x_tolerance_ok.json", R"({"case": "case.json", "variables": )" + kVars +
+                                            R"(, "objectives": )" + kObjs +
+                                            R"(, "optimizer": {"x_tolerance": 1e-10}})");
+    CHECK(load_design((kDir / "x_tolerance_ok.json").string()).optimizer.x_tolerance == 1e-10);
+    CHECK_FALSE(DesignOptimizerSpec{}.x_tolerance);  // unset: OptimizeOptions' 1e-6
+    CHECK(OptimizeOptions{}.x_tolerance == 1e-6);
+  }
   expect("unknown_key.json",
          R"({"case": "case.json", "variables": )" + kVars + R"(, "objectives": )" + kObjs +
              R"(, "optimizer": "lbfgs"})",
