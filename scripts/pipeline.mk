@@ -138,6 +138,24 @@ $(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO) \
 	echo "{\"case\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
 	if [ $$rc -ne 0 ]; then echo "case: $* exited with $$rc (see $(LOGS)/$*.log)"; fi
 
+# ---- the paper's law beside the energy law (fig07e; issue 11 item 4, session 43) ---------------
+# The uniform cases of Sect. 3.1.2 run again with "law": "paper" (the eq. 17 surfaces of the same
+# database) into results_paper_law/; drawn beside the default law's runs, not judged by the report.
+LAWCMP := s312_uniform_45_course s312_uniform_45_wale s312_uniform_65_course s312_uniform_65_wale
+RES_PAPER := $(OUT)/results_paper_law
+LAWCMP_STATUS := $(LAWCMP:%=$(RES_PAPER)/%.status)
+.SECONDARY: $(LAWCMP:%=$(OUT)/cases_paper_law/%.json)
+$(OUT)/cases_paper_law/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
+	@mkdir -p $(OUT)/cases_paper_law
+	@$(PY) $(FIGPY)/resolve_case.py $< $(DB) $@ paper
+$(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO)
+	@mkdir -p $(RES_PAPER) $(LOGS)
+	@echo "case (paper's law): $*"
+	@start=$$(date +%s.%N); rc=0; \
+	"$(MACRO)" run $< --output $(RES_PAPER)/$* > $(LOGS)/paper_law_$*.log 2>&1 || rc=$$?; \
+	end=$$(date +%s.%N); \
+	echo "{\"case\": \"$*\", \"law\": \"paper\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@
+
 # ---- unit cells (Fig. 5) ----------------------------------------------------------------------
 $(OUT)/cells/%/cell.json: $(MESO)
 	@mkdir -p $(OUT)/cells $(LOGS)
@@ -209,6 +227,10 @@ $(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fi
 $(eval $(call deformed,fig07b_uniform65_wale_E22,s312_uniform_65_wale,E22,0.3,Fig. 7b: l = 6.5 mm wale-wise at 30 % (E22),s312_uniform_45_wale))
 $(eval $(call load,fig07c_convergence,Fig. 7c: convergence wale-wise l = 4.5 mm,conv7c_p3h1 conv7c_p5h1 conv7c_p7h1 conv7c_p3h4 conv7c_p5h4 conv7c_p7h4))
 $(eval $(call load,fig07d_load_strain,Fig. 7d: uniform stitch values,s312_uniform_45_course s312_uniform_45_wale s312_uniform_65_course s312_uniform_65_wale))
+FIGURES += $(FIG)/fig07e_laws_load_strain.png
+PLOT_B_FIGS += $(FIG)/fig07e_laws_load_strain.png
+PLOT_B_DEPS += $(call st,$(LAWCMP)) $(LAWCMP_STATUS)
+PLOT_B_JOBS += $(call PLOTJOB,fig07e_laws_load_strain,laws --paper-results $(RES_PAPER) --title "Fig. 7d with both laws: energy (default, solid) and eq. 17 (dashed)" $(LAWCMP))
 # Sect. 3.1.3 (Figs. 8-9)
 $(eval $(call fields,fig08a_discontinuous_field,s313_discontinuous_course,Fig. 8a: stitch value 4.5 | 6.5 mm))
 $(eval $(call deformed,fig09b_discontinuous_course_E11,s313_discontinuous_course,E11,0.3,Fig. 9b: course-wise at 30 % (E11)))
@@ -352,7 +374,8 @@ clean:
 	  echo "clean: $(OUT) is another program's output, not the pipeline's: nothing removed" >&2; \
 	  exit 2; fi
 	rm -rf "$(OUT)/database.h5" "$(OUT)/database.source" "$(OUT)/database.time" "$(OUT)/cases" \
-	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md"
+	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md" \
+  "$(OUT)/cases_paper_law"
 # figures/ and results/ file by file: what the pipeline writes there (its figures and their
 # temporaries; each case's status, output directory, partial directories and lock), then the
 # directory if that emptied it (session 36's red team: a user's figures/my_plot.png and
@@ -361,7 +384,10 @@ clean:
 	  rm -f "$$f" "$$f.tmp.png"; done
 	@for c in $(CASES); do \
 	  rm -rf "$(RES)/$$c" "$(RES)/$$c.status" "$(RES)/$$c.lock" "$(RES)/$$c".partial-*; done
-	@for d in "$(FIG)" "$(RES)"; do \
+	@for c in $(LAWCMP); do \
+	  rm -rf "$(RES_PAPER)/$$c" "$(RES_PAPER)/$$c.status" "$(RES_PAPER)/$$c.lock" \
+	    "$(RES_PAPER)/$$c".partial-*; done
+	@for d in "$(FIG)" "$(RES)" "$(RES_PAPER)"; do \
 	  if [ -d "$$d" ]; then rmdir "$$d" 2>/dev/null \
 	    || echo "clean: kept $$d: it holds files the pipeline did not write" >&2; fi; done
 

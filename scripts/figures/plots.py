@@ -7,6 +7,9 @@
   plots.py --results DIR fields --case C --title T --out F.png   stitch value / knitting angle
   plots.py --results DIR geometry --case C --title T --out F.png reference surface (Fig. 16a)
   plots.py --results DIR placeholder --title T --message M --out F.png
+  plots.py --results DIR laws --paper-results DIR2 --title T --out F.png CASE...
+           the default energy law (solid) beside the paper's eq. 17 law (dashed, DIR2's runs of
+           the same cases), steps with det K < 0 on the paper law's LU path marked x
 
 Deformed shapes are coloured by a Green-Lagrange strain component of the local Cartesian frame
 (E11, E22, E12 as in the paper's figures): a planar patch in the x1-x2 plane with the reference
@@ -125,6 +128,14 @@ def cmd_load(a):
             warned += 1
         ax.plot(100 * eps, f, "-" if r.completed else "--", marker=".", ms=3, label=lab)
         drawn += 1
+    finish_load_figure(fig, ax, a, drawn, 8,
+                       "* knit-macro warns: the law's own uniaxial stress departs from the unit "
+                       "cell's there (the report's warnings; docs/database.md)" if warned else "")
+
+
+def finish_load_figure(fig, ax, a, drawn, legend_size, note):
+    """Axes, legend and the note below the axis label of a load-strain figure, saved to a.out;
+    its placeholder when no curve was drawn."""
     if drawn == 0:
         plt.close(fig)
         placeholder(a.out, a.title, "no results (the runs failed; see the report)")
@@ -133,13 +144,50 @@ def cmd_load(a):
     ax.set_ylabel("load [N]")
     ax.set_title(a.title, fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    if warned:
-        # Below the axis label (the saved figure's tight box takes it in).
-        ax.text(0.0, -0.16, "* knit-macro warns: the law's own uniaxial stress departs from the "
-                "unit cell's there (the report's warnings; docs/database.md)", fontsize=6.5,
-                color="0.3", ha="left", va="top", transform=ax.transAxes)
+    ax.legend(fontsize=legend_size)
+    if note:  # below the axis label (the saved figure's tight box takes it in)
+        ax.text(0.0, -0.16, note, fontsize=6.5, color="0.3", ha="left", va="top",
+                transform=ax.transAxes)
     save(fig, a.out)
+
+
+def negative_determinant(sign):
+    """The points of a load-strain curve (the origin first, then one per converged step) whose
+    step had det K < 0: load_strain.csv's determinant_sign (-1, +1; 0 unknown), None -> none."""
+    if sign is None or len(sign) == 0:
+        return np.zeros(1, dtype=bool)
+    return np.concatenate([[False], np.asarray(sign) < 0])
+
+
+def cmd_laws(a):
+    """The load-strain curves of the same cases with the two laws (issue 11 item 4, session
+    43): the energy law's runs in --results (solid), the paper's law's in --paper-results
+    (dashed, the same colour), its steps with det K < 0 (load_strain.csv's determinant_sign,
+    the LU path's stability indicator) marked x. A run that stopped early is drawn to its last
+    step and says so in the legend."""
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    drawn = 0
+    unstable = False
+    for k, name in enumerate(a.cases):
+        colour = f"C{k}"
+        for results, style, law in ((a.results, "-", "energy law"),
+                                    (a.paper_results, "--", "paper's law")):
+            r = Result(results, name)
+            if not r.ok or len(r.csv.get("strain", [])) == 0:
+                continue
+            eps, f = r.strain(), r.load()
+            lab = f"{label_of(name)}, {law}" + ("" if r.completed else " (stopped early)")
+            ax.plot(100 * eps, f, style, color=colour, lw=1.2, label=lab)
+            neg = negative_determinant(r.csv.get("determinant_sign"))
+            if law == "paper's law" and neg.any() and len(neg) == len(eps):
+                ax.plot(100 * eps[neg], f[neg], "x", color=colour, ms=6, mew=1.5)
+                unstable = True
+            drawn += 1
+    finish_load_figure(
+        fig, ax, a, drawn, 7,
+        "solid: the energy law (default); dashed: the paper's eq. 17 law, the same database"
+        + ("; x: det K < 0 on the paper law's LU path (an odd number of negative eigenvalues)"
+           if unstable else ""))
 
 
 def outline(ax, P, **kw):
@@ -402,6 +450,12 @@ def main():
     s.add_argument("--case", required=True)
     s.add_argument("--title", default="")
     s.add_argument("--out", required=True)
+    s = sub.add_parser("laws", help="the energy law beside the paper's law (load-strain)")
+    s.add_argument("--paper-results", required=True,
+                   help="the results directory of the same cases run with the paper's law")
+    s.add_argument("--title", default="")
+    s.add_argument("--out", required=True)
+    s.add_argument("cases", nargs="+")
     s = sub.add_parser("placeholder", help="a PNG that says why a figure is missing")
     s.add_argument("--title", default="")
     s.add_argument("--message", default="")
@@ -415,12 +469,18 @@ def main():
     # exit 0). A case counts as made once its status file or its output exists.
     if not os.path.isdir(a.results):
         p.error(f"--results: {a.results} is not a directory")
-    for name in getattr(a, "cases", None) or [a.case] + (getattr(a, "share_limits", None) or []):
-        if not (os.path.exists(os.path.join(a.results, name + ".status"))
-                or os.path.isdir(os.path.join(a.results, name))):
-            p.error(f"{name}: no status file and no output in {a.results} (a misspelt case?)")
+    dirs = [a.results] + ([a.paper_results] if a.cmd == "laws" else [])
+    for d in dirs[1:]:
+        if not os.path.isdir(d):
+            p.error(f"--paper-results: {d} is not a directory")
+    for d in dirs:
+        for name in getattr(a, "cases", None) or [a.case] + (getattr(a, "share_limits", None)
+                                                               or []):
+            if not (os.path.exists(os.path.join(d, name + ".status"))
+                    or os.path.isdir(os.path.join(d, name))):
+                p.error(f"{name}: no status file and no output in {d} (a misspelt case?)")
     {"load": cmd_load, "deformed": cmd_deformed, "fields": cmd_fields,
-     "geometry": cmd_geometry}[a.cmd](a)
+     "geometry": cmd_geometry, "laws": cmd_laws}[a.cmd](a)
 
 
 if __name__ == "__main__":

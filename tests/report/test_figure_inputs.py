@@ -95,6 +95,29 @@ def main():
         r = run("plots.py", "--results", res, "load", "--out", png, "made")
         c(r.returncode == 0 and os.path.exists(png),
           "plots.py on a made case without a curve draws its placeholder", r.stderr)
+        # The two laws side by side (fig07e, session 43): both directories must hold the case.
+        os.remove(png)
+        paper = os.path.join(tmp, "paper")
+        for args, needle in (
+                (("--results", res, "laws", "--paper-results", os.path.join(tmp, "nope"),
+                  "--out", png, "made"), "--paper-results: " + os.path.join(tmp, "nope")),
+                (("--results", res, "laws", "--paper-results", res, "--out", png, "mdae"),
+                 "mdae: no status file and no output in " + res)):
+            r = run("plots.py", *args)
+            c(r.returncode == 2 and needle in r.stderr and not os.path.exists(png),
+              "plots.py laws %s: exit 2, named" % args[4][len(tmp):], r.stderr)
+        for d in (res, paper):
+            os.makedirs(os.path.join(d, "made"), exist_ok=True)
+            with open(os.path.join(d, "made", "load_strain.csv"), "w") as f:
+                f.write("step,load_factor,applied_displacement_mm,strain,load_N,iterations,"
+                        "residual,seconds,negative_pivots,determinant_sign\n"
+                        "1,0.5,1,0.1,2,3,0,0,-1,1\n2,1,2,0.2,3,3,0,0,-1,-1\n")
+        r = run("plots.py", "--results", res, "laws", "--paper-results", paper, "--out", png,
+                "made")
+        c(r.returncode == 0 and os.path.exists(png), "plots.py laws draws both runs", r.stderr)
+    c(list(plots.negative_determinant(plots.np.array([1, -1, 0, -1]))) ==
+      [False, False, True, False, True] and not plots.negative_determinant(None).any(),
+      "negative_determinant: the steps with det K < 0, after the origin")
     # Figures are written through a temporary and a rename (figure_inputs.save_figure, session
     # 36): a drawing killed or failing half-way leaves no PNG that make takes as complete.
     sys.path.insert(0, FIG)
