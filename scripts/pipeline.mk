@@ -148,13 +148,16 @@ LAWCMP_STATUS := $(LAWCMP:%=$(RES_PAPER)/%.status)
 $(OUT)/cases_paper_law/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
 	@mkdir -p $(OUT)/cases_paper_law
 	@$(PY) $(FIGPY)/resolve_case.py $< $(DB) $@ paper
-$(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO)
+$(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO) \
+  $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(RES_PAPER)/$$*.status && \
+    [ ! -f $(RES_PAPER)/$$*/load_strain.csv ] && echo gone),FORCE)
 	@mkdir -p $(RES_PAPER) $(LOGS)
 	@echo "case (paper's law): $*"
 	@start=$$(date +%s.%N); rc=0; \
 	"$(MACRO)" run $< --output $(RES_PAPER)/$* > $(LOGS)/paper_law_$*.log 2>&1 || rc=$$?; \
 	end=$$(date +%s.%N); \
-	echo "{\"case\": \"$*\", \"law\": \"paper\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@
+	echo "{\"case\": \"$*\", \"law\": \"paper\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+	if [ $$rc -ne 0 ]; then echo "case (paper's law): $* exited with $$rc (see $(LOGS)/paper_law_$*.log)"; fi
 
 # ---- unit cells (Fig. 5) ----------------------------------------------------------------------
 $(OUT)/cells/%/cell.json: $(MESO)

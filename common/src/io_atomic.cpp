@@ -152,6 +152,7 @@ void unlink_live_temporaries() noexcept {
     if (g == 0 || g % 2 != 0) continue;  // never used, or released / being written
     std::memcpy(path, g_live_path[i], kLivePathMax);
     path[kLivePathMax - 1] = '\0';
+    std::atomic_thread_fence(std::memory_order_acquire);  // the copy before the re-check
     if (g_live_generation[i].load() == g) ::unlink(path);
   }
 }

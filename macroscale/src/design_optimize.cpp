@@ -131,8 +131,8 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
           "room to the bound it moves towards > 1e-2 J): raise max_iterations, lower "
           "function_tolerance (" +
           std::string(tol) + ") or x_tolerance (" + std::string(xtol) +
-          ": the smallest step, a fraction of each variable's interval; /optimizer) or start "
-          "from other values";
+          ": the smallest step, relative to |x| with ceres, to each variable's interval with "
+          "projected_gradient; /optimizer) or start from other values";
       break;
     case DesignStop::kPushesOut:
       why =

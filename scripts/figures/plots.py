@@ -168,12 +168,14 @@ def cmd_laws(a):
     fig, ax = plt.subplots(figsize=(6, 4.2))
     drawn = 0
     unstable = False
+    missing = []  # "NAME (law)" without a curve: said in the note (session 43's review)
     for k, name in enumerate(a.cases):
         colour = f"C{k}"
         for results, style, law in ((a.results, "-", "energy law"),
                                     (a.paper_results, "--", "paper's law")):
             r = Result(results, name)
             if not r.ok or len(r.csv.get("strain", [])) == 0:
+                missing.append(f"{label_of(name)} ({law})")
                 continue
             eps, f = r.strain(), r.load()
             lab = f"{label_of(name)}, {law}" + ("" if r.completed else " (stopped early)")
@@ -187,7 +189,9 @@ def cmd_laws(a):
         fig, ax, a, drawn, 7,
         "solid: the energy law (default); dashed: the paper's eq. 17 law, the same database"
         + ("; x: det K < 0 on the paper law's LU path (an odd number of negative eigenvalues)"
-           if unstable else ""))
+           if unstable else "")
+        + ("\nno curve (the run failed or converged no step; see the logs): " + ", ".join(missing)
+           if missing else ""))
 
 
 def outline(ax, P, **kw):

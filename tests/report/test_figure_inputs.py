@@ -115,6 +115,24 @@ def main():
         r = run("plots.py", "--results", res, "laws", "--paper-results", paper, "--out", png,
                 "made")
         c(r.returncode == 0 and os.path.exists(png), "plots.py laws draws both runs", r.stderr)
+        # A paper-law run without a curve is named below the axis (session 43's review: the
+        # figure drew the energy curve alone beside a note promising the dashed one).
+        notes = []
+        saved = plots.finish_load_figure
+        plots.finish_load_figure = lambda fig, ax, a, drawn, size, note: notes.append(note)
+        try:
+            os.remove(os.path.join(paper, "made", "load_strain.csv"))  # no curve, status kept
+            with open(os.path.join(paper, "made.status"), "w") as f:
+                f.write('{"case": "made", "exit_code": 1, "seconds": 0.1}')
+
+            class Args:
+                results, paper_results, cases, out, title = res, paper, ["made"], png, "t"
+            plots.cmd_laws(Args())
+        finally:
+            plots.finish_load_figure = saved
+        c(len(notes) == 1 and "no curve" in notes[0] and "made (paper's law)" in notes[0]
+          and "made (energy law)" not in notes[0], "plots.py laws names a missing paper-law curve",
+          repr(notes))
     c(list(plots.negative_determinant(plots.np.array([1, -1, 0, -1]))) ==
       [False, False, True, False, True] and not plots.negative_determinant(None).any(),
       "negative_determinant: the steps with det K < 0, after the origin")

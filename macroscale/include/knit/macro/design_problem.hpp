@@ -56,8 +56,10 @@ struct DesignOptimizerSpec {
   /// Converged when an accepted step lowers J by less than this fraction of J (choice: 1e-6,
   /// the last digits do not matter; a larger value stops a slow tail earlier).
   double function_tolerance = 1e-6;
-  /// Stop when a step changes no variable by more than this fraction of its interval (Ceres'
-  /// parameter_tolerance; the projected gradient's step floor). Since session 43 in the design
+  /// The step floor: with Ceres its parameter_tolerance (stop when |dx| <= tol (|x| + tol), the
+  /// whole vector of variables in their own units); with the projected gradient, when a step
+  /// changes no variable by more than this fraction of its interval. Since session 43 in the
+  /// design
   /// file: graded_wale stopped there at iteration 17 while J still fell, and the message's
   /// advice (more iterations, a lower function_tolerance) could not move it. Unset: the
   /// caller's OptimizeOptions::x_tolerance (1e-6).
