@@ -26,6 +26,7 @@ DB_SOURCE ?= auto
 # Sensitivity of the observables to the unit-cell parameters (issue #12; CSV columns parameter,
 # value, observable, result: scripts/figures/sensitivity.py). Drawn and reported when it exists.
 SENSITIVITY ?= $(ROOT)/cases/calibration/sensitivity.csv
+comma := ,
 CASEDIR := $(ROOT)/cases/paper
 FIGPY := $(ROOT)/scripts/figures
 DB := $(OUT)/database.h5
@@ -126,17 +127,24 @@ $(OUT)/cases/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
 # A case whose status says it completed but whose results are gone is run again (FORCE through
 # the second expansion; session 36's red team: results/NAME removed, the rerun re-made nothing
 # and the report kept its PASS verdicts on data that no longer existed).
+# $(call run_case,RESULTS,LOG,LABEL,JSON): the recipe of a case run: knit-macro run $< into
+# RESULTS/$*, its output in LOG, the status file $@ (JSON: members before the exit code).
+define run_case
+@mkdir -p $(1) $(LOGS)
+@echo "$(3): $*"
+@start=$$(date +%s.%N); rc=0; \
+"$(MACRO)" run $< --output $(1)/$* > $(2) 2>&1 || rc=$$?; \
+end=$$(date +%s.%N); \
+echo "{\"case\": \"$*\", $(4)\"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+if [ $$rc -ne 0 ]; then echo "$(3): $* exited with $$rc (see $(2))"; fi
+endef
+# The prerequisite that forces a rerun when RESULTS/$*.status says the run completed but its
+# load_strain.csv is gone (second expansion).
+case_gone = $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(1)/$$*.status && \
+    [ ! -f $(1)/$$*/load_strain.csv ] && echo gone),FORCE)
 .SECONDEXPANSION:
-$(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO) \
-  $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(RES)/$$*.status && \
-    [ ! -f $(RES)/$$*/load_strain.csv ] && echo gone),FORCE)
-	@mkdir -p $(RES) $(LOGS)
-	@echo "case: $*"
-	@start=$$(date +%s.%N); rc=0; \
-	"$(MACRO)" run $< --output $(RES)/$* > $(LOGS)/$*.log 2>&1 || rc=$$?; \
-	end=$$(date +%s.%N); \
-	echo "{\"case\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
-	if [ $$rc -ne 0 ]; then echo "case: $* exited with $$rc (see $(LOGS)/$*.log)"; fi
+$(RES)/%.status: $(OUT)/cases/%.json $(DB) $(MACRO) $(call case_gone,$(RES))
+	$(call run_case,$(RES),$(LOGS)/$*.log,case,)
 
 # ---- the paper's law beside the energy law (fig07e; issue 11 item 4, session 43) ---------------
 # The uniform cases of Sect. 3.1.2 run again with "law": "paper" (the eq. 17 surfaces of the same
@@ -148,16 +156,8 @@ LAWCMP_STATUS := $(LAWCMP:%=$(RES_PAPER)/%.status)
 $(OUT)/cases_paper_law/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
 	@mkdir -p $(OUT)/cases_paper_law
 	@$(PY) $(FIGPY)/resolve_case.py $< $(DB) $@ paper
-$(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO) \
-  $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(RES_PAPER)/$$*.status && \
-    [ ! -f $(RES_PAPER)/$$*/load_strain.csv ] && echo gone),FORCE)
-	@mkdir -p $(RES_PAPER) $(LOGS)
-	@echo "case (paper's law): $*"
-	@start=$$(date +%s.%N); rc=0; \
-	"$(MACRO)" run $< --output $(RES_PAPER)/$* > $(LOGS)/paper_law_$*.log 2>&1 || rc=$$?; \
-	end=$$(date +%s.%N); \
-	echo "{\"case\": \"$*\", \"law\": \"paper\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
-	if [ $$rc -ne 0 ]; then echo "case (paper's law): $* exited with $$rc (see $(LOGS)/paper_law_$*.log)"; fi
+$(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO) $(call case_gone,$(RES_PAPER))
+	$(call run_case,$(RES_PAPER),$(LOGS)/paper_law_$*.log,case (paper's law),\"law\": \"paper\"$(comma) )
 
 # ---- unit cells (Fig. 5) ----------------------------------------------------------------------
 $(OUT)/cells/%/cell.json: $(MESO)
