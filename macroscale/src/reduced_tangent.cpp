@@ -40,6 +40,11 @@ class PivotedSparseLU : public Eigen::SparseLU<SpMat, Eigen::COLAMDOrdering<int>
   }
 };
 
+/// The sign of det K from the number of negative pivots of an LDLT (det K = det D: Sylvester).
+int sign_of_inertia(int negative_pivots) {
+  return negative_pivots % 2 ? -1 : 1;
+}
+
 /// Fills in the pivot ratio and the singularity verdict from the pivots d.
 template <typename Vec>
 Factorization from_pivots(const Vec& d, bool count_negative, const char* kind) {
@@ -50,7 +55,7 @@ Factorization from_pivots(const Vec& d, bool count_negative, const char* kind) {
   f.pivot_ratio = hi > 0.0 ? lo / hi : 0.0;
   if (count_negative) {
     f.negative_pivots = static_cast<int>((d.array() < 0.0).count());
-    f.determinant_sign = f.negative_pivots % 2 ? -1 : 1;  // det K = det D (Sylvester)
+    f.determinant_sign = sign_of_inertia(f.negative_pivots);
   }
   if (!(f.pivot_ratio > ReducedTangent::kSingularPivotRatio) || !d.allFinite()) {
     std::ostringstream o;
@@ -387,7 +392,7 @@ bool ReducedTangent::factorize_multifrontal(Factorization& f) {
   ++multifrontal_factorizations_;
   f.method = "multifrontal LDLT";
   f.negative_pivots = m.negative_pivots();
-  if (f.negative_pivots >= 0) f.determinant_sign = f.negative_pivots % 2 ? -1 : 1;
+  if (f.negative_pivots >= 0) f.determinant_sign = sign_of_inertia(f.negative_pivots);
   if (st == MultifrontalLDLT::Status::kSingular) {
     f.pivot_ratio = 0.0;
     f.why =
