@@ -413,17 +413,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
       throw InputError(file, pointer + "/l_interpolation", "must be \"parameters\" or \"energy\"");
     o.l_interpolation = j["l_interpolation"].get<std::string>();
   }
-  if (j.contains("loss")) {
-    const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
-    if (l == "none")
-      o.loss = Loss::kNone;
-    else if (l == "huber")
-      o.loss = Loss::kHuber;
-    else if (l == "cauchy")
-      o.loss = Loss::kCauchy;
-    else
-      throw InputError(file, pointer + "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
-  }
+  read_loss_option(j, file, pointer, o.loss);
   if (j.contains("directions")) {
     const auto& d = j["directions"];
     if (!d.is_array() || d.empty())

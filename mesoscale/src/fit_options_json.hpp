@@ -7,6 +7,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/meso/fit/response_fit.hpp"
 
 namespace knit::meso::fit {
 
@@ -30,6 +31,22 @@ inline void read_double_option(const nlohmann::json& j, const char* key, const s
   if (!j.contains(key)) return;
   if (!j[key].is_number()) throw InputError(file, pointer + "/" + key, "must be a number");
   v = j[key].get<double>();
+}
+
+/// j["loss"] into v if present: "none", "huber" or "cauchy" (Loss of response_fit.hpp, used by
+/// both fits). Errors name file and pointer + "/loss".
+inline void read_loss_option(const nlohmann::json& j, const std::string& file,
+                             const std::string& pointer, Loss& v) {
+  if (!j.contains("loss")) return;
+  const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
+  if (l == "none")
+    v = Loss::kNone;
+  else if (l == "huber")
+    v = Loss::kHuber;
+  else if (l == "cauchy")
+    v = Loss::kCauchy;
+  else
+    throw InputError(file, pointer + "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
 }
 
 }  // namespace knit::meso::fit

@@ -228,17 +228,7 @@ FitOptions FitOptions::from_json(const std::string& text, const std::string& fil
     else
       throw InputError(file, "/initial_stiffness", "must be \"first_step\" or \"fit\"");
   }
-  if (j.contains("loss")) {
-    const std::string l = j["loss"].is_string() ? j["loss"].get<std::string>() : "";
-    if (l == "none")
-      o.loss = Loss::kNone;
-    else if (l == "huber")
-      o.loss = Loss::kHuber;
-    else if (l == "cauchy")
-      o.loss = Loss::kCauchy;
-    else
-      throw InputError(file, "/loss", "must be \"none\", \"huber\" or \"cauchy\"");
-  }
+  read_loss_option(j, file, "", o.loss);
   if (const auto bad = o.invalid()) throw InputError(file, bad->pointer, bad->message);
   return o;
 }

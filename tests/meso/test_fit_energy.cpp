@@ -623,6 +623,10 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("f.json: /l_interpolation"));
     CHECK(EnergyFitOptions::from_json(R"({"l_interpolation": "parameters"})", "f.json")
               .l_interpolation == "parameters");
+    // The loss is read by the helper the paper's fit shares (fit_options_json.hpp).
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"loss": "l1"})", "f.json", "/energy_fit"),
+                      Catch::Contains("f.json: /energy_fit/loss: must be \"none\""));
+    CHECK(EnergyFitOptions::from_json(R"({"loss": "cauchy"})", "f.json").loss == Loss::kCauchy);
     // Range before narrowing: 2^32 + 12 was read as 12 (the same check as the eq. 17 fit's).
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 4294967308})", "f.json"),
                       Catch::Contains("/hidden1") && Catch::Contains("32-bit"));
