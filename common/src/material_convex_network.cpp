@@ -392,7 +392,61 @@ std::string NetworkLawData::validate() const {
       if (shape.nonnegative(k) && theta(j, k) < 0.0)
         return "theta row " + std::to_string(j) + " column " + std::to_string(k) +
                ": the weights V, w, w1 must be >= 0 (they keep W convex)";
+  if (!(l_blend >= 0.0 && l_blend <= 0.5))
+    return "l_blend must be in [0, 0.5] (a fraction of the shorter span at each knot)";
   return {};
+}
+
+KnotWeights NetworkLawData::weights(double l) const {
+  const auto n = static_cast<Eigen::Index>(l_knots.size());
+  KnotWeights w;
+  w.count = 1;
+  w.c[0] = 1.0;
+  auto knot = [&](Eigen::Index j) { return l_knots[static_cast<std::size_t>(j)]; };
+  if (n <= 1 || l < knot(0) || l > knot(n - 1)) {  // clamped: one knot law, d/dl = 0
+    w.j[0] = n > 1 && l > knot(n - 1) ? n - 1 : 0;
+    return w;
+  }
+  // A rounding window around an interior knot j: [l_j - d, l_j + d], d = l_blend x the shorter
+  // neighbouring span. P0 = (1 - a) W_j + a W_j-1, P2 = (1 - b) W_j + b W_j+1 (a = d / h_j-1,
+  // b = d / h_j), W = (1 - s)^2 P0 + 2 s (1 - s) W_j + s^2 P2: c_j-1 = a (1 - s)^2, c_j+1 =
+  // b s^2; at s = 0 and 1 value and slope are the spans' (C1).
+  if (l_blend > 0.0 && n > 2) {
+    const auto up = static_cast<Eigen::Index>(std::upper_bound(l_knots.begin(), l_knots.end(), l) -
+                                              l_knots.begin());
+    for (Eigen::Index j : {up - 1, up}) {  // the knots either side of l
+      if (j < 1 || j > n - 2) continue;
+      const double hl = knot(j) - knot(j - 1), hr = knot(j + 1) - knot(j);
+      const double d = l_blend * std::min(hl, hr);
+      if (!(std::abs(l - knot(j)) < d)) continue;
+      const double s = (l - knot(j) + d) / (2.0 * d), a = d / hl, b = d / hr;
+      w.count = 3;
+      w.j[0] = j - 1;
+      w.j[1] = j;
+      w.j[2] = j + 1;
+      w.c[0] = a * (1.0 - s) * (1.0 - s);
+      w.c[2] = b * s * s;
+      w.c[1] = 1.0 - w.c[0] - w.c[2];
+      w.dc[0] = -a * (1.0 - s) / d;  // ds/dl = 1 / (2 d)
+      w.dc[2] = b * s / d;
+      w.dc[1] = -(w.dc[0] + w.dc[2]);
+      return w;
+    }
+  }
+  // A span [l_j, l_j+1) (the last knot itself: the span before it, one-sided).
+  Eigen::Index j = static_cast<Eigen::Index>(std::upper_bound(l_knots.begin(), l_knots.end(), l) -
+                                             l_knots.begin()) -
+                   1;
+  if (j >= n - 1) j = n - 2;
+  const double h = knot(j + 1) - knot(j), t = (l - knot(j)) / h;
+  w.count = 2;
+  w.j[0] = j;
+  w.j[1] = j + 1;
+  w.c[0] = 1.0 - t;
+  w.c[1] = t;
+  w.dc[0] = -1.0 / h;
+  w.dc[1] = 1.0 / h;
+  return w;
 }
 
 KnotSpan NetworkLawData::span(double l) const {

@@ -154,35 +154,27 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
     network_ = true;
     with_l_derivative_ = with_l_derivative;
     if (d.network.l_interpolation == LInterpolation::kEnergy) {
-      // W(e; l) = (1 - t) W_j + t W_j+1 (docs/database.md "Interpolation in l").
+      // W(e; l) = sum_k c_k W_j[k]: one knot's law, two in a span, three in a rounding window
+      // (NetworkLawData::weights; docs/database.md "Interpolation in l").
       energy_blend_ = true;
-      const KnotSpan s = d.network.span(l);
-      const std::vector<double> theta_j = d.network.theta_row(s.j);
-      net_ = NetworkLawAt(d.network.shape, theta_j);
-      lanes_ = NetworkLanesAt(d.network.shape, theta_j);
-      const auto& knots = d.network.l_knots;
-      if (s.inside && (s.t > 0.0 || with_l_derivative)) {
-        const std::vector<double> theta_next = d.network.theta_row(s.j + 1);
-        net_next_ = NetworkLawAt(d.network.shape, theta_next);
-        if (s.t > 0.0) lanes_ = NetworkLanesAt(d.network.shape, theta_j, theta_next, s.t);
-        has_next_ = true;
-        dl_span_ = knots[static_cast<std::size_t>(s.j + 1)] - knots[static_cast<std::size_t>(s.j)];
-      } else if (with_l_derivative && knots.size() > 1 &&
-                 (l == knots.front() || l == knots.back())) {
-        // At an end knot: the one-sided derivative of the span inside (session 39: it was 0,
-        // and a design stopped at the database's first or last loop length).
-        const auto n = static_cast<Eigen::Index>(knots.size());
-        if (l == knots.front()) {  // net_ is knot 0's law
-          net_next_ = NetworkLawAt(d.network.shape, d.network.theta_row(1));
-          has_next_ = true;
-          dl_span_ = knots[1] - knots[0];
-        } else {  // net_ is the last knot's law
-          net_prev_ = NetworkLawAt(d.network.shape, d.network.theta_row(n - 2));
-          has_prev_ = true;
-          dl_span_ =
-              knots[static_cast<std::size_t>(n - 1)] - knots[static_cast<std::size_t>(n - 2)];
-        }
+      const KnotWeights w = d.network.weights(l);
+      std::vector<std::vector<double>> th;
+      for (int k = 0; k < w.count; ++k) th.push_back(d.network.theta_row(w.j[k]));
+      if (w.count == 3) {
+        lanes_ =
+            NetworkLanesAt(d.network.shape, {&th[0], &th[1], &th[2]}, {w.c[0], w.c[1], w.c[2]});
+      } else if (w.count == 2 && w.c[1] > 0.0 && w.c[0] > 0.0) {
+        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], w.c[1]);
+      } else {  // one knot's law (at a knot: a span's t = 0 or 1)
+        const int k = w.count == 2 && w.c[0] == 0.0 ? 1 : 0;
+        lanes_ = NetworkLanesAt(d.network.shape, th[static_cast<std::size_t>(k)]);
       }
+      if (with_l_derivative)
+        for (int k = 0; k < w.count; ++k)
+          if (w.dc[k] != 0.0) {
+            dnet_.emplace_back(d.network.shape, th[static_cast<std::size_t>(k)]);
+            dweight_.push_back(w.dc[k]);
+          }
       return;
     }
     net_ = NetworkLawAt(d.network.shape, d.network.theta_at(l));
@@ -292,12 +284,10 @@ EnergyResponse EnergyLawAt::evaluate(const Eigen::Vector3d& e) const {
 Eigen::Vector3d EnergyLawAt::dS_dl(const Eigen::Vector3d& e) const {
   if (network_) {
     if (!with_l_derivative_) throw std::logic_error("EnergyLawAt: built without the l-derivative");
-    if (energy_blend_) {  // dW/dl = (W_j+1 - W_j) / dl in the span; 0 beyond the end knots
-      if (has_next_)
-        return Eigen::Vector3d((net_next_.evaluate(e).S - net_.evaluate(e).S) / dl_span_);
-      if (has_prev_)
-        return Eigen::Vector3d((net_.evaluate(e).S - net_prev_.evaluate(e).S) / dl_span_);
-      return Eigen::Vector3d::Zero();
+    if (energy_blend_) {  // dS/dl = sum_k dc_k/dl S_j[k] (0 beyond the end knots)
+      Eigen::Vector3d dS = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < dnet_.size(); ++k) dS += dweight_[k] * dnet_[k].evaluate(e).S;
+      return dS;
     }
     return (net_hi_.evaluate(e).S - net_lo_.evaluate(e).S) / (2.0 * net_h_);
   }

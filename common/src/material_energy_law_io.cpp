@@ -60,6 +60,15 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
     // "energy" (W piecewise linear: the convex combination of the two knots' laws).
     const bool energy = law.network.l_interpolation == LInterpolation::kEnergy;
     g.set_attribute(".", "l_interpolation", energy ? "energy" : "parameters");
+    // Since session 44, only when not 0 (a law without it is the law of sessions 16-43).
+    if (energy && law.network.l_blend > 0.0) {
+      g.set_attribute(".", "l_blend", law.network.l_blend);
+      g.set_attribute(".", "l_blend_law",
+                      "around each interior knot l_j, for |l - l_j| < d = l_blend x the shorter "
+                      "neighbouring span: W = (1 - s)^2 P0 + 2 s (1 - s) W_j + s^2 P2, s = (l - "
+                      "l_j + d) / (2 d), P0 and P2 the piecewise-linear law at l_j - d and l_j + "
+                      "d (C1 in l; knit/material/convex_network.hpp)");
+    }
     g.write("l_knots", law.network.l_knots);
     g.set_attribute("l_knots", "units",
                     energy ? "mm (W piecewise linear in l between these: W = (1 - t) W_j + t "
@@ -244,6 +253,13 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
                                "\"; this build reads \"parameters\" and \"energy\"");
         law.network.l_interpolation =
             li == "energy" ? LInterpolation::kEnergy : LInterpolation::kParameters;
+      }
+      // Optional (written since session 44 when not 0): the rounding of the knots' kinks.
+      if (root.has_attribute(g, "l_blend")) {
+        if (law.network.l_interpolation != LInterpolation::kEnergy)
+          throw InputError(file, g,
+                           "attribute l_blend is only read with l_interpolation \"energy\"");
+        law.network.l_blend = root.attribute_double(g, "l_blend");
       }
       law.network.l_knots = root.read_doubles(g + "/l_knots");
       law.network.theta = root.read_matrix(g + "/theta");

@@ -269,6 +269,10 @@ std::string EnergyFitOptions::validate() const {
   if (outer != "none" && outer != "exp") return "outer must be \"none\" or \"exp\"";
   if (l_interpolation != "parameters" && l_interpolation != "energy")
     return "l_interpolation must be \"parameters\" or \"energy\"";
+  if (!(l_blend >= 0.0 && l_blend <= 0.5))
+    return "l_blend must be in [0, 0.5] (a fraction of the shorter span at each knot)";
+  if (l_blend > 0.0 && l_interpolation != "energy")
+    return "l_blend needs l_interpolation \"energy\"";
   if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
   if (seed < 0) return "seed must be >= 0";
   if (network_iterations < 1 || network_iterations > 1000000)
@@ -308,6 +312,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"stiff2", stiff2},
                       {"outer", outer},
                       {"l_interpolation", l_interpolation},
+                      {"l_blend", l_blend},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
                       {"network_iterations", network_iterations},
@@ -356,6 +361,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
                                 "stiff2",
                                 "outer",
                                 "l_interpolation",
+                                "l_blend",
                                 "l_coupling",
                                 "seed",
                                 "network_iterations",
@@ -389,6 +395,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_int("hidden2", o.hidden2);
   get_int("stiff1", o.stiff1);
   get_int("stiff2", o.stiff2);
+  get_double("l_blend", o.l_blend);
   get_double("l_coupling", o.l_coupling);
   get_int("seed", o.seed);
   get_int("network_iterations", o.network_iterations);

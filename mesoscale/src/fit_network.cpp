@@ -360,6 +360,7 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   law.network.l_interpolation = o.l_interpolation == "energy"
                                     ? material::LInterpolation::kEnergy
                                     : material::LInterpolation::kParameters;
+  law.network.l_blend = o.l_blend;
   law.network.theta.resize(n, P);
   const double wscale = sh.outer != 0 ? 1.0 : sS * sE;
   const double lscale = sh.outer != 0 ? 1.0 / sE : std::sqrt(sS / sE);

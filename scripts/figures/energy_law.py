@@ -158,16 +158,48 @@ class NetworkLaw:
 
 class BlendedLaw:
     """W(e; l) = (1 - t) W_j(e) + t W_j+1(e) between two knots' laws (attribute
-    l_interpolation = "energy", session 16; knit/material/convex_network.hpp LInterpolation)."""
+    l_interpolation = "energy", session 16; knit/material/convex_network.hpp LInterpolation),
+    or sum_k c_k W_k(e) over three knots' laws in a rounding window (attribute l_blend, session
+    44): `a`, `b` and `t`, or `laws` and `weights`."""
 
-    def __init__(self, a, b, t):
-        self.a, self.b, self.t = a, b, t
-        self.floor = a.floor
+    def __init__(self, a=None, b=None, t=None, laws=None, weights=None):
+        if laws is None:
+            laws, weights = [a, b], [1.0 - t, t]
+        self.laws, self.weights = laws, weights
+        self.floor = laws[0].floor
 
     def eval(self, e):
-        Wa, Sa = self.a.eval(e)
-        Wb, Sb = self.b.eval(e)
-        return (1.0 - self.t) * Wa + self.t * Wb, (1.0 - self.t) * Sa + self.t * Sb
+        W, S = 0.0, 0.0
+        for law, c in zip(self.laws, self.weights):
+            Wk, Sk = law.eval(e)
+            W, S = W + c * Wk, S + c * Sk
+        return W, S
+
+
+def knot_weights(knots, l, l_blend):
+    """The knot laws' weights [(j, c_j)] of the law at l (NetworkLawData::weights of
+    knit/material/convex_network.hpp): one knot beyond the ends, two in a span, three within
+    d = l_blend x the shorter neighbouring span of an interior knot, where the kink is rounded
+    by the quadratic Bezier curve through the piecewise-linear law at l_j - d, l_j, l_j + d."""
+    n = len(knots)
+    if n == 1 or l <= knots[0]:
+        return [(0, 1.0)]
+    if l >= knots[-1]:
+        return [(n - 1, 1.0)]
+    up = int(np.searchsorted(knots, l, side="right"))
+    if l_blend > 0.0:
+        for j in (up - 1, up):
+            if j < 1 or j > n - 2:
+                continue
+            hl, hr = knots[j] - knots[j - 1], knots[j + 1] - knots[j]
+            d = l_blend * min(hl, hr)
+            if abs(l - knots[j]) < d:
+                s = (l - knots[j] + d) / (2.0 * d)
+                c0, c2 = d / hl * (1.0 - s) ** 2, d / hr * s * s
+                return [(j - 1, c0), (j, 1.0 - c0 - c2), (j + 1, c2)]
+    j = up - 1
+    t = (l - knots[j]) / (knots[j + 1] - knots[j])
+    return [(j, 1.0 - t), (j + 1, t)]
 
 
 def stored_l_interpolation(g):
@@ -196,15 +228,10 @@ def network_law(g, l, mode):
     if mode == "parameters":
         return NetworkLaw(g, l)
     knots = np.array(g["l_knots"])
-    if len(knots) == 1 or l <= knots[0]:
-        return NetworkLaw(g, l, row=0)
-    if l >= knots[-1]:
-        return NetworkLaw(g, l, row=len(knots) - 1)
-    j = int(np.searchsorted(knots, l, side="right")) - 1
-    t = (l - knots[j]) / (knots[j + 1] - knots[j])
-    if t == 0.0:
-        return NetworkLaw(g, l, row=j)
-    return BlendedLaw(NetworkLaw(g, l, row=j), NetworkLaw(g, l, row=j + 1), t)
+    w = [(j, c) for j, c in knot_weights(knots, l, float(g.attrs.get("l_blend", 0.0))) if c != 0.0]
+    if len(w) == 1:
+        return NetworkLaw(g, l, row=w[0][0])
+    return BlendedLaw(laws=[NetworkLaw(g, l, row=j) for j, _ in w], weights=[c for _, c in w])
 
 
 def main():

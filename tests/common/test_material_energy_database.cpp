@@ -382,9 +382,11 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   db.energy_law->network.shape.outer_cap = 1.7;
   // and the interpolation in l (session 16)
   db.energy_law->network.l_interpolation = LInterpolation::kEnergy;
+  db.energy_law->network.l_blend = 0.2;  // and the rounding of its kinks (session 44)
   write_database(file, db);
   {
     const auto f = knit::io::H5File::open_read(file);
+    CHECK(f.attribute_double("/energy_law", "l_blend") == 0.2);
     CHECK(f.attribute_string("/energy_law", "family") == "network");
     CHECK(f.attribute_string("/energy_law", "outer") == "exp");
     CHECK(f.attribute_string("/energy_law", "l_interpolation") == "energy");
@@ -402,6 +404,7 @@ TEST_CASE("database v3: the network law round trip", "[unit]") {
   CHECK(b.network.shape.outer_scale == 0.3);
   CHECK(b.network.shape.outer_cap == 1.7);
   CHECK(b.network.l_interpolation == LInterpolation::kEnergy);
+  CHECK(b.network.l_blend == 0.2);
   CHECK(b.network.l_knots == a.network.l_knots);
   CHECK(b.network.theta == a.network.theta);
   CHECK(b.floor == a.floor);
@@ -458,6 +461,34 @@ TEST_CASE("database v3: a network law without l_interpolation interpolates theta
   CHECK_THROWS_WITH(
       read_database(bad, false),
       Catch::Contains("/energy_law") && Catch::Contains("l_interpolation is \"spline\""));
+}
+
+TEST_CASE("database v3: l_blend is optional, written only when not 0, and checked", "[unit]") {
+  // Session 44: a law without the attribute is the law of sessions 16-43 (no rounding); the
+  // writer leaves it out at 0, so such a law's file is as before.
+  const auto file = tmp("network_no_l_blend.h5");
+  write_network_db_then(file, [](knit::io::H5File& f) {
+    CHECK_FALSE(f.has_attribute("/energy_law", "l_blend"));
+    f.remove_attribute("/energy_law", "l_interpolation");
+    f.set_attribute("/energy_law", "l_interpolation", "energy");
+  });
+  const Database back = read_database(file, false);
+  REQUIRE(back.energy_law);
+  CHECK(back.energy_law->network.l_blend == 0.0);
+  // Out of [0, 0.5], or beside the parameters' interpolation: refused with the HDF5 path.
+  const auto wide = tmp("network_wide_l_blend.h5");
+  write_network_db_then(wide, [](knit::io::H5File& f) {
+    f.remove_attribute("/energy_law", "l_interpolation");
+    f.set_attribute("/energy_law", "l_interpolation", "energy");
+    f.set_attribute("/energy_law", "l_blend", 0.6);
+  });
+  CHECK_THROWS_WITH(read_database(wide, false), Catch::Contains("/energy_law") &&
+                                                    Catch::Contains("l_blend must be in [0, 0.5]"));
+  const auto theta = tmp("network_theta_l_blend.h5");
+  write_network_db_then(
+      theta, [](knit::io::H5File& f) { f.set_attribute("/energy_law", "l_blend", 0.1); });
+  CHECK_THROWS_WITH(read_database(theta, false),
+                    Catch::Contains("/energy_law") && Catch::Contains("l_blend is only read with"));
 }
 
 TEST_CASE("database v3: an unknown outer function is refused with its HDF5 path", "[unit]") {

@@ -289,6 +289,90 @@ TEST_CASE("energy law: at an inner knot dS/dl is the slope of the span above it"
   CHECK(backward_gap > 1e-3);
 }
 
+TEST_CASE("energy law: l_blend rounds the kink at an inner knot (C1 in l, convex weights)",
+          "[unit]") {
+  // Session 44 (NetworkLawData::l_blend): graded_wale's design stopped with two quadrature
+  // points at l = 5.000 mm, on the piecewise-linear law's kink. With l_blend = 0.2 the test law
+  // (knots 4.5, 5.5, 6.5) is rounded in [5.3, 5.7]: there W = (1 - s)^2 P0 + 2 s (1 - s) W_5.5 +
+  // s^2 P2 with P0, P2 the piecewise-linear law at 5.3 and 5.7; outside, it is that law.
+  EnergyLawData d = testing::make_test_network_law();
+  d.network.l_interpolation = LInterpolation::kEnergy;
+  const EnergyLaw sharp(d);
+  d.network.l_blend = 0.2;
+  const EnergyLaw law(d);
+  std::mt19937 gen(44);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  const double h = 1e-6;
+  double kink = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    // Outside the window: the unrounded law, to the last bit (the same evaluator).
+    for (double l : {4.0, 4.5, 4.8, 5.299, 5.701, 6.25, 6.5, 7.0}) {
+      const EnergyResponse a = law.at(l).evaluate(e), b = sharp.at(l).evaluate(e);
+      REQUIRE(a.W == b.W);
+      REQUIRE(a.S == b.S);
+      REQUIRE(a.C == b.C);
+    }
+    // Inside: the Bezier combination of the unrounded law's values.
+    const EnergyResponse P0 = sharp.at(5.3).evaluate(e), P1 = sharp.at(5.5).evaluate(e),
+                         P2 = sharp.at(5.7).evaluate(e);
+    for (double l : {5.35, 5.5, 5.62}) {
+      const double s = (l - 5.3) / 0.4;
+      const double c0 = (1 - s) * (1 - s), c1 = 2 * s * (1 - s), c2 = s * s;
+      const EnergyResponse r = law.at(l).evaluate(e);
+      REQUIRE(r.W == Approx(c0 * P0.W + c1 * P1.W + c2 * P2.W).epsilon(1e-12).margin(1e-14));
+      REQUIRE((r.S - (c0 * P0.S + c1 * P1.S + c2 * P2.S)).norm() <= 1e-12 * (1 + r.S.norm()));
+      REQUIRE((r.C - (c0 * P0.C + c1 * P1.C + c2 * P2.C)).norm() <= 1e-12 * (1 + r.C.norm()));
+      // Convex: a nonnegative combination of convex laws, eig(C) >= the floor.
+      REQUIRE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.C).eigenvalues().minCoeff() >=
+              d.floor * (1 - 1e-12));
+    }
+    // dS/dl equals the central difference in l in the window, at its edges and at the knot,
+    // and (C1) so do both one-sided differences, to their O(h d2S/dl2) (a kink of the size
+    // checked below would put them 1 apart).
+    for (double l : {5.3, 5.31, 5.45, 5.5, 5.58, 5.7}) {
+      const Eigen::Vector3d dS = law.at(l, true).dS_dl(e);
+      const Eigen::Vector3d S = law.at(l).evaluate(e).S;
+      const Eigen::Vector3d fwd = (law.at(l + h).evaluate(e).S - S) / h;
+      const Eigen::Vector3d bwd = (S - law.at(l - h).evaluate(e).S) / h;
+      INFO("l = " << l << ": dS/dl " << dS.transpose() << ", forward " << fwd.transpose()
+                  << ", backward " << bwd.transpose());
+      // (At the window's edges d2S/dl2 jumps, so the central difference is first order there.)
+      const double central_tol = l == 5.3 || l == 5.7 ? 1e-4 : 1e-6;
+      REQUIRE((0.5 * (fwd + bwd) - dS).norm() <= central_tol * (1 + dS.norm()));
+      REQUIRE((fwd - dS).norm() <= 1e-4 * (1 + dS.norm()));
+      REQUIRE((bwd - dS).norm() <= 1e-4 * (1 + dS.norm()));
+    }
+    // At the knot: the mean of the two spans' slopes, and the value d / 4 times the slopes'
+    // difference off the knot's own law (d = 0.2 mm, the spans 1 mm).
+    const Eigen::Vector3d Sa = sharp.at(4.5).evaluate(e).S, Sc = sharp.at(6.5).evaluate(e).S;
+    REQUIRE((law.at(5.5, true).dS_dl(e) - 0.5 * (Sc - Sa)).norm() <= 1e-12 * (1 + Sc.norm()));
+    const Eigen::Vector3d off = 0.05 * ((Sc - P1.S) - (P1.S - Sa));
+    REQUIRE((law.at(5.5).evaluate(e).S - (P1.S + off)).norm() <= 1e-12 * (1 + P1.S.norm()));
+    kink = std::max(kink, ((Sc - P1.S) - (P1.S - Sa)).norm());
+  }
+  CHECK(kink > 1e-3);  // the test law has a kink to round, so the checks above can fail
+  // The weights: nonnegative, summing to 1, their derivatives to 0, on a fine grid of l.
+  for (double l = 4.0; l <= 7.0; l += 0.00123) {
+    const KnotWeights w = d.network.weights(l);
+    double sum = 0.0, dsum = 0.0;
+    for (int k = 0; k < w.count; ++k) {
+      REQUIRE(w.c[k] >= 0.0);
+      sum += w.c[k];
+      dsum += w.dc[k];
+    }
+    REQUIRE(sum == Approx(1.0).epsilon(1e-14));
+    REQUIRE(dsum == Approx(0.0).margin(1e-12));
+    REQUIRE(w.count == (std::abs(l - 5.5) < 0.2 ? 3 : (l < 4.5 || l > 6.5 ? 1 : 2)));
+  }
+  // Out of range: refused.
+  for (double bad : {-0.1, 0.51, static_cast<double>(NAN)}) {
+    EnergyLawData b = d;
+    b.network.l_blend = bad;
+    CHECK_THROWS_WITH(validate(b), Catch::Contains("l_blend must be in [0, 0.5]"));
+  }
+}
+
 TEST_CASE("energy law: validation refuses bad data", "[unit]") {
   const EnergyLawData good = testing::make_test_energy_law();
   CHECK_NOTHROW(validate(good));

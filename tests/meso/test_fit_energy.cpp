@@ -623,6 +623,13 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
                       Catch::Contains("f.json: /l_interpolation"));
     CHECK(EnergyFitOptions::from_json(R"({"l_interpolation": "parameters"})", "f.json")
               .l_interpolation == "parameters");
+    // The rounding of the knots' kinks (session 44): a fraction up to 0.5, energy interpolation.
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"l_blend": 0.6})", "f.json"),
+                      Catch::Contains("l_blend must be in [0, 0.5]"));
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(
+                          R"({"l_blend": 0.1, "l_interpolation": "parameters"})", "f.json"),
+                      Catch::Contains("l_blend needs l_interpolation"));
+    CHECK(EnergyFitOptions::from_json(R"({"l_blend": 0.1})", "f.json").l_blend == 0.1);
     // The loss is read by the helper the paper's fit shares (fit_options_json.hpp).
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"loss": "l1"})", "f.json", "/energy_fit"),
                       Catch::Contains("f.json: /energy_fit/loss: must be \"none\""));

@@ -237,13 +237,39 @@ struct KnotSpan {
   bool inside = false;
 };
 
+/// The knot laws that make up the law at one loop length with LInterpolation::kEnergy: W(e; l)
+/// = sum_k c_k W_j[k](e), c_k >= 0, sum c_k = 1 (so W stays convex with eig(C) >= the floor),
+/// and dc_k/dl (NetworkLawData::weights). One knot at a knot or beyond the ends, two in a span,
+/// three in a rounding window around an interior knot (l_blend > 0).
+struct KnotWeights {
+  int count = 0;
+  Eigen::Index j[3] = {0, 0, 0};
+  double c[3] = {0.0, 0.0, 0.0};
+  double dc[3] = {0.0, 0.0, 0.0};
+};
+
 /// The network family over l: knots and one theta per knot.
 struct NetworkLawData {
   NetworkShape shape;
   std::vector<double> l_knots;  ///< strictly increasing, mm (the fitted loop lengths)
   Eigen::MatrixXd theta;        ///< row j: theta at l_knots[j] (shape.size() columns)
   LInterpolation l_interpolation = LInterpolation::kParameters;
+  /// With kEnergy: the half-width of the window around each interior knot l_j in which the
+  /// kink of the piecewise-linear blend is rounded, as a fraction of the shorter neighbouring
+  /// span (0 ... 0.5; 0: no rounding, the law of sessions 16-43; attribute `l_blend` of
+  /// /energy_law, absent = 0). In [l_j - d, l_j + d], s = (l - l_j + d) / (2 d), the law is
+  /// the quadratic Bezier curve (1 - s)^2 P0 + 2 s (1 - s) W_j + s^2 P2 through the piecewise-
+  /// linear law's values P0 = W(l_j - d), P2 = W(l_j + d): W, S and C are then C1 in l (a
+  /// design's objective is smooth in its stitch values; session 44: graded_wale stopped on the
+  /// kink at 5.0 mm), the weights stay >= 0 (convex), and at l_j itself the law departs from
+  /// W_j by d/4 times the difference of the two spans' slopes (docs/database.md,
+  /// "Interpolation in l").
+  double l_blend = 0.0;
   KnotSpan span(double l) const;
+  /// The knot weights of the law at l (kEnergy). dc: d/dl, with the conventions of theta_at:
+  /// zero beyond the ends, one-sided at the end knots, the right span's at an interior knot
+  /// without rounding.
+  KnotWeights weights(double l) const;
   /// Row j of theta.
   std::vector<double> theta_row(Eigen::Index j) const;
   /// Empty if valid (sizes, finite, V, w, w1 >= 0, knots increasing), else the reason.

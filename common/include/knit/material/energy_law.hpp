@@ -142,15 +142,12 @@ class EnergyLawAt {
   NetworkLawAt net_;
   NetworkLawAt net_lo_, net_hi_;  ///< theta(l) -/+ h dtheta/dl, for dS_dl (network family)
   double net_h_ = 0.0;
-  /// LInterpolation::kEnergy: net_ is knot j's law, net_next_ knot j+1's (W = (1 - t) W_j +
-  /// t W_j+1 in lanes_); dS/dl = (S_j+1 - S_j) / dl_span_.
+  /// LInterpolation::kEnergy: W = sum_k c_k W_j[k] in lanes_ (NetworkLawData::weights); with
+  /// the l-derivative, the knot laws whose dc_k/dl is not 0 and those derivatives: dS/dl =
+  /// sum_k dweight_[k] S(dnet_[k]).
   bool energy_blend_ = false;
-  NetworkLawAt net_next_;
-  /// At the last knot (with the l-derivative only): knot n-2's law, for the one-sided
-  /// derivative (S_n-1 - S_n-2) / dl_span_.
-  NetworkLawAt net_prev_;
-  double dl_span_ = 0.0;
-  bool has_next_ = false, has_prev_ = false;
+  std::vector<NetworkLawAt> dnet_;
+  std::vector<double> dweight_;
 };
 
 /// The family over l: validated data and the l-basis.

@@ -69,6 +69,12 @@ struct EnergyFitOptions {
   /// 103 % of the stress range off the cell between two of them). The fit itself sees the
   /// knots only, so both give the same law there.
   std::string l_interpolation = "energy";
+  /// With l_interpolation "energy": the rounding of the kinks at the interior knots, the
+  /// window's half-width as a fraction of the shorter neighbouring span (0 ... 0.5; 0: none;
+  /// NetworkLawData::l_blend, session 44). The fit does not see it (it fits each knot's law to
+  /// that knot's data); the diagnostics evaluate the law with it, which departs from the knot
+  /// law at the knot by l_blend / 4 x the second difference of the knots' laws.
+  double l_blend = 0.0;
   double l_coupling = 1e-4;
   int seed = 1;
   int network_iterations = 4000;
