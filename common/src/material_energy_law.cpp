@@ -161,8 +161,13 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
       std::vector<std::vector<double>> th;
       for (int k = 0; k < w.count; ++k) th.push_back(d.network.theta_row(w.j[k]));
       if (w.count == 3) {
-        lanes_ =
-            NetworkLanesAt(d.network.shape, {&th[0], &th[1], &th[2]}, {w.c[0], w.c[1], w.c[2]});
+        // (c0 + c2) [(1 - t) W_j-1 + t W_j+1] in the four-lane evaluator (its AVX2 kernel),
+        // plus c1 W_j in a two-lane one (session 44: faster than one portable six-lane pass).
+        const double outer = w.c[0] + w.c[2];
+        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[2], w.c[2] / outer);
+        lanes_scale_ = outer;
+        middle_ = NetworkLanesAt(d.network.shape, th[1]);
+        middle_scale_ = w.c[1];
       } else if (w.count == 2 && w.c[1] > 0.0 && w.c[0] > 0.0) {
         lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], w.c[1]);
       } else {  // one knot's law (at a knot: a span's t = 0 or 1)
@@ -244,7 +249,13 @@ void EnergyLawAt::accumulate(const Eigen::Vector3d& e, EnergyResponse& r) const 
 }
 
 EnergyResponse EnergyLawAt::evaluate_network(const Eigen::Vector3d& e) const {
-  const NetworkResponse n = lanes_.evaluate(e);
+  NetworkResponse n = lanes_.evaluate(e);
+  if (middle_scale_ > 0.0) {  // a rounding window of l_blend: the middle knot's law besides
+    const NetworkResponse m = middle_.evaluate(e);
+    n.W = lanes_scale_ * n.W + middle_scale_ * m.W;
+    n.S = lanes_scale_ * n.S + middle_scale_ * m.S;
+    n.C = lanes_scale_ * n.C + middle_scale_ * m.C;
+  }
   EnergyResponse r;
   r.W = n.W + 0.5 * floor_ * e.squaredNorm();
   r.S = n.S + floor_ * e;

@@ -13,7 +13,7 @@ namespace knit::material {
 namespace {
 
 constexpr int kMaxUnitsPerLane = 64;  // NetworkShape::validate's bound
-constexpr int kMaxLanes = 6;          // three knot laws in a rounding window of l_blend
+constexpr int kMaxLanes = 4;
 
 /// The activation on the n units of a lane; rho on its last `stiff`. The sigma units two at a
 /// time, branch-free (SSE2, part of every x86-64): x clamped to [-1, 1] gives the cubic piece's
@@ -330,20 +330,6 @@ NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape, const std::vector<doub
   build(shape, {&theta_a, &theta_a, &theta_b, &theta_b}, {a, a, b, b}, kernel);
 }
 
-NetworkLanesAt::NetworkLanesAt(const NetworkShape& shape,
-                               const std::vector<const std::vector<double>*>& thetas,
-                               const std::vector<double>& weights) {
-  if (thetas.size() != weights.size() || thetas.empty())
-    throw std::invalid_argument("NetworkLanesAt: one weight per theta");
-  std::vector<const std::vector<double>*> lane_theta;
-  std::vector<double> lane_weight;
-  for (std::size_t k = 0; k < thetas.size(); ++k) {
-    lane_theta.insert(lane_theta.end(), 2, thetas[k]);  // the law and its mirror image
-    lane_weight.insert(lane_weight.end(), 2, 0.5 * weights[k]);
-  }
-  build(shape, lane_theta, lane_weight, LanesKernel::kPortable);
-}
-
 void NetworkLanesAt::build(const NetworkShape& shape,
                            const std::vector<const std::vector<double>*>& thetas,
                            const std::vector<double>& lane_weight, LanesKernel kernel) {
@@ -449,8 +435,6 @@ NetworkResponse NetworkLanesAt::evaluate(const Eigen::Vector3d& e) const {
     r = lanes_sum<12, 6, 2>(shape_, K_, q, om, Q, e);
   else if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 4)
     r = lanes_sum<12, 6, 4>(shape_, K_, q, om, Q, e);
-  else if (shape_.h1 == 12 && shape_.h2 == 6 && K_ == 6)
-    r = lanes_sum<12, 6, 6>(shape_, K_, q, om, Q, e);
   else
     r = lanes_sum<0, 0, 0>(shape_, K_, q, om, Q, e);
   r.W -= W0_ + S0_.dot(e);

@@ -41,10 +41,6 @@ class NetworkLanesAt {
   NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
                  const std::vector<double>& theta_b, double t,
                  LanesKernel kernel = LanesKernel::kAuto);
-  /// W = sum_k weight_k W(theta_k), each normalized as above (2 x thetas.size() lanes; the
-  /// rounding windows of l_blend take three). weights >= 0 keep W convex.
-  NetworkLanesAt(const NetworkShape& shape, const std::vector<const std::vector<double>*>& thetas,
-                 const std::vector<double>& weights);
   /// W, S, C at e (material frame, e finite). Allocation-free.
   NetworkResponse evaluate(const Eigen::Vector3d& e) const;
   int lanes() const { return K_; }
