@@ -6,8 +6,11 @@
 //   knit-meso fit db.h5                       # both laws
 //   knit-meso fit db.h5 --law energy --energy-options energy.json -o refit.h5
 //   knit-meso fit db.h5 --law paper --options fit.json
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -38,12 +41,58 @@ namespace {
                              "database first");
 }
 
+/// Which file a path names, and its state: a database replaced by rename (another sweep's or
+/// fit's atomic write) has another inode, one rewritten in place another size or mtime.
+struct FileIdentity {
+  dev_t dev = 0;
+  ino_t ino = 0;
+  off_t size = 0;
+  long long mtime_ns = 0;
+  bool operator==(const FileIdentity&) const = default;
+};
+
+/// The identity of `path` now (an empty one when it cannot be read: never that of a file).
+FileIdentity identity_of(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {};
+  return {st.st_dev, st.st_ino, st.st_size,
+          static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec};
+}
+
+/// The input opened again to copy what the refit does not write (carry_over_unwritten), if it
+/// is still the file that was read (`read`: its identity before it was read); otherwise sets
+/// `changed` and throws. Session 44's red team: a sweep that replaced DB during the fit gave an
+/// OUT with the first database's loop lengths and the second one's /loop_2, /loop_3 and
+/// /sweep/report, exit 0. Opened first, then compared: a replacement at any moment since the
+/// read is seen (a false alarm at worst).
+knit::io::H5File open_input_again(const std::string& input, const FileIdentity& read,
+                                  bool& changed) {
+  auto src = knit::io::H5File::open_read(input);
+  changed = !(identity_of(input) == read);
+  if (changed) throw std::runtime_error(input + ": changed during the fit");
+  return src;
+}
+
+/// The error of a refit whose input changed (write_database's own message would name the
+/// target first, and the input's change as a detail).
+[[noreturn]] void refuse_changed_input(const std::string& db, const std::string& target) {
+  std::error_code ec;
+  throw std::runtime_error(
+      db +
+      ": changed during the fit (replaced or rewritten since it was read: another sweep or "
+      "fit wrote it, say): nothing was written, since what the refit does not write itself "
+      "would come from another database (" +
+      target + (std::filesystem::exists(target, ec) ? " is left as it was" : " was not created") +
+      "); fit it again");
+}
+
 /// What an in-place refit of `input` (read into `db`) would drop: the database as read, written
 /// with the same carry-over to a scratch file in the system's temporary directory (removed
 /// after). The refit changes only the groups items_not_carried() leaves out (/energy_law,
 /// /loop_<k>/fit), so the scratch file lacks what the refit's file would lack.
 std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
-                                             const std::string& input, bool energy, bool paper) {
+                                             const std::string& input, const FileIdentity& read,
+                                             bool energy, bool paper) {
   namespace fs = std::filesystem;
   // No usable temporary directory (TMPDIR not a directory): no pre-check (the review of session
   // 42: temp_directory_path() threw, and ended the refit it should spare).
@@ -59,13 +108,15 @@ std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
     }
   } remove{scratch};
   std::vector<std::string> lost;
+  bool changed = false;
   try {
     knit::material::write_database(scratch, db, [&](knit::io::H5File& f) {
-      const auto src = knit::io::H5File::open_read(input);
+      const auto src = open_input_again(input, read, changed);
       knit::material::carry_over_unwritten(src, f, "check");
       lost = knit::material::items_not_carried(src, f, energy, paper);
     });
   } catch (const std::exception&) {
+    if (changed) refuse_changed_input(input, input);
     // A scratch file that cannot be written (a full temporary directory) does not stop the
     // refit: the same check after its write still keeps the input as it was.
     return {};
@@ -110,6 +161,8 @@ static knit::cli::SubcommandRegistrar reg_fit(
                                       o->out.empty() ? "database" : "--out",
                                       o->out.empty() ? "" : knit::material::kDatabaseFormatName);
         const knit::io::OutputLock lock(target);
+        // Before the read: a change from here on is seen when the input is opened again.
+        const auto read_as = knit::meso::cmd_fit::identity_of(o->db);
         auto db = knit::material::read_database(o->db, true);
         const bool paper = o->law != "energy", energy = o->law != "paper";
         // An options file the chosen law does not read is refused, not ignored unread (session
@@ -129,7 +182,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
           std::error_code ec;
           if (std::filesystem::equivalent(target, o->db, ec))
             if (const auto lost =
-                    knit::meso::cmd_fit::items_lost_by_refit(db, o->db, energy, paper);
+                    knit::meso::cmd_fit::items_lost_by_refit(db, o->db, read_as, energy, paper);
                 !lost.empty())
               knit::meso::cmd_fit::refuse_in_place(o->db, lost);
         }
@@ -182,9 +235,13 @@ static knit::cli::SubcommandRegistrar reg_fit(
         std::vector<std::string> carried, lost;
         std::error_code ec;
         const bool in_place = std::filesystem::equivalent(target, o->db, ec);
+        bool changed = false;
         try {
           knit::material::write_database(target, db, [&](knit::io::H5File& f) {
-            const auto src = knit::io::H5File::open_read(o->db);
+            // Test hook (tests/meso/test_fit_cli.cpp): the process stops itself here, and the
+            // test replaces the input before it lets it go on.
+            if (std::getenv("KNIT_FIT_TEST_STOP_BEFORE_COPY")) ::raise(SIGSTOP);
+            const auto src = knit::meso::cmd_fit::open_input_again(o->db, read_as, changed);
             carried = knit::material::carry_over_unwritten(
                 src, f,
                 "the laws were refitted by knit-meso fit (" + db.provenance.created +
@@ -196,6 +253,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
             if (in_place && !lost.empty()) throw std::runtime_error("items not carried over");
           });
         } catch (const std::exception&) {
+          if (changed) knit::meso::cmd_fit::refuse_changed_input(o->db, target);
           if (!in_place || lost.empty()) throw;
           knit::meso::cmd_fit::refuse_in_place(o->db, lost);
         }

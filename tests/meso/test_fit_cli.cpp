@@ -1,12 +1,16 @@
 // knit-meso synth / fit from the command line: a raw-only synthetic database is refitted in
 // place; bad options are input errors (exit 2) naming the file and the field.
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "knit/io/hdf5.hpp"
 #include "knit/material/database.hpp"
@@ -316,4 +320,94 @@ TEST_CASE("knit-meso fit and synth: empty values, devices and unused options are
   CHECK(run("fit " + db.string() + " --law energy --options " + (dir / "missing.json").string() +
             " -o " + unused.string()) == 2);
   CHECK_FALSE(fs::exists(unused));
+}
+
+namespace {
+/// `knit-meso ARGS...` with KNIT_FIT_TEST_STOP_BEFORE_COPY set: the fit stops itself
+/// (SIGSTOP) before it opens its input again to copy what it does not write. Returns the pid,
+/// once the process has stopped (-1 if it ended instead); stdout to /dev/null, stderr to `err`.
+pid_t spawn_fit_stopped_before_copy(const std::vector<std::string>& args, const fs::path& err) {
+  const std::string exe = std::string(KNIT_BIN_DIR) + "/knit-meso";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setenv("KNIT_FIT_TEST_STOP_BEFORE_COPY", "1", 1);
+    const int null_fd = ::open("/dev/null", O_WRONLY);
+    const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(null_fd, 1);
+    dup2(err_fd, 2);
+    std::vector<char*> argv{const_cast<char*>(exe.c_str())};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(exe.c_str(), argv.data());
+    _exit(127);
+  }
+  int st = 0;
+  if (pid < 0 || waitpid(pid, &st, WUNTRACED) != pid || !WIFSTOPPED(st)) return -1;
+  return pid;
+}
+
+/// Lets a process of spawn_fit_stopped_before_copy go on: its exit code.
+int continue_fit(pid_t pid) {
+  kill(pid, SIGCONT);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+}  // namespace
+
+// Session 44's red team: the fit read DB, and opened it again by name when it wrote OUT, to
+// copy what it does not write itself; a sweep that replaced DB in between (other loop lengths)
+// gave an OUT with the first database's data and the second one's /loop_2, /loop_3 and
+// /sweep/report, exit 0. Now the input must be the file that was read: else exit 1, nothing
+// written. The test hook stops the fit just before it opens the input again.
+TEST_CASE("knit-meso fit: an input replaced during the fit is refused, nothing written", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path a = dir / "cli_fit_changed_a.h5", b = dir / "cli_fit_changed_b.h5",
+                 db = dir / "cli_fit_changed.h5", out = dir / "cli_fit_changed_out.h5",
+                 err = dir / "cli_fit_changed.err";
+  REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + a.string()) == 0);
+  REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,5,5.5,6.5 --out " + b.string()) == 0);
+  const std::string b_bytes = bytes(b);
+  const auto replace_db = [&] {  // as a sweep's atomic write does: a new file, renamed
+    fs::copy_file(b, dir / "cli_fit_changed.new", fs::copy_options::overwrite_existing);
+    fs::rename(dir / "cli_fit_changed.new", db);
+  };
+  // Unchanged: the hook alone changes nothing.
+  fs::copy_file(a, db, fs::copy_options::overwrite_existing);
+  fs::remove(out);
+  pid_t pid = spawn_fit_stopped_before_copy(
+      {"fit", db.string(), "--law", "paper", "-o", out.string()}, err);
+  REQUIRE(pid > 0);
+  CHECK(continue_fit(pid) == 0);
+  CHECK(knit::material::read_database(out).entries.size() == 2);
+  // Replaced, into another file: refused, OUT not created.
+  fs::remove(out);
+  pid = spawn_fit_stopped_before_copy({"fit", db.string(), "--law", "paper", "-o", out.string()},
+                                      err);
+  REQUIRE(pid > 0);
+  replace_db();
+  CHECK(continue_fit(pid) == 1);
+  CHECK_FALSE(fs::exists(out));
+  std::ifstream in(err);
+  const std::string text(std::istreambuf_iterator<char>(in), {});
+  CHECK_THAT(text, Catch::StartsWith("knit-meso fit: error: " + db.string() +
+                                     ": changed during the fit (replaced or rewritten since it "
+                                     "was read") &&
+                       Catch::Contains("nothing was written") &&
+                       Catch::Contains(out.string() + " was not created"));
+  // In place: refused, the new database left as the other program wrote it.
+  fs::copy_file(a, db, fs::copy_options::overwrite_existing);
+  pid = spawn_fit_stopped_before_copy({"fit", db.string(), "--law", "paper"}, err);
+  REQUIRE(pid > 0);
+  replace_db();
+  CHECK(continue_fit(pid) == 1);
+  CHECK(bytes(db) == b_bytes);
+  // Rewritten in place (the same inode, another size and time): refused as well.
+  fs::copy_file(a, db, fs::copy_options::overwrite_existing);
+  pid = spawn_fit_stopped_before_copy({"fit", db.string(), "--law", "paper", "-o", out.string()},
+                                      err);
+  REQUIRE(pid > 0);
+  fs::copy_file(b, db, fs::copy_options::overwrite_existing);
+  CHECK(continue_fit(pid) == 1);
+  CHECK_FALSE(fs::exists(out));
 }
