@@ -22,6 +22,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/sweep/sweep.hpp"
@@ -129,6 +130,47 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
   std::fflush(stdout);
 }
 
+/// The one line a failing sweep writes on stderr: why it failed and what became of the output
+/// (session 44's red team: with --no-progress stderr was empty, only stdout's summary said why;
+/// knit-meso fit does the same since session 36).
+std::string failure_line(const knit::meso::sweep::SweepInput& in,
+                         const knit::meso::sweep::SweepReport& rep, const std::string& output) {
+  using namespace knit::meso::sweep;
+  std::string why;
+  if (!rep.not_written.empty())
+    return "knit-meso sweep: error: database not written: " + rep.not_written +
+           " (the sweep's report is on stdout)";
+  if (const int failed = rep.failed_cases(); failed > 0) {
+    const auto jobs = make_jobs(in);
+    for (std::size_t i = 0; i < rep.results.size() && why.empty(); ++i)
+      if (fails_sweep(rep.results[i]))
+        why = std::to_string(failed) + (failed == 1 ? " case" : " cases") +
+              " did not converge; the first: l = " + knit::io::format_number(jobs[i].loop_length) +
+              " mm case " + std::to_string(jobs[i].path) + " (" +
+              knit::material::to_string(jobs[i].load_path.kind) + ", " + jobs[i].load_path.set +
+              "): " + to_string(rep.results[i].status) + ": " + rep.results[i].message;
+  }
+  for (std::size_t k = 0; k < rep.fits.size() && why.empty(); ++k)
+    if (!rep.fits[k].ok())
+      why = "the paper law at l = " + knit::io::format_number(in.loop_lengths[k]) +
+            " mm: " + rep.fits[k].reason;
+  if (why.empty() && rep.energy_fit && !rep.energy_fit->ok())
+    why = "the energy law: " + rep.energy_fit->reason;
+  if (why.empty()) why = "the sweep failed";
+  std::string what;
+  if (rep.wrote_database && rep.written != std::filesystem::path(output))
+    what = output +
+           " is left as it was; this sweep's database, with every case's status and "
+           "message, is " +
+           rep.written.string();
+  else if (rep.wrote_database)
+    what = "wrote " + output +
+           " (no database was there) with every case's status and message, for the diagnosis";
+  else
+    what = "no database was written";
+  return "knit-meso sweep: error: " + why + "; " + what + " (the sweep's report is on stdout)";
+}
+
 // Ctrl-C (SIGINT), and SIGTERM and SIGHUP (a job scheduler's stop, a closed terminal; session
 // 22), say what is kept and how to go on, then end the process as the signal would (session
 // 21: it printed nothing). knit::cli::on_interrupt_say holds the async-signal-safe handler.
@@ -177,7 +219,9 @@ int run(const Cli& c) {
     const SweepReport rep = run_sweep(in, o, runner, &mpi);
     if (mpi.rank() != 0) return knit::kExitOk;
     print_summary(in, rep, c.output);
-    return rep.ok() ? knit::kExitOk : knit::kExitFailure;
+    if (rep.ok()) return knit::kExitOk;
+    std::fprintf(stderr, "%s\n", failure_line(in, rep, c.output).c_str());
+    return knit::kExitFailure;
   } catch (const knit::InputError&) {
     throw;  // every rank reads the same input and fails the same way
   } catch (const std::exception& e) {

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdlib>
@@ -277,4 +278,38 @@ TEST_CASE("knit-meso sweep: the database keeps a cell parameter file's contents,
       knit::meso::sweep::parse_sweep_input(db.sweep_input, (elsewhere / "stored.json").string());
   CHECK(nlohmann::json::parse(again.cell_json) == nlohmann::json::parse(cell));
   CHECK(again.cell_file.empty());
+}
+
+// Session 44's red team: a sweep that failed exited 1 with nothing on stderr (with
+// --no-progress); only stdout's summary said why. Now one line on stderr says why and what
+// became of the output, as knit-meso fit's does (session 36). An energy-law floor of 1000 MPa
+// fails the energy fit of the synthetic runner's data.
+TEST_CASE("knit-meso sweep: a failing sweep says why on stderr, and what it wrote", "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_stderr");
+  knit_test::write_text(dir / "f.json",
+                        R"({"loop_lengths": [5], "runner": "synthetic", "steps": 6,
+                            "energy_fit": {"floor": 1000, "network_iterations": 100}})");
+  const fs::path db = dir / "db.h5", err = dir / "stderr.txt";
+  const std::string sweep = kExe + " sweep " + (dir / "f.json").string() + " --output " +
+                            db.string() + " --no-progress > /dev/null 2> " + err.string();
+  // No database there: the failing sweep's own is written, for the diagnosis.
+  CHECK(shell(sweep) == 1);
+  std::string text = knit_test::read_text(err);
+  CHECK_THAT(text, Catch::StartsWith("knit-meso sweep: error: the energy law: ") &&
+                       Catch::EndsWith("; wrote " + db.string() +
+                                       " (no database was there) with every case's status and "
+                                       "message, for the diagnosis (the sweep's report is on "
+                                       "stdout)\n"));
+  CHECK(std::count(text.begin(), text.end(), '\n') == 1);
+  REQUIRE(fs::exists(db));
+  // A database there: kept, this sweep's beside it.
+  const std::string before = knit_test::read_text(db);
+  CHECK(shell(sweep) == 1);
+  text = knit_test::read_text(err);
+  CHECK_THAT(text, Catch::StartsWith("knit-meso sweep: error: the energy law: ") &&
+                       Catch::Contains("; " + db.string() +
+                                       " is left as it was; this sweep's database, with every "
+                                       "case's status and message, is " +
+                                       (dir / "db.failed.h5").string()));
+  CHECK(knit_test::read_text(db) == before);
 }
