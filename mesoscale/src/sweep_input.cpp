@@ -89,6 +89,38 @@ material::CoverageOptions read_coverage(const nlohmann::json& c, const material:
   return o;
 }
 
+/// The smallest area ratio J = det F a ray may run to: that of an explicit gradient path
+/// (det(I + H) > 0.05, explicit_paths).
+constexpr double kMinRayJ = 0.05;
+
+/// Rays are shortened to J = fill_min_J where they would leave the admissible states; below
+/// kMinRayJ that is refused, naming the field (session 44's red team: fill_min_J 0 ran rays of
+/// the default box to J = 0, a collapsed cell without a deformation gradient, and the sweep
+/// ended with exit 1 and "load path: no upper-triangular F for this strain", naming nothing).
+/// A ray that reaches the box's surface first is not shortened: fill_min_J does not matter
+/// for it, and a box whose rays all do so takes any value.
+void check_ray_floor(const material::CoverageOptions& co, const std::string& file) {
+  if (co.rays == 0 || co.fill_min_J >= kMinRayJ) return;
+  int below = 0;  // rays that reach J = kMinRayJ inside the box (shortened there)
+  for (int k = 0; k < co.rays; ++k) {
+    const Eigen::Vector3d E =
+        material::box_ray_end(co.box, material::half_sphere_direction(k, co.rays), kMinRayJ);
+    const double J2 = (1.0 + 2.0 * E(0)) * (1.0 + 2.0 * E(1)) - 4.0 * E(2) * E(2);
+    if (J2 < std::pow(kMinRayJ * (1.0 + 1e-6), 2)) ++below;
+  }
+  if (below == 0) return;
+  throw InputError(
+      file, "/load_paths/coverage/fill_min_J",
+      "is " + shortest(co.fill_min_J) + ", but " + std::to_string(below) + " of the " +
+          std::to_string(co.rays) +
+          " rays (/load_paths/coverage/rays) would run past J = det F = " + shortest(kMinRayJ) +
+          " in this box, towards a collapsed cell (J = 0: no deformation gradient); "
+          "with rays it must be >= " +
+          shortest(kMinRayJ) +
+          ", the floor of an explicit gradient path's det(I + H) (default 0.5: the "
+          "cell locks up below)");
+}
+
 /// An explicit list of paths (schemas/sweep.schema.json, the array form).
 std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int steps,
                                                const std::string& file,
@@ -241,8 +273,9 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     }
     const material::StrainBox box = read_box(lp, file);
     if (lp.contains("coverage")) {
-      const auto cov = material::coverage_load_paths(read_coverage(lp.at("coverage"), box));
-      append(in, cov);
+      const material::CoverageOptions co = read_coverage(lp.at("coverage"), box);
+      check_ray_floor(co, file);
+      append(in, material::coverage_load_paths(co));
     }
     if (lp.contains("holdout")) {
       const auto& h = lp.at("holdout");

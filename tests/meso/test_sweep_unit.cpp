@@ -255,6 +255,40 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
         "<no error>");
 }
 
+// Session 44's red team: rays with "fill_min_J": 0 ran to J = det F = 0 in the default box, and
+// the schema-valid input failed with exit 1 and "load path: no upper-triangular F for this
+// strain", naming no file or field. Refused up front now, where a ray would pass J = 0.05.
+TEST_CASE("sweep input: rays towards a collapsed cell are refused at fill_min_J", "[unit]") {
+  const auto input = [](const std::string& coverage, const std::string& box = "") {
+    return R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )" +
+           (box.empty() ? "" : R"("box": )" + box + ", ") + R"("coverage": )" + coverage + "}}";
+  };
+  const auto error_of = [](const std::string& text) {
+    try {
+      parse_sweep_input(text, "s.json");
+    } catch (const knit::InputError& e) {
+      return std::string(e.what());
+    } catch (const std::exception& e) {
+      return std::string("not an input error: ") + e.what();
+    }
+    return std::string("<no error>");
+  };
+  for (const char* j : {"0", "0.01"}) {
+    INFO("fill_min_J " << j);
+    CHECK_THAT(error_of(input(R"({"rays": 20, "fill_min_J": )" + std::string(j) + "}")),
+               Catch::StartsWith("s.json: /load_paths/coverage/fill_min_J: is " + std::string(j) +
+                                 ", but 3 of the 20 rays (/load_paths/coverage/rays) would run "
+                                 "past J = det F = 0.05 in this box") &&
+                   Catch::Contains("with rays it must be >= 0.05"));
+  }
+  CHECK(error_of(input(R"({"rays": 20, "fill_min_J": 0.05})")) == "<no error>");
+  CHECK(error_of(input(R"({"fill_min_J": 0})")) == "<no error>");  // no rays: fill points skip
+  // A box whose rays all reach its surface first: fill_min_J does not shorten them.
+  CHECK(error_of(input(R"({"rays": 20, "fill_min_J": 0})",
+                       R"({"E11": [-0.1, 0.1], "E22": [-0.1, 0.1], "E12_max": 0.1})")) ==
+        "<no error>");
+}
+
 // Session 25: an input without e_max ran the fan to 0.35 while the header of
 // default_load_paths and docs/database.md say 0.40.
 TEST_CASE("sweep input: the preset's fan without e_max and e_min is the documented default",
