@@ -99,7 +99,14 @@ std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
   std::error_code tmp_ec;
   const fs::path tmp = fs::temp_directory_path(tmp_ec);
   if (tmp_ec) return {};
-  const fs::path scratch = tmp / ("knit-meso-fit-check-" + std::to_string(::getpid()) + ".h5");
+  // A name of its own, created exclusively (session 44's red team: a user's file named
+  // knit-meso-fit-check-<pid>.h5 was overwritten, then deleted). write_database replaces this
+  // empty file of ours by rename; the Remove below removes only what was created here.
+  std::string name = (tmp / "knit-meso-fit-check-XXXXXX.h5").string();
+  const int fd = ::mkstemps(name.data(), 3);
+  if (fd < 0) return {};  // as without a temporary directory
+  ::close(fd);
+  const fs::path scratch = name;
   struct Remove {
     fs::path p;
     ~Remove() {

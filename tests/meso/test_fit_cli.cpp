@@ -411,3 +411,39 @@ TEST_CASE("knit-meso fit: an input replaced during the fit is refused, nothing w
   CHECK(continue_fit(pid) == 1);
   CHECK_FALSE(fs::exists(out));
 }
+
+// Session 44's red team: the in-place pre-check wrote $TMPDIR/knit-meso-fit-check-<pid>.h5 over
+// any file of that name, then deleted it. Its scratch file is now created exclusively under a
+// name of its own: a user's file of the old name (made by the test's child under its own pid,
+// which exec keeps) is left as it was, and nothing is left behind.
+TEST_CASE("knit-meso fit: the in-place pre-check never overwrites a file in TMPDIR", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_fit_tmpdir.h5", tmp = dir / "cli_fit_tmpdir";
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + db.string()) == 0);
+  const std::string exe = std::string(KNIT_BIN_DIR) + "/knit-meso";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string mine = (tmp / ("knit-meso-fit-check-" + std::to_string(getpid()) + ".h5"));
+    std::ofstream(mine) << "a user's file";
+    setenv("TMPDIR", tmp.c_str(), 1);
+    const int null_fd = ::open("/dev/null", O_WRONLY);
+    dup2(null_fd, 1);
+    dup2(null_fd, 2);
+    execl(exe.c_str(), exe.c_str(), "fit", db.c_str(), "--law", "paper",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  REQUIRE(pid > 0);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));
+  const fs::path mine = tmp / ("knit-meso-fit-check-" + std::to_string(pid) + ".h5");
+  CHECK(fs::exists(mine));
+  CHECK(bytes(mine) == "a user's file");
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(tmp)) files += e.path() != mine;
+  CHECK(files == 0);
+  CHECK(knit::material::read_database(db).entries[0].surface);  // refitted in place
+}
