@@ -16,6 +16,7 @@ set(knit_test_costs
   "test_meso:knit-meso cell/path: every option is checked for finiteness and range first=12.96"
   "test_meso:energy fit: the uniaxial-stress diagnostic compares the law driven like the cell=9.78"
   "test_meso:rod case: a reversed end moment stops at the work cap, outputs of converged steps kept=8.94"
+  "test_meso:knit-meso sweep: a sweep that writes nothing says so and leaves no new directories=8"
   "test_meso:4.5 mm cell is stiffer than 6.5 mm in both directions=7.86"
   "test_common:fuzz: mutated database files load or throw InputError=7.66"
   "test_meso:knit-meso path: a killed run leaves the previous output as it was=7.37"

@@ -19,6 +19,8 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -182,9 +184,35 @@ void explain_interrupt(const Cli& c) {
       " --resume`");
 }
 
+/// The output's parent directories that do not exist yet (deepest first): the sweep creates
+/// them (for its lock and checkpoints), and removes them again, if they are still empty, when
+/// it ends without a database in them (session 44's red team: a failed `sweep -o a/b/db.h5`
+/// left a/b behind). Only empty directories are removed (rmdir), so nothing but ours goes.
+struct NewParentDirectories {
+  std::vector<std::filesystem::path> dirs;
+  explicit NewParentDirectories(const std::string& output) {
+    std::error_code ec;
+    for (auto p = std::filesystem::path(output).parent_path();
+         !p.empty() && !std::filesystem::exists(std::filesystem::symlink_status(p, ec));
+         p = p.parent_path())
+      dirs.push_back(p);
+  }
+  ~NewParentDirectories() {
+    for (const auto& d : dirs) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(std::filesystem::symlink_status(d, ec)) &&
+          std::filesystem::is_empty(d, ec) && !ec)
+        std::filesystem::remove(d, ec);
+    }
+  }
+};
+
 int run(const Cli& c) {
   using namespace knit::meso::sweep;
   MpiSession mpi;
+  // (rank 0 only: the others create nothing, and end before it)
+  std::optional<NewParentDirectories> new_parents;
+  if (mpi.rank() == 0) new_parents.emplace(c.output);
   try {
     const SweepInput in = load_sweep_input(c.input);
     if (c.resume && c.force)

@@ -307,8 +307,11 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   // without a single state would replace whatever the output holds. Leave it as it was.
   if (std::none_of(rep.results.begin(), rep.results.end(),
                    [](const JobResult& r) { return r.converged_steps() > 0; })) {
+    // (session 44's red team: "left as it was" of an output that did not exist; fit's wording)
+    std::error_code ec;
     rep.not_written =
-        "no case converged a single step; " + opt.output.string() + " is left as it was";
+        "no case converged a single step; " + opt.output.string() +
+        (std::filesystem::exists(opt.output, ec) ? " is left as it was" : " was not created");
     rep.seconds_total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!opt.keep_parts) store->remove();

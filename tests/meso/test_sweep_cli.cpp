@@ -313,3 +313,28 @@ TEST_CASE("knit-meso sweep: a failing sweep says why on stderr, and what it wrot
                                        (dir / "db.failed.h5").string()));
   CHECK(knit_test::read_text(db) == before);
 }
+
+// Session 44's red team: a failed `knit-meso sweep c.json -o a/b/db.h5` said "a/b/db.h5 is
+// left as it was" of a file that never existed, and left the empty a/b behind (made for its
+// lock and checkpoints). Now "was not created", as knit-meso fit says since session 41, and
+// the empty directories it made are gone; a directory that was there stays. No case converges
+// a single step here (one paper path, two steps, a friction coefficient of 1e300, no retry).
+TEST_CASE("knit-meso sweep: a sweep that writes nothing says so and leaves no new directories",
+          "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_not_created");
+  knit_test::write_text(dir / "n.json",
+                        R"({"loop_lengths": [5], "steps": 2, "retry": {"max_retries": 0},
+                            "load_paths": {"preset": "default", "select": [0]},
+                            "cell": {"contact": {"mu": 1e300}}, "fit": false})");
+  const fs::path db = dir / "a" / "b" / "db.h5", err = dir / "stderr.txt";
+  const std::string sweep = kExe + " sweep " + (dir / "n.json").string() + " --output " +
+                            db.string() + " --no-progress > /dev/null 2> " + err.string();
+  CHECK(shell(sweep) == 1);
+  CHECK_THAT(knit_test::read_text(err), Catch::Contains("no case converged a single step; " +
+                                                        db.string() + " was not created"));
+  CHECK_FALSE(fs::exists(dir / "a"));
+  fs::create_directories(dir / "a");  // the user's: kept
+  CHECK(shell(sweep) == 1);
+  CHECK(fs::is_directory(dir / "a"));
+  CHECK_FALSE(fs::exists(dir / "a" / "b"));
+}
