@@ -575,9 +575,29 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
                   std::to_string(out.diagnostics.rms.maxCoeff()) + ", max " +
                   std::to_string(out.diagnostics.max.maxCoeff()) +
                   "): the raw data hold values too large to fit");
+  // Session 44's red team: smoothing 1000 on a 4 x 4 grid was written with a largest error of
+  // 98 % of the stress range (RMS 32-35 %), exit 0 (the default fits: RMS 0.1-0.2 %).
+  if (const std::string why =
+          fit_error_refusal(out.diagnostics.max_relative, out.diagnostics.rms_relative);
+      !why.empty()) {
+    out.status = FitStatus::kSolverFailed;
+    out.reason = "the surfaces miss their own fit data " + why +
+                 ": not a law of these data; look at the fit options (smoothing, control "
+                 "points, loss)";
+    return out;
+  }
   out.diagnostics.points_skipped = skipped;
   out.diagnostics.options_json = o.to_json();
   return out;
+}
+
+std::string fit_error_refusal(double max_relative, double rms_relative) {
+  if (!(max_relative > kMaxFitErrorRelative || rms_relative > kMaxFitRmsRelative)) return {};
+  std::ostringstream m;
+  m << "by up to " << 100.0 * max_relative << " % of the stress range, RMS " << 100.0 * rms_relative
+    << " % (more than " << 100.0 * kMaxFitErrorRelative << " % or an RMS of "
+    << 100.0 * kMaxFitRmsRelative << " %)";
+  return m.str();
 }
 
 material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
@@ -629,6 +649,7 @@ material::FitDiagnostics diagnose(const ResponseSurfaceData& surface,
   }
   for (int c = 0; c < 5; ++c) dg.rms(c) = count(c) ? std::sqrt(sum2(c) / count(c)) : 0.0;
   dg.max_relative = srange > 0.0 ? dg.max.tail<3>().maxCoeff() / srange : 0.0;
+  dg.rms_relative = srange > 0.0 ? dg.rms.tail<3>().maxCoeff() / srange : 0.0;
   return dg;
 }
 

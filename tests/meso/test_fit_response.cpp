@@ -74,6 +74,32 @@ TEST_CASE("fit: robust loss and foot-point optimization run and stay accurate", 
   CHECK(fp.diagnostics.max_relative < 0.01);
 }
 
+TEST_CASE("fit: a law that misses its data by their range, or by an RMS of a quarter, fails",
+          "[unit]") {
+  // Session 44's red team: the paper's surfaces smoothed flat (smoothing 1000, 4 x 4 control
+  // points) were written with a largest error of 98 % of the stress range and an RMS of 32-35
+  // %, exit 0; a ridge energy law of the one direction (1, 0, 0), 97.8 % and 30.7 %. The bound
+  // on the largest error alone (the whole range) cannot see such laws; the RMS bound does,
+  // and a robust fit that leaves out one outlier (largest 96 %, RMS 6 %, the Huber test above)
+  // stays a law. Both fits ask fit_error_refusal.
+  CHECK(fit_error_refusal(0.045, 0.02).empty());  // the default energy law
+  CHECK(fit_error_refusal(0.96, 0.062).empty());  // the Huber fit with its outlier
+  CHECK(fit_error_refusal(1.0, 0.25).empty());    // on both bounds
+  CHECK_THAT(fit_error_refusal(0.98, 0.32),       // the red team's flat surfaces
+             Catch::Equals("by up to 98 % of the stress range, RMS 32 % (more than 100 % or an "
+                           "RMS of 25 %)"));
+  CHECK_FALSE(fit_error_refusal(252.1, 70.5).empty());  // session 41's floor of 1000 MPa
+  CHECK_FALSE(fit_error_refusal(1.01, 0.1).empty());
+  // On the synthetic law the flattest surfaces miss by 64 % with an RMS of 18 %: a law.
+  SyntheticOptions so;
+  const FitSummary flat =
+      fit_loop_length(synthetic_paths(so, 5.5),
+                      FitOptions::from_json(
+                          R"({"smoothing": 1000, "control_points_1": 4, "control_points_2": 4})"));
+  CHECK(flat.ok());
+  CHECK(flat.diagnostics.rms_relative == Approx(0.183).margin(0.01));
+}
+
 TEST_CASE("fit: data that cannot determine the surface are refused with the reason", "[unit]") {
   SyntheticOptions so;
   auto raw = synthetic_paths(so, 5.0);

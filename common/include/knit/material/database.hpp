@@ -76,6 +76,9 @@ struct FitDiagnostics {
   Eigen::Matrix<double, kComponents, 1> max = Eigen::Matrix<double, kComponents, 1>::Zero();
   /// Largest stress error relative to the data's stress range (max |S| over all components).
   double max_relative = 0.0;
+  /// The largest of the stress components' RMS errors relative to the same range (not stored
+  /// in the database; the fit's refusal reads it).
+  double rms_relative = 0.0;
   int points_used = 0, points_skipped = 0;
   std::string options_json;  ///< the fit options used (JSON text)
 };

@@ -148,10 +148,6 @@ struct EnergyFitOptions {
                                     const std::string& pointer = "");
 };
 
-/// A fitted law whose largest error against its own fit data exceeds this fraction of a loop
-/// length's stress range fails (kSolverFailed; nothing is written): 1, the whole range.
-inline constexpr double kMaxFitErrorRelative = 1.0;
-
 struct EnergyFitSummary {
   FitStatus status = FitStatus::kOk;
   std::string reason;

@@ -86,6 +86,23 @@ struct FitOptions {
 
 enum class FitStatus { kOk, kRefused, kSolverFailed };
 
+/// A fitted law (the paper's surfaces or the energy law) whose largest error against its own
+/// fit data exceeds this fraction of a loop length's stress range fails (kSolverFailed; nothing
+/// is written): the whole range (session 41).
+inline constexpr double kMaxFitErrorRelative = 1.0;
+/// ... or whose RMS error (the largest of the three stress components') exceeds this fraction
+/// of it (session 44). A law that is no law misses one-signed data by at most their range, so
+/// the first bound alone let session 44's red team pass laws that miss 95-98 % of it (RMS 31-35
+/// %: the paper's surfaces smoothed flat, a ridge law of the one direction (1, 0, 0)). The
+/// largest error alone is no measure: a robust (Huber) fit that leaves out one outlier misses it
+/// by 96 % of the range with an RMS of 6 %. The default fits: the paper's largest 0.3-0.4 %, the
+/// energy law's RMS 1.7-2.3 %.
+inline constexpr double kMaxFitRmsRelative = 0.25;
+/// Empty if a law whose errors against its own fit data are these (fractions of the stress
+/// range) is within both bounds above, else the errors and the bounds, in words ("by up to X %
+/// of the stress range, RMS Y % (more than 100 % or an RMS of 25 %)"), for the fits' reasons.
+std::string fit_error_refusal(double max_relative, double rms_relative);
+
 struct FitSummary {
   FitStatus status = FitStatus::kOk;
   std::string reason;  ///< why it was refused / failed
