@@ -212,6 +212,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
                                     : EnergyFitOptions::from_json(read_text_file(o->energy_options),
                                                                   o->energy_options);
           eo.threads = o->threads;
+          eo.progress = stderr;  // a line every 5 s of the network's L-BFGS
           const auto s = fit_energy_database(db, eo);
           std::cout << energy_fit_report(s);
           if (s.status == FitStatus::kRefused)

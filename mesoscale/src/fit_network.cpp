@@ -34,7 +34,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <system_error>
 #include <thread>
@@ -248,6 +250,36 @@ std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
   return phi;
 }
 
+/// One line of progress every `every` seconds of L-BFGS (EnergyFitOptions::progress): the
+/// iteration, the objective and the time so far.
+class ProgressLines : public ceres::IterationCallback {
+ public:
+  ProgressLines(std::FILE* out, int iterations, double every)
+      : out_(out),
+        iterations_(iterations),
+        every_(every),
+        start_(std::chrono::steady_clock::now()),
+        last_(start_) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    const auto now = std::chrono::steady_clock::now();
+    if (out_ && std::chrono::duration<double>(now - last_).count() >= every_) {
+      last_ = now;
+      std::fprintf(out_,
+                   "energy fit: L-BFGS iteration %d of %d (%.0f %%), objective %.6g, %.0f s\n",
+                   s.iteration, iterations_, 100.0 * s.iteration / std::max(1, iterations_), s.cost,
+                   std::chrono::duration<double>(now - start_).count());
+      std::fflush(out_);
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  std::FILE* out_;
+  int iterations_;
+  double every_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
 }  // namespace
 
 std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
@@ -328,6 +360,8 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   so.gradient_tolerance = 1e-12;
   so.parameter_tolerance = 1e-14;
   so.logging_type = ceres::SILENT;
+  ProgressLines progress(o.progress, o.network_iterations, o.progress_seconds);
+  if (o.progress) so.callbacks.push_back(&progress);
   ceres::GradientProblemSolver::Summary summary;
   ceres::Solve(so, problem, phi.data(), &summary);
   iterations += static_cast<int>(summary.iterations.size());

@@ -323,6 +323,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   if (in.fit && in.energy_fit) {
     fit::EnergyFitOptions eo = in.energy_fit_options;
     eo.threads = rep.threads;  // the cases' threads are idle by now
+    eo.progress = opt.progress;
     rep.energy_fit = fit::fit_energy_database(db, eo);
   }
   rep.seconds_fit = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();

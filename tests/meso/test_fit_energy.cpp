@@ -314,6 +314,30 @@ TEST_CASE("energy fit: a heavier uniaxial tube brings the uniaxial curves closer
   CHECK(EnergyFitOptions::from_json(o.to_json()).to_json() == o.to_json());
 }
 
+TEST_CASE("energy fit: the network fit says how far it is", "[unit]") {
+  // Session 44's red team: knit-meso fit ran 45 s with nothing on stderr, and the sweep's bar
+  // stood at 100 % through its fit. EnergyFitOptions::progress gets one line every
+  // progress_seconds (here 0: every iteration); the law is the same with or without it.
+  const Database db = synthetic_coverage_db({4.5, 6.5}, 4);
+  EnergyFitOptions o = small_network(4, 3, 20);
+  const EnergyFitSummary quiet = fit_energy_law(db, o);
+  REQUIRE(quiet.ok());
+  std::FILE* f = std::tmpfile();
+  REQUIRE(f);
+  o.progress = f;
+  o.progress_seconds = 0.0;
+  const EnergyFitSummary loud = fit_energy_law(db, o);
+  REQUIRE(loud.ok());
+  std::rewind(f);
+  std::string text;
+  for (int c; (c = std::fgetc(f)) != EOF;) text += static_cast<char>(c);
+  std::fclose(f);
+  CHECK_THAT(text, Catch::StartsWith("energy fit: L-BFGS iteration ") &&
+                       Catch::Contains(" of 20 (") && Catch::Contains("objective"));
+  CHECK(std::count(text.begin(), text.end(), '\n') >= 5);
+  CHECK(loud.law.network.theta == quiet.law.network.theta);
+}
+
 TEST_CASE("energy fit: the softness prior pulls the network towards the slack cell", "[unit]") {
   // EnergyFitOptions::prior_points: quasi-random states of the data's box with the target
   // S = floor e. A dominant prior (weight 10 x the mean data weight) must make the law softer

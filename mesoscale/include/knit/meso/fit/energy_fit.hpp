@@ -139,6 +139,11 @@ struct EnergyFitOptions {
   /// Not a property of the law: every count gives the same law to the last bit
   /// (mesoscale/src/fit_network.cpp), so it is not in to_json() / from_json().
   int threads = 0;
+  /// Network family: where the fit says how far it is, one line every progress_seconds of
+  /// L-BFGS (nullptr: silent; session 44's red team: a fit of 45 s said nothing, the sweep's bar
+  /// stood at 100 % meanwhile). Not properties of the law, not in to_json().
+  std::FILE* progress = nullptr;
+  double progress_seconds = 5.0;
 
   std::string validate() const;
   std::string to_json() const;
