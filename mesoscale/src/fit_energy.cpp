@@ -57,7 +57,7 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
   skipped = 0;
   for (std::size_t k = 0; k < db.entries.size(); ++k) {
     const auto& entry = db.entries[k];
-    int used = 0;
+    int used = 0, gave_way_steps = 0;
     for (std::size_t q = 0; q < entry.raw.size(); ++q) {
       const auto& r = entry.raw[q];
       Eigen::Vector3d prev_e = Eigen::Vector3d::Zero(), prev_S = Eigen::Vector3d::Zero();
@@ -93,15 +93,24 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
         prev_S = p.S;
         if (unstable) {
           ++skipped;
+          ++gave_way_steps;
           continue;
         }
         (is_holdout(r) ? held : fit).push_back(p);
         if (!is_holdout(r)) ++used;
       }
     }
-    if (used < 4)
-      return "/loop_" + std::to_string(k) + "/raw: only " + std::to_string(used) +
-             " converged steps outside the held-out set (at least 4 needed)";
+    if (used < 4) {
+      // Session 44's red team: with stable_min_cos 0.99 this blamed the database, which had
+      // 34 such steps; the option had left them out.
+      std::string why = "/loop_" + std::to_string(k) + "/raw: only " + std::to_string(used) +
+                        " converged steps outside the held-out set (at least 4 needed)";
+      if (gave_way_steps > 0)
+        why += "; the option stable_min_cos " + std::to_string(o.stable_min_cos) + " left out " +
+               std::to_string(gave_way_steps) +
+               " more as steps where the cell gives way (lower it, or -2 to keep every step)";
+      return why;
+    }
   }
   return {};
 }

@@ -826,6 +826,25 @@ TEST_CASE("energy fit: steps that did not converge are skipped, counted, and too
   CHECK(few.status == FitStatus::kRefused);
   CHECK_THAT(few.reason, Catch::Contains("/loop_0/raw: only 3 converged steps outside the held-out "
                                          "set (at least 4 needed)"));
+  CHECK_THAT(few.reason, !Catch::Contains("stable_min_cos"));  // the data's doing, not the option's
+  // Session 44's red team: a threshold that leaves the steps out is named as the cause.
+  // Loop 0 keeps three fitted paths of 6 steps (18 steps, enough), whose stress increments are
+  // made not quite parallel to their strain increments: with stable_min_cos 1 every path gives
+  // way at its second step.
+  Database db2 = synthetic_coverage_db({4.5, 6.5}, 6);
+  auto& raw0 = db2.entries[0].raw;
+  int fitted = 0;
+  raw0.erase(std::remove_if(raw0.begin(), raw0.end(),
+                            [&](const auto& r) { return r.path.set != "holdout" && ++fitted > 3; }),
+             raw0.end());
+  for (auto& r : raw0)
+    for (int s = 0; s < r.steps(); ++s) r.S(s, 2) += s % 2 ? 1e-3 : -1e-3;
+  EnergyFitOptions strict = ridge_options();
+  strict.stable_min_cos = 1.0;
+  const EnergyFitSummary cut = fit_energy_law(db2, strict);
+  CHECK(cut.status == FitStatus::kRefused);
+  CHECK_THAT(cut.reason, Catch::Contains("the option stable_min_cos 1.000000 left out ") &&
+                             Catch::Contains("lower it"));
 }
 
 TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero included",
