@@ -1,5 +1,5 @@
 // knit-meso sweep SWEEP.json [--output DB.h5] [--resume | --force] [--threads N] [--keep-parts]
-//                [--no-progress] [--plain]
+//                [--no-progress] [--plain] [--max-output-size SIZE]
 //   The mesoscale database sweep (issue #7; paper Sect. 2.1.2, 3.1.1): every loop length x
 //   load case of SWEEP.json on the unit cell (one case per worker thread; across machines with
 //   `mpirun -np N knit-meso sweep ...`), then the response-surface fit, written as the material
@@ -38,6 +38,7 @@ struct Cli {
   std::string input, output = "database.h5";
   bool resume = false, force = false, keep_parts = false, no_progress = false, plain = false;
   int threads = 0;
+  std::string max_output_size;  ///< --max-output-size ("" = the default cap)
 };
 
 void print_summary(const knit::meso::sweep::SweepInput& in,
@@ -215,6 +216,11 @@ int run(const Cli& c) {
   if (mpi.rank() == 0) new_parents.emplace(c.output);
   try {
     const SweepInput in = load_sweep_input(c.input);
+    // The database and checkpoints' size, before any work (session 44's red team: 101,300
+    // cases of up to 10,000 steps were accepted, about 240 GB; path and rod have the cap).
+    check_output_size(in, c.max_output_size.empty()
+                              ? kDefaultMaxOutputBytes
+                              : knit::io::parse_size(c.max_output_size, "--max-output-size"));
     if (c.resume && c.force)
       throw knit::InputError("", "--force", "cannot be combined with --resume");
     if (c.threads < 0) throw knit::InputError("", "--threads", "must be >= 0");
@@ -285,6 +291,9 @@ knit::cli::SubcommandRegistrar reg(
       sub.add_flag("--keep-parts", c->keep_parts, "keep OUTPUT.parts after writing the database");
       sub.add_flag("--no-progress", c->no_progress, "no progress output");
       sub.add_flag("--plain", c->plain, "plain progress lines even on a terminal");
+      sub.add_option("--max-output-size", c->max_output_size,
+                     "refuse the sweep before any case runs if its database and checkpoints are "
+                     "estimated above this size (default 2GB; e.g. 500MB, 10GB; 0 = no cap)");
       return [c]() { return run(*c); };
     });
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -14,6 +15,7 @@
 #include "knit/io/csv.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/meso/fit/synthetic.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
@@ -190,6 +192,68 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
       fit_status.push_back(fs_.ok() ? "ok" : "not fitted: " + fs_.reason);
     if (!fit_status.empty()) g.write_strings("fit_status", fit_status);
   });
+}
+
+// ---- the output's size --------------------------------------------------------------------
+
+namespace {
+// Bytes per recorded step and per case, measured on the synthetic runner's output (a sweep of
+// 100 held-out paths with 2 and with 2,000 steps: 116 bytes per step in the database, 285 in
+// a checkpoint's hex floats; 17 kB of HDF5 groups and attributes per case), rounded up.
+constexpr std::uint64_t kDatabaseBytesPerStep = 120, kCheckpointBytesPerStep = 300;
+constexpr std::uint64_t kBytesPerCase = 18'000;
+
+std::uint64_t path_bytes(const material::LoadPath& p) {
+  return static_cast<std::uint64_t>(std::max(p.steps, 0)) *
+             (kDatabaseBytesPerStep + kCheckpointBytesPerStep) +
+         kBytesPerCase;
+}
+}  // namespace
+
+std::uint64_t estimate_output_bytes(const SweepInput& in) {
+  std::uint64_t per_loop = 0;
+  for (const auto& p : in.paths) per_loop += path_bytes(p);
+  return per_loop * static_cast<std::uint64_t>(in.loop_lengths.size());
+}
+
+void check_output_size(const SweepInput& in, std::uint64_t max_bytes) {
+  const std::uint64_t est = estimate_output_bytes(in);
+  if (max_bytes == 0 || est <= max_bytes) return;
+  // The field whose paths make most of it (session 44's red team: 1,000 held-out paths of
+  // 10,000 steps at 100 loop lengths were accepted as 101,300 cases, about 240 GB).
+  struct Share {
+    std::uint64_t bytes = 0;
+    int paths = 0, max_steps = 0;
+  };
+  std::map<std::string, Share> by;
+  for (std::size_t i = 0; i < in.paths.size(); ++i) {
+    auto& s = by[i < in.path_fields.size() ? in.path_fields[i] : "/load_paths"];
+    s.bytes += path_bytes(in.paths[i]);
+    s.paths += 1;
+    s.max_steps = std::max(s.max_steps, in.paths[i].steps);
+  }
+  const auto top = std::max_element(by.begin(), by.end(), [](const auto& a, const auto& b) {
+    return a.second.bytes < b.second.bytes;
+  });
+  const std::size_t loops = in.loop_lengths.size();
+  const std::string& field = top->first;
+  const std::string what = field == "/load_paths/holdout"    ? " (its count and steps)"
+                           : field == "/load_paths/coverage" ? " (its directions and *_steps)"
+                           : field == "/steps"               ? " (the steps of the preset's paths)"
+                                                             : " (their number and steps)";
+  throw InputError(in.file, field,
+                   "the estimated output size " + io::format_bytes(est) +
+                       " (the database and its "
+                       "checkpoints: " +
+                       std::to_string(loops * in.paths.size()) + " cases, " +
+                       std::to_string(loops) + " loop lengths (/loop_lengths) x " +
+                       std::to_string(in.paths.size()) + " paths) exceeds the cap of " +
+                       io::format_bytes(max_bytes) + "; " +
+                       io::format_bytes(top->second.bytes * loops) + " of it are the " +
+                       std::to_string(top->second.paths) + " paths of " + field + what +
+                       ", of up to " + std::to_string(top->second.max_steps) +
+                       " steps: use fewer loop lengths, paths or steps, or raise the cap with "
+                       "--max-output-size (0: no cap); nothing was run");
 }
 
 // ---- runners ----------------------------------------------------------------------------------

@@ -25,11 +25,14 @@ std::string shortest(double x) {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Appends generated or explicit paths (not in the shared default set: path id -1).
-void append(SweepInput& in, const std::vector<material::LoadPath>& paths) {
+/// Appends generated or explicit paths (not in the shared default set: path id -1), from the
+/// input field `field`.
+void append(SweepInput& in, const std::vector<material::LoadPath>& paths,
+            const std::string& field) {
   for (const auto& p : paths) {
     in.paths.push_back(p);
     in.path_ids.push_back(-1);
+    in.path_fields.push_back(field);
   }
 }
 
@@ -271,20 +274,23 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
       in.paths = all;
       for (std::size_t i = 0; i < all.size(); ++i) in.path_ids.push_back(static_cast<int>(i));
     }
+    in.path_fields.assign(in.paths.size(), "/steps");
     const material::StrainBox box = read_box(lp, file);
     if (lp.contains("coverage")) {
       const material::CoverageOptions co = read_coverage(lp.at("coverage"), box);
       check_ray_floor(co, file);
-      append(in, material::coverage_load_paths(co));
+      append(in, material::coverage_load_paths(co), "/load_paths/coverage");
     }
     if (lp.contains("holdout")) {
       const auto& h = lp.at("holdout");
-      append(in, material::holdout_load_paths(box, h.value("count", 24), h.value("steps", steps)));
+      append(in, material::holdout_load_paths(box, h.value("count", 24), h.value("steps", steps)),
+             "/load_paths/holdout");
     }
     if (lp.contains("extra"))
-      append(in, explicit_paths(lp.at("extra"), steps, file, "/load_paths/extra"));
+      append(in, explicit_paths(lp.at("extra"), steps, file, "/load_paths/extra"),
+             "/load_paths/extra");
   } else {
-    append(in, explicit_paths(lp, steps, file, "/load_paths"));
+    append(in, explicit_paths(lp, steps, file, "/load_paths"), "/load_paths");
   }
 
   if (j.contains("runner"))

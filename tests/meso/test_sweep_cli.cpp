@@ -338,3 +338,41 @@ TEST_CASE("knit-meso sweep: a sweep that writes nothing says so and leaves no ne
   CHECK(fs::is_directory(dir / "a"));
   CHECK_FALSE(fs::exists(dir / "a" / "b"));
 }
+
+// Session 44's red team: a schema-valid sweep of 100 loop lengths x 1,000 held-out paths of
+// 10,000 steps (the synthetic runner) was accepted as 101,300 cases; its checkpoints grew
+// 270 MB in 6 s towards about 240 GB. Now it is refused before any work, as knit-meso path
+// and rod refuse an output above --max-output-size (default 2 GB; 0: no cap).
+TEST_CASE("knit-meso sweep: a sweep whose output would exceed --max-output-size is refused",
+          "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_max_output");
+  std::string loops;
+  for (int k = 0; k < 100; ++k) loops += (k ? ", " : "") + std::to_string(4.0 + 0.01 * k);
+  knit_test::write_text(dir / "big.json",
+                        R"({"loop_lengths": [)" + loops + R"(], "runner": "synthetic",
+                            "load_paths": {"preset": "default",
+                                           "holdout": {"count": 1000, "steps": 10000}}})");
+  const fs::path db = dir / "db.h5", err = dir / "stderr.txt";
+  const std::string sweep = kExe + " sweep " + (dir / "big.json").string() + " --output " +
+                            db.string() + " --no-progress";
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK(shell(sweep + " > /dev/null 2> " + err.string()) == 2);
+  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10));
+  const std::string text = knit_test::read_text(err);
+  CHECK_THAT(text, Catch::Contains((dir / "big.json").string() +
+                                   ": /load_paths/holdout: the estimated output size ") &&
+                       Catch::Contains("101300 cases, 100 loop lengths (/loop_lengths)") &&
+                       Catch::Contains("exceeds the cap of 2 GB") &&
+                       Catch::Contains("--max-output-size (0: no cap)"));
+  // Nothing written: no database, checkpoints, lock.
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}) == 2);
+  // A smaller cap refuses a small sweep too, named at its largest part.
+  knit_test::write_text(dir / "s.json", knit_test::synthetic_sweep_json());
+  CHECK(shell(kExe + " sweep " + (dir / "s.json").string() + " --output " + db.string() +
+              " --no-progress --max-output-size 10k > /dev/null 2> " + err.string()) == 2);
+  CHECK_THAT(knit_test::read_text(err), Catch::Contains(": /steps: the estimated output size"));
+  CHECK_FALSE(fs::exists(db));
+  CHECK(shell(kExe + " sweep " + (dir / "s.json").string() + " --output " + db.string() +
+              " --no-progress --max-output-size lots > /dev/null 2> " + err.string()) == 2);
+  CHECK_THAT(knit_test::read_text(err), Catch::Contains("--max-output-size"));
+}

@@ -57,6 +57,45 @@ SweepOptions quiet(const std::filesystem::path& out) {
 
 }  // namespace
 
+// The estimate of --max-output-size (session 44's red team): the case files stay far below the
+// default cap, and the estimate is not below what a sweep writes (database and checkpoints,
+// here with --keep-parts, on the synthetic runner).
+TEST_CASE("sweep output size: the case files are far below the cap, the estimate above the files",
+          "[unit]") {
+  for (const char* name : {"default", "dense", "reduced", "wale_compressed_rays"}) {
+    const auto in =
+        load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/" + name + ".json");
+    INFO(name << ": " << estimate_output_bytes(in) << " bytes");
+    CHECK(estimate_output_bytes(in) < knit::meso::sweep::kDefaultMaxOutputBytes / 20);
+    CHECK_NOTHROW(check_output_size(in, knit::meso::sweep::kDefaultMaxOutputBytes));
+  }
+  const auto dir = knit_test::scratch("sweep_output_size");
+  auto in = parse_sweep_input(
+      R"({"loop_lengths": [4.5, 5.0], "runner": "synthetic", "steps": 20, "fit": false,
+          "load_paths": {"preset": "default", "holdout": {"count": 20, "steps": 500}}})",
+      "s.json");
+  SweepOptions o;
+  o.output = dir / "db.h5";
+  o.keep_parts = true;
+  o.progress = nullptr;
+  o.log = nullptr;
+  REQUIRE(run_sweep(in, o, synthetic_runner(in)).wrote_database);
+  std::uint64_t written = std::filesystem::file_size(o.output);
+  for (const auto& e : std::filesystem::directory_iterator(dir / "db.h5.parts"))
+    written += std::filesystem::file_size(e.path());
+  const std::uint64_t est = estimate_output_bytes(in);
+  CHECK(est >= written);
+  CHECK(est < 2 * written);
+  CHECK_NOTHROW(check_output_size(in, 0));  // 0: no cap
+  try {
+    check_output_size(in, est - 1);
+    FAIL("not refused");
+  } catch (const knit::InputError& e) {
+    CHECK(e.file() == "s.json");
+    CHECK(e.pointer() == "/load_paths/holdout");
+  }
+}
+
 TEST_CASE("sweep input: the default, dense, wale-compressed-rays and reduced case files",
           "[unit]") {
   const auto d = load_sweep_input(std::string(KNIT_SOURCE_DIR) + "/cases/sweep/default.json");

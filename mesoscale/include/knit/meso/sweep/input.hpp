@@ -54,6 +54,10 @@ struct SweepInput {
   std::vector<material::LoadPath> paths;
   /// Indices of `paths` in the shared default set (-1 for explicitly listed paths).
   std::vector<int> path_ids;
+  /// The input field each path comes from, for messages: "/steps" (the preset's paths, whose
+  /// steps it sets), "/load_paths/coverage", "/load_paths/holdout", "/load_paths/extra" or
+  /// "/load_paths" (an explicit list).
+  std::vector<std::string> path_fields;
   RunnerKind runner = RunnerKind::kCell;
   /// The cell parameters (schemas/cell.schema.json) as JSON text: the inline "cell" object or
   /// the content of the file it names; "{}" = the cell's defaults.

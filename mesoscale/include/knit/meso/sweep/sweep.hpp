@@ -10,6 +10,7 @@
 // at the end; SweepReport::ok() is then false (exit code 1).
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -97,6 +98,21 @@ std::vector<fit::FitSummary> fit_sweep_database(material::Database& db,
 void write_sweep_database(const std::filesystem::path& output, const material::Database& db,
                           const SweepInput& in, const std::vector<JobResult>& results,
                           const SweepReport& report);
+
+/// The default cap of knit-meso sweep --max-output-size, as knit-meso path's and rod's and
+/// knit-macro run's: 2 GB.
+inline constexpr std::uint64_t kDefaultMaxOutputBytes = 2'000'000'000;
+
+/// The estimated size of what the sweep writes: the database and its checkpoints (both on
+/// disk before the checkpoints are removed, and kept together with --keep-parts), from the
+/// cases x steps of the input (measured on the synthetic runner: 116 bytes per step in the
+/// database and 285 in a checkpoint, about 17 kB per case; rounded up).
+std::uint64_t estimate_output_bytes(const SweepInput& in);
+
+/// Refuses, before any case runs, a sweep whose estimated output exceeds max_bytes (0: no
+/// cap): knit::InputError at the input field whose paths make most of it ("/load_paths/
+/// holdout", "/load_paths/coverage", "/steps", ...), naming the loop lengths and the option.
+void check_output_size(const SweepInput& in, std::uint64_t max_bytes);
 
 /// The synthetic runner (knit-meso synth's law on the sweep's paths): deterministic, instant.
 /// Test hooks (environment): KNIT_SWEEP_TEST_DELAY_MS sleeps per case; KNIT_SWEEP_TEST_COUNT_FILE
