@@ -151,10 +151,11 @@ int default_threads(const MpiSession* mpi) {
 
 }  // namespace
 
-std::filesystem::path failed_database_path(const std::filesystem::path& output) {
+std::filesystem::path failed_database_path(const std::filesystem::path& output, int n) {
   std::filesystem::path p = output;
   const std::string ext = output.extension().string();
-  p.replace_filename(output.stem().string() + ".failed" + ext);
+  p.replace_filename(output.stem().string() + ".failed" + (n > 1 ? "-" + std::to_string(n) : "") +
+                     ext);
   return p;
 }
 
@@ -333,11 +334,38 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   // status and messages for the diagnosis (fit's policy is the same: a failed fit writes
   // nothing over its output).
   rep.written = opt.output;
+  // DB.failed.h5 is locked as every output is (session 44's red team: a `knit-meso fit
+  // DB.failed.h5` running, which holds DB.failed.h5.lock, renamed its refit over the one this
+  // wrote, and the failed sweep's database was lost): a name held by another process, or
+  // holding what is not a database, passes to the next, DB.failed-2.h5, ...; with none free
+  // nothing is written, and the cases stay in the checkpoints, said so.
+  std::optional<io::OutputLock> failed_lock;
   std::error_code ec;
   if (!rep.ok() && std::filesystem::exists(opt.output, ec)) {
-    rep.written = failed_database_path(opt.output);
-    io::check_output_target(rep.written, io::OutputKind::kFile, "--output",
-                            material::kDatabaseFormatName);
+    std::string first_refusal;
+    for (int n = 1; n <= kFailedDatabaseNames && !failed_lock; ++n) {
+      const std::filesystem::path name = failed_database_path(opt.output, n);
+      try {
+        io::OutputLock l(name);
+        io::check_output_target(name, io::OutputKind::kFile, "--output",
+                                material::kDatabaseFormatName);
+        failed_lock.emplace(std::move(l));
+        rep.written = name;
+      } catch (const InputError& e) {
+        if (first_refusal.empty()) first_refusal = e.what();
+      }
+    }
+    if (!failed_lock) {
+      rep.not_written =
+          "the sweep failed, so " + opt.output.string() +
+          " (an earlier database) is left as it was, and this sweep's database could not be "
+          "kept beside it: " +
+          first_refusal + " (nor " + failed_database_path(opt.output, 2).filename().string() +
+          " .. " + failed_database_path(opt.output, kFailedDatabaseNames).filename().string() +
+          "); its cases are kept in " + store->dir().string() +
+          ": run the sweep again with --resume once one of those is free";
+      return rep;  // the checkpoints stay (not marked written)
+    }
   }
   write_sweep_database(rep.written, db, in, rep.results, rep);
   rep.wrote_database = true;

@@ -11,12 +11,16 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <thread>
+#include <vector>
 
 #include "../output_test_util.hpp"
+#include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/sweep/input.hpp"
 #include "knit/meso/sweep/mpi.hpp"
+#include "knit/meso/sweep/sweep.hpp"
 #include "test_sweep_util.hpp"
 
 namespace fs = std::filesystem;
@@ -375,4 +379,45 @@ TEST_CASE("knit-meso sweep: a sweep whose output would exceed --max-output-size 
   CHECK(shell(kExe + " sweep " + (dir / "s.json").string() + " --output " + db.string() +
               " --no-progress --max-output-size lots > /dev/null 2> " + err.string()) == 2);
   CHECK_THAT(knit_test::read_text(err), Catch::Contains("--max-output-size"));
+}
+
+// Session 44's red team: a failing sweep wrote DB.failed.h5 without its lock, and a
+// `knit-meso fit db.failed.h5` running (holding db.failed.h5.lock) renamed its refit over it:
+// the failed sweep's database was lost. Now a held name passes to the next, db.failed-2.h5;
+// with every name held nothing is written, and the stderr line says so and where the cases are.
+TEST_CASE("knit-meso sweep: a failing sweep takes the lock of DB.failed.h5, or writes another name",
+          "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_failed_lock");
+  knit_test::write_text(dir / "f.json",
+                        R"({"loop_lengths": [5], "runner": "synthetic", "steps": 6,
+                            "energy_fit": {"floor": 1000, "network_iterations": 100}})");
+  const fs::path db = dir / "db.h5", err = dir / "stderr.txt";
+  const std::string sweep = kExe + " sweep " + (dir / "f.json").string() + " --output " +
+                            db.string() + " --no-progress > /dev/null 2> " + err.string();
+  REQUIRE(shell(sweep) == 1);  // no database there: db.h5 written
+  REQUIRE(fs::exists(db));
+  {
+    // The test holds db.failed.h5's lock, as a knit-meso fit writing it would.
+    const knit::io::OutputLock held(dir / "db.failed.h5");
+    CHECK(shell(sweep) == 1);
+    CHECK_THAT(knit_test::read_text(err),
+               Catch::Contains("this sweep's database, with every case's status and message, is " +
+                               (dir / "db.failed-2.h5").string()));
+    CHECK(fs::exists(dir / "db.failed-2.h5"));
+    CHECK_FALSE(fs::exists(dir / "db.failed.h5"));
+  }
+  // Every name held: nothing written, said so, the cases kept.
+  std::vector<std::unique_ptr<knit::io::OutputLock>> held;
+  for (int n = 1; n <= knit::meso::sweep::kFailedDatabaseNames; ++n)
+    held.push_back(
+        std::make_unique<knit::io::OutputLock>(knit::meso::sweep::failed_database_path(db, n)));
+  const std::string before = knit_test::read_text(dir / "db.failed-2.h5");
+  CHECK(shell(sweep) == 1);
+  CHECK_THAT(knit_test::read_text(err),
+             Catch::Contains("this sweep's database could not be kept beside it: " +
+                             (dir / "db.failed.h5").string() +
+                             ": is being written by another knitscale process") &&
+                 Catch::Contains("its cases are kept in " + (dir / "db.h5.parts").string()));
+  CHECK(knit_test::read_text(dir / "db.failed-2.h5") == before);
+  CHECK(count_job_files(dir / "db.h5.parts") == 13);
 }

@@ -70,8 +70,13 @@ struct SweepReport {
 };
 
 /// "DB.failed.h5" for "DB.h5" (the extension kept, ".failed" before it; "DB.failed" without
-/// one): where a failing sweep writes its database when one is at the output already.
-std::filesystem::path failed_database_path(const std::filesystem::path& output);
+/// one): where a failing sweep writes its database when one is at the output already. The
+/// n-th name (n >= 2), "DB.failed-n.h5", is taken when the ones before it are locked by
+/// another process (a `knit-meso fit DB.failed.h5` running) or are not a database.
+std::filesystem::path failed_database_path(const std::filesystem::path& output, int n = 1);
+
+/// How many names failed_database_path offers a failing sweep (n = 1 .. this).
+inline constexpr int kFailedDatabaseNames = 10;
 
 /// True if this result makes the sweep fail (see SweepReport::failed_cases).
 bool fails_sweep(const JobResult& r);
