@@ -124,6 +124,31 @@ void check_ray_floor(const material::CoverageOptions& co, const std::string& fil
           "cell locks up below)");
 }
 
+/// The generated shear-with-stretch paths, H = [[e1, sin gamma], [0, e2]], are held to the end
+/// an explicit path must reach (explicit_paths: largest |H| >= StrainBox::kMinExtent; session
+/// 44's red team: "gamma_deg": 0 with the stretch [0, 0] gave a path of ten states at F = I,
+/// fitted by the energy law with exit 0, and 0.0001 deg one ending at H12 = 1.7e-6).
+void check_gradient_ends(const material::CoverageOptions& co, const nlohmann::json& c,
+                         const std::string& file) {
+  const double m = material::StrainBox::kMinExtent;
+  const bool given = c.is_object() && c.contains("stretch");
+  for (std::size_t k = 0; k < co.stretch.size(); ++k) {
+    const Eigen::Vector2d& e = co.stretch[k];
+    const double reach = std::max({std::abs(e(0)), std::abs(e(1)), std::abs(std::sin(co.gamma))});
+    if (reach >= m) continue;
+    std::ostringstream o;
+    o << "is " << co.gamma * 180.0 / kPi << " deg, and the stretch [" << e(0) << ", " << e(1)
+      << "] (" << io::json_pointer_append("/load_paths/coverage/stretch", k)
+      << (given ? "" : ", the default") << ") is below " << m
+      << " too: its shear-with-stretch path ends " << (reach == 0.0 ? "at" : "within round-off of")
+      << " the reference state (largest |H| " << reach << ", below " << m
+      << ") and carries no data; give gamma_deg >= " << std::ceil(m * 180.0 / kPi * 1e4) / 1e4
+      << " (" << m << " rad) or stretches of at least " << m
+      << ", as for an explicit path, or leave \"stretch\" empty for no such paths";
+    throw InputError(file, "/load_paths/coverage/gamma_deg", o.str());
+  }
+}
+
 /// An explicit list of paths (schemas/sweep.schema.json, the array form).
 std::vector<material::LoadPath> explicit_paths(const nlohmann::json& lp, int steps,
                                                const std::string& file,
@@ -279,6 +304,7 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     if (lp.contains("coverage")) {
       const material::CoverageOptions co = read_coverage(lp.at("coverage"), box);
       check_ray_floor(co, file);
+      check_gradient_ends(co, lp.at("coverage"), file);
       append(in, material::coverage_load_paths(co), "/load_paths/coverage");
     }
     if (lp.contains("holdout")) {

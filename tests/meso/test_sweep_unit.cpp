@@ -328,6 +328,39 @@ TEST_CASE("sweep input: rays towards a collapsed cell are refused at fill_min_J"
         "<no error>");
 }
 
+// Session 44's red team: "coverage": {"gamma_deg": 0, "directions": 0, "stretch": [[0, 0]]} gave a
+// shear-with-stretch path of ten states at F = I, which the energy law fitted (exit 0), and
+// gamma_deg 0.0001 one ending at H12 = 1.7e-6. Generated paths are now held to the end of an
+// explicit path (largest |H| >= 1e-3, session 43), refused at gamma_deg.
+TEST_CASE("sweep input: shear-with-stretch coverage paths without an end are refused at gamma_deg",
+          "[unit]") {
+  const auto error_of = [](const std::string& coverage) {
+    try {
+      parse_sweep_input(R"({"loop_lengths": [4.5], "load_paths": {"preset": "default", )"
+                        R"("coverage": )" +
+                            coverage + "}}",
+                        "s.json");
+    } catch (const knit::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("<no error>");
+  };
+  CHECK_THAT(error_of(R"({"gamma_deg": 0, "directions": 0, "stretch": [[0.2, 0], [0, 0]]})"),
+             Catch::StartsWith("s.json: /load_paths/coverage/gamma_deg: is 0 deg, and the stretch "
+                               "[0, 0] (/load_paths/coverage/stretch/1) is below 0.001 too: its "
+                               "shear-with-stretch path ends at the reference state") &&
+                 Catch::Contains("give gamma_deg >= 0.0573 (0.001 rad) or stretches of at least "
+                                 "0.001"));
+  CHECK_THAT(error_of(R"({"gamma_deg": 0.0001})"),  // the default stretches hold [0, 0]
+             Catch::StartsWith("s.json: /load_paths/coverage/gamma_deg: is 0.0001 deg") &&
+                 Catch::Contains("(/load_paths/coverage/stretch/0, the default)") &&
+                 Catch::Contains("ends within round-off of the reference state"));
+  CHECK(error_of(R"({"gamma_deg": 0.0573, "stretch": [[0, 0]]})") == "<no error>");
+  CHECK(error_of(R"({"gamma_deg": 0, "stretch": [[0.001, 0], [0, -0.001]]})") == "<no error>");
+  CHECK(error_of(R"({"gamma_deg": 0, "stretch": []})") == "<no error>");
+  CHECK(error_of("true") == "<no error>");
+}
+
 // Session 25: an input without e_max ran the fan to 0.35 while the header of
 // default_load_paths and docs/database.md say 0.40.
 TEST_CASE("sweep input: the preset's fan without e_max and e_min is the documented default",
