@@ -379,6 +379,14 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
       in.energy_fit = f.get<bool>();
     else
       in.energy_fit_options = fit::EnergyFitOptions::from_json(f.dump(), file, "/energy_fit");
+    // Options of a fit that is not made are refused, not ignored unread (session 44's red
+    // team: "fit": false with an "energy_fit" object ran with exit 0 and no word; knit-meso fit
+    // refuses --energy-options with --law paper the same way, session 38).
+    if (f.is_object() && !in.fit)
+      throw InputError(file, "/energy_fit",
+                       "the energy law's fit options, but \"fit\": false fits no law (the "
+                       "energy law is fitted after the paper's): leave \"energy_fit\" out or "
+                       "set it false, or fit the laws");
   }
   return in;
 }

@@ -412,6 +412,33 @@ TEST_CASE("sweep input: cell parameters inline or from a file relative to the sw
   CHECK(std::string(missing.what()).find("missing.json: file not found") != std::string::npos);
 }
 
+// Session 44's red team: "fit": false with an "energy_fit" object ran with exit 0, the energy
+// options ignored without a word. Refused at /energy_fit, as knit-meso fit refuses
+// --energy-options with --law paper (session 38).
+TEST_CASE("sweep input: energy_fit options with \"fit\": false are refused at /energy_fit",
+          "[unit]") {
+  const auto error_of = [](const std::string& tail) {
+    try {
+      parse_sweep_input(R"({"loop_lengths": [4.5], "fit": false)" + tail + "}", "s.json");
+    } catch (const knit::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("<no error>");
+  };
+  for (const char* ef : {R"({"tube": 0.045})", "{}"}) {
+    INFO(ef);
+    CHECK(error_of(std::string(R"(, "energy_fit": )") + ef) ==
+          "s.json: /energy_fit: the energy law's fit options, but \"fit\": false fits no law (the "
+          "energy law is fitted after the paper's): leave \"energy_fit\" out or set it false, or "
+          "fit the laws");
+  }
+  CHECK(error_of(R"(, "energy_fit": false)") == "<no error>");
+  CHECK(error_of("") == "<no error>");
+  CHECK_NOTHROW(parse_sweep_input(
+      R"({"loop_lengths": [4.5], "fit": {"smoothing": 1e-3}, "energy_fit": {"tube": 0.045}})",
+      "a"));
+}
+
 TEST_CASE("sweep input: job definition ignores the fit options", "[unit]") {
   const auto a = parse_sweep_input(R"({"loop_lengths": [4.5], "fit": {"smoothing": 1e-3}})", "a");
   const auto b = parse_sweep_input(R"({"loop_lengths": [4.5], "fit": false})", "b");
