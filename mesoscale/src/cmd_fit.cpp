@@ -198,19 +198,21 @@ static knit::cli::SubcommandRegistrar reg_fit(
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()
                   << " loop lengths, law " << o->law << ")\n";
         if (paper) {
-          const FitOptions fo = o->options.empty()
-                                    ? FitOptions{}
-                                    : FitOptions::from_json(read_text_file(o->options), o->options);
+          const FitOptions fo =
+              o->options.empty()
+                  ? FitOptions{}
+                  : FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
           const auto fits = fit_paper_law(db, fo);
           print_fit_summaries(std::cout, db, fits);
           first_failure = knit::meso::fit::first_fit_failure(db, fits);
           if (!first_failure.empty()) rc = knit::kExitFailure;
         }
         if (energy) {
-          EnergyFitOptions eo = o->energy_options.empty()
-                                    ? EnergyFitOptions{}
-                                    : EnergyFitOptions::from_json(read_text_file(o->energy_options),
-                                                                  o->energy_options);
+          EnergyFitOptions eo =
+              o->energy_options.empty()
+                  ? EnergyFitOptions{}
+                  : EnergyFitOptions::from_json(
+                        read_text_file(o->energy_options, "--energy-options"), o->energy_options);
           eo.threads = o->threads;
           eo.progress = stderr;  // a line every 5 s of the network's L-BFGS
           const auto s = fit_energy_database(db, eo);

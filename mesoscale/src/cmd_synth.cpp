@@ -86,11 +86,11 @@ static knit::cli::SubcommandRegistrar reg_synth(
         int rc = knit::kExitOk;
         std::string first_failure;
         if (!o->no_fit) {
-          const FitOptions fo =
-              o->fit_options.empty()
-                  ? FitOptions{}
-                  : FitOptions::from_json(knit::meso::fit::read_text_file(o->fit_options),
-                                          o->fit_options);
+          const FitOptions fo = o->fit_options.empty()
+                                    ? FitOptions{}
+                                    : FitOptions::from_json(knit::meso::fit::read_text_file(
+                                                                o->fit_options, "--fit-options"),
+                                                            o->fit_options);
           const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
@@ -102,7 +102,8 @@ static knit::cli::SubcommandRegistrar reg_synth(
           EnergyFitOptions eo;
           eo.family = "ridge";
           if (!o->energy_options.empty())
-            eo = EnergyFitOptions::from_json(read_text_file(o->energy_options), o->energy_options);
+            eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
+                                             o->energy_options);
           const auto es = fit_energy_database(db, eo);
           std::cout << energy_fit_report(es);
           if (!es.ok()) {

@@ -272,10 +272,14 @@ std::string EnergyFitOptions::validate() const {
              what.substr(what.find(':') + 2);
     }
   if (family != "ridge" && family != "network") return "family must be \"ridge\" or \"network\"";
-  if (hidden1 < 1 || hidden1 > 64 || hidden2 < 1 || hidden2 > 64)
-    return "hidden1 and hidden2 must be in 1..64";
-  if (stiff1 < 0 || stiff1 > hidden1 || stiff2 < 0 || stiff2 > hidden2)
-    return "stiff1 and stiff2 must be in 0..hidden1 and 0..hidden2";
+  // One key per message: from_json names it by its pointer (session 44's red team: hidden2 0
+  // and stiff2 > hidden2 were named at /hidden1 or at no field).
+  if (hidden1 < 1 || hidden1 > 64) return "hidden1 must be in 1..64";
+  if (hidden2 < 1 || hidden2 > 64) return "hidden2 must be in 1..64";
+  if (stiff1 < 0 || stiff1 > hidden1)
+    return "stiff1 must be in 0..hidden1 (here 0.." + std::to_string(hidden1) + ")";
+  if (stiff2 < 0 || stiff2 > hidden2)
+    return "stiff2 must be in 0..hidden2 (here 0.." + std::to_string(hidden2) + ")";
   if (outer != "none" && outer != "exp") return "outer must be \"none\" or \"exp\"";
   if (l_interpolation != "parameters" && l_interpolation != "energy")
     return "l_interpolation must be \"parameters\" or \"energy\"";

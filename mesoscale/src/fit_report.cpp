@@ -45,10 +45,16 @@ std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& 
   return fits;
 }
 
-std::string read_text_file(const std::string& file) {
+std::string read_text_file(const std::string& file, const std::string& option) {
   // The defensive reader of every other input (session 24: an ifstream here read /dev/zero
   // until memory ran out and blocked for ever on a FIFO).
-  return knit::io::read_input_file(file);
+  try {
+    return knit::io::read_input_file(file);
+  } catch (const InputError& e) {
+    // (session 44's red team: "/nonexist.json: file not found" did not say which option)
+    if (option.empty()) throw;
+    throw InputError("", option, file + ": " + e.message());
+  }
 }
 
 }  // namespace knit::meso::fit

@@ -447,3 +447,27 @@ TEST_CASE("knit-meso fit: the in-place pre-check never overwrites a file in TMPD
   CHECK(files == 0);
   CHECK(knit::material::read_database(db).entries[0].surface);  // refitted in place
 }
+
+// Session 44's red team: `--energy-options /nonexist.json` said "/nonexist.json: file not found",
+// naming no option; now the option comes first, in fit and synth alike.
+TEST_CASE("knit-meso fit and synth: an options file that cannot be read names its option",
+          "[unit]") {
+  const fs::path dir = scratch_dir() / "fit_cli_option_file";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path db = dir / "db.h5", missing = dir / "nonexist.json", err = dir / "err.txt";
+  REQUIRE(run("synth --no-fit --no-coverage --steps 6 --loop-lengths 4.5,6.5 --out " +
+              db.string()) == 0);
+  std::string text;
+  for (const std::string opt : {"--options", "--energy-options"}) {
+    CHECK(run_with_stderr("fit " + db.string() + " " + opt + " " + missing.string(), err, text) ==
+          2);
+    CHECK_THAT(text, Catch::Contains(opt + ": " + missing.string() + ": file not found"));
+  }
+  for (const std::string opt : {"--fit-options", "--energy-options"}) {
+    CHECK(run_with_stderr(
+              "synth --out " + (dir / "s.h5").string() + " " + opt + " " + missing.string(), err,
+              text) == 2);
+    CHECK_THAT(text, Catch::Contains(opt + ": " + missing.string() + ": file not found"));
+  }
+}

@@ -634,9 +634,16 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"tube_weight": -1})", "f.json"),
                       Catch::Contains("tube_weight"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden1": 0})", "f.json"),
-                      Catch::Contains("hidden1 and hidden2"));
+                      Catch::Contains("f.json: /hidden1: hidden1 must be in 1..64"));
+    // Each option at its own pointer (session 44's red team: these were named at no field).
+    for (const char* h2 : {"0", "65"})
+      CHECK_THROWS_WITH(
+          EnergyFitOptions::from_json(std::string(R"({"hidden2": )") + h2 + "}", "f.json"),
+          "f.json: /hidden2: hidden2 must be in 1..64");
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"hidden2": 4, "stiff2": 5})", "f.json"),
-                      Catch::Contains("stiff1 and stiff2"));
+                      "f.json: /stiff2: stiff2 must be in 0..hidden2 (here 0..4)");
+    CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"stiff1": 13})", "f.json"),
+                      "f.json: /stiff1: stiff1 must be in 0..hidden1 (here 0..12)");
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"outer": "log"})", "f.json"),
                       Catch::Contains("outer must be"));
     CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"outer": 1})", "f.json"),

@@ -22,7 +22,8 @@ std::string first_fit_failure(const material::Database& db, const std::vector<Fi
 std::vector<FitSummary> fit_paper_law(material::Database& db, const FitOptions& options);
 
 /// The whole file as text (knit::io::read_input_file: a regular file of at most 64 MiB); throws
-/// knit::InputError if it cannot be read.
-std::string read_text_file(const std::string& file);
+/// knit::InputError if it cannot be read, naming the command-line option that gave the file
+/// first when there is one ("--energy-options: /x.json: file not found").
+std::string read_text_file(const std::string& file, const std::string& option = {});
 
 }  // namespace knit::meso::fit
