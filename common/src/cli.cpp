@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -32,6 +33,17 @@ std::vector<Entry>& registry() {
   return r;
 }
 }  // namespace
+
+std::string shell_quote(std::string_view arg) {
+  const bool plain = !arg.empty() && std::all_of(arg.begin(), arg.end(), [](char ch) {
+    const unsigned char u = static_cast<unsigned char>(ch);
+    return std::isalnum(u) || std::string_view("@%+=:,./_-").find(ch) != std::string_view::npos;
+  });
+  if (plain) return std::string(arg);
+  std::string q = "'";
+  for (const char ch : arg) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
 
 std::string describe_range(double lo, double hi, Ends ends) {
   const bool lo_open = ends == Ends::kOpenLow || ends == Ends::kOpen;

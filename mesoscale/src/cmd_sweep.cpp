@@ -181,8 +181,8 @@ void explain_interrupt(const Cli& c) {
   knit::cli::on_interrupt_say(
       "knit-meso sweep: interrupted; the cases finished so far are kept "
       "in " +
-      c.output + ".parts: continue with `knit-meso sweep " + c.input + " --output " + c.output +
-      " --resume`");
+      c.output + ".parts: continue with `knit-meso sweep " + knit::cli::shell_quote(c.input) +
+      " --output " + knit::cli::shell_quote(c.output) + " --resume`");
 }
 
 /// The output's parent directories that do not exist yet (deepest first): the sweep creates
@@ -267,9 +267,10 @@ int run(const Cli& c) {
     // say where they are and how to go on (session 22).
     std::error_code ec;
     if (std::filesystem::is_directory(c.output + ".parts", ec))
-      throw std::runtime_error(std::string(e.what()) + "; the cases finished so far are kept in " +
-                               c.output + ".parts: continue with `knit-meso sweep " + c.input +
-                               " --output " + c.output + " --resume` once the cause is fixed");
+      throw std::runtime_error(
+          std::string(e.what()) + "; the cases finished so far are kept in " + c.output +
+          ".parts: continue with `knit-meso sweep " + knit::cli::shell_quote(c.input) +
+          " --output " + knit::cli::shell_quote(c.output) + " --resume` once the cause is fixed");
     throw;
   }
 }

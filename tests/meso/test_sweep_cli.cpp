@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../output_test_util.hpp"
+#include "knit/core/cli.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/sweep/input.hpp"
@@ -420,4 +421,36 @@ TEST_CASE("knit-meso sweep: a failing sweep takes the lock of DB.failed.h5, or w
                  Catch::Contains("its cases are kept in " + (dir / "db.h5.parts").string()));
   CHECK(knit_test::read_text(dir / "db.failed-2.h5") == before);
   CHECK(count_job_files(dir / "db.h5.parts") == 13);
+}
+
+// Session 44's red team: the interrupt's resume command was not quoted: for "my input.json" it
+// said `knit-meso sweep my input.json --output my db.h5 --resume`, which fails when pasted.
+// Now every argument that needs it is in single quotes; the command, pasted, resumes.
+TEST_CASE("knit-meso sweep: the interrupt's resume command is quoted for the shell", "[case]") {
+  CHECK(knit::cli::shell_quote("cases/sweep/default.json") == "cases/sweep/default.json");
+  CHECK(knit::cli::shell_quote("my db.h5") == "'my db.h5'");
+  CHECK(knit::cli::shell_quote("it's") == "'it'\\''s'");
+  CHECK(knit::cli::shell_quote("$HOME;`x`") == "'$HOME;`x`'");
+  CHECK(knit::cli::shell_quote("") == "''");
+  const fs::path dir = knit_test::scratch("sweep_cli_quote") / "my dir's";
+  fs::create_directories(dir);
+  knit_test::write_text(dir / "my input.json", knit_test::synthetic_sweep_json());
+  const fs::path db = dir / "my db.h5", err = dir.parent_path() / "stderr.txt";
+  const pid_t pid = spawn_slow_sweep(dir / "my input.json", db, err, "");
+  REQUIRE(pid >= 0);
+  wait_for_jobs(dir / "my db.h5.parts", 3);
+  kill(pid, SIGINT);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  const std::string text = knit_test::read_text(err);
+  INFO(text);
+  const auto a = text.find("`knit-meso sweep "), b = text.rfind('`');
+  REQUIRE(a != std::string::npos);
+  REQUIRE(b > a);
+  std::string cmd = text.substr(a + 1, b - a - 1);
+  CHECK(cmd == "knit-meso sweep " + knit::cli::shell_quote((dir / "my input.json").string()) +
+                   " --output " + knit::cli::shell_quote(db.string()) + " --resume");
+  cmd.replace(0, std::string("knit-meso").size(), kExe);
+  CHECK(shell(cmd + " --no-progress > /dev/null 2>&1") == 0);
+  CHECK(fs::exists(db));
 }

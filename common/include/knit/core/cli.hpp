@@ -22,6 +22,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <string_view>
 
 namespace knit::cli {
 
@@ -47,6 +48,12 @@ CLI::Validator non_empty();
 
 /// The text "[lo, hi]" / "(lo, hi]" / "> lo" ... of a range, for messages and help.
 std::string describe_range(double lo, double hi, Ends ends);
+
+/// `arg` as one word of a POSIX shell command, for a command a message tells the user to run:
+/// unchanged when it holds only letters, digits and @%+=:,./_- (and is not empty), otherwise
+/// in single quotes, a ' inside as '\'' (session 44's red team: the sweep's resume command for
+/// "my input.json" failed when pasted).
+std::string shell_quote(std::string_view arg);
 
 /// Builds the app from the registered subcommands, parses, runs; returns the exit code.
 int run_main(int argc, char** argv, const std::string& program, const std::string& description);
