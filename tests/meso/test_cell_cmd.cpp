@@ -352,3 +352,23 @@ TEST_CASE("knit-meso path and cell warn of a coarse mesh and an extrapolated loo
   fs::remove_all(out);
   fs::remove(err);
 }
+
+// Session 44's red team: `knit-meso path --help` showed "--uniaxial FLOAT in (-0.5, 10] x 2"
+// for AXIS E, though AXIS must be 0 or 1. The help names both values; parsing is unchanged.
+TEST_CASE("knit-meso path --help names --uniaxial's AXIS (0 or 1) and E", "[unit]") {
+  const fs::path help = fs::path(KNIT_BINARY_DIR) / "test_path_help.txt";
+  REQUIRE(std::system(
+              (std::string(KNIT_BIN_DIR) + "/knit-meso path --help > " + help.string()).c_str()) ==
+          0);
+  std::ifstream in(help);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  CHECK(text.find("--uniaxial AXIS(0|1) E ") != std::string::npos);
+  CHECK(text.find("Green-Lagrange strain E in (-0.5, 10]") != std::string::npos);
+  CHECK(text.find("(-0.5, 10] x 2") == std::string::npos);
+  const std::string path = "path --loop-length 4.5 --steps 1 --no-vtp -o " +
+                           (fs::path(KNIT_BINARY_DIR) / "test_path_help_out").string();
+  CHECK(run(path + " --uniaxial 2 0.1") == 2);
+  CHECK(run(path + " --uniaxial 0 11") == 2);
+  CHECK(run(path + " --uniaxial 0 0.1 1") == 2);
+  CHECK(run(path + " --uniaxial 1 0.05") == 0);
+}
