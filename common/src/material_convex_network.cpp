@@ -449,22 +449,6 @@ KnotWeights NetworkLawData::weights(double l) const {
   return w;
 }
 
-KnotSpan NetworkLawData::span(double l) const {
-  const auto n = static_cast<Eigen::Index>(l_knots.size());
-  KnotSpan s;
-  if (n <= 1 || l <= l_knots.front()) return s;
-  if (l >= l_knots.back()) {
-    s.j = n - 1;
-    return s;
-  }
-  const auto it = std::upper_bound(l_knots.begin(), l_knots.end(), l);
-  s.j = static_cast<Eigen::Index>(it - l_knots.begin()) - 1;  // l in [l_j, l_j+1)
-  const double l0 = l_knots[static_cast<std::size_t>(s.j)];
-  s.t = (l - l0) / (l_knots[static_cast<std::size_t>(s.j + 1)] - l0);
-  s.inside = true;
-  return s;
-}
-
 std::vector<double> NetworkLawData::theta_row(Eigen::Index j) const {
   std::vector<double> out(static_cast<std::size_t>(shape.size()));
   for (int k = 0; k < shape.size(); ++k) out[static_cast<std::size_t>(k)] = theta(j, k);

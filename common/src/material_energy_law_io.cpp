@@ -70,10 +70,15 @@ void write_energy_law(io::H5Group& root, const EnergyLawData& law, const EnergyF
                       "d (C1 in l; knit/material/convex_network.hpp)");
     }
     g.write("l_knots", law.network.l_knots);
-    g.set_attribute("l_knots", "units",
-                    energy ? "mm (W piecewise linear in l between these: W = (1 - t) W_j + t "
-                             "W_j+1, each W_j the network at theta row j)"
-                           : "mm (theta piecewise linear in l between these)");
+    g.set_attribute(
+        "l_knots", "units",
+        !energy ? "mm (theta piecewise linear in l between these)"
+        : law.network.l_blend > 0.0
+            ? "mm (W piecewise linear in l between these: W = (1 - t) W_j + t W_j+1, each W_j "
+              "the network at theta row j; within l_blend x the shorter span of each inner knot "
+              "rounded, attribute l_blend of /energy_law)"
+            : "mm (W piecewise linear in l between these: W = (1 - t) W_j + t W_j+1, each W_j "
+              "the network at theta row j)");
     g.write("theta", RowMatrixX(law.network.theta));
     g.set_attribute(
         "theta", "layout",

@@ -228,7 +228,11 @@ def network_law(g, l, mode):
     if mode == "parameters":
         return NetworkLaw(g, l)
     knots = np.array(g["l_knots"])
-    w = [(j, c) for j, c in knot_weights(knots, l, float(g.attrs.get("l_blend", 0.0))) if c != 0.0]
+    l_blend = float(g.attrs.get("l_blend", 0.0))
+    if not 0.0 <= l_blend <= 0.5:  # as the C++ reader (NetworkLawData::validate)
+        raise ValueError(f"{g.file.filename}: {g.name}: attribute l_blend is {l_blend}; "
+                         "it must be in [0, 0.5]")
+    w = [(j, c) for j, c in knot_weights(knots, l, l_blend) if c != 0.0]
     if len(w) == 1:
         return NetworkLaw(g, l, row=w[0][0])
     return BlendedLaw(laws=[NetworkLaw(g, l, row=j) for j, _ in w], weights=[c for _, c in w])
@@ -242,7 +246,10 @@ def main():
                      f"{a.database} --law energy`)")
         k, l = pick_loop(f, a.loop_length)
         law = load_law(f["energy_law"], l)
-        family = "input-convex network" if isinstance(law, NetworkLaw) else "convex ridge-spline"
+        # The stored family (a law between knots or in a rounding window is a BlendedLaw).
+        fam = f["energy_law"].attrs.get("family", "ridge")
+        fam = fam.decode() if isinstance(fam, bytes) else str(fam)
+        family = "input-convex network" if fam == "network" else "convex ridge-spline"
         box_min, box_max = np.array(f["energy_law/box_min"]), np.array(f["energy_law/box_max"])
         pts, held = [], []
         raw = f[f"loop_{k}/raw"]

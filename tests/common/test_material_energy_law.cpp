@@ -352,6 +352,33 @@ TEST_CASE("energy law: l_blend rounds the kink at an inner knot (C1 in l, convex
     kink = std::max(kink, ((Sc - P1.S) - (P1.S - Sa)).norm());
   }
   CHECK(kink > 1e-3);  // the test law has a kink to round, so the checks above can fail
+  // Unequal spans (session 44's review: with equal spans a = b, and swapping them passed):
+  // knots 4.5, 5.0, 6.5, d = 0.2 x 0.5 = 0.1, the window [4.9, 5.1] with a = 0.2, b = 1/15.
+  EnergyLawData ud = d;
+  ud.network.l_knots = {4.5, 5.0, 6.5};
+  const EnergyLaw uneven(ud);
+  ud.network.l_blend = 0.0;
+  const EnergyLaw uneven_sharp(ud);
+  for (int k = 0; k < 30; ++k) {
+    const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+    const EnergyResponse P0 = uneven_sharp.at(4.9).evaluate(e),
+                         P1 = uneven_sharp.at(5.0).evaluate(e),
+                         P2 = uneven_sharp.at(5.1).evaluate(e);
+    for (double l : {4.93, 5.0, 5.07}) {
+      const double s = (l - 4.9) / 0.2;
+      const Eigen::Vector3d want = (1 - s) * (1 - s) * P0.S + 2 * s * (1 - s) * P1.S + s * s * P2.S;
+      REQUIRE((uneven.at(l).evaluate(e).S - want).norm() <= 1e-12 * (1 + want.norm()));
+    }
+    for (double l : {4.9, 5.0, 5.1}) {  // C1 at both edges and at the knot
+      const Eigen::Vector3d dS = uneven.at(l, true).dS_dl(e), S = uneven.at(l).evaluate(e).S;
+      const Eigen::Vector3d fwd = (uneven.at(l + h).evaluate(e).S - S) / h;
+      const Eigen::Vector3d bwd = (S - uneven.at(l - h).evaluate(e).S) / h;
+      INFO("uneven spans, l = " << l << ": dS/dl " << dS.transpose() << ", forward "
+                                << fwd.transpose() << ", backward " << bwd.transpose());
+      REQUIRE((fwd - dS).norm() <= 1e-4 * (1 + dS.norm()));
+      REQUIRE((bwd - dS).norm() <= 1e-4 * (1 + dS.norm()));
+    }
+  }
   // The weights: nonnegative, summing to 1, their derivatives to 0, on a fine grid of l.
   for (double l = 4.0; l <= 7.0; l += 0.00123) {
     const KnotWeights w = d.network.weights(l);

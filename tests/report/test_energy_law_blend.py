@@ -29,14 +29,14 @@ from energy_law import knot_weights, load_law  # noqa: E402
 FLOOR, Q = 0.2, [1.0, 3.0, 2.0]  # q_j at 4.5, 5.5, 6.5 mm: slopes +2 and -1 per mm
 
 
-def write_law(path, l_blend):
+def write_law(path, l_blend, knots=(4.5, 5.5, 6.5)):
     with h5py.File(path, "w") as f:
         law = f.create_group("energy_law")
         law.attrs["family"], law.attrs["l_interpolation"] = "network", "energy"
         law.attrs["h1"], law.attrs["h2"], law.attrs["floor"] = 1, 1, FLOOR
         if l_blend:
             law.attrs["l_blend"] = l_blend
-        law["l_knots"] = [4.5, 5.5, 6.5]
+        law["l_knots"] = list(knots)
         theta = np.zeros((3, 20))
         for j, q in enumerate(Q):
             theta[j, 11:20] = (np.sqrt(q) * np.eye(3)).ravel()  # L, the last 3 x 3
@@ -85,6 +85,25 @@ def main():
         c(gap_round < 1e-4 and gap_sharp > 2.9,
           "C1 with l_blend: one-sided slopes differ by %.2e at 5.3, 5.5, 5.7 (%.3f at the "
           "unrounded kink)" % (gap_round, gap_sharp))
+        # Unequal spans (session 44's review: with equal spans the two windows' fractions are
+        # equal, and swapping them passed): knots 4.5, 5.0, 6.5, the window [4.9, 5.1].
+        uneven = os.path.join(tmp, "uneven.h5")
+        write_law(uneven, 0.2, (4.5, 5.0, 6.5))
+
+        def sharp_u(l):
+            return FLOOR + np.interp(l, [4.5, 5.0, 6.5], Q)
+        worst, gap = 0.0, 0.0
+        for l in (4.93, 5.0, 5.07):
+            s = (l - 4.9) / 0.2
+            want = (1 - s) ** 2 * sharp_u(4.9) + 2 * s * (1 - s) * sharp_u(5.0) + s * s * sharp_u(5.1)
+            worst = max(worst, abs(s11(uneven, l) - want))
+        for l in (4.9, 5.0, 5.1):
+            fwd = (s11(uneven, l + h) - s11(uneven, l)) / h
+            bwd = (s11(uneven, l) - s11(uneven, l - h)) / h
+            gap = max(gap, abs(fwd - bwd))
+        c(worst < 1e-12 and gap < 1e-3,
+          "unequal spans: the Bezier curve (%.2e) and C1 at 4.9, 5.0, 5.1 (one-sided slopes "
+          "%.2e apart)" % (worst, gap))
         bad = []
         for l in np.linspace(4.0, 7.0, 2401):
             w = knot_weights(np.array([4.5, 5.5, 6.5]), l, 0.2)

@@ -228,15 +228,6 @@ enum class LInterpolation {
   kEnergy = 1,
 };
 
-/// The span that holds l: knot j and t in [0, 1) with l = (1 - t) l_j + t l_j+1; at or beyond
-/// the last knot j = n - 1, t = 0; at or before the first j = 0, t = 0 (clamped). `inside`:
-/// l_1 < l < l_n, where d/dl is that of the span [l_j, l_j+1) (as theta_at's derivative).
-struct KnotSpan {
-  Eigen::Index j = 0;
-  double t = 0.0;
-  bool inside = false;
-};
-
 /// The knot laws that make up the law at one loop length with LInterpolation::kEnergy: W(e; l)
 /// = sum_k c_k W_j[k](e), c_k >= 0, sum c_k = 1 (so W stays convex with eig(C) >= the floor),
 /// and dc_k/dl (NetworkLawData::weights). One knot at a knot or beyond the ends, two in a span,
@@ -265,7 +256,6 @@ struct NetworkLawData {
   /// W_j by d/4 times the difference of the two spans' slopes (docs/database.md,
   /// "Interpolation in l").
   double l_blend = 0.0;
-  KnotSpan span(double l) const;
   /// The knot weights of the law at l (kEnergy). dc: d/dl, with the conventions of theta_at:
   /// zero beyond the ends, one-sided at the end knots, the right span's at an interior knot
   /// without rounding.
