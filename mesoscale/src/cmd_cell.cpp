@@ -15,6 +15,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -50,15 +51,30 @@ int run(const Options& o) {
     throw knit::InputError("", "--loop-length",
                            "must be in (0, 50] mm, got " + std::to_string(o.loop_length));
   GeometryOptions go;
+  // The contact allowance the cell would be solved with (the sweep's and path's): a yarn no
+  // thicker than it is refused, as CellOptions::validate refuses it there (session 44's red
+  // team: --diameter 1e-300 wrote a cell whose yarns' centrelines were 1e-16 mm apart, exit 0).
+  double allowance = knit::meso::homog::CellOptions{}.contact.penalty.g0;
   if (!o.config.empty()) {  // yarn diameter and loop shape from the cell parameters
     const auto co = knit::meso::homog::read_cell_options(o.config);
     go.d = co.section.d;
     go.gamma_over_w = co.geometry.gamma_over_w;
+    allowance = co.contact.penalty.g0;
   }
   if (o.d_given || o.config.empty()) go.d = o.d;
   if (o.gamma_given || o.config.empty()) go.gamma_over_w = o.gamma_over_w;
   if (!(go.d > 0 && std::isfinite(go.d)))
     throw knit::InputError("", "--diameter", "must be a finite number > 0");
+  if (std::isfinite(allowance) && !(go.d > allowance)) {
+    std::ostringstream m;
+    m << "must be larger than the contact allowance " << allowance << " mm"
+      << (o.config.empty() ? " (its default)" : " (/contact/allowance of " + o.config + ")")
+      << ", got " << go.d
+      << " mm: the yarns' centrelines lie about one diameter apart, and within the allowance "
+         "they would pass through each other without force";
+    if (o.d_given || o.config.empty()) throw knit::InputError("", "--diameter", m.str());
+    throw knit::InputError(o.config, "/yarn/d", m.str());
+  }
   if (!(go.gamma_over_w >= 0 && go.gamma_over_w <= 1))
     throw knit::InputError("", "--gamma-over-w", "must be in [0, 1]");
   knit::io::check_output_target(o.out, knit::io::OutputKind::kDirectory, "--out");

@@ -179,6 +179,12 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       // 1 in `path`, naming no option; an empty value was taken as the option left out.
       // (session 29: named at the flag that makes it impossible, not at --loop-length)
       {"cell --loop-length 5 --diameter 1e308", "--diameter", "could not match"},
+      // Session 44's red team: a yarn thinner than the contact allowance was written with its
+      // yarns' centrelines 1e-16 mm apart, exit 0 (the sweep refuses it).
+      {"cell --loop-length 4.5 --diameter 1e-300", "--diameter",
+       "must be larger than the contact allowance 0.14 mm (its default), got 1e-300 mm"},
+      {"cell --loop-length 4.5 --diameter 0.14", "--diameter",
+       "must be larger than the contact allowance"},
       {"path --loop-length 2.5 --shear 5", "--loop-length", "no cell geometry for 2.5 mm"},
       {"cell --loop-length 4.5 --config ''", "--config", "must not be empty"},
       // Session 41's red team: a flag's value refused by the cell's own checks was named
