@@ -124,6 +124,8 @@ int run(const Options& o) {
 
   const Clearance cl = minimum_clearance(g.shape, g.dim.c);
   nlohmann::json j;
+  // (session 44's red team: the file carried no units)
+  j["units"] = "mm (every length and distance of this file; the curves' counts are numbers)";
   j["loop_length"] = g.dim.loop_length;
   j["w"] = g.dim.w;
   j["c"] = g.dim.c;

@@ -229,6 +229,7 @@ TEST_CASE("knit-meso cell --config reads the cell parameter file", "[unit]") {
   ss << in.rdbuf();
   const std::string js = ss.str();
   CHECK(js.find("\"yarn_diameter\": 0.3") != std::string::npos);
+  CHECK(js.find("\"units\": \"mm (every length") != std::string::npos);
   // a flag overrides the file
   REQUIRE(run_logged("cell --loop-length 4.5 --config " + dir +
                          "/cell.json --diameter 0.35 --out " + dir + "/b",
