@@ -174,6 +174,26 @@ std::string failure_line(const knit::meso::sweep::SweepInput& in,
   return "knit-meso sweep: error: " + why + "; " + what + " (the sweep's report is on stdout)";
 }
 
+/// The command that resumes this sweep, for pasting into a shell: every option that shapes the
+/// run again (the review of session 44: --max-output-size dropped made the command refuse the
+/// very sweep that needed it, --keep-parts dropped removed the checkpoints asked to be kept),
+/// each argument quoted (knit::cli::shell_quote), and a path that begins with '-' given as
+/// ./-path (CLI11 would read it as an option).
+std::string resume_command(const Cli& c) {
+  auto arg = [](const std::string& a) {
+    const bool dash = !a.empty() && a.front() == '-';
+    return knit::cli::shell_quote(dash ? "./" + a : a);
+  };
+  std::string cmd = "knit-meso sweep " + arg(c.input) + " --output " + arg(c.output) + " --resume";
+  if (c.threads > 0) cmd += " --threads " + std::to_string(c.threads);
+  if (!c.max_output_size.empty())
+    cmd += " --max-output-size " + knit::cli::shell_quote(c.max_output_size);
+  if (c.keep_parts) cmd += " --keep-parts";
+  if (c.no_progress) cmd += " --no-progress";
+  if (c.plain) cmd += " --plain";
+  return cmd;
+}
+
 // Ctrl-C (SIGINT), and SIGTERM and SIGHUP (a job scheduler's stop, a closed terminal; session
 // 22), say what is kept and how to go on, then end the process as the signal would (session
 // 21: it printed nothing). knit::cli::on_interrupt_say holds the async-signal-safe handler.
@@ -181,8 +201,7 @@ void explain_interrupt(const Cli& c) {
   knit::cli::on_interrupt_say(
       "knit-meso sweep: interrupted; the cases finished so far are kept "
       "in " +
-      c.output + ".parts: continue with `knit-meso sweep " + knit::cli::shell_quote(c.input) +
-      " --output " + knit::cli::shell_quote(c.output) + " --resume`");
+      c.output + ".parts: continue with `" + resume_command(c) + "`");
 }
 
 /// The output's parent directories that do not exist yet (deepest first): the sweep creates
@@ -267,10 +286,9 @@ int run(const Cli& c) {
     // say where they are and how to go on (session 22).
     std::error_code ec;
     if (std::filesystem::is_directory(c.output + ".parts", ec))
-      throw std::runtime_error(
-          std::string(e.what()) + "; the cases finished so far are kept in " + c.output +
-          ".parts: continue with `knit-meso sweep " + knit::cli::shell_quote(c.input) +
-          " --output " + knit::cli::shell_quote(c.output) + " --resume` once the cause is fixed");
+      throw std::runtime_error(std::string(e.what()) + "; the cases finished so far are kept in " +
+                               c.output + ".parts: continue with `" + resume_command(c) +
+                               "` once the cause is fixed");
     throw;
   }
 }

@@ -338,13 +338,21 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   // DB.failed.h5` running, which holds DB.failed.h5.lock, renamed its refit over the one this
   // wrote, and the failed sweep's database was lost): a name held by another process, or
   // holding what is not a database, passes to the next, DB.failed-2.h5, ...; with none free
-  // nothing is written, and the cases stay in the checkpoints, said so.
+  // nothing is written, and the cases stay in the checkpoints, said so. Only DB.failed.h5, the
+  // documented name, may be replaced; DB.failed-2.h5 ... are taken only where nothing is
+  // (the review of session 44: a user's database there was overwritten).
   std::optional<io::OutputLock> failed_lock;
   std::error_code ec;
   if (!rep.ok() && std::filesystem::exists(opt.output, ec)) {
     std::string first_refusal;
     for (int n = 1; n <= kFailedDatabaseNames && !failed_lock; ++n) {
       const std::filesystem::path name = failed_database_path(opt.output, n);
+      std::error_code there;
+      if (n > 1 &&
+          (std::filesystem::exists(name, there) || std::filesystem::is_symlink(name, there))) {
+        if (first_refusal.empty()) first_refusal = name.string() + " exists";
+        continue;
+      }
       try {
         io::OutputLock l(name);
         io::check_output_target(name, io::OutputKind::kFile, "--output",
