@@ -285,18 +285,35 @@ TEST_CASE("knit-meso sweep: the database keeps a cell parameter file's contents,
   CHECK(again.cell_file.empty());
 }
 
+// A scratch directory with f.json, a synthetic sweep whose energy fit fails (an energy-law
+// floor of 1000 MPa), and the command that runs it into db.h5 with stderr to stderr.txt.
+namespace {
+struct FailingSweep {
+  fs::path dir, db, err;
+  std::string sweep;
+};
+FailingSweep failing_sweep(const std::string& name) {
+  FailingSweep f;
+  f.dir = knit_test::scratch(name);
+  knit_test::write_text(f.dir / "f.json",
+                        R"({"loop_lengths": [5], "runner": "synthetic", "steps": 6,
+                            "energy_fit": {"floor": 1000, "network_iterations": 100}})");
+  f.db = f.dir / "db.h5";
+  f.err = f.dir / "stderr.txt";
+  f.sweep = kExe + " sweep " + (f.dir / "f.json").string() + " --output " + f.db.string() +
+            " --no-progress > /dev/null 2> " + f.err.string();
+  return f;
+}
+}  // namespace
+
 // Session 44's red team: a sweep that failed exited 1 with nothing on stderr (with
 // --no-progress); only stdout's summary said why. Now one line on stderr says why and what
 // became of the output, as knit-meso fit's does (session 36). An energy-law floor of 1000 MPa
 // fails the energy fit of the synthetic runner's data.
 TEST_CASE("knit-meso sweep: a failing sweep says why on stderr, and what it wrote", "[case]") {
-  const auto dir = knit_test::scratch("sweep_cli_stderr");
-  knit_test::write_text(dir / "f.json",
-                        R"({"loop_lengths": [5], "runner": "synthetic", "steps": 6,
-                            "energy_fit": {"floor": 1000, "network_iterations": 100}})");
-  const fs::path db = dir / "db.h5", err = dir / "stderr.txt";
-  const std::string sweep = kExe + " sweep " + (dir / "f.json").string() + " --output " +
-                            db.string() + " --no-progress > /dev/null 2> " + err.string();
+  const FailingSweep f = failing_sweep("sweep_cli_stderr");
+  const fs::path &dir = f.dir, &db = f.db, &err = f.err;
+  const std::string& sweep = f.sweep;
   // No database there: the failing sweep's own is written, for the diagnosis.
   CHECK(shell(sweep) == 1);
   std::string text = knit_test::read_text(err);
@@ -388,13 +405,9 @@ TEST_CASE("knit-meso sweep: a sweep whose output would exceed --max-output-size 
 // with every name held nothing is written, and the stderr line says so and where the cases are.
 TEST_CASE("knit-meso sweep: a failing sweep takes the lock of DB.failed.h5, or writes another name",
           "[case]") {
-  const auto dir = knit_test::scratch("sweep_cli_failed_lock");
-  knit_test::write_text(dir / "f.json",
-                        R"({"loop_lengths": [5], "runner": "synthetic", "steps": 6,
-                            "energy_fit": {"floor": 1000, "network_iterations": 100}})");
-  const fs::path db = dir / "db.h5", err = dir / "stderr.txt";
-  const std::string sweep = kExe + " sweep " + (dir / "f.json").string() + " --output " +
-                            db.string() + " --no-progress > /dev/null 2> " + err.string();
+  const FailingSweep f = failing_sweep("sweep_cli_failed_lock");
+  const fs::path &dir = f.dir, &db = f.db, &err = f.err;
+  const std::string& sweep = f.sweep;
   REQUIRE(shell(sweep) == 1);  // no database there: db.h5 written
   REQUIRE(fs::exists(db));
   {
