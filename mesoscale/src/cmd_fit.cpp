@@ -193,26 +193,28 @@ static knit::cli::SubcommandRegistrar reg_fit(
                 !lost.empty())
               knit::meso::cmd_fit::refuse_in_place(o->db, lost);
         }
+        // Both options files are read and checked before any fit (session 44's review: a
+        // missing --energy-options file was refused after the whole paper fit).
+        const FitOptions fo =
+            o->options.empty()
+                ? FitOptions{}
+                : FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
+        EnergyFitOptions eo =
+            o->energy_options.empty()
+                ? EnergyFitOptions{}
+                : EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
+                                              o->energy_options);
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()
                   << " loop lengths, law " << o->law << ")\n";
         if (paper) {
-          const FitOptions fo =
-              o->options.empty()
-                  ? FitOptions{}
-                  : FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
           const auto fits = fit_paper_law(db, fo);
           print_fit_summaries(std::cout, db, fits);
           first_failure = knit::meso::fit::first_fit_failure(db, fits);
           if (!first_failure.empty()) rc = knit::kExitFailure;
         }
         if (energy) {
-          EnergyFitOptions eo =
-              o->energy_options.empty()
-                  ? EnergyFitOptions{}
-                  : EnergyFitOptions::from_json(
-                        read_text_file(o->energy_options, "--energy-options"), o->energy_options);
           eo.threads = o->threads;
           eo.progress = stderr;  // a line every 5 s of the network's L-BFGS
           const auto s = fit_energy_database(db, eo);

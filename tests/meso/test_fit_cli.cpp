@@ -464,6 +464,21 @@ TEST_CASE("knit-meso fit and synth: an options file that cannot be read names it
           2);
     CHECK_THAT(text, Catch::Contains(opt + ": " + missing.string() + ": file not found"));
   }
+  // Before any fit (the review of session 44: the whole paper fit ran and printed first): the
+  // command prints nothing on stdout.
+  {
+    std::string cmd = KNIT_BIN_DIR;
+    cmd += "/knit-meso fit ";
+    cmd += db.string();
+    cmd += " --energy-options ";
+    cmd += missing.string();
+    cmd += " > ";
+    cmd += (dir / "out.txt").string();
+    cmd += " 2> /dev/null";
+    const int rc = std::system(cmd.c_str());
+    CHECK((WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) == 2);
+    CHECK(fs::file_size(dir / "out.txt") == 0);
+  }
   for (const std::string opt : {"--fit-options", "--energy-options"}) {
     CHECK(run_with_stderr(
               "synth --out " + (dir / "s.h5").string() + " " + opt + " " + missing.string(), err,
