@@ -137,11 +137,14 @@ void check_gradient_ends(const material::CoverageOptions& co, const nlohmann::js
     const double reach = std::max({std::abs(e(0)), std::abs(e(1)), std::abs(std::sin(co.gamma))});
     if (reach >= m) continue;
     std::ostringstream o;
-    o << "is " << co.gamma * 180.0 / kPi << " deg, and the stretch [" << e(0) << ", " << e(1)
-      << "] (" << io::json_pointer_append("/load_paths/coverage/stretch", k)
+    // (the values in full, shortest(): the review of session 44 had "[0.001, 0] ... is below
+    // 0.001" for 0.00099999999)
+    o << "is " << co.gamma * 180.0 / kPi << " deg, and the stretch [" << shortest(e(0)) << ", "
+      << shortest(e(1)) << "] (" << io::json_pointer_append("/load_paths/coverage/stretch", k)
       << (given ? "" : ", the default") << ") is below " << m
-      << " too: its shear-with-stretch path ends " << (reach == 0.0 ? "at" : "within round-off of")
-      << " the reference state (largest |H| " << reach << ", below " << m
+      << " too: its shear-with-stretch path ends "
+      << (reach == 0.0 ? "at" : "within " + shortest(m) + " of")
+      << " the reference state (largest |H| " << shortest(reach) << ", below " << m
       << ") and carries no data; give gamma_deg >= " << std::ceil(m * 180.0 / kPi * 1e4) / 1e4
       << " (" << m << " rad) or stretches of at least " << m
       << ", as for an explicit path, or leave \"stretch\" empty for no such paths";

@@ -155,7 +155,11 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"path --loop-length 4.5", "--biaxial, --shear, --uniaxial", ": give exactly one of them"},
       {"path --loop-length 4.5 --shear nan", "--shear", "in (-80, 80)"},
       {"path --loop-length 4.5 --biaxial nan 0", "--biaxial", "in (-1, 10]"},
-      {"path --loop-length 4.5 --uniaxial 1 nan", "--uniaxial", "in (-0.5, 10]"},
+      {"path --loop-length 4.5 --uniaxial 1 nan", "--uniaxial", "a finite number"},
+      {"path --loop-length 4.5 --uniaxial 1 11", "--uniaxial", "E must be in (-0.5, 10]"},
+      // (the review of session 44: AXIS 11 was refused with E's range)
+      {"path --loop-length 4.5 --uniaxial 11 0.05", "--uniaxial",
+       "AXIS must be 0 (course) or 1 (wale)"},
       {"path --loop-length 4.5 --uniaxial 2 0.1", "--uniaxial", "AXIS must be 0 (course) or 1"},
       {"path --loop-length 4.5 --uniaxial 1 0.1 --shear 5", "--uniaxial", "excludes"},
       {"path --loop-length 4.5 --shear 5 --steps 0", "--steps", "[1, 100000]"},

@@ -356,7 +356,7 @@ TEST_CASE("sweep input: shear-with-stretch coverage paths without an end are ref
   CHECK_THAT(error_of(R"({"gamma_deg": 0.0001})"),  // the default stretches hold [0, 0]
              Catch::StartsWith("s.json: /load_paths/coverage/gamma_deg: is 0.0001 deg") &&
                  Catch::Contains("(/load_paths/coverage/stretch/0, the default)") &&
-                 Catch::Contains("ends within round-off of the reference state"));
+                 Catch::Contains("ends within 0.001 of the reference state"));
   CHECK(error_of(R"({"gamma_deg": 0.0573, "stretch": [[0, 0]]})") == "<no error>");
   CHECK(error_of(R"({"gamma_deg": 0, "stretch": [[0.001, 0], [0, -0.001]]})") == "<no error>");
   CHECK(error_of(R"({"gamma_deg": 0, "stretch": []})") == "<no error>");
