@@ -111,7 +111,8 @@ inline constexpr std::uint64_t kDefaultMaxOutputBytes = 2'000'000'000;
 /// The estimated size of what the sweep writes: the database and its checkpoints (both on
 /// disk before the checkpoints are removed, and kept together with --keep-parts), from the
 /// cases x steps of the input (measured on the synthetic runner: 116 bytes per step in the
-/// database and 285 in a checkpoint, about 17 kB per case; rounded up).
+/// database and 285 in a checkpoint, about 17 kB per case; rounded up, with 340 bytes per
+/// checkpoint step for the cell runner's longer numbers and 128 kB per database).
 std::uint64_t estimate_output_bytes(const SweepInput& in);
 
 /// Refuses, before any case runs, a sweep whose estimated output exceeds max_bytes (0: no
