@@ -74,6 +74,21 @@ static knit::cli::SubcommandRegistrar reg_synth(
         if (!o->no_coverage)
           for (const auto& p : synthetic_coverage_paths(std::max(4, o->steps / 2)))
             so.paths.push_back(p);
+        // Both options files are read and checked before the database is built (the review of
+        // session 44: a missing --energy-options file was refused after the build and the
+        // paper fit). The synthetic law is exactly a sum of ridge functions of the default
+        // directions (knit/meso/fit/synthetic.hpp), so the stand-in fits the ridge family
+        // unless the options say otherwise (the network's fit costs seconds for nothing here).
+        const FitOptions fo = o->fit_options.empty()
+                                  ? FitOptions{}
+                                  : FitOptions::from_json(knit::meso::fit::read_text_file(
+                                                              o->fit_options, "--fit-options"),
+                                                          o->fit_options);
+        EnergyFitOptions eo;
+        eo.family = "ridge";
+        if (!o->energy_options.empty())
+          eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
+                                           o->energy_options);
         auto db = synthetic_database(so);
         // The stand-in's stiffness k = (4.5 / l)^2 overflows for a tiny l: its stresses were
         // written as inf and NaN with exit 0 (session 21, --loop-lengths 1e-300), and beyond
@@ -86,24 +101,11 @@ static knit::cli::SubcommandRegistrar reg_synth(
         int rc = knit::kExitOk;
         std::string first_failure;
         if (!o->no_fit) {
-          const FitOptions fo = o->fit_options.empty()
-                                    ? FitOptions{}
-                                    : FitOptions::from_json(knit::meso::fit::read_text_file(
-                                                                o->fit_options, "--fit-options"),
-                                                            o->fit_options);
           const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
           first_failure = knit::meso::fit::first_fit_failure(db, fits);
           if (!first_failure.empty()) rc = knit::kExitFailure;
-          // The synthetic law is exactly a sum of ridge functions of the default directions
-          // (knit/meso/fit/synthetic.hpp), so the stand-in fits the ridge family unless the
-          // options say otherwise (the network's fit costs seconds for nothing here).
-          EnergyFitOptions eo;
-          eo.family = "ridge";
-          if (!o->energy_options.empty())
-            eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
-                                             o->energy_options);
           const auto es = fit_energy_database(db, eo);
           std::cout << energy_fit_report(es);
           if (!es.ok()) {

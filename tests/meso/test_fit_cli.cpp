@@ -478,6 +478,19 @@ TEST_CASE("knit-meso fit and synth: an options file that cannot be read names it
     const int rc = std::system(cmd.c_str());
     CHECK((WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) == 2);
     CHECK(fs::file_size(dir / "out.txt") == 0);
+    // and synth before it builds the database (nothing on stdout, no file)
+    std::string syn = KNIT_BIN_DIR;
+    syn += "/knit-meso synth --out ";
+    syn += (dir / "s2.h5").string();
+    syn += " --energy-options ";
+    syn += missing.string();
+    syn += " > ";
+    syn += (dir / "out2.txt").string();
+    syn += " 2> /dev/null";
+    const int rs = std::system(syn.c_str());
+    CHECK((WIFEXITED(rs) ? WEXITSTATUS(rs) : -1) == 2);
+    CHECK(fs::file_size(dir / "out2.txt") == 0);
+    CHECK_FALSE(fs::exists(dir / "s2.h5"));
   }
   for (const std::string opt : {"--fit-options", "--energy-options"}) {
     CHECK(run_with_stderr(
