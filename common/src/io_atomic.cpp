@@ -494,4 +494,9 @@ std::string explain_unwritten_outputs(const std::string& message) {
          "): " + why;
 }
 
+const char* unwritten_output_state(const std::filesystem::path& path) {
+  std::error_code ec;
+  return std::filesystem::exists(path, ec) ? " is left as it was" : " was not created";
+}
+
 }  // namespace knit::io

@@ -19,6 +19,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 #include "knit/io/hdf5.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
@@ -76,14 +77,12 @@ knit::io::H5File open_input_again(const std::string& input, const FileIdentity& 
 /// The error of a refit whose input changed (write_database's own message would name the
 /// target first, and the input's change as a detail).
 [[noreturn]] void refuse_changed_input(const std::string& db, const std::string& target) {
-  std::error_code ec;
   throw std::runtime_error(
       db +
       ": changed during the fit (replaced or rewritten since it was read: another sweep or "
       "fit wrote it, say): nothing was written, since what the refit does not write itself "
       "would come from another database (" +
-      target + (std::filesystem::exists(target, ec) ? " is left as it was" : " was not created") +
-      "); fit it again");
+      target + knit::io::unwritten_output_state(target) + "); fit it again");
 }
 
 /// What an in-place refit of `input` (read into `db`) would drop: the database as read, written
@@ -232,8 +231,7 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // data). The target is left as it was.
         if (rc != knit::kExitOk) {
           // (session 41: "left as it was" of an -o file that did not exist)
-          const char* state =
-              std::filesystem::exists(target) ? " is left as it was" : " was not created";
+          const char* state = knit::io::unwritten_output_state(target);
           std::cout << "database NOT written: a fit failed; " << target << state << "\n";
           std::cout.flush();
           std::cerr << "knit-meso fit: error: " << first_failure << "; " << target << state

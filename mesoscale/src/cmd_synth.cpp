@@ -17,6 +17,7 @@
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/fit/energy_fit.hpp"
@@ -116,12 +117,10 @@ static knit::cli::SubcommandRegistrar reg_synth(
         // A fit that failed writes nothing, as knit-meso fit (session 41's red team: synth
         // replaced a good database by one whose loop length held raw data only, exit 1).
         if (rc != knit::kExitOk) {
-          const bool existed = std::filesystem::exists(o->out);
-          std::cout << "database NOT written: a fit failed; " << o->out
-                    << (existed ? " is left as it was\n" : " was not created\n");
+          const char* state = knit::io::unwritten_output_state(o->out);
+          std::cout << "database NOT written: a fit failed; " << o->out << state << "\n";
           std::cout.flush();
-          std::cerr << "knit-meso synth: error: " << first_failure << "; " << o->out
-                    << (existed ? " is left as it was" : " was not created")
+          std::cerr << "knit-meso synth: error: " << first_failure << "; " << o->out << state
                     << " (the fit's report is on stdout; --no-fit writes the raw data alone)\n";
           return rc;
         }

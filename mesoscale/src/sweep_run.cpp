@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/atomic.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/meso/sweep/checkpoint.hpp"
 #include "knit/meso/sweep/progress.hpp"
@@ -309,10 +310,8 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
   if (std::none_of(rep.results.begin(), rep.results.end(),
                    [](const JobResult& r) { return r.converged_steps() > 0; })) {
     // (session 44's red team: "left as it was" of an output that did not exist; fit's wording)
-    std::error_code ec;
-    rep.not_written =
-        "no case converged a single step; " + opt.output.string() +
-        (std::filesystem::exists(opt.output, ec) ? " is left as it was" : " was not created");
+    rep.not_written = "no case converged a single step; " + opt.output.string() +
+                      io::unwritten_output_state(opt.output);
     rep.seconds_total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!opt.keep_parts) store->remove();

@@ -126,4 +126,9 @@ class AtomicDirectory {
   bool active_ = true;
 };
 
+/// What a command that wrote nothing says of its output `path`: " is left as it was" when a
+/// file is there, " was not created" when none is (session 41: "left as it was" of an -o file
+/// that never existed). One wording for knit-meso fit, synth and sweep.
+const char* unwritten_output_state(const std::filesystem::path& path);
+
 }  // namespace knit::io
