@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -82,6 +83,51 @@ std::string not_ours(const fs::path& dir) {
   return "";
 }
 
+/// What differs between the job definition stored in a manifest and this sweep's, as pointers
+/// into the job definition with both values (at most `max_items`, then "and N more"); "" if
+/// the manifest holds none (written before session 26) or they are equal. Session 44's list of
+/// what was left open: the refusal said only "a different sweep input", and a user with a long
+/// input had to diff the manifest by hand to find the one step count they had changed.
+std::string describe_difference(const nlohmann::json& stored, const nlohmann::json& now,
+                                std::size_t max_items = 4) {
+  const auto short_text = [](const nlohmann::json& v) {
+    std::string t = v.dump();
+    constexpr std::size_t kMax = 60;
+    if (t.size() > kMax) t = t.substr(0, kMax - 3) + "...";
+    return t;
+  };
+  const nlohmann::json patch = nlohmann::json::diff(stored, now);
+  std::ostringstream o;
+  std::size_t shown = 0;
+  std::map<std::string, std::size_t> appended;
+  for (const auto& op : patch) {
+    if (shown == max_items) {
+      o << "; " << patch.size() - shown << " more";
+      break;
+    }
+    std::string path = op.at("path").get<std::string>();
+    const std::string kind = op.at("op").get<std::string>();
+    // JSON Patch appends to an array at ".../-": named here by the index it takes.
+    if (path.size() >= 2 && path.compare(path.size() - 2, 2, "/-") == 0) {
+      const std::string parent = path.substr(0, path.size() - 2);
+      path = parent + "/" +
+             std::to_string(stored.at(nlohmann::json::json_pointer(parent)).size() +
+                            appended[parent]++);
+    }
+    o << (shown == 0 ? "" : "; ") << (path.empty() ? "/" : path) << ": ";
+    if (kind == "replace")
+      o << short_text(stored.at(nlohmann::json::json_pointer(path))) << " in the checkpoints, "
+        << short_text(op.at("value")) << " now";
+    else if (kind == "add")
+      o << "only now (" << short_text(op.at("value")) << ")";
+    else
+      o << "only in the checkpoints (" << short_text(stored.at(nlohmann::json::json_pointer(path)))
+        << ")";
+    ++shown;
+  }
+  return o.str();
+}
+
 /// Whether the store `dir` (ours) holds a finished case's record (a job_NNNNN.txt).
 bool holds_job_records(const fs::path& dir) {
   std::error_code ec;
@@ -140,18 +186,31 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                        "discard them with --force");
     if (resume) {
       std::string have;
+      nlohmann::json manifest;
       try {
-        have = nlohmann::json::parse(slurp(dir_ / kManifest)).at("fingerprint").get<std::string>();
+        manifest = nlohmann::json::parse(slurp(dir_ / kManifest));
+        have = manifest.at("fingerprint").get<std::string>();
       } catch (const std::exception&) {
         throw InputError((dir_ / kManifest).string(), "",
                          "--resume: the checkpoints' manifest is missing or damaged, so they "
                          "cannot be matched to this sweep input; use --force to discard them");
       }
-      if (have != fp)
+      if (have != fp) {
+        std::string what;
+        try {
+          what = describe_difference(manifest.at("job_definition"),
+                                     nlohmann::json::parse(job_definition));
+        } catch (const std::exception&) {
+          // a manifest without a readable job definition: the general words alone
+        }
         throw InputError(dir_.string(), "",
                          "--resume: these checkpoints were made from a different sweep input "
-                         "(loop lengths, paths, steps, cell, retry or runner differ); use --force "
-                         "to discard them");
+                         "(loop lengths, paths, steps, cell, retry or runner differ" +
+                             (what.empty() ? std::string()
+                                           : "; in the job definition of " +
+                                                 (dir_ / kManifest).string() + ", " + what) +
+                             "); use --force to discard them");
+      }
       return;
     }
     remove();

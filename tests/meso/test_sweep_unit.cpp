@@ -938,6 +938,21 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                     Catch::Contains("checkpoints of an unfinished sweep exist"));
   CHECK_THROWS_WITH(CheckpointStore(out, R"({"other": 1})", n, true, false),
                     Catch::Contains("different sweep input"));
+  // The refusal says what differs, as pointers into the job definition with both values.
+  {
+    auto changed = in;
+    changed.paths[1].steps += 3;
+    const std::string want = "/paths/1/steps: " + std::to_string(in.paths[1].steps) +
+                             " in the checkpoints, " + std::to_string(changed.paths[1].steps) +
+                             " now";
+    CHECK_THROWS_WITH(CheckpointStore(out, changed.job_definition(), n, true, false),
+                      Catch::Contains(want) && Catch::Contains("manifest.json"));
+    changed = in;
+    changed.loop_lengths.push_back(9.0);
+    CHECK_THROWS_WITH(CheckpointStore(out, changed.job_definition(), n, true, false),
+                      Catch::Contains("/loop_lengths/" + std::to_string(in.loop_lengths.size()) +
+                                      ": only now (9.0)"));
+  }
   // Marked written (a sweep stopped after its database was in place, while it removed them;
   // session 38's red team: the next sweep said "checkpoints of an unfinished sweep exist"):
   // --resume takes them (and drops the mark: they are that run's again, and a --keep-parts
