@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "knit/core/build_info.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
 #include "knit/meso/sweep/checkpoint.hpp"
@@ -19,6 +20,11 @@ namespace {
 constexpr const char* kManifest = "manifest.json";
 /// Written once the database is in place (CheckpointStore::mark_written).
 constexpr const char* kWritten = "database_written";
+
+/// The build that writes a manifest, as it is recorded there: "knit-meso VERSION (git REV)".
+std::string build_name() {
+  return std::string("knit-meso ") + project_version() + " (git " + git_revision() + ")";
+}
 
 std::string job_file(int index) {
   char b[32];
@@ -211,6 +217,19 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                                                  (dir_ / kManifest).string() + ", " + what) +
                              "); use --force to discard them");
       }
+      // The same input, but another build (session 45; left open by session 44): the database
+      // would hold the cases of two builds and name only this one in its provenance.
+      const std::string built = build_name();
+      std::string wrote = "a knit-meso of session 44 or earlier (the manifest names none)";
+      if (const auto it = manifest.find("software"); it != manifest.end() && it->is_string())
+        wrote = it->get<std::string>();
+      if (wrote != built)
+        throw InputError((dir_ / kManifest).string(), "/software",
+                         "--resume: these checkpoints were written by " + wrote + ", this is " +
+                             built +
+                             ": a database of both builds' cases would name only this one. "
+                             "Resume with the build that wrote them, or discard them with "
+                             "--force");
       return;
     }
     remove();
@@ -221,6 +240,7 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
   const nlohmann::json m = {{"format", "knit-sweep-parts"},
                             {"version", 1},
                             {"fingerprint", fp},
+                            {"software", build_name()},
                             {"jobs", job_count},
                             {"job_definition", nlohmann::json::parse(job_definition)}};
   io::write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");

@@ -953,6 +953,27 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                       Catch::Contains("/loop_lengths/" + std::to_string(in.loop_lengths.size()) +
                                       ": only now (9.0)"));
   }
+  // The same input from another build (or from a manifest that names none, written before
+  // session 45) is refused as well, naming both builds; the manifest is left as it was.
+  {
+    const auto manifest_path = parts / "manifest.json";
+    const std::string original = knit_test::read_text(manifest_path);
+    auto m = nlohmann::json::parse(original);
+    REQUIRE(m.contains("software"));
+    CHECK(m["software"].get<std::string>().rfind("knit-meso ", 0) == 0);
+    m["software"] = "knit-meso 0.0.9 (git 0123456789ab)";
+    knit_test::write_text(manifest_path, m.dump());
+    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, true, false),
+                      Catch::Contains("written by knit-meso 0.0.9 (git 0123456789ab)") &&
+                          Catch::Contains("--force"));
+    m.erase("software");
+    knit_test::write_text(manifest_path, m.dump());
+    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, true, false),
+                      Catch::Contains("session 44 or earlier"));
+    CHECK(knit_test::read_text(manifest_path) == m.dump());
+    knit_test::write_text(manifest_path, original);
+    CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, true, false));
+  }
   // Marked written (a sweep stopped after its database was in place, while it removed them;
   // session 38's red team: the next sweep said "checkpoints of an unfinished sweep exist"):
   // --resume takes them (and drops the mark: they are that run's again, and a --keep-parts
