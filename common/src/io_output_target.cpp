@@ -266,8 +266,42 @@ fs::path OutputLock::lock_path(const fs::path& target) {
   return l;
 }
 
+namespace {
+/// The directories among `p` and its ancestors that do not exist, deepest first.
+std::vector<fs::path> missing_directories(fs::path p) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  for (; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+    out.push_back(p);
+    if (p.parent_path() == p) break;
+  }
+  return out;
+}
+
+/// Removes those of `dirs` (deepest first) that are empty directories: nothing else is touched.
+void remove_if_empty(const std::vector<fs::path>& dirs) {
+  for (const auto& d : dirs) {
+    std::error_code ec;
+    if (fs::is_directory(fs::symlink_status(d, ec)) && fs::is_empty(d, ec) && !ec)
+      fs::remove(d, ec);
+  }
+}
+}  // namespace
+
 OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
-  const std::string out = without_trailing_slash(target).string();
+  // The parent directories this lock creates (as the writer would) are removed again, if they
+  // are still empty, when it is released or cannot be taken (session 45; session 44's list:
+  // `knit-meso fit DB -o a/b/x.h5` refused its options and left the empty a/b behind).
+  if (file_.has_parent_path()) new_dirs_ = missing_directories(file_.parent_path());
+  try {
+    take(without_trailing_slash(target).string());
+  } catch (...) {
+    remove_if_empty(new_dirs_);
+    throw;
+  }
+}
+
+void OutputLock::take(const std::string& out) {
   std::error_code ec;
   if (file_.has_parent_path()) fs::create_directories(file_.parent_path(), ec);  // as the writer
   // A knitscale lock file never appears untagged at its final path: it is written and locked
@@ -290,6 +324,11 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
     // 1. A new lock: tagged and locked under a private name, then linked into place.
     std::string tmpl = file_.string() + ".new-XXXXXX";
     int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
+    if (fd < 0 && errno == ENOENT && attempt + 1 < 20) {
+      // The parent was removed in between (another lock released it empty): made again.
+      fs::create_directories(file_.parent_path(), ec);
+      continue;
+    }
     if (fd < 0) cannot("cannot create the lock file", errno);
     ::fchmod(fd, 0644);
     const bool tagged = ::pwrite(fd, me.data(), me.size(), 0) == static_cast<ssize_t>(me.size());
@@ -342,14 +381,17 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
   throw InputError(out, "", "cannot take the lock " + file_.string() + " (it keeps changing)");
 }
 
-OutputLock::OutputLock(OutputLock&& o) noexcept : file_(std::move(o.file_)), fd_(o.fd_) {
+OutputLock::OutputLock(OutputLock&& o) noexcept
+    : file_(std::move(o.file_)), fd_(o.fd_), new_dirs_(std::move(o.new_dirs_)) {
   o.fd_ = -1;
+  o.new_dirs_.clear();
 }
 
 OutputLock::~OutputLock() {
   if (fd_ < 0) return;
   ::unlink(file_.c_str());  // while still held: a waiting process retries on a new file
   ::close(fd_);
+  remove_if_empty(new_dirs_);
 }
 
 // ---- sizes ----------------------------------------------------------------------------------

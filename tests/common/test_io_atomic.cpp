@@ -367,6 +367,44 @@ TEST_CASE("OutputLock: one holder at a time, named in the refusal, stale locks t
   CHECK(fs::file_size(d / "out.lock") == 0);
 }
 
+TEST_CASE("OutputLock removes the parent directories it created, if still empty, and no others",
+          "[unit][io][atomic]") {
+  // Session 45 (session 44's list): `knit-meso fit DB -o a/b/x.h5` refused its options and
+  // left the empty a/b behind.
+  const fs::path d = scratch("lock_dirs");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  {
+    knit::io::OutputLock a(d / "a" / "b" / "out.h5");
+    CHECK(fs::is_directory(d / "a" / "b"));
+  }
+  CHECK_FALSE(fs::exists(d / "a"));  // both made by the lock, both empty: gone
+  // Moved, the new holder removes them.
+  {
+    knit::io::OutputLock a(d / "a" / "b" / "out.h5");
+    knit::io::OutputLock moved(std::move(a));
+  }
+  CHECK_FALSE(fs::exists(d / "a"));
+  // A directory that existed stays, empty or not; one that received a file stays.
+  fs::create_directories(d / "a");
+  {
+    knit::io::OutputLock a(d / "a" / "b" / "c" / "out.h5");
+    std::ofstream(d / "a" / "b" / "written.h5") << "x";
+  }
+  CHECK(fs::exists(d / "a" / "b" / "written.h5"));
+  CHECK_FALSE(fs::exists(d / "a" / "b" / "c"));
+  fs::remove(d / "a" / "b" / "written.h5");
+  { knit::io::OutputLock a(d / "a" / "b" / "out.h5"); }
+  CHECK(fs::is_directory(d / "a" / "b"));  // existed before this lock
+  // A lock refused (a file of its name that is not ours) leaves that file and its directories.
+  fs::remove_all(d / "a");
+  fs::create_directories(d / "a" / "b");
+  std::ofstream(d / "a" / "b" / "out.h5.lock") << "someone's notes";
+  CHECK_THROWS_AS(knit::io::OutputLock(d / "a" / "b" / "out.h5"), knit::InputError);
+  CHECK(fs::exists(d / "a" / "b" / "out.h5.lock"));
+  fs::remove_all(d / "a");
+}
+
 TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our stale partials",
           "[unit][io][atomic]") {
   const fs::path d = scratch("ours");

@@ -93,7 +93,8 @@ void check_output_target(const std::filesystem::path& target, OutputKind kind,
 /// the lock is released. A knitscale lock file is tagged and locked under a private name
 /// ("<target>.lock.new-XXXXXX") and then linked into place, so it is never seen untagged; a
 /// "<target>.lock" that is not a knitscale lock file, an empty one included, is never touched.
-/// Missing parent directories of the target are created (as the writer would).
+/// Missing parent directories of the target are created (as the writer would), and removed again
+/// on release (or when the lock cannot be taken) if they are still empty.
 class OutputLock {
  public:
   explicit OutputLock(std::filesystem::path target);
@@ -108,8 +109,12 @@ class OutputLock {
   const std::filesystem::path& path() const { return file_; }
 
  private:
+  void take(const std::string& out);
+
   std::filesystem::path file_;
   int fd_ = -1;
+  /// The parent directories the lock created (deepest first): removed on release if empty.
+  std::vector<std::filesystem::path> new_dirs_;
 };
 
 /// Estimated output size in bytes as "1.2 GB" / "350 MB" / "12 kB" (decimal units).
