@@ -25,6 +25,8 @@ constexpr const char* kWritten = "database_written";
 std::string build_name() {
   return std::string("knit-meso ") + project_version() + " (git " + git_revision() + ")";
 }
+/// In the list of builds for a manifest written before session 45, which names none.
+constexpr const char* kUnnamedBuild = "an earlier knit-meso (its manifest names no build)";
 
 std::string job_file(int index) {
   char b[32];
@@ -99,7 +101,11 @@ std::string describe_difference(const nlohmann::json& stored, const nlohmann::js
   const auto short_text = [](const nlohmann::json& v) {
     std::string t = v.dump();
     constexpr std::size_t kMax = 60;
-    if (t.size() > kMax) t = t.substr(0, kMax - 3) + "...";
+    if (t.size() > kMax) {
+      std::size_t cut = kMax - 3;  // not inside a UTF-8 sequence (the review of session 45)
+      while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
+      t = t.substr(0, cut) + "...";
+    }
     return t;
   };
   const nlohmann::json patch = nlohmann::json::diff(stored, now);
@@ -154,7 +160,7 @@ fs::path CheckpointStore::parts_dir(const fs::path& database) {
 
 CheckpointStore::CheckpointStore(const fs::path& database, const std::string& job_definition,
                                  int job_count, bool resume, bool force)
-    : dir_(parts_dir(database)), fingerprint_(fingerprint(job_definition)) {
+    : dir_(parts_dir(database)), fingerprint_(fingerprint(job_definition)), builds_{build_name()} {
   const std::string& fp = fingerprint_;
   std::error_code ec;
   if (fs::exists(fs::symlink_status(dir_, ec))) {
@@ -182,9 +188,6 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     if (fs::exists(fs::symlink_status(dir_, ec)))
       throw InputError(dir_.string(), "", "cannot discard the finished sweep's checkpoints");
   }
-  // Resumed, they are this run's again: the mark goes (a --keep-parts resume keeps them on
-  // purpose, and a later plain sweep must then refuse them, not discard them).
-  if (resume) fs::remove(dir_ / kWritten, ec);
   if (fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
       throw InputError(dir_.string(), "",
@@ -217,19 +220,25 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
                                                  (dir_ / kManifest).string() + ", " + what) +
                              "); use --force to discard them");
       }
-      // The same input, but another build (session 45; left open by session 44): the database
-      // would hold the cases of two builds and name only this one in its provenance.
-      const std::string built = build_name();
-      std::string wrote = "a knit-meso of session 44 or earlier (the manifest names none)";
-      if (const auto it = manifest.find("software"); it != manifest.end() && it->is_string())
-        wrote = it->get<std::string>();
-      if (wrote != built)
-        throw InputError((dir_ / kManifest).string(), "/software",
-                         "--resume: these checkpoints were written by " + wrote + ", this is " +
-                             built +
-                             ": a database of both builds' cases would name only this one. "
-                             "Resume with the build that wrote them, or discard them with "
-                             "--force");
+      // The builds whose cases the checkpoints hold (session 45; left open by session 44: a
+      // resume by a rebuilt knit-meso made a database of two builds' cases that named only the
+      // last). Another build may resume (a rebuild is routine, and the cases of hours would be
+      // lost otherwise): it is added to the manifest's list, which the database records
+      // (/sweep/report/case_builds) and the sweep prints.
+      builds_.clear();
+      if (const auto it = manifest.find("builds"); it != manifest.end() && it->is_array())
+        for (const auto& b : *it)
+          if (b.is_string()) builds_.push_back(b.get<std::string>());
+      if (builds_.empty()) builds_.push_back(kUnnamedBuild);
+      if (std::find(builds_.begin(), builds_.end(), build_name()) == builds_.end()) {
+        builds_.push_back(build_name());
+        manifest["builds"] = builds_;
+        io::write_file_atomically(dir_ / kManifest, manifest.dump(1) + "\n");
+      }
+      // Resumed, they are this run's again: the mark goes (a --keep-parts resume keeps them on
+      // purpose, and a later plain sweep must then refuse them, not discard them). Only once
+      // the checks above passed: a refused resume leaves it (the review of session 45).
+      fs::remove(dir_ / kWritten, ec);
       return;
     }
     remove();
@@ -240,7 +249,7 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
   const nlohmann::json m = {{"format", "knit-sweep-parts"},
                             {"version", 1},
                             {"fingerprint", fp},
-                            {"software", build_name()},
+                            {"builds", nlohmann::json::array({build_name()})},
                             {"jobs", job_count},
                             {"job_definition", nlohmann::json::parse(job_definition)}};
   io::write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");

@@ -185,6 +185,12 @@ void write_sweep_database(const fs::path& output, const material::Database& db,
     g.set_attribute(".", "threads", report.threads);
     g.set_attribute(".", "step_status_values",
                     "raw/path_NN/status: 0 = converged, 1 = did not converge, 2 = not reached");
+    if (!report.case_builds.empty()) {
+      g.write_strings("case_builds", report.case_builds);
+      g.set_attribute("case_builds", "meaning",
+                      "the knit-meso builds whose cases this database holds, oldest first (more "
+                      "than one when a sweep was resumed by another build)");
+    }
     std::vector<int> ids = in.path_ids;
     g.write("default_path_index", ids);
     std::vector<std::string> fit_status;

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <mutex>
 #include <optional>
@@ -189,6 +190,17 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
       store = std::make_unique<CheckpointStore>(
           opt.output, in.job_definition(), static_cast<int>(jobs.size()), opt.resume, opt.force);
       finished = store->load_finished(jobs);
+      rep.case_builds = store->builds();
+      if (rep.case_builds.size() > 1) {
+        std::string earlier;
+        for (std::size_t b = 0; b + 1 < rep.case_builds.size(); ++b)
+          earlier += (b ? "; " : "") + rep.case_builds[b];
+        // On stderr whatever --no-progress says: a warning, not progress.
+        std::fprintf(stderr,
+                     "knit-meso sweep: warning: resuming checkpoints of another build (%s) "
+                     "with %s: the database records every build in /sweep/report/case_builds\n",
+                     earlier.c_str(), rep.case_builds.back().c_str());
+      }
       std::ostringstream os;
       os << "OK";
       for (const auto& [i, r] : finished) os << ' ' << i;

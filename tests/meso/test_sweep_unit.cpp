@@ -954,25 +954,39 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                                       ": only now (9.0)"));
   }
   // The same input from another build (or from a manifest that names none, written before
-  // session 45) is refused as well, naming both builds; the manifest is left as it was.
+  // session 45) resumes, and the build is added to the manifest's list (what the database
+  // records); a refused resume leaves the database_written mark.
   {
     const auto manifest_path = parts / "manifest.json";
     const std::string original = knit_test::read_text(manifest_path);
     auto m = nlohmann::json::parse(original);
-    REQUIRE(m.contains("software"));
-    CHECK(m["software"].get<std::string>().rfind("knit-meso ", 0) == 0);
-    m["software"] = "knit-meso 0.0.9 (git 0123456789ab)";
+    REQUIRE(m.contains("builds"));
+    REQUIRE(m["builds"].size() == 1);
+    const std::string me = m["builds"][0].get<std::string>();
+    CHECK(me.rfind("knit-meso ", 0) == 0);
+    CHECK(CheckpointStore(out, in.job_definition(), n, true, false).builds() ==
+          std::vector<std::string>{me});
+    m["builds"] = {"knit-meso 0.0.9 (git 0123456789ab)"};
     knit_test::write_text(manifest_path, m.dump());
-    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, true, false),
-                      Catch::Contains("written by knit-meso 0.0.9 (git 0123456789ab)") &&
-                          Catch::Contains("--force"));
-    m.erase("software");
+    {
+      const CheckpointStore s(out, in.job_definition(), n, true, false);
+      CHECK(s.builds() == std::vector<std::string>{"knit-meso 0.0.9 (git 0123456789ab)", me});
+      CHECK(s.load_finished(make_jobs(in)).size() == 1);
+    }
+    CHECK(nlohmann::json::parse(knit_test::read_text(manifest_path))["builds"] ==
+          nlohmann::json({"knit-meso 0.0.9 (git 0123456789ab)", me}));
+    m.erase("builds");
     knit_test::write_text(manifest_path, m.dump());
-    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, true, false),
-                      Catch::Contains("session 44 or earlier"));
-    CHECK(knit_test::read_text(manifest_path) == m.dump());
+    const auto unnamed = CheckpointStore(out, in.job_definition(), n, true, false).builds();
+    REQUIRE(unnamed.size() == 2);
+    CHECK(unnamed[0].find("names no build") != std::string::npos);
+    CHECK(unnamed[1] == me);
     knit_test::write_text(manifest_path, original);
+    std::ofstream(parts / "database_written") << "x";
+    CHECK_THROWS(CheckpointStore(out, R"({"other": 2})", n, true, false));
+    CHECK(fs::exists(parts / "database_written"));
     CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, true, false));
+    CHECK_FALSE(fs::exists(parts / "database_written"));
   }
   // Marked written (a sweep stopped after its database was in place, while it removed them;
   // session 38's red team: the next sweep said "checkpoints of an unfinished sweep exist"):

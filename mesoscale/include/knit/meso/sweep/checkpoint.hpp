@@ -36,6 +36,10 @@ class CheckpointStore {
                   int job_count, bool resume, bool force);
 
   const std::filesystem::path& dir() const { return dir_; }
+  /// The builds ("knit-meso VERSION (git REV)") whose cases the checkpoints hold, oldest
+  /// first, this one last (only this one for new checkpoints). A resume by another build adds
+  /// it to the manifest's "builds" (session 45).
+  const std::vector<std::string>& builds() const { return builds_; }
   /// Finished results found on opening, validated against the jobs: a record with a missing
   /// or wrong digest, or one that does not parse, throws knit::InputError (file + record);
   /// a valid record of another job definition, or one sealed for another sweep (its sweep
@@ -56,6 +60,7 @@ class CheckpointStore {
  private:
   std::filesystem::path dir_;
   std::string fingerprint_;  ///< of the job definition; every record carries it
+  std::vector<std::string> builds_;
 };
 
 }  // namespace knit::meso::sweep

@@ -52,6 +52,9 @@ struct SweepReport {
   std::optional<fit::EnergyFitSummary> energy_fit;
   double seconds_cases = 0, seconds_fit = 0, seconds_total = 0;
   int threads = 1, ranks = 1;
+  /// The builds whose cases the database holds (CheckpointStore::builds(): more than this one
+  /// after a resume by another build); /sweep/report/case_builds (rank 0 only).
+  std::vector<std::string> case_builds;
   bool wrote_database = false;  ///< false on ranks other than 0
   /// Where rank 0 wrote the database: the output, or, for a sweep that fails (ok() false)
   /// while a database is at the output, beside it as failed_database_path(output) (session
