@@ -267,24 +267,26 @@ fs::path OutputLock::lock_path(const fs::path& target) {
 }
 
 namespace {
-/// The directories among `p` and its ancestors that do not exist, deepest first.
-std::vector<fs::path> missing_directories(fs::path p) {
-  std::vector<fs::path> out;
-  std::error_code ec;
-  for (; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
-    out.push_back(p);
-    if (p.parent_path() == p) break;
+/// Creates the missing directories of `dir`, one component at a time with mkdir(2), and appends
+/// to `made` those that this call created (mkdir returned 0), deepest last. Only what mkdir
+/// itself made counts: a path like "new/../keep" names the existing keep/ as well, and a
+/// directory another process creates at the same moment is not ours (the review of session
+/// 45). Stops at the first component it cannot make; the caller's next step reports it.
+void make_directories(const fs::path& dir, std::vector<fs::path>& made) {
+  fs::path p;
+  for (const auto& part : dir) {
+    p /= part;
+    if (part == "/" || part == "." || part == "..") continue;
+    if (::mkdir(p.c_str(), 0777) == 0)
+      made.push_back(p);
+    else if (errno != EEXIST)
+      return;
   }
-  return out;
 }
 
-/// Removes those of `dirs` (deepest first) that are empty directories: nothing else is touched.
-void remove_if_empty(const std::vector<fs::path>& dirs) {
-  for (const auto& d : dirs) {
-    std::error_code ec;
-    if (fs::is_directory(fs::symlink_status(d, ec)) && fs::is_empty(d, ec) && !ec)
-      fs::remove(d, ec);
-  }
+/// rmdir(2) of `made` (deepest first): removes only empty directories, nothing else.
+void remove_if_empty(const std::vector<fs::path>& made) {
+  for (auto it = made.rbegin(); it != made.rend(); ++it) ::rmdir(it->c_str());
 }
 }  // namespace
 
@@ -292,7 +294,6 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
   // The parent directories this lock creates (as the writer would) are removed again, if they
   // are still empty, when it is released or cannot be taken (session 45; session 44's list:
   // `knit-meso fit DB -o a/b/x.h5` refused its options and left the empty a/b behind).
-  if (file_.has_parent_path()) new_dirs_ = missing_directories(file_.parent_path());
   try {
     take(without_trailing_slash(target).string());
   } catch (...) {
@@ -303,7 +304,7 @@ OutputLock::OutputLock(fs::path target) : file_(lock_path(target)) {
 
 void OutputLock::take(const std::string& out) {
   std::error_code ec;
-  if (file_.has_parent_path()) fs::create_directories(file_.parent_path(), ec);  // as the writer
+  if (file_.has_parent_path()) make_directories(file_.parent_path(), new_dirs_);  // as the writer
   // A knitscale lock file never appears untagged at its final path: it is written and locked
   // under a private name, then link()ed to "<target>.lock" (atomic; EEXIST if one is there).
   // So a "<target>.lock" that is empty or holds anything but the tag is someone else's and is
@@ -326,7 +327,7 @@ void OutputLock::take(const std::string& out) {
     int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
     if (fd < 0 && errno == ENOENT && attempt + 1 < 20) {
       // The parent was removed in between (another lock released it empty): made again.
-      fs::create_directories(file_.parent_path(), ec);
+      make_directories(file_.parent_path(), new_dirs_);
       continue;
     }
     if (fd < 0) cannot("cannot create the lock file", errno);

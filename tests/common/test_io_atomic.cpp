@@ -403,6 +403,19 @@ TEST_CASE("OutputLock removes the parent directories it created, if still empty,
   CHECK_THROWS_AS(knit::io::OutputLock(d / "a" / "b" / "out.h5"), knit::InputError);
   CHECK(fs::exists(d / "a" / "b" / "out.h5.lock"));
   fs::remove_all(d / "a");
+  // A lock that cannot be taken in directories it made removes them (a name whose lock
+  // temporary, "<name>.lock.new-XXXXXX", is longer than NAME_MAX: mkostemp fails).
+  CHECK_THROWS_AS(knit::io::OutputLock(d / "a" / "b" / std::string(250, 'x')), knit::InputError);
+  CHECK_FALSE(fs::exists(d / "a"));
+  // Only what the lock made itself: "new/../keep" names the existing, empty keep/ as well
+  // (the review of session 45: it was removed with new/).
+  fs::create_directories(d / "keep");
+  { knit::io::OutputLock a(d / "new" / ".." / "keep" / "out.h5"); }
+  CHECK(fs::is_directory(d / "keep"));
+  CHECK_FALSE(fs::exists(d / "new"));
+  // knit::io::AtomicDirectory leaves the parents to its lock: abandoned, it leaves none.
+  { knit::io::AtomicDirectory a(d / "fresh" / "sub" / "out"); }
+  CHECK_FALSE(fs::exists(d / "fresh"));
 }
 
 TEST_CASE("AtomicDirectory never deletes what is not ours and cleans only our stale partials",
