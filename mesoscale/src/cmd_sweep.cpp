@@ -204,35 +204,13 @@ void explain_interrupt(const Cli& c) {
       c.output + ".parts: continue with `" + resume_command(c) + "`");
 }
 
-/// The output's parent directories that do not exist yet (deepest first): the sweep creates
-/// them (for its lock and checkpoints), and removes them again, if they are still empty, when
-/// it ends without a database in them (session 44's red team: a failed `sweep -o a/b/db.h5`
-/// left a/b behind). Only empty directories are removed (rmdir), so nothing but ours goes.
-struct NewParentDirectories {
-  std::vector<std::filesystem::path> dirs;
-  explicit NewParentDirectories(const std::string& output) {
-    std::error_code ec;
-    for (auto p = std::filesystem::path(output).parent_path();
-         !p.empty() && !std::filesystem::exists(std::filesystem::symlink_status(p, ec));
-         p = p.parent_path())
-      dirs.push_back(p);
-  }
-  ~NewParentDirectories() {
-    for (const auto& d : dirs) {
-      std::error_code ec;
-      if (std::filesystem::is_directory(std::filesystem::symlink_status(d, ec)) &&
-          std::filesystem::is_empty(d, ec) && !ec)
-        std::filesystem::remove(d, ec);
-    }
-  }
-};
-
 int run(const Cli& c) {
   using namespace knit::meso::sweep;
   MpiSession mpi;
-  // (rank 0 only: the others create nothing, and end before it)
-  std::optional<NewParentDirectories> new_parents;
-  if (mpi.rank() == 0) new_parents.emplace(c.output);
+  // The output's missing parent directories are made by its lock (rank 0, io::OutputLock),
+  // which removes them again if they are still empty when the sweep ends without a database in
+  // them (session 44's red team: a failed `sweep -o a/b/db.h5` left a/b behind; since session
+  // 45 the lock does it for every command, and only for the directories its mkdir made).
   try {
     const SweepInput in = load_sweep_input(c.input);
     // The database and checkpoints' size, before any work (session 44's red team: 101,300

@@ -223,22 +223,22 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
       // The builds whose cases the checkpoints hold (session 45; left open by session 44: a
       // resume by a rebuilt knit-meso made a database of two builds' cases that named only the
       // last). Another build may resume (a rebuild is routine, and the cases of hours would be
-      // lost otherwise): it is added to the manifest's list, which the database records
-      // (/sweep/report/case_builds) and the sweep prints.
+      // lost otherwise); it is added to the manifest's list when it stores its first case
+      // (store()), and the database records the list (/sweep/report/case_builds). Nothing is
+      // changed on disk here: a resume refused later (a damaged record) leaves the checkpoints
+      // as they were (the second review of session 45).
       builds_.clear();
+      const auto add = [&](const nlohmann::json& b) {
+        if (b.is_string() &&
+            std::find(builds_.begin(), builds_.end(), b.get<std::string>()) == builds_.end())
+          builds_.push_back(b.get<std::string>());
+      };
       if (const auto it = manifest.find("builds"); it != manifest.end() && it->is_array())
-        for (const auto& b : *it)
-          if (b.is_string()) builds_.push_back(b.get<std::string>());
+        for (const auto& b : *it) add(b);
+      else if (const auto sw = manifest.find("software"); sw != manifest.end())
+        add(*sw);  // the one-build form of 192295e
       if (builds_.empty()) builds_.push_back(kUnnamedBuild);
-      if (std::find(builds_.begin(), builds_.end(), build_name()) == builds_.end()) {
-        builds_.push_back(build_name());
-        manifest["builds"] = builds_;
-        io::write_file_atomically(dir_ / kManifest, manifest.dump(1) + "\n");
-      }
-      // Resumed, they are this run's again: the mark goes (a --keep-parts resume keeps them on
-      // purpose, and a later plain sweep must then refuse them, not discard them). Only once
-      // the checks above passed: a refused resume leaves it (the review of session 45).
-      fs::remove(dir_ / kWritten, ec);
+      resumed_ = true;
       return;
     }
     remove();
@@ -303,6 +303,10 @@ std::string open_record(const std::string& text, const std::string& file, const 
 
 }  // namespace
 
+std::string CheckpointStore::this_build() {
+  return build_name();
+}
+
 std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& jobs) const {
   std::map<int, JobResult> out;
   for (const Job& j : jobs) {
@@ -322,10 +326,26 @@ std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& 
     }
     if (matches(r, j)) out.emplace(j.index, std::move(r));  // else: foreign, recomputed
   }
+  // Resumed, and every record read: they are this run's again, and the mark goes (a
+  // --keep-parts resume keeps them on purpose, and a later plain sweep must then refuse them,
+  // not discard them). Only now: a refused resume leaves it (the reviews of session 45).
+  if (resumed_) {
+    std::error_code ec;
+    fs::remove(dir_ / kWritten, ec);
+  }
   return out;
 }
 
-void CheckpointStore::store(const JobResult& r) const {
+void CheckpointStore::store(const JobResult& r) {
+  // The first case this build adds to checkpoints of other builds: its name goes into the
+  // manifest first, so that the list never misses a build whose case is stored.
+  if (std::find(builds_.begin(), builds_.end(), build_name()) == builds_.end()) {
+    nlohmann::json m = nlohmann::json::parse(slurp(dir_ / kManifest));
+    builds_.push_back(build_name());
+    m["builds"] = builds_;
+    m.erase("software");
+    io::write_file_atomically(dir_ / kManifest, m.dump(1) + "\n");
+  }
   io::write_file_atomically(dir_ / job_file(r.index), seal_record(serialize(r), fingerprint_));
 }
 

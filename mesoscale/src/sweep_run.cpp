@@ -44,6 +44,20 @@ bool SweepReport::fits_ok() const {
 }
 
 namespace {
+/// A build name from a manifest as a line of the terminal may show it (the second review of
+/// session 45: a hand-edited entry went to stderr with its control characters, 6 kB long):
+/// control characters as '?', at most 120 bytes, not cut inside a UTF-8 sequence.
+std::string printable(std::string t) {
+  for (char& c : t)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  constexpr std::size_t kMax = 120;
+  if (t.size() > kMax) {
+    std::size_t cut = kMax - 3;
+    while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
+    t = t.substr(0, cut) + "...";
+  }
+  return t;
+}
 
 /// Jobs waiting to run: filled up front (rank 0) or as rank 0 hands them out (other ranks).
 class JobQueue {
@@ -190,16 +204,17 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
       store = std::make_unique<CheckpointStore>(
           opt.output, in.job_definition(), static_cast<int>(jobs.size()), opt.resume, opt.force);
       finished = store->load_finished(jobs);
-      rep.case_builds = store->builds();
-      if (rep.case_builds.size() > 1) {
+      // Resuming another build's checkpoints: said at the start (session 45), on stderr
+      // whatever --no-progress says (a warning, not progress).
+      if (const auto& b = store->builds();
+          std::find(b.begin(), b.end(), CheckpointStore::this_build()) == b.end()) {
         std::string earlier;
-        for (std::size_t b = 0; b + 1 < rep.case_builds.size(); ++b)
-          earlier += (b ? "; " : "") + rep.case_builds[b];
-        // On stderr whatever --no-progress says: a warning, not progress.
+        for (const auto& x : b) earlier += (earlier.empty() ? "" : "; ") + printable(x);
         std::fprintf(stderr,
                      "knit-meso sweep: warning: resuming checkpoints of another build (%s) "
-                     "with %s: the database records every build in /sweep/report/case_builds\n",
-                     earlier.c_str(), rep.case_builds.back().c_str());
+                     "with %s: the database records every build whose cases it holds in "
+                     "/sweep/report/case_builds\n",
+                     earlier.c_str(), CheckpointStore::this_build().c_str());
       }
       std::ostringstream os;
       os << "OK";
@@ -386,6 +401,7 @@ SweepReport run_sweep(const SweepInput& in, const SweepOptions& opt, const PathR
       return rep;  // the checkpoints stay (not marked written)
     }
   }
+  rep.case_builds = store->builds();  // with this build once it stored a case
   write_sweep_database(rep.written, db, in, rep.results, rep);
   rep.wrote_database = true;
   if (opt.on_written) opt.on_written(rep.written);

@@ -954,38 +954,59 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
                                       ": only now (9.0)"));
   }
   // The same input from another build (or from a manifest that names none, written before
-  // session 45) resumes, and the build is added to the manifest's list (what the database
-  // records); a refused resume leaves the database_written mark.
+  // session 45) resumes; the build joins the manifest's list when it stores its first case
+  // (what the database records), and a refused resume changes nothing on disk.
   {
     const auto manifest_path = parts / "manifest.json";
     const std::string original = knit_test::read_text(manifest_path);
     auto m = nlohmann::json::parse(original);
-    REQUIRE(m.contains("builds"));
-    REQUIRE(m["builds"].size() == 1);
-    const std::string me = m["builds"][0].get<std::string>();
+    const std::string me = CheckpointStore::this_build();
     CHECK(me.rfind("knit-meso ", 0) == 0);
+    CHECK(m["builds"] == nlohmann::json({me}));
     CHECK(CheckpointStore(out, in.job_definition(), n, true, false).builds() ==
           std::vector<std::string>{me});
-    m["builds"] = {"knit-meso 0.0.9 (git 0123456789ab)"};
+    const std::string other = "knit-meso 0.0.9 (git 0123456789ab)";
+    m["builds"] = {other, other};  // a duplicate is listed once
     knit_test::write_text(manifest_path, m.dump());
     {
-      const CheckpointStore s(out, in.job_definition(), n, true, false);
-      CHECK(s.builds() == std::vector<std::string>{"knit-meso 0.0.9 (git 0123456789ab)", me});
-      CHECK(s.load_finished(make_jobs(in)).size() == 1);
+      CheckpointStore s(out, in.job_definition(), n, true, false);
+      CHECK(s.builds() == std::vector<std::string>{other});
+      const auto done = s.load_finished(make_jobs(in));
+      REQUIRE(done.size() == 1);
+      CHECK(knit_test::read_text(manifest_path) == m.dump());  // nothing stored yet
+      s.store(run_job(make_jobs(in)[1], in.retry, synthetic_runner()));
+      CHECK(s.builds() == std::vector<std::string>{other, me});
     }
     CHECK(nlohmann::json::parse(knit_test::read_text(manifest_path))["builds"] ==
-          nlohmann::json({"knit-meso 0.0.9 (git 0123456789ab)", me}));
+          nlohmann::json({other, me}));
+    fs::remove(parts / "job_00001.txt");
+    // The one-build form of 192295e ("software"), and a manifest naming none.
     m.erase("builds");
+    m["software"] = other;
+    knit_test::write_text(manifest_path, m.dump());
+    CHECK(CheckpointStore(out, in.job_definition(), n, true, false).builds() ==
+          std::vector<std::string>{other});
+    m.erase("software");
     knit_test::write_text(manifest_path, m.dump());
     const auto unnamed = CheckpointStore(out, in.job_definition(), n, true, false).builds();
-    REQUIRE(unnamed.size() == 2);
+    REQUIRE(unnamed.size() == 1);
     CHECK(unnamed[0].find("names no build") != std::string::npos);
-    CHECK(unnamed[1] == me);
+    // Refused (another input, or a damaged record): the mark and the manifest stay.
     knit_test::write_text(manifest_path, original);
     std::ofstream(parts / "database_written") << "x";
     CHECK_THROWS(CheckpointStore(out, R"({"other": 2})", n, true, false));
     CHECK(fs::exists(parts / "database_written"));
-    CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, true, false));
+    const std::string record = knit_test::read_text(parts / "job_00000.txt");
+    knit_test::write_text(parts / "job_00000.txt",
+                          record.substr(0, record.rfind("digest ")) + "digest fnv1a64 0000\n");
+    CHECK_THROWS(
+        CheckpointStore(out, in.job_definition(), n, true, false).load_finished(make_jobs(in)));
+    CHECK(fs::exists(parts / "database_written"));
+    CHECK(knit_test::read_text(manifest_path) == original);
+    knit_test::write_text(parts / "job_00000.txt", record);
+    CHECK(CheckpointStore(out, in.job_definition(), n, true, false)
+              .load_finished(make_jobs(in))
+              .size() == 1);
     CHECK_FALSE(fs::exists(parts / "database_written"));
   }
   // Marked written (a sweep stopped after its database was in place, while it removed them;

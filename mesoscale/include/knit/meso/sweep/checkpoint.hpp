@@ -37,17 +37,19 @@ class CheckpointStore {
 
   const std::filesystem::path& dir() const { return dir_; }
   /// The builds ("knit-meso VERSION (git REV)") whose cases the checkpoints hold, oldest
-  /// first, this one last (only this one for new checkpoints). A resume by another build adds
-  /// it to the manifest's "builds" (session 45).
+  /// first, as the manifest's "builds" lists them (session 45): this build alone for new
+  /// checkpoints; resumed ones add this build when it stores its first case (store()).
   const std::vector<std::string>& builds() const { return builds_; }
+  /// This build as the manifest names it.
+  static std::string this_build();
   /// Finished results found on opening, validated against the jobs: a record with a missing
   /// or wrong digest, or one that does not parse, throws knit::InputError (file + record);
   /// a valid record of another job definition, or one sealed for another sweep (its sweep
   /// line names another fingerprint: a job file copied from other checkpoints), is ignored
   /// and recomputed.
   std::map<int, JobResult> load_finished(const std::vector<Job>& jobs) const;
-  /// Persists one result atomically.
-  void store(const JobResult& r) const;
+  /// Persists one result atomically (and, the first time, this build in the manifest's list).
+  void store(const JobResult& r);
   /// Removes the directory (after the database is in place).
   void remove() const;
   /// Marks the checkpoints as those of a sweep whose database is in place (the file
@@ -61,6 +63,7 @@ class CheckpointStore {
   std::filesystem::path dir_;
   std::string fingerprint_;  ///< of the job definition; every record carries it
   std::vector<std::string> builds_;
+  bool resumed_ = false;  ///< opened with --resume on existing checkpoints
 };
 
 }  // namespace knit::meso::sweep
