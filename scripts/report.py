@@ -775,7 +775,8 @@ class Report:
     # -- output ------------------------------------------------------------------------------------
     def write(self, db_path, cells):
         src_file = os.path.join(self.out, "database.source")
-        mode = open(src_file).read().split()[0] if os.path.exists(src_file) else "?"
+        source = open(src_file).read().split() if os.path.exists(src_file) else []
+        mode = source[0] if source else "?"
         tfile = os.path.join(self.out, "database.time")
         db_seconds = json.load(open(tfile)).get("seconds") if os.path.exists(tfile) else None
         generator, loops = "?", []
@@ -840,9 +841,9 @@ class Report:
                      "the paper's values; the structural statements (symmetry, convergence, "
                      "alpha range, stiffening of the law) still test the chain.\n")
         else:
-            L.append("The database was computed by the mesoscale sweep (`knit-meso sweep "
-                     "cases/sweep/default.json`): homogenized unit cells, fitted response "
-                     "surfaces.\n")
+            L.append(f"The database was computed by the mesoscale sweep "
+                     f"({sweep_command(source)}): homogenized unit cells, fitted response "
+                     f"surfaces.\n")
         L.append(f"- file: `{db_path}`; generator attribute: `{generator}`; loop lengths: "
                  f"{', '.join(f'{x:g}' for x in loops)} mm")
         L.append(database_time_line(db_seconds, loops) + "\n")
@@ -1163,8 +1164,13 @@ def knitmap_section(out):
     before only by `make ... knitmaps`): per planar paper case, the totals of its summary.txt
     ($(OUT)/knitmap/NAME/) and its figure; warnings named."""
     L = ["## Knitting maps (knit-macro knitmap)\n"]
-    names = sorted(os.path.basename(os.path.dirname(p))
-                   for p in glob.glob(os.path.join(out, "knitmap", "*", "summary.txt")))
+    # Since session 45 the pipeline records each run's exit code in knitmap/NAME.status: a run
+    # that failed is said so, and an earlier run's summary.txt left in knitmap/NAME is not shown
+    # as its result.
+    names = sorted({os.path.basename(os.path.dirname(p))
+                    for p in glob.glob(os.path.join(out, "knitmap", "*", "summary.txt"))}
+                   | {os.path.basename(p)[:-len(".status")]
+                      for p in glob.glob(os.path.join(out, "knitmap", "*.status"))})
     if not names:
         L.append("No knitting map was made (`make -f scripts/pipeline.mk knitmaps`).\n")
         return L
@@ -1174,6 +1180,10 @@ def knitmap_section(out):
     L.append("| case | stitches | needles | courses | yarn [m] | l [mm] | warnings |")
     L.append("|---|---|---|---|---|---|---|")
     for n in names:
+        failed = knitmap_failure(out, n)
+        if failed:
+            L.append(f"| {n} | - | - | - | - | - | **failed**: {md(failed)} |")
+            continue
         summ = read_design_summary(os.path.join(out, "knitmap", n, "summary.txt"))
         try:
             yarn = f"{float(summ.get('yarn_length_mm', 'nan')) / 1000:.2f}"
@@ -1192,6 +1202,43 @@ def knitmap_section(out):
                  f"{summ.get('courses', '?')} | {yarn} | {lrange} | "
                  f"{md('; '.join(warnings)) if warnings else '-'} |")
     return L + section_figures(out, [f"knitmap_{n}.png" for n in names])
+
+
+def sweep_command(source):
+    """The sweep that made the database, from database.source's words (mode, sweep input):
+    the input as the pipeline was given it (SWEEP_INPUT), relative to the checkout when inside
+    it. Session 45: the report named cases/sweep/default.json whatever the input was."""
+    if len(source) < 2 or source[0] != "sweep":
+        return "its sweep input is not recorded in database.source"
+    path = " ".join(source[1:])
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    rel = os.path.relpath(path, root) if os.path.isabs(path) else path
+    return f"`knit-meso sweep {rel if not rel.startswith('..') else path}`"
+
+
+def knitmap_failure(out, name):
+    """Why the pipeline's knitmap run of `name` failed, or "" if it did not (or was made
+    before status files existed, session 45): its exit code and the first error line of
+    logs/knitmap_NAME.log."""
+    path = os.path.join(out, "knitmap", name + ".status")
+    if not os.path.exists(path):
+        return ""
+    try:
+        with open(path) as f:
+            code = json.load(f).get("exit_code", "?")
+    except (OSError, ValueError):
+        return f"its status file {path} is unreadable"
+    if code == 0:
+        return ""
+    why = f"exit {code}"
+    try:
+        with open(os.path.join(out, "logs", f"knitmap_{name}.log")) as f:
+            errors = [line.strip() for line in f if "error:" in line]
+        if errors:
+            why += f": {errors[0]}"
+    except OSError:
+        pass
+    return why
 
 
 def twin_cell(summ, declared=None, exit_code=0):

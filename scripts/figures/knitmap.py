@@ -1,14 +1,17 @@
 #!/usr/bin/python3
 """The knitting map as a picture (matplotlib, PNG), from a `knit-macro knitmap` directory.
 
-  knitmap.py DIR [--out F.png] [--title T]
+  knitmap.py DIR [--out F.png] [--title T] [--status NAME.status]
 
 Left: the machine's view, course (row) by needle (column), coloured by the loop length;
 needles out of work are blank. Right: the stitches at their positions in the patch's plane
 (mm), same colours. Writes DIR_knitmap.png (beside DIR) unless --out is given. The pipeline calls it; the
-C++ command never needs python.
+C++ command never needs python. With --status (the pipeline's status file of the run, JSON with
+its exit_code), a run that did not exit with 0 is an error (exit 1) and nothing is drawn: DIR
+may still hold an earlier run's map, which is not this run's (session 45).
 """
 import argparse
+import json
 import os
 import sys
 
@@ -43,7 +46,14 @@ def main():
     ap.add_argument("dir")
     ap.add_argument("--out")
     ap.add_argument("--title", default="")
+    ap.add_argument("--status", help="the pipeline's status file of the knitmap run")
     a = ap.parse_args()
+    if a.status:
+        with open(a.status) as f:
+            code = json.load(f).get("exit_code")
+        if code != 0:
+            raise SystemExit(f"knitmap.py: {a.status}: the knitmap run exited with {code} (its "
+                             f"log: logs/knitmap_<case>.log); {a.dir} is not its map")
     m = read_map(os.path.join(a.dir, "knitmap.csv"))
     s = read_summary(os.path.join(a.dir, "summary.txt"))
     courses = int(m["course"].max())

@@ -46,6 +46,19 @@ def main():
              os.path.join(damaged, "cell.json") + ": not valid JSON (line 2"),
             (("sensitivity.py", "--out", png, table), table + ":1: header must be"),
         ]
+        # A knitmap run that failed (the pipeline's status file, session 45): its directory may
+        # hold an earlier map, which is not drawn as this run's.
+        stale = os.path.join(tmp, "stale")
+        os.makedirs(stale)
+        with open(os.path.join(stale, "knitmap.csv"), "w") as f:
+            f.write("course,needle,x_mm,y_mm,l_mm\n1,1,0,0,5.0\n1,2,1,0,5.5\n")
+        with open(os.path.join(stale, "summary.txt"), "w") as f:
+            f.write("stitches: 2\nyarn_length_mm: 10.5\n")
+        status = os.path.join(tmp, "stale.status")
+        with open(status, "w") as f:
+            f.write('{"knitmap": "stale", "exit_code": 2}\n')
+        jobs.append((("knitmap.py", stale, "--status", status, "--out", png),
+                     status + ": the knitmap run exited with 2"))
         for args, expect in jobs:
             r = run(*args)
             what = " ".join(os.path.relpath(a, tmp) if a.startswith(tmp) else a for a in args)
@@ -53,6 +66,11 @@ def main():
               f"{what}: refused (exit {r.returncode}), nothing drawn", r.stderr[-500:])
             c(expect in r.stderr and "Traceback" not in r.stderr,
               f"{what}: one line naming the file, no traceback", r.stderr[-500:])
+        with open(status, "w") as f:  # the same directory with a run that exited with 0
+            f.write('{"knitmap": "stale", "exit_code": 0}\n')
+        r = run("knitmap.py", stale, "--status", status, "--out", png)
+        c(r.returncode == 0 and os.path.exists(png), "knitmap.py --status of a run that "
+          "exited with 0: drawn", r.stderr[-500:])
     # A mesh study's legend names each mesh and its corner condition (session 26: the h = 1
     # curve of Sect. 3.2.1's study read "diagonal (load along the diagonal)").
     sys.path.insert(0, FIG)

@@ -1153,6 +1153,38 @@ def main():
         text = "\n".join(report.knitmap_section(km))
         if "| patch | 1547 | 40 | 41 | 8.31 | 4.52-6.44 | first one; second one |" not in text:
             failures.append("knitmap section row: " + text[-300:])
+        # A run that failed (its status file, session 45): said so with the log's error line,
+        # and the earlier run's summary.txt left in knitmap/patch is not shown as its result.
+        # A failed run without any map is listed too.
+        os.makedirs(os.path.join(km, "logs"))
+        with open(os.path.join(km, "knitmap", "patch.status"), "w") as f:
+            f.write('{"knitmap": "patch", "exit_code": 2}\n')
+        with open(os.path.join(km, "knitmap", "other.status"), "w") as f:
+            f.write('{"knitmap": "other", "exit_code": 1}\n')
+        with open(os.path.join(km, "logs", "knitmap_patch.log"), "w") as f:
+            f.write("knit-macro knitmap: error: p.json: /material/stitch_value/values/2: 6.5 mm "
+                    "is outside the database's 4.5-4.5 mm\n")
+        text = "\n".join(report.knitmap_section(km))
+        if ("| patch | - | - | - | - | - | **failed**: exit 2: knit-macro knitmap: error: p.json: "
+                "/material/stitch_value/values/2: 6.5 mm is outside" not in text
+                or "1547" in text or "| other | - | - | - | - | - | **failed**: exit 1 |" not in text):
+            failures.append("knitmap section, failed runs: " + text[-600:])
+        with open(os.path.join(km, "knitmap", "patch.status"), "w") as f:
+            f.write('{"knitmap": "patch", "exit_code": 0}\n')
+        text = "\n".join(report.knitmap_section(km))
+        if "| patch | 1547 | 40 | 41 |" not in text:
+            failures.append("knitmap section, a run that exited with 0: " + text[-300:])
+        # The sweep input the database was made from, as the pipeline recorded it (session 45:
+        # the report named cases/sweep/default.json whatever SWEEP_INPUT was).
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        for words, want in (
+                (["sweep", os.path.join(root, "cases", "sweep", "reduced.json")],
+                 "`knit-meso sweep cases/sweep/reduced.json`"),
+                (["sweep", "/elsewhere/my sweep.json"], "`knit-meso sweep /elsewhere/my sweep.json`"),
+                (["sweep"], "not recorded"), ([], "not recorded")):
+            got = report.sweep_command(words)
+            if want not in got:
+                failures.append(f"sweep_command({words}) = {got!r}, wanted {want!r}")
         # A value beside its bound prints the digits that tell it from the bound (session 42's
         # red team: "largest 2.0 %" FAILed against "<= 2 %").
         for v, b, want in ((2.0004, 2.0, "2.0004"), (1.9996, 2.0, "1.9996"), (2.0, 2.0, "2.0"),
