@@ -333,7 +333,7 @@ DESIGN_FIG_ARGS_graded_wale := --section E22
 # The design figures, and the knitting-map figures (`knitmaps`; part of `all` since session 39,
 # when the main job drew no knitting map although the docs promised them): one batch
 # each (scripts/figures/batch.py, as the plots above).
-DESIGN_JOB = '$(FIG)/design_$(1).png $(FIGPY)/design.py $(OUT)/design/$(1) --design $(OUT)/design/inputs/$(1).json $(DESIGN_FIG_ARGS_$(1)) --title "design: $(1)"'
+DESIGN_JOB = '$(FIG)/design_$(1).png $(FIGPY)/design.py $(OUT)/design/$(1) --design $(OUT)/design/inputs/$(1).json --status $(OUT)/design/$(1).status $(DESIGN_FIG_ARGS_$(1)) --title "design: $(1)"'
 KNITMAP_JOB = '$(FIG)/knitmap_$(1).png $(FIGPY)/knitmap.py $(OUT)/knitmap/$(1) --status $(OUT)/knitmap/$(1).status --title "knitting map: $(1)"'
 $(DESIGN_FIGURES) &: $(DESIGN_STATUS) $(FIGPY)/design.py $(FIGPY)/batch.py
 	@mkdir -p $(FIG) $(LOGS)/figures

@@ -1134,11 +1134,18 @@ def design_section(out):
                 st = json.load(f)
         except (OSError, ValueError):
             st = None  # unreadable
-        summ = read_design_summary(os.path.join(out, "design", n, "summary.txt"))
         missing = not os.path.exists(os.path.join(out, "design", n + ".status"))
         exit_code = ("? (no status file)" if missing else "? (status file unreadable)"
                      if st is None else st.get("exit_code", "?"))
+        # Exit 2 or more wrote nothing: a summary.txt in design/NAME is an earlier run's
+        # (session 45: it was shown as this run's, with "(exit 2)" beside it).
+        wrote = exit_code in (0, 1) or st is None
+        summ = (read_design_summary(os.path.join(out, "design", n, "summary.txt")) if wrote
+                else {})
         status = summ.get("status", f"no output (exit {exit_code})")
+        if not wrote:
+            why = first_error_line(os.path.join(out, "logs", f"design_{n}.log"))
+            status += f": {why}" if why else ""
         if "status" in summ and exit_code != 0:  # the summary alone is not the verdict
             status += f" (exit {exit_code})"
         L.append(f"| {n} | {md(status)} | {md(summ.get('J_initial', '-'))} | "
@@ -1231,14 +1238,17 @@ def knitmap_failure(out, name):
     if code == 0:
         return ""
     why = f"exit {code}"
+    first = first_error_line(os.path.join(out, "logs", f"knitmap_{name}.log"))
+    return why + (f": {first}" if first else "")
+
+
+def first_error_line(log):
+    """The first line of a command's log that says "error:", or "" (none, or no log)."""
     try:
-        with open(os.path.join(out, "logs", f"knitmap_{name}.log")) as f:
-            errors = [line.strip() for line in f if "error:" in line]
-        if errors:
-            why += f": {errors[0]}"
+        with open(log) as f:
+            return next((line.strip() for line in f if "error:" in line), "")
     except OSError:
-        pass
-    return why
+        return ""
 
 
 def twin_cell(summ, declared=None, exit_code=0):

@@ -35,7 +35,7 @@ except ImportError:  # the section panel is then left out
     h5py = None
 from scipy.interpolate import BSpline  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main, read_json, save_figure  # noqa: E402
+from figure_inputs import guarded_main, read_json, refuse_failed_run, save_figure  # noqa: E402
 
 
 def read_history(path):
@@ -137,7 +137,10 @@ def main():
     ap.add_argument("--section", default="", help="strain field along v = 0.5 of the final run (E11, E22, E12)")
     ap.add_argument("--design", default="",
                     help="the design file, for its objectives (default: DIR/../inputs/NAME.json)")
+    ap.add_argument("--status", help="the pipeline's status file of the design run: a run "
+                    "that exited with 2 or more wrote nothing, and DIR is not its output")
     a = ap.parse_args()
+    refuse_failed_run(a.status, a.dir, ok_codes=(0, 1))  # 1: iteration limit, outputs written
     history = os.path.join(a.dir, "history.csv")
     h = read_history(history)
     if h.dtype.names is None or not {"iteration", "J"} <= set(h.dtype.names):

@@ -35,6 +35,20 @@ def guarded_main(main):
                          f"{tb.lineno}; the command line: {_command_line()})")
 
 
+def refuse_failed_run(status, directory, ok_codes=(0,)):
+    """With the pipeline's status file of a run (JSON with its exit_code; `status` None or ""
+    skips the check), exits with one line unless the run's exit code is one of `ok_codes`: its
+    output directory may still hold an earlier run's files, which are not this run's
+    (session 45: a design or knitting map refused with exit 2 was drawn from the last run)."""
+    if not status:
+        return
+    with open(status) as f:
+        code = json.load(f).get("exit_code")
+    if code not in ok_codes:
+        raise SystemExit(f"{os.path.basename(sys.argv[0])}: {status}: the run exited with {code} "
+                         f"(its log is in the pipeline's logs/); {directory} is not its output")
+
+
 def save_figure(fig, out, **savefig_args):
     """Writes `fig` to `out` through a temporary beside it and a rename, so a figure killed
     while it is drawn leaves no empty or half-written PNG that make would take as complete

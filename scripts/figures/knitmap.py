@@ -11,7 +11,6 @@ its exit_code), a run that did not exit with 0 is an error (exit 1) and nothing 
 may still hold an earlier run's map, which is not this run's (session 45).
 """
 import argparse
-import json
 import os
 import sys
 
@@ -21,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main, save_figure  # noqa: E402
+from figure_inputs import guarded_main, refuse_failed_run, save_figure  # noqa: E402
 
 
 def read_map(path):
@@ -48,12 +47,7 @@ def main():
     ap.add_argument("--title", default="")
     ap.add_argument("--status", help="the pipeline's status file of the knitmap run")
     a = ap.parse_args()
-    if a.status:
-        with open(a.status) as f:
-            code = json.load(f).get("exit_code")
-        if code != 0:
-            raise SystemExit(f"knitmap.py: {a.status}: the knitmap run exited with {code} (its "
-                             f"log: logs/knitmap_<case>.log); {a.dir} is not its map")
+    refuse_failed_run(a.status, a.dir)
     m = read_map(os.path.join(a.dir, "knitmap.csv"))
     s = read_summary(os.path.join(a.dir, "summary.txt"))
     courses = int(m["course"].max())

@@ -101,6 +101,17 @@ def main():
         table = "\n".join(report.design_section(out))
         c("the input's twin is 5.0, not 6 (a stale summary)" in table and "exit 1" in table,
           "the table says why", table)
+        # Exit 2 wrote nothing: the summary left in design/refused is an earlier run's, not
+        # shown as this one's (session 45); the log's error line says why.
+        write_design(out, "refused", recovered, exit_code=2, twin='{"l": 6.0}')
+        os.makedirs(os.path.join(out, "logs"), exist_ok=True)
+        with open(os.path.join(out, "logs", "design_refused.log"), "w") as f:
+            f.write("knit-macro design: error: c.json: /material/stitch_value: 6.5 mm is "
+                    "outside the database's 4.5-4.5 mm\n")
+        row = "\n".join(report.design_section(out)).split("| refused |")[1].split("\n")[0]
+        c("no output (exit 2): knit-macro design: error: c.json: /material/stitch_value" in row
+          and "122.66" not in row and "converged" not in row,
+          "exit 2: no output, the log's error, not the earlier summary", row)
     # Session 42's red team: with $(OUT)/design deleted (its inputs too) the twin verdict
     # dropped out of the summary without a FAIL. An expected design (--expect-designs) takes its
     # twin from --designs-dir.

@@ -58,7 +58,13 @@ def main():
         with open(status, "w") as f:
             f.write('{"knitmap": "stale", "exit_code": 2}\n')
         jobs.append((("knitmap.py", stale, "--status", status, "--out", png),
-                     status + ": the knitmap run exited with 2"))
+                     status + ": the run exited with 2"))
+        # design.py: exit 1 (an iteration limit) wrote its outputs, 2 wrote nothing.
+        dstatus = os.path.join(tmp, "design.status")
+        with open(dstatus, "w") as f:
+            f.write('{"design": "d", "exit_code": 2}\n')
+        jobs.append((("design.py", damaged, "--status", dstatus, "--out", png),
+                     dstatus + ": the run exited with 2"))
         for args, expect in jobs:
             r = run(*args)
             what = " ".join(os.path.relpath(a, tmp) if a.startswith(tmp) else a for a in args)
