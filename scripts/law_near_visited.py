@@ -17,7 +17,6 @@ the law is re-evaluated by scripts/figures/energy_law.py, the cell states read b
 scripts/cell_paths.py.
 """
 import argparse
-import glob
 import os
 import sys
 
@@ -29,7 +28,7 @@ sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
 from cell_paths import load_paths, open_database, positive_number, stress_range  # noqa: E402
 from energy_law import load_law  # noqa: E402
-from strain_box import read_case  # noqa: E402
+from strain_box import current_results, read_case  # noqa: E402
 
 RADIUS = 0.05
 BOUND = 0.05  # issue 11: within 5 % of the stress range
@@ -38,8 +37,7 @@ BOUND = 0.05  # issue 11: within 5 % of the stress range
 def visited_strains(results_dir):
     """(E11, E22, E12) of every output sample of every results.h5 under results_dir, with its
     mirror image E12 -> -E12, finite ones only, rounded to 1e-4 and deduplicated."""
-    parts = [read_case(p) for p in
-             sorted(glob.glob(os.path.join(results_dir, "**", "results.h5"), recursive=True))]
+    parts = [read_case(p) for p in current_results(results_dir)]
     V = np.vstack(parts) if parts else np.zeros((0, 3))
     V = V[np.all(np.isfinite(V), axis=1)]
     V = np.vstack([V, V * [1.0, 1.0, -1.0]])

@@ -38,6 +38,14 @@ export MPLBACKEND := Agg
 
 # A subcommand exists when `knit-meso --help` lists it.
 MESO_SUBCOMMANDS := $(shell "$(MESO)" --help 2>/dev/null | sed -n 's/^  \([a-z][a-z-]*\)  .*/\1/p')
+# A SWEEP_INPUT given (command line or environment) that does not exist is a mistake, not a
+# reason to fall back on the synthetic stand-in (session 45's red team: a misspelt input gave
+# `database: synth` with exit 0, and replaced an earlier sweep's database).
+ifneq ($(filter command line environment,$(origin SWEEP_INPUT)),)
+ifeq ($(wildcard $(SWEEP_INPUT)),)
+$(error SWEEP_INPUT=$(SWEEP_INPUT) does not exist: give an existing sweep input, or leave SWEEP_INPUT out for cases/sweep/default.json)
+endif
+endif
 HAVE_SWEEP := $(if $(and $(filter sweep,$(MESO_SUBCOMMANDS)),$(wildcard $(SWEEP_INPUT))),yes)
 HAVE_CELL := $(if $(filter cell,$(MESO_SUBCOMMANDS)),yes)
 ifeq ($(DB_SOURCE),auto)
@@ -101,9 +109,14 @@ $(MESO) $(MACRO):
 # ---- material database ------------------------------------------------------------------------
 # database.source holds the mode; it is rewritten only when the mode changes, so switching from
 # the stand-in to the sweep rebuilds the database (and everything after it).
+# With the inputs' contents (sha256 of the sweep input and of the cell file it names, by
+# scripts/figures/input_digest.py): a sweep input edited, or replaced by an older file, or a
+# changed cell file rebuilds the database (session 45's red team: make compared time stamps
+# only, and a database of the former input stayed).
 $(OUT)/database.source: FORCE
 	@mkdir -p $(OUT)
-	@echo "$(DB_MODE) $(DB_INPUTS)" | cmp -s - $@ || echo "$(DB_MODE) $(DB_INPUTS)" > $@
+	@src="$(DB_MODE) $(DB_INPUTS)$(if $(DB_INPUTS), $$($(PY) $(FIGPY)/input_digest.py $(DB_INPUTS) || echo unreadable))"; \
+	echo "$$src" | cmp -s - $@ || echo "$$src" > $@
 
 $(DB): $(OUT)/database.source $(MESO) $(DB_INPUTS)
 	@mkdir -p $(LOGS)

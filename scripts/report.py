@@ -1211,13 +1211,39 @@ def knitmap_section(out):
     return L + section_figures(out, [f"knitmap_{n}.png" for n in names])
 
 
+def no_result_reason(res_dir, names):
+    """Why no case has a result: the cases were not run, or (session 45's red team) they ran
+    and were refused, e.g. by a database whose loop lengths cover none of them: then how many
+    and the first refusal's error line from its log (OUT/logs/NAME.log)."""
+    codes = {}
+    for n in names:
+        try:
+            with open(os.path.join(res_dir, n + ".status")) as f:
+                codes[n] = json.load(f).get("exit_code")
+        except (OSError, ValueError, AttributeError):
+            pass
+    if not codes:
+        return "run the cases first (make -f scripts/pipeline.mk cases)"
+    refused = [n for n in names if codes.get(n) not in (None, 0, 1)]
+    why = ""
+    for n in refused:
+        why = first_error_line(os.path.join(os.path.dirname(res_dir), "logs", n + ".log"))
+        if why:
+            why = f" (first: {n}: {why})"
+            break
+    return (f"{len(codes)} of {len(names)} cases ran, {len(refused)} of them refused with exit "
+            f"2 or more{why}: fix what the logs say (e.g. a database whose loop lengths do not "
+            f"cover the cases) and run them again")
+
+
 def sweep_command(source):
     """The sweep that made the database, from database.source's words (mode, sweep input):
     the input as the pipeline was given it (SWEEP_INPUT), relative to the checkout when inside
     it. Session 45: the report named cases/sweep/default.json whatever the input was."""
     if len(source) < 2 or source[0] != "sweep":
         return "its sweep input is not recorded in database.source"
-    path = " ".join(source[1:])
+    # (the words after the path are the inputs' digests, scripts/figures/input_digest.py)
+    path = " ".join(w for w in source[1:] if not w.startswith(("sha256:", "cell:", "unreadable")))
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     rel = os.path.relpath(path, root) if os.path.isabs(path) else path
     return f"`knit-meso sweep {rel if not rel.startswith('..') else path}`"
@@ -1326,8 +1352,8 @@ def main():
     if not any(rep.r(n).ok for n in rep.names):
         # Nothing to judge: a report of 0 passes would read as a result (session 30: exit 0).
         print(f"report: error: {rep.res_dir}: no case of {a.cases_dir} has a result "
-              "(load_strain.csv); run the cases first (make -f scripts/pipeline.mk cases); "
-              "report.md is left as it was", file=sys.stderr)
+              f"(load_strain.csv); {no_result_reason(rep.res_dir, rep.names)}; report.md is "
+              "left as it was", file=sys.stderr)
         sys.exit(1)
     rep.checks()
     rep.write(a.database, a.cells)

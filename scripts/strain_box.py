@@ -17,6 +17,7 @@ StrainBox (E11 up to 0.45, not the default sweep's 0.60), and the first line say
 """
 import argparse
 import glob
+import json
 import os
 import sys
 
@@ -28,6 +29,27 @@ from cell_paths import stored_sweep_input  # noqa: E402
 
 # The default box of knit/material/load_paths.hpp (StrainBox): E11, E22 ranges and |E12| bound.
 DEFAULT_BOX = (-0.35, 0.45, -0.30, 0.55, 0.40)
+
+
+def current_results(results_dir):
+    """Every results.h5 under results_dir, but those the pipeline's status file beside their
+    run's directory (NAME.status beside NAME/) says the last run did not write: exit code 2
+    or more is a refused run (bad input, e.g. a loop length the database does not cover),
+    which wrote nothing, so NAME/ is an earlier run's (session 45's red team: a sweep input
+    switched in the same OUT left the former database's runs, which were counted as this
+    one's)."""
+    out = []
+    for p in sorted(glob.glob(os.path.join(results_dir, "**", "results.h5"), recursive=True)):
+        run = os.path.dirname(p)
+        try:
+            with open(run + ".status") as f:
+                code = json.load(f).get("exit_code", 0)
+        except (OSError, ValueError, AttributeError):
+            code = 0  # no pipeline status (a run of one's own): taken
+        if isinstance(code, int) and code >= 2:
+            continue
+        out.append(p)
+    return out
 
 
 def read_case(path):
@@ -107,7 +129,7 @@ def main():
             return 2
     elif a.box is None:
         a.box, origin = DEFAULT_BOX, "the API's built-in default (no --database or --box)"
-    files = sorted(glob.glob(os.path.join(a.results, "**", "results.h5"), recursive=True))
+    files = current_results(a.results)
     if not files:
         print("no results.h5 under %s" % a.results, file=sys.stderr)
         return 2

@@ -101,6 +101,16 @@ class Result:
                 self.status = {}
                 self.problem = f"{sp} is unreadable ({e}); delete it to rerun the case"
         self.ok = os.path.isdir(self.dir) and os.path.exists(os.path.join(self.dir, "load_strain.csv"))
+        # A last run that wrote nothing (exit code 2 or more: refused, e.g. a loop length the
+        # database does not cover): NAME/ is an earlier run's output, not this run's (session
+        # 45's red team: a sweep input switched in the same OUT left the former database's
+        # results, which the report and the figures took as this run's).
+        code = self.status.get("exit_code")
+        if isinstance(code, int) and code >= 2:
+            self.problem = self.problem or (
+                f"the last run exited with {code} (refused: see its log) and wrote nothing"
+                + (f"; {self.dir} is an earlier run's output" if self.ok else ""))
+            self.ok = False
         marker = os.path.join(self.dir, ".knitscale-output")
         if self.ok and os.path.exists(marker):
             with open(marker, errors="replace") as f:

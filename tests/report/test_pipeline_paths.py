@@ -169,6 +169,52 @@ def main():
             check(rc == 0 and "case: s312_uniform_45_wale" in log
                   and os.path.exists(os.path.join(res, "load_strain.csv")),
                   "its results removed: the case is run again", log)
+        # The sweep input (session 45's red team): a SWEEP_INPUT given that does not exist is
+        # refused (it gave the synthetic stand-in with exit 0), and database.source, on which
+        # the database depends, follows the input's and its cell file's contents, not their
+        # time stamps (an older file copied over the input, or an edited cell file, rebuilt
+        # nothing).
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "o")
+            sweep = os.path.join(d, "s.json")
+            source = os.path.join(out, "database.source")
+
+            def make_source(sweep_input):
+                r = subprocess.run(["make", "-f", os.path.join(ROOT, "scripts", "pipeline.mk"),
+                                    "ROOT=" + ROOT, "BUILD=" + build, "OUT=" + out,
+                                    "SWEEP_INPUT=" + sweep_input, source], capture_output=True,
+                                   text=True, timeout=120)
+                text = open(source).read() if os.path.exists(source) else ""
+                return r.returncode, r.stdout + r.stderr, text
+
+            rc, log, _ = make_source(os.path.join(d, "missing.json"))
+            check(rc != 0 and "SWEEP_INPUT=" in log and "does not exist" in log
+                  and not os.path.exists(source), "a SWEEP_INPUT that does not exist: refused",
+                  log)
+            with open(os.path.join(d, "c.json"), "w") as f:
+                f.write('{"yarn": {"diameter": 0.38}}')
+            with open(sweep, "w") as f:
+                f.write('{"loop_lengths": [4.5], "cell": "c.json"}')
+            rc, log, first = make_source(sweep)
+            check(rc == 0 and first.startswith("sweep " + sweep + " sha256:")
+                  and " cell:sha256:" in first, "database.source names the input's contents",
+                  log + first)
+            with open(sweep, "w") as f:
+                f.write('{"loop_lengths": [5.5], "cell": "c.json"}')
+            os.utime(sweep, (1, 1))  # older than database.source
+            rc, log, second = make_source(sweep)
+            check(rc == 0 and second != first, "an edited input with an old time stamp: "
+                  "database.source changes", first + second)
+            with open(os.path.join(d, "c.json"), "w") as f:
+                f.write('{"yarn": {"diameter": 0.45}}')
+            rc, log, third = make_source(sweep)
+            check(rc == 0 and third != second, "an edited cell file: database.source changes",
+                  second + third)
+            os.utime(source, (1000, 1000))
+            rc, log, fourth = make_source(sweep)
+            check(rc == 0 and fourth == third and os.path.getmtime(source) == 1000,
+                  "nothing changed: database.source not rewritten (the database stays)",
+                  third + fourth)
     else:
         check(False, "KNIT_BUILD names no build with bin/knit-macro: %r" % build)
     return check.exit_code()

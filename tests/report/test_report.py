@@ -856,6 +856,16 @@ def unusable_result_failures(tmp):
         if r.completed or r.ok or needle not in r.problem:
             out.append(f"unusable results, {what}: completed={r.completed}, problem "
                        f"{r.problem!r}")
+    # The last run refused (exit 2: it wrote nothing): results/a is an earlier run's, not
+    # taken (session 45's red team: a switched sweep input's refused runs were judged, drawn
+    # and counted on the former database's results). Exit 1 (stopped early) wrote its steps.
+    for code, taken in ((2, False), (3, False), (1, True)):
+        fresh("a")
+        with open(os.path.join(res, "a.status"), "w") as f:
+            json.dump({"case": "a", "exit_code": code, "seconds": 0.1}, f)
+        r = Result(res, "a")
+        if r.ok is not taken or (not taken and "earlier run's output" not in r.problem):
+            out.append(f"refused last run, exit {code}: ok={r.ok}, problem {r.problem!r}")
     return out
 
 
@@ -1181,10 +1191,30 @@ def main():
                 (["sweep", os.path.join(root, "cases", "sweep", "reduced.json")],
                  "`knit-meso sweep cases/sweep/reduced.json`"),
                 (["sweep", "/elsewhere/my sweep.json"], "`knit-meso sweep /elsewhere/my sweep.json`"),
-                (["sweep"], "not recorded"), ([], "not recorded")):
+                (["sweep"], "not recorded"), ([], "not recorded"),
+                (["sweep", os.path.join(root, "cases", "sweep", "reduced.json"), "sha256:ab",
+                  "cell:sha256:cd"], "`knit-meso sweep cases/sweep/reduced.json`")):
             got = report.sweep_command(words)
             if want not in got:
                 failures.append(f"sweep_command({words}) = {got!r}, wanted {want!r}")
+        # No case with a result: not run, or run and refused (session 45's red team: "run the
+        # cases first" when every case had run and been refused by the database).
+        nr = os.path.join(tmp, "no_result")
+        os.makedirs(os.path.join(nr, "results"))
+        os.makedirs(os.path.join(nr, "logs"))
+        why = report.no_result_reason(os.path.join(nr, "results"), ["a", "b"])
+        if "run the cases first" not in why:
+            failures.append("no_result_reason without status files: " + why)
+        for n, code in (("a", 2), ("b", 0)):
+            with open(os.path.join(nr, "results", n + ".status"), "w") as f:
+                json.dump({"case": n, "exit_code": code}, f)
+        with open(os.path.join(nr, "logs", "a.log"), "w") as f:
+            f.write("knit-macro run: error: a.json: /material/stitch_value: 6.5 mm is outside "
+                    "the database's 5-6 mm\n")
+        why = report.no_result_reason(os.path.join(nr, "results"), ["a", "b"])
+        if ("2 of 2 cases ran, 1 of them refused" not in why
+                or "first: a: knit-macro run: error: a.json" not in why):
+            failures.append("no_result_reason with a refused case: " + why)
         # A value beside its bound prints the digits that tell it from the bound (session 42's
         # red team: "largest 2.0 %" FAILed against "<= 2 %").
         for v, b, want in ((2.0004, 2.0, "2.0004"), (1.9996, 2.0, "1.9996"), (2.0, 2.0, "2.0"),

@@ -57,6 +57,15 @@ def main():
               "no box given: the built-in box (0.45), said so, half the samples inside", out)
         rc, out = run(res, "--box", "-0.35", "0.60", "-0.30", "0.55", "0.40")
         check(rc == 0 and inside_all(out) == 100.0, "--box as given", out)
+        # A run the pipeline's status says was refused (exit 2) wrote nothing: its directory
+        # is an earlier run's and is not counted (session 45's red team); exit 0 is.
+        for code, counted in ((2, False), (0, True)):
+            with open(case + ".status", "w") as f:
+                json.dump({"case": "case_a", "exit_code": code}, f)
+            rc, out = run(res, "--database", db)
+            check((rc == 0 and "case_a" in out) if counted else (rc == 2 and "no results.h5" in out),
+                  f"status exit {code}: {'counted' if counted else 'not counted'}", out)
+        os.remove(case + ".status")
         bare = os.path.join(d, "bare.h5")
         with h5py.File(bare, "w") as f:
             f.create_group("loop_0")
