@@ -37,6 +37,10 @@ def run_script(script, argv, log):
             ok = e.code in (None, 0)
             if not ok:
                 print(f"exit code {e.code}")
+        except KeyboardInterrupt:
+            # Ctrl-C stops the batch, not the figure alone (session 45's red team: the figure
+            # became a placeholder and the rest of the batch was drawn for seconds more).
+            raise
         except BaseException:  # noqa: B902 (the figure's error goes to its log)
             traceback.print_exc()
             ok = False

@@ -35,6 +35,8 @@ if a.mode == "raise":
     raise RuntimeError("deliberate failure")
 if a.mode == "exit3":
     sys.exit(3)
+if a.mode == "interrupt":
+    raise KeyboardInterrupt
 if a.mode == "rc":
     matplotlib.rcParams["lines.linewidth"] = 7.5
     plt.figure()
@@ -94,6 +96,16 @@ def main():
         with open(os.path.join(logs, "e_check.log")) as f:
             text = f.read()
             check("leaked" not in text, "no rcParams or figure leaks into the next job")
+        # Ctrl-C (KeyboardInterrupt) stops the batch: no placeholder, no later job (session
+        # 45's red team: the figure became a placeholder and the batch drew on).
+        stop = {k: os.path.join(d, "figures", k + ".png") for k in ("h_interrupt", "i_after")}
+        r = subprocess.run([sys.executable, BATCH, "--logs", logs,
+                            f"{stop['h_interrupt']} {script} --mode interrupt",
+                            f"{stop['i_after']} {script} --mode draw"], capture_output=True,
+                           text=True, env=dict(os.environ, MPLBACKEND="Agg"))
+        check(r.returncode != 0 and not os.path.exists(stop["h_interrupt"])
+              and not os.path.exists(stop["i_after"]),
+              "an interrupt stops the batch (exit %d), nothing drawn after it" % r.returncode)
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1
