@@ -173,9 +173,15 @@ $(RES_PAPER)/%.status: $(OUT)/cases_paper_law/%.json $(DB) $(MACRO) $(call case_
 	$(call run_case,$(RES_PAPER),$(LOGS)/paper_law_$*.log,case (paper's law),\"law\": \"paper\"$(comma) )
 
 # ---- unit cells (Fig. 5) ----------------------------------------------------------------------
-$(OUT)/cells/%/cell.json: $(MESO)
+# The sweep's own cell parameters (scripts/figures/sweep_cell.py; session 45's red team: Fig. 5
+# drew the default cell beside a database swept with another yarn diameter). Remade with
+# database.source, which follows the input's and its cell file's contents.
+$(OUT)/cells/params.json: $(OUT)/database.source $(FIGPY)/sweep_cell.py
+	@mkdir -p $(OUT)/cells
+	@$(PY) $(FIGPY)/sweep_cell.py "$(DB_INPUTS)" $@
+$(OUT)/cells/%/cell.json: $(MESO) $(OUT)/cells/params.json
 	@mkdir -p $(OUT)/cells $(LOGS)
-	@"$(MESO)" cell --loop-length $* --out $(OUT)/cells/$* > $(LOGS)/cell_$*.log 2>&1
+	@"$(MESO)" cell --loop-length $* --config $(OUT)/cells/params.json --out $(OUT)/cells/$* > $(LOGS)/cell_$*.log 2>&1
 
 # ---- figures ----------------------------------------------------------------------------------
 FIGURES :=

@@ -192,7 +192,7 @@ def main():
                   and not os.path.exists(source), "a SWEEP_INPUT that does not exist: refused",
                   log)
             with open(os.path.join(d, "c.json"), "w") as f:
-                f.write('{"yarn": {"diameter": 0.38}}')
+                f.write('{"yarn": {"d": 0.38}}')
             with open(sweep, "w") as f:
                 f.write('{"loop_lengths": [4.5], "cell": "c.json"}')
             rc, log, first = make_source(sweep)
@@ -206,10 +206,19 @@ def main():
             check(rc == 0 and second != first, "an edited input with an old time stamp: "
                   "database.source changes", first + second)
             with open(os.path.join(d, "c.json"), "w") as f:
-                f.write('{"yarn": {"diameter": 0.45}}')
+                f.write('{"yarn": {"d": 0.45}}')
             rc, log, third = make_source(sweep)
             check(rc == 0 and third != second, "an edited cell file: database.source changes",
                   second + third)
+            # Fig. 5's cells take the sweep's cell parameters (the red team: the default d).
+            params = os.path.join(out, "cells", "params.json")
+            r = subprocess.run(["make", "-f", os.path.join(ROOT, "scripts", "pipeline.mk"),
+                                "ROOT=" + ROOT, "BUILD=" + build, "OUT=" + out,
+                                "SWEEP_INPUT=" + sweep, params], capture_output=True, text=True,
+                               timeout=120)
+            got = json.load(open(params)) if os.path.exists(params) else None
+            check(r.returncode == 0 and got == {"yarn": {"d": 0.45}},
+                  "the cells' parameters are the sweep's cell file", r.stdout + r.stderr + str(got))
             os.utime(source, (1000, 1000))
             rc, log, fourth = make_source(sweep)
             check(rc == 0 and fourth == third and os.path.getmtime(source) == 1000,
