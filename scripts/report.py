@@ -813,6 +813,7 @@ class Report:
         law = law_checks(db_path, extrapolations)
         law_pass = sum(1 for r in law if r[3])
         law_text = (f"; material law: {law_pass} of {len(law)} checks pass" if law else "")
+        law_text += laws_used_text(extrapolations)
         twins_ok, twins = twin_counts(self.out)
         if twins:
             law_text += f"; inverse design: {twins_ok} of {twins} twin experiments recovered"
@@ -1209,6 +1210,19 @@ def knitmap_section(out):
                  f"{summ.get('courses', '?')} | {yarn} | {lrange} | "
                  f"{md('; '.join(warnings)) if warnings else '-'} |")
     return L + section_figures(out, [f"knitmap_{n}.png" for n in names])
+
+
+def laws_used_text(extrapolations):
+    """'; the cases evaluated ...' for the summary line when the cases' logs (extrapolation()
+    per case) show a law other than the energy law alone, else "" (session 45's red team: with
+    "energy_fit": false every case ran on the paper's eq. 17 surfaces, and the report never
+    said so)."""
+    used = sorted({ex[3] for ex in extrapolations.values() if ex is not None})
+    if not used or used == ["energy"]:
+        return ""
+    names = {"paper": "the paper's law (eq. 17)", "energy": "the energy law"}
+    return ("; the cases evaluated " + " and ".join(names.get(u, u) for u in used) +
+            ", by their logs")
 
 
 def no_result_reason(res_dir, names):

@@ -1197,6 +1197,16 @@ def main():
             got = report.sweep_command(words)
             if want not in got:
                 failures.append(f"sweep_command({words}) = {got!r}, wanted {want!r}")
+        # The summary names the law the cases evaluated unless it is the energy law alone
+        # (session 45's red team: with "energy_fit": false it never said so).
+        for ex, want in (({"a": (10, 0, [], "energy"), "b": None}, ""),
+                         ({"a": (10, 0, [], "paper")}, "; the cases evaluated the paper's law "
+                                                       "(eq. 17), by their logs"),
+                         ({"a": (10, 0, [], "energy"), "b": (5, 0, [], "paper")},
+                          "the energy law and the paper's law (eq. 17)")):
+            got = report.laws_used_text(ex)
+            if (want == "" and got != "") or want not in got:
+                failures.append(f"laws_used_text({ex}) = {got!r}")
         # No case with a result: not run, or run and refused (session 45's red team: "run the
         # cases first" when every case had run and been refused by the database).
         nr = os.path.join(tmp, "no_result")
