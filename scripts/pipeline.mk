@@ -403,6 +403,7 @@ clean:
 	  echo "clean: $(OUT) is another program's output, not the pipeline's: nothing removed" >&2; \
 	  exit 2; fi
 	rm -rf "$(OUT)/database.h5" "$(OUT)/database.source" "$(OUT)/database.time" "$(OUT)/cases" \
+	  "$(OUT)/database.h5.parts" \
 	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md" \
   "$(OUT)/cases_paper_law"
 # figures/ and results/ file by file: what the pipeline writes there (its figures and their

@@ -83,10 +83,16 @@ def main():
         os.makedirs(os.path.join(plain, "figures"))
         with open(os.path.join(plain, ".knitscale-output"), "w") as f:
             f.write("knitscale output: the reproduction pipeline (scripts/run.sh)\n")
+        # (and an interrupted sweep's checkpoints: session 45's red team found them left)
+        os.makedirs(os.path.join(plain, "database.h5.parts"))
+        with open(os.path.join(plain, "database.h5.parts", "manifest.json"), "w") as f:
+            f.write("{}")
         rc, out = make_clean(plain, d)
         check(rc == 0 and not os.path.exists(os.path.join(plain, "figures"))
+              and not os.path.exists(os.path.join(plain, "database.h5.parts"))
               and open(callers).read() == "the caller's",
-              "make clean of a plain OUT removes its figures/ only", out)
+              "make clean of a plain OUT removes its figures/ and the sweep's checkpoints only",
+              out)
         # A user's files inside figures/ and results/ stay, with the pipeline's own removed.
         for sub, mine_name, ours in (("figures", "my_plot.png", "fig07d_load_strain.png"),
                                      ("results", "my_analysis.txt", "s312_uniform_45_wale.status")):
