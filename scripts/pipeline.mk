@@ -41,9 +41,15 @@ MESO_SUBCOMMANDS := $(shell "$(MESO)" --help 2>/dev/null | sed -n 's/^  \([a-z][
 # A SWEEP_INPUT given (command line or environment) that does not exist is a mistake, not a
 # reason to fall back on the synthetic stand-in (session 45's red team: a misspelt input gave
 # `database: synth` with exit 0, and replaced an earlier sweep's database).
+# (Not for clean, nor for DB_SOURCE=synth, which read no sweep input; the review of session 45.)
 ifneq ($(filter command line environment,$(origin SWEEP_INPUT)),)
+ifeq ($(filter clean,$(MAKECMDGOALS))$(filter synth,$(DB_SOURCE)),)
+ifneq ($(words $(SWEEP_INPUT)),1)
+$(error SWEEP_INPUT="$(SWEEP_INPUT)" holds a space, which make cannot carry in a path: give a path without spaces)
+endif
 ifeq ($(wildcard $(SWEEP_INPUT)),)
-$(error SWEEP_INPUT=$(SWEEP_INPUT) does not exist: give an existing sweep input, or leave SWEEP_INPUT out for cases/sweep/default.json)
+$(error SWEEP_INPUT=$(SWEEP_INPUT) does not exist (relative paths are taken from $(CURDIR)): give an existing sweep input, or leave SWEEP_INPUT out for cases/sweep/default.json)
+endif
 endif
 endif
 HAVE_SWEEP := $(if $(and $(filter sweep,$(MESO_SUBCOMMANDS)),$(wildcard $(SWEEP_INPUT))),yes)
@@ -115,7 +121,7 @@ $(MESO) $(MACRO):
 # only, and a database of the former input stayed).
 $(OUT)/database.source: FORCE
 	@mkdir -p $(OUT)
-	@src="$(DB_MODE) $(DB_INPUTS)$(if $(DB_INPUTS), $$($(PY) $(FIGPY)/input_digest.py $(DB_INPUTS) || echo unreadable))"; \
+	@src="$(DB_MODE) $(abspath $(DB_INPUTS))$(if $(DB_INPUTS), $$($(PY) $(FIGPY)/input_digest.py $(DB_INPUTS) || echo unreadable))"; \
 	echo "$$src" | cmp -s - $@ || echo "$$src" > $@
 
 $(DB): $(OUT)/database.source $(MESO) $(DB_INPUTS)
@@ -142,13 +148,19 @@ $(OUT)/cases/%.json: $(CASEDIR)/%.json $(FIGPY)/resolve_case.py
 # and the report kept its PASS verdicts on data that no longer existed).
 # $(call run_case,RESULTS,LOG,LABEL,JSON): the recipe of a case run: knit-macro run $< into
 # RESULTS/$*, its output in LOG, the status file $@ (JSON: members before the exit code).
+# $(call wrote_json,DIR): `, "wrote": true` when DIR's output marker (.knitscale-output, written
+# by knit-macro with every output it writes) is not older than the recipe's start $$s0, else
+# false: whether this run wrote its output (session 45's review: knit-macro exits with 1 and
+# writes nothing when no load step converges, and the earlier run's output was taken as this
+# one's). scripts/figures/results.py, strain_box.current_results and the report read it.
+wrote_json = , \"wrote\": $$(if [ -f $(1)/.knitscale-output ] && [ $$(stat -c %Y $(1)/.knitscale-output) -ge $$s0 ]; then echo true; else echo false; fi)
 define run_case
 @mkdir -p $(1) $(LOGS)
 @echo "$(3): $*"
-@start=$$(date +%s.%N); rc=0; \
+@s0=$$(date +%s); start=$$(date +%s.%N); rc=0; \
 "$(MACRO)" run $< --output $(1)/$* > $(2) 2>&1 || rc=$$?; \
 end=$$(date +%s.%N); \
-echo "{\"case\": \"$*\", $(4)\"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+echo "{\"case\": \"$*\", $(4)\"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")$(call wrote_json,$(1)/$*)}" > $@; \
 if [ $$rc -ne 0 ]; then echo "$(3): $* exited with $$rc (see $(2))"; fi
 endef
 # The prerequisite that forces a rerun when RESULTS/$*.status says the run completed but its
@@ -320,8 +332,8 @@ knitmap_gone = $$(if $$(shell grep -qsE '"exit_code". 0[,}]' $(OUT)/knitmap/$$*.
     [ ! -f $(OUT)/knitmap/$$*/summary.txt ] && echo gone),FORCE)
 $(OUT)/knitmap/%.status: $(OUT)/cases/%.json $(DB) $(MACRO) $(knitmap_gone)
 	@mkdir -p $(OUT)/knitmap $(LOGS)
-	@rc=0; "$(MACRO)" knitmap $< --output $(OUT)/knitmap/$* > $(LOGS)/knitmap_$*.log 2>&1 || rc=$$?; \
-	echo "{\"knitmap\": \"$*\", \"exit_code\": $$rc}" > $@; \
+	@s0=$$(date +%s); rc=0; "$(MACRO)" knitmap $< --output $(OUT)/knitmap/$* > $(LOGS)/knitmap_$*.log 2>&1 || rc=$$?; \
+	echo "{\"knitmap\": \"$*\", \"exit_code\": $$rc$(call wrote_json,$(OUT)/knitmap/$*)}" > $@; \
 	if [ $$rc -ne 0 ]; then echo "knitmap: $* exited with $$rc (see $(LOGS)/knitmap_$*.log)"; fi
 .PHONY: knitmaps
 knitmaps: $(KNITMAP_STATUS) $(KNITMAP_FIGURES)
@@ -343,10 +355,10 @@ $(OUT)/design/inputs/%.json: $(ROOT)/cases/design/%.json $(FIGPY)/resolve_case.p
 $(OUT)/design/%.status: $(DESIGN_INPUTS) $(DB) $(MACRO)
 	@mkdir -p $(LOGS)
 	@echo "design: $*"
-	@start=$$(date +%s.%N); rc=0; \
+	@s0=$$(date +%s); start=$$(date +%s.%N); rc=0; \
 	"$(MACRO)" design $(OUT)/design/inputs/$*.json --output $(OUT)/design/$* > $(LOGS)/design_$*.log 2>&1 || rc=$$?; \
 	end=$$(date +%s.%N); \
-	echo "{\"design\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")}" > $@; \
+	echo "{\"design\": \"$*\", \"exit_code\": $$rc, \"seconds\": $$(awk "BEGIN{printf \"%.3f\", $$end - $$start}")$(call wrote_json,$(OUT)/design/$*)}" > $@; \
 	if [ $$rc -ne 0 ]; then echo "design: $* exited with $$rc (see $(LOGS)/design_$*.log)"; fi
 DESIGN_FIG_ARGS_graded_wale := --section E22
 # The design figures, and the knitting-map figures (`knitmaps`; part of `all` since session 39,

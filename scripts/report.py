@@ -33,7 +33,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from results import Result, root_text_attribute  # noqa: E402
+from results import Result, last_run_wrote, root_text_attribute  # noqa: E402
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
 from design import read_summary as read_design_summary  # noqa: E402
 
@@ -1140,7 +1140,7 @@ def design_section(out):
                      if st is None else st.get("exit_code", "?"))
         # Exit 2 or more wrote nothing: a summary.txt in design/NAME is an earlier run's
         # (session 45: it was shown as this run's, with "(exit 2)" beside it).
-        wrote = exit_code in (0, 1) or st is None
+        wrote = st is None or last_run_wrote(st)
         summ = (read_design_summary(os.path.join(out, "design", n, "summary.txt")) if wrote
                 else {})
         status = summ.get("status", f"no output (exit {exit_code})")

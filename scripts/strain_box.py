@@ -26,6 +26,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cell_paths import stored_sweep_input  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
+from results import last_run_wrote  # noqa: E402
 
 # The default box of knit/material/load_paths.hpp (StrainBox): E11, E22 ranges and |E12| bound.
 DEFAULT_BOX = (-0.35, 0.45, -0.30, 0.55, 0.40)
@@ -33,20 +35,22 @@ DEFAULT_BOX = (-0.35, 0.45, -0.30, 0.55, 0.40)
 
 def current_results(results_dir):
     """Every results.h5 under results_dir, but those the pipeline's status file beside their
-    run's directory (NAME.status beside NAME/) says the last run did not write: exit code 2
-    or more is a refused run (bad input, e.g. a loop length the database does not cover),
-    which wrote nothing, so NAME/ is an earlier run's (session 45's red team: a sweep input
-    switched in the same OUT left the former database's runs, which were counted as this
-    one's)."""
+    run's directory (NAME.status beside NAME/) says the last run did not write
+    (results.last_run_wrote: a refused run, or one that converged no step, wrote nothing, so
+    NAME/ is an earlier run's; session 45's red team: a sweep input switched in the same OUT
+    left the former database's runs, which were counted as this one's), and knit-macro's
+    partial directories (NAME.partial-PID)."""
     out = []
     for p in sorted(glob.glob(os.path.join(results_dir, "**", "results.h5"), recursive=True)):
         run = os.path.dirname(p)
+        if ".partial-" in os.path.basename(run):
+            continue  # a run being written, or one killed while it was (knit-macro's partials)
         try:
             with open(run + ".status") as f:
-                code = json.load(f).get("exit_code", 0)
-        except (OSError, ValueError, AttributeError):
-            code = 0  # no pipeline status (a run of one's own): taken
-        if isinstance(code, int) and code >= 2:
+                status = json.load(f)
+        except (OSError, ValueError):
+            status = {}  # no pipeline status (a run of one's own): taken
+        if isinstance(status, dict) and not last_run_wrote(status):
             continue
         out.append(p)
     return out

@@ -35,7 +35,7 @@ except ImportError:  # the section panel is then left out
     h5py = None
 from scipy.interpolate import BSpline  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main, read_json, refuse_failed_run, save_figure  # noqa: E402
+from figure_inputs import guarded_main, read_json, refused_run_placeholder, save_figure  # noqa: E402
 
 
 def read_history(path):
@@ -140,7 +140,9 @@ def main():
     ap.add_argument("--status", help="the pipeline's status file of the design run: a run "
                     "that exited with 2 or more wrote nothing, and DIR is not its output")
     a = ap.parse_args()
-    refuse_failed_run(a.status, a.dir, ok_codes=(0, 1))  # 1: iteration limit, outputs written
+    if refused_run_placeholder(a.status, a.dir, a.out or os.path.normpath(a.dir) + "_design.png", a.title,
+                               ok_codes=(0, 1)):  # 1: an iteration limit, its outputs written
+        return
     history = os.path.join(a.dir, "history.csv")
     h = read_history(history)
     if h.dtype.names is None or not {"iteration", "J"} <= set(h.dtype.names):

@@ -35,18 +35,45 @@ def guarded_main(main):
                          f"{tb.lineno}; the command line: {_command_line()})")
 
 
-def refuse_failed_run(status, directory, ok_codes=(0,)):
-    """With the pipeline's status file of a run (JSON with its exit_code; `status` None or ""
-    skips the check), exits with one line unless the run's exit code is one of `ok_codes`: its
-    output directory may still hold an earlier run's files, which are not this run's
-    (session 45: a design or knitting map refused with exit 2 was drawn from the last run)."""
+def refused_run_placeholder(status, directory, out, title="", ok_codes=(0,)):
+    """With the pipeline's status file of a run (JSON: exit_code, and since session 45 "wrote";
+    `status` None or "" skips the check): when the run wrote nothing (its "wrote" false, or
+    without it an exit code not in `ok_codes`), draws the figure `out` as a placeholder that
+    says so, with the first error line of its log (OUT/logs/<kind>_<name>.log, kind the status
+    file's directory: knitmap, design), and returns True; the caller then draws nothing else.
+    Its directory may still hold an earlier run's files, which are not this run's (session 45:
+    a design or knitting map refused with exit 2 was drawn from the last run). A placeholder
+    with the normal date and exit 0, not a failure: the figure is right to say this, and a
+    second make does not draw it again (the review of session 45).
+    """
     if not status:
-        return
+        return False
     with open(status) as f:
-        code = json.load(f).get("exit_code")
-    if code not in ok_codes:
-        raise SystemExit(f"{os.path.basename(sys.argv[0])}: {status}: the run exited with {code} "
-                         f"(its log is in the pipeline's logs/); {directory} is not its output")
+        st = json.load(f)
+    code = st.get("exit_code")
+    wrote = st["wrote"] if isinstance(st.get("wrote"), bool) else code in ok_codes
+    if wrote:
+        return False
+    kind = os.path.basename(os.path.dirname(os.path.abspath(status)))
+    name = os.path.basename(status)[:-len(".status")] if status.endswith(".status") else ""
+    log = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(status))), "logs",
+                       f"{kind}_{name}.log")
+    first = ""
+    try:
+        with open(log) as f:
+            first = next((line.strip() for line in f if "error:" in line), "")
+    except OSError:
+        pass
+    message = (f"the run exited with {code} and wrote nothing"
+               + (f":\n{first}" if first else f" (its log: {log})")
+               + f"\n({directory} is not its output)")
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plots  # noqa: E402 (plots imports this module)
+
+    plots.placeholder(out, title or os.path.basename(out), message)
+    print(f"{os.path.basename(sys.argv[0])}: {status}: the run exited with {code} and wrote "
+          f"nothing: drew a placeholder {out}")
+    return True
 
 
 def save_figure(fig, out, **savefig_args):

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from figure_inputs import guarded_main, refuse_failed_run, save_figure  # noqa: E402
+from figure_inputs import guarded_main, refused_run_placeholder, save_figure  # noqa: E402
 
 
 def read_map(path):
@@ -47,7 +47,9 @@ def main():
     ap.add_argument("--title", default="")
     ap.add_argument("--status", help="the pipeline's status file of the knitmap run")
     a = ap.parse_args()
-    refuse_failed_run(a.status, a.dir)
+    out = a.out or os.path.normpath(a.dir) + "_knitmap.png"
+    if refused_run_placeholder(a.status, a.dir, out, a.title):
+        return
     m = read_map(os.path.join(a.dir, "knitmap.csv"))
     s = read_summary(os.path.join(a.dir, "summary.txt"))
     courses = int(m["course"].max())

@@ -79,6 +79,21 @@ def root_text_attribute(path, name):
     return d or None
 
 
+def last_run_wrote(status):
+    """Whether the run a pipeline status file (a dict) describes wrote its output: its "wrote"
+    (since session 45: the output's marker is not older than the run's start), else, for status
+    files without it, an exit code below 2 (2 and more: refused before writing, or killed).
+    Session 45: knit-macro refused a case (exit 2) or converged no step (exit 1) and wrote
+    nothing, and the earlier run's output was taken as this one's. No status (a run of one's
+    own, outside the pipeline): True."""
+    if not status:
+        return True
+    if isinstance(status.get("wrote"), bool):
+        return status["wrote"]
+    code = status.get("exit_code")
+    return not (isinstance(code, int) and code >= 2)
+
+
 class Result:
     """One case's output directory plus the pipeline's status file next to it."""
 
@@ -105,11 +120,10 @@ class Result:
         # database does not cover): NAME/ is an earlier run's output, not this run's (session
         # 45's red team: a sweep input switched in the same OUT left the former database's
         # results, which the report and the figures took as this run's).
-        code = self.status.get("exit_code")
-        if isinstance(code, int) and code >= 2:
+        if not last_run_wrote(self.status):
             self.problem = self.problem or (
-                f"the last run exited with {code} (refused: see its log) and wrote nothing"
-                + (f"; {self.dir} is an earlier run's output" if self.ok else ""))
+                f"the last run exited with {self.status.get('exit_code')} and wrote nothing "
+                f"(see its log)" + (f"; {self.dir} is an earlier run's output" if self.ok else ""))
             self.ok = False
         marker = os.path.join(self.dir, ".knitscale-output")
         if self.ok and os.path.exists(marker):

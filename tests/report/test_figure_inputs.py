@@ -46,25 +46,6 @@ def main():
              os.path.join(damaged, "cell.json") + ": not valid JSON (line 2"),
             (("sensitivity.py", "--out", png, table), table + ":1: header must be"),
         ]
-        # A knitmap run that failed (the pipeline's status file, session 45): its directory may
-        # hold an earlier map, which is not drawn as this run's.
-        stale = os.path.join(tmp, "stale")
-        os.makedirs(stale)
-        with open(os.path.join(stale, "knitmap.csv"), "w") as f:
-            f.write("course,needle,x_mm,y_mm,l_mm\n1,1,0,0,5.0\n1,2,1,0,5.5\n")
-        with open(os.path.join(stale, "summary.txt"), "w") as f:
-            f.write("stitches: 2\nyarn_length_mm: 10.5\n")
-        status = os.path.join(tmp, "stale.status")
-        with open(status, "w") as f:
-            f.write('{"knitmap": "stale", "exit_code": 2}\n')
-        jobs.append((("knitmap.py", stale, "--status", status, "--out", png),
-                     status + ": the run exited with 2"))
-        # design.py: exit 1 (an iteration limit) wrote its outputs, 2 wrote nothing.
-        dstatus = os.path.join(tmp, "design.status")
-        with open(dstatus, "w") as f:
-            f.write('{"design": "d", "exit_code": 2}\n')
-        jobs.append((("design.py", damaged, "--status", dstatus, "--out", png),
-                     dstatus + ": the run exited with 2"))
         for args, expect in jobs:
             r = run(*args)
             what = " ".join(os.path.relpath(a, tmp) if a.startswith(tmp) else a for a in args)
@@ -72,11 +53,49 @@ def main():
               f"{what}: refused (exit {r.returncode}), nothing drawn", r.stderr[-500:])
             c(expect in r.stderr and "Traceback" not in r.stderr,
               f"{what}: one line naming the file, no traceback", r.stderr[-500:])
-        with open(status, "w") as f:  # the same directory with a run that exited with 0
-            f.write('{"knitmap": "stale", "exit_code": 0}\n')
-        r = run("knitmap.py", stale, "--status", status, "--out", png)
-        c(r.returncode == 0 and os.path.exists(png), "knitmap.py --status of a run that "
-          "exited with 0: drawn", r.stderr[-500:])
+        # A run that wrote nothing (the pipeline's status file, session 45): its directory may
+        # hold an earlier run's map or design, which is not drawn as this run's; the figure is
+        # a placeholder saying so with its log's error line, exit 0 (not a failed figure).
+        stale = os.path.join(tmp, "stale")
+        os.makedirs(stale)
+        with open(os.path.join(stale, "knitmap.csv"), "w") as f:
+            f.write("course,needle,x_mm,y_mm,l_mm\n1,1,0,0,5.0\n1,2,1,0,5.5\n")
+        with open(os.path.join(stale, "summary.txt"), "w") as f:
+            f.write("stitches: 2\nyarn_length_mm: 10.5\n")
+        os.makedirs(os.path.join(tmp, "knitmap"))
+        os.makedirs(os.path.join(tmp, "design"))
+        os.makedirs(os.path.join(tmp, "logs"))
+        with open(os.path.join(tmp, "logs", "knitmap_stale.log"), "w") as f:
+            f.write("knit-macro knitmap: error: c.json: 6.5 mm is outside the database's\n")
+        status = os.path.join(tmp, "knitmap", "stale.status")
+        dstatus = os.path.join(tmp, "design", "d.status")
+        for st_path, st, script, d, want_placeholder, what in (
+                (status, '{"knitmap": "stale", "exit_code": 2}', "knitmap.py", stale, True,
+                 "knitmap.py, exit 2"),
+                (status, '{"knitmap": "stale", "exit_code": 0, "wrote": false}', "knitmap.py",
+                 stale, True, "knitmap.py, exit 0 but wrote false"),
+                (dstatus, '{"design": "d", "exit_code": 1, "wrote": false}', "design.py",
+                 damaged, True, "design.py, exit 1 that wrote nothing"),
+                (dstatus, '{"design": "d", "exit_code": 2}', "design.py", damaged, True,
+                 "design.py, exit 2"),
+                (status, '{"knitmap": "stale", "exit_code": 0, "wrote": true}', "knitmap.py",
+                 stale, False, "knitmap.py, a run that wrote its map")):
+            with open(st_path, "w") as f:
+                f.write(st + "\n")
+            if os.path.exists(png):
+                os.remove(png)
+            r = run(script, d, "--status", st_path, "--out", png)
+            said = "wrote nothing: drew a placeholder" in r.stdout
+            c(r.returncode == 0 and os.path.exists(png) and said == want_placeholder
+              and "Traceback" not in r.stderr,
+              f"{what}: {'a placeholder' if want_placeholder else 'drawn'}, exit 0",
+              r.stdout[-300:] + r.stderr[-300:])
+    sys.path.insert(0, FIG)
+    from results import last_run_wrote  # noqa: E402
+    for st, want in (({}, True), ({"exit_code": 0}, True), ({"exit_code": 1}, True),
+                     ({"exit_code": 2}, False), ({"exit_code": 1, "wrote": False}, False),
+                     ({"exit_code": 2, "wrote": True}, True)):
+        c(last_run_wrote(st) is want, f"last_run_wrote({st}) is {want}")
     # A mesh study's legend names each mesh and its corner condition (session 26: the h = 1
     # curve of Sect. 3.2.1's study read "diagonal (load along the diagonal)").
     sys.path.insert(0, FIG)

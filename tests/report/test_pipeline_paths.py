@@ -168,6 +168,9 @@ def main():
             rc, log = make_status()
             check(rc == 0 and os.path.exists(os.path.join(res, "load_strain.csv")),
                   "the case runs on a synthetic database", log)
+            st = json.load(open(target)) if os.path.exists(target) else {}
+            check(st.get("exit_code") == 0 and st.get("wrote") is True,
+                  "its status says it wrote its output (session 45)", str(st))
             rc, log = make_status()
             check(rc == 0 and "case: s312" not in log, "made again: nothing re-made", log)
             shutil.rmtree(res)
@@ -197,6 +200,13 @@ def main():
             check(rc != 0 and "SWEEP_INPUT=" in log and "does not exist" in log
                   and not os.path.exists(source), "a SWEEP_INPUT that does not exist: refused",
                   log)
+            r = subprocess.run(["make", "-f", os.path.join(ROOT, "scripts", "pipeline.mk"),
+                                "ROOT=" + ROOT, "BUILD=" + build, "OUT=" + out,
+                                "SWEEP_INPUT=" + os.path.join(d, "missing.json"),
+                                "DB_SOURCE=synth", "-n", source], capture_output=True,
+                               text=True, timeout=60)
+            check(r.returncode == 0, "... but not with DB_SOURCE=synth, which reads none",
+                  r.stdout + r.stderr)
             with open(os.path.join(d, "c.json"), "w") as f:
                 f.write('{"yarn": {"d": 0.38}}')
             with open(sweep, "w") as f:

@@ -859,10 +859,14 @@ def unusable_result_failures(tmp):
     # The last run refused (exit 2: it wrote nothing): results/a is an earlier run's, not
     # taken (session 45's red team: a switched sweep input's refused runs were judged, drawn
     # and counted on the former database's results). Exit 1 (stopped early) wrote its steps.
-    for code, taken in ((2, False), (3, False), (1, True)):
+    # Since the review of session 45 the status says whether the run wrote ("wrote"): exit 1
+    # with nothing written (no load step converged) is not taken either.
+    for code, taken, wrote in ((2, False, None), (3, False, None), (1, True, None),
+                               (1, False, False), (0, True, True)):
         fresh("a")
         with open(os.path.join(res, "a.status"), "w") as f:
-            json.dump({"case": "a", "exit_code": code, "seconds": 0.1}, f)
+            json.dump({"case": "a", "exit_code": code, "seconds": 0.1}
+                      | ({} if wrote is None else {"wrote": wrote}), f)
         r = Result(res, "a")
         if r.ok is not taken or (not taken and "earlier run's output" not in r.problem):
             out.append(f"refused last run, exit {code}: ok={r.ok}, problem {r.problem!r}")
