@@ -92,7 +92,7 @@ std::string not_ours(const fs::path& dir) {
 }
 
 /// What differs between the job definition stored in a manifest and this sweep's, as pointers
-/// into the job definition with both values (at most `max_items`, then "and N more"); "" if
+/// into the job definition with both values (at most `max_items`, then "; N more"); "" if
 /// the manifest holds none (written before session 26) or they are equal. Session 44's list of
 /// what was left open: the refusal said only "a different sweep input", and a user with a long
 /// input had to diff the manifest by hand to find the one step count they had changed.
