@@ -9,7 +9,9 @@
 #
 # DB_SOURCE = auto | sweep | synth. auto uses `knit-meso sweep $(SWEEP_INPUT)` when knit-meso has
 # the sweep subcommand and the input exists, and otherwise the SYNTHETIC stand-in
-# `knit-meso synth` (the report says which one was used, from $(OUT)/database.source).
+# `knit-meso synth` (the report says which one was used, from $(OUT)/database.source). A
+# SWEEP_INPUT given on the command line or in the environment must exist (session 45: a
+# misspelt one fell back on the stand-in); the default one may be missing.
 # Outputs: $(OUT)/database.h5, $(OUT)/cases/NAME.json (the case with the database path set),
 # $(OUT)/results/NAME/ (knit-macro's output directory), $(OUT)/results/NAME.status (exit code
 # and wall time), $(OUT)/logs/, $(OUT)/figures/*.png, $(OUT)/report.md.
