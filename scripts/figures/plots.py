@@ -159,6 +159,19 @@ def negative_determinant(sign):
     return np.concatenate([[False], np.asarray(sign) < 0])
 
 
+def law_of_run(summary, default):
+    """The law a knit run evaluated, from its summary.txt's material report ("knit material
+    (energy law): ..." or "knit material: ...", the paper's eq. 17), else `default` (session 45's
+    red team: with a database without the energy law the default runs evaluated the paper's law,
+    and fig07e labelled them "energy law")."""
+    for line in summary.splitlines():
+        if line.startswith("material report: knit material (energy law):"):
+            return "energy law"
+        if line.startswith("material report: knit material:"):
+            return "paper's law"
+    return default
+
+
 def cmd_laws(a):
     """The load-strain curves of the same cases with the two laws (issue 11 item 4, session
     43): the energy law's runs in --results (solid), the paper's law's in --paper-results
@@ -169,6 +182,7 @@ def cmd_laws(a):
     drawn = 0
     unstable = False
     missing = []  # "NAME (law)" without a curve: said in the note (session 43's review)
+    mislabelled = []  # runs whose summary names the other law (the label follows the run)
     for k, name in enumerate(a.cases):
         colour = f"C{k}"
         for results, style, law in ((a.results, "-", "energy law"),
@@ -178,7 +192,10 @@ def cmd_laws(a):
                 missing.append(f"{label_of(name)} ({law})")
                 continue
             eps, f = r.strain(), r.load()
-            lab = f"{label_of(name)}, {law}" + ("" if r.completed else " (stopped early)")
+            ran = law_of_run(r.summary(), law)
+            if ran != law:
+                mislabelled.append(f"{label_of(name)} ({'solid' if style == '-' else 'dashed'})")
+            lab = f"{label_of(name)}, {ran}" + ("" if r.completed else " (stopped early)")
             ax.plot(100 * eps, f, style, color=colour, lw=1.2, label=lab)
             neg = negative_determinant(r.csv.get("determinant_sign"))
             if law == "paper's law" and neg.any() and len(neg) == len(eps):
@@ -191,7 +208,9 @@ def cmd_laws(a):
         + ("; x: det K < 0 on the paper law's LU path (an odd number of negative eigenvalues)"
            if unstable else "")
         + ("\nno curve (the run failed or converged no step; see the logs): " + ", ".join(missing)
-           if missing else ""))
+           if missing else "")
+        + ("\nby their summaries these runs evaluated the other law (labelled as they ran): "
+           + ", ".join(mislabelled) if mislabelled else ""))
 
 
 def outline(ax, P, **kw):

@@ -115,6 +115,14 @@ def main():
       "label_of: by mesh in a study only")
     # The load-strain figures mark the runs whose law departs from the cell in uniaxial
     # tension (session 41): knit-macro's warning line in summary.txt, not another warning.
+    # fig07e labels each run by the law its summary says it evaluated (session 45's red team:
+    # with a database without the energy law, the default runs were labelled "energy law").
+    c(plots.law_of_run("material report: knit material (energy law): 10 evaluations; 0 "
+                       "extrapolated\n", "paper's law") == "energy law"
+      and plots.law_of_run("status: completed\nmaterial report: knit material: 10 evaluations; "
+                           "extrapolated:\n", "energy law") == "paper's law"
+      and plots.law_of_run("status: completed\n", "energy law") == "energy law",
+      "law_of_run: the summary's material report, else the expected law")
     c(plots.uniaxial_warned("status: completed\nwarning: where the fabric is stretched "
                             "uniaxially along the wale (E22), ...\n")
       and not plots.uniaxial_warned("status: completed\nwarning: load drop: ...\n")
