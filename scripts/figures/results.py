@@ -79,6 +79,24 @@ def root_text_attribute(path, name):
     return d or None
 
 
+def pipeline_log_error(results_dir, name):
+    """The first line saying "error:" of a pipeline run's log, or "": OUT/logs/NAME.log for
+    OUT/results, OUT/logs/paper_law_NAME.log for OUT/results_paper_law (scripts/pipeline.mk),
+    nothing for other directories (session 45's red team: a refused case's row said only that
+    it had no output, where the design and knitting-map tables quote the error)."""
+    prefix = {"results": "", "results_paper_law": "paper_law_"}.get(
+        os.path.basename(os.path.normpath(results_dir)))
+    if prefix is None:
+        return ""
+    log = os.path.join(os.path.dirname(os.path.normpath(results_dir)), "logs",
+                       f"{prefix}{name}.log")
+    try:
+        with open(log, errors="replace") as f:
+            return next((line.strip() for line in f if "error:" in line), "")
+    except OSError:
+        return ""
+
+
 def last_run_wrote(status):
     """Whether the run a pipeline status file (a dict) describes wrote its output: its "wrote"
     (since session 45: the output's marker is not older than the run's start), else, for status
@@ -121,9 +139,11 @@ class Result:
         # 45's red team: a sweep input switched in the same OUT left the former database's
         # results, which the report and the figures took as this run's).
         if not last_run_wrote(self.status):
+            why = pipeline_log_error(results_dir, name)
             self.problem = self.problem or (
                 f"the last run exited with {self.status.get('exit_code')} and wrote nothing "
-                f"(see its log)" + (f"; {self.dir} is an earlier run's output" if self.ok else ""))
+                + (f"({why})" if why else "(see its log)")
+                + (f"; {self.dir} is an earlier run's output" if self.ok else ""))
             self.ok = False
         marker = os.path.join(self.dir, ".knitscale-output")
         if self.ok and os.path.exists(marker):

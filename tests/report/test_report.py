@@ -870,6 +870,20 @@ def unusable_result_failures(tmp):
         r = Result(res, "a")
         if r.ok is not taken or (not taken and "earlier run's output" not in r.problem):
             out.append(f"refused last run, exit {code}: ok={r.ok}, problem {r.problem!r}")
+    # ... and its log's error line, where the pipeline keeps it (OUT/logs/NAME.log beside
+    # OUT/results; paper_law_NAME.log for results_paper_law).
+    for sub, log in (("results", "a.log"), ("results_paper_law", "paper_law_a.log")):
+        base = os.path.join(tmp, "pipeline_out_" + sub)
+        d = os.path.join(base, sub)
+        os.makedirs(os.path.join(d, "a"), exist_ok=True)
+        os.makedirs(os.path.join(base, "logs"), exist_ok=True)
+        with open(os.path.join(d, "a.status"), "w") as f:
+            json.dump({"case": "a", "exit_code": 2, "wrote": False}, f)
+        with open(os.path.join(base, "logs", log), "w") as f:
+            f.write("knit-macro run: error: a.json: /material: 6.5 mm is outside\n")
+        r = Result(d, "a")
+        if "(knit-macro run: error: a.json: /material: 6.5 mm is outside)" not in r.problem:
+            out.append(f"refused last run in {sub}: its log's error not quoted: {r.problem!r}")
     return out
 
 
