@@ -33,7 +33,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from results import Result, last_run_wrote, root_text_attribute  # noqa: E402
+from results import Result, first_error_line, last_run_wrote, root_text_attribute  # noqa: E402
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
 from design import read_summary as read_design_summary  # noqa: E402
 
@@ -1280,15 +1280,6 @@ def knitmap_failure(out, name):
     why = f"exit {code}"
     first = first_error_line(os.path.join(out, "logs", f"knitmap_{name}.log"))
     return why + (f": {first}" if first else "")
-
-
-def first_error_line(log):
-    """The first line of a command's log that says "error:", or "" (none, or no log)."""
-    try:
-        with open(log) as f:
-            return next((line.strip() for line in f if "error:" in line), "")
-    except OSError:
-        return ""
 
 
 def twin_cell(summ, declared=None, exit_code=0):

@@ -58,12 +58,10 @@ def refused_run_placeholder(status, directory, out, title="", ok_codes=(0,)):
     name = os.path.basename(status)[:-len(".status")] if status.endswith(".status") else ""
     log = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(status))), "logs",
                        f"{kind}_{name}.log")
-    first = ""
-    try:
-        with open(log) as f:
-            first = next((line.strip() for line in f if "error:" in line), "")
-    except OSError:
-        pass
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from results import first_error_line  # noqa: E402 (results needs numpy: imported here)
+
+    first = first_error_line(log)
     message = (f"the run exited with {code} and wrote nothing"
                + (f":\n{first}" if first else f" (its log: {log})")
                + f"\n({directory} is not its output)")

@@ -88,8 +88,13 @@ def pipeline_log_error(results_dir, name):
         os.path.basename(os.path.normpath(results_dir)))
     if prefix is None:
         return ""
-    log = os.path.join(os.path.dirname(os.path.normpath(results_dir)), "logs",
-                       f"{prefix}{name}.log")
+    return first_error_line(os.path.join(os.path.dirname(os.path.normpath(results_dir)), "logs",
+                                         f"{prefix}{name}.log"))
+
+
+def first_error_line(log):
+    """The first line of a command's log that says "error:", or "" (none, or no log): what
+    the report's tables and the placeholders quote of a run that failed."""
     try:
         with open(log, errors="replace") as f:
             return next((line.strip() for line in f if "error:" in line), "")
