@@ -98,16 +98,7 @@ std::string not_ours(const fs::path& dir) {
 /// input had to diff the manifest by hand to find the one step count they had changed.
 std::string describe_difference(const nlohmann::json& stored, const nlohmann::json& now,
                                 std::size_t max_items = 4) {
-  const auto short_text = [](const nlohmann::json& v) {
-    std::string t = v.dump();
-    constexpr std::size_t kMax = 60;
-    if (t.size() > kMax) {
-      std::size_t cut = kMax - 3;  // not inside a UTF-8 sequence (the review of session 45)
-      while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
-      t = t.substr(0, cut) + "...";
-    }
-    return t;
-  };
+  const auto short_text = [](const nlohmann::json& v) { return shortened(v.dump(), 60); };
   const nlohmann::json patch = nlohmann::json::diff(stored, now);
   std::ostringstream o;
   std::size_t shown = 0;
@@ -305,6 +296,13 @@ std::string open_record(const std::string& text, const std::string& file, const 
 
 std::string CheckpointStore::this_build() {
   return build_name();
+}
+
+std::string shortened(std::string text, std::size_t max_bytes) {
+  if (text.size() <= max_bytes || max_bytes < 3) return text;
+  std::size_t cut = max_bytes - 3;  // not inside a UTF-8 sequence (the review of session 45)
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+  return text.substr(0, cut) + "...";
 }
 
 std::map<int, JobResult> CheckpointStore::load_finished(const std::vector<Job>& jobs) const {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
@@ -50,13 +51,7 @@ namespace {
 std::string printable(std::string t) {
   for (char& c : t)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  constexpr std::size_t kMax = 120;
-  if (t.size() > kMax) {
-    std::size_t cut = kMax - 3;
-    while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
-    t = t.substr(0, cut) + "...";
-  }
-  return t;
+  return shortened(std::move(t), 120);
 }
 
 /// Jobs waiting to run: filled up front (rank 0) or as rank 0 hands them out (other ranks).

@@ -48,24 +48,22 @@ def refused_run_placeholder(status, directory, out, title="", ok_codes=(0,)):
     """
     if not status:
         return False
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from results import first_error_line, last_run_wrote  # noqa: E402 (numpy: imported here)
+
     with open(status) as f:
         st = json.load(f)
     code = st.get("exit_code")
-    wrote = st["wrote"] if isinstance(st.get("wrote"), bool) else code in ok_codes
-    if wrote:
+    if last_run_wrote(st, ok_codes):
         return False
     kind = os.path.basename(os.path.dirname(os.path.abspath(status)))
     name = os.path.basename(status)[:-len(".status")] if status.endswith(".status") else ""
     log = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(status))), "logs",
                        f"{kind}_{name}.log")
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from results import first_error_line  # noqa: E402 (results needs numpy: imported here)
-
     first = first_error_line(log)
     message = (f"the run exited with {code} and wrote nothing"
                + (f":\n{first}" if first else f" (its log: {log})")
                + f"\n({directory} is not its output)")
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import plots  # noqa: E402 (plots imports this module)
 
     plots.placeholder(out, title or os.path.basename(out), message)

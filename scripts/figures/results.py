@@ -102,7 +102,7 @@ def first_error_line(log):
         return ""
 
 
-def last_run_wrote(status):
+def last_run_wrote(status, ok_codes=None):
     """Whether the run a pipeline status file (a dict) describes wrote its output: its "wrote"
     (since session 45: the output's marker is not older than the run's start), else, for status
     files without it, an exit code below 2 (2 and more: refused before writing, or killed).
@@ -114,6 +114,8 @@ def last_run_wrote(status):
     if isinstance(status.get("wrote"), bool):
         return status["wrote"]
     code = status.get("exit_code")
+    if ok_codes is not None:  # a command whose other exit codes write nothing either
+        return code in ok_codes
     return not (isinstance(code, int) and code >= 2)
 
 

@@ -1322,3 +1322,13 @@ TEST_CASE("sweep database: the residual is subtracted from the converged steps o
     CHECK((Eigen::RowVector4d(P(0, 0), P(0, 1), P(1, 0), P(1, 1)) - b.P.row(k)).norm() < 1e-13);
   }
 }
+
+TEST_CASE("sweep: shortened cuts long texts, never inside a UTF-8 sequence", "[unit]") {
+  using knit::meso::sweep::shortened;
+  CHECK(shortened("abc", 60) == "abc");
+  CHECK(shortened(std::string(10, 'a'), 8) == "aaaaa...");
+  // "é" is two bytes (0xC3 0xA9): a cut after 5 bytes of "aaaaé..." would split it.
+  const std::string e = "\xC3\xA9";
+  CHECK(shortened("aaaa" + e + e + e, 8) == "aaaa...");
+  CHECK(shortened("aaa" + e + e + e, 8) == "aaa" + e + "...");
+}

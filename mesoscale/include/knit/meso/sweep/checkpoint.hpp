@@ -66,4 +66,8 @@ class CheckpointStore {
   bool resumed_ = false;  ///< opened with --resume on existing checkpoints
 };
 
+/// `text` cut to at most `max_bytes` bytes with "..." at the end, never inside a UTF-8
+/// sequence (the checkpoints' messages: a manifest's values and build names).
+std::string shortened(std::string text, std::size_t max_bytes);
+
 }  // namespace knit::meso::sweep
