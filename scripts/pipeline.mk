@@ -256,7 +256,7 @@ $(DB_FIGS) &: $(DB) $(FIGPY)/surfaces.py $(FIGPY)/energy_law.py $(FIGPY)/batch.p
 	@mkdir -p $(FIG) $(LOGS)/figures
 	@$(PY) $(FIGPY)/batch.py --logs $(LOGS)/figures \
 	  '$(FIG)/fig06_response_surfaces.png $(FIGPY)/surfaces.py --database $(DB) --loop-length 6.5' \
-	  '$(FIG)/fig06e_energy_law.png $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5'
+	  '$(FIG)/fig06e_energy_law.png $(FIGPY)/energy_law.py --database $(DB) --loop-length 6.5 --absent-placeholder'
 
 # Sect. 3.1.2 (Fig. 7): 7a and 7b share their colour scale (the paper compares their uniformity).
 $(eval $(call deformed,fig07a_uniform45_wale_E22,s312_uniform_45_wale,E22,0.3,Fig. 7a: l = 4.5 mm wale-wise at 30 % (E22),s312_uniform_65_wale))

@@ -61,12 +61,17 @@ def pick_loop(f, l):
     return k, float(ls[k])
 
 
-def database_figure_args():
-    """The command line of the database figures: --database, --loop-length (6.5), --out."""
+def database_figure_args(absent_placeholder=False):
+    """The command line of the database figures: --database, --loop-length (6.5), --out, and
+    with `absent_placeholder` (Fig. 6e) the flag --absent-placeholder."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--database", required=True)
     ap.add_argument("--loop-length", type=float, default=6.5)
     ap.add_argument("--out", required=True)
+    if absent_placeholder:
+        ap.add_argument("--absent-placeholder", action="store_true",
+                        help="a database without /energy_law gets a placeholder figure that "
+                             "says so, exit 0 (the pipeline); without it, an error, exit 1")
     return ap.parse_args()
 
 
