@@ -55,6 +55,12 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+/// An angle in degrees as printed: within 1e-9 deg of 0 it is 0 (session 42's red team:
+/// 4.599205532e-16 and -6.9e-15 of round-off for courses along x).
+double angle(double deg) {
+  return std::abs(deg) < 1e-9 ? 0.0 : deg;
+}
+
 /// The planar patch seen in the course frame: (s, t) = (p . d1, p . d2) for p = (x, y).
 class PlanarPatch {
  public:
@@ -189,7 +195,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     std::ostringstream os;
     os.precision(4);
     os << "the course direction varies by up to " << map.angle_spread_deg << " deg from its mean "
-       << map.course_direction_deg
+       << angle(map.course_direction_deg)
        << " deg over the patch; a flat-knitting machine knits straight courses, so the map "
           "needs a course direction constant within "
        << opt.angle_tolerance_deg << " deg (--angle-tolerance)";
@@ -381,6 +387,26 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
                            " at the end of the patch are narrower than one stitch and are "
                            "left out (the patch tapers below one stitch width there)");
 
+  // The course direction at every stitch (session 46's red team: the 21 x 21 grid above missed
+  // a knitting angle that turns between its points, e.g. a band of 1 rad a few stitches wide,
+  // and the map said "spread 0", exit 0): each stitch is knitted along phi0, so its own course
+  // direction must lie within the tolerance of it too.
+  auto check_stitch_direction = [&](const KnitStitch& st) {
+    const double d = std::remainder(patch.course_angle(patch.invert(st.position)) - phi0, kPi);
+    map.angle_spread_deg = std::max(map.angle_spread_deg, std::abs(d) * 180 / kPi);
+    if (map.angle_spread_deg <= opt.angle_tolerance_deg) return;
+    std::ostringstream os;
+    os.precision(4);
+    os << "the course direction at the stitch of course " << st.course << ", needle " << st.needle
+       << " (x = " << st.position.x() << ", y = " << st.position.y() << " mm) differs by "
+       << std::abs(d) * 180 / kPi << " deg from the map's " << angle(map.course_direction_deg)
+       << " deg (the knitting angle turns between the points where it was first checked); a "
+          "flat-knitting machine knits straight courses, so the map needs a course direction "
+          "constant within "
+       << opt.angle_tolerance_deg << " deg (--angle-tolerance)";
+    throw InputError(c.file, "/material/knitting_angle", os.str());
+  };
+
   // Round half up with a tolerance: a centred course of an even stitch count has r exactly at
   // a half integer, where round-off must not shift some courses by one needle.
   auto first_of = [](double r) { return static_cast<long>(std::floor(r + 0.5 + 1e-6)); };
@@ -404,6 +430,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
         throw InputError(
             c.file, "/material/stitch_value",
             "a non-finite stitch value or position in course " + std::to_string(st.course));
+      check_stitch_direction(st);
       map.yarn_length += st.l;
       map.l_min = std::min(map.l_min, st.l);
       map.l_max = std::max(map.l_max, st.l);
@@ -424,9 +451,6 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
 std::string knitmap_summary(const KnitMap& map) {
   std::ostringstream os;
   os.precision(10);
-  // Angles within 1e-9 deg of 0 are 0 (session 42's red team: 4.599205532e-16 and -6.9e-15 of
-  // round-off for courses along x).
-  auto angle = [](double deg) { return std::abs(deg) < 1e-9 ? 0.0 : deg; };
   os << "stitches: " << map.stitches.size() << "\n"
      << "yarn_length_mm: " << map.yarn_length << "\n"
      << "needles: " << map.needles << "\n"

@@ -749,3 +749,30 @@ TEST_CASE("knitmap: summary.txt prints round-off angles as 0", "[unit]") {
   m.course_direction_deg = -0.2642998643;  // a real angle stays
   CHECK(knitmap_summary(m).find("\ncourse_direction_deg: -0.2642998643\n") != std::string::npos);
 }
+
+// Session 46's red team: the course direction was checked on a 21 x 21 grid of the parameter
+// domain only, so a knitting angle that turns between its points (here a tent of 60 deg on
+// u = 0.505 ... 0.545, between the grid's u = 0.50 and 0.55) gave a map with "spread 0", exit
+// 0. Every stitch's own course direction is checked now.
+TEST_CASE("knitmap: a knitting angle that turns between the grid points is refused", "[unit]") {
+  const std::string file =
+      write_case("band.json", case_text(knit_material(database(), "5.0", R"({"degrees": [1, 0],
+                                      "knots_u": [0, 0, 0.505, 0.525, 0.545, 1, 1],
+                                      "knots_v": [0, 1], "values": [0, 0, 60, 0, 0],
+                                      "unit": "deg"})"),
+                                        50, 10));
+  const auto in = load_knitmap_input(file);
+  try {
+    make_knitmap(in.c, in.cells);
+    FAIL("a map was made");
+  } catch (const knit::InputError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("/material/knitting_angle") != std::string::npos);
+    CHECK(what.find("the course direction at the stitch of course") != std::string::npos);
+  }
+  KnitMapOptions wide;
+  wide.angle_tolerance_deg = 90;
+  const KnitMap m = make_knitmap(in.c, in.cells, wide);
+  CHECK(m.angle_spread_deg > 2.0);  // the stitches in the band, not the grid's 0
+  CHECK(m.angle_spread_deg <= 60.0 + 1e-9);
+}
