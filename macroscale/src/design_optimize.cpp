@@ -135,14 +135,22 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
           "projected_gradient; /optimizer) or start from other values";
       break;
     case DesignStop::kPushesOut:
+      // A local verdict (session 46's red team: a reaction target of 60 N, started at
+      // l = 5.75, stopped at 6.5 with 36 N and read as out of reach, while l = 4.65 meets it:
+      // the wale-wise load is not monotone in l). "Infeasible" here means beyond the bounds
+      // in the direction J falls from this design; J need not be convex in the variables.
       why =
           ", with a variable on a bound whose gradient points out of the bounds: the targets "
-          "lie outside the bounds";
+          "lie outside the bounds in the direction J falls from here (a local verdict: J need "
+          "not be convex in the variables, so another start, e.g. from the other end of a "
+          "bound variable's interval, may still reach them inside)";
       break;
     case DesignStop::kUnknown:
     case DesignStop::kInside:
       if (stop == DesignStop::kUnknown && on_bound) {
-        why = ", with a variable on a bound: the targets lie outside the bounds";
+        why =
+            ", with a variable on a bound: the targets lie outside the bounds in the direction "
+            "J falls from here (a local verdict; another start may still reach them inside)";
         break;
       }
       why = on_bound ? std::string(": a local minimum of J; no gradient points out of the bounds")

@@ -734,6 +734,8 @@ TEST_CASE("design status: the gradient on the bounds decides an infeasible targe
            Row{5.0, 1e-12, 5.5, DesignStatus::kTargetNotMet, kMinimum},  // moved: a minimum
            Row{4.5, 1e-12, 5.5, DesignStatus::kTargetNotMet, "a local minimum of J; no gradient"},
            Row{4.5, 1.0, 5.5, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
+           // Session 46's red team: "outside the bounds" is local (J need not be convex).
+           Row{4.5, 1.0, 5.5, DesignStatus::kInfeasible, "(a local verdict: J need not be convex"},
            Row{6.5, -1.0, 5.5, DesignStatus::kInfeasible, "the targets lie outside the bounds"},
            Row{6.5, 1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},
            Row{4.5, -1.0, 5.5, DesignStatus::kTargetNotMet, "J still decreases inside the bounds"},

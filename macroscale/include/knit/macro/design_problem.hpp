@@ -150,9 +150,10 @@ namespace knit::macro {
 /// `max_iterations`. The result's status: kConverged (J at most `feasible` x J0: the targets
 /// are met; J and J0 here without the smoothness penalty, a regularization), kIterationLimit,
 /// kInfeasible (converged with J above `feasible` x J0 and a variable on a bound: the target is out
-/// of reach inside the bounds; the best design is kept), kTargetNotMet (the same inside the bounds:
-/// a local minimum, or a loose function tolerance; the best design is kept) or kFailed (a solve
-/// failed). The two misses say why in DesignResult::message.
+/// of reach inside the bounds in the direction J falls from there, a local verdict, since J need
+/// not be convex in the variables; the best design is kept), kTargetNotMet (the same inside the
+/// bounds: a local minimum, or a loose function tolerance; the best design is kept) or kFailed (a
+/// solve failed). The two misses say why in DesignResult::message.
 struct OptimizeOptions {
   int max_iterations = 30;
   double x_tolerance = 1e-6;
