@@ -187,6 +187,26 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
                  "give the real path");
   }
   ec.clear();
+  // Inside another run's output (session 46's red team: `knit-macro design D.json -o og2/run`,
+  // og2 an earlier design output, replaced og2's run/ by another design's whole output, exit 0,
+  // and og2's summary still described the old run). A directory whose marker a run wrote (a
+  // "for:" line or a manifest) holds that run's files only; a container such as the
+  // pipeline's OUT (its marker has neither) holds outputs. The partial directory of this very
+  // process, not yet committed (no manifest), is where its nested outputs go (a design's run/).
+  {
+    const fs::path abs = fs::weakly_canonical(fs::absolute(target, ec), ec);
+    for (fs::path a = abs.parent_path(); !ec && !a.empty(); a = a.parent_path()) {
+      const auto m = read_output_marker(a);
+      const bool own_partial = m && !m->has_manifest && m->writer_pid == ::getpid();
+      if (m && (!m->for_name.empty() || m->has_manifest) && !own_partial)
+        refuse("lies inside " + a.string() + ", the output of a knitscale run (its " +
+               kOutputMarker +
+               " says so): a new output there would change that run's files; give a path "
+               "outside it");
+      if (a == a.parent_path()) break;
+    }
+    ec.clear();
+  }
   const fs::path parent =
       target.has_parent_path() ? fs::absolute(target, ec).parent_path() : fs::current_path(ec);
   if (fs::exists(st)) {

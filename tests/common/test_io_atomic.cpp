@@ -842,3 +842,53 @@ TEST_CASE("a signal that ends the program unlinks the temporaries not yet commit
   CHECK(entries(d) == 1);  // done.txt only: no ".db.h5.tmp-<pid>-<n>", no ".open.txt.tmp-..."
   fs::remove_all(d);
 }
+
+// Session 46's red team: `knit-macro design D.json -o og2/run`, og2 an earlier design output,
+// replaced og2's run/ by another design's whole output (exit 0), og2's summary still
+// describing the old run. An output inside another run's output is refused, for directories
+// and files alike; a container such as the pipeline's OUT (its marker names no run) is not one,
+// and the partial directory of this process takes its nested outputs (a design's run/).
+TEST_CASE("check_output_target refuses an output inside another run's output",
+          "[unit][io][atomic]") {
+  using knit::io::OutputKind;
+  const fs::path d = scratch("nested");
+  const fs::path pipeline = d / "out";
+  fs::create_directories(pipeline);
+  std::ofstream(pipeline / knit::io::kOutputMarker)
+      << "knitscale output: the reproduction pipeline (scripts/pipeline.mk)\n";
+  // A committed run's output inside the container.
+  const fs::path design = pipeline / "design";
+  {
+    knit::io::AtomicDirectory a(design);
+    fs::create_directories(a.path() / "run");
+    std::ofstream(a.path() / "run" / "x.txt") << "x";
+    a.commit();
+  }
+  CHECK_NOTHROW(knit::io::check_output_target(pipeline / "results", OutputKind::kDirectory));
+  CHECK_NOTHROW(knit::io::check_output_target(pipeline / "db.h5", OutputKind::kFile));
+  for (const fs::path& inner : {design / "run", design / "run" / "deeper", design / "new"})
+    CHECK_THROWS_WITH(
+        knit::io::check_output_target(inner, OutputKind::kDirectory, "--output"),
+        Catch::Contains("lies inside " + design.string() + ", the output of a knitscale run"));
+  CHECK_THROWS_WITH(knit::io::check_output_target(design / "x.h5", OutputKind::kFile),
+                    Catch::Contains("lies inside"));
+  CHECK_THROWS_AS(knit::io::AtomicDirectory(design / "run"), knit::InputError);
+  CHECK(slurp(design / "run" / "x.txt") == "x");
+  // The nested output of this process's own partial directory (a design's final run).
+  {
+    knit::io::AtomicDirectory a(design);
+    CHECK_NOTHROW(knit::io::check_output_target(a.path() / "run", OutputKind::kDirectory));
+    knit::io::AtomicDirectory run(a.path() / "run");
+    std::ofstream(run.path() / "y.txt") << "y";
+    run.commit();
+    a.commit();
+  }
+  CHECK(slurp(design / "run" / "y.txt") == "y");
+  // Another process's partial directory is another run's output as well.
+  const fs::path other = pipeline / "design2.partial-999999999";
+  fs::create_directories(other);
+  std::ofstream(other / knit::io::kOutputMarker)
+      << "knitscale output\n{}\nfor: design2\npid 999999999\n";
+  CHECK_THROWS_WITH(knit::io::check_output_target(other / "run", OutputKind::kDirectory),
+                    Catch::Contains("lies inside"));
+}
