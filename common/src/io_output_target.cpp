@@ -380,8 +380,11 @@ void OutputLock::take(const std::string& out) {
       const int e = errno;
       ::close(fd);
       if (e != EWOULDBLOCK) cannot("cannot lock", e);
+      // Up to the line's end: a take-over writes the new tag over a longer old one before it
+      // cuts the file to size.
       std::string pid = have.substr(std::strlen(kLockTag));
-      while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+      pid = pid.substr(0, pid.find('\n'));
+      while (!pid.empty() && pid.back() == ' ') pid.pop_back();
       throw InputError(out, "",
                        "is being written by another knitscale process (pid " +
                            (pid.empty() ? std::string("unknown") : pid) + ", lock file " +
@@ -393,9 +396,14 @@ void OutputLock::take(const std::string& out) {
       ::close(fd);
       continue;
     }
-    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) < 0) {
-      // Holding the lock is what counts; the pid is for the message of the refused one.
-    }
+    // The tag first, then the cut to its size: the file never reads empty (session 46's red
+    // team, by reading: cut first, a process killed between the two left an empty lock file,
+    // "not a knitscale lock file (it is empty)", which refused every later run until removed
+    // by hand). Holding the lock is what counts; the pid is for the refused one's message.
+    const bool retagged =
+        ::pwrite(fd, me.data(), me.size(), 0) == static_cast<ssize_t>(me.size()) &&
+        ::ftruncate(fd, static_cast<off_t>(me.size())) == 0;
+    (void)retagged;
     fd_ = fd;
     return;
   }

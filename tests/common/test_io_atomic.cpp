@@ -1,4 +1,6 @@
 // Atomic files/directories, CSV writer and provenance records.
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -351,9 +353,26 @@ TEST_CASE("OutputLock: one holder at a time, named in the refusal, stale locks t
     CHECK_THROWS_AS(knit::io::OutputLock(target), knit::InputError);
   }
   CHECK_FALSE(fs::exists(d / "out.lock"));  // removed on release
-  // The lock file of a killed process: not held, taken over.
-  std::ofstream(d / "out.lock") << "knitscale lock pid 999999999\n";
-  { knit::io::OutputLock b(target); }
+  // The lock file of a killed process: not held, taken over, and holding our tag only (session
+  // 46: the take-over writes the tag before it cuts the file to size, so the file never reads
+  // empty; a longer old pid's tail is cut).
+  std::ofstream(d / "out.lock") << "knitscale lock pid 999999999999\n";
+  {
+    knit::io::OutputLock b(target);
+    CHECK(slurp(d / "out.lock") == "knitscale lock pid " + std::to_string(::getpid()) + "\n");
+  }
+  // A held lock caught between the two (the new tag over a longer old one): its pid is read to
+  // the line's end.
+  std::ofstream(d / "out.lock") << "knitscale lock pid 123\n45\n";
+  {
+    const int fd = ::open((d / "out.lock").c_str(), O_RDWR);
+    REQUIRE(fd >= 0);
+    REQUIRE(::flock(fd, LOCK_EX | LOCK_NB) == 0);  // another open file: another holder
+    CHECK_THROWS_WITH(knit::io::OutputLock(target),
+                      Catch::Contains("another knitscale process (pid 123, lock file"));
+    ::close(fd);
+  }
+  fs::remove(d / "out.lock");
   // A file of that name that is not a lock file is neither used nor changed.
   std::ofstream(d / "out.lock") << "someone's notes";
   CHECK_THROWS_WITH(knit::io::OutputLock(target), Catch::Contains("not a knitscale lock file"));
