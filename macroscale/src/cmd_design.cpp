@@ -104,7 +104,7 @@ knit::cli::SubcommandRegistrar reg(
         // meanwhile was silently replaced, and a run into it failed the design after all its
         // work). Until commit() only DIR.partial-<pid> exists; a failure removes it.
         knit::io::AtomicDirectory out(dir, knit::io::AtomicDirectory::OnAbandon::Remove,
-                                      "output directory", o->file);
+                                      o->output.empty() ? "output directory" : "--output", o->file);
         // The twin's targets: the case solved at the twin's values (not for --check).
         if (const std::string why = knit::macro::set_twin_targets(d); !why.empty()) {
           std::cerr << "knit-macro design: " << o->file << ": " << why << "\n";

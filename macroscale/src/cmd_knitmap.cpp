@@ -60,10 +60,12 @@ knit::cli::SubcommandRegistrar reg(
                 : std::filesystem::path(o->output);
         // Before the map is made, named as run and design name it (session 36's red team:
         // knitmap said "output directory:" for --output, after the layout).
-        knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
-                                      o->output.empty() ? "output directory" : "--output");
+        const char* option = o->output.empty() ? "output directory" : "--output";
+        knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory, option);
         const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
-        knit::macro::write_knitmap(map, in, dir);
+        // The same name when the output is checked again under its lock (session 46's red
+        // team: a target that changed meanwhile was refused as "output directory:").
+        knit::macro::write_knitmap(map, in, dir, option);
         std::cout << knit::macro::knitmap_summary(map) << "wrote " << dir.string() << "\n";
         // Warnings on stderr as well, as the help's footer says (session 26: only on stdout
         // and in summary.txt).

@@ -34,9 +34,9 @@ KnitMapInput load_knitmap_input(const std::string& case_file) {
   return in;
 }
 
-void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir) {
-  io::AtomicDirectory out(dir, io::AtomicDirectory::OnAbandon::Remove, "output directory",
-                          in.c.file);
+void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir,
+                   std::string_view option) {
+  io::AtomicDirectory out(dir, io::AtomicDirectory::OnAbandon::Remove, option, in.c.file);
   const std::string prov = "provenance: " + io::Provenance::current(in.c.file).to_json_string();
   {
     io::CsvWriter csv(out / "knitmap.csv", {"course", "needle", "l_mm", "x_mm", "y_mm"});

@@ -776,3 +776,20 @@ TEST_CASE("knitmap: a knitting angle that turns between the grid points is refus
   CHECK(m.angle_spread_deg > 2.0);  // the stitches in the band, not the grid's 0
   CHECK(m.angle_spread_deg <= 60.0 + 1e-9);
 }
+
+// Session 46's red team: an output refused when it is checked again under its lock (it changed
+// while the map was made) was named "output directory:" although --output had been given.
+TEST_CASE("knitmap: the output is named as the command line gave it", "[unit]") {
+  const std::string file =
+      write_case("named.json", case_text(knit_material(database(), "5.5"), 10, 10));
+  const auto in = load_knitmap_input(file);
+  const KnitMap m = make_knitmap(in.c, in.cells);
+  const fs::path foreign = kDir / "named_foreign";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "notes.txt") << "notes";
+  CHECK_THROWS_WITH(write_knitmap(m, in, foreign, "--output"),
+                    Catch::Contains(foreign.string() + ": --output: is a non-empty directory"));
+  CHECK_THROWS_WITH(write_knitmap(m, in, foreign),
+                    Catch::Contains(": output directory: is a non-empty directory"));
+  CHECK(fs::exists(foreign / "notes.txt"));
+}

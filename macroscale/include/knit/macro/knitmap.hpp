@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "knit/macro/case.hpp"
@@ -112,7 +113,9 @@ KnitMapInput load_knitmap_input(const std::string& case_file);
 std::string knitmap_summary(const KnitMap& map);
 
 /// Writes DIR/knitmap.csv (course, needle, l_mm, x_mm, y_mm), DIR/courses.csv and
-/// DIR/summary.txt atomically (the directory appears complete or not at all).
-void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir);
+/// DIR/summary.txt atomically (the directory appears complete or not at all). `option` names the
+/// output in a refusal ("--output", or "output directory" for the default name).
+void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir,
+                   std::string_view option = "output directory");
 
 }  // namespace knit::macro
