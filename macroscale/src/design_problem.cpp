@@ -380,12 +380,18 @@ DesignProblem load_design(const std::string& path) {
     throw InputError(path, "/case",
                      "the design needs a knit case (" + d.case_file + " has the material \"" +
                          d.c.material->name() + "\")");
-  if (!root.contains("variables") || !root.at("variables").is_array() ||
-      root.at("variables").empty())
-    throw InputError(path, "/variables", "needs at least one design variable");
-  if (!root.contains("objectives") || !root.at("objectives").is_array() ||
-      root.at("objectives").empty())
-    throw InputError(path, "/objectives", "needs at least one objective");
+  // A wrong type is named as such (session 46's red team: "variables": "l" read "needs at
+  // least one design variable").
+  for (const auto& [key, what] :
+       {std::pair{"variables", "design variable"}, std::pair{"objectives", "objective"}}) {
+    const std::string ptr = std::string("/") + key;
+    if (root.contains(key) && !root.at(key).is_array())
+      throw InputError(
+          path, ptr,
+          std::string("must be an array of ") + what + "s, not " + root.at(key).type_name());
+    if (!root.contains(key) || root.at(key).empty())
+      throw InputError(path, ptr, std::string("needs at least one ") + what);
+  }
   std::vector<std::pair<int, int>> used;
   std::vector<std::string> columns;  // history.csv's variable columns
   for (std::size_t k = 0; k < root.at("variables").size(); ++k) {

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "../output_test_util.hpp"
 #include "../process_tmp.hpp"
@@ -211,6 +212,19 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_bounds.json", one_variable("knitting_angle", "[0]", "-10", "200"),
          "/variables/0/upper");
   expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
+  // Session 46's red team: a wrong type read "needs at least one design variable".
+  for (const auto& [vars, objs, ptr] :
+       {std::tuple{std::string(R"("l")"), std::string(kObjs), "/variables"},
+        std::tuple{std::string(kVars), std::string(R"({"type": "reaction"})"), "/objectives"}}) {
+    write(kDir / "wrong_type.json", design(vars, objs));
+    try {
+      (void)load_design((kDir / "wrong_type.json").string());
+      FAIL_CHECK("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == ptr);
+      CHECK_THAT(e.message(), Catch::StartsWith("must be an array of "));
+    }
+  }
   // A case file that is not there (session 29: the message named only the case's path).
   {
     std::string t = design(kVars, kObjs);
