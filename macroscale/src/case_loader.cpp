@@ -40,6 +40,9 @@ constexpr double kMaxAbsoluteTolerance = 1e-3;
 /// strain 0 at every step).
 constexpr double kMinThicknessPerSize = 1e-4;
 constexpr double kMaxThicknessPerSize = 1.0;
+/// The farthest a control point's coordinate may lie from the origin, relative to the patch's
+/// size D (session 46): at 1e8 D a double keeps about 8 of its 16 digits for the patch itself.
+constexpr double kMaxOffsetPerSize = 1e8;
 constexpr double kMinGaugePerSize = 1e-2;
 /// The smallest non-zero prescribed displacement, relative to the patch's size D (session 29).
 constexpr double kMinPrescribedPerSize = 1e-12;
@@ -247,6 +250,17 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
     r.fail("/geometry/control_points",
            "the patch's size (its largest extent) is " + std::to_string(size) +
                " mm: the control points must span a finite, non-degenerate patch");
+  // Session 46's red team: a flat patch at z = 1e300 was refused as "folded geometry ...
+  // control points out of order?": so far from the origin its own extent is lost to round-off.
+  for (Eigen::Index a = 0; a < P.rows(); ++a)
+    if (P.row(a).cwiseAbs().maxCoeff() > kMaxOffsetPerSize * size) {
+      std::ostringstream m;
+      m.precision(4);
+      m << "lies " << P.row(a).cwiseAbs().maxCoeff() << " mm from the origin in a coordinate, "
+        << "more than " << kMaxOffsetPerSize << " times the patch's size (" << size
+        << " mm): the patch's own shape would be lost to round-off; move it nearer the origin";
+      r.fail("/geometry/control_points/" + std::to_string(a), m.str());
+    }
   if (!(c.thickness >= kMinThicknessPerSize * size && c.thickness <= kMaxThicknessPerSize * size))
     r.fail("/geometry/thickness",
            "the thickness must lie in " +

@@ -186,6 +186,17 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     CHECK(error_of(j).rfind("bad.json: /geometry/control_points: the patch's size", 0) == 0);
   }
   {
+    // A patch far from the origin (session 46's red team: z = 1e300 on every control point
+    // read "folded geometry"); 1e7 mm away a patch of this size still works.
+    json j = base;
+    for (auto& p : j["geometry"]["control_points"]) p[2] = 1e300;
+    CHECK(error_of(j).rfind("bad.json: /geometry/control_points/0: lies 1e+300 mm from the "
+                            "origin in a coordinate, more than 1e+08 times the patch's size",
+                            0) == 0);
+    for (auto& p : j["geometry"]["control_points"]) p[2] = 1e7;
+    CHECK(error_of(j).empty());
+  }
+  {
     json j = base;
     j["geometry"]["knots_u"] = {0, 0, 1, 0.5};
     CHECK(error_of(j).rfind("bad.json: /geometry/knots_u: ", 0) == 0);
