@@ -13,6 +13,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <new>
 #include <sstream>
 #include <vector>
 
@@ -207,6 +208,14 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
   } catch (const InputError& e) {
     std::cerr << who() << ": error: " << e.what() << "\n";
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    // Out of memory names what ran out and what to do (session 46's red team: a design under a
+    // memory limit ended in "error: std::bad_alloc"); earlier outputs stay (atomic writers).
+    std::cerr << who()
+              << ": error: out of memory (std::bad_alloc); outputs not yet complete are not "
+                 "written, earlier outputs stay as they were: make the problem smaller (fewer "
+                 "elements, samples or steps) or give the process more memory\n";
+    return kExitFailure;
   } catch (const std::exception& e) {
     // An output directory abandoned by the failure is named as itself, not as its partial
     // directory (gone by now), with what became of it (knit/io/atomic.hpp).

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "knit/core/errors.hpp"
@@ -57,8 +58,16 @@ std::vector<double> numbers(const json& j, const std::string& file, const std::s
   return v;
 }
 
+/// `loop_lengths`: the case database's loop lengths, read by the first stitch-value variable
+/// and kept for the others (session 46's red team: read once per variable, 2,000 variables took
+/// 25 s of `--check`).
+/// The most strain samples (samples_u x samples_v x applied strains, summed over the strain
+/// terms) a design may ask for per evaluation (session 46).
+constexpr double kMaxStrainSamples = 250000;
+
 void read_variable(const json& j, const std::string& p, const json& case_root, const Case& c,
-                   const std::string& file, DesignVariableSpec& v) {
+                   const std::string& file, DesignVariableSpec& v,
+                   std::optional<std::vector<double>>& loop_lengths) {
   if (!j.is_object()) throw InputError(file, p, "must be an object");
   for (const char* k : {"field", "indices", "lower", "upper"})
     if (!j.contains(k))
@@ -69,8 +78,11 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
   v.field = field == "stitch_value" ? DesignVariable::Field::kStitchValue
                                     : DesignVariable::Field::kKnittingAngle;
   if (j.contains("name") && j.at("name").is_string()) v.name = j.at("name").get<std::string>();
+  // A reference, not `cond ? at(field) : json()`: the conditional's prvalue copied the whole
+  // field for every variable (session 46's red team: 10,000 variables took 43 s of --check).
+  static const json kNone;
   const json& f =
-      case_root.at("material").contains(field) ? case_root.at("material").at(field) : json();
+      case_root.at("material").contains(field) ? case_root.at("material").at(field) : kNone;
   if (!f.is_object() || !f.contains("values") || !f.at("values").is_array())
     throw InputError(file, p + "/field",
                      "the case's /material/" + field +
@@ -95,7 +107,8 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
   if (v.field == DesignVariable::Field::kStitchValue) {
     std::filesystem::path db =
         io::resolve_input_path(c.file, case_root.at("material").at("database").get<std::string>());
-    const auto ls = material::read_database(db, false).loop_lengths();
+    if (!loop_lengths) loop_lengths = material::read_database(db, false).loop_lengths();
+    const std::vector<double>& ls = *loop_lengths;
     for (const char* b : {"lower", "upper"}) {
       const double x = std::string(b) == "lower" ? v.lower : v.upper;
       if (x < ls.front() || x > ls.back())
@@ -394,10 +407,11 @@ DesignProblem load_design(const std::string& path) {
   }
   std::vector<std::pair<int, int>> used;
   std::vector<std::string> columns;  // history.csv's variable columns
+  std::optional<std::vector<double>> loop_lengths;
   for (std::size_t k = 0; k < root.at("variables").size(); ++k) {
     const std::string p = "/variables/" + std::to_string(k);
     DesignVariableSpec v;
-    read_variable(root.at("variables")[k], p, case_root, d.c, path, v);
+    read_variable(root.at("variables")[k], p, case_root, d.c, path, v, loop_lengths);
     for (std::size_t n = 0; n < v.indices.size(); ++n) {
       const int i = v.indices[n];
       const std::pair<int, int> key(static_cast<int>(v.field), i);
@@ -497,6 +511,37 @@ DesignProblem load_design(const std::string& path) {
                          "its default name \"" + o.name + "\" is taken: give it a \"name\"");
     }
     d.objectives.push_back(o);
+  }
+  // The strain terms' samples, each evaluated with its sensitivities at every applied strain of
+  // every design evaluation (session 46's red team: 1000 x 1000 samples at one strain took 540
+  // MB and 10 s per evaluation, at three strains no iteration ended in 120 s, and under a
+  // memory limit the design ended in "std::bad_alloc" naming nothing).
+  {
+    double total = 0.0, largest = 0.0;
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < d.objectives.size(); ++k) {
+      const DesignObjective& o = d.objectives[k];
+      if (o.kind != DesignObjective::Kind::kStrainVariance &&
+          o.kind != DesignObjective::Kind::kTargetStrain)
+        continue;
+      const double n = double(o.samples_u) * o.samples_v * double(o.at_strain.size());
+      total += n;
+      if (n > largest) {
+        largest = n;
+        at = k;
+      }
+    }
+    if (total > kMaxStrainSamples) {
+      const DesignObjective& o = d.objectives[at];
+      throw InputError(path, "/objectives/" + std::to_string(at) + "/samples",
+                       "the strain terms ask for " + std::to_string(static_cast<long long>(total)) +
+                           " samples per design evaluation (this one " +
+                           std::to_string(o.samples_u) + " x " + std::to_string(o.samples_v) +
+                           " at " + std::to_string(o.at_strain.size()) + " strain(s)), more than " +
+                           fmt(kMaxStrainSamples) +
+                           " (each with its sensitivities, about 0.5 kB and 10 us); fewer "
+                           "samples resolve a region's strain as well (the default is 11 x 11)");
+    }
   }
   if (twin && std::none_of(d.twin_targets.begin(), d.twin_targets.end(), [](bool b) { return b; }))
     throw InputError(path, "/twin",

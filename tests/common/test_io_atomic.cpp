@@ -7,6 +7,8 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <new>
 #include <optional>
 #include <regex>
 #include <sstream>
@@ -910,4 +912,28 @@ TEST_CASE("check_output_target refuses an output inside another run's output",
       << "knitscale output\n{}\nfor: design2\npid 999999999\n";
   CHECK_THROWS_WITH(knit::io::check_output_target(other / "run", OutputKind::kDirectory),
                     Catch::Contains("lies inside"));
+}
+
+// Session 46's red team: a design under a memory limit ended in "knit-macro design: error:
+// std::bad_alloc", naming neither what ran out nor what to do. run_main says so, exit 1.
+namespace {
+const knit::cli::SubcommandRegistrar kOutOfMemory("test-out-of-memory",
+                                                  "a subcommand that runs out of memory (test)",
+                                                  [](CLI::App&) -> knit::cli::Runner {
+                                                    return []() -> int { throw std::bad_alloc(); };
+                                                  });
+}  // namespace
+
+TEST_CASE("run_main: out of memory is said as such, exit 1", "[unit][cli]") {
+  std::string prog = "knit-test", sub = "test-out-of-memory";
+  char* argv[] = {prog.data(), sub.data(), nullptr};
+  std::ostringstream err;
+  std::streambuf* old = std::cerr.rdbuf(err.rdbuf());
+  const int code = knit::cli::run_main(2, argv, "knit-test", "test");
+  std::cerr.rdbuf(old);
+  knit::io::set_output_owner("");  // run_main named the outputs' owner after the subcommand
+  CHECK(code == knit::kExitFailure);
+  CHECK_THAT(err.str(), Catch::StartsWith("knit-test test-out-of-memory: error: out of memory "
+                                          "(std::bad_alloc); outputs not yet complete are not "
+                                          "written, earlier outputs stay as they were"));
 }

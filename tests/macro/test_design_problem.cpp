@@ -369,6 +369,19 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
                          "region": {"u": [0.5, 0.5], "v": [0.5, 0.5]}}])"),
          "/objectives/0/region");
+  // Session 46's red team: 1000 x 1000 samples took 540 MB and 10 s per evaluation (at three
+  // strains no iteration in 120 s): more than 250,000 samples per evaluation are refused at
+  // the largest term; 500 x 500 at one strain (250,000) is not.
+  expect("many_samples.json",
+         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                         "region": {"u": [0, 1], "v": [0.4, 0.6]}, "samples": [10, 10]},
+                        {"type": "strain_variance", "component": "E11", "at_strain": [0.1, 0.2],
+                         "region": {"u": [0, 1], "v": [0.4, 0.6]}, "samples": [400, 400]}])"),
+         "/objectives/1/samples");
+  write(kDir / "max_samples.json",
+        design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
+                        "region": {"u": [0, 1], "v": [0.4, 0.6]}, "samples": [500, 500]}])"));
+  CHECK_NOTHROW(load_design((kDir / "max_samples.json").string()));
   // Session 34 (the design audit's mutants 76 to 82): each check of the loader, off alone,
   // survived (`--check` exited 0): equal bounds, an upper bound beyond the database's 6.5, an
   // angle bound below -180 deg, tied control values that differ in the case (5.0 and 5.6 in
