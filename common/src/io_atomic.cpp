@@ -409,37 +409,46 @@ void AtomicDirectory::commit() {
   }
   fsync_path(partial_, true);
 
-  if (!fs::exists(target_, ec)) {
-    if (::rename(partial_.c_str(), target_.c_str()) != 0)
-      fail(target_, "cannot rename " + partial_.string(), errno);
+  // What took the target's place while the run went on is left alone, and the new output is
+  // kept beside it under a name of its own (the clean-up of partial directories would remove
+  // it; session 26: the message named it, and it was gone; session 46's red team: a file or a
+  // symbolic link there made the commit fail and the finished output was deleted).
+  const auto keep_beside = [&](const std::string& what) {
+    std::string where;
+    for (int k = 0; k < 100 && where.empty(); ++k) {
+      fs::path kept = target_;
+      kept += ".new-" + std::to_string(::getpid()) + (k ? "-" + std::to_string(k) : "");
+      if (!fs::exists(fs::symlink_status(kept, ec)) &&
+          ::rename(partial_.c_str(), kept.c_str()) == 0)
+        where = kept.string();
+    }
+    if (where.empty()) {  // kept as the partial directory, complete, without INCOMPLETE
+      where =
+          partial_.string() + " (rename it: the next run into " + target_.string() + " removes it)";
+    }
+    active_ = false;  // nothing to remove or mark
+    fail(target_, what + " while the run went on: left alone; the new output is kept in " + where);
+  };
+  const fs::file_status now = fs::symlink_status(target_, ec);
+  if (!fs::exists(now)) {
+    if (::rename(partial_.c_str(), target_.c_str()) != 0) {
+      const int err = errno;
+      // Something appeared at the target between the look and the rename.
+      if (err == EEXIST || err == ENOTEMPTY || err == ENOTDIR || err == EISDIR)
+        keep_beside("appeared");
+      fail(target_, "cannot rename " + partial_.string(), err);
+    }
   } else {
-    if (!fs::is_directory(fs::symlink_status(target_, ec)))
-      fail(target_, "exists and is not a directory");
+    if (!fs::is_directory(now))
+      keep_beside(std::string("became ") +
+                  (fs::is_symlink(now) ? "a symbolic link" : "a file or another non-directory"));
     const std::vector<std::string> foreign = foreign_entries(target_);
     if ((!is_own_output(target_) || !foreign.empty()) && !fs::is_empty(target_, ec)) {
-      // Keep the new output beside it under a name of its own (the clean-up of partial
-      // directories would remove it; session 26: the message named it, and it was gone).
-      std::string where;
-      for (int k = 0; k < 100 && where.empty(); ++k) {
-        fs::path kept = target_;
-        kept += ".new-" + std::to_string(::getpid()) + (k ? "-" + std::to_string(k) : "");
-        if (!fs::exists(fs::symlink_status(kept, ec)) &&
-            ::rename(partial_.c_str(), kept.c_str()) == 0)
-          where = kept.string();
-      }
-      if (where.empty()) {  // kept as the partial directory, complete, without INCOMPLETE
-        where = partial_.string() + " (rename it: the next run into " + target_.string() +
-                " removes it)";
-      }
-      active_ = false;  // nothing to remove or mark
       if (!foreign.empty())
-        fail(target_, "received entries that the earlier run did not write (" + foreign[0] +
-                          (foreign.size() > 1 ? ", ..." : "") +
-                          ") while the run went on: left alone; the new output is kept in " +
-                          where);
-      fail(target_, "became a non-empty directory that is not this program's output (its " +
-                        std::string(kOutputMarker) + " is missing or names another) while " +
-                        "the run went on: left alone; the new output is kept in " + where);
+        keep_beside("received entries that the earlier run did not write (" + foreign[0] +
+                    (foreign.size() > 1 ? ", ..." : "") + ")");
+      keep_beside("became a non-empty directory that is not this program's output (its " +
+                  std::string(kOutputMarker) + " is missing or names another)");
     }
     // So that the clean-up after a kill knows the earlier output for ours wherever the kill
     // leaves it (DIR.partial-<pid> after the exchange, DIR.old-<pid> below): appended to a

@@ -774,6 +774,47 @@ TEST_CASE("AtomicDirectory keeps the new output when a foreign directory took it
   CHECK_FALSE(fs::exists(target / knit::io::kOutputMarker));
 }
 
+// Session 46's red team: a file or a symbolic link that took the target's place while a design
+// ran made the commit fail ("exists and is not a directory") and the finished output was
+// deleted. It is kept beside them as DIR.new-<pid>, and they are left alone.
+TEST_CASE("AtomicDirectory keeps the new output when a file or a link took its place",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("taken_by_file");
+  for (const std::string kind : {"file", "link", "dangling link"}) {
+    INFO(kind);
+    const std::string tag = kind == "file" ? "f" : kind == "link" ? "l" : "d";
+    const fs::path target = d / ("out_" + tag);
+    const fs::path elsewhere = d / ("elsewhere_" + tag);
+    std::string kept, message;
+    {
+      knit::io::AtomicDirectory a(target);
+      std::ofstream(a.path() / "result.txt") << "new";
+      if (kind == "file") {
+        std::ofstream(target) << "theirs";
+      } else {
+        if (kind == "link") fs::create_directories(elsewhere);
+        fs::create_directory_symlink(elsewhere, target);
+      }
+      try {
+        a.commit();
+        FAIL("no error");
+      } catch (const std::runtime_error& e) {
+        message = e.what();
+        const std::size_t at = message.find("the new output is kept in ");
+        REQUIRE(at != std::string::npos);
+        kept = message.substr(at + std::string("the new output is kept in ").size());
+      }
+    }
+    CHECK_THAT(message, Catch::Contains(kind == "file" ? "became a file" : "a symbolic link"));
+    CHECK(kept ==
+          (d / (target.filename().string() + ".new-" + std::to_string(::getpid()))).string());
+    CHECK(slurp(fs::path(kept) / "result.txt") == "new");
+    if (kind == "file") CHECK(slurp(target) == "theirs");
+    if (kind != "file") CHECK(fs::is_symlink(target));
+    fs::remove_all(kept);
+  }
+}
+
 TEST_CASE("AtomicFile removes the stale temporaries of killed writers of its target",
           "[unit][io][atomic]") {
   const fs::path d = scratch("stale_tmp");
