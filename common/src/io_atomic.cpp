@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
@@ -314,12 +315,21 @@ void remove_stale_siblings(const fs::path& target) {
 }
 
 /// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
-void remove_old_output(const fs::path& old) {
+void remove_old_output(const fs::path& old, const fs::path& target) {
   std::error_code ec;
   if (is_knitscale_output(old))
     remove_marked_tree(old);
   else if (fs::is_empty(old, ec))
     fs::remove(old, ec);
+  // What could not be removed (a subdirectory the user cannot write) stays, marked; the next
+  // run into the target tries again. Said once on stderr (session 46's red team: every rerun
+  // left another copy of the earlier output beside the target without a word).
+  if (fs::exists(fs::symlink_status(old, ec)))
+    std::cerr << (output_owner().empty() ? std::string("knitscale") : output_owner())
+              << ": warning: " << target.string()
+              << ": the new output is in place, but the earlier one, moved to " << old.string()
+              << ", could not be removed entirely (permissions?); the next run into "
+              << target.string() << " tries again, or remove it by hand\n";
 }
 
 }  // namespace
@@ -459,7 +469,7 @@ void AtomicDirectory::commit() {
       marker << "replaced by pid " << ::getpid() << "\n";
     }
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
-      remove_old_output(partial_);  // now holds the old contents
+      remove_old_output(partial_, target_);  // now holds the old contents
     } else {
       // File system without RENAME_EXCHANGE: move the old directory aside first.
       fs::path old = target_;
@@ -474,7 +484,7 @@ void AtomicDirectory::commit() {
         ::rename(old.c_str(), target_.c_str());  // put the old output back
         fail(target_, "cannot rename " + partial_.string(), err);
       }
-      remove_old_output(old);
+      remove_old_output(old, target_);
     }
   }
   committed_ = true;
