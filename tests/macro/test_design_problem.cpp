@@ -270,6 +270,32 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
       CHECK_THAT(e.pointer() + ": " + e.message(), Catch::StartsWith(want));
     }
   }
+  // Session 46's red team: a linearity term could not be used on a compression case ("the
+  // last strain must be positive"). Its line ends at the strain farthest from 0.
+  {
+    std::string text = knit_test::read_text(kDir / "case.json");
+    const std::string from = "\"y\": 4.0";
+    text.replace(text.find(from), from.size(), "\"y\": -4.0");
+    write(kDir / "case_compression.json", text);
+    for (const auto& [strains, want] :
+         {std::pair{"[-0.05, -0.1, -0.2]", ""},
+          std::pair{"[-0.2, -0.1]",
+                    "/objectives/0/at_strain/0: must be nearer 0 than the last "
+                    "strain (the line's end point, -0.1)"}}) {
+      INFO("at_strain " << strains);
+      std::string d = design(kVars, std::string(R"([{"type": "reaction_linearity", "reaction": )"
+                                                R"("fy", "at_strain": )") +
+                                        strains + "}]");
+      d.replace(d.find("case.json"), 9, "case_compression.json");
+      write(kDir / "linearity_compression.json", d);
+      try {
+        (void)load_design((kDir / "linearity_compression.json").string());
+        CHECK(std::string(want).empty());
+      } catch (const knit::InputError& e) {
+        CHECK(e.pointer() + ": " + e.message() == want);
+      }
+    }
+  }
   // Session 36's red team: two objectives of one name (given, or the type by default) were
   // reported as two indistinguishable lines of summary.txt.
   expect("same_name.json",
