@@ -38,13 +38,16 @@ def current_results(results_dir):
     run's directory (NAME.status beside NAME/) says the last run did not write
     (results.last_run_wrote: a refused run, or one that converged no step, wrote nothing, so
     NAME/ is an earlier run's; session 45's red team: a sweep input switched in the same OUT
-    left the former database's runs, which were counted as this one's), and knit-macro's
-    partial directories (NAME.partial-PID)."""
+    left the former database's runs, which were counted as this one's), knit-macro's
+    partial directories (NAME.partial-PID) and the completed outputs that stopped reruns
+    replaced (NAME.last-completed)."""
     out = []
     for p in sorted(glob.glob(os.path.join(results_dir, "**", "results.h5"), recursive=True)):
         run = os.path.dirname(p)
-        if ".partial-" in os.path.basename(run):
-            continue  # a run being written, or one killed while it was (knit-macro's partials)
+        if ".partial-" in os.path.basename(run) or run.endswith(".last-completed"):
+            # a run being written, or one killed while it was (knit-macro's partials); and the
+            # completed output a stopped rerun replaced (NAME.last-completed, session 46)
+            continue
         try:
             with open(run + ".status") as f:
                 status = json.load(f)

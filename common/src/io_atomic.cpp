@@ -388,6 +388,36 @@ AtomicDirectory::~AtomicDirectory() {
   }
 }
 
+void AtomicDirectory::dispose_replaced(const fs::path& old) {
+  std::error_code ec;
+  if (!keep_replaced_.empty() && is_knitscale_output(old)) {
+    // The marker's "replaced by pid" line goes: the kept output is no stale directory of a
+    // killed run, and the clean-up of such directories must never take it.
+    {
+      std::ifstream in(old / kOutputMarker, std::ios::binary);
+      std::string text, line;
+      while (std::getline(in, line))
+        if (line.rfind("replaced by pid ", 0) != 0) text += line + "\n";
+      in.close();
+      std::ofstream(old / kOutputMarker, std::ios::binary | std::ios::trunc) << text;
+    }
+    fs::path where = keep_replaced_;
+    // An earlier kept output of ours there goes first; anything else stays, and this one
+    // takes a name of its own beside it.
+    if (fs::exists(fs::symlink_status(where, ec))) {
+      if (fs::is_directory(fs::symlink_status(where, ec)) && is_own_output(where) &&
+          foreign_entries(where).empty())
+        remove_marked_tree(where);
+      if (fs::exists(fs::symlink_status(where, ec))) where += "-" + std::to_string(::getpid());
+    }
+    if (!fs::exists(fs::symlink_status(where, ec)) && ::rename(old.c_str(), where.c_str()) == 0) {
+      replaced_kept_in_ = where;
+      return;
+    }
+  }
+  remove_old_output(old, target_);
+}
+
 void AtomicDirectory::commit() {
   if (committed_) return;
   if (!active_) fail(target_, "commit() on a moved-from AtomicDirectory");
@@ -469,7 +499,7 @@ void AtomicDirectory::commit() {
       marker << "replaced by pid " << ::getpid() << "\n";
     }
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
-      remove_old_output(partial_, target_);  // now holds the old contents
+      dispose_replaced(partial_);  // now holds the old contents
     } else {
       // File system without RENAME_EXCHANGE: move the old directory aside first.
       fs::path old = target_;
@@ -484,7 +514,7 @@ void AtomicDirectory::commit() {
         ::rename(old.c_str(), target_.c_str());  // put the old output back
         fail(target_, "cannot rename " + partial_.string(), err);
       }
-      remove_old_output(old, target_);
+      dispose_replaced(old);
     }
   }
   committed_ = true;

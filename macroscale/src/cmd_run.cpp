@@ -50,10 +50,13 @@ knit::cli::SubcommandRegistrar reg(
           std::cerr << "knit-macro run: " << o->case_file << ": "
                     << knit::macro::run_failure_message(r)
                     << (r.wrote_outputs ? "; outputs in " + ro.output_dir.string() : "")
-                    << (r.wrote_outputs && r.replaced_earlier
+                    << (!r.wrote_outputs || !r.replaced_earlier ? ""
+                        : r.earlier_kept_in.empty()
                             ? " (they replace the earlier outputs there: a stopped run keeps its "
                               "converged steps)"
-                            : "")
+                            : " (they replace the earlier outputs there, a stopped run keeps its "
+                              "converged steps; the completed earlier output is kept in " +
+                                  r.earlier_kept_in.string() + ")")
                     << "\n";
           return knit::kExitFailure;
         }

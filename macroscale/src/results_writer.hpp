@@ -42,6 +42,9 @@ class ResultsWriter {
   void set_solver_warning(std::string w) { solver_warning_ = std::move(w); }
   /// RunResult::input_warnings: "warning: " lines of summary.txt.
   void set_input_warnings(std::vector<std::string> w) { input_warnings_ = std::move(w); }
+  /// io::AtomicDirectory::keep_replaced_as: the earlier output this one replaces is kept there.
+  void keep_replaced_as(std::filesystem::path where) { dir_.keep_replaced_as(std::move(where)); }
+  const std::filesystem::path& replaced_kept_in() const { return dir_.replaced_kept_in(); }
   /// Empty, or where the sampled output fields first held a non-finite number (the first
   /// field, step and point, and how many values in all): the quadrature points, which Newton
   /// checks, may never reach a strain where the material's stress overflows, the output grid

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <ostream>
 #include <sstream>
 
@@ -289,6 +290,14 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   std::error_code ec;
   const bool had_output = writer && std::filesystem::is_directory(opt.output_dir, ec) &&
                           !std::filesystem::is_empty(opt.output_dir, ec);
+  // A completed earlier output is not lost to a stopped rerun (session 46's red team: a rerun
+  // that stopped after 14 of 20 steps replaced the complete result): it is kept beside it.
+  const bool had_completed = had_output && [&] {
+    std::ifstream in(opt.output_dir / "summary.txt");
+    std::string first;
+    std::getline(in, first);
+    return first == "status: completed";
+  }();
   RunResult res;
   for (const std::string& w : p.warnings) {
     res.input_warnings.push_back(w);
@@ -388,9 +397,12 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)
       writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
+    if (had_completed && !res.succeeded())
+      writer->keep_replaced_as(opt.output_dir.string() + ".last-completed");
     writer->finish(res.report);
     res.wrote_outputs = true;
     res.replaced_earlier = had_output;
+    res.earlier_kept_in = writer->replaced_kept_in();
     res.output_failure = writer->output_failure();
   }
   return res;

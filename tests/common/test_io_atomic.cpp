@@ -978,3 +978,35 @@ TEST_CASE("run_main: out of memory is said as such, exit 1", "[unit][cli]") {
                                           "(std::bad_alloc); outputs not yet complete are not "
                                           "written, earlier outputs stay as they were"));
 }
+
+// Session 46: keep_replaced_as moves the replaced output aside instead of removing it; an
+// earlier kept output of ours there is replaced, anything else is left alone.
+TEST_CASE("AtomicDirectory keeps the output it replaces where it is asked to",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("keep_replaced");
+  const fs::path target = d / "out", kept = d / "out.kept";
+  const auto write = [&](const std::string& text, bool keep) {
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "x.txt") << text;
+    if (keep) a.keep_replaced_as(kept);
+    a.commit();
+    return a.replaced_kept_in();
+  };
+  CHECK(write("1", true).empty());  // nothing replaced
+  CHECK(write("2", true) == kept);
+  CHECK(slurp(kept / "x.txt") == "1");
+  CHECK(slurp(target / "x.txt") == "2");
+  CHECK(slurp(kept / knit::io::kOutputMarker).find("replaced by pid") == std::string::npos);
+  CHECK(write("3", true) == kept);  // ours there: replaced
+  CHECK(slurp(kept / "x.txt") == "2");
+  CHECK(write("4", false).empty());  // not asked: removed as before
+  CHECK(slurp(kept / "x.txt") == "2");
+  // Somebody else's directory of that name stays; the output goes beside it.
+  fs::remove_all(kept);
+  fs::create_directories(kept);
+  std::ofstream(kept / "notes.txt") << "notes";
+  const fs::path beside = write("5", true);
+  CHECK(beside == d / ("out.kept-" + std::to_string(::getpid())));
+  CHECK(slurp(beside / "x.txt") == "4");
+  CHECK(slurp(kept / "notes.txt") == "notes");
+}

@@ -141,6 +141,28 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
     };
     CHECK(knit_test::contains(r.output,
                               outputs_in("replaced", " (they replace the earlier outputs there")));
+    // Session 46's red team: the completed earlier output was lost to the stopped rerun. It
+    // is kept as DIR.last-completed (said in the message); a second stopped rerun keeps it,
+    // and a completed one keeps none.
+    const fs::path kept = d / "replaced.last-completed";
+    CHECK(knit_test::contains(r.output,
+                              "the completed earlier output is kept in " + kept.string() + ")"));
+    const auto first_line = [](const fs::path& f) {
+      std::ifstream in(f);
+      std::string line;
+      std::getline(in, line);
+      return line;
+    };
+    CHECK(first_line(kept / "summary.txt") == "status: completed");
+    CHECK(first_line(d / "replaced" / "summary.txt") == "status: stopped");
+    CHECK_FALSE(
+        knit_test::contains(knit_test::read_text(kept / ".knitscale-output"), "replaced by pid"));
+    r = macro((d / "crush.json").string() + " --output " + (d / "replaced").string());
+    CHECK(r.rc == 1);
+    CHECK(first_line(kept / "summary.txt") == "status: completed");
+    REQUIRE(macro(c + " --output " + (d / "replaced").string()).rc == 0);
+    CHECK(first_line(kept / "summary.txt") == "status: completed");  // left as it was
+    CHECK(first_line(d / "replaced" / "summary.txt") == "status: completed");
     r = macro((d / "crush.json").string() + " --output " + (d / "fresh").string());
     CHECK(r.rc == 1);
     CHECK(knit_test::contains(r.output, outputs_in("fresh", "\n")));

@@ -66,6 +66,15 @@ def main():
             check((rc == 0 and "case_a" in out) if counted else (rc == 2 and "no results.h5" in out),
                   f"status exit {code}: {'counted' if counted else 'not counted'}", out)
         os.remove(case + ".status")
+        # The completed output a stopped rerun replaced (knit-macro keeps it as
+        # NAME.last-completed, session 46) is not one of the runs.
+        kept = case + ".last-completed"
+        os.makedirs(kept)
+        with h5py.File(os.path.join(kept, "results.h5"), "w") as f:
+            f.create_group("fields/step_0001")["E_course"] = np.array([0.9])
+        rc, out = run(res, "--database", db)
+        check(rc == 0 and "last-completed" not in out and inside_all(out) == 100.0,
+              "NAME.last-completed is not counted", out)
         bare = os.path.join(d, "bare.h5")
         with h5py.File(bare, "w") as f:
             f.create_group("loop_0")

@@ -117,6 +117,9 @@ struct RunResult {
   /// run's message says: session 40's red team found a complete earlier output replaced by a
   /// stopped run's, unsaid).
   bool replaced_earlier = false;
+  /// Where the completed earlier output went when a run that did not succeed replaced it
+  /// (DIR.last-completed; session 46), else empty.
+  std::filesystem::path earlier_kept_in;
   /// Plain success: every step converged, the material never failed and every output value is
   /// finite.
   bool succeeded() const {
