@@ -58,13 +58,17 @@ std::vector<double> numbers(const json& j, const std::string& file, const std::s
   return v;
 }
 
+/// The most strain samples (samples_u x samples_v x applied strains, summed over the strain
+/// terms) a design may ask for per evaluation, and the most entries of their sensitivities
+/// (those samples x (variables + 1)): each sample keeps a gradient row per variable, about
+/// 50-70 bytes an entry (session 46: 250,000 samples took 154 MB with 8 variables and 4.8 GB
+/// with 400, 9 s per evaluation).
+constexpr double kMaxStrainSamples = 250000;
+constexpr double kMaxStrainEntries = 5e6;
+
 /// `loop_lengths`: the case database's loop lengths, read by the first stitch-value variable
 /// and kept for the others (session 46's red team: read once per variable, 2,000 variables took
 /// 25 s of `--check`).
-/// The most strain samples (samples_u x samples_v x applied strains, summed over the strain
-/// terms) a design may ask for per evaluation (session 46).
-constexpr double kMaxStrainSamples = 250000;
-
 void read_variable(const json& j, const std::string& p, const json& case_root, const Case& c,
                    const std::string& file, DesignVariableSpec& v,
                    std::optional<std::vector<double>>& loop_lengths) {
@@ -533,16 +537,21 @@ DesignProblem load_design(const std::string& path) {
         at = k;
       }
     }
-    if (total > kMaxStrainSamples) {
+    const double entries = total * double(d.variables.size() + 1);
+    if (total > kMaxStrainSamples || entries > kMaxStrainEntries) {
       const DesignObjective& o = d.objectives[at];
-      throw InputError(path, "/objectives/" + std::to_string(at) + "/samples",
-                       "the strain terms ask for " + std::to_string(static_cast<long long>(total)) +
-                           " samples per design evaluation (this one " +
-                           std::to_string(o.samples_u) + " x " + std::to_string(o.samples_v) +
-                           " at " + std::to_string(o.at_strain.size()) + " strain(s)), more than " +
-                           fmt(kMaxStrainSamples) +
-                           " (each with its sensitivities, about 0.5 kB and 10 us); fewer "
-                           "samples resolve a region's strain as well (the default is 11 x 11)");
+      const std::string ptr = "/objectives/" + std::to_string(at);
+      const auto count = [](double x) { return std::to_string(static_cast<long long>(x)); };
+      throw InputError(
+          path, root.at("objectives")[at].contains("samples") ? ptr + "/samples" : ptr,
+          "the strain terms ask for " + count(total) + " samples per design evaluation (this one " +
+              std::to_string(o.samples_u) + " x " + std::to_string(o.samples_v) + " at " +
+              std::to_string(o.at_strain.size()) + " strain(s)), each with a sensitivity per " +
+              "variable: " + count(total) + " x (" + std::to_string(d.variables.size()) +
+              " variables + 1) = " + count(entries) + " entries; at most " +
+              count(kMaxStrainSamples) + " samples and " + count(kMaxStrainEntries) +
+              " entries (about 50-70 bytes each) are allowed: fewer samples resolve a region's "
+              "strain as well (the default is 11 x 11), or fewer variables or strains");
     }
   }
   if (twin && std::none_of(d.twin_targets.begin(), d.twin_targets.end(), [](bool b) { return b; }))

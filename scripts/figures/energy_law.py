@@ -251,8 +251,8 @@ def main():
             # says the database has no such law, a final placeholder with exit 0, not a failed
             # figure script (the report's law table says "absent" as well).
             plots.placeholder(a.out, "Fig. 6e: energy-based law",
-                              why + "\n(a sweep input with \"energy_fit\": false; the cases "
-                              "use the paper's eq. 17 surfaces)")
+                              why + "\n(the database holds no energy-based law, e.g. from a "
+                              "sweep input with \"energy_fit\": false)")
             print(f"energy_law.py: {why}: drew a placeholder {a.out}")
             return
         k, l = pick_loop(f, a.loop_length)

@@ -408,6 +408,44 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
         design(kL, R"([{"type": "strain_variance", "component": "E22", "at_strain": [0.2],
                         "region": {"u": [0, 1], "v": [0.4, 0.6]}, "samples": [500, 500]}])"));
   CHECK_NOTHROW(load_design((kDir / "max_samples.json").string()));
+  // The review of session 46: each sample keeps a sensitivity per variable (250,000 samples
+  // took 4.8 GB with 400 variables), so samples x (variables + 1) is capped at 5e6 as well: 30
+  // variables with 410 x 410 samples (5.2e6 entries) are refused, with 300 x 300 they load.
+  {
+    std::string text = knit_test::read_text(kDir / "case.json");
+    std::string knots = "0, 0", values = "5.0", vars;
+    for (int k = 1; k < 29; ++k) knots += ", " + std::to_string(k / 29.0);
+    knots += ", 1, 1";
+    for (int k = 1; k < 30; ++k) values += ", 5.0";
+    for (int k = 0; k < 30; ++k)
+      vars += std::string(k ? ", " : "") + R"({"name": "v)" + std::to_string(k) +
+              R"(", "field": "stitch_value", "indices": [)" + std::to_string(k) +
+              R"(], "lower": 4.5, "upper": 6.5})";
+    const std::string from = R"("knots_u": [0, 0, 1, 1], "knots_v": [0, 1],
+                       "values": [5.0, 5.0])";
+    REQUIRE(text.find(from) != std::string::npos);
+    text.replace(text.find(from), from.size(),
+                 R"("knots_u": [)" + knots + R"(], "knots_v": [0, 1], "values": [)" + values + "]");
+    write(kDir / "case_30.json", text);
+    for (const auto& [n, refused] : {std::pair{"300", false}, std::pair{"410", true}}) {
+      INFO("samples " << n << " x " << n << ", 30 variables");
+      std::string d =
+          design("[" + vars + "]", std::string(R"([{"type": "strain_variance", "component": "E22",
+                                 "at_strain": [0.2], "region": {"u": [0, 1], "v": [0.4, 0.6]},
+                                 "samples": [)") +
+                                       n + ", " + n + "]}]");
+      d.replace(d.find("case.json"), 9, "case_30.json");
+      write(kDir / "samples_30.json", d);
+      try {
+        (void)load_design((kDir / "samples_30.json").string());
+        CHECK_FALSE(refused);
+      } catch (const knit::InputError& e) {
+        CHECK(refused);
+        CHECK(e.pointer() == "/objectives/0/samples");
+        CHECK_THAT(e.message(), Catch::Contains("x (30 variables + 1) = 5211100 entries"));
+      }
+    }
+  }
   // Session 34 (the design audit's mutants 76 to 82): each check of the loader, off alone,
   // survived (`--check` exited 0): equal bounds, an upper bound beyond the database's 6.5, an
   // angle bound below -180 deg, tied control values that differ in the case (5.0 and 5.6 in
