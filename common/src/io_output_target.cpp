@@ -193,17 +193,33 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
   // "for:" line or a manifest) holds that run's files only; a container such as the
   // pipeline's OUT (its marker has neither) holds outputs. The partial directory of this very
   // process, not yet committed (no manifest), is where its nested outputs go (a design's run/).
+  // Both the path as given and its lexical normal form are resolved (the review of session 46:
+  // "nx/../lnk/db.h5", nx missing and lnk a link to an output, resolved lexically past the
+  // missing nx and never followed lnk, while the writer, which makes nx, writes through it).
+  // A marker that cannot be read, or a path that cannot be resolved for want of permission or
+  // in a loop of links, cannot be told to lie outside a run's output, and is refused.
   {
-    const fs::path abs = fs::weakly_canonical(fs::absolute(target, ec), ec);
-    for (fs::path a = abs.parent_path(); !ec && !a.empty(); a = a.parent_path()) {
-      const auto m = read_output_marker(a);
-      const bool own_partial = m && !m->has_manifest && m->writer_pid == ::getpid();
-      if (m && (!m->for_name.empty() || m->has_manifest) && !own_partial)
-        refuse("lies inside " + a.string() + ", the output of a knitscale run (its " +
-               kOutputMarker +
-               " says so): a new output there would change that run's files; give a path "
-               "outside it");
-      if (a == a.parent_path()) break;
+    const fs::path abs = fs::absolute(target, ec);
+    for (const fs::path& form : {abs, abs.lexically_normal()}) {
+      std::error_code cec;
+      const fs::path canon = fs::weakly_canonical(form, cec);
+      if (cec == std::errc::permission_denied || cec == std::errc::too_many_symbolic_link_levels)
+        refuse("cannot be resolved (" + cec.message() +
+               "), so it cannot be told to lie outside another run's output");
+      if (cec) continue;  // e.g. a parent that is a file: the checks below name it
+      for (fs::path a = canon.parent_path(); !a.empty(); a = a.parent_path()) {
+        if (is_knitscale_output(a) && !std::ifstream(a / kOutputMarker))
+          refuse("lies inside " + a.string() + ", whose " + kOutputMarker +
+                 " cannot be read: it cannot be told whether that is a run's output");
+        const auto m = read_output_marker(a);
+        const bool own_partial = m && !m->has_manifest && m->writer_pid == ::getpid();
+        if (m && (!m->for_name.empty() || m->has_manifest) && !own_partial)
+          refuse("lies inside " + a.string() + ", the output of a knitscale run (its " +
+                 kOutputMarker +
+                 " says so): a new output there would change that run's files; give a path "
+                 "outside it");
+        if (a == a.parent_path()) break;
+      }
     }
     ec.clear();
   }

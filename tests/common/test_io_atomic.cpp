@@ -934,6 +934,13 @@ TEST_CASE("check_output_target refuses an output inside another run's output",
         Catch::Contains("lies inside " + design.string() + ", the output of a knitscale run"));
   CHECK_THROWS_WITH(knit::io::check_output_target(design / "x.h5", OutputKind::kFile),
                     Catch::Contains("lies inside"));
+  // Through a link behind a missing directory and ".." (the review of session 46: resolved
+  // lexically past the missing nx, the link was never followed, and a file was written there).
+  fs::create_directory_symlink(design, d / "lnk");
+  CHECK_THROWS_WITH(
+      knit::io::check_output_target(d / "nx" / ".." / "lnk" / "x.h5", OutputKind::kFile),
+      Catch::Contains("lies inside " + design.string()));
+  CHECK_FALSE(fs::exists(d / "nx"));
   CHECK_THROWS_AS(knit::io::AtomicDirectory(design / "run"), knit::InputError);
   CHECK(slurp(design / "run" / "x.txt") == "x");
   // The nested output of this process's own partial directory (a design's final run).
