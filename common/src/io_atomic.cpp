@@ -315,8 +315,31 @@ void remove_stale_siblings(const fs::path& target) {
 }
 
 /// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
+/// rename(2) that never replaces what is at `to` (renameat2 RENAME_NOREPLACE; on a file system
+/// without it, a look and a rename). 0, or the errno (EEXIST when something is there).
+int rename_noreplace(const fs::path& from, const fs::path& to) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(to, ec))) return EEXIST;
+  return ::rename(from.c_str(), to.c_str()) == 0 ? 0 : errno;
+}
+
 void remove_old_output(const fs::path& old, const fs::path& target) {
   std::error_code ec;
+  const fs::file_status st = fs::symlink_status(old, ec);
+  // What the exchange took out of the target's place is ours only as a directory (the review of
+  // session 46: a file or a link that raced into the target's place just before the exchange
+  // was removed if it was, or pointed to, something empty). Anything else stays, and is named.
+  if (!fs::is_directory(st)) {
+    if (fs::exists(st))
+      std::cerr << (output_owner().empty() ? std::string("knitscale") : output_owner())
+                << ": warning: " << target.string()
+                << ": something that took its place just before the new output was moved in (a "
+                << (fs::is_symlink(st) ? "symbolic link" : "file") << ") is now at " << old.string()
+                << ", left alone\n";
+    return;
+  }
   if (is_knitscale_output(old))
     remove_marked_tree(old);
   else if (fs::is_empty(old, ec))
@@ -458,9 +481,7 @@ void AtomicDirectory::commit() {
     for (int k = 0; k < 100 && where.empty(); ++k) {
       fs::path kept = target_;
       kept += ".new-" + std::to_string(::getpid()) + (k ? "-" + std::to_string(k) : "");
-      if (!fs::exists(fs::symlink_status(kept, ec)) &&
-          ::rename(partial_.c_str(), kept.c_str()) == 0)
-        where = kept.string();
+      if (rename_noreplace(partial_, kept) == 0) where = kept.string();
     }
     if (where.empty()) {  // kept as the partial directory, complete, without INCOMPLETE
       where =
@@ -470,14 +491,15 @@ void AtomicDirectory::commit() {
     fail(target_, what + " while the run went on: left alone; the new output is kept in " + where);
   };
   const fs::file_status now = fs::symlink_status(target_, ec);
-  if (!fs::exists(now)) {
-    if (::rename(partial_.c_str(), target_.c_str()) != 0) {
-      const int err = errno;
-      // Something appeared at the target between the look and the rename.
-      if (err == EEXIST || err == ENOTEMPTY || err == ENOTDIR || err == EISDIR)
-        keep_beside("appeared");
+  // Into a target that is not there (any more): never over something that appeared meanwhile.
+  const auto move_in = [&](const char* what) {
+    if (const int err = rename_noreplace(partial_, target_); err != 0) {
+      if (err == EEXIST) keep_beside(what);
       fail(target_, "cannot rename " + partial_.string(), err);
     }
+  };
+  if (!fs::exists(now)) {
+    move_in("appeared");
   } else {
     if (!fs::is_directory(now))
       keep_beside(std::string("became ") +
@@ -500,6 +522,11 @@ void AtomicDirectory::commit() {
     }
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
       dispose_replaced(partial_);  // now holds the old contents
+    } else if (errno == ENOENT) {
+      // The earlier output went away after the look (the review of session 46: a user's rm -rf
+      // during the commit made the exchange and the move aside fail, and the finished output
+      // was deleted).
+      move_in("was removed, and something else appeared in its place,");
     } else {
       // File system without RENAME_EXCHANGE: move the old directory aside first.
       fs::path old = target_;
@@ -507,8 +534,13 @@ void AtomicDirectory::commit() {
       old += std::to_string(::getpid());
       if (fs::exists(fs::symlink_status(old, ec)))
         fail(old, "exists and is not ours to remove; rename or remove it");
-      if (::rename(target_.c_str(), old.c_str()) != 0)
-        fail(target_, "cannot move the previous output aside", errno);
+      if (::rename(target_.c_str(), old.c_str()) != 0) {
+        if (errno != ENOENT) fail(target_, "cannot move the previous output aside", errno);
+        move_in("was removed, and something else appeared in its place,");
+        committed_ = true;
+        fsync_path(parent_or_dot(target_), true);
+        return;
+      }
       if (::rename(partial_.c_str(), target_.c_str()) != 0) {
         const int err = errno;
         ::rename(old.c_str(), target_.c_str());  // put the old output back
