@@ -78,8 +78,12 @@ ifneq ($(words $(OUT)),1)
 $(error OUT="$(OUT)" holds a space (or is empty): make cannot carry it as one path; give a path of letters, digits and / . _ - + @)
 endif
 ifneq ($(filter-out clean,$(or $(MAKECMDGOALS),all)),)
-OUT_STATE := $(shell d='$(OUT)'; \
-  if [ -e "$$d" ] && [ ! -d "$$d" ]; then echo notdir; \
+OUT_STATE := $(shell d='$(OUT)'; p=$$(dirname "$$(realpath -m "$$d")"); in=; \
+  while [ "$$p" != / ]; do [ -f "$$p/.knitscale-output" ] \
+    && grep -q -E '^(for|file): ' "$$p/.knitscale-output" && in=$$p && break; \
+    p=$$(dirname "$$p"); done; \
+  if [ -n "$$in" ]; then echo inside; \
+  elif [ -e "$$d" ] && [ ! -d "$$d" ]; then echo notdir; \
   elif [ "$$d" != '$(ROOT)/out' ] && [ -d "$$d" ] && [ -n "$$(ls -A "$$d")" ] \
        && [ ! -f "$$d/.knitscale-output" ]; then echo foreign; \
   elif [ -f "$$d/.knitscale-output" ] \
@@ -87,6 +91,11 @@ OUT_STATE := $(shell d='$(OUT)'; \
     echo other; \
   else mkdir -p "$$d" && { [ -f "$$d/.knitscale-output" ] || echo "knitscale output: the \
 reproduction pipeline (scripts/pipeline.mk)" > "$$d/.knitscale-output"; } && echo ours; fi)
+# Inside a run's output (its marker has a "for:" or "file:" line; the review of session 46:
+# figures/, logs/ and report.md went into a design's output, whose next design was refused).
+ifeq ($(OUT_STATE),inside)
+$(error OUT=$(OUT) lies inside the output of a knitscale run (an enclosing directory's .knitscale-output says so): the pipeline would change that run's files; give a path outside it)
+endif
 ifeq ($(OUT_STATE),notdir)
 $(error OUT=$(OUT) exists and is not a directory)
 endif

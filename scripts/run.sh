@@ -36,6 +36,19 @@ if [ -n "${KNIT_OUT:-}" ]; then
     echo "run: KNIT_OUT=$out exists and is not a directory" >&2
     exit 2
   fi
+  # Inside a run's output (a marker with a "for:" or "file:" line; the review of session 46:
+  # the pipeline wrote figures/, logs/ and report.md into a design's output, whose next design
+  # was then refused). The pipeline's own OUT, a container, says neither.
+  p=$(dirname "$(realpath -m "$out")")
+  while [ "$p" != / ]; do
+    if [ -f "$p/.knitscale-output" ] && grep -q -E '^(for|file): ' "$p/.knitscale-output"; then
+      echo "run: KNIT_OUT=$out lies inside $p, the output of a knitscale run (its" \
+        ".knitscale-output says so): the pipeline would change that run's files; give a path" \
+        "outside it" >&2
+      exit 2
+    fi
+    p=$(dirname "$p")
+  done
   if [ -d "$out" ] && [ -n "$(ls -A "$out")" ] && [ ! -f "$marker" ]; then
     echo "run: KNIT_OUT=$out is a non-empty directory that is not a knitscale output (no" \
       ".knitscale-output file): its files are not ours to replace; give a new or empty directory" >&2

@@ -314,7 +314,6 @@ void remove_stale_siblings(const fs::path& target) {
   }
 }
 
-/// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
 /// rename(2) that never replaces what is at `to` (renameat2 RENAME_NOREPLACE; on a file system
 /// without it, a look and a rename). 0, or the errno (EEXIST when something is there).
 int rename_noreplace(const fs::path& from, const fs::path& to) {
@@ -325,6 +324,7 @@ int rename_noreplace(const fs::path& from, const fs::path& to) {
   return ::rename(from.c_str(), to.c_str()) == 0 ? 0 : errno;
 }
 
+/// The old output after a replacement: removed if it is ours (marker) or empty, else kept.
 void remove_old_output(const fs::path& old, const fs::path& target) {
   std::error_code ec;
   const fs::file_status st = fs::symlink_status(old, ec);

@@ -125,6 +125,19 @@ def main():
         check(rc != 0 and "another program's output" in out
               and os.path.exists(os.path.join(other, "load_strain.csv")),
               "make clean refuses it and removes nothing", out)
+        # An OUT inside a run's output (the review of session 46: figures/, logs/ and
+        # report.md went into a design's output): refused by run.sh and by the makefile.
+        inside = os.path.join(other, "o")
+        rc, out = run_sh(inside)
+        check(rc == 2 and "lies inside " + other in out and not os.path.exists(inside),
+              "run.sh refuses KNIT_OUT inside a run's output (exit %d)" % rc, out)
+        r = subprocess.run(["make", "-f", os.path.join(ROOT, "scripts", "pipeline.mk"),
+                            "ROOT=" + ROOT, "BUILD=" + os.path.join(d, "nobuild"),
+                            "OUT=" + inside, "-n", "all"], cwd=d, capture_output=True,
+                           text=True, timeout=60)
+        check(r.returncode != 0 and "lies inside the output of a knitscale run" in r.stderr
+              and not os.path.exists(inside),
+              "the makefile refuses OUT inside a run's output", r.stdout + r.stderr)
         dangling = os.path.join(d, "dangling")
         os.symlink(os.path.join(d, "nowhere"), dangling)
         rc, out = run_sh(dangling)
