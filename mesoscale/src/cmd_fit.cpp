@@ -147,10 +147,12 @@ static knit::cli::SubcommandRegistrar reg_fit(
       sub.add_option("--law", o->law, "which law to fit: energy, paper or both (default)")
           ->check(CLI::IsMember({"energy", "paper", "both"}));
       sub.add_option("--options", o->options,
-                     "paper-law fit options (JSON file; defaults otherwise)");
+                     "paper-law fit options (JSON file; without it: the options the database "
+                     "records for its paper law, else the code's defaults; {} for the code's)");
       sub.add_option(
           "--energy-options", o->energy_options,
-          "energy-law fit options (JSON file; defaults otherwise: the input-convex network family "
+          "energy-law fit options (JSON file; without it: the options the database records for "
+          "its energy law, else the code's defaults, {} for them: the input-convex network family "
           "without a tube or outer function, docs/database.md; the default sweep's law is the "
           "energy_fit object of cases/sweep/default.json, {\"outer\": \"exp\", \"tube\": "
           "0.045, ...}; {\"family\": \"ridge\"} for the ridge-spline law)");
@@ -194,15 +196,47 @@ static knit::cli::SubcommandRegistrar reg_fit(
         }
         // Both options files are read and checked before any fit (session 44's review: a
         // missing --energy-options file was refused after the whole paper fit).
-        const FitOptions fo =
-            o->options.empty()
-                ? FitOptions{}
-                : FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
-        EnergyFitOptions eo =
-            o->energy_options.empty()
-                ? EnergyFitOptions{}
-                : EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
-                                              o->energy_options);
+        // Without an options file a law is refitted with the options it was fitted with, as
+        // the database records them (session 46's walkthrough: a plain `knit-meso fit DB`
+        // refitted the default sweep's tuned energy law with the code's defaults, no tube and
+        // no outer function: its largest error went from 6.5 to 17.5 %, and the record of how
+        // the good law was made was overwritten, silently). `{}` gives the code's defaults.
+        const auto stored_paper = [&]() -> std::string {
+          std::string same;
+          for (const auto& e : db.entries) {
+            if (!e.surface || e.diagnostics.options_json.empty()) return {};
+            if (!same.empty() && same != e.diagnostics.options_json) return {};
+            same = e.diagnostics.options_json;
+          }
+          return same;
+        }();
+        const std::string stored_energy =
+            db.energy_law ? db.energy_diagnostics.options_json : std::string();
+        FitOptions fo;
+        if (!o->options.empty()) {
+          fo = FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
+        } else if (paper && !stored_paper.empty()) {
+          try {
+            fo = FitOptions::from_json(stored_paper, o->db);
+          } catch (const knit::InputError& e) {
+            throw knit::InputError(o->db, "/loop_0/fit/diagnostics@options_json",
+                                   e.pointer() + ": " + e.message());
+          }
+          std::cout << "paper law: the options it was fitted with (" << o->db
+                    << ": /loop_<k>/fit/diagnostics, attribute options_json); --options FILE "
+                       "changes them, {} gives the code's defaults\n";
+        }
+        EnergyFitOptions eo;
+        if (!o->energy_options.empty()) {
+          eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
+                                           o->energy_options);
+        } else if (energy && !stored_energy.empty()) {
+          eo = EnergyFitOptions::from_json(stored_energy, o->db,
+                                           "/energy_law/diagnostics@options_json");
+          std::cout << "energy law: the options it was fitted with (" << o->db
+                    << ": /energy_law/diagnostics, attribute options_json); --energy-options "
+                       "FILE changes them, {} gives the code's defaults\n";
+        }
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()
@@ -278,6 +312,9 @@ static knit::cli::SubcommandRegistrar reg_fit(
           for (const auto& c : lost) std::cout << " " << c;
           std::cout << "\n";
         }
+        // Where it went, as the other commands say (session 46's walkthrough: with -o it named
+        // only the input).
+        std::cout << "wrote " << target << "\n";
         return rc;
       };
     });

@@ -484,3 +484,32 @@ TEST_CASE("knit-meso fit and synth: an options file that cannot be read names it
     CHECK_THAT(text, Catch::Contains(opt + ": " + missing.string() + ": file not found"));
   }
 }
+
+// Session 46's walkthrough: a plain `knit-meso fit DB` refitted the default sweep's tuned energy
+// law with the code's defaults (its largest error 6.5 -> 17.5 %, the record of its options
+// overwritten), silently. Without an options file each law is refitted with the options the
+// database records for it; `{}` gives the code's defaults.
+TEST_CASE("knit-meso fit: without an options file a law keeps the options it was fitted with",
+          "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path db = dir / "cli_stored_opts.h5", again = dir / "cli_stored_again.h5",
+                 fresh = dir / "cli_stored_fresh.h5", opts = dir / "cli_stored_opts.json",
+                 empty = dir / "cli_stored_empty.json", log = dir / "cli_stored.log";
+  for (const fs::path& p : {db, again, fresh}) fs::remove(p);
+  std::ofstream(opts) << R"({"family": "ridge", "max_iterations": 150})";
+  std::ofstream(empty) << "{}";
+  REQUIRE(run("synth --steps 8 --loop-lengths 4.5,6.5 --energy-options " + opts.string() +
+              " --out " + db.string()) == 0);
+  const std::string stored =
+      knit::material::read_database(db, false).energy_diagnostics.options_json;
+  REQUIRE(stored.find("\"max_iterations\":150") != std::string::npos);
+  REQUIRE(run_to("fit " + db.string() + " --law energy -o " + again.string(), "/dev/null",
+                 log.string()) == 0);
+  CHECK(knit::material::read_database(again, false).energy_diagnostics.options_json == stored);
+  CHECK(bytes(log).find("energy law: the options it was fitted with") != std::string::npos);
+  CHECK(bytes(log).find("\nwrote " + again.string() + "\n") != std::string::npos);
+  REQUIRE(run("fit " + db.string() + " --law energy --energy-options " + empty.string() + " -o " +
+              fresh.string()) == 0);
+  CHECK(knit::material::read_database(fresh, false)
+            .energy_diagnostics.options_json.find("\"max_iterations\":150") == std::string::npos);
+}
