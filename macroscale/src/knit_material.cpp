@@ -283,15 +283,16 @@ std::string KnitMaterial::last_step_share() const {
 
 std::string KnitMaterial::warning() const {
   const long n = audit_evaluations_.load();
-  if (n == 0) return {};
+  if (n == 0) return source_.input_warning;
   const double share = static_cast<double>(audit_outside_.load()) / static_cast<double>(n);
   const long n_last = last_step_[0].load();
   const double last =
       n_last > 0 ? static_cast<double>(last_step_[1].load()) / static_cast<double>(n_last) : 0.0;
   // The law's own uniaxial response against the cell's, after the extrapolation's warning.
   const std::string uniaxial = energy_ ? uniaxial_warning() : std::string();
-  auto with_uniaxial = [&uniaxial](std::string w) {
+  auto with_uniaxial = [&](std::string w) {
     if (!uniaxial.empty()) w += (w.empty() ? "" : "\n") + uniaxial;
+    if (!source_.input_warning.empty()) w += (w.empty() ? "" : "\n") + source_.input_warning;
     return w;
   };
   if (!(share > kExtrapolatedWarning) && !(last > kExtrapolatedWarning))

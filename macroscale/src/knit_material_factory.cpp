@@ -36,6 +36,10 @@ namespace knit::macro {
 
 namespace {
 
+/// A patch whose size (its control net's bounding-box diagonal) is below this many times the
+/// database's largest loop runs with a warning (session 46): 3 x 6.5 mm, about 15 stitches.
+constexpr double kFewLoops = 3.0;
+
 std::vector<double> number_array(const nlohmann::json& j, const std::string& p,
                                  const CaseContext& ctx) {
   if (!j.is_array()) throw InputError(ctx.file, p, "must be an array of numbers");
@@ -257,6 +261,7 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
       throw InputError(ctx.file, "/geometry/thickness", os.str());
     }
   }
+  std::string small_patch;
   {
     // A homogenized fabric spans many stitches: a patch smaller than one loop of the database
     // is a case in other units (a 50 mm patch written in metres ran with exit 0, session 22).
@@ -271,6 +276,18 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
          << "): a knit case is in mm, N, MPa, and a homogenized fabric spans many stitches";
       throw InputError(ctx.file, "/geometry/control_points", os.str());
     }
+    // A few loops only: runs, but is likely a case in cm (session 46's walkthrough: a 60 x 40
+    // mm patch written in cm ran as 6 x 4 mm, some 4 stitches by 3 courses, with exit 0).
+    if (size < kFewLoops * l_max) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "warning: " << ctx.file << ": /geometry/control_points: the patch is only " << size
+         << " mm across (the diagonal of its control net's bounding box), " << size / l_max
+         << " times the database's largest loop (" << l_max
+         << " mm): a homogenized fabric spans many stitches, and a knit case is in mm (is it "
+            "in cm?)";
+      small_patch = os.str();
+    }
   }
   const auto l = read_field(m.at("stitch_value"), p + "/stitch_value", ctx, false);
   const auto a = m.contains("knitting_angle")
@@ -284,6 +301,7 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // When the database file was written: results.h5 keeps it, and the report refuses results
   // of another database (session 38's red team).
   src.database_date_utc = data.provenance.date_utc;
+  src.input_warning = small_patch;
   // The law's own uniaxial response beside the cell's (session 41): warned about after a run
   // where it departs by more than /material/uniaxial_tolerance (KnitMaterial::warning()).
   // Every loop length of the diagnostics, those without a curve too: the knots' neighbours

@@ -340,6 +340,17 @@ TEST_CASE("knit material: a case in other units is refused", "[unit]") {
       parse_case(j.dump(), "c.json"),
       Catch::StartsWith("c.json: /geometry/control_points: the patch (size 0.0707107 mm") &&
           Catch::Contains("smaller than one loop of the database (6.5 mm"));
+  // A patch of a few loops runs, with a warning (session 46's walkthrough: a 60 x 40 mm patch
+  // written in cm ran as 6 x 4 mm, exit 0): here 0.2 of the 50 mm patch, 14.1 mm across
+  // (below 3 x 6.5 mm), and the 50 mm patch itself says nothing.
+  CHECK(parse_case(mm, "c.json").material->warning().empty());
+  j = nlohmann::json::parse(mm);
+  for (auto& p : j["geometry"]["control_points"])
+    p = {p[0].get<double>() * 0.2, p[1].get<double>() * 0.2, 0.0};
+  CHECK_THAT(parse_case(j.dump(), "c.json").material->warning(),
+             Catch::StartsWith("warning: c.json: /geometry/control_points: the patch is only 14.1 "
+                               "mm across") &&
+                 Catch::Contains("(is it in cm?)"));
   // Other materials take any consistent units.
   j["material"] = {
       {"type", "saint_venant_kirchhoff"}, {"youngs_modulus", 1.0}, {"poisson_ratio", 0.3}};

@@ -84,6 +84,9 @@ struct KnitMaterialSource {
   std::vector<std::pair<double, std::array<material::UniaxialCurve, 2>>> uniaxial;
   double uniaxial_tolerance = 0.25;
   std::string uniaxial_tolerance_pointer = "/material/uniaxial_tolerance";
+  /// Input that runs but is likely not what was meant (a patch of few loops: a case in cm?),
+  /// a line of warning() (session 46).
+  std::string input_warning;
 };
 
 class KnitMaterial : public Material {
