@@ -19,6 +19,7 @@ import argparse
 import glob
 import json
 import os
+import re
 import sys
 
 import h5py
@@ -44,7 +45,7 @@ def current_results(results_dir):
     out = []
     for p in sorted(glob.glob(os.path.join(results_dir, "**", "results.h5"), recursive=True)):
         run = os.path.dirname(p)
-        if ".partial-" in os.path.basename(run) or run.endswith(".last-completed"):
+        if ".partial-" in os.path.basename(run) or re.search(r"\.last-completed(-\d+)?$", run):
             # a run being written, or one killed while it was (knit-macro's partials); and the
             # completed output a stopped rerun replaced (NAME.last-completed, session 46)
             continue

@@ -413,27 +413,41 @@ AtomicDirectory::~AtomicDirectory() {
 
 void AtomicDirectory::dispose_replaced(const fs::path& old) {
   std::error_code ec;
-  if (!keep_replaced_.empty() && is_knitscale_output(old)) {
-    // The marker's "replaced by pid" line goes: the kept output is no stale directory of a
-    // killed run, and the clean-up of such directories must never take it.
-    {
-      std::ifstream in(old / kOutputMarker, std::ios::binary);
+  if (!keep_suffix_.empty() && is_knitscale_output(old)) {
+    // The order keeps every state a kill can leave recognisable (the review of session 46):
+    // the output kept before for this DIR is exchanged with the replaced one and marked
+    // "replaced by pid" first, so that the clean-up of DIR.partial-<pid> removes it if the
+    // removal below is cut short; the newly kept output loses that line once it is in place.
+    const auto strip_replaced_line = [](const fs::path& dir) {
+      std::ifstream in(dir / kOutputMarker, std::ios::binary);
       std::string text, line;
       while (std::getline(in, line))
         if (line.rfind("replaced by pid ", 0) != 0) text += line + "\n";
       in.close();
-      std::ofstream(old / kOutputMarker, std::ios::binary | std::ios::trunc) << text;
+      std::ofstream(dir / kOutputMarker, std::ios::binary | std::ios::trunc) << text;
+    };
+    fs::path where = target_;
+    where += keep_suffix_;
+    const auto kept_before = read_output_marker(where);
+    const bool ours_for_here = kept_before && is_own_output(where) &&
+                               kept_before->for_name == target_.filename().string() &&
+                               foreign_entries(where).empty();
+    if (ours_for_here) {
+      {
+        std::ofstream marker(where / kOutputMarker, std::ios::binary | std::ios::app);
+        marker << "replaced by pid " << ::getpid() << "\n";
+      }
+      if (::renameat2(AT_FDCWD, old.c_str(), AT_FDCWD, where.c_str(), RENAME_EXCHANGE) == 0) {
+        strip_replaced_line(where);
+        replaced_kept_in_ = where;
+        remove_old_output(old, target_);  // the output kept before, now at `old`
+        return;
+      }
+      strip_replaced_line(where);  // no exchange: it stays as it was
     }
-    fs::path where = keep_replaced_;
-    // An earlier kept output of ours there goes first; anything else stays, and this one
-    // takes a name of its own beside it.
-    if (fs::exists(fs::symlink_status(where, ec))) {
-      if (fs::is_directory(fs::symlink_status(where, ec)) && is_own_output(where) &&
-          foreign_entries(where).empty())
-        remove_marked_tree(where);
-      if (fs::exists(fs::symlink_status(where, ec))) where += "-" + std::to_string(::getpid());
-    }
-    if (!fs::exists(fs::symlink_status(where, ec)) && ::rename(old.c_str(), where.c_str()) == 0) {
+    if (fs::exists(fs::symlink_status(where, ec))) where += "-" + std::to_string(::getpid());
+    if (rename_noreplace(old, where) == 0) {
+      strip_replaced_line(where);
       replaced_kept_in_ = where;
       return;
     }
@@ -541,9 +555,11 @@ void AtomicDirectory::commit() {
         fsync_path(parent_or_dot(target_), true);
         return;
       }
-      if (::rename(partial_.c_str(), target_.c_str()) != 0) {
-        const int err = errno;
-        ::rename(old.c_str(), target_.c_str());  // put the old output back
+      if (const int err = rename_noreplace(partial_, target_); err != 0) {
+        if (err != EEXIST) ::rename(old.c_str(), target_.c_str());  // put the old output back
+        // Something appeared at the target between the two renames: the earlier output stays
+        // at its .old- name (the next run puts it back), the new one is kept beside.
+        if (err == EEXIST) keep_beside("appeared (the earlier output is in " + old.string() + ")");
         fail(target_, "cannot rename " + partial_.string(), err);
       }
       dispose_replaced(old);

@@ -43,7 +43,7 @@ class ResultsWriter {
   /// RunResult::input_warnings: "warning: " lines of summary.txt.
   void set_input_warnings(std::vector<std::string> w) { input_warnings_ = std::move(w); }
   /// io::AtomicDirectory::keep_replaced_as: the earlier output this one replaces is kept there.
-  void keep_replaced_as(std::filesystem::path where) { dir_.keep_replaced_as(std::move(where)); }
+  void keep_replaced_as(std::string suffix) { dir_.keep_replaced_as(std::move(suffix)); }
   const std::filesystem::path& replaced_kept_in() const { return dir_.replaced_kept_in(); }
   /// Empty, or where the sampled output fields first held a non-finite number (the first
   /// field, step and point, and how many values in all): the quadrature points, which Newton

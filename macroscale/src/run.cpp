@@ -307,11 +307,18 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
                           !std::filesystem::is_empty(opt.output_dir, ec);
   // A completed earlier output is not lost to a stopped rerun (session 46's red team: a rerun
   // that stopped after 14 of 20 steps replaced the complete result): it is kept beside it.
+  // Completed and trustworthy: no material failure, no non-finite output (the review of session
+  // 46: such a run also says "status: completed", exits 1, and would have been kept over the
+  // clean result kept before).
   const bool had_completed = had_output && [&] {
     std::ifstream in(opt.output_dir / "summary.txt");
-    std::string first;
-    std::getline(in, first);
-    return first == "status: completed";
+    std::string line;
+    std::getline(in, line);
+    if (line != "status: completed") return false;
+    while (std::getline(in, line))
+      if (line.rfind("material failures: ", 0) == 0 || line.rfind("output failure: ", 0) == 0)
+        return false;
+    return true;
   }();
   RunResult res;
   for (const std::string& w : p.warnings) {
@@ -412,8 +419,7 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
     if (res.report.status != RunStatus::kCompleted && !res.rows.empty() &&
         outputs % c.output.every != 0)
       writer->add_step(res.rows.back().step, res.rows.back().lambda, res.u);
-    if (had_completed && !res.succeeded())
-      writer->keep_replaced_as(opt.output_dir.string() + ".last-completed");
+    if (had_completed && !res.succeeded()) writer->keep_replaced_as(".last-completed");
     writer->finish(res.report);
     res.wrote_outputs = true;
     res.replaced_earlier = had_output;

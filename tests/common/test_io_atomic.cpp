@@ -987,33 +987,45 @@ TEST_CASE("run_main: out of memory is said as such, exit 1", "[unit][cli]") {
 }
 
 // Session 46: keep_replaced_as moves the replaced output aside instead of removing it; an
-// earlier kept output of ours there is replaced, anything else is left alone.
+// output kept there before for the same target is replaced, anything else is left alone (the
+// review: a user's own output of that name, "for:" another, was deleted; a target given with a
+// trailing '/' kept the output inside the new one).
 TEST_CASE("AtomicDirectory keeps the output it replaces where it is asked to",
           "[unit][io][atomic]") {
   const fs::path d = scratch("keep_replaced");
   const fs::path target = d / "out", kept = d / "out.kept";
-  const auto write = [&](const std::string& text, bool keep) {
-    knit::io::AtomicDirectory a(target);
+  const auto write = [&](const std::string& text, bool keep, const fs::path& to) {
+    knit::io::AtomicDirectory a(to);
     std::ofstream(a.path() / "x.txt") << text;
-    if (keep) a.keep_replaced_as(kept);
+    if (keep) a.keep_replaced_as(".kept");
     a.commit();
     return a.replaced_kept_in();
   };
-  CHECK(write("1", true).empty());  // nothing replaced
-  CHECK(write("2", true) == kept);
+  CHECK(write("1", true, target).empty());                 // nothing replaced
+  CHECK(write("2", true, target.string() + "/") == kept);  // a trailing '/': beside, not in
+  CHECK_FALSE(fs::exists(target / ".kept"));
   CHECK(slurp(kept / "x.txt") == "1");
   CHECK(slurp(target / "x.txt") == "2");
   CHECK(slurp(kept / knit::io::kOutputMarker).find("replaced by pid") == std::string::npos);
-  CHECK(write("3", true) == kept);  // ours there: replaced
+  CHECK(write("3", true, target) == kept);  // kept before for this target: replaced
   CHECK(slurp(kept / "x.txt") == "2");
-  CHECK(write("4", false).empty());  // not asked: removed as before
+  CHECK(slurp(kept / knit::io::kOutputMarker).find("replaced by pid") == std::string::npos);
+  for (const auto& e : fs::directory_iterator(d))  // the one kept before is gone, no partial
+    CHECK(e.path().filename().string().find(".partial-") == std::string::npos);
+  CHECK(write("4", false, target).empty());  // not asked: removed as before
   CHECK(slurp(kept / "x.txt") == "2");
-  // Somebody else's directory of that name stays; the output goes beside it.
+  // The program's own output written for that very name, and somebody else's directory, stay;
+  // the output goes beside them.
+  fs::remove_all(kept);
+  CHECK(write("mine", false, kept).empty());
+  const fs::path beside = write("5", true, target);
+  CHECK(beside == d / ("out.kept-" + std::to_string(::getpid())));
+  CHECK(slurp(beside / "x.txt") == "4");
+  CHECK(slurp(kept / "x.txt") == "mine");
+  fs::remove_all(beside);
   fs::remove_all(kept);
   fs::create_directories(kept);
   std::ofstream(kept / "notes.txt") << "notes";
-  const fs::path beside = write("5", true);
-  CHECK(beside == d / ("out.kept-" + std::to_string(::getpid())));
-  CHECK(slurp(beside / "x.txt") == "4");
+  CHECK(write("6", true, target) == d / ("out.kept-" + std::to_string(::getpid())));
   CHECK(slurp(kept / "notes.txt") == "notes");
 }

@@ -163,6 +163,14 @@ TEST_CASE("knit-macro run keeps other programs' outputs and earlier results of a
     REQUIRE(macro(c + " --output " + (d / "replaced").string()).rc == 0);
     CHECK(first_line(kept / "summary.txt") == "status: completed");  // left as it was
     CHECK(first_line(d / "replaced" / "summary.txt") == "status: completed");
+    // A completed run that is not trustworthy (its material failed; it exits 1 as well) is not
+    // kept over the clean one kept before (the review of session 46).
+    std::ofstream(kept / "summary.txt", std::ios::app) << "# the clean one\n";
+    std::ofstream(d / "replaced" / "summary.txt", std::ios::app)
+        << "material failures: 3 evaluations (a stand-in)\n";
+    r = macro((d / "crush.json").string() + " --output " + (d / "replaced").string());
+    CHECK(r.rc == 1);
+    CHECK(knit_test::contains(knit_test::read_text(kept / "summary.txt"), "# the clean one"));
     r = macro((d / "crush.json").string() + " --output " + (d / "fresh").string());
     CHECK(r.rc == 1);
     CHECK(knit_test::contains(r.output, outputs_in("fresh", "\n")));

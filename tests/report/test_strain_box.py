@@ -72,9 +72,13 @@ def main():
         os.makedirs(kept)
         with h5py.File(os.path.join(kept, "results.h5"), "w") as f:
             f.create_group("fields/step_0001")["E_course"] = np.array([0.9])
+        os.rename(kept, kept + "-4242")  # and one beside a directory of that name
+        os.makedirs(kept)
+        with h5py.File(os.path.join(kept, "results.h5"), "w") as f:
+            f.create_group("fields/step_0001")["E_course"] = np.array([0.9])
         rc, out = run(res, "--database", db)
         check(rc == 0 and "last-completed" not in out and inside_all(out) == 100.0,
-              "NAME.last-completed is not counted", out)
+              "NAME.last-completed and NAME.last-completed-PID are not counted", out)
         bare = os.path.join(d, "bare.h5")
         with h5py.File(bare, "w") as f:
             f.create_group("loop_0")

@@ -116,22 +116,24 @@ class AtomicDirectory {
   /// when DIR became a non-empty directory without the marker meanwhile (it is left alone).
   void commit();
   bool committed() const { return committed_; }
-  /// At commit, the earlier output this one replaces is moved to `where` instead of being
-  /// removed (session 46: a stopped rerun replaced a completed earlier output). An earlier
-  /// output of this program at `where` is removed first; anything else there is left alone and
-  /// the replaced output goes to `where`-<pid>. Returns where it went after commit() (empty
+  /// At commit, the earlier output this one replaces is moved to DIR`suffix` (e.g.
+  /// "DIR.last-completed", DIR without a trailing '/') instead of being removed (session 46: a
+  /// stopped rerun replaced a completed earlier output). An output kept there before for this
+  /// DIR (its marker's "for:" names DIR) is replaced; anything else there is left alone and the
+  /// output goes to DIR`suffix`-<pid>. replaced_kept_in(): where it went after commit() (empty
   /// when nothing was replaced, or when it could not be moved and was removed as before).
-  void keep_replaced_as(std::filesystem::path where) { keep_replaced_ = std::move(where); }
+  void keep_replaced_as(std::string suffix) { keep_suffix_ = std::move(suffix); }
   const std::filesystem::path& replaced_kept_in() const { return replaced_kept_in_; }
 
  private:
-  /// Removes the replaced output `old` (now beside the target), or moves it to keep_replaced_.
+  /// Removes the replaced output `old` (now beside the target), or keeps it (keep_replaced_as).
   void dispose_replaced(const std::filesystem::path& old);
 
   std::filesystem::path target_;
   OutputLock lock_;  ///< held from construction to destruction (after the checks)
   std::filesystem::path partial_;
-  std::filesystem::path keep_replaced_, replaced_kept_in_;
+  std::string keep_suffix_;
+  std::filesystem::path replaced_kept_in_;
   OnAbandon on_abandon_;
   bool committed_ = false;
   bool active_ = true;
