@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -201,41 +202,88 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // refitted the default sweep's tuned energy law with the code's defaults, no tube and
         // no outer function: its largest error went from 6.5 to 17.5 %, and the record of how
         // the good law was made was overwritten, silently). `{}` gives the code's defaults.
+        // The paper law's options when every loop length was fitted with the same ones; else
+        // the code's defaults, said (the review of session 46: silently otherwise).
+        bool paper_options_differ = false;
         const auto stored_paper = [&]() -> std::string {
           std::string same;
           for (const auto& e : db.entries) {
-            if (!e.surface || e.diagnostics.options_json.empty()) return {};
-            if (!same.empty() && same != e.diagnostics.options_json) return {};
+            if (!e.surface || e.diagnostics.options_json.empty()) {
+              paper_options_differ = !same.empty() || paper_options_differ;
+              continue;
+            }
+            if (!same.empty() && same != e.diagnostics.options_json) {
+              paper_options_differ = true;
+              return {};
+            }
             same = e.diagnostics.options_json;
           }
-          return same;
+          return paper_options_differ ? std::string() : same;
         }();
         const std::string stored_energy =
             db.energy_law ? db.energy_diagnostics.options_json : std::string();
+        // The keys a stored option list lacks take this build's defaults (options gained keys
+        // over the sessions; the review of session 46: a law fitted with "parameters"
+        // interpolation before the key existed was refitted with "energy"): named.
+        const auto missing_keys = [](const std::string& stored, const std::string& defaults) {
+          std::string out;
+          try {
+            const auto s = nlohmann::json::parse(stored), d = nlohmann::json::parse(defaults);
+            for (const auto& [k, v] : d.items())
+              if (!s.contains(k)) out += (out.empty() ? "" : ", ") + k;
+          } catch (const std::exception&) {
+          }
+          return out;
+        };
+        const auto say_stored = [&](const char* law, const std::string& where, const char* option,
+                                    const std::string& missing) {
+          std::cout << law << ": the options it was fitted with (" << o->db << ": " << where
+                    << ", attribute options_json); " << option
+                    << " FILE changes them, {} gives the code's defaults\n";
+          if (!missing.empty())
+            std::cout << law << ": the stored options lack " << missing
+                      << ", which take this build's defaults (the law may have been fitted "
+                         "with another value: give "
+                      << option << " FILE to be sure)\n";
+        };
+        const auto stored_refused = [&](const std::string& where, const char* option,
+                                        const knit::InputError& e) {
+          return knit::InputError(o->db, where,
+                                  e.pointer() + ": " + e.message() +
+                                      " (the stored options of an older build?): give " + option +
+                                      " FILE, or a file {} for the code's defaults");
+        };
+        // A law's stored options, parsed (`defaults`: a default-constructed options object of
+        // its kind), with what was said about them.
+        const auto from_stored = [&](auto defaults, const std::string& stored, const char* law,
+                                     const std::string& where, const char* option) {
+          decltype(defaults) parsed;
+          try {
+            parsed = decltype(defaults)::from_json(stored, o->db);
+          } catch (const knit::InputError& e) {
+            throw stored_refused(where + "@options_json", option, e);
+          }
+          say_stored(law, where, option, missing_keys(stored, defaults.to_json()));
+          return parsed;
+        };
         FitOptions fo;
         if (!o->options.empty()) {
           fo = FitOptions::from_json(read_text_file(o->options, "--options"), o->options);
         } else if (paper && !stored_paper.empty()) {
-          try {
-            fo = FitOptions::from_json(stored_paper, o->db);
-          } catch (const knit::InputError& e) {
-            throw knit::InputError(o->db, "/loop_0/fit/diagnostics@options_json",
-                                   e.pointer() + ": " + e.message());
-          }
-          std::cout << "paper law: the options it was fitted with (" << o->db
-                    << ": /loop_<k>/fit/diagnostics, attribute options_json); --options FILE "
-                       "changes them, {} gives the code's defaults\n";
+          fo = from_stored(FitOptions{}, stored_paper, "paper law", "/loop_0/fit/diagnostics",
+                           "--options");
+        } else if (paper && paper_options_differ) {
+          std::cout << "paper law: its loop lengths were fitted with different options (or some "
+                       "not at all): the code's defaults for every one; --options FILE sets "
+                       "them\n";
         }
         EnergyFitOptions eo;
         if (!o->energy_options.empty()) {
           eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
                                            o->energy_options);
         } else if (energy && !stored_energy.empty()) {
-          eo = EnergyFitOptions::from_json(stored_energy, o->db,
-                                           "/energy_law/diagnostics@options_json");
-          std::cout << "energy law: the options it was fitted with (" << o->db
-                    << ": /energy_law/diagnostics, attribute options_json); --energy-options "
-                       "FILE changes them, {} gives the code's defaults\n";
+          eo = from_stored(EnergyFitOptions{}, stored_energy, "energy law",
+                           "/energy_law/diagnostics", "--energy-options");
         }
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
