@@ -351,6 +351,17 @@ TEST_CASE("knit material: a case in other units is refused", "[unit]") {
              Catch::StartsWith("warning: c.json: /geometry/control_points: the patch is only 14.1 "
                                "mm across") &&
                  Catch::Contains("(is it in cm?)"));
+  // A strip narrower than one loop (the second review: 200 x 10 mm written in cm, 20 x 1 mm,
+  // has a diagonal above the limit): here 50 x 5 mm and 50 x 1 mm.
+  for (const double w : {5.0, 1.0}) {
+    j = nlohmann::json::parse(mm);
+    for (auto& p : j["geometry"]["control_points"])
+      p = {p[0].get<double>(), p[1].get<double>() * w / 50.0, 0.0};
+    j["geometry"]["thickness"] = 0.76;
+    CHECK_THAT(parse_case(j.dump(), "c.json").material->warning(),
+               Catch::StartsWith("warning: c.json: /geometry/control_points: the patch is only " +
+                                 std::to_string(static_cast<int>(w)) + " mm wide"));
+  }
   // Other materials take any consistent units.
   j["material"] = {
       {"type", "saint_venant_kirchhoff"}, {"youngs_modulus", 1.0}, {"poisson_ratio", 0.3}};
