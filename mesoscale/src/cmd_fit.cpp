@@ -202,23 +202,21 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // refitted the default sweep's tuned energy law with the code's defaults, no tube and
         // no outer function: its largest error went from 6.5 to 17.5 %, and the record of how
         // the good law was made was overwritten, silently). `{}` gives the code's defaults.
-        // The paper law's options when every loop length was fitted with the same ones; else
-        // the code's defaults, said (the review of session 46: silently otherwise).
+        // The paper law's options when every fitted loop length was fitted with the same ones
+        // (a loop length without a fit takes them too); else the code's defaults, said (the
+        // review of session 46: silently otherwise).
         bool paper_options_differ = false;
         const auto stored_paper = [&]() -> std::string {
           std::string same;
           for (const auto& e : db.entries) {
-            if (!e.surface || e.diagnostics.options_json.empty()) {
-              paper_options_differ = !same.empty() || paper_options_differ;
-              continue;
-            }
+            if (!e.surface || e.diagnostics.options_json.empty()) continue;
             if (!same.empty() && same != e.diagnostics.options_json) {
               paper_options_differ = true;
               return {};
             }
             same = e.diagnostics.options_json;
           }
-          return paper_options_differ ? std::string() : same;
+          return same;
         }();
         const std::string stored_energy =
             db.energy_law ? db.energy_diagnostics.options_json : std::string();
@@ -273,9 +271,8 @@ static knit::cli::SubcommandRegistrar reg_fit(
           fo = from_stored(FitOptions{}, stored_paper, "paper law", "/loop_0/fit/diagnostics",
                            "--options");
         } else if (paper && paper_options_differ) {
-          std::cout << "paper law: its loop lengths were fitted with different options (or some "
-                       "not at all): the code's defaults for every one; --options FILE sets "
-                       "them\n";
+          std::cout << "paper law: its loop lengths were fitted with different options: the "
+                       "code's defaults for every one; --options FILE sets them\n";
         }
         EnergyFitOptions eo;
         if (!o->energy_options.empty()) {

@@ -534,4 +534,21 @@ TEST_CASE("knit-meso fit: without an options file a law keeps the options it was
       CHECK(bytes(log.string() + ".err").find("give --energy-options FILE, or a file {}") !=
             std::string::npos);
   }
+  // The paper law: the loop lengths' stored options, the same for both, are taken; when they
+  // differ, the code's defaults, said (the second review: silently).
+  for (const bool differ : {false, true}) {
+    INFO("differ " << differ);
+    if (differ) {
+      auto f = knit::io::H5File::open_rw(db);
+      f.set_attribute("/loop_1/fit/diagnostics", "options_json",
+                      std::string(R"({"smoothing": 1e-5})"));
+    }
+    fs::remove(again);
+    REQUIRE(run_to("fit " + db.string() + " --law paper -o " + again.string(), "/dev/null",
+                   log.string()) == 0);
+    CHECK((bytes(log).find("paper law: the options it was fitted with") != std::string::npos) ==
+          !differ);
+    CHECK((bytes(log).find("paper law: its loop lengths were fitted with different options") !=
+           std::string::npos) == differ);
+  }
 }
