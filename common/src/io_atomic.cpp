@@ -314,6 +314,19 @@ void remove_stale_siblings(const fs::path& target) {
   }
 }
 
+/// "replaced by pid <pid>" appended to the marker of `dir` (best effort): the clean-up after a
+/// kill then knows the output there for one this process was replacing.
+void mark_replaced(const fs::path& dir) {
+  std::ofstream(dir / kOutputMarker, std::ios::binary | std::ios::app)
+      << "replaced by pid " << ::getpid() << "\n";
+}
+
+/// A warning about `target` on stderr, named by the program (output_owner).
+void warn_about(const fs::path& target, const std::string& what) {
+  std::cerr << (output_owner().empty() ? std::string("knitscale") : output_owner())
+            << ": warning: " << target.string() << ": " << what << "\n";
+}
+
 /// rename(2) that never replaces what is at `to` (renameat2 RENAME_NOREPLACE; on a file system
 /// without it, a look and a rename). 0, or the errno (EEXIST when something is there).
 int rename_noreplace(const fs::path& from, const fs::path& to) {
@@ -333,11 +346,10 @@ void remove_old_output(const fs::path& old, const fs::path& target) {
   // was removed if it was, or pointed to, something empty). Anything else stays, and is named.
   if (!fs::is_directory(st)) {
     if (fs::exists(st))
-      std::cerr << (output_owner().empty() ? std::string("knitscale") : output_owner())
-                << ": warning: " << target.string()
-                << ": something that took its place just before the new output was moved in (a "
-                << (fs::is_symlink(st) ? "symbolic link" : "file") << ") is now at " << old.string()
-                << ", left alone\n";
+      warn_about(target, std::string("something that took its place just before the new output "
+                                     "was moved in (a ") +
+                             (fs::is_symlink(st) ? "symbolic link" : "file") + ") is now at " +
+                             old.string() + ", left alone");
     return;
   }
   if (is_knitscale_output(old))
@@ -348,11 +360,9 @@ void remove_old_output(const fs::path& old, const fs::path& target) {
   // run into the target tries again. Said once on stderr (session 46's red team: every rerun
   // left another copy of the earlier output beside the target without a word).
   if (fs::exists(fs::symlink_status(old, ec)))
-    std::cerr << (output_owner().empty() ? std::string("knitscale") : output_owner())
-              << ": warning: " << target.string()
-              << ": the new output is in place, but the earlier one, moved to " << old.string()
-              << ", could not be removed entirely (permissions?); the next run into "
-              << target.string() << " tries again, or remove it by hand\n";
+    warn_about(target, "the new output is in place, but the earlier one, moved to " + old.string() +
+                           ", could not be removed entirely (permissions?); the next run into " +
+                           target.string() + " tries again, or remove it by hand");
 }
 
 }  // namespace
@@ -433,10 +443,7 @@ void AtomicDirectory::dispose_replaced(const fs::path& old) {
                                kept_before->for_name == target_.filename().string() &&
                                foreign_entries(where).empty();
     if (ours_for_here) {
-      {
-        std::ofstream marker(where / kOutputMarker, std::ios::binary | std::ios::app);
-        marker << "replaced by pid " << ::getpid() << "\n";
-      }
+      mark_replaced(where);
       if (::renameat2(AT_FDCWD, old.c_str(), AT_FDCWD, where.c_str(), RENAME_EXCHANGE) == 0) {
         strip_replaced_line(where);
         replaced_kept_in_ = where;
@@ -530,10 +537,7 @@ void AtomicDirectory::commit() {
     // leaves it (DIR.partial-<pid> after the exchange, DIR.old-<pid> below): appended to a
     // marker of ours only (an empty target has none), best effort (without it a killed run
     // leaves the earlier output for the user).
-    if (read_output_marker(target_)) {
-      std::ofstream marker(target_ / kOutputMarker, std::ios::binary | std::ios::app);
-      marker << "replaced by pid " << ::getpid() << "\n";
-    }
+    if (read_output_marker(target_)) mark_replaced(target_);
     if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
       dispose_replaced(partial_);  // now holds the old contents
     } else if (errno == ENOENT) {

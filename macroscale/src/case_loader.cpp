@@ -540,9 +540,7 @@ void read_output(const Reader& r, const json& root, Case& c) {
       ro.component = r.component(rs[k].at("component"), ptr + "/component");
       if (rs[k].contains("rows")) {
         ro.rows = r.integer(rs[k].at("rows"), ptr + "/rows", 1, 2);
-      } else if (ro.at_edge && std::any_of(c.bcs.begin(), c.bcs.end(), [&](const auto& bc) {
-                   return bc.clamp && bc.edge == ro.edge;
-                 })) {
+      } else if (ro.at_edge && edge_is_clamped(c.bcs, ro.edge)) {
         // A clamped edge's second row of control points carries part of its support force
         // (session 46's walkthrough: a clamped jaw read 5.72 N with one row against 14.78 N,
         // silently): its default is both rows.

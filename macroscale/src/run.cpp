@@ -1,6 +1,5 @@
 #include "knit/macro/run.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -162,9 +161,7 @@ Problem setup_problem(const Case& c) {
   // edge's reaction takes both (case_loader); an explicit 1 is named here.
   for (std::size_t k = 0; k < c.output.reactions.size(); ++k) {
     const ReactionOutput& ro = c.output.reactions[k];
-    if (ro.at_edge && ro.rows == 1 &&
-        std::any_of(c.bcs.begin(), c.bcs.end(),
-                    [&](const BoundaryCondition& bc) { return bc.clamp && bc.edge == ro.edge; }))
+    if (ro.at_edge && ro.rows == 1 && edge_is_clamped(c.bcs, ro.edge))
       p.warnings.push_back("/output/reactions/" + std::to_string(k) +
                            "/rows: 1 row of a clamped edge: its second row of control points, "
                            "tied to the first, carries part of the support force, which this "

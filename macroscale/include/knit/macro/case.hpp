@@ -37,6 +37,13 @@ struct BoundaryCondition {
   std::string pointer;  ///< JSON pointer of the entry (for messages)
 };
 
+/// Whether a condition of `bcs` clamps `edge` (its second row of control points tied to it).
+inline bool edge_is_clamped(const std::vector<BoundaryCondition>& bcs, Edge edge) {
+  for (const BoundaryCondition& bc : bcs)
+    if (bc.clamp && bc.target == BoundaryCondition::Target::kEdge && bc.edge == edge) return true;
+  return false;
+}
+
 struct Load {
   enum class Kind { kPoint, kEdge, kArea };
   Kind kind = Kind::kPoint;
