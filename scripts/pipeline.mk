@@ -430,16 +430,19 @@ clean:
 	  "$(OUT)/logs" "$(OUT)/cells" "$(OUT)/knitmap" "$(OUT)/design" "$(OUT)/report.md" \
   "$(OUT)/cases_paper_law"
 # figures/ and results/ file by file: what the pipeline writes there (its figures and their
-# temporaries; each case's status, output directory, partial directories and lock), then the
+# temporaries; each case's status, output directory, partial directories, lock and the completed
+# output a stopped rerun kept beside it, NAME.last-completed[-PID], session 46), then the
 # directory if that emptied it (session 36's red team: a user's figures/my_plot.png and
 # results/my_analysis/ went with the whole directories).
 	@for f in $(FIGURES) $(KNITMAP_FIGURES) $(DESIGN_FIGURES); do \
 	  rm -f "$$f" "$$f.tmp.png"; done
 	@for c in $(CASES); do \
-	  rm -rf "$(RES)/$$c" "$(RES)/$$c.status" "$(RES)/$$c.lock" "$(RES)/$$c".partial-*; done
+	  rm -rf "$(RES)/$$c" "$(RES)/$$c.status" "$(RES)/$$c.lock" "$(RES)/$$c".partial-* \
+	    "$(RES)/$$c.last-completed" "$(RES)/$$c".last-completed-*; done
 	@for c in $(LAWCMP); do \
 	  rm -rf "$(RES_PAPER)/$$c" "$(RES_PAPER)/$$c.status" "$(RES_PAPER)/$$c.lock" \
-	    "$(RES_PAPER)/$$c".partial-*; done
+	    "$(RES_PAPER)/$$c".partial-* "$(RES_PAPER)/$$c.last-completed" \
+	    "$(RES_PAPER)/$$c".last-completed-*; done
 	@for d in "$(FIG)" "$(RES)" "$(RES_PAPER)"; do \
 	  if [ -d "$$d" ]; then rmdir "$$d" 2>/dev/null \
 	    || echo "clean: kept $$d: it holds files the pipeline did not write" >&2; fi; done

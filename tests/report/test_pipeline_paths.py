@@ -94,18 +94,27 @@ def main():
               "make clean of a plain OUT removes its figures/ and the sweep's checkpoints only",
               out)
         # A user's files inside figures/ and results/ stay, with the pipeline's own removed.
+        # (and the completed outputs a stopped rerun kept, NAME.last-completed[-PID]: left
+        # behind by clean until session 47)
         for sub, mine_name, ours in (("figures", "my_plot.png", "fig07d_load_strain.png"),
                                      ("results", "my_analysis.txt", "s312_uniform_45_wale.status")):
             os.makedirs(os.path.join(plain, sub), exist_ok=True)
             for n in (mine_name, ours):
                 with open(os.path.join(plain, sub, n), "w") as f:
                     f.write(n)
+        kept_runs = [os.path.join(plain, "results", "s312_uniform_45_wale.last-completed"),
+                     os.path.join(plain, "results", "s312_uniform_45_wale.last-completed-77")]
+        for k in kept_runs:
+            os.makedirs(k)
+            with open(os.path.join(k, "load_strain.csv"), "w") as f:
+                f.write("step\n")
         rc, out = make_clean(plain, d)
         check(rc == 0 and os.path.exists(os.path.join(plain, "figures", "my_plot.png"))
               and os.path.exists(os.path.join(plain, "results", "my_analysis.txt"))
               and not os.path.exists(os.path.join(plain, "figures", "fig07d_load_strain.png"))
               and not os.path.exists(os.path.join(plain, "results",
                                                   "s312_uniform_45_wale.status"))
+              and not any(os.path.exists(k) for k in kept_runs)
               and "kept" in out,
               "make clean keeps a user's files in figures/ and results/, removes the pipeline's",
               out)
