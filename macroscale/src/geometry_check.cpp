@@ -78,6 +78,25 @@ double patch_size(const spline::SplineSurface& s) {
   return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
 }
 
+double patch_width(const spline::SplineSurface& s) {
+  constexpr int kSegments = 64;
+  const auto line_length = [&s](bool along_u) {
+    const auto& b = along_u ? s.basis_u() : s.basis_v();
+    const auto& o = along_u ? s.basis_v() : s.basis_u();
+    const double mid = 0.5 * (o.lo() + o.hi());
+    double len = 0.0;
+    Eigen::VectorXd prev;
+    for (int i = 0; i <= kSegments; ++i) {
+      const double t = b.lo() + (b.hi() - b.lo()) * i / kSegments;
+      Eigen::VectorXd x = along_u ? s.eval(t, mid) : s.eval(mid, t);
+      if (i > 0) len += (x - prev).norm();
+      prev = std::move(x);
+    }
+    return len;
+  };
+  return std::min(line_length(true), line_length(false));
+}
+
 int dense_samples_per_span(const spline::SplineSurface& s) {
   const auto spans = [](const std::vector<double>& U) {
     return std::max<std::size_t>(1, spline::unique_knots(U).size() - 1);

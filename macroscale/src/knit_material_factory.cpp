@@ -289,17 +289,16 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
       small_patch = os.str();
     } else {
       // A strip narrower than one loop (the second review of session 46: a 200 x 10 mm strip
-      // written in cm, 20 x 1 mm, has a diagonal above the limit): the bounding box's second
-      // largest extent, the strip's width when it lies along the axes.
-      const Eigen::MatrixXd& P = ctx.patch->control_points();
-      Eigen::Vector3d ext = P.colwise().maxCoeff() - P.colwise().minCoeff();
-      std::sort(ext.data(), ext.data() + 3);
-      if (ext(1) < l_max) {
+      // written in cm, 20 x 1 mm, has a diagonal above the limit): the patch's width, its
+      // shorter parameter line through the middle (until session 47 the bounding box's second
+      // extent, which a strip turned 45 deg in its plane escaped: 14.8 mm for 20 x 1 mm).
+      const double width = patch_width(*ctx.patch);
+      if (width < l_max) {
         std::ostringstream os;
         os.precision(3);
-        os << "warning: " << ctx.file << ": /geometry/control_points: the patch is only " << ext(1)
-           << " mm wide (its control net's bounding box), less than the database's "
-           << "largest loop (" << l_max
+        os << "warning: " << ctx.file << ": /geometry/control_points: the patch is only " << width
+           << " mm wide (its shorter parameter line through the middle), less than the "
+           << "database's largest loop (" << l_max
            << " mm): a homogenized fabric spans many stitches, and a knit case is in mm (is it "
               "in cm?)";
         small_patch = os.str();

@@ -361,6 +361,15 @@ TEST_CASE("knit material: a case in other units is refused", "[unit]") {
     CHECK_THAT(parse_case(j.dump(), "c.json").material->warning(),
                Catch::StartsWith("warning: c.json: /geometry/control_points: the patch is only " +
                                  std::to_string(static_cast<int>(w)) + " mm wide"));
+    // The same strip turned 45 deg in its plane (the review of session 46: its bounding box,
+    // 38.9 x 38.9 mm for 50 x 5 mm, hid it until session 47).
+    const double c = std::sqrt(0.5);
+    for (auto& p : j["geometry"]["control_points"])
+      p = {c * (p[0].get<double>() - p[1].get<double>()),
+           c * (p[0].get<double>() + p[1].get<double>()), 0.0};
+    CHECK_THAT(parse_case(j.dump(), "c.json").material->warning(),
+               Catch::StartsWith("warning: c.json: /geometry/control_points: the patch is only " +
+                                 std::to_string(static_cast<int>(w)) + " mm wide"));
   }
   // Other materials take any consistent units.
   j["material"] = {

@@ -37,6 +37,12 @@ struct GeometryDefect {
 /// (thickness, gauge length, a knit patch against one loop).
 double patch_size(const spline::SplineSurface& surface);
 
+/// The patch's width: the shorter of its two parameter lines through the middle (u and v at
+/// the middle of the other's range), each the length of a 64-segment polyline on the surface,
+/// mm. Unlike the bounding box it does not depend on how the patch lies in space (the review
+/// of session 46: a 20 x 1 mm strip turned 45 deg has a bounding box of 14.8 x 14.8 mm).
+double patch_width(const spline::SplineSurface& surface);
+
 /// The first defect of the reference surface, or nothing; `samples_per_span` Gauss points per
 /// knot span and direction, at least p + 1.
 std::optional<GeometryDefect> find_geometry_defect(const spline::SplineSurface& surface,
