@@ -1094,6 +1094,51 @@ TEST_CASE("design: summary.txt gives what the design reached, the final run's ow
   fs::remove_all(out);
 }
 
+TEST_CASE("design: the case's and the final run's warnings reach stderr and summary.txt",
+          "[case]") {
+  // Session 47's walkthrough: a reaction objective over one row of a clamped jaw "met" 5 N
+  // where the jaw carried 23 N, exit 0, and the run's warning was only in run/summary.txt.
+  // Here the test case's pulled edge is clamped and its reaction given rows 1.
+  write_case(false, "clamped_case.json");
+  {
+    std::string text = knit_test::read_text(kDir / "clamped_case.json");
+    const auto replace = [&text](const std::string& a, const std::string& b) {
+      const auto at = text.find(a);
+      REQUIRE(at != std::string::npos);
+      text.replace(at, a.size(), b);
+    };
+    replace(R"({"edge": "v1", "prescribe": {"y": 4.0}})",
+            R"({"edge": "v1", "prescribe": {"y": 4.0}, "clamp": true})");
+    replace(R"("component": "y"}],)", R"("component": "y", "rows": 1}],)");
+    write(kDir / "clamped_case.json", text);
+  }
+  write(kDir / "clamped.json",
+        R"({"case": "clamped_case.json",
+            "variables": [{"name": "l", "field": "stitch_value", "indices": [0, 1],
+                           "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                            "target": [1.0]}],
+            "optimizer": {"max_iterations": 1}})");
+  const std::string rows_warning =
+      "/output/reactions/0/rows: 1 row of a clamped edge: its second row of control points";
+  CHECK(run_design(kDir / "clamped.json") == 0);
+  const std::string check_log = knit_test::read_text(kDir / "cmd.log");
+  CHECK(check_log.find("warning: " + (kDir / "clamped_case.json").string() + ": " + rows_warning) !=
+        std::string::npos);
+  const fs::path out = kDir / "clamped_out";
+  (void)design_into(kDir / "clamped.json", out);
+  const std::string log = knit_test::read_text(kDir / "clamped.log");
+  // Before the optimization (the case) and from the final run (its case.json).
+  CHECK(log.find("warning: " + (kDir / "clamped_case.json").string() + ": " + rows_warning) !=
+        std::string::npos);
+  CHECK(log.find("warning: " + (out / "case.json").string() + ": " + rows_warning) !=
+        std::string::npos);
+  const std::string summary = knit_test::read_text(out / "summary.txt");
+  INFO(summary);
+  CHECK(summary.find("\nwarning: final run: " + rows_warning) != std::string::npos);
+  fs::remove_all(out);
+}
+
 TEST_CASE("design twin: a design started on the database's first or last loop length leaves it",
           "[case]") {
   // Session 39's fresh-user walkthrough: the network law's dS/dl was 0 at the database's first
