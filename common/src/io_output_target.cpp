@@ -17,6 +17,8 @@
 #include <set>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
 
@@ -102,6 +104,11 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
   std::string line;
   for (int k = 0; std::getline(in, line); ++k) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (k == 1) {  // the provenance (JSON); its input file, if it names one
+      const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+      if (j.is_object() && j.contains("input") && j["input"].is_string())
+        m.input = j["input"].get<std::string>();
+    }
     if (k < 2) continue;  // the owner and the provenance
     if (line.rfind("for: ", 0) == 0) {
       m.for_name = line.substr(5);
@@ -139,6 +146,18 @@ std::vector<std::string> foreign_entries(const fs::path& dir, std::size_t max) {
   if (ec)  // what cannot be listed cannot be told ours: named as such
     out.insert(out.begin(), "(some of it could not be listed: " + ec.message() + ")");
   return out;
+}
+
+void check_default_output_input(const fs::path& target, const std::string& input) {
+  const auto m = read_output_marker(without_trailing_slash(target));
+  if (!m || m->input.empty() || input.empty()) return;
+  std::error_code e1, e2;
+  const fs::path was = fs::weakly_canonical(m->input, e1), is = fs::weakly_canonical(input, e2);
+  if (e1 || e2 || was == is) return;
+  throw InputError(target.string(), "output directory",
+                   "holds the output of another input file, " + m->input +
+                       " (the default output name is the input file's name; this input is " +
+                       input + "): give --output to name this output, or to replace that one");
 }
 
 void check_output_target(const fs::path& target_in, OutputKind kind, std::string_view option,

@@ -57,7 +57,10 @@ knit::cli::SubcommandRegistrar reg(
                      "reaction_linearity; at applied strains) and a smoothness penalty")
           ->required();
       sub.add_flag("--check", o->check, "read and check the design file, print the problem");
-      sub.add_option("-o,--output,--out", o->output, "output directory");
+      sub.add_option(
+          "-o,--output,--out", o->output,
+          "output directory (default: the design file's name without its extension, in the "
+          "current directory)");
       sub.add_option("--max-output-size", o->max_output_size,
                      "refuse a design whose final run's outputs (run/) are estimated larger "
                      "(default 2G; 0: no cap), as knit-macro run does");
@@ -87,6 +90,7 @@ knit::cli::SubcommandRegistrar reg(
         // it was checked only when the results were written, after minutes of optimizing).
         knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory,
                                       o->output.empty() ? "output directory" : "--output");
+        if (o->output.empty()) knit::io::check_default_output_input(dir, o->file);
         // The final run's outputs against the cap, before the optimization and by --check
         // (session 42's red team: the final run refused them after the whole optimization,
         // naming DIR/case.json, which was never written, and an option design did not have).

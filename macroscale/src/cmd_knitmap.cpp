@@ -62,6 +62,7 @@ knit::cli::SubcommandRegistrar reg(
         // knitmap said "output directory:" for --output, after the layout).
         const char* option = o->output.empty() ? "output directory" : "--output";
         knit::io::check_output_target(dir, knit::io::OutputKind::kDirectory, option);
+        if (o->output.empty()) knit::io::check_default_output_input(dir, o->case_file);
         const auto map = knit::macro::make_knitmap(in.c, in.cells, opt);
         // The same name when the output is checked again under its lock (session 46's red
         // team: a target that changed meanwhile was refused as "output directory:").

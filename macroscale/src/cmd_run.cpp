@@ -31,7 +31,10 @@ knit::cli::SubcommandRegistrar reg(
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("case", o->case_file, "case file (JSON)")->required();
-      sub.add_option("-o,--output,--out", o->output, "output directory");
+      sub.add_option(
+          "-o,--output,--out", o->output,
+          "output directory (default: the case file's name without its extension, in the "
+          "current directory)");
       sub.add_option("--max-output-size", o->max_output_size,
                      "refuse a run whose estimated output is larger (default 2G; 0: no cap)");
       return [o]() -> int {
@@ -40,6 +43,7 @@ knit::cli::SubcommandRegistrar reg(
                                           : std::filesystem::path(o->output);
         knit::io::check_output_target(ro.output_dir, knit::io::OutputKind::kDirectory,
                                       o->output.empty() ? "output directory" : "--output");
+        if (o->output.empty()) knit::io::check_default_output_input(ro.output_dir, o->case_file);
         if (!o->max_output_size.empty())
           ro.max_output_bytes = knit::io::parse_size(o->max_output_size, "--max-output-size");
         const knit::macro::Case c = knit::macro::load_case(o->case_file);

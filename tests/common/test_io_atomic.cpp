@@ -1029,3 +1029,37 @@ TEST_CASE("AtomicDirectory keeps the output it replaces where it is asked to",
   CHECK(write("6", true, target) == d / ("out.kept-" + std::to_string(::getpid())));
   CHECK(slurp(kept / "notes.txt") == "notes");
 }
+
+TEST_CASE("check_default_output_input refuses a default-named output of another input file",
+          "[unit][io][atomic]") {
+  // Session 47's walkthrough: `knit-macro knitmap desA/case.json` and then `desB/case.json`
+  // both wrote ./case_knitmap, the second replacing the first with exit 0.
+  const fs::path d = scratch("default_input");
+  const fs::path a = d / "desA" / "case.json", b = d / "desB" / "case.json";
+  const fs::path out = d / "case_knitmap";
+  {
+    knit::io::AtomicDirectory w(out, knit::io::AtomicDirectory::OnAbandon::Remove,
+                                "output directory", a.string());
+    std::ofstream(w.path() / "map.csv") << "x";
+    w.commit();
+  }
+  CHECK_NOTHROW(knit::io::check_default_output_input(out, a.string()));
+  // The same file spelled otherwise is the same input.
+  CHECK_NOTHROW(knit::io::check_default_output_input(
+      out, (d / "desB" / ".." / "desA" / "case.json").string()));
+  CHECK_THROWS_WITH(knit::io::check_default_output_input(out, b.string()),
+                    Catch::StartsWith(out.string() +
+                                      ": output directory: holds the output of another input "
+                                      "file, " +
+                                      a.string()) &&
+                        Catch::Contains("give --output"));
+  // No input in the marker (a library caller's, or markers before the provenance had one):
+  // nothing to tell, nothing refused; nor is a directory that is no output.
+  const fs::path plain = d / "plain";
+  {
+    knit::io::AtomicDirectory w(plain);
+    w.commit();
+  }
+  CHECK_NOTHROW(knit::io::check_default_output_input(plain, b.string()));
+  CHECK_NOTHROW(knit::io::check_default_output_input(d / "none", b.string()));
+}

@@ -56,6 +56,9 @@ struct OutputMarker {
   /// The "pid <pid>" line: the process that built the directory as DIR.partial-<pid> (-1
   /// without it; markers before session 38).
   long writer_pid = -1;
+  /// The provenance's "input" (the input file as the run was given it; empty without one, or
+  /// when the provenance line is not JSON).
+  std::string input;
 };
 /// The marker of `dir`, read; nothing without a marker.
 std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);
@@ -66,6 +69,14 @@ std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir)
 std::vector<std::string> foreign_entries(const std::filesystem::path& dir, std::size_t max = 5);
 
 enum class OutputKind { kDirectory, kFile };
+
+/// For an output directory named by default after its input file (no --output given): refuses
+/// (knit::InputError(target, "output directory", why)) a `target` that holds the output of
+/// another input file, by its marker's provenance "input", both resolved from the current
+/// directory. Session 47's walkthrough: two designs' case.json files, each mapped with
+/// `knit-macro knitmap DIR/case.json`, went to one ./case_knitmap, the second replacing the
+/// first with exit 0. Nothing to refuse without a marker or an input in it.
+void check_default_output_input(const std::filesystem::path& target, const std::string& input);
 
 /// Refuses, before any work, an output target the run could not (or must not) write. Throws
 /// knit::InputError(target, option, why) ("out: --output: is a regular file ...") for
