@@ -203,6 +203,26 @@ int num_filters(hid_t ds) {
   return dcpl.valid() ? H5Pget_nfilters(dcpl.get()) : 0;
 }
 
+/// The first filter of `ds` that is not lossless-known (deflate, shuffle, Fletcher32; the
+/// writer's are deflate and Fletcher32) as "name (id N)", or "" (session 47's red team: a
+/// database rewritten with HDF5's lossy scale-offset filter read as 59.8 N for 82.8 N, exit 0).
+std::string unknown_filter(hid_t ds) {
+  H5Handle dcpl(H5Dget_create_plist(ds));
+  if (!dcpl.valid()) return {};
+  const int n = H5Pget_nfilters(dcpl.get());
+  for (int k = 0; k < n; ++k) {
+    unsigned flags = 0, config = 0;
+    std::size_t nelem = 0;
+    char name[64] = {0};
+    const H5Z_filter_t id = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(k), &flags, &nelem,
+                                           nullptr, sizeof name, name, &config);
+    if (id == H5Z_FILTER_DEFLATE || id == H5Z_FILTER_SHUFFLE || id == H5Z_FILTER_FLETCHER32)
+      continue;
+    return std::string(name[0] ? name : "unnamed") + " (id " + std::to_string(id) + ")";
+  }
+  return {};
+}
+
 std::string bytes_text(long double b) {
   char buf[48];
   if (b >= 1e9L)
@@ -421,7 +441,9 @@ H5Group H5Group::create_group(const std::string& path) {
   errno = 0;
   H5Handle g(H5Gcreate2(id_.get(), h5name(path).c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT));
   if (!g.valid()) fail(path, create_failure("cannot create group"));
-  return H5Group(std::move(g), file_, full(path));
+  H5Group out(std::move(g), file_, full(path));
+  out.real_only_ = real_only_;
+  return out;
 }
 
 H5Group H5Group::open_group(const std::string& path) const {
@@ -430,7 +452,9 @@ H5Group H5Group::open_group(const std::string& path) const {
   if (!is_group(path)) fail(path, "not a group");
   H5Handle g(H5Gopen2(id_.get(), h5name(path).c_str(), H5P_DEFAULT));
   if (!g.valid()) fail(path, "cannot open group");
-  return H5Group(std::move(g), file_, full(path));
+  H5Group out(std::move(g), file_, full(path));
+  out.real_only_ = real_only_;
+  return out;
 }
 
 std::vector<std::string> H5Group::children(const std::string& path) const {
@@ -571,6 +595,10 @@ static OpenDataset open_dataset(hid_t loc, const std::string& name, const Fail& 
   d.type = H5Handle(H5Dget_type(d.ds.get()));
   d.dims = dims_of(d.space.get());
   d.cls = H5Tget_class(d.type.get());
+  // A null dataspace has rank 0 like a scalar, and was read as one value of 0 (session 47's
+  // red team).
+  if (H5Sget_simple_extent_type(d.space.get()) == H5S_NULL)
+    fail("the dataset is empty (a null dataspace, no value)");
   return d;
 }
 
@@ -583,12 +611,24 @@ std::vector<std::size_t> H5Group::shape(const std::string& path) const {
 
 template <class T>
 static std::vector<T> read_numeric(hid_t loc, const std::string& name, std::size_t want_rank,
-                                   std::vector<std::size_t>& dims_out, const Fail& fail) {
+                                   std::vector<std::size_t>& dims_out, const Fail& fail,
+                                   bool real_only = false) {
   auto d = open_dataset(loc, name, fail);
   if (d.cls != H5T_INTEGER && d.cls != H5T_FLOAT)
     fail(std::string("expected a numeric dataset, found ") + class_name(d.cls));
   if (std::is_same_v<T, int> && d.cls != H5T_INTEGER)
     fail(std::string("expected an integer dataset, found ") + class_name(d.cls));
+  // Real data in doubles, as the writer stores it (session 47's red team: the network's theta
+  // stored as integers gave 3.85 N for 82.8 N, exit 0, and in 2-byte floats 82.78 N).
+  if (std::is_same_v<T, double> && real_only &&
+      (d.cls != H5T_FLOAT || H5Tget_size(d.type.get()) < sizeof(double)))
+    fail(std::string("expected 8-byte floating-point values (double), found ") +
+         (d.cls == H5T_FLOAT ? std::to_string(H5Tget_size(d.type.get())) + "-byte floats"
+                             : std::string(class_name(d.cls))) +
+         ": the values would have lost digits");
+  if (const std::string f = unknown_filter(d.ds.get()); !f.empty())
+    fail("stored with the HDF5 filter " + f +
+         ", which may be lossy (the writer uses deflate and Fletcher32 only)");
   const std::size_t rank = d.dims.size();
   constexpr std::size_t kAnyRank = static_cast<std::size_t>(-1);
   if (want_rank != kAnyRank && !(rank == want_rank || (want_rank == 1 && rank == 0)))
@@ -625,7 +665,8 @@ std::vector<double> H5Group::read_doubles(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  return read_numeric<double>(id_.get(), h5name(path), 1, dims, H5GroupAccess::fail(*this, path));
+  return read_numeric<double>(id_.get(), h5name(path), 1, dims, H5GroupAccess::fail(*this, path),
+                              real_only_);
 }
 
 std::vector<int> H5Group::read_ints(const std::string& path) const {
@@ -640,7 +681,7 @@ H5Array H5Group::read_array(const std::string& path) const {
   if (!is_dataset(path)) fail(path, "dataset missing");
   H5Array a;
   a.data = read_numeric<double>(id_.get(), h5name(path), static_cast<std::size_t>(-1), a.shape,
-                                H5GroupAccess::fail(*this, path));
+                                H5GroupAccess::fail(*this, path), real_only_);
   return a;
 }
 
@@ -648,7 +689,8 @@ RowMatrixXd H5Group::read_matrix(const std::string& path) const {
   silence_hdf5();
   if (!is_dataset(path)) fail(path, "dataset missing");
   std::vector<std::size_t> dims;
-  auto v = read_numeric<double>(id_.get(), h5name(path), 2, dims, H5GroupAccess::fail(*this, path));
+  auto v = read_numeric<double>(id_.get(), h5name(path), 2, dims, H5GroupAccess::fail(*this, path),
+                                real_only_);
   RowMatrixXd m(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
   std::copy(v.begin(), v.end(), m.data());
   return m;
@@ -797,6 +839,11 @@ static OpenAttribute open_attribute(const H5Group& g, hid_t loc, const std::stri
   o.type = H5Handle(H5Aget_type(o.a.get()));
   o.dims = dims_of(o.space.get());
   o.cls = H5Tget_class(o.type.get());
+  // A null dataspace has rank 0 like a scalar: read as one value of 0 or "" until session 47
+  // (the red team: an empty /energy_law@outer_cap gave 38.7 N for 82.8 N, exit 0, and an empty
+  // /loop_k@thickness turned the thickness check off).
+  if (H5Sget_simple_extent_type(o.space.get()) == H5S_NULL)
+    fail("attribute " + name + " is empty (a null dataspace, no value)");
   return o;
 }
 

@@ -318,7 +318,10 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     if (std::error_code ec; !std::filesystem::is_regular_file(file, ec))
       throw InputError(fname, "", "not a regular file (a directory, a device or a pipe?)");
     if (!io::is_hdf5_file(file)) throw InputError(fname, "", "not an HDF5 file (or truncated)");
-    const H5File f = H5File::open_read(file);
+    H5File f = H5File::open_read(file);
+    // Real data as written, in doubles (session 47's red team: theta stored as integers ran
+    // with 3.85 N for 82.8 N, exit 0).
+    f.require_real_data();
     Database db;
     where = "/";
     if (!f.has_attribute(".", "format") || f.attribute_string(".", "format") != kDatabaseFormatName)
@@ -350,6 +353,19 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                            " is not supported (this build reads versions " +
                            std::to_string(kOldestReadableVersion) + " to " +
                            std::to_string(kDatabaseFormatVersion) + ")");
+    // Format 3 came after the checksums (d72a908 after c7dca30): every format-3 file knit-meso
+    // wrote carries them, so one without any was rewritten by another program (session 47's
+    // red team: every dataset and attribute copied by value with h5py, /energy_law/theta
+    // scaled by 1.5, read as an old, unverifiable file: 17,408 N for 82.8 N, exit 0).
+    if (db.format_version >= 3 && !f.any_checksum())
+      throw InputError(
+          fname, "",
+          "format_version " + std::to_string(db.format_version) +
+              " databases are written with checksums, and this one has none: it was rewritten "
+              "by another program (a copy made dataset by dataset, h5py), so a change to its law "
+              "or data cannot be ruled out; use the database as knit-meso wrote it (a copy made "
+              "with cp keeps the checksums), or write a new one (knit-meso sweep, or knit-meso "
+              "fit from the original)");
     auto require_group = [&](const std::string& p) {
       if (!f.is_group(p)) throw InputError(fname, p, "group missing");
     };

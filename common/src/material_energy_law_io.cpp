@@ -208,6 +208,18 @@ void read_energy_law(const io::H5Group& root, const std::string& file, EnergyLaw
       throw InputError(
           file, g,
           "attribute family is \"" + family + "\"; this build reads \"ridge\" and \"network\"");
+    // The network family came with format 3 (and with it the checksums): a file that says it
+    // is older and holds a network law was relabelled (session 47's red team: a format-3
+    // database copied without its checksums by h5py and relabelled format 2 was read as an
+    // old, unverifiable file).
+    if (family == "network" && root.has_attribute(".", "format_version") &&
+        root.attribute_int(".", "format_version") < 3)
+      throw InputError(file, g,
+                       "attribute family is \"network\" in a format_version " +
+                           std::to_string(root.attribute_int(".", "format_version")) +
+                           " database: the network family came with format 3, so the file was "
+                           "relabelled (and read unverified); use the database as knit-meso "
+                           "wrote it");
     law.family = family == "network" ? EnergyFamily::kNetwork : EnergyFamily::kRidge;
     const std::vector<const char*> needed =
         law.family == EnergyFamily::kNetwork

@@ -203,6 +203,12 @@ class H5Group {
   int attribute_int(const std::string& obj_path, const std::string& name) const;
   std::vector<double> attribute_doubles(const std::string& obj_path, const std::string& name) const;
 
+  /// From now on, and in the groups opened from this one, real datasets (read_doubles,
+  /// read_array, read_matrix) must be stored as they are written, as 8-byte floats: integer
+  /// storage is refused (its values would have been truncated). For files written by knitscale
+  /// only (the material database); results.h5 stores its step numbers as integers.
+  void require_real_data() { real_only_ = true; }
+
  protected:
   H5Group(H5Handle id, std::string file, std::string path)
       : id_(std::move(id)), file_(std::move(file)), path_(std::move(path)) {}
@@ -217,6 +223,7 @@ class H5Group {
 
   H5Handle id_;
   std::string file_, path_;
+  bool real_only_ = false;  ///< require_real_data()
 };
 
 /// An HDF5 file; as a group it is the root "/".
