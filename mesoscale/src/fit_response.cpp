@@ -240,7 +240,12 @@ std::string check_fan(const FitOptions& o, const FanShape& fan) {
     return std::to_string(m) + " biaxial paths cannot determine a degree-" +
            std::to_string(o.degree1) +
            " surface across the paths (need >= " + std::to_string(o.degree1 + 1) + ")";
-  if (!fan.shear) return "no pure-shear path: the S12(E12) curve cannot be fitted";
+  if (fan.shear == 0) return "no pure-shear path: the S12(E12) curve cannot be fitted";
+  if (fan.shear > 1)
+    return std::to_string(fan.shear) +
+           " pure-shear paths in the paper set: the S12(E12) curve of eq. 17 is fitted to one "
+           "(the paper's); give the others \"set\": \"coverage\", where the energy law uses "
+           "them";
   // Directions not known in advance (NaN: a path whose end strain only the run tells) take
   // no part in the direction checks.
   std::vector<double> phi;
@@ -272,7 +277,7 @@ std::string check_feasible(const FitOptions& options, const std::vector<material
     // (coverage and holdout paths, e.g. the full circle of directions, never enter eq. 17).
     if (p.set != "paper") continue;
     if (p.kind == material::PathKind::kShear) {
-      fan.shear = true;
+      ++fan.shear;
       continue;
     }
     if (p.kind != material::PathKind::kBiaxial) continue;
@@ -302,6 +307,7 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
   };
   std::vector<Path> fan;
   const RawPath* shear = nullptr;
+  int shear_paths = 0;
   int skipped = 0;
   for (std::size_t q = 0; q < raw.size(); ++q) {
     const RawPath& r = raw[q];
@@ -322,6 +328,7 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     }
     if (last < 0) return refuse("path " + std::to_string(q) + " has no converged step");
     if (r.path.kind == material::PathKind::kShear) {
+      ++shear_paths;
       if (!shear) shear = &r;
       continue;
     }
@@ -334,7 +341,7 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     FanShape shape;  // the refusals shared with check_feasible()
     for (const auto& f : fan) shape.phi.push_back(f.phi);
     shape.min_steps = m > 0 ? min_steps : 0;
-    shape.shear = shear != nullptr;
+    shape.shear = shear_paths;
     if (const std::string why = check_fan(o, shape); !why.empty()) return refuse(why);
   }
   std::sort(fan.begin(), fan.end(), [](const Path& a, const Path& b) { return a.phi < b.phi; });

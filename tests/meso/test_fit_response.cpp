@@ -113,6 +113,16 @@ TEST_CASE("fit: data that cannot determine the surface are refused with the reas
     raw.pop_back();
     CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("no pure-shear path"));
   }
+  SECTION("two pure-shear paths in the paper set") {
+    // Session 47's red team: the second was left out of the S12(E12) fit, with exit 0 ("fit
+    // ... ok", the curve ending at a quarter of the data's E12). As a coverage path it is
+    // not the paper's and does not count.
+    raw.push_back(raw.back());
+    CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason,
+               Catch::StartsWith("2 pure-shear paths in the paper set"));
+    raw.back().path.set = "coverage";
+    CHECK(fit_loop_length(raw, FitOptions{}).ok());
+  }
   SECTION("duplicate direction") {
     raw[4] = raw[5];
     CHECK_THAT(fit_loop_length(raw, FitOptions{}).reason, Catch::Contains("same strain direction"));
@@ -389,6 +399,9 @@ TEST_CASE("fit: a fan of exactly 180 degrees is refused, and paths of too few st
   CHECK_THAT(check_fan(o, fan), Catch::Contains("span 180 degrees or more"));
   fan.phi.back() = std::nextafter(M_PI, 0.0);
   CHECK(check_fan(o, fan).empty());
+  fan.shear = 2;  // two paper shear paths: refused before a sweep (check_feasible) too
+  CHECK_THAT(check_fan(o, fan), Catch::StartsWith("2 pure-shear paths in the paper set"));
+  fan.shear = 1;
   fan.min_steps = o.degree2;
   CHECK(check_fan(o, fan) == "paths with " + std::to_string(o.degree2) +
                                  " steps cannot determine a degree-" + std::to_string(o.degree2) +

@@ -118,7 +118,9 @@ struct FitSummary {
 struct FanShape {
   std::vector<double> phi;
   int min_steps = 0;
-  bool shear = false;
+  /// Pure-shear paths of the paper set: eq. 17's S12(E12) curve is fitted to exactly one (the
+  /// paper's; session 47's red team: a second one was left out of the fit, silently).
+  int shear = 0;
 };
 
 /// The fit's refusals that depend only on the options and the shape of the fan (too few
