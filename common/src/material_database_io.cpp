@@ -508,6 +508,13 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                     "step " + std::to_string(s + 1) + " " + why + ": a damaged database");
             }
           }
+          // The path's planned steps are its rows (a stopped path keeps its unreached steps,
+          // status 2): the red team's steps -3 on a 20-row path was read and written back.
+          if (r.path.steps != n)
+            throw InputError(fname, p,
+                             "attribute steps is " + std::to_string(r.path.steps) +
+                                 ", but the path has " + std::to_string(n) +
+                                 " rows (the length of status): a damaged database");
           e.raw.push_back(std::move(r));
         }
       }

@@ -292,6 +292,18 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     knit::io::H5File::open_rw(bad).remove_attribute("/loop_0", "wale_width");
     CHECK_THROWS_WITH(read_database(bad), bad.string() + ": /loop_0: attribute wale_width missing");
   }
+  SECTION("a path's steps attribute that is not its rows") {
+    // Session 47's red team: steps -3 on a 20-row path was read and written back by a refit.
+    const auto bad = tmp("badsteps.h5");
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    knit::io::H5File::open_rw(bad).set_attribute("/loop_0/raw/path_00", "steps", -3);
+    CHECK_THROWS_WITH(read_database(bad),
+                      bad.string() +
+                          ": /loop_0/raw/path_00: attribute steps is -3, but the path "
+                          "has " +
+                          std::to_string(small_db().entries[0].raw[0].status.size()) +
+                          " rows (the length of status): a damaged database");
+  }
   SECTION("raw data whose rows do not match its status") {
     // Without the check the reader's finiteness loop ran past F's rows (session 33, a
     // helper's audit).
