@@ -22,11 +22,23 @@ LoopLengthFamily::LoopLengthFamily(std::vector<double> loop_lengths,
     validate(laws_[k]);
     const auto& a = laws_[0];
     const auto& b = laws_[k];
-    if (a.degree1 != b.degree1 || a.degree2 != b.degree2 || a.knots1 != b.knots1 ||
-        a.knots2 != b.knots2 || a.shear_degree != b.shear_degree || a.shear_knots != b.shear_knots)
-      throw std::invalid_argument(
-          "loop-length family: the law at loop length " + std::to_string(l_[k]) +
-          " has other degrees or knots than the first; eq. (25) needs one parameterization");
+    // Which item differs, and both loop lengths (session 47's red team: a damaged knot vector
+    // of the first loop length was blamed on the second, "5.000000", alone).
+    const char* differs = a.degree1 != b.degree1             ? "degree_1"
+                          : a.degree2 != b.degree2           ? "degree_2"
+                          : a.knots1 != b.knots1             ? "knots_1"
+                          : a.knots2 != b.knots2             ? "knots_2"
+                          : a.shear_degree != b.shear_degree ? "shear/degree"
+                          : a.shear_knots != b.shear_knots   ? "shear/knots"
+                                                             : nullptr;
+    if (differs) {
+      std::ostringstream os;
+      os << "loop-length family: the laws at loop lengths " << l_[0] << " mm (the first) and "
+         << l_[k] << " mm differ in " << differs << " (/loop_0/fit and /loop_" << k
+         << "/fit of a database); eq. (25) needs one parameterization: one of them is damaged, "
+            "or they were fitted with other options";
+      throw std::invalid_argument(os.str());
+    }
   }
   if (m == 1) return;
   const int q = std::min(3, m - 1);

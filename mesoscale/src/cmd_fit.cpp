@@ -173,6 +173,16 @@ static knit::cli::SubcommandRegistrar reg_fit(
         // Before the read: a change from here on is seen when the input is opened again.
         const auto read_as = knit::meso::cmd_fit::identity_of(o->db);
         auto db = knit::material::read_database(o->db, true);
+        // An old file (written before the checksums) is read unverified; what the refit writes
+        // is sealed, so say so (session 47's red team: an unverified file's edited contents
+        // came out of a refit as a checksummed database, with nothing said).
+        if (!knit::io::H5File::open_read(o->db).any_checksum())
+          std::cerr
+              << "warning: " << o->db << ": written without checksums (format_version "
+              << db.format_version
+              << ", written before the integrity checks of issue 14), so its contents are not "
+                 "verified; the refitted database carries them over with checksums of its "
+                 "own\n";
         const bool paper = o->law != "energy", energy = o->law != "paper";
         // An options file the chosen law does not read is refused, not ignored unread (session
         // 38's red team: `--law paper --energy-options /nonexistent.json` ended with exit 0;

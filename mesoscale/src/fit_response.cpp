@@ -317,14 +317,18 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     const int n = r.steps();
     if (r.E.rows() != n || r.S.rows() != n || r.E.cols() != 3 || r.S.cols() != 3)
       return refuse("path " + std::to_string(q) + ": E and S need one row of 3 per step");
-    if (!r.E.allFinite() || !r.S.allFinite())
-      return refuse("path " + std::to_string(q) + ": non-finite strain or stress data");
     int last = -1;
     for (int k = 0; k < n; ++k) {
-      if (r.status[k] == 0)
+      if (r.status[k] == 0) {
+        // Only converged steps are data: a step that did not converge may hold anything
+        // (session 47's red team: a NaN there refused the whole fit, naming no step).
+        if (!r.E.row(k).allFinite() || !r.S.row(k).allFinite())
+          return refuse("path " + std::to_string(q) + ", step " + std::to_string(k + 1) +
+                        ": non-finite strain or stress data in a converged step");
         last = k;
-      else
+      } else {
         ++skipped;
+      }
     }
     if (last < 0) return refuse("path " + std::to_string(q) + " has no converged step");
     if (r.path.kind == material::PathKind::kShear) {

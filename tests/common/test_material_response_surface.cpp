@@ -150,8 +150,13 @@ TEST_CASE("loop-length family: cubic in l from four intervals on, and its refusa
                     Catch::Contains("increase strictly"));
   ResponseSurfaceData other = laws[1];
   other.knots2[other.knots2.size() / 2] += 0.05;
+  // Named by the item and both loop lengths (session 47's red team: only the second was
+  // named, whichever was damaged).
   CHECK_THROWS_WITH(LoopLengthFamily({4.5, 5.0}, {laws[0], other}),
-                    Catch::Contains("other degrees or knots"));
+                    "loop-length family: the laws at loop lengths 4.5 mm (the first) and 5 mm "
+                    "differ in knots_2 (/loop_0/fit and /loop_1/fit of a database); eq. (25) "
+                    "needs one parameterization: one of them is damaged, or they were fitted "
+                    "with other options");
 }
 
 TEST_CASE("response surface: inversion never fails in a large box, tangent consistent", "[unit]") {

@@ -9,7 +9,8 @@ team), each by the file and the field, exit 2:
   network law, which came with format 3;
 * in an old (format 2, checksum-free) file, an attribute with a null dataspace (read as 0:
   /energy_law@floor), real data stored as integers (truncated) or in 4-byte floats, and a
-  dataset under HDF5's scale-offset filter (lossy).
+  dataset under HDF5's scale-offset filter (lossy); and knit-meso fit of such an old file warns
+  that its contents are not verified (the refit writes them with checksums of its own).
 
 The intact copies of each kind run (exit 0), so each refusal is the damage's. Run by CTest
 (tests/CMakeLists.txt, label report) with /usr/bin/python3; KNIT_BIN_DIR names the directory of
@@ -121,6 +122,12 @@ def main():
         rewrite_without_checksums(made["ridge"], old, version=2)
         rc, err = run_case(tmp, old, "old")
         c(rc == 0, "an intact old (format 2, checksum-free) ridge database runs", err[-800:])
+        # A refit of the old file says that its contents were not verified.
+        r = subprocess.run([os.path.join(BIN, "knit-meso"), "fit", old, "--law", "paper", "-o",
+                            os.path.join(tmp, "refit.h5")], capture_output=True, text=True)
+        c(r.returncode == 0 and "warning: " + old + ": written without checksums" in r.stderr,
+          "knit-meso fit of an old file warns that its contents are not verified",
+          r.stdout[-500:] + r.stderr[-800:])
         damages = {
             "an attribute with a null dataspace": (
                 lambda f: f["energy_law"].attrs.__setitem__("floor", h5py.Empty("f8")),
