@@ -226,6 +226,14 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
               " (output.applied_displacement: " + fmt(c.output.applied->value) +
               " mm over the gauge length " + fmt(c.output.applied->gauge_length) + " mm), got " +
               fmt(o.at_strain[k]));
+    // One strain once (session 47's walkthrough: [0.2, 0.2] with targets [25, 20] passed
+    // --check and ended "target not met" between the two).
+    for (std::size_t i = 0; i < k; ++i)
+      if (o.at_strain[i] == o.at_strain[k])
+        throw InputError(file, p + "/at_strain/" + std::to_string(k),
+                         "repeats the strain " + fmt(o.at_strain[k]) + " of /at_strain/" +
+                             std::to_string(i) +
+                             " (each strain once; its target or weight says how much it counts)");
   }
   const bool targets = o.kind != DesignObjective::Kind::kStrainVariance &&
                        o.kind != DesignObjective::Kind::kReactionLinearity;

@@ -203,13 +203,20 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
     throw InputError(ctx.file, p + "/database", "must not be empty: give the database's file");
   if (!ctx.patch) throw InputError(ctx.file, p, "the knit material needs the patch");
   std::filesystem::path db = m.at("database").get<std::string>();
-  if (db.is_relative() && !ctx.file.empty())
-    db = std::filesystem::path(ctx.file).parent_path() / db;
+  const bool relative = db.is_relative();
+  if (relative && !ctx.file.empty()) db = std::filesystem::path(ctx.file).parent_path() / db;
   material::Database data;
   try {
     data = material::read_database(db, false);
   } catch (const InputError& e) {
-    throw InputError(ctx.file, p + "/database", e.what());
+    // A relative path is the case file's (session 47's walkthrough: "out/database.h5: file not
+    // found" did not say where it was looked for).
+    std::error_code ec;
+    std::string hint;
+    if (relative && !std::filesystem::exists(db, ec))
+      hint = " (a relative database path is taken from the case file's directory: here " +
+             std::filesystem::absolute(db, ec).lexically_normal().string() + ")";
+    throw InputError(ctx.file, p + "/database", e.what() + hint);
   }
   // The law: "energy" (issue 11) by default when the database has it, else "paper" (eq. 17).
   std::string law = data.energy_law ? "energy" : "paper";

@@ -212,6 +212,11 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_bounds.json", one_variable("knitting_angle", "[0]", "-10", "200"),
          "/variables/0/upper");
   expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
+  // Session 47's walkthrough: one strain twice with two targets passed --check.
+  expect("repeated_strain.json",
+         design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2, 0.1],
+                            "target": [1.0, 2.5, 2.0]}])"),
+         "/objectives/0/at_strain/2");
   // Session 46's red team: a wrong type read "needs at least one design variable".
   for (const auto& [vars, objs, ptr] :
        {std::tuple{std::string(R"("l")"), std::string(kObjs), "/variables"},
@@ -466,10 +471,11 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
     expect("tied_unequal.json", t, "/variables/0/indices");
   }
   expect("start_outside.json", one_variable("stitch_value", "[0]", "5.5", "6.5"), "/variables/0");
+  // (Since session 47 a repeated strain is refused at the repeat, for every term.)
   expect("linearity_tied_strains.json",
          design(kVars, R"([{"type": "reaction_linearity", "reaction": "fy",
                             "at_strain": [0.2, 0.2]}])"),
-         "/objectives/0/at_strain/0");
+         "/objectives/0/at_strain/1");
   expect("linearity_one_strain.json",
          design(kVars, R"([{"type": "reaction_linearity", "reaction": "fy",
                             "at_strain": [0.2]}])"),

@@ -224,3 +224,27 @@ TEST_CASE("knit chain: bad knit inputs name the field", "[unit]") {
   CHECK_THROWS_WITH(load(R"({"type": "knit", "database": "", "stitch_value": 5})"),
                     Catch::Contains("bad.json: /material/database: must not be empty"));
 }
+
+TEST_CASE("knit chain: a relative database path that is not there says where it was looked for",
+          "[unit]") {
+  // Session 47's walkthrough: "out/database.h5: file not found" did not say that the path is
+  // the case file's, nor where that led.
+  const std::string text =
+      R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+          "control_points": [[0, 0, 0], [50, 0, 0], [0, 50, 0], [50, 50, 0]], "thickness": 0.76},
+        "refinement": {"degree": 2, "elements": [1, 1]},
+        "material": {"type": "knit", "database": "no_such_dir/db.h5", "stitch_value": 5},
+        "boundary_conditions": [{"edge": "u0", "fix": ["x", "y", "z"]}]})";
+  const std::string where =
+      (std::filesystem::current_path() / "cases" / "no_such_dir" / "db.h5").string();
+  CHECK_THROWS_WITH(parse_case(text, "cases/bad.json"),
+                    Catch::Contains("cases/no_such_dir/db.h5: file not found (a relative database "
+                                    "path is taken from the case file's directory: here " +
+                                    where + ")"));
+  // An absolute path needs no such note.
+  std::string abs = text;
+  abs.replace(abs.find("no_such_dir/db.h5"), 17, "/no_such_dir/db.h5");
+  CHECK_THROWS_WITH(
+      parse_case(abs, "cases/bad.json"),
+      Catch::Contains("/no_such_dir/db.h5: file not found") && !Catch::Contains("relative"));
+}

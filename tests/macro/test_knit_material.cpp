@@ -161,8 +161,9 @@ TEST_CASE("knit material: alpha aligned across the branch cut at +-pi is not tor
   // field is unwrapped before it is interpolated, so at v = 0.25 alpha is pi - atan(2.5 / 50)
   // (mod 2 pi), not the mean of the raw angles near 0 (session 32, a mutation audit: the
   // unwrapping removed survived every test).
-  Eigen::MatrixXd P(4, 3);
-  P << 0, 0, 0, 50, 5, 0, 0, 50, 0, 50, 45, 0;
+  // (An initializer list: with a comma initializer GCC 12 warned "may be used uninitialized"
+  // in Eigen's copy of P, depending on what else its unity batch held; session 47.)
+  const Eigen::MatrixXd P{{0, 0, 0}, {50, 5, 0}, {0, 50, 0}, {50, 45, 0}};
   const knit::spline::SplineSurface geo(knit::spline::BSplineBasis(1, {0, 0, 1, 1}),
                                         knit::spline::BSplineBasis(1, {0, 0, 1, 1}), P);
   const auto alpha =
