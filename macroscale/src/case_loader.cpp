@@ -610,6 +610,13 @@ Case parse_case(const std::string& text, const std::string& file) {
 namespace {
 Case parse_case_json(const json& root, const std::string& text, const std::string& file) {
   Reader r(file);
+  // A design file given for the case (session 47's walkthrough: "/case: unknown key" said
+  // nothing of what the file is).
+  if (root.is_object() && root.contains("case") && root.contains("variables") &&
+      !root.contains("geometry"))
+    throw InputError(file, "",
+                     "is a design file (it has \"case\" and \"variables\"), not a case file: run "
+                     "it with knit-macro design, or give the case file it names in \"case\"");
   r.keys(root, "",
          {"$schema", "description", "units", "geometry", "refinement", "material",
           "boundary_conditions", "loads", "solver", "output"},

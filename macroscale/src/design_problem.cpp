@@ -384,6 +384,13 @@ DesignProblem load_design(const std::string& path) {
   d.file = path;
   const json root = io::read_json_file(path);
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
+  // A case file given for the design file (session 47's walkthrough: "/boundary_conditions:
+  // unknown key" said nothing of what the file is).
+  if (!root.contains("case") && root.contains("geometry") && root.contains("material"))
+    throw InputError(path, "",
+                     "is a case file (it has \"geometry\" and \"material\"), not a design file: "
+                     "run it with knit-macro run, or write a design file whose \"case\" names it "
+                     "(docs/design.md, \"The design file\")");
   const std::vector<std::string> top_keys = {"$schema",    "description", "case",      "variables",
                                              "objectives", "smoothness",  "optimizer", "twin"};
   if (auto u = io::find_unknown_key(root, "", top_keys))

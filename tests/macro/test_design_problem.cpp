@@ -212,6 +212,15 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_bounds.json", one_variable("knitting_angle", "[0]", "-10", "200"),
          "/variables/0/upper");
   expect("empty_objectives.json", design(kVars, "[]"), "/objectives");
+  // The wrong kind of file, each way (session 47's walkthrough: "/boundary_conditions: unknown
+  // key" and "/case: unknown key").
+  CHECK_THROWS_WITH(load_design((kDir / "case.json").string()),
+                    Catch::Contains("is a case file (it has \"geometry\" and \"material\"), not "
+                                    "a design file: run it with knit-macro run"));
+  write(kDir / "a_design.json", design(kVars, kObjs));
+  CHECK_THROWS_WITH(load_case((kDir / "a_design.json").string()),
+                    Catch::Contains("is a design file (it has \"case\" and \"variables\"), not "
+                                    "a case file: run it with knit-macro design"));
   // Session 47's walkthrough: one strain twice with two targets passed --check.
   expect("repeated_strain.json",
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2, 0.1],
