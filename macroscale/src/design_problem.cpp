@@ -135,8 +135,24 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
       throw InputError(file, p + "/indices",
                        "tied control values must start equal in the case (" + fmt(v.initial) +
                            " and " + vals[static_cast<std::size_t>(i)].dump() + ")");
-  if (v.initial < v.lower || v.initial > v.upper)
-    throw InputError(file, p, "the case's value " + fmt(v.initial) + " is outside the bounds");
+  if (v.initial < v.lower || v.initial > v.upper) {
+    // An angle and its bounds in different units (session 47's walkthrough: a field in deg at
+    // 90 with bounds 1.2 ... 1.9 read only "outside the bounds").
+    std::string hint;
+    if (v.field == DesignVariable::Field::kKnittingAngle) {
+      const double to_rad = std::numbers::pi / 180.0;
+      if (v.unit == "deg" && v.initial * to_rad >= v.lower && v.initial * to_rad <= v.upper)
+        hint = "; the field is in deg (its \"unit\") and the bounds hold " +
+               fmt(v.initial * to_rad) + " rad: are the bounds in rad? give them in deg";
+      else if (v.unit == "rad" && v.initial / to_rad >= v.lower && v.initial / to_rad <= v.upper)
+        hint = "; the field is in rad and the bounds hold " + fmt(v.initial / to_rad) +
+               " deg: are the bounds in deg? give them in rad, or the field \"unit\": \"deg\"";
+    }
+    throw InputError(file, p,
+                     "the case's value " + fmt(v.initial) + " " + v.unit +
+                         " is outside the bounds [" + fmt(v.lower) + ", " + fmt(v.upper) + "]" +
+                         hint);
+  }
 }
 
 int find_name(const std::vector<std::string>& names, const json& j, const std::string& file,

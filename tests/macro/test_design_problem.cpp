@@ -472,6 +472,20 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_lower.json", one_variable("knitting_angle", "[0]", "-200", "45"),
          "/variables/0/lower");
   {
+    // An angle field in deg with bounds in rad (session 47's walkthrough: "outside the
+    // bounds" alone): the message asks whether the bounds are in rad.
+    std::string c = knit_test::read_text(kDir / "case.json");
+    c.replace(c.find(R"("values": [0], "unit": "deg")"), 28, R"("values": [90], "unit": "deg")");
+    write(kDir / "case_90deg.json", c);
+    std::string t = one_variable("knitting_angle", "[0]", "1.2", "1.9");
+    t.replace(t.find("case.json"), 9, "case_90deg.json");
+    write(kDir / "rad_bounds.json", t);
+    CHECK_THROWS_WITH(load_design((kDir / "rad_bounds.json").string()),
+                      Catch::Contains("/variables/0: the case's value 90 deg is outside the "
+                                      "bounds [1.2, 1.9]; the field is in deg (its \"unit\") and "
+                                      "the bounds hold 1.5708 rad: are the bounds in rad?"));
+  }
+  {
     std::string c = knit_test::read_text(kDir / "case.json");
     c.replace(c.find("[5.0, 5.0]"), 10, "[5.0, 5.6]");
     write(kDir / "case_untied.json", c);
