@@ -92,7 +92,10 @@ def main():
                     help=f"largest strain component of a small-strain state (default {SMALL})")
     a = ap.parse_args()
     open_database(a.database, "law_small_strain").close()
-    rows = small_strain_ratios(a.database, a.small)
+    try:
+        rows = small_strain_ratios(a.database, a.small)
+    except ValueError as err:  # a law that cannot be evaluated as stored (session 47)
+        sys.exit(f"law_small_strain: {err}")
     if not rows:
         sys.exit(f"law_small_strain: {a.database}: no /energy_law")
     print(summary(rows, a.small))

@@ -214,10 +214,50 @@ def stored_l_interpolation(g):
     return li
 
 
+def check_law_group(g, fam):
+    """Refuses, as the C++ reader does, a stored law that cannot be evaluated as written:
+    ValueError naming the file and the HDF5 path (session 47's red team: a NaN in theta gave
+    "nan" figures and a blank plot with exit 0, h1 not matching theta's width re-read theta
+    silently, unsorted knots and a negative floor were taken)."""
+    where = f"{g.file.filename}: {g.name}"
+
+    def real(name, ndim):
+        if name not in g:
+            raise ValueError(f"{where}/{name}: dataset missing")
+        a = np.asarray(g[name][()])
+        if a.dtype.kind != "f" or a.ndim != ndim or not np.all(np.isfinite(a)):
+            raise ValueError(f"{where}/{name}: expected finite real numbers in {ndim}-D, found "
+                             f"{a.dtype} of shape {a.shape}" +
+                             ("" if a.dtype.kind != "f" or np.all(np.isfinite(a))
+                              else " holding a NaN or inf"))
+        return a
+
+    floor = g.attrs.get("floor")
+    if floor is None or not np.isfinite(float(floor)) or float(floor) < 0.0:
+        raise ValueError(f"{where}: attribute floor must be finite and >= 0, got {floor!r}")
+    knots = real("l_knots", 1)
+    if fam == "network":
+        if np.any(np.diff(knots) <= 0.0):
+            raise ValueError(f"{where}/l_knots: must increase strictly, got {knots.tolist()}")
+        theta = real("theta", 2)
+        h1, h2 = int(g.attrs["h1"]), int(g.attrs["h2"])
+        width = 3 * h1 + 2 * h1 + h2 * h1 + 3 * h2 + 2 * h2 + 9
+        if theta.shape != (len(knots), width):
+            raise ValueError(f"{where}/theta: shape {theta.shape}, but h1 = {h1} and h2 = {h2} "
+                             f"with {len(knots)} loop-length knots need ({len(knots)}, {width})")
+    else:
+        if np.any(np.diff(knots) < 0.0):
+            raise ValueError(f"{where}/l_knots: must not decrease, got {knots.tolist()}")
+        if np.any(real("coefficients", 2) < 0.0):
+            raise ValueError(f"{where}/coefficients: must be >= 0 (a convex law)")
+
+
 def load_law(g, l):
-    """The stored law of /energy_law at loop length l, either family."""
+    """The stored law of /energy_law at loop length l, either family; a law that cannot be
+    evaluated as written raises ValueError naming the file and the HDF5 path."""
     fam = g.attrs.get("family", "ridge")
     fam = fam.decode() if isinstance(fam, bytes) else str(fam)
+    check_law_group(g, fam)
     if fam != "network":
         return Law(g, l)
     return network_law(g, l, stored_l_interpolation(g))
@@ -256,7 +296,10 @@ def main():
             print(f"energy_law.py: {why}: drew a placeholder {a.out}")
             return
         k, l = pick_loop(f, a.loop_length)
-        law = load_law(f["energy_law"], l)
+        try:
+            law = load_law(f["energy_law"], l)
+        except ValueError as err:
+            sys.exit(f"energy_law.py: {err}")
         # The stored family (a law between knots or in a rounding window is a BlendedLaw).
         fam = f["energy_law"].attrs.get("family", "ridge")
         fam = fam.decode() if isinstance(fam, bytes) else str(fam)

@@ -9,7 +9,9 @@ hand-made database of one loop length whose law is S = 2 e (fixtures.py):
   scripts/figures/surfaces.py, Fig. 6);
 * a format-1 file (which never had the attribute) still draws;
 * a database without /energy_law is refused by name, and with --absent-placeholder (the
-  pipeline's call) gets a placeholder figure with exit 0.
+  pipeline's call) gets a placeholder figure with exit 0;
+* a law that cannot be evaluated as stored (a NaN in theta, h1 not matching theta's width, a
+  negative floor) is refused by name, without a traceback, here and by law_held_out.py.
 Run by CTest (tests/CMakeLists.txt, label report) with Debian's /usr/bin/python3.
 """
 import os
@@ -71,6 +73,28 @@ def main():
                 c(r.returncode != 0 and what in r.stderr and "Traceback" not in r.stderr,
                   "%s, %s: refused by name (exit %d): %s" % (os.path.basename(script), what,
                                                             r.returncode, r.stderr.strip()[-200:]))
+        # A law that cannot be evaluated as stored (session 47's red team: a NaN in theta drew
+        # a blank figure with exit 0; law_small_strain.py printed "nan" with exit 0): refused
+        # by name, without a traceback, by the figure and by law_held_out.py (the shared reader,
+        # load_law).
+        held_out = os.path.join(ROOT, "scripts", "law_held_out.py")
+        for what, damage, message in (
+                ("a NaN in theta", lambda f: f["energy_law/theta"].__setitem__((0, 0), float("nan")),
+                 "/energy_law/theta: expected finite real numbers in 2-D"),
+                ("h1 not matching theta", lambda f: f["energy_law"].attrs.__setitem__("h1", 11),
+                 "/energy_law/theta: shape"),
+                ("a negative floor", lambda f: f["energy_law"].attrs.__setitem__("floor", -1.0),
+                 "/energy_law: attribute floor must be finite and >= 0")):
+            write_db(db, 3)
+            with h5py.File(db, "a") as f:
+                damage(f)
+            for cmd in ([sys.executable, SCRIPT, "--database", db, "--loop-length", "5", "--out",
+                         png], [sys.executable, held_out, db]):
+                r = subprocess.run(cmd, capture_output=True, text=True)
+                c(r.returncode != 0 and db + ": " + message in r.stderr
+                  and "Traceback" not in r.stderr and not os.path.exists(png),
+                  "%s, %s: refused by name, no figure (exit %d): %s"
+                  % (os.path.basename(cmd[1]), what, r.returncode, r.stderr.strip()[-300:]))
         write_db(db, 1, drop_set=True)
         r = draw(db, png)
         c(r.returncode == 0 and os.path.exists(png),
