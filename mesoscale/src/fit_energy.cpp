@@ -831,7 +831,9 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
        << " within 5 % of the stress range at every converged step, "
        << d.holdout_run_ends_within_5_percent << " at their end state\n";
   else
-    os << "    held out: none (no path with set \"holdout\")\n";
+    // (Session 47's red team: said also when held-out paths exist but none converged.)
+    os << "    held out: no converged state (no path with set \"holdout\", or none of them "
+          "converged)\n";
   return os.str();
 }
 

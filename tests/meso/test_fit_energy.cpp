@@ -435,6 +435,25 @@ TEST_CASE("energy fit: states where the cell gives way are left out of the fit",
   const EnergyFitSummary clean = fit_energy_law(db, o);
   REQUIRE(clean.ok());
   CHECK(clean.gave_way.empty());
+  {
+    // Held-out paths none of which converged: the report does not claim there is no held-out
+    // path (session 47's red team: "none (no path with set "holdout")").
+    Database unconverged = db;
+    int held = 0;
+    for (auto& e : unconverged.entries)
+      for (auto& p : e.raw)
+        if (p.path.set == "holdout") {
+          std::fill(p.status.begin(), p.status.end(), 1);
+          ++held;
+        }
+    REQUIRE(held > 0);
+    const EnergyFitSummary none = fit_energy_law(unconverged, o);
+    REQUIRE(none.ok());
+    CHECK(none.diagnostics.holdout_points == 0);
+    CHECK(energy_fit_report(none).find("held out: no converged state (no path with set "
+                                       "\"holdout\", or none of them converged)") !=
+          std::string::npos);
+  }
   const std::size_t q = first_coverage_path(db, 6);
   REQUIRE(q < db.entries[0].raw.size());
   auto& r = db.entries[0].raw[q];
