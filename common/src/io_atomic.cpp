@@ -388,6 +388,13 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
          << Provenance::current(input).to_json_string() << "\n"
          << "for: " << target_.filename().string() << "\n"
          << "pid " << ::getpid() << "\n";
+  // The input file's absolute path: the provenance keeps it as typed, relative to a directory
+  // the marker does not record (check_default_output_input; session 47's review).
+  if (!input.empty()) {
+    std::error_code aec;
+    const fs::path abs = fs::absolute(input, aec);
+    if (!aec) marker << "input: " << abs.lexically_normal().string() << "\n";
+  }
   if (!marker.flush()) {
     // The directory is ours, just created, and holds only this file: without its marker no
     // later run would remove it (session 34: a full disk left DIR.partial-<pid> for good).

@@ -119,6 +119,8 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
       char* end = nullptr;
       const long pid = std::strtol(line.c_str() + 16, &end, 10);
       if (end && *end == '\0' && pid > 0) m.replaced_by_pid = pid;
+    } else if (line.rfind("input: ", 0) == 0) {
+      m.input_absolute = line.substr(7);
     } else if (line.rfind("pid ", 0) == 0) {
       char* end = nullptr;
       const long pid = std::strtol(line.c_str() + 4, &end, 10);
@@ -150,12 +152,25 @@ std::vector<std::string> foreign_entries(const fs::path& dir, std::size_t max) {
 
 void check_default_output_input(const fs::path& target, const std::string& input) {
   const auto m = read_output_marker(without_trailing_slash(target));
-  if (!m || m->input.empty() || input.empty()) return;
-  std::error_code e1, e2;
-  const fs::path was = fs::weakly_canonical(m->input, e1), is = fs::weakly_canonical(input, e2);
-  if (e1 || e2 || was == is) return;
+  if (!m || input.empty()) return;
+  std::error_code e1, e2, e3;
+  const fs::path is = fs::weakly_canonical(input, e2);
+  if (e2) return;
+  std::string named;  // the other input, as the message names it
+  if (!m->input_absolute.empty()) {
+    const fs::path was = fs::weakly_canonical(m->input_absolute, e1);
+    if (e1 || was == is) return;
+    named = m->input_absolute;
+  } else {
+    // An older marker: the input as typed, perhaps relative to another directory. Refused
+    // only when it names an existing file here that is not this input.
+    if (m->input.empty() || !fs::is_regular_file(m->input, e1) || e1 ||
+        fs::equivalent(m->input, input, e3) || e3)
+      return;
+    named = m->input;
+  }
   throw InputError(target.string(), "output directory",
-                   "holds the output of another input file, " + m->input +
+                   "holds the output of another input file, " + named +
                        " (the default output name is the input file's name; this input is " +
                        input + "): give --output to name this output, or to replace that one");
 }

@@ -127,7 +127,12 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
     if (v.lower < -lim || v.upper > lim)
       throw InputError(file, p + (v.lower < -lim ? "/lower" : "/upper"),
                        "knitting-angle bounds must lie in [-" + fmt(lim) + ", " + fmt(lim) + "] (" +
-                           (deg ? "deg" : "rad") + ", the field's unit)");
+                           (deg ? "deg" : "rad") + ", the field's unit)" +
+                           // Degrees for a field in rad (session 47's review).
+                           (!deg && v.lower >= -180.0 && v.upper <= 180.0
+                                ? "; are the bounds in deg? give them in rad, or the field "
+                                  "\"unit\": \"deg\""
+                                : ""));
   }
   v.initial = number(vals[static_cast<std::size_t>(v.indices[0])], file, "/material/" + field);
   for (int i : v.indices)

@@ -232,15 +232,22 @@ def check_law_group(g, fam):
                               else " holding a NaN or inf"))
         return a
 
-    floor = g.attrs.get("floor")
-    if floor is None or not np.isfinite(float(floor)) or float(floor) < 0.0:
+    def number(name, kind=float):
+        v = g.attrs.get(name)
+        try:
+            return kind(v)
+        except (TypeError, ValueError):  # missing, h5py.Empty, a string or an array
+            raise ValueError(f"{where}: attribute {name} must be one number, got {v!r}") from None
+
+    floor = number("floor")
+    if not np.isfinite(floor) or floor < 0.0:
         raise ValueError(f"{where}: attribute floor must be finite and >= 0, got {floor!r}")
     knots = real("l_knots", 1)
     if fam == "network":
         if np.any(np.diff(knots) <= 0.0):
             raise ValueError(f"{where}/l_knots: must increase strictly, got {knots.tolist()}")
         theta = real("theta", 2)
-        h1, h2 = int(g.attrs["h1"]), int(g.attrs["h2"])
+        h1, h2 = number("h1", int), number("h2", int)
         width = 3 * h1 + 2 * h1 + h2 * h1 + 3 * h2 + 2 * h2 + 9
         if theta.shape != (len(knots), width):
             raise ValueError(f"{where}/theta: shape {theta.shape}, but h1 = {h1} and h2 = {h2} "

@@ -1053,6 +1053,41 @@ TEST_CASE("check_default_output_input refuses a default-named output of another 
                                       "file, " +
                                       a.string()) &&
                         Catch::Contains("give --output"));
+  // The same file typed relative to another directory (session 47's review: a run with -o
+  // from one directory, then the default name from another, was refused): the marker keeps
+  // the absolute path.
+  {
+    fs::create_directories(d / "desA" / "sub");
+    std::ofstream(a) << "{}";
+    const fs::path here = fs::current_path();
+    fs::current_path(d);
+    const fs::path rel_out = "rel_knitmap";
+    {
+      knit::io::AtomicDirectory w(rel_out, knit::io::AtomicDirectory::OnAbandon::Remove,
+                                  "output directory", "desA/case.json");
+      w.commit();
+    }
+    CHECK(knit::io::read_output_marker(rel_out)->input_absolute == a.string());
+    fs::current_path(d / "desA" / "sub");
+    CHECK_NOTHROW(knit::io::check_default_output_input(d / rel_out, "../case.json"));
+    CHECK_THROWS(knit::io::check_default_output_input(d / rel_out, b.string()));
+    fs::current_path(here);
+    // A marker without the line (before session 47): its provenance input as typed counts only
+    // where it names an existing file that is not this input.
+    const fs::path old_marker = d / "old_knitmap";
+    fs::create_directories(old_marker);
+    const auto write_old = [&](const std::string& typed) {
+      std::ofstream(old_marker / knit::io::kOutputMarker)
+          << "knitscale output\n{\"input\":\"" << typed << "\"}\nfor: old_knitmap\n";
+    };
+    fs::create_directories(b.parent_path());
+    std::ofstream(b) << "{}";
+    write_old(a.string());
+    CHECK_THROWS(knit::io::check_default_output_input(old_marker, b.string()));
+    CHECK_NOTHROW(knit::io::check_default_output_input(old_marker, a.string()));
+    write_old("no/such/dir/case.json");
+    CHECK_NOTHROW(knit::io::check_default_output_input(old_marker, b.string()));
+  }
   // No input in the marker (a library caller's, or markers before the provenance had one):
   // nothing to tell, nothing refused; nor is a directory that is no output.
   const fs::path plain = d / "plain";

@@ -472,18 +472,32 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
   expect("angle_lower.json", one_variable("knitting_angle", "[0]", "-200", "45"),
          "/variables/0/lower");
   {
-    // An angle field in deg with bounds in rad (session 47's walkthrough: "outside the
-    // bounds" alone): the message asks whether the bounds are in rad.
-    std::string c = knit_test::read_text(kDir / "case.json");
-    c.replace(c.find(R"("values": [0], "unit": "deg")"), 28, R"("values": [90], "unit": "deg")");
-    write(kDir / "case_90deg.json", c);
-    std::string t = one_variable("knitting_angle", "[0]", "1.2", "1.9");
-    t.replace(t.find("case.json"), 9, "case_90deg.json");
-    write(kDir / "rad_bounds.json", t);
-    CHECK_THROWS_WITH(load_design((kDir / "rad_bounds.json").string()),
+    // Angle fields and bounds in different units (session 47's walkthrough: "outside the
+    // bounds" alone): the messages ask. A case whose angle field is `angle` (values and unit),
+    // and a design of its angle in [lower, upper], written as kDir/name.
+    const auto angle_design = [&](const std::string& angle, const std::string& lower,
+                                  const std::string& upper, const std::string& name) {
+      std::string c = knit_test::read_text(kDir / "case.json");
+      c.replace(c.find(R"("values": [0], "unit": "deg")"), 28, angle);
+      write(kDir / ("case_" + name), c);
+      std::string t = one_variable("knitting_angle", "[0]", lower, upper);
+      t.replace(t.find("case.json"), 9, "case_" + name);
+      write(kDir / name, t);
+      return (kDir / name).string();
+    };
+    // A field in deg at 90 with bounds in rad.
+    CHECK_THROWS_WITH(load_design(angle_design(R"("values": [90], "unit": "deg")", "1.2", "1.9",
+                                               "rad_bounds.json")),
                       Catch::Contains("/variables/0: the case's value 90 deg is outside the "
                                       "bounds [1.2, 1.9]; the field is in deg (its \"unit\") and "
                                       "the bounds hold 1.5708 rad: are the bounds in rad?"));
+    // Bounds in deg for a field in rad (the review: refused by the +-pi check first, which
+    // now asks as well).
+    CHECK_THROWS_WITH(load_design(angle_design(R"("values": [0.5], "unit": "rad")", "-20", "100",
+                                               "deg_bounds.json")),
+                      Catch::Contains("/variables/0/lower: knitting-angle bounds must lie in "
+                                      "[-3.14159, 3.14159] (rad, the field's unit); are the "
+                                      "bounds in deg?"));
   }
   {
     std::string c = knit_test::read_text(kDir / "case.json");

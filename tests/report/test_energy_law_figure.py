@@ -84,7 +84,11 @@ def main():
                 ("h1 not matching theta", lambda f: f["energy_law"].attrs.__setitem__("h1", 11),
                  "/energy_law/theta: shape"),
                 ("a negative floor", lambda f: f["energy_law"].attrs.__setitem__("floor", -1.0),
-                 "/energy_law: attribute floor must be finite and >= 0")):
+                 "/energy_law: attribute floor must be finite and >= 0"),
+                ("an empty floor", lambda f: f["energy_law"].attrs.__setitem__(
+                    "floor", h5py.Empty("f8")), "/energy_law: attribute floor must be one number"),
+                ("no h1", lambda f: f["energy_law"].attrs.__delitem__("h1"),
+                 "/energy_law: attribute h1 must be one number")):
             write_db(db, 3)
             with h5py.File(db, "a") as f:
                 damage(f)

@@ -59,6 +59,8 @@ struct OutputMarker {
   /// The provenance's "input" (the input file as the run was given it; empty without one, or
   /// when the provenance line is not JSON).
   std::string input;
+  /// The "input: PATH" line (since session 47): the input file's absolute path; empty without.
+  std::string input_absolute;
 };
 /// The marker of `dir`, read; nothing without a marker.
 std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);
@@ -72,10 +74,13 @@ enum class OutputKind { kDirectory, kFile };
 
 /// For an output directory named by default after its input file (no --output given): refuses
 /// (knit::InputError(target, "output directory", why)) a `target` that holds the output of
-/// another input file, by its marker's provenance "input", both resolved from the current
-/// directory. Session 47's walkthrough: two designs' case.json files, each mapped with
-/// `knit-macro knitmap DIR/case.json`, went to one ./case_knitmap, the second replacing the
-/// first with exit 0. Nothing to refuse without a marker or an input in it.
+/// another input file: by the marker's "input:" line (absolute) when it has one; for older
+/// markers by the provenance "input" resolved from the current directory, and then only when
+/// both name existing files that are not the same file (a relative input typed in another
+/// directory resolves elsewhere: session 47's review found a rerun of the same case refused).
+/// Session 47's walkthrough: two designs' case.json files, each mapped with `knit-macro knitmap
+/// DIR/case.json`, went to one ./case_knitmap, the second replacing the first with exit 0. Nothing
+/// to refuse without a marker or an input in it.
 void check_default_output_input(const std::filesystem::path& target, const std::string& input);
 
 /// Refuses, before any work, an output target the run could not (or must not) write. Throws
