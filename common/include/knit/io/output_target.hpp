@@ -43,6 +43,8 @@ bool is_own_output(const std::filesystem::path& dir);
 
 /// The marker's further lines (session 29), below the owner and the provenance:
 ///   "for: NAME"            the name of the output the directory was written for (at creation)
+///   "input: PATH"          the input file's absolute path (at creation, when there is one;
+///                          since session 47, for check_default_output_input)
 ///   "file: REL/PATH"       one per file and directory the run wrote (at commit: the manifest)
 ///   "replaced by pid N"    the output is being moved aside by process N (DIR.old-<N>)
 /// A rerun replaced its output directory as a whole and deleted the files a user had put in
