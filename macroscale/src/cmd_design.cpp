@@ -246,18 +246,8 @@ knit::cli::SubcommandRegistrar reg(
         sum << "final run: " << (run.succeeded() ? "completed" : run_failure) << "\n";
         for (const std::string& n : knit::macro::final_run_step_notes(d))
           sum << "note: " << n << "\n";
-        {
-          // One "warning: final run: ..." line per line of its warnings (the material's come
-          // with their own "warning: ").
-          std::vector<std::string> warn = run.input_warnings;
-          for (const std::string& w : run.load_drops) warn.push_back(w);
-          if (!run.solver_warning.empty()) warn.push_back(run.solver_warning);
-          std::istringstream mw(run.material_warning);
-          for (std::string line; std::getline(mw, line);)
-            if (!line.empty())
-              warn.push_back(line.rfind("warning: ", 0) == 0 ? line.substr(9) : line);
-          for (const std::string& w : warn) sum << "warning: final run: " << w << "\n";
-        }
+        for (const std::string& w : knit::macro::run_warning_lines(run))
+          sum << "warning: final run: " << w << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());
         out.commit();
         std::cout << sum.str() << "wrote " << dir.string() << "\n";

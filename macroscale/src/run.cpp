@@ -221,6 +221,17 @@ std::string solver_fallback_message(const SolverStats& stats) {
   return m;
 }
 
+std::vector<std::string> run_warning_lines(const RunResult& r) {
+  std::vector<std::string> out = r.input_warnings;
+  out.insert(out.end(), r.load_drops.begin(), r.load_drops.end());
+  if (!r.solver_warning.empty()) out.push_back(r.solver_warning);
+  // The material's warning comes as lines of its own, each with "warning: ".
+  std::istringstream mw(r.material_warning);
+  for (std::string line; std::getline(mw, line);)
+    if (!line.empty()) out.push_back(line.rfind("warning: ", 0) == 0 ? line.substr(9) : line);
+  return out;
+}
+
 std::string run_failure_message(const RunResult& r) {
   std::string m;
   const auto add = [&m](const std::string& part) {

@@ -145,4 +145,9 @@ std::string solver_fallback_message(const SolverStats& stats);
 /// empty if it succeeded.
 std::string run_failure_message(const RunResult& r);
 
+/// Every warning of a finished run, one line each, without the "warning: " prefix: the input
+/// warnings, the load drops, the solver's fallback and each line of the material's warning
+/// (knit-macro design's summary.txt; session 47).
+std::vector<std::string> run_warning_lines(const RunResult& r);
+
 }  // namespace knit::macro
