@@ -1,9 +1,9 @@
 // The lane evaluator of the network law (knit/material/network_lanes.hpp) against the
 // reference pass by pass (NetworkLawAt, itself tested against the formula written out in
 // test_material_convex_network.cpp): two lanes = the mirror-averaged law at one theta, four
-// lanes = the convex combination of two knots' laws (both kernels: AVX2 and portable); on the
-// compiled sizes (12 / 6) and the general path (9 / 5, 16 / 8), with stiffening units and the
-// exponential outer function.
+// lanes = the convex combination of two knots' laws, six = of three (every kernel: AVX-512,
+// AVX2 and portable, where the processor has them); on the compiled sizes (12 / 6) and the
+// general path (9 / 5, 16 / 8), with stiffening units and the exponential outer function.
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -55,16 +55,26 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
   const NetworkShape sh = lanes_shape(h1, h2, s1[variant], s2[variant], outer);
   INFO("units " << h1 << " / " << h2 << ", stiffening " << sh.stiff1 << " and " << sh.stiff2
                 << ", outer " << sh.outer);
-  const std::vector<double> ta = lanes_theta(sh, 31), tb = lanes_theta(sh, 32);
-  const NetworkLawAt ref_a(sh, ta), ref_b(sh, tb);
+  const std::vector<double> ta = lanes_theta(sh, 31), tb = lanes_theta(sh, 32),
+                            tc = lanes_theta(sh, 33);
+  const NetworkLawAt ref_a(sh, ta), ref_b(sh, tb), ref_c(sh, tc);
   const NetworkLanesAt two(sh, ta);
   CHECK(two.lanes() == 2);
   const double t = GENERATE(0.0, 0.3, 1.0);
-  // Both four-lane kernels: the AVX2 one (where the processor has it) and the portable one.
-  const LanesKernel kernel = GENERATE(LanesKernel::kAuto, LanesKernel::kPortable);
+  // Every kernel: the widest the processor has (kAuto), AVX2 (where it has it), portable.
+  const LanesKernel kernel =
+      GENERATE(LanesKernel::kAuto, LanesKernel::kAvx2, LanesKernel::kPortable);
   const NetworkLanesAt four(sh, ta, tb, t, kernel);
+  // Six lanes: weights of a rounding window (1 - s)^2 / 2, ..., here with s = t.
+  const Eigen::Vector3d c(0.5 * (1 - t) * (1 - t), 0.5 + t * (1 - t), 0.5 * t * t);
+  const NetworkLanesAt six(sh, ta, tb, tc, c, kernel);
   CHECK(four.lanes() == 4);
-  CHECK(four.wide() == (kernel == LanesKernel::kAuto && __builtin_cpu_supports("avx2")));
+  CHECK(six.lanes() == 6);
+  const bool avx2 = __builtin_cpu_supports("avx2"), avx512 = NetworkLanesAt::six_lane_kernel();
+  CHECK(four.wide() == (kernel == LanesKernel::kAuto   ? avx2 || avx512
+                        : kernel == LanesKernel::kAvx2 ? avx2
+                                                       : false));
+  CHECK(six.wide() == (kernel == LanesKernel::kAuto && avx512));
   CHECK_FALSE(two.wide());
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> u(-0.7, 0.7);
@@ -79,6 +89,11 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
     blend.S = (1 - t) * a.S + t * b.S;
     blend.C = (1 - t) * a.C + t * b.C;
     require_close(four.evaluate(e), blend);
+    const NetworkResponse cc = ref_c.evaluate(e);
+    blend.W = c(0) * a.W + c(1) * b.W + c(2) * cc.W;
+    blend.S = c(0) * a.S + c(1) * b.S + c(2) * cc.S;
+    blend.C = c(0) * a.C + c(1) * b.C + c(2) * cc.C;
+    require_close(six.evaluate(e), blend);
     if (network_evaluate(sh, ta.data(), e, false).W > sh.outer_cap) ++beyond_cap;
   }
   if (outer) CHECK(beyond_cap > 10);  // both pieces of the outer function are exercised
@@ -86,8 +101,13 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
 
 TEST_CASE("network lanes: stress-free at 0 and even in E12", "[unit]") {
   const NetworkShape sh = lanes_shape(12, 6, 0, 0, true);
-  const NetworkLanesAt law(sh, lanes_theta(sh, 41), lanes_theta(sh, 42), 0.6,
-                           GENERATE(LanesKernel::kAuto, LanesKernel::kPortable));
+  const LanesKernel kernel =
+      GENERATE(LanesKernel::kAuto, LanesKernel::kAvx2, LanesKernel::kPortable);
+  const bool six_lanes = GENERATE(false, true);
+  const NetworkLanesAt law =
+      six_lanes ? NetworkLanesAt(sh, lanes_theta(sh, 41), lanes_theta(sh, 42), lanes_theta(sh, 43),
+                                 Eigen::Vector3d(0.2, 0.5, 0.3), kernel)
+                : NetworkLanesAt(sh, lanes_theta(sh, 41), lanes_theta(sh, 42), 0.6, kernel);
   const NetworkResponse r0 = law.evaluate(Eigen::Vector3d::Zero());
   CHECK(std::abs(r0.W) <= 1e-14);
   CHECK(r0.S.norm() <= 1e-14);

@@ -24,15 +24,17 @@
 
 namespace knit::material {
 
-/// Which code evaluates four lanes: kAuto = the AVX2 kernel where the processor has AVX2 (one
-/// 256-bit vector holds a unit's four lanes; +45 % on the default law between knots, session
-/// 17), else the portable one (Eigen, SSE2); kPortable = always the portable one (tests).
-/// Two lanes always take the portable one (faster there than the four-wide kernel).
-enum class LanesKernel { kAuto, kPortable };
+/// Which code evaluates four or six lanes: kAuto = the widest kernel the processor has: AVX-512
+/// (four lanes in a 256-bit vector, six in a 512-bit one; session 48), else AVX2 for four lanes
+/// (one 256-bit vector holds a unit's four lanes; +45 % on the default law between knots,
+/// session 17), else the portable one (Eigen, SSE2); kAvx2 = the AVX2 kernel for four lanes
+/// where the processor has AVX2, the portable one otherwise (tests); kPortable = always the
+/// portable one (tests). Two lanes always take the portable one (faster there).
+enum class LanesKernel { kAuto, kAvx2, kPortable };
 
 class NetworkLanesAt {
  public:
-  /// The AVX2 kernel's signature (common/src/material_network_lanes.cpp).
+  /// The wide kernels' signature (common/src/material_network_lanes.cpp).
   using WideKernel = void (*)(int, int, int, int, const double*, const double*, double*);
   NetworkLanesAt() = default;
   /// W at one theta: 1/2 (G(e) + G(M e)) - W0 - S0 . e (two lanes).
@@ -41,11 +43,19 @@ class NetworkLanesAt {
   NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
                  const std::vector<double>& theta_b, double t,
                  LanesKernel kernel = LanesKernel::kAuto);
+  /// W = c0 W(theta_a) + c1 W(theta_b) + c2 W(theta_c), each normalized as above (six lanes:
+  /// a rounding window's three knots); c >= 0 with sum 1.
+  NetworkLanesAt(const NetworkShape& shape, const std::vector<double>& theta_a,
+                 const std::vector<double>& theta_b, const std::vector<double>& theta_c,
+                 const Eigen::Vector3d& c, LanesKernel kernel = LanesKernel::kAuto);
   /// W, S, C at e (material frame, e finite). Allocation-free.
   NetworkResponse evaluate(const Eigen::Vector3d& e) const;
   int lanes() const { return K_; }
-  /// True if evaluate() runs the AVX2 kernel.
+  /// True if evaluate() runs a wide (AVX2 or AVX-512) kernel.
   bool wide() const { return wide_ != nullptr; }
+  /// True if this processor has the six-lane kernel (AVX-512); without it six lanes are
+  /// slower than four plus two (EnergyLawAt).
+  static bool six_lane_kernel();
 
  private:
   void build(const NetworkShape& shape, const std::vector<const std::vector<double>*>& thetas,
@@ -53,14 +63,15 @@ class NetworkLanesAt {
 
   NetworkShape shape_;
   int K_ = 0;
+  int width_ = 4;  ///< lanes in the wide kernel's vectors: 4, or 8 for six lanes
   /// Packed, each array K h1 (first layer) or K h2 (second layer) long, lane-major (lane k's
   /// units at k h + i): c0, c1, c2, b0, w1, p00, p01, p02, p11, p12, p22 (products of the
   /// columns of A0); then V (K blocks h2 x h1, row-major); then a10, a11, a12, b1, w.
   std::vector<double> packed_;
   /// Per lane: weight omega_k and Q = L L^T (upper triangle: 00, 01, 02, 11, 12, 22).
   std::vector<double> omega_, Q_;
-  /// The same, unit-major for the four-wide kernel: [field][unit][lane], 4 lanes (empty when
-  /// the portable code evaluates).
+  /// The same, unit-major for the wide kernel: [field][unit][lane], width_ lanes (the lanes
+  /// beyond K_ copies of lane 0, not summed; empty when the portable code evaluates).
   std::vector<double> packed4_;
   WideKernel wide_ = nullptr;
   double W0_ = 0.0;
