@@ -27,6 +27,7 @@
 #include "knit/io/csv.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
+#include "knit/meso/cell/geometry.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
 // A named namespace per command: the cmd_*.cpp files share one unity translation unit
@@ -213,6 +214,14 @@ int run(const Cli& c) {
   // 45 the lock does it for every command, and only for the directories its mkdir made).
   try {
     const SweepInput in = load_sweep_input(c.input);
+    // Session 48's walkthrough: cell and path warn of a loop length outside the published
+    // cells (there the cell stiffens as the loops lengthen: S22 at E = 0.05 is 250 x larger
+    // at 12 mm than at 6.5 mm), while a sweep of 12 mm wrote its database without a word.
+    if (mpi.rank() == 0 && in.runner == RunnerKind::kCell)
+      for (const double l : in.loop_lengths)
+        if (const std::string w = knit::meso::cell::loop_length_range_warning(l); !w.empty())
+          std::fprintf(stderr, "knit-meso sweep: %s (%s: /loop_lengths)\n", w.c_str(),
+                       c.input.c_str());
     // The database and checkpoints' size, before any work (session 44's red team: 101,300
     // cases of up to 10,000 steps were accepted, about 240 GB; path and rod have the cap).
     check_output_size(in, c.max_output_size.empty()

@@ -361,6 +361,32 @@ TEST_CASE("knit-meso sweep: a sweep that writes nothing says so and leaves no ne
   CHECK_FALSE(fs::exists(dir / "a" / "b"));
 }
 
+// Session 48's walkthrough: knit-meso cell and path warn of a loop length outside the
+// published cells (4.5-6.5 mm), a sweep did not. The warning comes as soon as the input is
+// read, before any check of the output (here a size cap that refuses the sweep at once).
+TEST_CASE("knit-meso sweep: a loop length outside the published cells is warned of", "[case]") {
+  const auto dir = knit_test::scratch("sweep_cli_range_warning");
+  for (const char* l : {"12", "5"}) {
+    knit_test::write_text(dir / "w.json", std::string(R"({"loop_lengths": [)") + l +
+                                              R"(], "steps": 2, "retry": {"max_retries": 0},
+                              "load_paths": {"preset": "default", "select": [0]},
+                              "cell": {"contact": {"mu": 1e300}}, "fit": false})");
+    const fs::path err = dir / "stderr.txt";
+    CHECK(shell(kExe + " sweep " + (dir / "w.json").string() + " --output " +
+                (dir / "db.h5").string() + " --max-output-size 1 --no-progress > /dev/null 2> " +
+                err.string()) == 2);
+    const std::string text = knit_test::read_text(err);
+    INFO(text);
+    if (std::string(l) == "12") {
+      CHECK_THAT(text, Catch::Contains("warning: loop length 12 mm lies outside the cells with "
+                                       "published wale width"));
+      CHECK_THAT(text, Catch::Contains((dir / "w.json").string() + ": /loop_lengths"));
+    } else {
+      CHECK_THAT(text, !Catch::Contains("lies outside the cells"));
+    }
+  }
+}
+
 // Session 44's red team: a schema-valid sweep of 100 loop lengths x 1,000 held-out paths of
 // 10,000 steps (the synthetic runner) was accepted as 101,300 cases; its checkpoints grew
 // 270 MB in 6 s towards about 240 GB. Now it is refused before any work, as knit-meso path
