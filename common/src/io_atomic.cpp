@@ -6,6 +6,7 @@
 #include <stdio.h>  // renameat2 (glibc >= 2.28, _GNU_SOURCE is defined by g++)
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -393,7 +394,13 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   if (!input.empty()) {
     std::error_code aec;
     const fs::path abs = fs::absolute(input, aec);
-    if (!aec) marker << "input: " << abs.lexically_normal().string() << "\n";
+    const std::string line = abs.lexically_normal().string();
+    // (no control character: read_input_file refuses them in an input's name; a caller that
+    // did not read its input through it gets no "input:" line rather than a forged one)
+    const bool plain = std::none_of(line.begin(), line.end(), [](char ch) {
+      return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+    });
+    if (!aec && plain) marker << "input: " << line << "\n";
   }
   if (!marker.flush()) {
     // The directory is ours, just created, and holds only this file: without its marker no

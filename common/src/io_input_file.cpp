@@ -50,10 +50,30 @@ struct Fd {
   }
 };
 
+/// Control characters (a newline above all) in an input's path (session 48's red team): its
+/// absolute path is a line of the output's marker ("input: ...", io/atomic.hpp), and a case
+/// named "x\nfile: notes.txt" put notes.txt into a run's own files, which a rerun then deleted.
+/// Output paths are refused the same way (check_output_target). The name is shown with each
+/// control character as '?'.
+void check_input_name(const std::string& name) {
+  std::string shown = name;
+  bool control = false;
+  for (char& ch : shown)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) {
+      ch = '?';
+      control = true;
+    }
+  if (control)
+    throw InputError(shown, "",
+                     "the file's name holds a control character (a newline, a tab, ...; shown "
+                     "as '?'); rename it to a plain name");
+}
+
 }  // namespace
 
 std::uint64_t check_input_file(const std::filesystem::path& file, std::uint64_t max_bytes) {
   const std::string name = file.string();
+  check_input_name(name);
   struct stat st {};
   if (::stat(name.c_str(), &st) != 0)
     throw InputError(name, "",
@@ -64,6 +84,7 @@ std::uint64_t check_input_file(const std::filesystem::path& file, std::uint64_t 
 
 std::string read_input_file(const std::filesystem::path& file, std::uint64_t max_bytes) {
   const std::string name = file.string();
+  check_input_name(name);
   // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
   Fd f{::open(name.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)};
   if (f.fd < 0)

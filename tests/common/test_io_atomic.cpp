@@ -1030,6 +1030,29 @@ TEST_CASE("AtomicDirectory keeps the output it replaces where it is asked to",
   CHECK(slurp(kept / "notes.txt") == "notes");
 }
 
+TEST_CASE("a marker never holds a line forged by its input's name", "[unit][io][atomic]") {
+  // Session 48's red team: the input's absolute path is a marker line, and "x\nfile: notes.txt"
+  // became two lines, the second listing notes.txt as the output's own. read_input_file refuses
+  // such names; a caller that did not read through it gets no "input:" line.
+  const fs::path d = scratch("marker_forged");
+  const fs::path out = d / "o";
+  {
+    knit::io::AtomicDirectory w(out, knit::io::AtomicDirectory::OnAbandon::Remove,
+                                "output directory", (d / "x\nfile: notes.txt").string());
+    w.commit();
+  }
+  const std::string marker = slurp(out / ".knitscale-output");
+  CHECK(marker.find("\nfile: notes.txt") == std::string::npos);
+  CHECK(marker.find("\ninput: ") == std::string::npos);
+  {
+    knit::io::AtomicDirectory w(out, knit::io::AtomicDirectory::OnAbandon::Remove,
+                                "output directory", (d / "case.json").string());
+    w.commit();
+  }
+  CHECK_THAT(slurp(out / ".knitscale-output"),
+             Catch::Contains("\ninput: " + (d / "case.json").string() + "\n"));
+}
+
 TEST_CASE("check_default_output_input refuses a default-named output of another input file",
           "[unit][io][atomic]") {
   // Session 47's walkthrough: `knit-macro knitmap desA/case.json` and then `desB/case.json`

@@ -468,6 +468,23 @@ TEST_CASE("only regular files of bounded size are read", "[unit][io][json]") {
   CHECK_THROWS_WITH(knit::io::read_json_file(big), Catch::Contains("more than the 64 MiB"));
 }
 
+TEST_CASE("an input whose name holds a control character is refused, shown with '?'",
+          "[unit][io][json]") {
+  // Session 48's red team: a case named "x\nfile: notes.txt" wrote a line "file: notes.txt"
+  // into its run's marker (the input's path is a line there), and a rerun deleted the user's
+  // notes.txt. The file exists and is valid JSON: only its name is refused.
+  const fs::path odd = scratch("x\nfile: notes.txt", "{}");
+  const std::string shown = odd.parent_path().string() + "/x?file: notes.txt";
+  CHECK_THROWS_WITH(knit::io::read_json_file(odd), Catch::StartsWith(shown) &&
+                                                       Catch::Contains("control character") &&
+                                                       Catch::Contains("rename it"));
+  CHECK_THROWS_WITH(knit::io::check_input_file(odd, knit::io::kMaxJsonInputBytes),
+                    Catch::StartsWith(shown));
+  const fs::path tab = scratch("a\tb.json", "{}");
+  CHECK_THROWS_WITH(knit::io::read_input_file(tab), Catch::Contains("control character"));
+  CHECK_NOTHROW(knit::io::read_input_file(scratch("plain name.json", "{}")));
+}
+
 TEST_CASE("schema patterns run in linear time without recursion", "[unit][io][json][schema]") {
   // A 30,000-character name overflowed std::regex's recursive executor.
   const knit::io::JsonSchema s(json::parse(R"({"type": "string", "pattern": "^[^,\"/\\n]+$"})"),

@@ -5,7 +5,9 @@
 //   knit::io::check_input_file(db, knit::io::kMaxHdf5InputBytes);    // before HDF5 opens it
 //
 // Errors are knit::InputError(file, "", message): "file not found", "not a regular file (a
-// FIFO)", "cannot read file", "is 80 MiB, more than the 64 MiB accepted for this input".
+// FIFO)", "cannot read file", "is 80 MiB, more than the 64 MiB accepted for this input", and
+// a name with a control character (a newline: an output's marker records its input's path
+// line by line; session 48) is refused before the file is opened.
 #pragma once
 
 #include <cstdint>
