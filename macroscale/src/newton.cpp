@@ -282,8 +282,16 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       if (stats.iterations >= work_cap) {
         o.work_cap = true;
         std::ostringstream s;
-        s << "the cap on the total work was reached: " << stats.iterations
-          << " Newton iterations (max_total_iterations " << work_cap << ")";
+        s << "the cap on the total work was reached: " << stats.iterations << " Newton iterations";
+        // The case file cannot set the cap (session 48's red team: the message named
+        // max_total_iterations, which a case refuses as an unknown key): say what sets it.
+        if (opt.max_total_iterations > 0)
+          s << " (max_total_iterations " << work_cap << ")";
+        else
+          s << " (the cap is 20 x /solver/steps x /solver/max_iterations = 20 x " << nsteps << " x "
+            << std::max(1, opt.max_iterations) << " = " << work_cap
+            << "; the cut-backs spent it: raise /solver/steps, so that each step asks less, or "
+               "/solver/max_iterations)";
         o.why = s.str();
         return o;
       }

@@ -380,6 +380,19 @@ TEST_CASE("load stepping: a floor on the increment and a cap on the work, named 
   CHECK(cap.report.reason == StopReason::kWorkCap);
   CHECK(cap.report.message.find("cap on the total work") != std::string::npos);
   CHECK(cap.report.stats.iterations == 30);
+  // The default cap (20 x steps x max_iterations), which a case cannot set by name: the
+  // message says what sets it (session 48's red team: it named max_total_iterations).
+  const RunResult dflt = run(j, [&](Case& c) {
+    brittle(c);
+    c.solver.max_cutbacks = 40;
+    c.solver.max_iterations = 5;
+    c.solver.steps = 1;
+  });
+  CHECK(dflt.report.reason == StopReason::kWorkCap);
+  CHECK(dflt.report.stats.iterations == 100);
+  CHECK_THAT(dflt.report.message,
+             Catch::Contains("20 x /solver/steps x /solver/max_iterations = 20 x 1 x 5 = 100") &&
+                 !Catch::Contains("max_total_iterations"));
 }
 
 TEST_CASE("DofMap: a rigid mode is found with fewer than five constrained DOFs", "[unit]") {
