@@ -569,18 +569,48 @@ void read_output(const Reader& r, const json& root, Case& c) {
              "the gauge length (the distance between the jaws) must lie in " +
                  relative_range(kMinGaugePerSize, kMaxGaugePerSize, size) + ", got " +
                  a.at("gauge_length").dump());
-    bool found = false;
+    // The condition that prescribes the component there: one on the same edge or corner, else
+    // (a corner) one on an edge through it, else one on all control points (session 48's red
+    // team: a corner whose edge was prescribed was refused with "no boundary condition
+    // prescribes this component", which was false). Two that disagree are refused by the run
+    // (a displacement takes one value).
+    using Target = BoundaryCondition::Target;
+    const auto on_edge = [](const Eigen::Vector2d& corner, Edge e) {
+      switch (e) {
+        case Edge::kU0:
+          return corner(0) == 0.0;
+        case Edge::kU1:
+          return corner(0) == 1.0;
+        case Edge::kV0:
+          return corner(1) == 0.0;
+        case Edge::kV1:
+          return corner(1) == 1.0;
+      }
+      return false;
+    };
+    int best = 3;  // 0 the same place, 1 an edge through the corner, 2 everywhere
     for (const BoundaryCondition& bc : c.bcs) {
-      const bool same =
-          ad.at_edge ? (bc.target == BoundaryCondition::Target::kEdge && bc.edge == ad.edge)
-                     : (bc.target == BoundaryCondition::Target::kCorner && bc.corner == ad.corner);
-      if (same && bc.prescribe[ad.component]) {
+      if (!bc.prescribe[ad.component]) continue;
+      int rank = 3;
+      if (bc.target == Target::kAll)
+        rank = 2;
+      else if (ad.at_edge)
+        rank = bc.target == Target::kEdge && bc.edge == ad.edge ? 0 : 3;
+      else if (bc.target == Target::kCorner)
+        rank = bc.corner == ad.corner ? 0 : 3;
+      else if (bc.target == Target::kEdge)
+        rank = on_edge(ad.corner, bc.edge) ? 1 : 3;
+      if (rank < best) {
+        best = rank;
         ad.value = *bc.prescribe[ad.component];
-        found = true;
       }
     }
-    if (!found)
-      r.fail(ptr, "no boundary condition prescribes this component on that edge or corner");
+    if (best == 3)
+      r.fail(ptr, ad.at_edge
+                      ? "no boundary condition prescribes this component on that edge (or on "
+                        "all control points)"
+                      : "no boundary condition prescribes this component at that corner (on "
+                        "it, on an edge through it or on all control points)");
     out.applied = ad;
   }
 }

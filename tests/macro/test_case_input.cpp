@@ -281,6 +281,27 @@ TEST_CASE("bad case input names the file and the JSON pointer", "[unit]") {
     j["output"]["applied_displacement"]["gauge_length"] = g;
     CHECK(error_of(j).empty());
   }
+  // Session 48's red team: a corner on the prescribed edge was refused with "no boundary
+  // condition prescribes this component", which was false. The edge v1 prescribes y = 15.
+  for (const char* corner : {"u0v1", "u1v1"}) {
+    json j = base;
+    j["output"]["applied_displacement"] = {
+        {"corner", corner}, {"component", "y"}, {"gauge_length", 50}};
+    CHECK(error_of(j).empty());
+    REQUIRE(parse_case(j.dump(), "c.json").output.applied);
+    CHECK(parse_case(j.dump(), "c.json").output.applied->value == 15.0);
+  }
+  {
+    json j = base;  // u1v0 lies on the fixed edge v0 (y held, not prescribed) and u1
+    j["output"]["applied_displacement"] = {
+        {"corner", "u1v0"}, {"component", "y"}, {"gauge_length", 50}};
+    CHECK(error_of(j).rfind("bad.json: /output/applied_displacement: no boundary condition "
+                            "prescribes this component at that corner (on it, on an edge "
+                            "through it or on all control points)",
+                            0) == 0);
+    j["output"]["applied_displacement"]["component"] = "x";  // nothing prescribes x anywhere
+    CHECK_FALSE(error_of(j).empty());
+  }
   {
     json j = base;
     j["material"]["type"] = "rubber";
