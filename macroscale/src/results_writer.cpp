@@ -41,6 +41,7 @@ void write_text(const fs::path& file, const std::string& text) {
 
 ResultsWriter::ResultsWriter(const Case& c, const ShellModel& m, fs::path dir)
     : case_(c),
+      units_(unit_labels(c.units)),
       model_(m),
       dir_(std::move(dir), io::AtomicDirectory::OnAbandon::Remove, "output directory", c.file),
       pvd_(dir_.path() / "results.pvd") {
@@ -87,6 +88,62 @@ std::string result_unit(const std::string& name) {
     if (name == n) return u;
   return "";
 }
+
+}  // namespace
+
+/// The case's units (session 48's red team: a case in "m, kN, kPa" was written with mm, N and
+/// MPa on every label). "L, F, S" gives the length, force and stress symbols; no /units, or
+/// "mm, N, MPa", the defaults; anything else (the benchmarks' "consistent (dimensionless
+/// benchmark)") has no symbols, and every dimensional label refers to /units.
+ResultsWriter::UnitLabels ResultsWriter::unit_labels(const std::string& declared) {
+  UnitLabels u;
+  std::vector<std::string> parts;
+  std::string cur;
+  for (const char ch : declared + ",") {
+    if (ch == ',') {
+      const auto b = cur.find_first_not_of(" \t"), e = cur.find_last_not_of(" \t");
+      parts.push_back(b == std::string::npos ? "" : cur.substr(b, e - b + 1));
+      cur.clear();
+    } else {
+      cur += ch;
+    }
+  }
+  const bool three = parts.size() == 3 && std::none_of(parts.begin(), parts.end(), [](auto& p) {
+                       return p.empty() || p.find_first_of(" \t") != std::string::npos;
+                     });
+  std::string bare;
+  for (const auto& p : parts) bare += p + ",";
+  if (declared.empty() || bare == "mm,N,MPa,")
+    return u;  // written "mm, N, MPa" whatever the blanks
+  u.root = declared;
+  if (three) {
+    u.length = parts[0];
+    u.force = parts[1];
+    u.stress = parts[2];
+  } else {
+    u.length = u.force = u.stress = "";
+  }
+  return u;
+}
+
+std::string ResultsWriter::UnitLabels::of(const std::string& mm_unit) const {
+  if (mm_unit != "mm" && mm_unit != "1/mm" && mm_unit != "N/mm" && mm_unit != "N" &&
+      mm_unit != "MPa")
+    return mm_unit;  // dimensionless, rad, s
+  if (length.empty()) return "in the case's units (/units: " + root + ")";
+  if (mm_unit == "mm") return length;
+  if (mm_unit == "1/mm") return "1/" + length;
+  if (mm_unit == "N/mm") return force + "/" + length;
+  if (mm_unit == "N") return force;
+  return stress;
+}
+
+std::string ResultsWriter::UnitLabels::suffix(const std::string& mm_unit) const {
+  if (length.empty()) return "";
+  return "_" + of(mm_unit);
+}
+
+namespace {
 
 /// What n and m are: the resultants of the 2nd Piola-Kirchhoff stress through the thickness
 /// (work conjugate to E and kappa, per unit reference length, in the reference surface's local
@@ -204,7 +261,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   h5.set_attribute(".", "status", report.status == RunStatus::kCompleted ? "completed" : "stopped");
   h5.set_attribute(".", "message", report.message);
   h5.set_attribute(".", "stability", stability_summary(report));
-  h5.set_attribute(".", "units", "mm, N, MPa");
+  h5.set_attribute(".", "units", units_.root);
   h5.set_attribute(".", "material", case_.material->name());
   h5.set_attribute(".", "material_report", material_report_);
   for (const auto& [k, v] : case_.material->data_provenance()) h5.set_attribute(".", k, v);
@@ -256,11 +313,11 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
   for (const char* name : {"step", "load_factor", "applied_displacement", "strain", "iterations",
                            "residual", "seconds", "negative_pivots", "determinant_sign"})
     if (h5.exists(std::string("steps/") + name))
-      h5.set_attribute(std::string("steps/") + name, "units", result_unit(name));
+      h5.set_attribute(std::string("steps/") + name, "units", units_.of(result_unit(name)));
   for (const ReactionOutput& r : case_.output.reactions)
-    h5.set_attribute("steps/reactions/" + r.name, "units", "N");
+    h5.set_attribute("steps/reactions/" + r.name, "units", units_.of("N"));
   for (const OutputPoint& p : case_.output.points) {
-    h5.set_attribute("steps/points/" + p.name, "units", "mm");
+    h5.set_attribute("steps/points/" + p.name, "units", units_.of("mm"));
     h5.set_attribute("steps/points/" + p.name, "columns", "ux, uy, uz");
   }
   // Sampled fields of each output step.
@@ -279,10 +336,10 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
       h5.write(grp + "/" + f.names[c], Eigen::VectorXd(f.values.col(c)));
     for (const std::string& name :
          {std::string("X"), std::string("x"), std::string("displacement")})
-      h5.set_attribute(grp + "/" + name, "units", result_unit(name));
+      h5.set_attribute(grp + "/" + name, "units", units_.of(result_unit(name)));
     for (const std::string& name : f.names) {
       if (const std::string u = result_unit(name); !u.empty())
-        h5.set_attribute(grp + "/" + name, "units", u);
+        h5.set_attribute(grp + "/" + name, "units", units_.of(u));
       if (name.size() == 3 && (name[0] == 'n' || name[0] == 'm') && result_unit(name) != "")
         h5.set_attribute(grp + "/" + name, "measure", kResultantMeasure);
     }
@@ -292,15 +349,17 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
 
 void ResultsWriter::finish(const RunReport& report) {
   std::vector<std::string> header = {"step", "load_factor"};
-  if (case_.output.applied) header.insert(header.end(), {"applied_displacement_mm", "strain"});
-  for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + "_N");
+  const std::string L = units_.suffix("mm"), F = units_.suffix("N");
+  if (case_.output.applied) header.insert(header.end(), {"applied_displacement" + L, "strain"});
+  for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + F);
   for (const OutputPoint& p : case_.output.points)
-    header.insert(header.end(), {p.name + "_ux_mm", p.name + "_uy_mm", p.name + "_uz_mm"});
+    header.insert(header.end(), {p.name + "_ux" + L, p.name + "_uy" + L, p.name + "_uz" + L});
   header.insert(header.end(),
                 {"iterations", "residual", "seconds", "negative_pivots", "determinant_sign"});
   io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
   csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
                   ", git " + git_revision() + ")");
+  if (units_.length.empty()) csv.add_comment("units: as the case's /units: " + units_.root);
   if (report.status != RunStatus::kCompleted)
     csv.add_comment("run stopped early: " + report.message);
   if (!material_failure_.empty()) csv.add_comment(material_failure_);

@@ -778,6 +778,49 @@ TEST_CASE("knit-macro run writes CSV, PVD/VTU and HDF5 with the case and provena
   fs::remove_all(d);
 }
 
+TEST_CASE("knit-macro run labels its outputs in the case's units", "[unit]") {
+  // Session 48's red team: tensile_svk in metres ("m, kN, kPa") was written with mm, N and MPa
+  // on every label; the shipped benchmarks' "consistent (dimensionless benchmark)" as well.
+  const fs::path d = temp_dir("units");
+  json j = verification_case("tensile_svk.json");
+  j["solver"]["steps"] = 1;
+  j["output"]["grid"] = {3, 3};
+  j["output"]["vtk"] = false;
+  for (const std::string units :
+       {"m, kN, kPa", "consistent (dimensionless benchmark)", "mm,N,MPa"}) {
+    INFO(units);
+    j["units"] = units;
+    std::ofstream(d / "t.json") << j.dump(2);
+    REQUIRE(run_exe((d / "t.json").string() + " --output " + (d / "out").string(), d / "log.txt") ==
+            0);
+    const std::string csv = slurp(d / "out" / "load_strain.csv");
+    auto h5 = knit::io::H5File::open_read(d / "out" / "results.h5");
+    if (units == "mm,N,MPa") {  // the default units, written as always whatever the blanks
+      CHECK(h5.attribute_string(".", "units") == "mm, N, MPa");
+      CHECK_THAT(csv, Catch::Contains("applied_displacement_mm,strain,jaw_force_N"));
+      continue;
+    }
+    CHECK(h5.attribute_string(".", "units") == units);
+    if (units[0] == 'm') {
+      CHECK_THAT(csv, Catch::Contains("step,load_factor,applied_displacement_m,strain,"
+                                      "jaw_force_kN"));
+      CHECK(h5.attribute_string("steps/applied_displacement", "units") == "m");
+      CHECK(h5.attribute_string("steps/reactions/jaw_force", "units") == "kN");
+      CHECK(h5.attribute_string("fields/step_0001/X", "units") == "m");
+      CHECK(h5.attribute_string("fields/step_0001/kappa11", "units") == "1/m");
+      CHECK(h5.attribute_string("fields/step_0001/n11", "units") == "kN/m");
+      CHECK(h5.attribute_string("fields/step_0001/m12", "units") == "kN");
+    } else {
+      CHECK_THAT(csv, Catch::Contains("step,load_factor,applied_displacement,strain,jaw_force,") &&
+                          Catch::Contains("# units: as the case's /units: " + units));
+      CHECK(h5.attribute_string("steps/reactions/jaw_force", "units") ==
+            "in the case's units (/units: " + units + ")");
+    }
+    CHECK(h5.attribute_string("steps/strain", "units") == "1");
+  }
+  fs::remove_all(d);
+}
+
 TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry", "[unit]") {
   // Issue 14: the corner u1v1 pulled in so that A1 || A2 there: |A1 x A2| = 0 only at that
   // corner, positive at every quadrature point -- the loader used to accept it and the run

@@ -92,6 +92,9 @@ struct OutputOptions {
 struct Case {
   std::string file;  ///< path of the case file
   std::string text;  ///< the case JSON as read (stored with the outputs)
+  /// /units as declared ("" when absent): the outputs' unit labels follow it (ResultsWriter;
+  /// a knit case is refused unless it is "mm, N, MPa").
+  std::string units;
   std::string description;
   spline::SplineSurface input_surface;  ///< the patch as given
   spline::SplineSurface surface;        ///< after refinement
