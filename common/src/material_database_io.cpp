@@ -386,6 +386,15 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     db.generator = f.attribute_string(".", "generator");
     require_group("/sweep");
     db.sweep_input = f.attribute_string("/sweep", "input_json");
+    // A failed sweep's database, written for the diagnosis (session 48's walkthrough: a case
+    // ran on one with exit 0, its failed cases unmentioned; the macroscale warns).
+    if (f.is_group("/sweep/report") && f.has_attribute("/sweep/report", "failed_cases")) {
+      db.sweep_failed_cases = f.attribute_int("/sweep/report", "failed_cases");
+      if (db.sweep_failed_cases < 0)
+        throw InputError(fname, "/sweep/report",
+                         "attribute failed_cases is " + std::to_string(db.sweep_failed_cases) +
+                             ", a count must be >= 0");
+    }
     require_group("/yarn");
     for (const auto& n : f.attribute_names("/yarn")) {
       if (n == "units") continue;  // the text naming the others' units (since session 38)

@@ -325,6 +325,17 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // of another database (session 38's red team).
   src.database_date_utc = data.provenance.date_utc;
   src.input_warning = small_patch;
+  if (data.sweep_failed_cases > 0) {
+    // Session 48's walkthrough: a case ran on a failed sweep's database with exit 0 and no
+    // word of the cases that failed.
+    std::ostringstream os;
+    os << "warning: " << db.string() << ": /sweep/report@failed_cases: the sweep that wrote "
+       << "this database failed (" << data.sweep_failed_cases << " case"
+       << (data.sweep_failed_cases == 1 ? " did" : "s did")
+       << " not converge; knit-meso sweep wrote it for the diagnosis, with exit 1): its laws "
+          "lack those cases' states; rerun the sweep (its summary says why they failed)";
+    src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
+  }
   // The law's own uniaxial response beside the cell's (session 41): warned about after a run
   // where it departs by more than /material/uniaxial_tolerance (KnitMaterial::warning()).
   // Every loop length of the diagnostics, those without a curve too: the knots' neighbours

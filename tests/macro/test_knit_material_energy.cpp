@@ -519,3 +519,32 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   CHECK_THAT(report_of(), Catch::Contains("\n  uniaxial check: not available (the database has "
                                           "no /energy_law/diagnostics/uniaxial"));
 }
+
+// Session 48's walkthrough: a case ran on a failed sweep's database (written for the diagnosis,
+// knit-meso sweep's exit 1) with exit 0, its failed cases unmentioned.
+TEST_CASE("knit material: a failed sweep's database is warned of, a bad count refused", "[unit]") {
+  for (const int failed : {0, 3, -1}) {
+    INFO(failed);
+    const std::string db = db_file("failed_sweep.h5", true, kDatabaseFormatVersion);
+    {
+      auto h = knit::io::H5File::open_rw(db);
+      h.create_group("/sweep/report");
+      h.set_attribute("/sweep/report", "failed_cases", failed);
+    }
+    const std::string text =
+        square_case(R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": 5.0})");
+    if (failed < 0) {
+      CHECK_THROWS_WITH(parse_case(text, "c.json"),
+                        Catch::Contains("/sweep/report: attribute failed_cases is -1"));
+      continue;
+    }
+    const Case c = parse_case(text, "c.json");
+    const auto& m = dynamic_cast<const KnitMaterial&>(*c.material);
+    if (failed == 0)
+      CHECK_THAT(m.warning(), !Catch::Contains("failed_cases"));
+    else
+      CHECK_THAT(m.warning(), Catch::Contains(db + ": /sweep/report@failed_cases: the sweep that "
+                                                   "wrote this database failed (3 cases did not "
+                                                   "converge"));
+  }
+}

@@ -153,8 +153,11 @@ struct Provenance {
 struct Database {
   int format_version = kDatabaseFormatVersion;
   Provenance provenance;
-  std::string generator;                 ///< "sweep", "synth" (synthetic stand-in), ...
-  std::string sweep_input;               ///< the sweep's input (JSON text)
+  std::string generator;    ///< "sweep", "synth" (synthetic stand-in), ...
+  std::string sweep_input;  ///< the sweep's input (JSON text)
+  /// /sweep/report@failed_cases when the file has it (read only): above 0, the sweep that
+  /// wrote this database failed, and wrote it for the diagnosis (knit-meso sweep, exit 1).
+  int sweep_failed_cases = 0;
   std::map<std::string, double> yarn;    ///< e.g. diameter, youngs_modulus, poisson_ratio
   std::vector<LoopLengthEntry> entries;  ///< increasing loop length
   /// The energy-based law (format version 2, /energy_law); absent in version-1 files and
