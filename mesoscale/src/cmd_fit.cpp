@@ -154,9 +154,11 @@ static knit::cli::SubcommandRegistrar reg_fit(
           "--energy-options", o->energy_options,
           "energy-law fit options (JSON file; without it: the options the database records for "
           "its energy law, else the code's defaults, {} for them: the input-convex network family "
-          "without a tube or outer function, docs/database.md; the default sweep's law is the "
-          "energy_fit object of cases/sweep/default.json, {\"outer\": \"exp\", \"tube\": "
-          "0.045, ...}; {\"family\": \"ridge\"} for the ridge-spline law)");
+          "without a tube or outer function, a far looser fit (up to 30 % of the stress range "
+          "where the default sweep's options give 5 %), docs/database.md; the default sweep's "
+          "law is the energy_fit object of cases/sweep/default.json, {\"outer\": \"exp\", "
+          "\"tube\": 0.045, ...}: copy it to start from; {\"family\": \"ridge\"} for the "
+          "ridge-spline law; a law that misses its data by more than 10 % is warned of)");
       sub.add_option("-o,--output,--out", o->out, "write here instead of replacing the input");
       sub.add_option("--threads", o->threads,
                      "threads of the energy-law fit (default 0: all cores, at most one per loop "
@@ -307,6 +309,8 @@ static knit::cli::SubcommandRegistrar reg_fit(
           eo.progress = stderr;  // a line every 5 s of the network's L-BFGS
           const auto s = fit_energy_database(db, eo);
           std::cout << energy_fit_report(s);
+          if (const std::string w = knit::meso::fit::energy_fit_warning(s); !w.empty())
+            std::cerr << "knit-meso fit: " << w << "\n";
           if (s.status == FitStatus::kRefused)
             throw knit::InputError(o->db, "", "energy law refused: " + s.reason);
           if (!s.ok()) {

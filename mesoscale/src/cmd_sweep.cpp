@@ -78,6 +78,8 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
   }
   if (rep.energy_fit) {
     std::printf("%s", knit::meso::fit::energy_fit_report(*rep.energy_fit).c_str());
+    if (const std::string w = knit::meso::fit::energy_fit_warning(*rep.energy_fit); !w.empty())
+      std::fprintf(stderr, "knit-meso sweep: %s\n", w.c_str());
     // Session 39's walkthrough: a sweep input without "energy_fit" got the code's defaults
     // (no tube, no outer function, 4,000 iterations: 12 % of the range at 5.0 mm) without a word.
     if (!in.energy_fit_given)

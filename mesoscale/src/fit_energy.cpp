@@ -834,6 +834,24 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     // (Session 47's red team: said also when held-out paths exist but none converged.)
     os << "    held out: no converged state (no path with set \"holdout\", or none of them "
           "converged)\n";
+  if (const std::string w = energy_fit_warning(s); !w.empty()) os << "    " << w << "\n";
+  return os.str();
+}
+
+std::string energy_fit_warning(const EnergyFitSummary& s) {
+  if (!s.ok()) return {};
+  const material::EnergyFitDiagnostics::PerLoop* worst = nullptr;
+  for (const auto& p : s.diagnostics.per_loop)
+    if (!worst || p.max_relative > worst->max_relative) worst = &p;
+  if (!worst || !(worst->max_relative > kEnergyFitWarnRelative)) return {};
+  std::ostringstream os;
+  os << "warning: the energy law misses its data by up to " << 100 * worst->max_relative
+     << " % of the stress range (at l = " << worst->loop_length << " mm; more than "
+     << 100 * kEnergyFitWarnRelative
+     << " %): its options do not suit this data (the default sweep's, the energy_fit object of "
+        "cases/sweep/default.json, hold it near 5 %; {} gives the code's defaults, without a "
+        "tube or outer function); refit with `knit-meso fit DB --law energy --energy-options "
+        "FILE`";
   return os.str();
 }
 

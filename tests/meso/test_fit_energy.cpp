@@ -1063,3 +1063,25 @@ TEST_CASE("energy fit: without smoothing along l the middle loop length follows 
   CHECK(midpoint_gap(0.0) > 0.05);
   CHECK(midpoint_gap(1e-10) > 0.05);
 }
+
+TEST_CASE("energy fit: a law that misses its data by more than 10 % is warned of", "[unit]") {
+  // Session 48's walkthrough: `knit-meso fit --energy-options {}` (the code's defaults) missed
+  // its data by 28-30 % of the stress range with exit 0 and no word.
+  knit::meso::fit::EnergyFitSummary s;
+  for (const double m : {0.045, 0.283, 0.09}) {
+    knit::material::EnergyFitDiagnostics::PerLoop p;
+    p.loop_length = 5.0 + 0.5 * static_cast<double>(s.diagnostics.per_loop.size());
+    p.max_relative = m;
+    s.diagnostics.per_loop.push_back(p);
+  }
+  CHECK_THAT(knit::meso::fit::energy_fit_warning(s),
+             Catch::StartsWith("warning: the energy law misses its data by up to 28.3 % of the "
+                               "stress range (at l = 5.5 mm; more than 10 %)"));
+  CHECK_THAT(knit::meso::fit::energy_fit_report(s), Catch::Contains("    warning: the energy law"));
+  s.diagnostics.per_loop[1].max_relative = 0.10;  // at the threshold: no warning
+  CHECK(knit::meso::fit::energy_fit_warning(s).empty());
+  CHECK_THAT(knit::meso::fit::energy_fit_report(s), !Catch::Contains("warning"));
+  s.diagnostics.per_loop[1].max_relative = 0.5;
+  s.status = knit::meso::fit::FitStatus::kSolverFailed;  // a failed fit says why, not this
+  CHECK(knit::meso::fit::energy_fit_warning(s).empty());
+}

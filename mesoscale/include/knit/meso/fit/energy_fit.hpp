@@ -189,4 +189,13 @@ material::EnergyFitDiagnostics diagnose_energy_law(const material::EnergyLawData
 /// Text summary (per l: RMS, max, relative; held-out) for the command line.
 std::string energy_fit_report(const EnergyFitSummary& s);
 
+/// Above this largest fit error (a fraction of a loop length's stress range) a fitted law is
+/// warned of: the default sweep's options hold it near 5 %, the code's defaults ({}) gave 28-30 %
+/// with exit 0 and no word (session 48's walkthrough).
+inline constexpr double kEnergyFitWarnRelative = 0.10;
+
+/// "warning: ..." naming the loop length of the largest fit error when it exceeds
+/// kEnergyFitWarnRelative, else empty (also empty for a fit that did not succeed).
+std::string energy_fit_warning(const EnergyFitSummary& s);
+
 }  // namespace knit::meso::fit
