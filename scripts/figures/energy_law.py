@@ -302,7 +302,7 @@ def main():
                               "sweep input with \"energy_fit\": false)")
             print(f"energy_law.py: {why}: drew a placeholder {a.out}")
             return
-        k, l = pick_loop(f, a.loop_length)
+        k, l = pick_loop(f, a.loop_length, "energy_law.py")
         try:
             law = load_law(f["energy_law"], l)
         except ValueError as err:

@@ -53,6 +53,15 @@ def main():
         r = draw(db, png)
         c(r.returncode == 0 and os.path.getsize(png) > 0,
           "format 3 with every set: drawn (exit %d, %s)" % (r.returncode, r.stderr.strip()[-300:]))
+        c("note:" not in r.stderr, "its own loop length: no note (%s)" % r.stderr.strip()[-200:])
+        os.remove(png)
+        # A loop length the database does not have (session 48's walkthrough: the nearest was
+        # drawn without a word): drawn, with a note that names both.
+        r = draw(db, png, "--loop-length", "5.6")
+        c(r.returncode == 0 and "energy_law.py: note: the database has no loop length 5.6 mm "
+          "(it has 5 mm); the figure shows the nearest, 5 mm" in r.stderr,
+          "another loop length: drawn with a note (exit %d, %s)"
+          % (r.returncode, r.stderr.strip()[-300:]))
         os.remove(png)
         write_db(db, 3, drop_set=True)
         r = draw(db, png)
