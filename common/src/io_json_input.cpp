@@ -167,6 +167,14 @@ struct LineScanner {
 }  // namespace
 
 std::string closest_key(const std::string& key, const std::vector<std::string>& known) {
+  // One quantity's names across knitscale's files first (session 48's walkthrough: the yarn's
+  // "diameter" of a database, written in a cell input whose key is "d", got no suggestion): a
+  // database's /yarn and a case's material use the long names, a cell input the short ones.
+  static const std::pair<const char*, const char*> kSameQuantity[] = {
+      {"diameter", "d"},       {"d", "diameter"},       {"youngs_modulus", "E"},
+      {"E", "youngs_modulus"}, {"poisson_ratio", "nu"}, {"nu", "poisson_ratio"}};
+  for (const auto& [name, other] : kSameQuantity)
+    if (key == name && std::find(known.begin(), known.end(), other) != known.end()) return other;
   // Levenshtein distance, case-insensitive, two rows.
   const auto distance = [](const std::string& a, const std::string& b) {
     std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);

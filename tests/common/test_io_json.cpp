@@ -105,6 +105,14 @@ TEST_CASE("unknown_key_note and with_line: one wording and one line rule for eve
   CHECK(unknown_key_note("nu", {}) == "");
   CHECK(unknown_key_note("zzzz", {"E", "nu"}) == " (allowed: \"E\", \"nu\")");
   CHECK(unknown_key_note("Nu", {"E", "nu"}) == " (did you mean \"nu\"? allowed: \"E\", \"nu\")");
+  // One quantity's other name in knitscale's files (session 48): a database's yarn "diameter"
+  // in a cell input ("d"), a cell input's "E" in a case's material ("youngs_modulus").
+  CHECK(unknown_key_note("diameter", {"E", "d", "nu"}) ==
+        " (did you mean \"d\"? allowed: \"E\", \"d\", \"nu\")");
+  CHECK(unknown_key_note("E", {"type", "youngs_modulus", "poisson_ratio"}) ==
+        " (did you mean \"youngs_modulus\"? allowed: \"type\", \"youngs_modulus\", "
+        "\"poisson_ratio\")");
+  CHECK(unknown_key_note("diameter", {"E", "nu"}) == " (allowed: \"E\", \"nu\")");  // no "d"
   // More than kMaxListedKeys: the suggestion alone, or nothing.
   std::vector<std::string> many;
   for (std::size_t i = 0; i <= knit::io::kMaxListedKeys; ++i)
