@@ -199,8 +199,8 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
         // The last attempt's reason stays in the message (a Newton failure, or the
         // pass-through guard's refusal).
         res.message =
-            "sub-steps below " + std::to_string(kMinSubstep) + " of the step at load fraction " +
-            std::to_string(lam) +
+            "sub-steps below " + std::to_string(kMinSubstep) + " of the step, stuck at " +
+            std::to_string(lam) + " of the way from the step's start to its end" +
             (last_refused_
                  ? ": the last converged sub-step was refused by the pass-through guard: "
                  : " (a limit point: the cell does not pass this strain); last attempt: ") +

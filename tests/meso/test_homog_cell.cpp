@@ -198,6 +198,10 @@ TEST_CASE("a step that meets a limit point ends, not converged, instead of sub-s
   INFO(message);
   CHECK(failed_step == 7);
   CHECK(message.find("limit point") != std::string::npos);
+  // Where within the step it stuck, said as such (session 48's walkthrough read "at load
+  // fraction 0.11" of step 6 of 6 as a contradiction).
+  CHECK(message.find("of the step, stuck at 0.94") != std::string::npos);
+  CHECK(message.find("of the way from the step's start to its end") != std::string::npos);
 }
 
 TEST_CASE("a periodic cell is refused where its loop does not interlock", "[unit]") {
