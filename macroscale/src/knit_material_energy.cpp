@@ -250,7 +250,12 @@ std::string KnitMaterial::energy_report() const {
   else
     os << "\n  uniaxial check: the law's own uniaxial response against the cell's, tolerance "
        << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer
-       << "); a departure beyond it is a warning";
+       << "); a departure beyond it is a warning"
+       // The verdict of this run (session 48's walkthrough: a pass was never stated).
+       << (audit_evaluations_.load() == 0 ? std::string()
+           : uniaxial_warning().empty()
+               ? std::string(": this run's states are within it")
+               : std::string(": this run's states depart beyond it (the warning)"));
   const Stats st = stats();
   if (!st.first.empty()) {
     // Every evaluation, Newton's trial iterates too (session 39's walkthrough read an iterate's

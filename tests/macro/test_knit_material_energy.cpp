@@ -434,7 +434,7 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   // The field's ends and a point 30 % of the way (l0 + 0.3 (l1 - l0)), each with its strain
   // at the converged state (material frame: alpha = 0).
   auto run = [&](double l0, double l1, const std::array<Eigen::Vector3d, 3>& E,
-                 double tolerance = 0.25) {
+                 double tolerance = 0.25, bool report = false) {
     KnitMaterialSource s = src;
     s.uniaxial_tolerance = tolerance;
     KnitMaterial m(nullptr, std::make_shared<const EnergyLaw>(testing::make_test_energy_law()),
@@ -455,7 +455,7 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
       m.evaluate(E[static_cast<std::size_t>(i)], p);
     }
     m.end_converged_audit();
-    return m.warning();
+    return report ? m.report() : m.warning();
   };
   auto all = [](const Eigen::Vector3d& E) { return std::array<Eigen::Vector3d, 3>{E, E, E}; };
   // Graded 4.5 ... 6.5 mm, the converged states at E22 = 0.25: the 6.5 mm wale curve departs
@@ -513,6 +513,14 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   CHECK_THAT(report_of(), Catch::Contains("\n  uniaxial check: the law's own uniaxial response "
                                           "against the cell's, tolerance 25 % "
                                           "(/material/uniaxial_tolerance)"));
+  // After a run, the report states the verdict (session 48's walkthrough: a pass was never
+  // stated).
+  CHECK_THAT(run(4.5, 6.5, all(wale), 0.25, true),
+             Catch::Contains("a departure beyond it is a warning: this run's states depart "
+                             "beyond it (the warning)"));
+  CHECK_THAT(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.1, 0.0)), 0.25, true),
+             Catch::Contains("a departure beyond it is a warning: this run's states are within "
+                             "it"));
   // No curves (a database written before session 41): no warning, and the report says so.
   src.uniaxial.clear();
   CHECK(run(4.5, 6.5, all(wale)).empty());
