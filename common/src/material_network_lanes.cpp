@@ -176,7 +176,8 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
 // vector, so every step is vertical (no horizontal sums). GCC's vector extension, compiled for
 // AVX2 only (target attribute on the entry point; without AVX GCC splits the vectors into SSE2
 // halves and it ran at half the portable code's rate, so a processor without AVX2 takes
-// lanes_sum). No contraction (-std=c++20 keeps -ffp-contract=off): the portable code's IEEE
+// lanes_sum). No contraction (-ffp-contract=off on knit_common, common/CMakeLists.txt: GCC's
+// C++ default contracts, and the AVX-512 target has FMA): the portable code's IEEE
 // operations in another order, equal to round-off (tested).
 // -Wpsabi (GCC's note that a 256-bit vector passed by value without AVX changes the ABI) is
 // silenced for the rest of this translation unit (and its unity group; the note is issued at

@@ -135,10 +135,12 @@ class EnergyLawAt {
   Eigen::Vector3d box_min_, box_max_;
   bool network_ = false;
   /// What evaluate() calls: every network pass of the law at l in one sweep (two lanes at a
-  /// knot or with theta interpolated, four between knots with l_interpolation "energy").
+  /// knot or with theta interpolated, four between knots with l_interpolation "energy", six in
+  /// a rounding window of l_blend where the processor has the six-lane kernel, AVX-512).
   NetworkLanesAt lanes_;
-  /// In a rounding window of l_blend (three knot laws): lanes_ holds the outer two, scaled by
-  /// lanes_scale_, middle_ the middle knot's law with its weight middle_scale_ (0 elsewhere).
+  /// In a rounding window without the six-lane kernel (three knot laws): lanes_ holds the outer
+  /// two, scaled by lanes_scale_, middle_ the middle knot's law with its weight middle_scale_
+  /// (0 elsewhere).
   NetworkLanesAt middle_;
   double lanes_scale_ = 1.0, middle_scale_ = 0.0;
   /// dS_dl of the network family (one pass per knot law, not the hot path):

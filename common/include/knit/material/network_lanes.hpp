@@ -9,7 +9,7 @@
 // minus the affine normalization W(0), S(0). The mirrored pass needs no mirrored input: the
 // network at theta with the E12 column of A0 and A1 and the third row of L negated is
 // N(M e; theta) as a function of e, with its gradient M S_N(M e) and Hessian M C_N(M e) M. So
-// every lane takes the same e, and the K lanes (2 or 4) are K networks side by side: one
+// every lane takes the same e, and the K lanes (2, 4 or 6) are K networks side by side: one
 // first layer of K h1 units, one second layer of K h2 units (V block diagonal), each loop over
 // all of them at once. The arithmetic is that of NetworkLawAt::evaluate (the reference, tested
 // equal to round-off); what is saved is the per-pass overhead and the serial dependence of one
