@@ -2,6 +2,7 @@
 #include "knit/io/json_input.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -170,11 +171,19 @@ std::string closest_key(const std::string& key, const std::vector<std::string>& 
   // One quantity's names across knitscale's files first (session 48's walkthrough: the yarn's
   // "diameter" of a database, written in a cell input whose key is "d", got no suggestion): a
   // database's /yarn and a case's material use the long names, a cell input the short ones.
-  static const std::pair<const char*, const char*> kSameQuantity[] = {
-      {"diameter", "d"},       {"d", "diameter"},       {"youngs_modulus", "E"},
-      {"E", "youngs_modulus"}, {"poisson_ratio", "nu"}, {"nu", "poisson_ratio"}};
-  for (const auto& [name, other] : kSameQuantity)
-    if (key == name && std::find(known.begin(), known.end(), other) != known.end()) return other;
+  // Only where a companion key says it is that kind of object (session 48's review: "E" is also
+  // a strain, in a sweep's uniaxial load path).
+  static const std::array<const char*, 3> kSameQuantity[] = {
+      {"diameter", "d", "nu"},
+      {"youngs_modulus", "E", "nu"},
+      {"poisson_ratio", "nu", "E"},
+      {"E", "youngs_modulus", "poisson_ratio"},
+      {"nu", "poisson_ratio", "youngs_modulus"}};
+  const auto has = [&](const char* k) {
+    return std::find(known.begin(), known.end(), k) != known.end();
+  };
+  for (const auto& [name, other, companion] : kSameQuantity)
+    if (key == name && has(other) && has(companion)) return other;
   // Levenshtein distance, case-insensitive, two rows.
   const auto distance = [](const std::string& a, const std::string& b) {
     std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);

@@ -13,6 +13,7 @@
 #include "knit/macro/case.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/material_factory.hpp"
+#include "knit/macro/output_units.hpp"
 #include "knit/macro/refinement.hpp"
 #include "knit/spline/basis.hpp"
 #include "knit/spline/knot_vector.hpp"
@@ -718,6 +719,15 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   read_loads(r, root, c);
   read_solver(r, root, c);
   read_output(r, root, c);
+  // The columns of load_strain.csv, unit suffixes included, must not repeat (session 48's
+  // review: without suffixes, in a case's own units, a reaction "strain" hid the strain column
+  // from a reader by name).
+  if (const std::string rep = repeated_load_strain_column(c); !rep.empty())
+    r.fail("/output",
+           "the column \"" + rep +
+               "\" of load_strain.csv would appear twice: a reaction or output point is named "
+               "like another column (with its unit suffix, if the case's /units has symbols); "
+               "rename it");
   if (c.integration == ThicknessIntegration::kAnalytic &&
       !c.material->has_analytic_thickness_integration())
     r.fail("/solver/thickness_integration",

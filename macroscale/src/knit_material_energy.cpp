@@ -162,6 +162,20 @@ std::string KnitMaterial::far_excursion_warning() const {
   return {};
 }
 
+std::string KnitMaterial::uniaxial_verdict() const {
+  if (audit_evaluations_.load() == 0) return {};
+  // Compared only where a knot's law was stretched along an axis (session 48's review: a run
+  // in compression or shear alone read "within it" with nothing compared).
+  bool stretched = false;
+  for (std::size_t k = 0; k < 2 * source_.uniaxial.size(); ++k)
+    stretched = stretched || uniaxial_reached_[k].load() > 0.0;
+  if (!stretched)
+    return ": this run stretched no loop length's law along the course or the wale (nothing "
+           "compared)";
+  return uniaxial_warning().empty() ? ": this run's states are within it"
+                                    : ": this run's states depart beyond it (the warning)";
+}
+
 std::string KnitMaterial::uniaxial_warning() const {
   const auto& curves = source_.uniaxial;
   if (curves.empty() || audit_evaluations_.load() == 0) return {};
@@ -252,10 +266,7 @@ std::string KnitMaterial::energy_report() const {
        << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer
        << "); a departure beyond it is a warning"
        // The verdict of this run (session 48's walkthrough: a pass was never stated).
-       << (audit_evaluations_.load() == 0 ? std::string()
-           : uniaxial_warning().empty()
-               ? std::string(": this run's states are within it")
-               : std::string(": this run's states depart beyond it (the warning)"));
+       << uniaxial_verdict();
   const Stats st = stats();
   if (!st.first.empty()) {
     // Every evaluation, Newton's trial iterates too (session 39's walkthrough read an iterate's

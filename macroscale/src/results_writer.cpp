@@ -15,6 +15,7 @@
 #include "knit/io/output_target.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/io/vtk.hpp"
+#include "knit/macro/output_units.hpp"
 
 namespace knit::macro {
 
@@ -90,58 +91,6 @@ std::string result_unit(const std::string& name) {
 }
 
 }  // namespace
-
-/// The case's units (session 48's red team: a case in "m, kN, kPa" was written with mm, N and
-/// MPa on every label). "L, F, S" gives the length, force and stress symbols; no /units, or
-/// "mm, N, MPa", the defaults; anything else (the benchmarks' "consistent (dimensionless
-/// benchmark)") has no symbols, and every dimensional label refers to /units.
-ResultsWriter::UnitLabels ResultsWriter::unit_labels(const std::string& declared) {
-  UnitLabels u;
-  std::vector<std::string> parts;
-  std::string cur;
-  for (const char ch : declared + ",") {
-    if (ch == ',') {
-      const auto b = cur.find_first_not_of(" \t"), e = cur.find_last_not_of(" \t");
-      parts.push_back(b == std::string::npos ? "" : cur.substr(b, e - b + 1));
-      cur.clear();
-    } else {
-      cur += ch;
-    }
-  }
-  const bool three = parts.size() == 3 && std::none_of(parts.begin(), parts.end(), [](auto& p) {
-                       return p.empty() || p.find_first_of(" \t") != std::string::npos;
-                     });
-  std::string bare;
-  for (const auto& p : parts) bare += p + ",";
-  if (declared.empty() || bare == "mm,N,MPa,")
-    return u;  // written "mm, N, MPa" whatever the blanks
-  u.root = declared;
-  if (three) {
-    u.length = parts[0];
-    u.force = parts[1];
-    u.stress = parts[2];
-  } else {
-    u.length = u.force = u.stress = "";
-  }
-  return u;
-}
-
-std::string ResultsWriter::UnitLabels::of(const std::string& mm_unit) const {
-  if (mm_unit != "mm" && mm_unit != "1/mm" && mm_unit != "N/mm" && mm_unit != "N" &&
-      mm_unit != "MPa")
-    return mm_unit;  // dimensionless, rad, s
-  if (length.empty()) return "in the case's units (/units: " + root + ")";
-  if (mm_unit == "mm") return length;
-  if (mm_unit == "1/mm") return "1/" + length;
-  if (mm_unit == "N/mm") return force + "/" + length;
-  if (mm_unit == "N") return force;
-  return stress;
-}
-
-std::string ResultsWriter::UnitLabels::suffix(const std::string& mm_unit) const {
-  if (length.empty()) return "";
-  return "_" + of(mm_unit);
-}
 
 namespace {
 
@@ -348,14 +297,7 @@ void ResultsWriter::write_hdf5(const fs::path& file, const RunReport& report) co
 }
 
 void ResultsWriter::finish(const RunReport& report) {
-  std::vector<std::string> header = {"step", "load_factor"};
-  const std::string L = units_.suffix("mm"), F = units_.suffix("N");
-  if (case_.output.applied) header.insert(header.end(), {"applied_displacement" + L, "strain"});
-  for (const ReactionOutput& r : case_.output.reactions) header.push_back(r.name + F);
-  for (const OutputPoint& p : case_.output.points)
-    header.insert(header.end(), {p.name + "_ux" + L, p.name + "_uy" + L, p.name + "_uz" + L});
-  header.insert(header.end(),
-                {"iterations", "residual", "seconds", "negative_pivots", "determinant_sign"});
+  const std::vector<std::string> header = load_strain_columns(case_);
   io::CsvWriter csv(dir_.path() / "load_strain.csv", header);
   csv.add_comment("knit-macro results of " + case_.file + " (knitscale " + project_version() +
                   ", git " + git_revision() + ")");

@@ -10,6 +10,7 @@
 #include "knit/io/atomic.hpp"
 #include "knit/io/vtk.hpp"
 #include "knit/macro/case.hpp"
+#include "knit/macro/output_units.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/shell_model.hpp"
 
@@ -64,19 +65,8 @@ class ResultsWriter {
   void write_vtu(const std::filesystem::path& file, const Fields& f) const;
   void write_hdf5(const std::filesystem::path& file, const RunReport& report) const;
 
-  /// The unit symbols of the outputs' labels, from the case's /units (default mm, N, MPa).
-  struct UnitLabels {
-    std::string root = "mm, N, MPa", length = "mm", force = "N", stress = "MPa";
-    /// The label of a quantity whose mm-N-MPa unit is mm_unit ("mm", "1/mm", "N/mm", "N",
-    /// "MPa"; others pass unchanged) in these units.
-    std::string of(const std::string& mm_unit) const;
-    /// "_" + of(mm_unit) for a CSV column name, "" when the units have no symbols.
-    std::string suffix(const std::string& mm_unit) const;
-  };
-  static UnitLabels unit_labels(const std::string& declared);
-
   const Case& case_;
-  UnitLabels units_;
+  UnitLabels units_;  ///< from the case's /units (knit/macro/output_units.hpp)
   const ShellModel& model_;
   io::AtomicDirectory dir_;  ///< DIR.partial-<pid> until finish(); removed if abandoned
   io::PvdCollection pvd_;

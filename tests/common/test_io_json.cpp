@@ -113,6 +113,8 @@ TEST_CASE("unknown_key_note and with_line: one wording and one line rule for eve
         " (did you mean \"youngs_modulus\"? allowed: \"type\", \"youngs_modulus\", "
         "\"poisson_ratio\")");
   CHECK(unknown_key_note("diameter", {"E", "nu"}) == " (allowed: \"E\", \"nu\")");  // no "d"
+  // "E" as a strain (a sweep's uniaxial load path has no "nu"): no suggestion of it.
+  CHECK(unknown_key_note("youngs_modulus", {"E", "steps"}) == " (allowed: \"E\", \"steps\")");
   // More than kMaxListedKeys: the suggestion alone, or nothing.
   std::vector<std::string> many;
   for (std::size_t i = 0; i <= knit::io::kMaxListedKeys; ++i)

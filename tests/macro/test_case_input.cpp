@@ -17,6 +17,7 @@
 #include "knit/io/hdf5.hpp"
 #include "knit/macro/case.hpp"
 #include "knit/macro/geometry_check.hpp"
+#include "knit/macro/output_units.hpp"
 #include "knit/macro/refinement.hpp"
 #include "knit/macro/run.hpp"
 #include "knit/macro/svk_material.hpp"
@@ -819,6 +820,41 @@ TEST_CASE("knit-macro run labels its outputs in the case's units", "[unit]") {
     CHECK(h5.attribute_string("steps/strain", "units") == "1");
   }
   fs::remove_all(d);
+}
+
+TEST_CASE("output units: the symbols of /units, and load_strain.csv's columns never repeat",
+          "[unit]") {
+  using knit::macro::unit_labels;
+  // Blanks anywhere are ignored (as the knit material's check of /units does; session 48's
+  // review: "mm, N, M Pa", accepted for a knit case, lost its suffixes).
+  for (const std::string u : {"", "mm, N, MPa", "mm,N,MPa", " mm , N , M Pa "}) {
+    INFO(u);
+    CHECK(unit_labels(u).root == "mm, N, MPa");
+    CHECK(unit_labels(u).suffix("N/mm") == "_N/mm");
+  }
+  CHECK(unit_labels(" m ,kN, kPa").length == "m");
+  CHECK(unit_labels(" m ,kN, kPa").of("MPa") == "kPa");
+  CHECK(unit_labels(" m ,kN, kPa").root == " m ,kN, kPa");
+  // Not three symbols: no suffixes, every dimensional label refers to /units.
+  for (const std::string u : {"m, kN, kPa,", "m kN kPa", "m, kN", "consistent", "m,\x01N,kPa"}) {
+    INFO(u);
+    CHECK(unit_labels(u).suffix("mm").empty());
+    CHECK(unit_labels(u).of("N") == "in the case's units (/units: " + u + ")");
+    CHECK(unit_labels(u).of("1") == "1");
+  }
+  // A reaction named like another column: refused where the names would meet (session 48's
+  // review: without suffixes a reaction "strain" hid the strain column from a reader by name).
+  json j = verification_case("tensile_svk.json");
+  j["output"]["reactions"][0]["name"] = "strain";
+  CHECK(error_of(j).empty());  // strain_N beside strain
+  j["units"] = "consistent (dimensionless benchmark)";
+  CHECK(error_of(j).rfind("bad.json: /output: the column \"strain\" of load_strain.csv would "
+                          "appear twice",
+                          0) == 0);
+  j["output"]["reactions"][0]["name"] = "center_ux";  // beside the point "center"'s columns
+  CHECK(error_of(j).rfind("bad.json: /output: the column \"center_ux\"", 0) == 0);
+  j["output"]["reactions"][0]["name"] = "jaw_force";
+  CHECK(error_of(j).empty());
 }
 
 TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry", "[unit]") {

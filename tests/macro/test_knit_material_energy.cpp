@@ -521,6 +521,10 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   CHECK_THAT(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.1, 0.0)), 0.25, true),
              Catch::Contains("a departure beyond it is a warning: this run's states are within "
                              "it"));
+  // Compressed both ways: nothing compared, and said so (not "within it").
+  CHECK_THAT(run(4.5, 6.5, all(Eigen::Vector3d(-0.1, -0.1, 0.0)), 0.25, true),
+             Catch::Contains("a departure beyond it is a warning: this run stretched no loop "
+                             "length's law along the course or the wale (nothing compared)"));
   // No curves (a database written before session 41): no warning, and the report says so.
   src.uniaxial.clear();
   CHECK(run(4.5, 6.5, all(wale)).empty());

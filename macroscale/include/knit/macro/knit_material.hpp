@@ -247,6 +247,8 @@ class KnitMaterial : public Material {
   /// warning(), the energy law: where the law's own uniaxial response departs from the cell's
   /// by more than source_.uniaxial_tolerance at the axial strains the converged states reached
   /// and the loop lengths the case uses; "" if nowhere (or no curves).
+  /// The report's verdict of the uniaxial check after a run ("" before one).
+  std::string uniaxial_verdict() const;
   std::string uniaxial_warning() const;
   /// The knots of source_.uniaxial whose law enters the law at l: knot k when l lies strictly
   /// (by more than 1e-6 mm) between knots k - 1 and k + 1 (the energy law between two knots is
