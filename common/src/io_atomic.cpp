@@ -16,6 +16,7 @@
 #include <system_error>
 #include <vector>
 
+#include "knit/io/names.hpp"
 #include "knit/io/provenance.hpp"
 
 namespace fs = std::filesystem;
@@ -397,9 +398,7 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
     const std::string line = abs.lexically_normal().string();
     // (no control character: read_input_file refuses them in an input's name; a caller that
     // did not read its input through it gets no "input:" line rather than a forged one)
-    const bool plain = std::none_of(line.begin(), line.end(), [](char ch) {
-      return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
-    });
+    const bool plain = !has_control_character(line);
     if (!aec && plain) marker << "input: " << line << "\n";
   }
   if (!marker.flush()) {

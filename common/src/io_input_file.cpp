@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/names.hpp"
 
 namespace knit::io {
 
@@ -56,17 +57,13 @@ struct Fd {
 /// Output paths are refused the same way (check_output_target). The name is shown with each
 /// control character as '?'.
 void check_input_name(const std::string& name) {
+  if (!has_control_character(name)) return;
   std::string shown = name;
-  bool control = false;
   for (char& ch : shown)
-    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) {
-      ch = '?';
-      control = true;
-    }
-  if (control)
-    throw InputError(shown, "",
-                     "the file's name holds a control character (a newline, a tab, ...; shown "
-                     "as '?'); rename it to a plain name");
+    if (is_control_character(ch)) ch = '?';
+  throw InputError(shown, "",
+                   "the file's name holds a control character (a newline, a tab, ...; shown "
+                   "as '?'); rename it to a plain name");
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
+#include "knit/io/names.hpp"
 
 namespace fs = std::filesystem;
 
@@ -196,9 +197,8 @@ void check_output_target(const fs::path& target_in, OutputKind kind, std::string
   // Control characters (a newline above all) in the output's path: the marker is written line
   // by line, and a name "o\nfile: notes.txt" put notes.txt into the run's manifest (review of
   // session 29); no one means them in a file name.
-  for (const char ch : target.string())
-    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
-      refuse("holds a control character (a newline, a tab, ...): give a plain path");
+  if (has_control_character(target.string()))
+    refuse("holds a control character (a newline, a tab, ...): give a plain path");
   // Names the file system cannot hold (session 29: a 5,000-character path failed later with
   // exit 1, naming no option). The partial and lock names add up to 30 characters.
   for (const auto& part : target)

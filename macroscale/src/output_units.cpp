@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <set>
 
+#include "knit/io/names.hpp"
+
 namespace knit::macro {
 
 UnitLabels unit_labels(const std::string& declared) {
@@ -16,7 +18,7 @@ UnitLabels unit_labels(const std::string& declared) {
     else if (ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f')
       continue;
     else {
-      control = control || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+      control = control || io::is_control_character(ch);
       parts.back() += ch;
     }
   }

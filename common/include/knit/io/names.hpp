@@ -20,6 +20,17 @@ inline constexpr std::size_t kMaxOutputNameLength = 64;
 /// Why `name` is not a valid output name, or nullopt if it is.
 std::optional<std::string> output_name_problem(std::string_view name);
 
+/// A control character (C0 or DEL): never meant in a path or a marker line, which is written
+/// line by line (output paths, input file names, the marker's input line, unit symbols).
+inline bool is_control_character(char ch) {
+  return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+}
+inline bool has_control_character(std::string_view s) {
+  for (const char ch : s)
+    if (is_control_character(ch)) return true;
+  return false;
+}
+
 /// The names joined by ", " for a message ("design, knitmap, run"); "" for none.
 std::string join_names(const std::vector<std::string>& names);
 
