@@ -283,6 +283,17 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
       r.fail("/refinement/elements", "must be [elements_u, elements_v]");
     const int eu = r.integer(el[0], "/refinement/elements/0", 1, 256);
     const int ev = r.integer(el[1], "/refinement/elements/1", 1, 256);
+    // Refuse a refinement that cannot fit in memory before making it (a lower bound; the
+    // exact estimate below judges the refined patch).
+    if (const MemoryEstimate low = estimate_refinement_memory(p, eu, ev);
+        low.total() > memory_limit_bytes())
+      r.fail("/refinement",
+             std::to_string(eu) + " x " + std::to_string(ev) + " elements of degree " +
+                 std::to_string(p) + " (at least " + std::to_string(eu + p) + " x " +
+                 std::to_string(ev + p) + " control points) need at least " + low.describe() +
+                 ", more than the " + format_bytes(memory_limit_bytes()) +
+                 " available (KNIT_MAX_MEMORY_MB overrides); use fewer elements or a lower "
+                 "degree");
     c.surface = refine_patch(c.input_surface, p, eu, ev);
   }
   // The analysis basis must be C^1 everywhere, which degree 1 is not between elements (session

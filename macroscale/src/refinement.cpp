@@ -50,15 +50,13 @@ std::string MemoryEstimate::describe() const {
          format_bytes(global_system) + ")";
 }
 
-MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
+MemoryEstimate estimate_shell_memory(double pu, double pv, double spans, double size_u,
+                                     double size_v) {
   // Doubles throughout: the counts reach 1e11 for the largest schema-legal refinement.
-  const double pu = s.basis_u().degree(), pv = s.basis_v().degree();
   const double nloc = (pu + 1) * (pv + 1), q = nloc;
-  const double E = static_cast<double>(num_spans(s.basis_u().knots())) *
-                   static_cast<double>(num_spans(s.basis_v().knots()));
-  const double N = 3.0 * s.size_u() * s.size_v();
+  const double N = 3.0 * size_u * size_v;
   MemoryEstimate m;
-  m.quadrature = static_cast<std::uint64_t>(E * q * (11.0 * nloc * 8.0 + 256.0));
+  m.quadrature = static_cast<std::uint64_t>(spans * q * (11.0 * nloc * 8.0 + 256.0));
   // The element tangents go straight into the reduced matrix (ReducedTangent as the model's
   // ElementTangentSink): one buffer per assembly thread, counted for two (session 37: all E
   // were counted, 6.1 GB of a 256 x 256 patch of degree 5 that the run never holds, so the
@@ -68,6 +66,19 @@ MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
   m.global_system =
       static_cast<std::uint64_t>(N <= 2500 ? 2.0 * N * N * 8.0 : 3.0 * 16.0 * std::min(nnz, N * N));
   return m;
+}
+
+MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
+  return estimate_shell_memory(s.basis_u().degree(), s.basis_v().degree(),
+                               static_cast<double>(num_spans(s.basis_u().knots())) *
+                                   static_cast<double>(num_spans(s.basis_v().knots())),
+                               static_cast<double>(s.size_u()), static_cast<double>(s.size_v()));
+}
+
+MemoryEstimate estimate_refinement_memory(int p, int elements_u, int elements_v) {
+  return estimate_shell_memory(p, p, static_cast<double>(elements_u) * elements_v,
+                               static_cast<double>(elements_u) + p,
+                               static_cast<double>(elements_v) + p);
 }
 
 std::uint64_t memory_limit_bytes() {
