@@ -496,10 +496,10 @@ TEST_CASE("knit-meso fit: without an options file a law keeps the options it was
   const fs::path dir = scratch_dir();
   const fs::path db = dir / "cli_stored_opts.h5", again = dir / "cli_stored_again.h5",
                  fresh = dir / "cli_stored_fresh.h5", opts = dir / "cli_stored_opts.json",
-                 empty = dir / "cli_stored_empty.json", log = dir / "cli_stored.log";
+                 other = dir / "cli_stored_other.json", log = dir / "cli_stored.log";
   for (const fs::path& p : {db, again, fresh}) fs::remove(p);
   std::ofstream(opts) << R"({"family": "ridge", "max_iterations": 150})";
-  std::ofstream(empty) << "{}";
+  std::ofstream(other) << R"({"family": "ridge", "max_iterations": 20})";  // any other options
   REQUIRE(run("synth --steps 8 --loop-lengths 4.5,6.5 --energy-options " + opts.string() +
               " --out " + db.string()) == 0);
   const std::string stored =
@@ -510,7 +510,7 @@ TEST_CASE("knit-meso fit: without an options file a law keeps the options it was
   CHECK(knit::material::read_database(again, false).energy_diagnostics.options_json == stored);
   CHECK(bytes(log).find("energy law: the options it was fitted with") != std::string::npos);
   CHECK(bytes(log).find("\nwrote " + again.string() + "\n") != std::string::npos);
-  REQUIRE(run("fit " + db.string() + " --law energy --energy-options " + empty.string() + " -o " +
+  REQUIRE(run("fit " + db.string() + " --law energy --energy-options " + other.string() + " -o " +
               fresh.string()) == 0);
   CHECK(knit::material::read_database(fresh, false)
             .energy_diagnostics.options_json.find("\"max_iterations\":150") == std::string::npos);
