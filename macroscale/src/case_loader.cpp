@@ -50,12 +50,18 @@ constexpr double kMinPrescribedPerSize = 1e-12;
 constexpr double kMaxPrescribedPerSize = 100.0;
 constexpr double kMaxGaugePerSize = 10.0;
 
-/// "[lo, hi] mm (a and b times the patch's size D = ... mm)"
-std::string relative_range(double lo, double hi, double size) {
+/// " mm", or the case's length unit (session 49: a case in m said mm in its messages).
+std::string length_unit(const Case& c) {
+  return " " + unit_labels(c.units).of("mm");
+}
+
+/// "[lo, hi] mm (a and b times the patch's size D = ... mm)", in the case's length unit.
+std::string relative_range(double lo, double hi, double size, const Case& c) {
+  const std::string mm = length_unit(c);
   std::ostringstream o;
-  o << "[" << lo * size << ", " << hi * size << "] mm (" << lo << " to " << hi
-    << " times the patch's size D = " << size
-    << " mm, the diagonal of its control net's bounding box)";
+  o << "[" << lo * size << ", " << hi * size << "]" << mm << " (" << lo << " to " << hi
+    << " times the patch's size D = " << size << mm
+    << ", the diagonal of its control net's bounding box)";
   return o.str();
 }
 
@@ -249,23 +255,24 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
   // the message blamed the thickness ("must lie in [inf, inf] mm").
   if (!(std::isfinite(size) && size > 0.0))
     r.fail("/geometry/control_points",
-           "the patch's size (its largest extent) is " + std::to_string(size) +
-               " mm: the control points must span a finite, non-degenerate patch");
+           "the patch's size (its largest extent) is " + std::to_string(size) + length_unit(c) +
+               ": the control points must span a finite, non-degenerate patch");
   // Session 46's red team: a flat patch at z = 1e300 was refused as "folded geometry ...
   // control points out of order?": so far from the origin its own extent is lost to round-off.
   for (Eigen::Index a = 0; a < P.rows(); ++a)
     if (P.row(a).cwiseAbs().maxCoeff() > kMaxOffsetPerSize * size) {
       std::ostringstream m;
       m.precision(4);
-      m << "lies " << P.row(a).cwiseAbs().maxCoeff() << " mm from the origin in a coordinate, "
-        << "more than " << kMaxOffsetPerSize << " times the patch's size (" << size
-        << " mm): the patch's own shape would be lost to round-off; move it nearer the origin";
+      m << "lies " << P.row(a).cwiseAbs().maxCoeff() << length_unit(c)
+        << " from the origin in a coordinate, more than " << kMaxOffsetPerSize
+        << " times the patch's size (" << size << length_unit(c)
+        << "): the patch's own shape would be lost to round-off; move it nearer the origin";
       r.fail("/geometry/control_points/" + std::to_string(a), m.str());
     }
   if (!(c.thickness >= kMinThicknessPerSize * size && c.thickness <= kMaxThicknessPerSize * size))
     r.fail("/geometry/thickness",
            "the thickness must lie in " +
-               relative_range(kMinThicknessPerSize, kMaxThicknessPerSize, size) + ", got " +
+               relative_range(kMinThicknessPerSize, kMaxThicknessPerSize, size, c) + ", got " +
                g.at("thickness").dump() +
                "; are the control points and the thickness in the same length unit (mm for a "
                "knit case)?");
@@ -386,16 +393,17 @@ void read_bcs(const Reader& r, const json& root, Case& c) {
         const double v = *bc.prescribe[comp];
         if (v != 0.0 && std::abs(v) < kMinPrescribedPerSize * size)
           r.fail(ptr + "/prescribe/" + it.key(),
-                 "a prescribed displacement of " + it.value().dump() +
-                     " mm is below 1e-12 of the patch's size (" + std::to_string(size) +
-                     " mm): round-off, not a load; give 0 or a displacement the patch can feel");
+                 "a prescribed displacement of " + it.value().dump() + length_unit(c) +
+                     " is below 1e-12 of the patch's size (" + std::to_string(size) +
+                     length_unit(c) +
+                     "): round-off, not a load; give 0 or a displacement the patch can feel");
         // Above 100 times the patch's size no fabric follows (2.1e9 mm on a 50 mm patch ran to
         // reactions of 1e49 N with exit 0; session 29).
         if (std::abs(v) > kMaxPrescribedPerSize * size)
           r.fail(ptr + "/prescribe/" + it.key(),
-                 "a prescribed displacement of " + it.value().dump() +
-                     " mm is more than 100 times the patch's size (" + std::to_string(size) +
-                     " mm): check the units (mm)");
+                 "a prescribed displacement of " + it.value().dump() + length_unit(c) +
+                     " is more than 100 times the patch's size (" + std::to_string(size) +
+                     length_unit(c) + "): check the units (" + unit_labels(c.units).root + ")");
       }
     }
     if (j.contains("clamp")) {
@@ -579,7 +587,7 @@ void read_output(const Reader& r, const json& root, Case& c) {
     if (!(ad.gauge_length >= kMinGaugePerSize * size && ad.gauge_length <= kMaxGaugePerSize * size))
       r.fail(ptr + "/gauge_length",
              "the gauge length (the distance between the jaws) must lie in " +
-                 relative_range(kMinGaugePerSize, kMaxGaugePerSize, size) + ", got " +
+                 relative_range(kMinGaugePerSize, kMaxGaugePerSize, size, c) + ", got " +
                  a.at("gauge_length").dump());
     // The condition that prescribes the component there: one on the same edge or corner, else
     // (a corner) one on an edge through it, else one on all control points (session 48's red

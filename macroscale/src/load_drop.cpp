@@ -43,14 +43,15 @@ std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>&
   return drops;
 }
 
-std::string load_drop_message(const LoadDrop& d, double tolerance) {
+std::string load_drop_message(const LoadDrop& d, double tolerance, const std::string& force) {
+  const std::string N = " " + force;
   std::ostringstream m;
   m.precision(4);
   m << "load drop: reaction '" << d.reaction << "' falls from " << d.from_load << " to "
-    << d.to_load << " N (by " << d.largest << " N";
-  if (d.direction < 0.0) m << " along its largest load, " << -d.max_load << " N";
-  m << "; " << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load
-    << " N) between step " << d.from_step << " (strain " << d.from_strain << ") and step "
+    << d.to_load << N << " (by " << d.largest << N;
+  if (d.direction < 0.0) m << " along its largest load, " << -d.max_load << N;
+  m << "; " << 100.0 * d.largest / d.max_load << " % of its largest " << d.max_load << N
+    << ") between step " << d.from_step << " (strain " << d.from_strain << ") and step "
     << d.to_step << " (strain " << d.to_strain << ") while the applied displacement grows";
   // Which drop is named (session 39's walkthrough had to read the header to learn it is the
   // largest), and where the first one was.

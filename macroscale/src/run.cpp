@@ -10,6 +10,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/macro/geometry_check.hpp"
 #include "knit/macro/load_drop.hpp"
+#include "knit/macro/output_units.hpp"
 #include "results_writer.hpp"
 
 namespace knit::macro {
@@ -294,7 +295,7 @@ std::string unstrained_warning(const Case& c, const ShellModel& m, const RunResu
   o.precision(3);
   o << "the patch is not strained (largest strain " << largest << " on a " << kGrid << " x "
     << kGrid << " grid of the last converged step) although the applied displacement reached "
-    << res.rows.back().applied << " mm (strain " << applied
+    << res.rows.back().applied << " " << unit_labels(c.units).of("mm") << " (strain " << applied
     << "): it moved as a rigid body, and the reactions are round-off. Is the edge opposite the "
        "moving one held (/boundary_conditions)?";
   return o.str();
@@ -398,7 +399,8 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
   if (opt.warnings && !res.solver_warning.empty())
     *opt.warnings << "warning: " << res.solver_warning << std::endl;
   for (const LoadDrop& d : find_load_drops(c, res.rows))
-    res.load_drops.push_back(load_drop_message(d));
+    res.load_drops.push_back(
+        load_drop_message(d, kLoadDropTolerance, unit_labels(c.units).of("N")));
   if (opt.warnings)
     for (const std::string& w : res.load_drops) *opt.warnings << "warning: " << w << std::endl;
   if (std::string w = unstrained_warning(c, m, res); !w.empty()) {

@@ -855,6 +855,17 @@ TEST_CASE("output units: the symbols of /units, and load_strain.csv's columns ne
   CHECK(error_of(j).rfind("bad.json: /output: the column \"center_ux\"", 0) == 0);
   j["output"]["reactions"][0]["name"] = "jaw_force";
   CHECK(error_of(j).empty());
+  // The loader's messages give lengths in the case's unit (session 49: a case in metres read
+  // "a prescribed displacement of 1e-20 mm").
+  j["units"] = "m, kN, kPa";
+  for (json& bc : j["boundary_conditions"])
+    if (bc.contains("prescribe")) bc["prescribe"] = {{"y", 1e-20}};
+  const std::string e = error_of(j);
+  CHECK_THAT(e, Catch::Contains("a prescribed displacement of 1e-20 m is below 1e-12 of the "
+                                "patch's size") &&
+                    !Catch::Contains(" mm"));
+  j["units"] = "mm, N, MPa";
+  CHECK_THAT(error_of(j), Catch::Contains("a prescribed displacement of 1e-20 mm is below"));
 }
 
 TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry", "[unit]") {

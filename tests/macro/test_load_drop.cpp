@@ -59,6 +59,10 @@ TEST_CASE("load drop: a monotone tensile curve has none, a snap is found with it
   CHECK(d[0].to_strain == Approx(10.0 * 4.0 / 6.0 / 50.0).epsilon(1e-12));
   const std::string m = knit::macro::load_drop_message(d[0]);
   CHECK(m.find("'jaw' falls from 17.1 to 5.7 N") != std::string::npos);
+  // In the case's force unit (session 49: a case in kN read N).
+  const std::string kn = knit::macro::load_drop_message(d[0], 0.01, "kN");
+  CHECK_THAT(kn, Catch::Contains("falls from 17.1 to 5.7 kN (by 11.4 kN; ") &&
+                     Catch::Contains("% of its largest 17.1 kN)") && !Catch::Contains(" N"));
   CHECK(m.find("between step 3") != std::string::npos);
   CHECK(m.find("; the largest of 2 drops in all, the first between step 3 and step 4") !=
         std::string::npos);

@@ -45,6 +45,8 @@ std::vector<LoadDrop> find_load_drops(const Case& c, const std::vector<StepRow>&
 /// One line (no "warning: " prefix): "load drop: reaction 'jaw_force' falls from 17.1 to 5.74 N
 /// between step 12 (strain 0.2) and step 13 (strain 0.21) while the applied displacement grows
 /// ...".
-std::string load_drop_message(const LoadDrop& d, double tolerance = kLoadDropTolerance);
+/// `force`: the force unit's label (the case's /units; unit_labels(c.units).of("N")).
+std::string load_drop_message(const LoadDrop& d, double tolerance = kLoadDropTolerance,
+                              const std::string& force = "N");
 
 }  // namespace knit::macro
