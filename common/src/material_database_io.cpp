@@ -448,6 +448,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           where = p;
           require_group(p);
           RawPath r;
+          r.index = q;
           try {
             r.path.kind = path_kind_from_string(f.attribute_string(p, "kind"));
           } catch (const std::invalid_argument& ex) {

@@ -158,8 +158,8 @@ std::string failure_line(const knit::meso::sweep::SweepInput& in,
   }
   for (std::size_t k = 0; k < rep.fits.size() && why.empty(); ++k)
     if (!rep.fits[k].ok())
-      why = "the paper law at l = " + knit::io::format_number(in.loop_lengths[k]) +
-            " mm: " + rep.fits[k].reason;
+      why = "the paper law at l = " + knit::io::format_number(in.loop_lengths[k]) + " mm (/loop_" +
+            std::to_string(k) + "): " + rep.fits[k].reason;
   if (why.empty() && rep.energy_fit && !rep.energy_fit->ok())
     why = "the energy law: " + rep.energy_fit->reason;
   if (why.empty()) why = "the sweep failed";

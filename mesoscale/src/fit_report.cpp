@@ -11,7 +11,7 @@ std::string first_fit_failure(const material::Database& db, const std::vector<Fi
   for (std::size_t k = 0; k < fits.size() && k < db.entries.size(); ++k)
     if (!fits[k].ok())
       return "the paper law at l = " + io::format_number(db.entries[k].loop_length) +
-             " mm: " + fits[k].reason;
+             " mm (/loop_" + std::to_string(k) + "): " + fits[k].reason;
   return {};
 }
 

@@ -305,6 +305,13 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     double phi;
     int last;
   };
+  // A path by its name in the file (raw/path_03) when known; the callers pass the paper
+  // paths alone, so the position q in `raw` is not the file's (session 48's red team).
+  const auto name = [&](std::size_t q) {
+    const int i = raw[q].index;
+    if (i < 0) return "path " + std::to_string(q);
+    return std::string("raw/path_") + (i < 10 ? "0" : "") + std::to_string(i);
+  };
   std::vector<Path> fan;
   const RawPath* shear = nullptr;
   int shear_paths = 0;
@@ -316,21 +323,21 @@ FitSummary fit_loop_length(const std::vector<RawPath>& raw, const FitOptions& o)
     if (!in_paper_fit(r)) continue;
     const int n = r.steps();
     if (r.E.rows() != n || r.S.rows() != n || r.E.cols() != 3 || r.S.cols() != 3)
-      return refuse("path " + std::to_string(q) + ": E and S need one row of 3 per step");
+      return refuse(name(q) + ": E and S need one row of 3 per step");
     int last = -1;
     for (int k = 0; k < n; ++k) {
       if (r.status[k] == 0) {
         // Only converged steps are data: a step that did not converge may hold anything
         // (session 47's red team: a NaN there refused the whole fit, naming no step).
         if (!r.E.row(k).allFinite() || !r.S.row(k).allFinite())
-          return refuse("path " + std::to_string(q) + ", step " + std::to_string(k + 1) +
+          return refuse(name(q) + ", step " + std::to_string(k + 1) +
                         ": non-finite strain or stress data in a converged step");
         last = k;
       } else {
         ++skipped;
       }
     }
-    if (last < 0) return refuse("path " + std::to_string(q) + " has no converged step");
+    if (last < 0) return refuse(name(q) + " has no converged step");
     if (r.path.kind == material::PathKind::kShear) {
       ++shear_paths;
       if (!shear) shear = &r;

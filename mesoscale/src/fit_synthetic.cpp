@@ -88,6 +88,7 @@ std::vector<RawPath> synthetic_paths(const SyntheticOptions& o, double l) {
   for (const auto& path : o.paths) {
     RawPath r;
     r.path = path;
+    r.index = static_cast<int>(out.size());
     const int n = path.steps;
     r.F.resize(n, 4);
     r.P.resize(n, 4);

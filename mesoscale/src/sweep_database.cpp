@@ -71,6 +71,7 @@ material::Database assemble_database(const SweepInput& in, const std::vector<Job
     for (std::size_t p = 0; p < np; ++p) {
       const JobResult& r = results.at(l * np + p);
       material::RawPath raw = r.raw;
+      raw.index = static_cast<int>(p);
       if (in.subtract_residual && !r.residual.isZero()) {
         Eigen::Matrix2d S0;
         S0 << r.residual(0), r.residual(2), r.residual(2), r.residual(1);

@@ -178,9 +178,32 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
                         dir / "cli_fit_fails_paper.err", err) == 1);
   CHECK(bytes(clean) == clean_before);
   // The reason on stderr too (session 36's red team: stderr was empty, only stdout said why).
-  CHECK_THAT(err, Catch::StartsWith("knit-meso fit: error: the paper law at l = 4.5 mm: ") &&
-                      Catch::EndsWith(clean.string() +
-                                      " is left as it was (the fit's report is on stdout)\n"));
+  CHECK_THAT(
+      err,
+      Catch::StartsWith("knit-meso fit: error: the paper law at l = 4.5 mm (/loop_0): ") &&
+          Catch::EndsWith(clean.string() + " is left as it was (the fit's report is on stdout)\n"));
+  // A paper path without a converged step is named as the file names it (session 48's red
+  // team: "path 3" counted the paper paths alone, not /loop_1/raw's groups).
+  {
+    const fs::path stalled = dir / "cli_fit_fails_stalled.h5";
+    fs::copy_file(clean, stalled, fs::copy_options::overwrite_existing);
+    std::string name;
+    {
+      auto f = knit::io::H5File::open_rw(stalled);
+      const auto paths = f.children("/loop_1/raw");
+      for (auto it = paths.rbegin(); it != paths.rend() && name.empty(); ++it)
+        if (f.attribute_string("/loop_1/raw/" + *it, "set") == "paper") name = *it;
+      REQUIRE(!name.empty());
+      const std::string st = "/loop_1/raw/" + name + "/status";
+      std::vector<int> status = f.read_ints(st);
+      std::fill(status.begin(), status.end(), 1);
+      f.write(st, status);
+    }
+    CHECK(run_with_stderr("fit " + stalled.string() + " --law paper",
+                          dir / "cli_fit_fails_stalled.err", err) != 0);
+    CHECK_THAT(err, Catch::Contains("the paper law at l = 6.5 mm (/loop_1): raw/" + name +
+                                    " has no converged step"));
+  }
   const fs::path bad_energy = dir / "cli_fit_fails_directions.json";
   std::ofstream(bad_energy) << R"({"family": "ridge", "directions": [[1, 0, 0], [2, 0, 0]]})";
   CHECK(run("fit " + clean.string() + " --law energy --energy-options " + bad_energy.string()) ==
@@ -266,8 +289,9 @@ TEST_CASE("knit-meso synth: a fit that fails writes nothing", "[unit]") {
   std::string err;
   CHECK(run_with_stderr(failing + " --out " + db.string(), dir / "cli_synth_fails.err", err) == 1);
   CHECK(bytes(db) == before);
-  CHECK_THAT(err, Catch::StartsWith("knit-meso synth: error: the paper law at l = 4.5 mm: ") &&
-                      Catch::Contains(db.string() + " is left as it was"));
+  CHECK_THAT(err,
+             Catch::StartsWith("knit-meso synth: error: the paper law at l = 4.5 mm (/loop_0): ") &&
+                 Catch::Contains(db.string() + " is left as it was"));
   const fs::path fresh = dir / "cli_synth_fails_new.h5";
   fs::remove(fresh);
   CHECK(run_with_stderr(failing + " --out " + fresh.string(), dir / "cli_synth_fails.err", err) ==

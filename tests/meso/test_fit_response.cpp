@@ -130,6 +130,10 @@ TEST_CASE("fit: data that cannot determine the surface are refused with the reas
   SECTION("non-finite data") {
     raw[2].S(3, 1) = std::nan("");
     CHECK(fit_loop_length(raw, FitOptions{}).reason ==
+          "raw/path_02, step 4: non-finite strain or stress data in a converged step");
+    // Without its number in a file, its place in the list.
+    raw[2].index = -1;
+    CHECK(fit_loop_length(raw, FitOptions{}).reason ==
           "path 2, step 4: non-finite strain or stress data in a converged step");
     // In a step that did not converge it is no datum (session 47's red team: refused).
     raw[2].status[3] = 1;

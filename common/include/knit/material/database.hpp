@@ -56,6 +56,10 @@ struct RawPath {
   LoadPath path;
   RowMatrixX F, P, E, S;
   std::vector<int> status;
+  /// Its number among its loop length's paths (/loop_<k>/raw/path_<index>, two digits at
+  /// least), so that a message about a path in a filtered list names it in the file; -1 when
+  /// not known.
+  int index = -1;
   int steps() const { return static_cast<int>(status.size()); }
 };
 
