@@ -376,6 +376,7 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   // put an earlier output back in place), then check again what the target holds.
   remove_stale_siblings(target_);
   check_output_target(target_, OutputKind::kDirectory, option);
+  if (const auto m = read_output_marker(target_)) earlier_completed_ = m->completed;
   partial_ = target_;
   partial_ += ".partial-";
   partial_ += std::to_string(::getpid());
@@ -415,6 +416,10 @@ AtomicDirectory::AtomicDirectory(AtomicDirectory&& o) noexcept
     : target_(std::move(o.target_)),
       lock_(std::move(o.lock_)),
       partial_(std::move(o.partial_)),
+      keep_suffix_(std::move(o.keep_suffix_)),
+      replaced_kept_in_(std::move(o.replaced_kept_in_)),
+      completed_flag_(o.completed_flag_),
+      earlier_completed_(o.earlier_completed_),
       on_abandon_(o.on_abandon_),
       committed_(o.committed_),
       active_(o.active_) {
@@ -489,6 +494,9 @@ void AtomicDirectory::commit() {
       if (rel != kOutputMarker) manifest += "file: " + rel + "\n";
     }
     if (ec) fail(partial_, "cannot list the outputs: " + ec.message());
+    if (completed_flag_ >= 0) manifest += completed_flag_ ? "completed: yes\n" : "completed: no\n";
+    if (completed_flag_ == 0 && earlier_completed_ && keep_suffix_.empty())
+      keep_suffix_ = ".last-completed";
     std::ofstream marker(partial_ / kOutputMarker, std::ios::binary | std::ios::app);
     marker << manifest;
     if (!marker.flush()) fail(partial_ / kOutputMarker, "cannot write");

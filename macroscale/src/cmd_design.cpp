@@ -249,12 +249,22 @@ knit::cli::SubcommandRegistrar reg(
         for (const std::string& w : knit::macro::run_warning_lines(run))
           sum << "warning: final run: " << w << "\n";
         knit::io::write_file_atomically(out / "summary.txt", sum.str());
+        const auto verdict = knit::macro::design_verdict(r, run);
+        // A design that ends with exit 1 keeps a completed earlier design of DIR beside it
+        // (session 49's red team: a rerun stopped at its iteration limit replaced a converged
+        // design).
+        out.set_completed(verdict.exit_code == knit::kExitOk);
         out.commit();
         std::cout << sum.str() << "wrote " << dir.string() << "\n";
-        const auto verdict = knit::macro::design_verdict(r, run);
         if (verdict.exit_code != knit::kExitOk)
           std::cerr << "knit-macro design: " << o->file << ": " << verdict.reason << "; outputs in "
-                    << dir.string() << "\n";
+                    << dir.string()
+                    << (out.replaced_kept_in().empty()
+                            ? ""
+                            : " (they replace the earlier outputs there; the completed earlier "
+                              "design is kept in " +
+                                  out.replaced_kept_in().string() + ")")
+                    << "\n";
         return verdict.exit_code;
       };
     });

@@ -339,6 +339,8 @@ void ResultsWriter::finish(const RunReport& report) {
   sum << "material: " << case_.material->name() << "\n";
   if (!material_report_.empty()) sum << "material report: " << material_report_ << "\n";
   write_text(dir_.path() / "summary.txt", sum.str());
+  // No set_completed here: run.cpp judges an earlier output from its summary.txt (older outputs
+  // and the material-failure line too), and the marker's line would override that judgement.
   dir_.commit();  // DIR.partial-<pid> -> DIR
 }
 

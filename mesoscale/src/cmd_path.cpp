@@ -222,7 +222,8 @@ int run(const Options& o) {
   }
   knit::meso::cell::write_text_atomic((dir / "path.csv").string(), csv);
   if (!o.no_vtp) knit::meso::cell::write_pvd((dir / "yarn.pvd").string(), pvd);
-  dir.commit();  // a run that stopped early keeps its converged steps (exit 1)
+  dir.set_completed(res.completed);  // a stopped run keeps a completed earlier output beside
+  dir.commit();                      // a run that stopped early keeps its converged steps (exit 1)
   std::printf(
       "%s: %d steps in %.3f s (%.4f s/step, %.1f Newton iterations/step), "
       "equilibration %.3f s -> %s/path.csv\n",
@@ -230,8 +231,11 @@ int run(const Options& o) {
       n > 0 ? double(res.iterations) / n : 0.0, res.equilibration_seconds, o.out.c_str());
   if (res.completed) return knit::kExitOk;
   // Said on stderr too, as the other commands do (before: on stdout only, stderr empty).
-  std::fprintf(stderr, "knit-meso path: %s; the %d converged step(s) are kept in %s\n",
-               res.message.c_str(), n, o.out.c_str());
+  const std::string kept = dir.replaced_kept_in().empty() ? std::string()
+                                                          : ", the completed earlier output in " +
+                                                                dir.replaced_kept_in().string();
+  std::fprintf(stderr, "knit-meso path: %s; the %d converged step(s) are kept in %s%s\n",
+               res.message.c_str(), n, o.out.c_str(), kept.c_str());
   return knit::kExitFailure;
 }
 

@@ -76,7 +76,16 @@ knit::cli::SubcommandRegistrar reg(
           else
             std::cout << "resolution: " << rc.describe() << "\n";
         }
-        return rep.completed ? knit::kExitOk : knit::kExitFailure;
+        if (rep.completed) return knit::kExitOk;
+        // Said on stderr too, as knit-meso path says it (session 49's red team: stdout only,
+        // and printed under -q).
+        std::cerr << "knit-meso rod: " << rep.message << " (lambda reached " << rep.lambda_reached
+                  << "); the converged steps are kept in " << out.string()
+                  << (rep.earlier_kept_in.empty()
+                          ? ""
+                          : ", the completed earlier output in " + rep.earlier_kept_in.string())
+                  << "\n";
+        return knit::kExitFailure;
       };
     });
 

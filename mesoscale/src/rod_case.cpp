@@ -504,7 +504,9 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
   }
   csv.commit();
   if (c.write_vtp) write_pvd(dir / "centerline.pvd", pvd);
+  dir.set_completed(rep.completed);  // a stopped run keeps a completed earlier output beside
   dir.commit();
+  rep.earlier_kept_in = dir.replaced_kept_in();
   return rep;
 }
 

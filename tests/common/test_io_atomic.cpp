@@ -1030,6 +1030,34 @@ TEST_CASE("AtomicDirectory keeps the output it replaces where it is asked to",
   CHECK(slurp(kept / "notes.txt") == "notes");
 }
 
+// Session 49's red team: a failed rerun of knit-macro design, knit-meso path or rod replaced a
+// completed output. An output that says it stopped (set_completed(false)) keeps a completed one
+// (its marker's "completed: yes") as DIR.last-completed; a stopped one is replaced as before.
+TEST_CASE("AtomicDirectory: a stopped output keeps the completed one it replaces",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("keep_completed");
+  const fs::path target = d / "out", kept = d / "out.last-completed";
+  const auto write = [&](const std::string& text, int completed) {
+    knit::io::AtomicDirectory a(target);
+    std::ofstream(a.path() / "x.txt") << text;
+    if (completed >= 0) a.set_completed(completed == 1);
+    a.commit();
+    return a.replaced_kept_in();
+  };
+  CHECK(write("done", 1).empty());
+  CHECK(knit::io::read_output_marker(target)->completed);
+  CHECK(write("stopped", 0) == kept);  // the completed one is kept
+  CHECK(slurp(kept / "x.txt") == "done");
+  CHECK_FALSE(knit::io::read_output_marker(target)->completed);
+  CHECK(write("stopped again", 0).empty());  // a stopped one is not
+  CHECK(slurp(kept / "x.txt") == "done");
+  CHECK(write("done again", 1).empty());  // a completed output replaces without keeping
+  CHECK(write("not said", -1).empty());   // nor does a command that says nothing
+  CHECK_FALSE(knit::io::read_output_marker(target)->completed);
+  CHECK(slurp(kept / "x.txt") == "done");
+  fs::remove_all(d);
+}
+
 TEST_CASE("a marker never holds a line forged by its input's name", "[unit][io][atomic]") {
   // Session 48's red team: the input's absolute path is a marker line, and "x\nfile: notes.txt"
   // became two lines, the second listing notes.txt as the output's own. read_input_file refuses

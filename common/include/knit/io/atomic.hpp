@@ -124,6 +124,15 @@ class AtomicDirectory {
   /// when nothing was replaced, or when it could not be moved and was removed as before).
   void keep_replaced_as(std::string suffix) { keep_suffix_ = std::move(suffix); }
   const std::filesystem::path& replaced_kept_in() const { return replaced_kept_in_; }
+  /// Whether this output's command ended with its work done, recorded in the marker at commit
+  /// ("completed: yes" / "no"; not called: no line). A stopped output (false) that replaces a
+  /// completed one of the same DIR (its marker says "completed: yes") keeps that one as
+  /// "DIR.last-completed" (keep_replaced_as) unless another suffix was set: a failed rerun of
+  /// knit-macro design or knit-meso path or rod never costs a completed output (session 49's
+  /// red team; knit-macro run judges from summary.txt since session 46 and does not call this).
+  void set_completed(bool completed) { completed_flag_ = completed ? 1 : 0; }
+  /// The output in DIR when this one was started was a completed one (its marker said so).
+  bool earlier_completed() const { return earlier_completed_; }
 
  private:
   /// Removes the replaced output `old` (now beside the target), or keeps it (keep_replaced_as).
@@ -134,6 +143,8 @@ class AtomicDirectory {
   std::filesystem::path partial_;
   std::string keep_suffix_;
   std::filesystem::path replaced_kept_in_;
+  int completed_flag_ = -1;  ///< set_completed: 1 yes, 0 no, -1 not said
+  bool earlier_completed_ = false;
   OnAbandon on_abandon_;
   bool committed_ = false;
   bool active_ = true;

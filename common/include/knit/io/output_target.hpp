@@ -63,6 +63,9 @@ struct OutputMarker {
   std::string input;
   /// The "input: PATH" line (since session 47): the input file's absolute path; empty without.
   std::string input_absolute;
+  /// A "completed: yes" line (since session 49): the command that wrote it ended with its work
+  /// done (AtomicDirectory::set_completed); false with "completed: no" or without the line.
+  bool completed = false;
 };
 /// The marker of `dir`, read; nothing without a marker.
 std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);

@@ -49,6 +49,9 @@ struct CasePathReport : PathReport {
   /// output in the directory is left as it was (session 41's red team: it was replaced by the
   /// reference state alone; knit-meso path and knit-macro run do the same).
   bool written = true;
+  /// Where the completed earlier output of the directory went when this stopped run replaced
+  /// it (DIR.last-completed; io::AtomicDirectory::set_completed), else empty.
+  std::filesystem::path earlier_kept_in;
 };
 
 /// The full load's scaled residual at the reference state must exceed the Newton tolerance by
