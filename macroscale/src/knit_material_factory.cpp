@@ -39,6 +39,8 @@ namespace {
 /// A patch whose size (its control net's bounding-box diagonal) is below this many times the
 /// database's largest loop runs with a warning (session 46): 3 x 6.5 mm, about 15 stitches.
 constexpr double kFewLoops = 3.0;
+/// The bounds of the law's largest stress at 5 % strain (MPa; the check in make_knit_material).
+constexpr double kMinLawStress = 1e-9, kMaxLawStress = 1e9;
 
 std::vector<double> number_array(const nlohmann::json& j, const std::string& p,
                                  const CaseContext& ctx) {
@@ -252,6 +254,45 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
       throw InputError(ctx.file, p + "/database",
                        db.string() + ": /loop_" + std::to_string(k) + "/fit: " + e.what());
     }
+  }
+  // The law's stress scale (session 49's red team: control points scaled by 1e-200, or a ridge
+  // law of zero coefficients and floor, ran to "completed" with a load of 1e-197 N or 0 and
+  // exit 0; scaled by 1e300, the run overflowed and blamed the case): at every loop length of
+  // the database the law's largest stress component at 5 % strain along the course, the wale
+  // and both must lie in [kMinLawStress, kMaxLawStress] MPa. A fabric at 5 % strain carries at
+  // least the stiffness floor's share (0.01 x its secant stiffness) and at most what its yarn
+  // (E of order 1e3 MPa) can: the bounds are 1e-9 and 1e9 MPa, ten decades beyond both.
+  for (std::size_t k = 0; k < data.entries.size(); ++k) {
+    const double l = data.entries[k].loop_length;
+    double largest = 0.0;
+    bool finite = true;
+    for (const Eigen::Vector3d& e :
+         {Eigen::Vector3d(0.05, 0.0, 0.0), Eigen::Vector3d(0.0, 0.05, 0.0),
+          Eigen::Vector3d(0.05, 0.05, 0.0)}) {
+      Eigen::Vector3d S;
+      if (energy) {
+        S = energy->at(l).evaluate(e).S;
+      } else {
+        if (!data.entries[k].surface) continue;
+        S = material::ResponseSurface(*data.entries[k].surface).evaluate(e).S;
+      }
+      finite = finite && S.allFinite();
+      if (finite) largest = std::max(largest, S.cwiseAbs().maxCoeff());
+    }
+    if (finite && largest >= kMinLawStress && largest <= kMaxLawStress) continue;
+    std::ostringstream os;
+    os << db.string() << ": "
+       << (energy ? std::string("/energy_law") : "/loop_" + std::to_string(k) + "/fit")
+       << ": at l = " << l << " mm the " << (energy ? "energy" : "paper")
+       << " law's stress at 5 % strain ";
+    if (!finite)
+      os << "is not finite";
+    else
+      os << "reaches " << largest << " MPa, " << (largest < kMinLawStress ? "below " : "above ")
+         << (largest < kMinLawStress ? kMinLawStress : kMaxLawStress);
+    os << " MPa: not a fabric's law in MPa (a damaged or rescaled file?); refit it with knit-meso "
+          "fit";
+    throw InputError(ctx.file, p + "/database", os.str());
   }
   // The database's stresses are per its cell's thickness t = 2d (eq. 8's volume w c t): a
   // shell of another thickness scales every force by the ratio (session 39's walkthrough: a

@@ -1443,6 +1443,62 @@ TEST_CASE("a knit case whose thickness is not the database's cell thickness is r
   CHECK(error_of(j).empty());
 }
 
+TEST_CASE("a knit database whose law carries no stress, or absurd stress, is refused", "[unit]") {
+  // Session 49's red team: the control points of every fit scaled by 1e-200 (or an energy law
+  // of zero coefficients and floor) ran to "completed" with a load of 1e-197 N and exit 0; by
+  // 1e300 the run overflowed and blamed the case. The law's stress at 5 % strain must lie in
+  // [1e-9, 1e9] MPa at every loop length.
+  const auto write = [](const std::string& name, double scale, bool energy) {
+    const std::filesystem::path f = std::filesystem::path(KNIT_BINARY_DIR) / "test_tmp" / name;
+    std::filesystem::create_directories(f.parent_path());
+    knit::material::Database db;
+    db.provenance = knit::material::current_provenance();
+    db.generator = "test";
+    for (double l : {4.5, 6.5}) {
+      knit::material::LoopLengthEntry e;
+      e.loop_length = l;
+      e.surface = knit::material::testing::make_test_surface(l == 6.5 && !energy ? scale : 1.0);
+      db.entries.push_back(e);
+    }
+    if (energy) {
+      db.energy_law = knit::material::testing::make_test_energy_law();
+      db.energy_law->coefficients *= scale;
+      db.energy_law->floor *= scale;
+    }
+    knit::material::write_database(f, db);
+    return f.string();
+  };
+  json j = verification_case("tensile_svk.json");
+  // (A scale of 0 is refused by the surface's own check: no positive initial stiffness.)
+  for (const double scale : {1.0, 1e-200, 1e300}) {
+    INFO("scale " << scale);
+    const std::string paper = write("law_scale_paper.h5", scale, false);
+    j["material"] = {{"type", "knit"}, {"database", paper}, {"stitch_value", 5.0}};
+    const std::string e = error_of(j);
+    if (scale == 1.0) {
+      CHECK(e.empty());
+      continue;
+    }
+    CHECK_THAT(e, Catch::StartsWith("bad.json: /material/database: " + paper +
+                                    ": /loop_1/fit: at l = 6.5 mm the paper law's stress at 5 % "
+                                    "strain ") &&
+                      Catch::Contains("not a fabric's law in MPa"));
+  }
+  for (const double scale : {1.0, 1e-200, 0.0}) {
+    INFO("energy scale " << scale);
+    const std::string energy = write("law_scale_energy.h5", scale, true);
+    j["material"] = {{"type", "knit"}, {"database", energy}, {"stitch_value", 5.0}};
+    const std::string e = error_of(j);
+    if (scale == 1.0)
+      CHECK(e.empty());
+    else
+      CHECK_THAT(e, Catch::StartsWith("bad.json: /material/database: " + energy +
+                                      ": /energy_law: at l = 4.5 mm the energy law's stress at "
+                                      "5 % strain reaches ") &&
+                        Catch::Contains(", below 1e-09 MPa"));
+  }
+}
+
 TEST_CASE(
     "a symmetry condition on an edge that is not in its plane, or not crossed at a right "
     "angle, is refused",
