@@ -1376,19 +1376,25 @@ TEST_CASE("a refinement that cannot fit in memory is refused at load with the es
         static_cast<std::uint64_t>(2.0 * n_small * n_small * 8.0));
 }
 
-TEST_CASE("a knit field degree of 1e10 is an input error before any int conversion", "[unit]") {
-  // static_cast<int>(1e10) is undefined behaviour (seen under UBSan).
-  const fs::path dir = temp_dir("knit_degree");
+/// A database of the test law at 4.5 and 6.5 mm, the 6.5 mm paper law's stresses times
+/// `scale_65`.
+static knit::material::Database two_loop_test_database(double scale_65 = 1.0) {
   knit::material::Database db;
   db.provenance = knit::material::current_provenance();
   db.generator = "test";
   for (double l : {4.5, 6.5}) {
     knit::material::LoopLengthEntry e;
     e.loop_length = l;
-    e.surface = knit::material::testing::make_test_surface(1.0);
+    e.surface = knit::material::testing::make_test_surface(l == 6.5 ? scale_65 : 1.0);
     db.entries.push_back(e);
   }
-  knit::material::write_database(dir / "db.h5", db);
+  return db;
+}
+
+TEST_CASE("a knit field degree of 1e10 is an input error before any int conversion", "[unit]") {
+  // static_cast<int>(1e10) is undefined behaviour (seen under UBSan).
+  const fs::path dir = temp_dir("knit_degree");
+  knit::material::write_database(dir / "db.h5", two_loop_test_database());
   json j = verification_case("tensile_svk.json");
   j["material"] = {{"type", "knit"},
                    {"database", (dir / "db.h5").string()},
@@ -1451,15 +1457,7 @@ TEST_CASE("a knit database whose law carries no stress, or absurd stress, is ref
   const auto write = [](const std::string& name, double scale, bool energy) {
     const std::filesystem::path f = std::filesystem::path(KNIT_BINARY_DIR) / "test_tmp" / name;
     std::filesystem::create_directories(f.parent_path());
-    knit::material::Database db;
-    db.provenance = knit::material::current_provenance();
-    db.generator = "test";
-    for (double l : {4.5, 6.5}) {
-      knit::material::LoopLengthEntry e;
-      e.loop_length = l;
-      e.surface = knit::material::testing::make_test_surface(l == 6.5 && !energy ? scale : 1.0);
-      db.entries.push_back(e);
-    }
+    knit::material::Database db = two_loop_test_database(energy ? 1.0 : scale);
     if (energy) {
       db.energy_law = knit::material::testing::make_test_energy_law();
       db.energy_law->coefficients *= scale;
