@@ -9,7 +9,8 @@ team), each by the file and the field, exit 2:
   network law, which came with format 3;
 * in an old (format 2, checksum-free) file, an attribute with a null dataspace (read as 0:
   /energy_law@floor), real data stored as integers (truncated) or in 4-byte floats, and a
-  dataset under HDF5's scale-offset filter (lossy); and knit-meso fit of such an old file warns
+  dataset under HDF5's scale-offset filter (lossy), a fixed-length string with a NUL byte inside
+  it (session 49); and knit-meso fit of such an old file warns
   that its contents are not verified (the refit writes them with checksums of its own).
 
 The intact copies of each kind run (exit 0), so each refusal is the damage's. Run by CTest
@@ -142,6 +143,10 @@ def main():
                                   f["energy_law/coefficients"][()].astype(np.float32)),
                 "/energy_law/coefficients: expected 8-byte floating-point values (double), "
                 "found 4-byte floats"),
+            # Session 49's red team: "ridge\0network" was read as "ridge", the rest dropped.
+            "a fixed-length string with a NUL inside it": (
+                lambda f: f["energy_law"].attrs.__setitem__("family", np.bytes_(b"ridge\0network")),
+                "/energy_law: a string with a NUL byte inside it (at character 6 of 13)"),
             "a dataset under the scale-offset filter": (
                 lambda f: replace(f, "energy_law/coefficients", f["energy_law/coefficients"][()],
                                   scaleoffset=2, chunks=True),
