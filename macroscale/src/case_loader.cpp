@@ -676,7 +676,10 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   c.text = text;
   if (root.contains("description"))
     c.description = r.string(root.at("description"), "/description");
-  if (root.contains("units")) c.units = r.string(root.at("units"), "/units");
+  if (root.contains("units")) {
+    c.units = r.string(root.at("units"), "/units");
+    if (const std::string why = units_problem(c.units); !why.empty()) r.fail("/units", why);
+  }
   read_geometry(r, root, c);
   // A zero or flipped Jacobian anywhere (corners and edges included) is bad input, refused
   // before any work (knit/macro/geometry_check.hpp).

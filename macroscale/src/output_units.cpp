@@ -1,6 +1,7 @@
 #include "knit/macro/output_units.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "knit/io/names.hpp"
@@ -36,6 +37,76 @@ UnitLabels unit_labels(const std::string& declared) {
     u.length = u.force = u.stress = "";
   }
   return u;
+}
+
+namespace {
+
+/// Known symbols in SI (m, N, Pa).
+struct KnownUnit {
+  const char* symbol;
+  int kind;  ///< 0 length, 1 force, 2 stress
+  double si;
+};
+constexpr KnownUnit kKnownUnits[] = {{"m", 0, 1.0},
+                                     {"cm", 0, 1e-2},
+                                     {"mm", 0, 1e-3},
+                                     {"um", 0, 1e-6},
+                                     {"km", 0, 1e3},
+                                     {"in", 0, 0.0254},
+                                     {"ft", 0, 0.3048},
+                                     {"N", 1, 1.0},
+                                     {"mN", 1, 1e-3},
+                                     {"kN", 1, 1e3},
+                                     {"MN", 1, 1e6},
+                                     {"lbf", 1, 4.4482216152605},
+                                     {"Pa", 2, 1.0},
+                                     {"kPa", 2, 1e3},
+                                     {"MPa", 2, 1e6},
+                                     {"GPa", 2, 1e9},
+                                     {"psi", 2, 6894.757293168361},
+                                     {"N/mm2", 2, 1e6},
+                                     {"N/mm^2", 2, 1e6},
+                                     {"N/m2", 2, 1.0},
+                                     {"N/m^2", 2, 1.0}};
+
+const KnownUnit* known_unit(const std::string& s) {
+  for (const KnownUnit& u : kKnownUnits)
+    if (s == u.symbol) return &u;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string units_problem(const std::string& declared) {
+  // Tabs are blanks, as in unit_labels; a line break or any other control character would go
+  // into the outputs' labels (a CSV comment, HDF5 attributes).
+  if (std::any_of(declared.begin(), declared.end(),
+                  [](char ch) { return ch != '\t' && io::is_control_character(ch); }))
+    return "a control character in the units (they label every output): give printable text";
+  const UnitLabels u = unit_labels(declared);
+  if (u.length.empty()) return {};
+  static const char* const kKinds[] = {"length", "force", "stress"};
+  const std::string symbols[3] = {u.length, u.force, u.stress};
+  const KnownUnit* known[3];
+  for (int k = 0; k < 3; ++k) {
+    known[k] = known_unit(symbols[k]);
+    if (known[k] && known[k]->kind != k)
+      return std::string("\"L, F, S\" gives the length, force and stress units in this order; \"") +
+             symbols[k] + "\" is a " + kKinds[known[k]->kind] + " unit, given as the " + kKinds[k];
+  }
+  if (known[0] && known[1] && known[2]) {
+    const double f_over_l2 = known[1]->si / (known[0]->si * known[0]->si);
+    if (std::abs(f_over_l2 / known[2]->si - 1.0) > 1e-9) {
+      std::string fits;
+      for (const KnownUnit& s : kKnownUnits)
+        if (s.kind == 2 && std::abs(f_over_l2 / s.si - 1.0) <= 1e-9 && fits.empty())
+          fits = s.symbol;
+      return "not consistent: a stress in " + symbols[1] + " per " + symbols[0] + "^2 is " +
+             (fits.empty() ? std::string("none of the known stress units") : fits) + ", not " +
+             symbols[2] + " (the material's moduli and the loads must be in one set of units)";
+    }
+  }
+  return {};
 }
 
 std::string UnitLabels::of(const std::string& mm_unit) const {

@@ -842,6 +842,27 @@ TEST_CASE("output units: the symbols of /units, and load_strain.csv's columns ne
     CHECK(unit_labels(u).of("N") == "in the case's units (/units: " + u + ")");
     CHECK(unit_labels(u).of("1") == "1");
   }
+  // Session 49's red team: inconsistent or misplaced known symbols and control characters,
+  // which labelled the outputs wrongly with exit 0, are refused at /units.
+  using knit::macro::units_problem;
+  for (const std::string u : {"", "mm, N, MPa", "m, N, Pa", "m, kN, kPa", "in, lbf, psi",
+                              "mm,N,N/mm2", "cm, N, foo", "consistent (dimensionless benchmark)"}) {
+    INFO(u);
+    CHECK(units_problem(u).empty());
+  }
+  CHECK(units_problem("mm, N, kPa") ==
+        "not consistent: a stress in N per mm^2 is MPa, not kPa (the material's moduli and the "
+        "loads must be in one set of units)");
+  CHECK_THAT(units_problem("MPa, N, mm"), Catch::Contains("\"MPa\" is a stress unit, given as "
+                                                          "the length"));
+  CHECK_THAT(units_problem("N, N, N"), Catch::Contains("\"N\" is a force unit, given as the "
+                                                       "length"));
+  CHECK_THAT(units_problem("mm, N\n# injected, MPa"), Catch::StartsWith("a control character"));
+  {
+    json k = verification_case("tensile_svk.json");
+    k["units"] = "mm, N, kPa";
+    CHECK_THAT(error_of(k), Catch::StartsWith("bad.json: /units: not consistent: "));
+  }
   // A reaction named like another column: refused where the names would meet (session 48's
   // review: without suffixes a reaction "strain" hid the strain column from a reader by name).
   json j = verification_case("tensile_svk.json");

@@ -23,6 +23,14 @@ struct UnitLabels {
 };
 UnitLabels unit_labels(const std::string& declared);
 
+/// What is wrong with a case's /units, "" if nothing (session 49's red team: "mm, N, kPa"
+/// labelled forces N where they are mN, "MPa, N, mm" labelled displacements MPa, and control
+/// characters went into the outputs' labels): a control character anywhere; with three symbols
+/// "L, F, S", a length, force or stress symbol that is a known unit of another kind, or known
+/// symbols whose stress is not force per length squared (mm, N, MPa; m, N, Pa; m, kN, kPa;
+/// in, lbf, psi ...). Unknown symbols and other text pass (a consistent set without names).
+std::string units_problem(const std::string& declared);
+
 /// The header of load_strain.csv: step, load factor, [applied displacement, strain], one column
 /// per reaction, three per output point, then the solver's columns; suffixed with the units.
 std::vector<std::string> load_strain_columns(const Case& c);
