@@ -295,6 +295,13 @@ RodCase load_rod_case(const std::filesystem::path& path) {
       if (c.path.newton.tol > 1e-2)
         R.fail("/steps/tolerance",
                "must be at most 0.01 (a dimensionless residual), got " + js["tolerance"].dump());
+      // Below the double's round-off no residual gets there in general: 1e-300 with a million
+      // iterations ran for minutes to "did not converge" (session 49's red team).
+      if (c.path.newton.tol < 2.2e-16)  // the double's epsilon, 2.22e-16, as the schema says it
+        R.fail("/steps/tolerance",
+               "must be at least 2.2e-16 (the round-off of a double: a dimensionless residual "
+               "does not get below it), got " +
+                   js["tolerance"].dump());
     }
     if (js.contains("max_iterations"))
       c.path.newton.max_iterations = R.integer(js["max_iterations"], "/steps/max_iterations", 1);

@@ -279,6 +279,7 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
       // 1e308 accepted every first iterate: an undeformed rod with exit 0 (session 21).
       {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 1e308}})", "/steps/tolerance"},
       {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 0.5}})", "/steps/tolerance"},
+      {R"({"rods": [)" + good_rod + R"(], "steps": {"tolerance": 1e-300}})", "/steps/tolerance"},
       // d = 1e308: E A = inf, every residual scaled to 0, the rod "converged" undeformed with
       // exit 0; d = 1e-300: E I = 0 (session 23). The section names itself.
       {R"({"section": {"d": 1e308}, "rods": [)" + good_rod + "]}", "/section"},
