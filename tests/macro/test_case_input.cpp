@@ -1090,6 +1090,21 @@ TEST_CASE("a load within the solver's tolerance stops the run instead of reporti
   CHECK_THAT(tiny.message, Catch::Contains("lower /solver/absolute_tolerance"));
   // No load at all converges at the undeformed state by right; a load the solver sees runs.
   CHECK(run_with(0.0, "zero").status == RunStatus::kCompleted);
+  // Also where the internal forces there carry round-off above absolute_tolerance (session 49's
+  // red team: the Sze cantilever, E = 1.2e6 MPa, with zero load: 1.5e-10 N, "no convergence in
+  // 25 iterations" after 8 cut-backs).
+  {
+    json sze = verification_case("sze_cantilever.json");
+    for (json& l : sze["loads"]) l["force_per_length"] = {0.0, 0.0, 0.0};
+    sze["solver"]["steps"] = 2;
+    RunOptions zo;
+    zo.output_dir = d / "sze_zero";
+    const RunResult z = run_case(parse_case(sze.dump(), "sze_zero.json"), zo);
+    INFO(z.report.message);
+    CHECK(z.report.status == RunStatus::kCompleted);
+    CHECK(z.report.converged_steps == 2);
+    CHECK(z.u.lpNorm<Eigen::Infinity>() == 0.0);
+  }
   CHECK(run_with(1e-3, "small").status == RunStatus::kCompleted);
   // A load that goes straight into the supports (on the fixed edge u0, x) deforms nothing:
   // the undeformed state is the answer (review of session 27: it was refused).
