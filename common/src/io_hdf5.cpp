@@ -282,22 +282,26 @@ std::vector<std::string> read_string_data(hid_t obj, hid_t ftype, hid_t space,
     H5Dvlen_reclaim(mtype.get(), space, H5P_DEFAULT, buf.data());
   } else {
     const std::size_t len = H5Tget_size(ftype);
-    H5Handle mtype(H5Tcopy(H5T_C_S1));
-    H5Tset_size(mtype.get(), len);
-    // Null-padded in memory: every byte of a null-padded file string arrives (null-terminated,
-    // HDF5's conversion stops at the first NUL and an embedded one could not be seen below).
-    H5Tset_strpad(mtype.get(), H5T_STR_NULLPAD);
+    // The file's own string type in memory: every byte arrives as stored (a conversion to a
+    // null-terminated C type stopped at the first NUL, so an embedded one could not be seen
+    // below, and one between ASCII and UTF-8 failed with "cannot read string data"; the
+    // review of session 49).
+    H5Handle mtype(H5Tcopy(ftype));
+    const H5T_str_t pad = H5Tget_strpad(ftype);
     std::vector<char> buf(n * len, '\0');
     if (read(mtype.get(), buf.data()) < 0) fail("cannot read string data");
     out.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
       const char* s = buf.data() + i * len;
-      const std::size_t k = strnlen(s, len);
-      // A NUL inside the string, not padding (session 49's red team: "ridge\0network" read as
-      // "ridge", the rest dropped in silence). Variable-length strings cannot hold one.
+      std::size_t k = strnlen(s, len);
+      // A NUL inside the string, not padding or the terminator's trailing bytes (session 49's
+      // red team: "ridge\0network" read as "ridge", the rest dropped in silence), whatever
+      // the padding. Variable-length strings cannot hold one.
       if (std::any_of(s + k, s + len, [](char c) { return c != '\0'; }))
         fail.input("a string with a NUL byte inside it (at character " + std::to_string(k + 1) +
                    " of " + std::to_string(len) + "): not a text this program wrote");
+      if (pad == H5T_STR_SPACEPAD)
+        while (k > 0 && s[k - 1] == ' ') --k;
       out.emplace_back(s, k);
     }
   }

@@ -76,9 +76,18 @@ MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
 }
 
 MemoryEstimate estimate_refinement_memory(int p, int elements_u, int elements_v) {
-  return estimate_shell_memory(p, p, static_cast<double>(elements_u) * elements_v,
-                               static_cast<double>(elements_u) + p,
-                               static_cast<double>(elements_v) + p);
+  MemoryEstimate m = estimate_shell_memory(p, p, static_cast<double>(elements_u) * elements_v,
+                                           static_cast<double>(elements_u) + p,
+                                           static_cast<double>(elements_v) + p);
+  // The global system's term is not monotone in N: dense up to N = 2500 unknowns, sparse
+  // beyond, and the sparse figure can be the smaller (the review of session 49: 25 x 25
+  // elements of degree 3 on a patch with interior knots were refused by a dense bound of 105
+  // MB where the refined patch's estimate is 41 MB). The smaller of the two formulas at the
+  // bound's N is a lower bound in either regime.
+  const double pd = p, N = 3.0 * (elements_u + pd) * (elements_v + pd);
+  const double sparse = 3.0 * 16.0 * std::min(N * 3.0 * (2 * pd + 1) * (2 * pd + 1), N * N);
+  m.global_system = std::min(m.global_system, static_cast<std::uint64_t>(sparse));
+  return m;
 }
 
 std::uint64_t memory_limit_bytes() {

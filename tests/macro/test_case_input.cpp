@@ -1377,6 +1377,21 @@ TEST_CASE("a refinement that cannot fit in memory is refused at load with the es
     CHECK(estimate_refinement_memory(4, 7, 5).total() ==
           estimate_shell_memory(refined.surface).total());
   }
+  // A lower bound also where the refined patch's system is sparse and the bound's dense (the
+  // review of session 49: interior knots off the uniform grid, 25 x 25 elements of degree 3,
+  // refused by a dense bound of 105 MB where the refined patch needs 41 MB).
+  {
+    const std::vector<double> U = {0, 0, 0, 0.13, 0.27, 0.41, 0.59, 1, 1, 1},
+                              V = {0, 0, 0, 1, 1, 1};
+    Eigen::MatrixXd P(21, 3);
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 7; ++i) P.row(7 * j + i) << 10.0 * i / 6.0, 5.0 * j, 0.0;
+    const knit::spline::SplineSurface s(knit::spline::BSplineBasis(2, U),
+                                        knit::spline::BSplineBasis(2, V), P);
+    const auto exact = estimate_shell_memory(refine_patch(s, 3, 25, 25));
+    CHECK(3.0 * (25 + 3) * (25 + 3) <= 2500.0);  // the bound's N: the dense regime
+    CHECK(estimate_refinement_memory(3, 25, 25).total() <= exact.total());
+  }
   // Session 24: a KNIT_MAX_MEMORY_MB that is not a whole number of MiB was ignored in silence.
   for (const char* bad : {"4G", "-1", "0", "1e308", "", "99999999999999999999"}) {
     INFO("KNIT_MAX_MEMORY_MB=" << bad);

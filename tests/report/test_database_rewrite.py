@@ -62,6 +62,20 @@ def replace(f, name, data, **kw):
         f[name].attrs[k] = v
 
 
+def set_fixed_string(obj, name, data, pad, utf8=False):
+    """Attribute `name` of `obj` as one fixed-length string of the bytes `data`, padded `pad`
+    (h5py.h5t.STR_NULLTERM, STR_NULLPAD or STR_SPACEPAD), ASCII or UTF-8."""
+    tid = h5py.h5t.C_S1.copy()
+    tid.set_size(len(data))
+    tid.set_strpad(pad)
+    if utf8:
+        tid.set_cset(h5py.h5t.CSET_UTF8)
+    if name in obj.attrs:
+        del obj.attrs[name]
+    aid = h5py.h5a.create(obj.id, name.encode(), tid, h5py.h5s.create(h5py.h5s.SCALAR))
+    aid.write(np.array(data, dtype="S%d" % len(data)), mtype=tid)
+
+
 def run_case(tmp, db, tag):
     """A small wale-wise tensile case on `db` at l = 5 mm: (exit code, stderr)."""
     case = {
@@ -147,11 +161,27 @@ def main():
             "a fixed-length string with a NUL inside it": (
                 lambda f: f["energy_law"].attrs.__setitem__("family", np.bytes_(b"ridge\0network")),
                 "/energy_law: a string with a NUL byte inside it (at character 6 of 13)"),
+            # The review of session 49: stored null-terminated, HDF5's conversion hid it.
+            "a null-terminated fixed-length string with a NUL inside it": (
+                lambda f: set_fixed_string(f["energy_law"], "family", b"ridge\0network",
+                                           h5py.h5t.STR_NULLTERM),
+                "/energy_law: a string with a NUL byte inside it (at character 6 of 13)"),
             "a dataset under the scale-offset filter": (
                 lambda f: replace(f, "energy_law/coefficients", f["energy_law/coefficients"][()],
                                   scaleoffset=2, chunks=True),
                 "/energy_law/coefficients: stored with the HDF5 filter"),
         }
+        # Fixed-length strings without damage are read, whatever their padding and character
+        # set (the review of session 49: UTF-8 ones failed with "cannot read string data").
+        for tag, pad, text, utf8 in (("nullterm", h5py.h5t.STR_NULLTERM, b"ridge\0\0\0", False),
+                                     ("spacepad", h5py.h5t.STR_SPACEPAD, b"ridge   ", False),
+                                     ("utf8", h5py.h5t.STR_NULLPAD, b"ridge", True)):
+            db = os.path.join(tmp, "old_%s.h5" % tag)
+            rewrite_without_checksums(made["ridge"], db, version=2)
+            with h5py.File(db, "r+") as f:
+                set_fixed_string(f["energy_law"], "family", text, pad, utf8)
+            rc, err = run_case(tmp, db, "old_" + tag)
+            c(rc == 0, "a fixed-length string (%s) is read" % tag, err[-800:])
         for k, (what, (damage, message)) in enumerate(damages.items()):
             db = os.path.join(tmp, "old_%d.h5" % k)
             rewrite_without_checksums(made["ridge"], db, version=2)

@@ -128,11 +128,16 @@ class AtomicDirectory {
   /// ("completed: yes" / "no"; not called: no line). A stopped output (false) that replaces a
   /// completed one of the same DIR (its marker says "completed: yes") keeps that one as
   /// "DIR.last-completed" (keep_replaced_as) unless another suffix was set: a failed rerun of
-  /// knit-macro design or knit-meso path or rod never costs a completed output (session 49's
-  /// red team; knit-macro run judges from summary.txt since session 46 and does not call this).
+  /// knit-macro design or knit-meso path or rod does not cost a completed output written since
+  /// session 49 (its red team; an older output has no such line: a command may judge it from
+  /// its files, set_earlier_completed; knit-macro run judges from summary.txt since session 46
+  /// and does not call this).
   void set_completed(bool completed) { completed_flag_ = completed ? 1 : 0; }
   /// The output in DIR when this one was started was a completed one (its marker said so).
   bool earlier_completed() const { return earlier_completed_; }
+  /// The command's own judgement of the earlier output (one written before the marker had the
+  /// line: knit-macro design reads its summary.txt).
+  void set_earlier_completed(bool completed) { earlier_completed_ = completed; }
 
  private:
   /// Removes the replaced output `old` (now beside the target), or keeps it (keep_replaced_as).
