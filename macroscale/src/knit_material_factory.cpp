@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "knit/core/errors.hpp"
@@ -264,18 +265,20 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // (E of order 1e3 MPa) can: the bounds are 1e-9 and 1e9 MPa, ten decades beyond both.
   for (std::size_t k = 0; k < data.entries.size(); ++k) {
     const double l = data.entries[k].loop_length;
+    if (!energy && !data.entries[k].surface) continue;
+    // The law at this loop length, built once (a paper surface was checked above).
+    std::optional<material::EnergyLawAt> at;
+    std::optional<material::ResponseSurface> surface;
+    if (energy)
+      at.emplace(energy->at(l));
+    else
+      surface.emplace(*data.entries[k].surface);
     double largest = 0.0;
     bool finite = true;
     for (const Eigen::Vector3d& e :
          {Eigen::Vector3d(0.05, 0.0, 0.0), Eigen::Vector3d(0.0, 0.05, 0.0),
           Eigen::Vector3d(0.05, 0.05, 0.0)}) {
-      Eigen::Vector3d S;
-      if (energy) {
-        S = energy->at(l).evaluate(e).S;
-      } else {
-        if (!data.entries[k].surface) continue;
-        S = material::ResponseSurface(*data.entries[k].surface).evaluate(e).S;
-      }
+      const Eigen::Vector3d S = at ? at->evaluate(e).S : surface->evaluate(e).S;
       finite = finite && S.allFinite();
       if (finite) largest = std::max(largest, S.cwiseAbs().maxCoeff());
     }

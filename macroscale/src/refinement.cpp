@@ -32,6 +32,16 @@ std::uint64_t num_spans(const std::vector<double>& U) {
   return n;
 }
 
+/// The global system of N unknowns: a dense matrix (two copies, the factor's too) up to
+/// kDenseUnknowns, else 3 copies of 16 bytes per entry of the sparse pattern (bounded by N^2).
+constexpr double kDenseUnknowns = 2500;
+double dense_system_bytes(double N) {
+  return 2.0 * N * N * 8.0;
+}
+double sparse_system_bytes(double N, double pu, double pv) {
+  return 3.0 * 16.0 * std::min(N * 3.0 * (2 * pu + 1) * (2 * pv + 1), N * N);
+}
+
 }  // namespace
 
 std::string format_bytes(std::uint64_t b) {
@@ -62,9 +72,8 @@ MemoryEstimate estimate_shell_memory(double pu, double pv, double spans, double 
   // were counted, 6.1 GB of a 256 x 256 patch of degree 5 that the run never holds, so the
   // estimate stood 1.5-2 x above the measured peak and refused runs that fit).
   m.element_tangents = static_cast<std::uint64_t>(2.0 * 9.0 * nloc * nloc * 8.0);
-  const double nnz = N * 3.0 * (2 * pu + 1) * (2 * pv + 1);
-  m.global_system =
-      static_cast<std::uint64_t>(N <= 2500 ? 2.0 * N * N * 8.0 : 3.0 * 16.0 * std::min(nnz, N * N));
+  m.global_system = static_cast<std::uint64_t>(
+      N <= kDenseUnknowns ? dense_system_bytes(N) : sparse_system_bytes(N, pu, pv));
   return m;
 }
 
@@ -84,9 +93,9 @@ MemoryEstimate estimate_refinement_memory(int p, int elements_u, int elements_v)
   // elements of degree 3 on a patch with interior knots were refused by a dense bound of 105
   // MB where the refined patch's estimate is 41 MB). The smaller of the two formulas at the
   // bound's N is a lower bound in either regime.
-  const double pd = p, N = 3.0 * (elements_u + pd) * (elements_v + pd);
-  const double sparse = 3.0 * 16.0 * std::min(N * 3.0 * (2 * pd + 1) * (2 * pd + 1), N * N);
-  m.global_system = std::min(m.global_system, static_cast<std::uint64_t>(sparse));
+  const double N = 3.0 * (elements_u + static_cast<double>(p)) * (elements_v + p);
+  m.global_system =
+      static_cast<std::uint64_t>(std::min(dense_system_bytes(N), sparse_system_bytes(N, p, p)));
   return m;
 }
 
