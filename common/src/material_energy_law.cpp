@@ -98,6 +98,12 @@ void validate(const EnergyLawData& d) {
   const int G = d.functions();
   for (int g : d.directions.function_of)
     if (g < 0) fail("function_of has a negative index");
+  // Each ridge function serves at least one direction (session 49's red team: function_of[0] = 99
+  // was refused as "s_range needs one row per function").
+  if (G > K)
+    fail("function_of names function " + std::to_string(G - 1) + ", but there are only " +
+         std::to_string(K) +
+         " directions: the function indices run from 0 to the number of functions - 1");
   for (Eigen::Index k = 0; k < K; ++k) {
     const double n = d.directions.d.row(k).norm();
     if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-9)
@@ -105,7 +111,10 @@ void validate(const EnergyLawData& d) {
   }
   if (d.s_degree < 0 || d.s_degree > 5) fail("s_degree must be in 0..5");
   if (d.s_spans < 1 || d.s_spans > 1000) fail("s_spans must be in 1..1000");
-  if (d.s_range.rows() != G) fail("s_range needs one row per function");
+  if (d.s_range.rows() != G)
+    fail("s_range needs one row per function: function_of names " + std::to_string(G) +
+         " functions (indices 0 to " + std::to_string(G - 1) + "), s_range has " +
+         std::to_string(d.s_range.rows()) + " rows");
   for (int g = 0; g < G; ++g) {
     const std::string why = d.grid(g).validate();
     if (!why.empty()) fail("function " + std::to_string(g) + ": " + why);

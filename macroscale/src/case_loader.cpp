@@ -373,7 +373,9 @@ void read_bcs(const Reader& r, const json& root, Case& c) {
       if (bc.target != BoundaryCondition::Target::kCorner)
         r.fail(ptr + "/radius", "a radius spreads a corner condition: it needs \"corner\"");
       bc.radius = r.number(j.at("radius"), ptr + "/radius");
-      if (bc.radius < 0) r.fail(ptr + "/radius", "must be >= 0 (mm), got " + j.at("radius").dump());
+      if (bc.radius < 0)
+        r.fail(ptr + "/radius", "must be >= 0 (" + unit_labels(c.units).of("mm") + "), got " +
+                                    j.at("radius").dump());
     }
     if (j.contains("fix")) {
       const json& f = r.array(j.at("fix"), ptr + "/fix");
@@ -477,8 +479,8 @@ void read_solver(const Reader& r, const json& root, Case& c) {
   if (s.contains("absolute_tolerance")) {
     o.absolute_tolerance = r.positive(s.at("absolute_tolerance"), "/solver/absolute_tolerance");
     if (o.absolute_tolerance > kMaxAbsoluteTolerance)
-      r.fail("/solver/absolute_tolerance",
-             "must be at most 0.001 N, got " + s.at("absolute_tolerance").dump());
+      r.fail("/solver/absolute_tolerance", "must be at most 0.001 " + unit_labels(c.units).of("N") +
+                                               ", got " + s.at("absolute_tolerance").dump());
   }
   if (s.contains("max_iterations"))
     o.max_iterations = r.integer(s.at("max_iterations"), "/solver/max_iterations", 1, 1000);
@@ -555,7 +557,8 @@ void read_output(const Reader& r, const json& root, Case& c) {
         if (ro.at_edge) r.fail(ptr + "/radius", "a radius applies to corners only");
         ro.radius = r.number(rs[k].at("radius"), ptr + "/radius");
         if (ro.radius < 0)
-          r.fail(ptr + "/radius", "must be >= 0 (mm), got " + rs[k].at("radius").dump());
+          r.fail(ptr + "/radius", "must be >= 0 (" + unit_labels(c.units).of("mm") + "), got " +
+                                      rs[k].at("radius").dump());
       }
       ro.component = r.component(rs[k].at("component"), ptr + "/component");
       if (rs[k].contains("rows")) {
@@ -740,6 +743,7 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   read_bcs(r, root, c);
   read_loads(r, root, c);
   read_solver(r, root, c);
+  c.solver.force_unit = unit_labels(c.units).of("N");
   read_output(r, root, c);
   // The columns of load_strain.csv, unit suffixes included, must not repeat (session 48's
   // review: without suffixes, in a case's own units, a reaction "strain" hid the strain column

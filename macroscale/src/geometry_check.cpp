@@ -184,7 +184,7 @@ std::optional<AreaQuadratureDefect> area_quadrature_defect(const spline::SplineS
 
 std::string symmetry_plane_problem(const spline::SplineSurface& surface,
                                    const std::vector<int>& row0, const std::vector<int>& row1,
-                                   int component) {
+                                   int component, const std::string& length_unit) {
   const Eigen::MatrixXd& P = surface.control_points();
   const char* axis = component == 0 ? "x" : component == 1 ? "y" : "z";
   std::ostringstream m;
@@ -196,8 +196,9 @@ std::string symmetry_plane_problem(const spline::SplineSurface& surface,
   }
   if (hi - lo > kSymmetryPlaneTolerance * patch_size(surface)) {
     m << "the edge does not lie in a plane of normal " << axis << ": its control points' " << axis
-      << " run from " << lo << " to " << hi << " mm (a symmetry plane of normal " << axis
-      << " needs " << axis << " constant along the edge; check the edge and the plane's normal)";
+      << " run from " << lo << " to " << hi << " " << length_unit << " (a symmetry plane of normal "
+      << axis << " needs " << axis
+      << " constant along the edge; check the edge and the plane's normal)";
     return m.str();
   }
   for (std::size_t k = 0; k < row0.size() && k < row1.size(); ++k) {
@@ -207,8 +208,8 @@ std::string symmetry_plane_problem(const spline::SplineSurface& surface,
     if (along.norm() > kSymmetryAngleTolerance * d.norm()) {
       m << "the control net does not leave the plane of normal " << axis
         << " along that normal: at the edge's control point " << k + 1 << " of " << row0.size()
-        << " the next row is offset by (" << d(0) << ", " << d(1) << ", " << d(2)
-        << ") mm, not along " << axis
+        << " the next row is offset by (" << d(0) << ", " << d(1) << ", " << d(2) << ") "
+        << length_unit << ", not along " << axis
         << " (the condition ties control points, so the net's second row must lie on the "
            "plane's normal; check the edge and the plane's normal)";
       return m.str();

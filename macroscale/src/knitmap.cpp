@@ -259,6 +259,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     KnitCourse course;
     Laid laid;
     double r = 0;
+    double chord = 0;  ///< the patch's width along the course line (mm)
   };
   std::vector<Row> rows;
   double t = t_min;
@@ -328,6 +329,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
         }
       }
       row.laid = lay(cr.front(), cr.back(), tc);
+      row.chord = cr.back() - cr.front();
       row.course.t = tc - t_min;
       if (row.laid.l.empty()) {
         empty = true;
@@ -409,7 +411,9 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
 
   // Round half up with a tolerance: a centred course of an even stitch count has r exactly at
   // a half integer, where round-off must not shift some courses by one needle.
-  auto first_of = [](double r) { return static_cast<long>(std::floor(r + 0.5 + 1e-6)); };
+  auto first_of = [](double r) {
+    return static_cast<long>(std::floor(r + 0.5 + kNeedleRoundingTolerance));
+  };
   long first_min = std::numeric_limits<long>::max();
   for (const auto& row : rows) first_min = std::min(first_min, first_of(row.r));
   map.l_min = 1e300;
@@ -444,6 +448,37 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     os << "the course height c(l) varies by up to " << 100 * map.max_height_mismatch
        << " % along a course; the map knits each course at its mean height (no short rows)";
     map.warnings.push_back(os.str());
+  }
+  // A patch about one stitch wide or one course tall (session 49's red team: a strip thinner
+  // than a course was mapped to one course, exit 0, without a word): the map knits whole
+  // stitches and courses, so its fabric may differ from such a patch by most of a stitch. Said
+  // when the fabric's extent differs from the patch's by more than kNarrowPatchMismatch of it,
+  // which a patch at least two stitches (courses) across never does: the nearest whole count
+  // is off by at most half a stitch.
+  {
+    const double across = t_max - t_min;
+    const double tall = rows.back().course.t + 0.5 * rows.back().course.height;
+    std::ostringstream os;
+    os.precision(3);
+    if (std::abs(tall - across) > kNarrowPatchMismatch * across) {
+      os << "the map's " << rows.size() << " course(s) are " << tall
+         << " mm tall where the patch is " << across
+         << " mm across the courses: a patch about one course tall is knitted to whole courses "
+            "(c = "
+         << rows.back().course.height << " mm here)";
+      map.warnings.push_back(os.str());
+    }
+    const Row& wide = *std::max_element(
+        rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.chord < b.chord; });
+    double width = 0;
+    for (double l : wide.laid.l) width += cells.wale_width(l);
+    if (std::abs(width - wide.chord) > kNarrowPatchMismatch * wide.chord) {
+      os.str("");
+      os << "the widest course's " << wide.laid.l.size() << " stitch(es) are " << width
+         << " mm wide where the patch is " << wide.chord
+         << " mm wide along it: a patch about one stitch wide is knitted to whole stitches";
+      map.warnings.push_back(os.str());
+    }
   }
   return map;
 }

@@ -446,9 +446,9 @@ RunReport solve_load_steps(const ShellModel& model, const DofMap& dofs, const Ei
       std::ostringstream s;
       s << "load step to lambda = " << lam1
         << " converged at the undeformed state with no iteration: its out-of-balance force "
-        << o.residual << " N is already within the tolerance (tolerance " << opt.tolerance
-        << " x reference force " << o.reference << " N + absolute_tolerance "
-        << opt.absolute_tolerance << " N), ";
+        << o.residual << " is already within the tolerance (tolerance " << opt.tolerance
+        << " x reference force " << o.reference << " + absolute_tolerance "
+        << opt.absolute_tolerance << "; forces in " << opt.force_unit << "), ";
       // Which part of the tolerance hides the step (session 36's red team: a pressure of 1e10
       // MPa on a patch held in z, carried by the supports alone, was reported as loads too
       // small to see).

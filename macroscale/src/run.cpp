@@ -37,13 +37,14 @@ Problem setup_problem(const Case& c) {
     const char* how = "";
   };
   std::vector<Holder> holder(static_cast<std::size_t>(m.num_dofs()));
+  const std::string length = unit_labels(c.units).of("mm");  // the case's length symbol
   const auto where = [&](int dof) {
     std::ostringstream s;
     s.precision(6);
     const auto X = c.surface.control_points().row(dof / 3);
     s << "component "
       << "xyz"[dof % 3] << " of control point " << dof / 3 << " of the analysis "
-      << "net, at (" << X(0) << ", " << X(1) << ", " << X(2) << ") mm";
+      << "net, at (" << X(0) << ", " << X(1) << ", " << X(2) << ") " << length;
     return s.str();
   };
   for (std::size_t bi = 0; bi < c.bcs.size(); ++bi) {
@@ -51,10 +52,11 @@ Problem setup_problem(const Case& c) {
     const auto hold = [&](int dof, double value, const char* how) {
       const Holder& h = holder[static_cast<std::size_t>(dof)];
       if (h.bc >= 0 && values_conflict(h.value, value)) {
-        const auto what = [](const char* verb, double v) {
+        const auto what = [&](const char* verb, double v) {
           std::ostringstream w;
           w << verb;
-          if (std::string(verb).find("symmetry") == std::string::npos) w << " (" << v << " mm)";
+          if (std::string(verb).find("symmetry") == std::string::npos)
+            w << " (" << v << " " << length << ")";
           return w.str();
         };
         std::ostringstream s;
@@ -91,7 +93,8 @@ Problem setup_problem(const Case& c) {
           for (int i = 0; i < 3; ++i) con.tie(3 * row1[k] + i, 3 * row0[k] + i);
       if (bc.symmetry >=
           0) {  // u_s = 0 on the edge, the cross-edge slope stays normal to the plane
-        if (const std::string why = symmetry_plane_problem(c.surface, row0, row1, bc.symmetry);
+        if (const std::string why =
+                symmetry_plane_problem(c.surface, row0, row1, bc.symmetry, length);
             !why.empty())
           throw InputError(c.file, bc.pointer + "/symmetry", why);
         for (size_t k = 0; k < row0.size(); ++k)

@@ -420,6 +420,12 @@ TEST_CASE("energy law: validation refuses bad data", "[unit]") {
       std::invalid_argument);
   CHECK_THROWS_AS(validate(bad([](auto& d) { d.directions.d(0, 0) = 2.0; })),
                   std::invalid_argument);
+  // A function index beyond the directions is named as such (session 49's red team: it was
+  // refused as "s_range needs one row per function").
+  CHECK_THROWS_WITH(validate(bad([](auto& d) { d.directions.function_of[0] = 99; })),
+                    Catch::Contains("function_of names function 99"));
+  CHECK_THROWS_WITH(validate(bad([](auto& d) { d.s_range.conservativeResize(3, 2); })),
+                    Catch::Contains("s_range has 3 rows"));
 }
 
 TEST_CASE("energy law: at the end knots dS/dl is the one-sided slope of the span inside",

@@ -887,6 +887,13 @@ TEST_CASE("output units: the symbols of /units, and load_strain.csv's columns ne
                     !Catch::Contains(" mm"));
   j["units"] = "mm, N, MPa";
   CHECK_THAT(error_of(j), Catch::Contains("a prescribed displacement of 1e-20 mm is below"));
+  // And so do the solver's force bound (session 49's review: "at most 0.001 N" in kN).
+  j["units"] = "m, kN, kPa";
+  for (json& bc : j["boundary_conditions"])
+    if (bc.contains("prescribe")) bc["prescribe"] = {{"y", 1.0}};
+  REQUIRE(error_of(j).empty());
+  j["solver"]["absolute_tolerance"] = 0.5;
+  CHECK_THAT(error_of(j), Catch::Contains("/solver/absolute_tolerance: must be at most 0.001 kN"));
 }
 
 TEST_CASE("a degenerate corner is refused at load, naming the file and /geometry", "[unit]") {

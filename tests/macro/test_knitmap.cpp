@@ -662,7 +662,7 @@ TEST_CASE("knitmap: first needles of a sheared graded patch follow rule 5", "[un
     for (const auto& s : st) wsum += w_of(s.l);
     const double mid = 0.5 * (st.front().position.x() + st.back().position.x());
     const double r = (mid - 30.0) / (wsum / k.stitches) - 0.5 * (k.stitches - 1);
-    first.push_back(std::lround(std::floor(r + 0.5 + 1e-6)));
+    first.push_back(std::lround(std::floor(r + 0.5 + kNeedleRoundingTolerance)));
   }
   const long least = *std::min_element(first.begin(), first.end());
   for (const auto& k : m.courses) {
@@ -694,6 +694,42 @@ TEST_CASE("knitmap: a turned or a mirrored patch holds the stitches of the untur
       CHECK((t.stitches[i].position - (m.stitches[i].position + shift)).norm() < 1e-9);
     }
   }
+}
+
+// Session 49's red team: at a knitting angle of pi - 3e-6 (or 3e-6) the courses' first stitches
+// drift by about 6e-5 stitches over 30 mm, across the half-integer where a course of 40
+// stitches starts; rounded with a tolerance of 1e-6 some courses moved by one needle, and the
+// map needed 41 needles for 40 stitches per course.
+TEST_CASE("knitmap: a patch turned by a few microradians keeps its needle count", "[unit]") {
+  const std::string db = database();
+  const long n = std::lround(40.0 / w_of(5.5));
+  REQUIRE(n % 2 == 0);  // a half-integer r: the rounding's edge
+  for (const char* alpha : {"3.1415896535897932", "3e-6", "-3e-6"}) {
+    INFO("alpha " << alpha);
+    const KnitMap m = map_of("microturn.json", case_text(knit_material(db, "5.5", alpha), 40, 30));
+    for (const auto& k : m.courses) CHECK(k.stitches == n);
+    CHECK(m.needles == n);
+  }
+}
+
+// Session 49's red team: a strip thinner than a course was mapped to one course, exit 0, with
+// no warning. At l = 5.5 (c = 1.24 mm, w = 1.33 mm) a 40 x 0.7 mm strip gets one course 77 %
+// taller than itself and a 1.0 x 30 mm strip one stitch a third wider; a 40 x 2.5 mm and a
+// 2.5 x 30 mm patch (two courses, two stitches) are within a quarter and not warned of.
+TEST_CASE("knitmap: a patch about one course tall or one stitch wide is warned of", "[unit]") {
+  const std::string l = knit_material(database(), "5.5");
+  REQUIRE(c_of(5.5) > 0.7);
+  REQUIRE(w_of(5.5) > 1.0 / 0.75);
+  const KnitMap thin = map_of("thin.json", case_text(l, 40.0, 0.7));
+  CHECK(thin.courses.size() == 1);
+  REQUIRE(thin.warnings.size() == 1);
+  CHECK_THAT(thin.warnings[0], Catch::Contains("about one course tall"));
+  const KnitMap narrow = map_of("narrow.json", case_text(l, 1.0, 30.0));
+  CHECK(narrow.needles == 1);
+  REQUIRE(narrow.warnings.size() == 1);
+  CHECK_THAT(narrow.warnings[0], Catch::Contains("about one stitch wide"));
+  CHECK(map_of("two_courses.json", case_text(l, 40.0, 2.5)).warnings.empty());
+  CHECK(map_of("two_stitches.json", case_text(l, 2.5, 30.0)).warnings.empty());
 }
 
 // Session 34 (the design/knitmap audit's mutant 24): rule 3 knits a course while its centre

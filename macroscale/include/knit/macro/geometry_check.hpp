@@ -87,6 +87,6 @@ inline constexpr double kSymmetryPlaneTolerance = 1e-4;
 inline constexpr double kSymmetryAngleTolerance = 1e-3;
 std::string symmetry_plane_problem(const spline::SplineSurface& surface,
                                    const std::vector<int>& row0, const std::vector<int>& row1,
-                                   int component);
+                                   int component, const std::string& length_unit = "mm");
 
 }  // namespace knit::macro

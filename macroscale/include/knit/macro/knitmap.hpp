@@ -70,6 +70,19 @@ struct KnitMapOptions {
   double max_stitches = 1e7;
 };
 
+/// The tolerance of rule 5's rounding of a course's first stitch to a needle, in stitches
+/// (docs/design.md, "Needles"): f_k = floor(r_k + 0.5 + kNeedleRoundingTolerance). A thousandth
+/// of a stitch (about a micrometre) is far below what a machine places, so a patch turned by a
+/// few microradians keeps its needle count (session 49's red team: with 1e-6, a 40 x 30 mm
+/// patch at a knitting angle of pi - 3e-6 moved some courses by a needle and needed 41 needles
+/// for its courses of 40 stitches).
+inline constexpr double kNeedleRoundingTolerance = 1e-3;
+
+/// A map whose fabric is taller (wider) than the patch across (along) the courses by more than
+/// this fraction of the patch's extent is warned of: a patch about one course tall or one
+/// stitch wide (docs/design.md, "Warnings").
+inline constexpr double kNarrowPatchMismatch = 0.25;
+
 struct KnitStitch {
   int course = 0, needle = 0;                          ///< 1-based
   double l = 0.0;                                      ///< loop length (mm)

@@ -50,6 +50,9 @@ struct SolverOptions {
   int steps = 10;                     ///< nominal load steps from lambda = 0 to 1
   double tolerance = 1e-8;            ///< relative residual tolerance
   double absolute_tolerance = 1e-10;  ///< N, floor of the residual tolerance
+  /// The case's force symbol ("N" by default, unit_labels(/units).of("N")), for messages only
+  /// (session 49's review: a case in m, kN, kPa was told its out-of-balance force in N).
+  std::string force_unit = "N";
   double displacement_tolerance =
       1e-8;                 ///< ||du|| / ||u|| accepted when the residual is at round-off
   int max_iterations = 25;  ///< Newton iterations per step
