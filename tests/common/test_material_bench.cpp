@@ -122,7 +122,8 @@ TEST_CASE("bench: energy-law evaluations per second", "[.bench]") {
   // KNIT_BENCH_DATABASE=FILE also the law stored in that material database, at its middle
   // loop length (a fitted law: its units are curved where the data put them) and between its
   // two middle knots (with l_interpolation "energy" there: two laws, four network passes; with
-  // l_blend, session 44, the middle knot lies in a rounding window: three laws, six passes).
+  // l_blend, session 44, the middle knot lies in a rounding window: three laws, six passes;
+  // one six-lane pass with AVX-512, a four-lane and a two-lane pass without it).
   for (const int kind : {0, 1, 2}) {
     EnergyLawData d = kind == 0 ? testing::make_test_energy_law()
                                 : testing::make_test_network_law(7, 0.02, 12, 6);
@@ -146,7 +147,8 @@ TEST_CASE("bench: energy-law evaluations per second", "[.bench]") {
     const double l_between =
         n > 1 ? 0.5 * (db.entries[m == 0 ? 0 : m - 1].loop_length + db.entries[m].loop_length)
               : l_mid;
-    for (const double l : {l_mid, l_between}) {
+    // And at the first loop length, an end knot: one law, two passes (session 50).
+    for (const double l : {l_mid, l_between, db.entries.front().loop_length}) {
       double sink = 0.0;
       const double rate = energy_law_rate(law, l, sink);
       const EnergyLawData& d = law.data();
