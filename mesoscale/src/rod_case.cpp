@@ -297,7 +297,7 @@ RodCase load_rod_case(const std::filesystem::path& path) {
                "must be at most 0.01 (a dimensionless residual), got " + js["tolerance"].dump());
       // Below the double's round-off no residual gets there in general: 1e-300 with a million
       // iterations ran for minutes to "did not converge" (session 49's red team).
-      if (c.path.newton.tol < 2.2e-16)  // the double's epsilon, 2.22e-16, as the schema says it
+      if (c.path.newton.tol < kMinRodTolerance)  // as the schema says it
         R.fail("/steps/tolerance",
                "must be at least 2.2e-16 (the round-off of a double: a dimensionless residual "
                "does not get below it), got " +
@@ -351,6 +351,33 @@ RodCase load_rod_case(const std::filesystem::path& path) {
       }
     }
   }
+  // A prescribed end rotation turns an end by at most kMaxStepRotation per load step.
+  for (int k = 0; k < c.system.num_rods(); ++k)
+    for (const auto& [where, bc] :
+         {std::pair{"start", &c.system.spec(k).start}, std::pair{"end", &c.system.spec(k).end}}) {
+      const double turn = bc->rotation.stableNorm();  // no overflow at 1e300
+      const int steps = std::max(1, c.path.steps);
+      if (!(turn / steps <= kMaxStepRotation)) {
+        std::ostringstream o;
+        o.precision(4);
+        const double need = std::ceil(turn / kMaxStepRotation);
+        const std::string ptr = "/rods/" + std::to_string(k) + "/" + where + "/rotation_vector";
+        if (!(need <= kMaxRodSteps)) {  // no step count resolves it (1e300 rad, say)
+          o << "turns its end by " << turn << " rad, more than " << kMaxRodSteps
+            << " load steps (/steps/count's maximum) of a third of a turn resolve; a rotation "
+               "vector is in radians (its length the angle, its direction the axis)";
+          R.fail(ptr, o.str());
+        }
+        o << "/rods/" << k << "/" << where << "/rotation_vector turns its end by " << turn
+          << " rad, " << turn / steps << " rad in each of " << steps
+          << " load step(s): more than a third of a turn per step (" << kMaxStepRotation
+          << " rad); an end rotation is reached modulo a full turn, so a "
+             "step of pi or more is solved the shorter way round (the rod curls the other way, "
+             "or not at all at a full turn); use at least "
+          << static_cast<long>(need) << " steps";
+        R.fail("/steps/count", o.str());
+      }
+    }
   // Loads the solver cannot see (session 29, found by a helper's fuzzing audit): the residual is
   // scaled per row (force rows L/EA, moment rows 1/EA, ...: row_scales()), so on a long slender
   // rod a real load is within the tolerance at the reference state. A 1000 mm rod of d = 0.1 mm
@@ -381,8 +408,21 @@ RodCase load_rod_case(const std::filesystem::path& path) {
         << " (dimensionless: force rows scaled by L/EA, moment rows by 1/EA), is within "
         << kLoadResolution << " x the tolerance " << c.path.newton.tol
         << ": the solver would resolve them to fewer than three digits, or stop at once with "
-           "nothing moved; lower /steps/tolerance to about "
-        << std::setprecision(2) << suggest << " or below, or raise the loads";
+           "nothing moved; ";
+      // No tolerance the case may set resolves them (session 49's red team: E = 1e300 was
+      // told to lower the tolerance to 1.2e-18, which /steps/tolerance refuses).
+      if (!(suggest >= kMinRodTolerance)) {
+        double ea = 0.0;
+        for (int k = 0; k < c.system.num_rods(); ++k)
+          ea = std::max(ea, c.system.spec(k).section.C_Gamma()(2));
+        o << "no tolerance resolves them (the smallest is " << kMinRodTolerance
+          << ", a double's round-off): the loads are negligible beside the rods' stiffness "
+             "(largest EA "
+          << ea << " N); check the section (/section: E and d) and the loads' size";
+      } else {
+        o << "lower /steps/tolerance to about " << std::setprecision(2) << suggest
+          << " or below, or raise the loads";
+      }
       R.fail("/steps/tolerance", o.str());
     }
   }

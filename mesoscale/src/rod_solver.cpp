@@ -6,6 +6,7 @@
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace knit::meso::rod {
 
@@ -189,8 +190,25 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
                     std::to_string(rep.total_iterations) + " Newton iterations spent (cap " +
                         std::to_string(cap) + ", steps.max_total_iterations) at lambda = " +
                         std::to_string(lam) + " of " + std::to_string(opt.lambda_end));
-      const NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
+      NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
       rep.total_iterations += r.iterations;
+      // A converged state whose centerline passed through zero length is no rod state: the
+      // increment fails and is cut back (session 49's red team: a rod shortened by three times
+      // its length "completed" at an axial strain of -3, exit 0).
+      if (r.converged) {
+        const RodSystem::AxialStretch a = sys.min_axial_stretch(x);
+        if (!(a.value > 0.0)) {
+          std::ostringstream o;
+          o.precision(4);
+          o << "the converged state's axial stretch d3 . r' / |r0'| is " << a.value
+            << " (<= 0) on rod " << sys.spec(a.rod).name << " at xi = " << a.xi
+            << ": the centerline would pass through zero length there, which no rod state "
+               "describes (the loads or the prescribed end positions shorten it by its whole "
+               "length)";
+          r.converged = false;
+          r.message = o.str();
+        }
+      }
       if (r.converged) {
         x_last = x_prev;
         last_inc = next - lam;

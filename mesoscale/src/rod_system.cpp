@@ -253,6 +253,19 @@ PointState RodSystem::state(int rod, double xi, const Eigen::VectorXd& x) const 
   return s;
 }
 
+RodSystem::AxialStretch RodSystem::min_axial_stretch(const Eigen::VectorXd& x) const {
+  AxialStretch a;
+  bool first = true;
+  for (int k = 0; k < num_rods(); ++k)
+    for (const CollocationPoint& c : rods_[k].points) {
+      const PointState s = state(k, c.xi, x);
+      const double v = s.R.col(2).dot(s.r_xi) / s.jac;
+      if (first || !(v >= a.value)) a = {v, k, c.xi};
+      first = false;
+    }
+  return a;
+}
+
 void RodSystem::residual(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd& F) const {
   std::vector<Trip> dummy;
   dummy.reserve(1);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../process_tmp.hpp"
+#include "knit/core/errors.hpp"
 #include "knit/meso/rod/rod_case.hpp"
 
 namespace fs = std::filesystem;
@@ -466,4 +467,84 @@ TEST_CASE("rod case: a prescribed end rotation of a full turn rolls the rod up",
   REQUIRE(half[1] == Approx(0.5));
   CHECK(half[3] == Approx(-10.0).margin(1e-3));
   CHECK(half[5] == Approx(20.0 / M_PI).margin(1e-3));
+}
+
+namespace {
+/// cases/rod/elastica.json with its end condition and step count replaced.
+fs::path elastica_with(const std::string& name, const std::string& end, int steps) {
+  std::string text = case_text("elastica.json");
+  const std::string old_end =
+      R"("end": { "position": "free", "rotation": "free", "force": [0, 0, 1.5707963267948966e-4] })";
+  const auto at = text.find(old_end);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, old_end.size(), R"("end": )" + end);
+  const auto st = text.find(R"("steps": { "count": 8 })");
+  REQUIRE(st != std::string::npos);
+  text.replace(st, 23, R"("steps": { "count": )" + std::to_string(steps) + " }");
+  const fs::path f = kTmp / name;
+  write(f, text);
+  return f;
+}
+/// The InputError's text of loading a rod case, "" if it loads.
+std::string load_error(const fs::path& f) {
+  try {
+    (void)knit::meso::rod::load_rod_case(f);
+  } catch (const knit::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST_CASE("rod case: a step turning an end by more than a third of a turn is refused", "[unit]") {
+  // Session 49's red team: 4 rad in one step was solved as -2.28 rad (the rod curled the other
+  // way), 2 pi in one step as no rotation at all, exit 0. An end rotation is reached modulo a
+  // full turn, so each step may turn an end by at most kMaxStepRotation (2 pi / 3).
+  const std::string turn4 =
+      R"({"position": "free", "rotation": "fixed", "rotation_vector": [0, -4.0, 0]})";
+  const std::string e1 = load_error(elastica_with("turn4_1.json", turn4, 1));
+  CHECK_THAT(e1, Catch::Contains("turn4_1.json: /steps/count: /rods/0/end/rotation_vector "
+                                 "turns its end by 4 rad") &&
+                     Catch::Contains("use at least 2 steps"));
+  CHECK(load_error(elastica_with("turn4_2.json", turn4, 2)).empty());  // 2 rad per step
+  // No step count resolves 1e300 rad: the rotation vector itself is named.
+  const std::string huge =
+      R"({"position": "free", "rotation": "fixed", "rotation_vector": [0, 1e300, 0]})";
+  CHECK_THAT(load_error(elastica_with("turn_huge.json", huge, 8)),
+             Catch::Contains("/rods/0/end/rotation_vector: turns its end by 1e+300 rad"));
+}
+
+TEST_CASE("rod case: a rod pushed through zero length stops, exit 1", "[unit]") {
+  // Session 49's red team: the elastica's end moved by -30 mm along the 10 mm rod "completed"
+  // with exit 0 at an axial strain of -3. A state with an axial stretch <= 0 is no rod state:
+  // the path stops before it (at lambda = 1/3, where the rod would have zero length).
+  const fs::path f = elastica_with(
+      "push.json", R"({"position": "fixed", "rotation": "free", "displacement": [-30, 0, 0]})", 8);
+  const fs::path out = kTmp / "push_out";
+  fs::remove_all(out);
+  std::string msg;
+  const int rc = run("rod " + f.string() + " -q -o " + out.string(), &msg);
+  INFO(msg);
+  CHECK(rc == 1);
+  CHECK_THAT(msg, Catch::Contains("axial stretch") && Catch::Contains("zero length"));
+  const auto rows = read_csv(out / "load_displacement.csv");
+  REQUIRE(!rows.empty());
+  CHECK(rows.back()[1] < 1.0 / 3.0 + 1e-9);
+}
+
+TEST_CASE("rod case: loads no tolerance resolves are not sent to /steps/tolerance's minimum",
+          "[unit]") {
+  // Session 49's red team: with E = 1e300 the elastica's load was within the tolerance, and
+  // the message said to lower it to 1.2e-18, which /steps/tolerance refuses (>= 2.2e-16).
+  std::string text = case_text("elastica.json");
+  const std::string sec = R"("E": 800.0)";
+  const auto at = text.find(sec);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, sec.size(), R"("E": 1e300)");
+  const fs::path f = kTmp / "stiff.json";
+  write(f, text);
+  const std::string e = load_error(f);
+  CHECK_THAT(e, Catch::Contains("/steps/tolerance: ") &&
+                    Catch::Contains("no tolerance resolves them") &&
+                    !Catch::Contains("lower /steps/tolerance"));
 }

@@ -58,6 +58,19 @@ struct CasePathReport : PathReport {
 /// this factor, or the case is refused at /steps/tolerance (the loads would not be resolved).
 inline constexpr double kLoadResolution = 1e3;
 
+/// The largest turn of a prescribed end rotation in one load step, rad (choice: a third of a
+/// turn). An end rotation is reached as exp(lambda theta), a rotation, which is the same for
+/// theta and theta minus a full turn along it: a step that turns an end by pi or more is
+/// solved the shorter way round (session 49's red team: 4 rad in one step gave the arc of
+/// -2.28 rad, curled the other way, and 2 pi in one step no deformation at all, exit 0). At a
+/// third of a turn the other way round is twice as long, far from the tie at pi; the case is
+/// refused at /steps/count, with the count that keeps each step within it.
+inline constexpr double kMaxStepRotation = 2.0 * 3.14159265358979323846 / 3.0;
+/// /steps/tolerance's minimum, a double's round-off (schemas/rod.schema.json).
+inline constexpr double kMinRodTolerance = 2.2e-16;
+/// /steps/count's maximum (schemas/rod.schema.json).
+inline constexpr double kMaxRodSteps = 1e6;
+
 /// The estimated size of a case's outputs in bytes: one VTP per load step and the start (about
 /// 200 bytes per sampled centerline point), and the CSV.
 std::uint64_t estimate_output_bytes(const RodCase& c);
