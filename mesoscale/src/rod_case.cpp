@@ -409,7 +409,7 @@ RodCase load_rod_case(const std::filesystem::path& path) {
         << kLoadResolution << " x the tolerance " << c.path.newton.tol
         << ": the solver would resolve them to fewer than three digits, or stop at once with "
            "nothing moved; ";
-      // No tolerance the case may set resolves them (session 49's red team: E = 1e300 was
+      // No tolerance the case may set resolves them (session 50's red team: E = 1e300 was
       // told to lower the tolerance to 1.2e-18, which /steps/tolerance refuses).
       if (!(suggest >= kMinRodTolerance)) {
         double ea = 0.0;

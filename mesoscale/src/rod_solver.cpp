@@ -193,7 +193,7 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
       NewtonReport r = solve_newton(sys, x, next, extra, opt.newton);
       rep.total_iterations += r.iterations;
       // A converged state whose centerline passed through zero length is no rod state: the
-      // increment fails and is cut back (session 49's red team: a rod shortened by three times
+      // increment fails and is cut back (session 50's red team: a rod shortened by three times
       // its length "completed" at an axial strain of -3, exit 0).
       if (r.converged) {
         const RodSystem::AxialStretch a = sys.min_axial_stretch(x);

@@ -497,7 +497,7 @@ std::string load_error(const fs::path& f) {
 }  // namespace
 
 TEST_CASE("rod case: a step turning an end by more than a third of a turn is refused", "[unit]") {
-  // Session 49's red team: 4 rad in one step was solved as -2.28 rad (the rod curled the other
+  // Session 50's red team: 4 rad in one step was solved as -2.28 rad (the rod curled the other
   // way), 2 pi in one step as no rotation at all, exit 0. An end rotation is reached modulo a
   // full turn, so each step may turn an end by at most kMaxStepRotation (2 pi / 3).
   const std::string turn4 =
@@ -515,7 +515,7 @@ TEST_CASE("rod case: a step turning an end by more than a third of a turn is ref
 }
 
 TEST_CASE("rod case: a rod pushed through zero length stops, exit 1", "[unit]") {
-  // Session 49's red team: the elastica's end moved by -30 mm along the 10 mm rod "completed"
+  // Session 50's red team: the elastica's end moved by -30 mm along the 10 mm rod "completed"
   // with exit 0 at an axial strain of -3. A state with an axial stretch <= 0 is no rod state:
   // the path stops before it (at lambda = 1/3, where the rod would have zero length).
   const fs::path f = elastica_with(
@@ -534,7 +534,7 @@ TEST_CASE("rod case: a rod pushed through zero length stops, exit 1", "[unit]") 
 
 TEST_CASE("rod case: loads no tolerance resolves are not sent to /steps/tolerance's minimum",
           "[unit]") {
-  // Session 49's red team: with E = 1e300 the elastica's load was within the tolerance, and
+  // Session 50's red team: with E = 1e300 the elastica's load was within the tolerance, and
   // the message said to lower it to 1.2e-18, which /steps/tolerance refuses (>= 2.2e-16).
   std::string text = case_text("elastica.json");
   const std::string sec = R"("E": 800.0)";

@@ -61,7 +61,7 @@ inline constexpr double kLoadResolution = 1e3;
 /// The largest turn of a prescribed end rotation in one load step, rad (choice: a third of a
 /// turn). An end rotation is reached as exp(lambda theta), a rotation, which is the same for
 /// theta and theta minus a full turn along it: a step that turns an end by pi or more is
-/// solved the shorter way round (session 49's red team: 4 rad in one step gave the arc of
+/// solved the shorter way round (session 50's red team: 4 rad in one step gave the arc of
 /// -2.28 rad, curled the other way, and 2 pi in one step no deformation at all, exit 0). At a
 /// third of a turn the other way round is twice as long, far from the tie at pi; the case is
 /// refused at /steps/count, with the count that keeps each step within it.

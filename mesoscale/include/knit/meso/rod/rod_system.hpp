@@ -184,7 +184,7 @@ class RodSystem {
   Eigen::Vector3d reference_position(int rod, double xi) const;
   /// The smallest axial stretch d3 . r' / |r0'| over every rod's collocation points (1 in the
   /// reference state; <= 0 where the centerline has been pushed through zero length, which no
-  /// rod state describes: session 49's red team, a rod shortened by three times its length
+  /// rod state describes: session 50's red team, a rod shortened by three times its length
   /// "completed" at a strain of -3), with the rod and the parameter where it lies.
   struct AxialStretch {
     double value = 1.0;
