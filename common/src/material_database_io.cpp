@@ -309,6 +309,27 @@ std::runtime_error database_not_written(const std::filesystem::path& target, boo
       (existed ? "the earlier file is left as it was" : "no file was created") + "): " + why);
 }
 
+void refuse_replacing_swept_database(const std::filesystem::path& file, const std::string& option) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec) || !io::is_hdf5_file(file)) return;
+  std::string generator, date;
+  try {
+    const H5File f = H5File::open_read(file);
+    if (!f.has_attribute(".", "generator")) return;
+    generator = f.attribute_string(".", "generator");
+    if (f.has_attribute(".", "date_utc")) date = f.attribute_string(".", "date_utc");
+  } catch (const std::exception&) {
+    return;  // not ours to judge here: check_output_target decides about the file
+  }
+  if (generator != "sweep") return;
+  throw InputError(file.string(), "/@generator",
+                   "holds a material database swept on the unit cell (generator \"sweep\"" +
+                       (date.empty() ? std::string() : ", written " + date) +
+                       "), which a synthetic stand-in does not replace (" + option +
+                       "): write the stand-in to another file, or move the swept database "
+                       "away first");
+}
+
 Database read_database(const std::filesystem::path& file, bool with_raw) {
   const std::string fname = file.string();
   std::string where;  // HDF5 path being read, for messages

@@ -380,6 +380,19 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
           "lack those cases' states; rerun the sweep (its summary says why they failed)";
     src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
   }
+  // A synthetic stand-in is no knit's response (session 50's red team: knit-meso synth wrote
+  // over a swept database in place, and a wale-wise case ran on it to 41.3 N for 154.7 N, exit 0,
+  // with "synthetic" nowhere in its outputs): said wherever the case's warnings go.
+  if (data.generator == "synth" || data.generator.find("synthetic") != std::string::npos) {
+    std::ostringstream os;
+    os << "warning: " << db.string() << ": /@generator: this database is a synthetic stand-in (\""
+       << data.generator
+       << "\": knit-meso synth, or a sweep with the synthetic runner), not the unit cell's "
+          "response: its laws are closed-form placeholders for tests and demonstrations, and "
+          "the results are not a knitted fabric's; for those, write the database with "
+          "knit-meso sweep (runner \"cell\", the default)";
+    src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
+  }
   // The law's own uniaxial response beside the cell's (session 41): warned about after a run
   // where it departs by more than /material/uniaxial_tolerance (KnitMaterial::warning()).
   // Every loop length of the diagnostics, those without a curve too: the knots' neighbours

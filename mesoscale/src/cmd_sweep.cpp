@@ -235,6 +235,8 @@ int run(const Cli& c) {
     // Before any case runs (the lock is taken by run_sweep, on rank 0).
     knit::io::check_output_target(c.output, knit::io::OutputKind::kFile, "--output",
                                   knit::material::kDatabaseFormatName);
+    if (in.runner == RunnerKind::kSynthetic)
+      knit::material::refuse_replacing_swept_database(c.output, "--output, runner \"synthetic\"");
     SweepOptions o;
     o.output = c.output;
     o.resume = c.resume;

@@ -61,6 +61,7 @@ static knit::cli::SubcommandRegistrar reg_synth(
         using namespace knit::meso::fit;
         knit::io::check_output_target(o->out, knit::io::OutputKind::kFile, "--out",
                                       knit::material::kDatabaseFormatName);
+        knit::material::refuse_replacing_swept_database(o->out, "--out");
         const knit::io::OutputLock lock(o->out);
         SyntheticOptions so;
         so.loop_lengths = o->loop_lengths;

@@ -560,3 +560,27 @@ TEST_CASE("knit material: a failed sweep's database is warned of, a bad count re
                                                    "converge"));
   }
 }
+
+// Session 50's red team: knit-meso synth wrote over a swept database in place, and a wale-wise
+// case ran on it (41.3 N for 154.7 N) with exit 0 and "synthetic" nowhere in its outputs.
+TEST_CASE("knit material: a synthetic stand-in database is warned of", "[unit]") {
+  for (const std::string generator : {"test", "sweep", "synth", "sweep (synthetic runner)"}) {
+    INFO(generator);
+    const std::string db = db_file("generator.h5", true, kDatabaseFormatVersion);
+    {
+      auto h = knit::io::H5File::open_rw(db);
+      h.set_attribute(".", "generator", generator);
+    }
+    const Case c = parse_case(
+        square_case(R"({"type": "knit", "database": ")" + db + R"(", "stitch_value": 5.0})"),
+        "c.json");
+    const auto& m = dynamic_cast<const KnitMaterial&>(*c.material);
+    if (generator.find("synth") == std::string::npos)
+      CHECK_THAT(m.warning(), !Catch::Contains("synthetic stand-in"));
+    else
+      CHECK_THAT(m.warning(), Catch::Contains(db +
+                                              ": /@generator: this database is a synthetic "
+                                              "stand-in (\"" +
+                                              generator + "\""));
+  }
+}

@@ -577,3 +577,25 @@ TEST_CASE("knit-meso fit: without an options file a law keeps the options it was
            std::string::npos) == differ);
   }
 }
+
+// Session 50's red team: knit-meso synth (and a sweep with the synthetic runner) wrote over a
+// database swept on the unit cell, exit 0, and the cases then ran on the stand-in. A database
+// whose generator is "sweep" is refused, left byte for byte; a stand-in replaces a stand-in.
+TEST_CASE("knit-meso synth does not replace a database swept on the cell", "[unit]") {
+  const fs::path dir = scratch_dir(), db = dir / "swept_stand_in.h5", err = dir / "swept.err";
+  fs::remove(db);
+  const std::string synth = "synth --no-fit --no-coverage --loop-lengths 4.5,6.5 --out ";
+  REQUIRE(run(synth + db.string()) == 0);
+  REQUIRE(run(synth + db.string()) == 0);  // a stand-in over a stand-in
+  {
+    auto h = knit::io::H5File::open_rw(db.string());
+    h.set_attribute(".", "generator", std::string("sweep"));
+  }
+  const std::string before = bytes(db);
+  std::string msg;
+  CHECK(run_with_stderr(synth + db.string(), err, msg) == 2);
+  CHECK_THAT(msg, Catch::Contains(db.string() + ": /@generator: holds a material database swept "
+                                                "on the unit cell"));
+  CHECK(bytes(db) == before);
+  fs::remove(db);
+}

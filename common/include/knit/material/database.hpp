@@ -227,6 +227,13 @@ std::vector<std::string> items_not_carried(const io::H5File& from, const io::H5F
 std::runtime_error database_not_written(const std::filesystem::path& target, bool existed,
                                         const std::filesystem::path& temp, const std::exception& e);
 
+/// Refuses to let a synthetic stand-in (`knit-meso synth`, a sweep with the synthetic runner)
+/// replace a database swept on the unit cell (root attribute generator "sweep"): throws
+/// knit::InputError(file, "/@generator", ...) naming `option`. Nothing when `file` is absent,
+/// not HDF5 or holds another generator. Session 50's red team: synth wrote over a swept
+/// database in place, exit 0, and the cases ran on the stand-in (41.3 N for 154.7 N).
+void refuse_replacing_swept_database(const std::filesystem::path& file, const std::string& option);
+
 /// Reads and validates. Throws knit::InputError(file, hdf5_path, what) on a bad file.
 /// raw = false skips the raw path data (faster for the macroscale).
 Database read_database(const std::filesystem::path& file, bool raw = true);
