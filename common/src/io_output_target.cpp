@@ -497,8 +497,13 @@ std::uint64_t parse_size(std::string_view text, std::string_view option) {
                      "\"" + s + "\" is not a size (a number with an optional k, M, G or T: 500M)");
   };
   if (s.empty()) return bad();
+  // A decimal number only: strtod also reads hexadecimal ("0x10", 16 bytes; session 50's red
+  // team), "inf", "nan" and leading blanks.
+  // strtod must read exactly the leading run of decimal characters.
+  const std::size_t number = std::min(s.find_first_not_of("0123456789.eE+-"), s.size());
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
+  if (number == 0 || end != s.c_str() + number) return bad();
   std::string unit(end);
   if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
   double f = 1;

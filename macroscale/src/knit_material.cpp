@@ -308,6 +308,10 @@ std::string KnitMaterial::warning() const {
      << (energy_ ? "the law's convex extension"
                  : "the response surfaces' extension (eq. 17) and the linear initial law")
      << ", not from cell runs (docs/database.md)";
+  // And how far, when it is far (session 50's red team: a tensile case stretched to 1000 %,
+  // E22 = 60 against the box's 0.55, said only the share).
+  if (energy_)
+    if (const std::string far = far_excursion_warning(false); !far.empty()) os << "\n" << far;
   return with_uniaxial(os.str());
 }
 

@@ -140,7 +140,7 @@ MaterialResponse KnitMaterial::evaluate_energy(const Eigen::Vector3d& E,
   return out;
 }
 
-std::string KnitMaterial::far_excursion_warning() const {
+std::string KnitMaterial::far_excursion_warning(bool local) const {
   // A few converged states far outside the box, below the share that warns (session 37): beyond
   // the box by more than its width. None of the 26 paper cases, nor s312 refined to 32 x 32
   // (converged E11 up to 0.83 against the box's 0.6; its trial iterates reached 4.28), warns.
@@ -154,9 +154,11 @@ std::string KnitMaterial::far_excursion_warning() const {
     std::ostringstream os;
     os << std::setprecision(4) << "warning: converged states reach " << names[k] << " = " << far
        << ", beyond the law's data box [" << lo << ", " << hi
-       << "] by more than its width (material frame; the report gives the first locations): a "
-          "local concentration, such as a clamped corner, whose stresses come from the law's "
-          "convex extension and grow with mesh refinement there";
+       << "] by more than its width (material frame; the report gives the first locations): "
+       << (local ? "a local concentration, such as a clamped corner, whose stresses come from "
+                   "the law's convex extension and grow with mesh refinement there"
+                 : "the stresses there come from the law's convex extension, far from any cell "
+                   "run; a fabric does not stretch this far");
     return os.str();
   }
   return {};
@@ -258,9 +260,12 @@ std::string KnitMaterial::energy_report() const {
   // Whether the law's own uniaxial response was checked (session 41's review: a database
   // without the curves said nothing, which read as "checked, fine").
   if (source_.uniaxial.empty())
+    // Two causes (session 50's red team: a synth database fitted seconds before was said to
+    // be "fitted before session 41").
     os << "\n  uniaxial check: not available (the database has no "
-          "/energy_law/diagnostics/uniaxial: fitted before session 41; `knit-meso fit DB --law "
-          "energy --energy-options OPTS` with its options adds it)";
+          "/energy_law/diagnostics/uniaxial: its raw data hold no uniaxial-stress path (knit-meso "
+          "synth, or a sweep input without them), or its law was fitted before session 41, when "
+          "`knit-meso fit DB --law energy --energy-options OPTS` with its options adds it)";
   else
     os << "\n  uniaxial check: the law's own uniaxial response against the cell's, tolerance "
        << 100.0 * source_.uniaxial_tolerance << " % (" << source_.uniaxial_tolerance_pointer

@@ -584,3 +584,42 @@ TEST_CASE("knit material: a synthetic stand-in database is warned of", "[unit]")
                                               generator + "\""));
   }
 }
+
+// Session 37: a converged state beyond the law's box by more than its width warns even when the
+// share outside is small (then as a local concentration). Session 50's red team: a case
+// stretched to 1000 % (E22 = 60) read only the share's warning; the excursion is given beside
+// it, not as a local concentration.
+TEST_CASE("knit material, energy law: a far excursion is warned of, with or without the share",
+          "[unit]") {
+  const EnergyLawData d = testing::make_test_energy_law();
+  const double far = d.box_max(1) + 1.5 * (d.box_max(1) - d.box_min(1));
+  auto warning_with = [&](int far_points) {
+    KnitMaterialSource src;
+    src.database = "db.h5";
+    KnitMaterial m(nullptr, std::make_shared<const EnergyLaw>(d),
+                   make_scalar_field(ScalarFieldSpec::constant(5.0)),
+                   make_scalar_field(ScalarFieldSpec::constant(0.0)), src);
+    std::vector<Eigen::Vector2d> pts;
+    for (int i = 0; i < 60; ++i) pts.emplace_back((i + 0.5) / 60.0, 0.5);
+    m.bind_points(pts);
+    REQUIRE(m.begin_converged_audit());
+    MaterialPoint p;
+    for (int i = 0; i < 60; ++i) {
+      p.point_id = i;
+      p.theta = pts[static_cast<std::size_t>(i)];
+      m.evaluate(Eigen::Vector3d(0.0, i < far_points ? far : 0.01, 0.0), p);
+    }
+    m.end_converged_audit();
+    return m.warning();
+  };
+  CHECK(warning_with(0).empty());
+  const std::string one = warning_with(1);  // 1 of 60: below the share that warns
+  CHECK_THAT(one, Catch::StartsWith("warning: converged states reach E22 = ") &&
+                      Catch::Contains("a local concentration") &&
+                      !Catch::Contains("% of the material evaluations"));
+  const std::string every = warning_with(60);
+  CHECK_THAT(every, Catch::Contains("100 % of the material evaluations") &&
+                        Catch::Contains("\nwarning: converged states reach E22 = ") &&
+                        Catch::Contains("a fabric does not stretch this far") &&
+                        !Catch::Contains("a local concentration"));
+}

@@ -243,7 +243,9 @@ class KnitMaterial : public Material {
   mutable std::array<std::atomic<double>, 6> audit_visited_;
   /// warning() below the share that warns: a converged state beyond the energy law's box by
   /// more than the box's width in one component; "" if none.
-  std::string far_excursion_warning() const;
+  /// `local`: the states outside the box are few (below the share that warns), so the text
+  /// names a local concentration as the likely cause; else the whole run is far outside.
+  std::string far_excursion_warning(bool local = true) const;
   /// warning(), the energy law: where the law's own uniaxial response departs from the cell's
   /// by more than source_.uniaxial_tolerance at the axial strains the converged states reached
   /// and the loop lengths the case uses; "" if nowhere (or no curves).
