@@ -18,11 +18,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "knit/core/cli.hpp"
 #include "knit/core/errors.hpp"
@@ -37,6 +39,26 @@
 // (docs/build.md), and each defines its own Options, run and reg.
 namespace knit::meso::cmd_path {
 namespace {
+
+/// Whether the path.csv of an earlier output ends at lambda = 1 (its path completed): the
+/// second column of its last data row; false when it cannot be read.
+bool path_csv_completed(const std::string& csv) {
+  std::ifstream in(csv);
+  std::string line, last;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (std::exchange(header, false)) continue;
+    last = line;
+  }
+  const auto a = last.find(','), b = last.find(',', a == std::string::npos ? a : a + 1);
+  if (a == std::string::npos || b == std::string::npos) return false;
+  try {
+    return std::stod(last.substr(a + 1, b - a - 1)) == 1.0;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
 
 struct Options {
   double loop_length = 0;
@@ -170,6 +192,11 @@ int run(const Options& o) {
                  co.elements, CellOptions{}.elements);
   knit::io::AtomicDirectory dir(o.out, knit::io::AtomicDirectory::OnAbandon::Remove, "--out",
                                 o.config);
+  // An earlier output written before its marker said whether it completed (session 49) is
+  // judged from its path.csv: a path output holds at least one converged step, and the path
+  // completed when its last row is at lambda = 1 (session 50; before, such outputs were
+  // replaced by a stopped rerun).
+  if (!dir.earlier_completed()) dir.set_earlier_completed(path_csv_completed(o.out + "/path.csv"));
   // The outputs' size, estimated before the run from one VTP of the reference state (session
   // 41's red team: --steps 100000 started writing about 5.9 GB without a word; knit-meso rod
   // and knit-macro run have the same cap).

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -474,6 +475,17 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
   // OUT.partial-<pid>, renamed onto OUT by commit()
   io::AtomicDirectory dir(outdir, io::AtomicDirectory::OnAbandon::Remove, "output directory",
                           c.file);
+  // An earlier output written before its marker said whether it completed (session 49) is
+  // judged from its load_displacement.csv, whose comment has said how the path ended since the
+  // first rod outputs ("...; path: completed"; session 50: before, such outputs were replaced
+  // by a stopped rerun).
+  if (!dir.earlier_completed()) {
+    std::ifstream in(outdir / "load_displacement.csv");
+    bool completed = false;
+    for (std::string line; std::getline(in, line) && (line.empty() || line[0] == '#');)
+      completed = completed || line.ends_with("; path: completed");
+    dir.set_earlier_completed(completed);
+  }
 
   std::vector<std::string> header{"step", "lambda", "iterations"};
   for (const auto& p : c.points)
