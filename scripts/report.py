@@ -463,6 +463,16 @@ class Data:
                     "material_database_date_utc: written before session 38, changed since, or "
                     "no results.h5, which the report needs for a knit run: rerun the case with "
                     "/output/hdf5 true, the default)")
+        # The case the run was computed from against the pipeline's copy of it (session 50's
+        # red team): OUT/cases/NAME.json beside OUT/results (OUT/cases_paper_law beside
+        # OUT/results_paper_law).
+        base = os.path.basename(os.path.normpath(self.res_dir))
+        if base.startswith("results"):
+            cases = os.path.join(os.path.dirname(os.path.normpath(self.res_dir)),
+                                 "cases" + base[len("results"):])
+            why = r.case_defect(os.path.join(cases, name + ".json"))
+            if why:
+                return why
         # The run's own outputs against each other (session 42's red team: a doubled strain
         # column, another step's fields, a summary of fewer steps than the CSV).
         why = r.consistency_defect()
@@ -1004,6 +1014,34 @@ TWIN_TOLERANCE = 0.005
 # summary without a FAIL). Set by main(); empty in the tests that build their own outputs.
 EXPECTED_DESIGNS = []
 DESIGNS_DIR = None
+# The database's date_utc, set by main() (None in the tests that build their own outputs): a
+# design or knitting map computed with another database is stale (session 50's red team: with
+# the database rebuilt, the twin still counted as recovered and the maps were shown as its own).
+DATABASE_DATE = None
+
+
+def stale_output(used, what):
+    """Why an output computed with the database of date `used` (None: it does not say) is not
+    the current database's, or None (no database date known, or the same one)."""
+    if DATABASE_DATE is None:
+        return None
+    if used is None:
+        return (f"{what} does not say which database it read (written before it recorded the "
+                f"date; rerun it)")
+    if used != DATABASE_DATE:
+        return (f"stale: {what} was computed with the database written {used}; the database "
+                f"is of {DATABASE_DATE} (rerun it)")
+    return None
+
+
+def design_stale(out, name):
+    """stale_output() of design NAME's final run (design/NAME/run/results.h5's
+    material_database_date_utc), None when the design wrote no run."""
+    h5 = os.path.join(out, "design", name, "run", "results.h5")
+    if not os.path.exists(h5):
+        return None
+    return stale_output(root_text_attribute(h5, "material_database_date_utc"),
+                        "its final run")
 
 
 def declared_twins(out):
@@ -1149,11 +1187,14 @@ def design_section(out):
             status += f": {why}" if why else ""
         if "status" in summ and exit_code != 0:  # the summary alone is not the verdict
             status += f" (exit {exit_code})"
+        stale = design_stale(out, n) if wrote else None
+        if stale:
+            status += f"; **{stale}**"
         L.append(f"| {n} | {md(status)} | {md(summ.get('J_initial', '-'))} | "
                  f"{md(summ.get('J_final', '-'))} | {summ.get('iterations', '-')} | "
                  f"{summ.get('evaluations', '-')} | "
                  f"{fmt((st or {}).get('seconds', float('nan')), 1)} | "
-                 f"{md(twin_cell(summ, twins.get(n), None if st is None else exit_code))} |")
+                 f"{md(twin_cell(summ, twins.get(n), None if st is None else exit_code, stale))} |")
     return L + section_figures(out, [f"design_{n}.png" for n in names])
 
 
@@ -1193,6 +1234,10 @@ def knitmap_section(out):
             L.append(f"| {n} | - | - | - | - | - | **failed**: {md(failed)} |")
             continue
         summ = read_design_summary(os.path.join(out, "knitmap", n, "summary.txt"))
+        stale = stale_output(summ.get("database_date_utc"), "the map")
+        if stale:
+            L.append(f"| {n} | - | - | - | - | - | **{md(stale)}** |")
+            continue
         try:
             yarn = f"{float(summ.get('yarn_length_mm', 'nan')) / 1000:.2f}"
             lo, hi = (float(summ.get(k, "nan")) for k in ("loop_length_min_mm",
@@ -1282,10 +1327,13 @@ def knitmap_failure(out, name):
     return why + (f": {first}" if first else "")
 
 
-def twin_cell(summ, declared=None, exit_code=0):
-    """The design table's twin column: '-' without a twin, else the verdict and the numbers."""
+def twin_cell(summ, declared=None, exit_code=0, stale=None):
+    """The design table's twin column: '-' without a twin, else the verdict and the numbers;
+    a stale design (design_stale) does not recover."""
     t = twin_verdict(summ, declared, exit_code)
-    return "-" if t is None else f"{verdict(t[0])}: {t[1]}"
+    if t is None:
+        return "-"
+    return f"{verdict(t[0] and not stale)}: {t[1]}" + (f"; {stale}" if stale else "")
 
 
 def database_time_line(db_seconds, loops):
@@ -1305,11 +1353,11 @@ def twin_counts(out):
     twins = declared_twins(out)
     names = ({os.path.basename(p)[:-7] for p in glob.glob(os.path.join(out, "design", "*.status"))}
              | set(twins) | set(EXPECTED_DESIGNS))
-    got = [twin_verdict(read_design_summary(os.path.join(out, "design", n, "summary.txt")),
-                        twins.get(n), design_exit_code(out, n))
+    got = [(twin_verdict(read_design_summary(os.path.join(out, "design", n, "summary.txt")),
+                         twins.get(n), design_exit_code(out, n)), design_stale(out, n))
            for n in sorted(names)]
-    got = [t for t in got if t is not None]
-    return sum(1 for ok, _ in got if ok), len(got)
+    got = [(t, stale) for t, stale in got if t is not None]
+    return sum(1 for (ok, _), stale in got if ok and not stale), len(got)
 
 
 def figure_failed(path):
@@ -1346,8 +1394,9 @@ def main():
                     help="where the expected designs' files are when $(OUT)/design/inputs lacks "
                          "them (default: the checkout's cases/design)")
     a = ap.parse_args()
-    global EXPECTED_DESIGNS, DESIGNS_DIR
+    global EXPECTED_DESIGNS, DESIGNS_DIR, DATABASE_DATE
     EXPECTED_DESIGNS, DESIGNS_DIR = a.expect_designs.split(), a.designs_dir
+    DATABASE_DATE = database_date(a.database)
     if not glob.glob(os.path.join(a.cases_dir, "*.json")):
         print(f"report: error: --cases-dir {a.cases_dir}: holds no case file (*.json)",
               file=sys.stderr)

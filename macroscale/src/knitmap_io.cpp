@@ -31,6 +31,7 @@ KnitMapInput load_knitmap_input(const std::string& case_file) {
     throw InputError(case_file, "/material/database", e.what());
   }
   in.cells = CellTable(db, in.database);
+  in.database_date_utc = db.provenance.date_utc;
   return in;
 }
 
@@ -55,9 +56,12 @@ void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesy
                    k.t, k.height_mismatch});
     csv.commit();
   }
-  io::write_file_atomically(out / "summary.txt", "# " + prov + "\ncase: " + in.c.file +
-                                                     "\ndatabase: " + in.database + "\n" +
-                                                     knitmap_summary(map));
+  io::write_file_atomically(
+      out / "summary.txt",
+      "# " + prov + "\ncase: " + in.c.file + "\ndatabase: " + in.database + "\n" +
+          (in.database_date_utc.empty() ? std::string()
+                                        : "database_date_utc: " + in.database_date_utc + "\n") +
+          knitmap_summary(map));
   out.commit();
 }
 

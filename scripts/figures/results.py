@@ -119,6 +119,27 @@ def last_run_wrote(status, ok_codes=None):
     return not (isinstance(code, int) and code >= 2)
 
 
+def json_difference(a, b, ptr=""):
+    """The JSON pointer of the first place where a and b differ, or None."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in sorted(set(a) | set(b)):
+            if k not in a or k not in b:
+                return f"{ptr}/{k}"
+            d = json_difference(a[k], b[k], f"{ptr}/{k}")
+            if d is not None:
+                return d
+        return None
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return ptr
+        for i, (x, y) in enumerate(zip(a, b)):
+            d = json_difference(x, y, f"{ptr}/{i}")
+            if d is not None:
+                return d
+        return None
+    return None if a == b and type(a) is type(b) else ptr
+
+
 class Result:
     """One case's output directory plus the pipeline's status file next to it."""
 
@@ -207,6 +228,40 @@ class Result:
         since session 38), or None."""
         return root_text_attribute(os.path.join(self.dir, "results.h5"),
                                    "material_database_date_utc")
+
+    def case_defect(self, case_file):
+        """Why this run was not computed from `case_file` (the pipeline's copy of the case it
+        ran), or None: results.h5's /case_json, and the run directory's case.json, must hold
+        the same JSON as the file (session 50's red team: the results.h5 of
+        s312_uniform_65_wale copied over s312_uniform_45_wale turned two FAILs into passes, and
+        a by-hand rerun of the case at another stitch value was judged as the pipeline's).
+        None when `case_file` is absent (nothing to compare)."""
+        if not os.path.exists(case_file):
+            return None
+        try:
+            with open(case_file) as f:
+                want = json.load(f)
+        except (OSError, ValueError) as e:
+            return f"{case_file} is unreadable ({e})"
+        held = []
+        h5 = os.path.join(self.dir, "results.h5")
+        if os.path.exists(h5):
+            import h5py
+            try:
+                with h5py.File(h5, "r") as f:
+                    v = np.asarray(f["case_json"][()]).ravel()[0]
+                held.append((h5 + " /case_json", json.loads(v.decode() if isinstance(v, bytes)
+                                                            else str(v))))
+            except (OSError, KeyError, ValueError, IndexError) as e:
+                return f"{h5} /case_json cannot be read ({e})"
+        if self.case:
+            held.append((os.path.join(self.dir, "case.json"), self.case))
+        for where, got in held:
+            ptr = json_difference(want, got)
+            if ptr is not None:
+                return (f"its results were computed from another case: {where} differs from "
+                        f"{case_file} at {ptr or '/'} (rerun the case)")
+        return None
 
     def summary(self):
         p = os.path.join(self.dir, "summary.txt")

@@ -132,6 +132,33 @@ def main():
               "the table names the expected design without output", table)
         finally:
             report.EXPECTED_DESIGNS, report.DESIGNS_DIR = [], None
+    # Session 50's red team: with the database rebuilt (another date_utc), the twin of a
+    # design whose final run read the former database still counted as recovered, and the
+    # knitting maps were shown as the new database's.
+    import h5py
+    with tempfile.TemporaryDirectory(prefix="design_twin_test_") as out:
+        write_design(out, "twin", SUMMARY.format(status="converged", end="6", got="6"),
+                     twin='{"l": 6.0}')
+        os.makedirs(os.path.join(out, "design", "twin", "run"))
+        with h5py.File(os.path.join(out, "design", "twin", "run", "results.h5"), "w") as h:
+            h.attrs["material_database_date_utc"] = "2026-12-01T10:00:00Z"
+        os.makedirs(os.path.join(out, "knitmap", "m"))
+        with open(os.path.join(out, "knitmap", "m", "summary.txt"), "w") as f:
+            f.write("database_date_utc: 2026-12-01T10:00:00Z\nstitches: 10\nneedles: 5\n")
+        try:
+            for date, recovered in (("2026-12-01T10:00:00Z", 1), ("2026-12-05T12:00:00Z", 0)):
+                report.DATABASE_DATE = date
+                c(report.twin_counts(out) == (recovered, 1),
+                  f"database of {date}: {recovered} of 1 recovered", repr(report.twin_counts(out)))
+                stale = "stale: its final run was computed with the database written" in \
+                    "\n".join(report.design_section(out))
+                c(stale == (recovered == 0), f"database of {date}: the design table says stale "
+                  f"{recovered == 0}", "\n".join(report.design_section(out)))
+                maps = "\n".join(report.knitmap_section(out))
+                c(("stale: the map was computed" in maps) == (recovered == 0),
+                  f"database of {date}: the map stale {recovered == 0}", maps)
+        finally:
+            report.DATABASE_DATE = None
     return c.exit_code()
 
 

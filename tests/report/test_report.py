@@ -846,6 +846,33 @@ def unusable_result_failures(tmp):
     unknown = report.Data(res, None).run_defect("a")
     if same is not None or unknown is not None or other is None or "stale" not in other:
         out.append(f"stale results: same date {same!r}, another {other!r}, no date {unknown!r}")
+    # The case the run was computed from (session 50's red team: another case's results.h5
+    # copied in turned two FAILs into passes): results.h5's /case_json against the pipeline's
+    # copy OUT/cases/NAME.json beside OUT/results.
+    out_dir = os.path.join(tmp, "case_identity")
+    results, cases = os.path.join(out_dir, "results"), os.path.join(out_dir, "cases")
+    case = {"material": {"type": "knit", "stitch_value": 4.5}, "loads": [1.5]}
+    for held, defect in ((case, None), (case | {"material": {"type": "knit", "stitch_value": 6.5}},
+                                        "/material/stitch_value")):
+        shutil.rmtree(out_dir, ignore_errors=True)
+        os.makedirs(os.path.join(results, "a"))
+        os.makedirs(cases)
+        with open(os.path.join(cases, "a.json"), "w") as f:
+            json.dump(case, f)
+        with open(os.path.join(results, "a", "load_strain.csv"), "w") as f:
+            f.write("step,strain,load_N\n1,0.1,2.0\n2,0.2,5.0\n")
+        with open(os.path.join(results, "a.status"), "w") as f:
+            json.dump({"case": "a", "exit_code": 0, "seconds": 0.1}, f)
+        with open(os.path.join(results, "a", "summary.txt"), "w") as f:
+            f.write("status: completed\n")
+        with h5py.File(os.path.join(results, "a", "results.h5"), "w") as h:
+            h.create_dataset("case_json", data=[json.dumps(held)], dtype=h5py.string_dtype())
+        got = report.Data(results, None).run_defect("a")
+        if defect is None and got is not None and "another case" in got:
+            out.append(f"case identity: the pipeline's own case was taken for another ({got})")
+        if defect is not None and (got is None or "computed from another case" not in got
+                                   or defect not in got):
+            out.append(f"case identity: results of another case were not refused ({got!r})")
     for what, (damage, needle) in variants.items():
         damage(fresh("a"))
         try:

@@ -119,6 +119,10 @@ struct KnitMapInput {
   Case c;
   CellTable cells;
   std::string database;  ///< resolved path
+  /// The database's date_utc (when it was written; "" for a file without it), in summary.txt
+  /// as `database_date_utc:` so that a map of another database is told apart (session 50's
+  /// red team: the report showed knitting maps of an earlier database as the current one's).
+  std::string database_date_utc;
 };
 KnitMapInput load_knitmap_input(const std::string& case_file);
 
