@@ -160,6 +160,20 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
                            tol + ")";
       break;
   }
+  // A twin experiment's targets are met at the twin's values, inside the bounds (session 50's
+  // red team: uniform_load with twin l = 4.5, started at 5.75, ended at 6.5 as "infeasible
+  // target": a local verdict, never infeasibility there).
+  bool twin_inside = !d.twin.empty() && d.twin.size() == d.variables.size();
+  for (std::size_t i = 0; twin_inside && i < d.twin.size(); ++i)
+    twin_inside = d.twin[i] >= d.variables[i].lower && d.twin[i] <= d.variables[i].upper;
+  if (twin_inside && r.status == DesignStatus::kInfeasible) {
+    r.status = DesignStatus::kTargetNotMet;
+    why +=
+        "; but this is a twin experiment, whose targets are met at the twin's values inside "
+        "the bounds: the optimizer ended in a local minimum on a bound (J is not convex in "
+        "the variables); start the variables from other values, e.g. nearer the other end "
+        "of their intervals";
+  }
   r.message = (r.message.empty() ? "" : r.message + "; ") + std::string(buf) + why;
 }
 

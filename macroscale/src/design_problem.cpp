@@ -15,6 +15,7 @@
 #include "knit/core/errors.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/io/names.hpp"
+#include "knit/macro/knit_material.hpp"
 #include "knit/material/database.hpp"
 
 namespace knit::macro {
@@ -116,9 +117,10 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
     for (const char* b : {"lower", "upper"}) {
       const double x = std::string(b) == "lower" ? v.lower : v.upper;
       if (x < ls.front() || x > ls.back())
+        // As many digits as tell x from the ends (session 50's red team: 6.5000000001 was
+        // said as "6.5 mm is outside the database's 4.5-6.5 mm").
         throw InputError(file, p + "/" + b,
-                         fmt(x) + " mm is outside the database's " + fmt(ls.front()) + "-" +
-                             fmt(ls.back()) + " mm (" + db.string() + ")");
+                         loop_length_outside(x, ls.front(), ls.back()) + " (" + db.string() + ")");
     }
   } else {
     const bool deg = f.contains("unit") && f.at("unit") == "deg";

@@ -469,6 +469,19 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          "/variables/0/upper");
   expect("upper_bound.json", one_variable("stitch_value", "[0]", "4.5", "7.0"),
          "/variables/0/upper");
+  // Session 50's red team: 6.5000000001 was said as "6.5 mm is outside ... 4.5-6.5 mm".
+  {
+    const fs::path f = kDir / "upper_just_beyond.json";
+    write(f, one_variable("stitch_value", "[0]", "4.5", "6.5000000001"));
+    std::string what;
+    try {
+      (void)load_design(f.string());
+    } catch (const knit::InputError& e) {
+      what = e.what();
+    }
+    CHECK_THAT(what, Catch::Contains("/variables/0/upper: 6.5000000001 mm is outside the "
+                                     "database's 4.5-6.5 mm"));
+  }
   expect("angle_lower.json", one_variable("knitting_angle", "[0]", "-200", "45"),
          "/variables/0/lower");
   {
@@ -842,6 +855,32 @@ TEST_CASE("design status: a variable on either bound makes a stop an infeasible 
     r.J = 1.0;
     classify_result(d, opt, SolverEnd::kConverged, r);
     CHECK(r.status == expected);
+  }
+}
+
+// Session 50's red team: a twin experiment (uniform_load with twin l = 4.5, started at 5.75)
+// ended on the upper bound as "infeasible target", although its targets are met at the twin's
+// value inside the bounds. With a twin inside the bounds such a stop is "target not met".
+TEST_CASE("design status: a twin experiment's stop on a bound is not an infeasible target",
+          "[unit]") {
+  for (const auto& [twin, expected] :
+       {std::pair{std::vector<double>{}, DesignStatus::kInfeasible},
+        std::pair{std::vector<double>{4.5}, DesignStatus::kTargetNotMet},
+        std::pair{std::vector<double>{7.0}, DesignStatus::kInfeasible}}) {
+    INFO("twin " << (twin.empty() ? -1.0 : twin[0]));
+    DesignProblem d = one_variable_design(0.0);
+    d.twin = twin;
+    DesignResult r;
+    r.x = {6.5};
+    r.gradient = Eigen::VectorXd::Constant(1, -1.0);  // out of the bounds at the upper one
+    r.terms0 = {{"load", 10.0}};
+    r.J0 = 10.0;
+    r.terms = {{"load", 1.0}};
+    r.J = 1.0;
+    classify_result(d, OptimizeOptions{}, SolverEnd::kConverged, r);
+    CHECK(r.status == expected);
+    if (expected == DesignStatus::kTargetNotMet)
+      CHECK_THAT(r.message, Catch::Contains("but this is a twin experiment"));
   }
 }
 
