@@ -280,6 +280,25 @@ class Result:
         c = self.csv
         lf, d, e = c.get("load_factor"), c.get("applied_displacement_mm"), c.get("strain")
         ad = self.case.get("output", {}).get("applied_displacement") or {}
+        # knit-macro run writes summary.txt with every output, and results.h5's /steps holds the
+        # CSV's rows (session 50's red team: summary.txt deleted and the CSV cut to 10 of its 20
+        # rows was counted as a completed run and judged "monotone" on half its curve).
+        if not os.path.exists(os.path.join(self.dir, "summary.txt")):
+            return "its summary.txt is missing (knit-macro run writes one with every output)"
+        h5 = os.path.join(self.dir, "results.h5")
+        if lf is not None and os.path.exists(h5):
+            import h5py
+            try:
+                with h5py.File(h5, "r") as f:
+                    steps = np.asarray(f["steps/load_factor"][()], dtype=float) \
+                        if "steps/load_factor" in f else None
+            except OSError as err:
+                return f"{h5} cannot be read ({err})"
+            if steps is not None and (len(steps) != len(lf) or not np.array_equal(steps, lf)
+                                      and not np.allclose(steps, lf, rtol=1e-9, atol=0.0)):
+                return (f"results.h5 /steps holds {len(steps)} converged steps up to load factor "
+                        f"{steps[-1] if len(steps) else float('nan'):g}, load_strain.csv "
+                        f"{len(lf)} up to {lf[-1] if len(lf) else float('nan'):g}")
         if d is not None and e is not None and len(d):
             if not all(np.all(np.isfinite(v)) for v in (d, e) + ((lf,) if lf is not None else ())):
                 return "load_strain.csv holds a non-finite load factor, displacement or strain"

@@ -1035,6 +1035,20 @@ def consistency_failures(tmp):
     fresh(strain_scale=2.0)
     if report.completed_runs(["a"], report.Data(res, "2026-12-01T10:00:00Z")) != []:
         out.append("consistency: a defective run is counted as completed")
+    # Session 50's red team: summary.txt deleted and the CSV cut to half its rows counted as
+    # completed; results.h5's /steps holds the run's converged steps.
+    r = fresh()
+    os.remove(os.path.join(res, "a", "summary.txt"))
+    why = r.consistency_defect()
+    if why is None or "its summary.txt is missing" not in why:
+        out.append(f"consistency, no summary.txt: {why!r}")
+    for steps, defect in (([0.5, 1.0], False), ([0.5, 1.0, 1.5], True), ([0.25, 1.0], True)):
+        r = fresh()
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            h["steps/load_factor"] = np.asarray(steps)
+        why = r.consistency_defect()
+        if (why is not None) != defect or (defect and "results.h5 /steps holds" not in why):
+            out.append(f"consistency, results.h5 /steps {steps} beside the CSV's [0.5, 1]: {why!r}")
     return out
 
 
