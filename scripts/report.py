@@ -750,6 +750,13 @@ def database_date(db_path):
     return root_text_attribute(db_path, "date_utc") if db_path else None
 
 
+def is_run_check(c):
+    """Whether a check row judges the run itself rather than a statement of the paper: the
+    "runs" rows (reaches the paper's strain, monotone curve) and the kinematic bound on max E22
+    (met by any run that holds its boundary conditions)."""
+    return c.section == "runs" or "respects the kinematic bound" in c.statement
+
+
 def completed_runs(names, data):
     """The runs of `names` that completed and have no defect (Data.run_defect): what the
     summary counts as completed."""
@@ -798,6 +805,9 @@ class Report:
                 loops = [float(x) for x in f["loop_lengths"]]
         except Exception as e:  # the report still says what it could not read
             generator = f"unreadable ({e})"
+        # knit-meso synth's "synth" and a sweep with the synthetic runner's "sweep (synthetic
+        # runner)" (session 50: the second was reported as the mesoscale sweep).
+        synthetic = mode == "synth" or generator == "synth" or "synthetic" in generator
         try:
             rev = subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(__file__)),
                                   "rev-parse", "--short", "HEAD"], capture_output=True,
@@ -813,6 +823,13 @@ class Report:
         npass = sum(1 for c in self.rows if c.ok is True)
         nfail = sum(1 for c in self.rows if c.ok is False)
         ninfo = sum(1 for c in self.rows if c.ok is None)
+        # The summary counts the paper's statements apart from the checks of the runs
+        # themselves (session 50's red team: "73 of 82 checks of the paper's statements" held
+        # 50 rows of reach and monotone curves and 4 of the kinematic bound on max E22, which a
+        # run that holds its boundary conditions meets by kinematics alone).
+        run_rows = [c for c in self.rows if is_run_check(c)]
+        rpass = sum(1 for c in run_rows if c.ok is True)
+        rfail = sum(1 for c in run_rows if c.ok is False)
         # A completed run with a defect (Data.run_defect: stale, inconsistent, not trustworthy)
         # is not counted as completed (session 42's red team: "26 of 26 cases completed" beside
         # a run whose every check FAILed for its defect).
@@ -835,14 +852,18 @@ class Report:
                         if not os.path.exists(os.path.join(self.out, "figures", n))]
         if missing_figs:
             law_text += f"; {len(missing_figs)} figure(s) MISSING"
-        L.append(f"**Summary:** {npass} of {npass + nfail} checks of the paper's statements pass, "
-                 f"{nfail} fail, and {ninfo} more are listed with our numbers only (the paper "
+        spass, sfail = npass - rpass, nfail - rfail
+        L.append(f"**Summary:** {spass} of {spass + sfail} checks of the paper's statements pass, "
+                 f"{sfail} fail, and {ninfo} more are listed with our numbers only (the paper "
                  "giving none); "
+                 f"{rpass} of {rpass + rfail} checks of the runs themselves pass (each case "
+                 "reaches the paper's strain with a monotone load-strain curve; max E22 above "
+                 "the kinematic bound); "
                  f"{ndone} of {len(names)} cases completed; material database: "
-                 f"{'SYNTHETIC stand-in' if mode == 'synth' or generator == 'synth' else 'mesoscale sweep'}"
+                 f"{'SYNTHETIC stand-in' if synthetic else 'mesoscale sweep'}"
                  f"{law_text}.\n")
         L.append("## Material database\n")
-        if mode == "synth" or generator == "synth":
+        if synthetic:
             L.append("> **The SYNTHETIC stand-in database was used** (`knit-meso synth`: a known "
                      "orthotropic stiffening law, S1 = k(0.5 E1 + 0.1 E2 + 8 E1^3), S2 = k(0.1 E1 "
                      "+ E2 + 12 E2^3), S12 = k(0.3 E12 + 4 E12^3), k = (4.5/l)^2 MPa; not a knit). "
