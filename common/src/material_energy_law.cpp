@@ -98,8 +98,8 @@ void validate(const EnergyLawData& d) {
   const int G = d.functions();
   for (int g : d.directions.function_of)
     if (g < 0) fail("function_of has a negative index");
-  // Each ridge function serves at least one direction (session 49's red team: function_of[0] = 99
-  // was refused as "s_range needs one row per function").
+  // No more functions than directions (session 49's red team: function_of[0] = 99 was refused
+  // as "s_range needs one row per function").
   if (G > K)
     fail("function_of names function " + std::to_string(G - 1) + ", but there are only " +
          std::to_string(K) +

@@ -452,15 +452,17 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
   // A patch about one stitch wide or one course tall (session 49's red team: a strip thinner
   // than a course was mapped to one course, exit 0, without a word): the map knits whole
   // stitches and courses, so its fabric may differ from such a patch by most of a stitch. Said
-  // when the fabric's extent differs from the patch's by more than kNarrowPatchMismatch of it,
-  // which a patch at least two stitches (courses) across never does: the nearest whole count
-  // is off by at most half a stitch.
+  // when a map of one or two courses (stitches) differs from the patch's extent by more than
+  // kNarrowPatchMismatch of it, which a uniform patch two stitches (courses) across or more
+  // about never does: the nearest whole count is off by at most half a stitch.
   {
     const double across = t_max - t_min;
     const double tall = rows.back().course.t + 0.5 * rows.back().course.height;
     std::ostringstream os;
     os.precision(3);
-    if (std::abs(tall - across) > kNarrowPatchMismatch * across) {
+    // Only for a map of one or two courses (stitches): a taper's courses left out at one end
+    // made a tall patch's 20 courses "about one course tall" (the review of session 50).
+    if (rows.size() <= 2 && std::abs(tall - across) > kNarrowPatchMismatch * across) {
       os << "the map's " << rows.size() << " course(s) are " << tall
          << " mm tall where the patch is " << across
          << " mm across the courses: a patch about one course tall is knitted to whole courses "
@@ -472,7 +474,8 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
         rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.chord < b.chord; });
     double width = 0;
     for (double l : wide.laid.l) width += cells.wale_width(l);
-    if (std::abs(width - wide.chord) > kNarrowPatchMismatch * wide.chord) {
+    if (wide.laid.l.size() <= 2 &&
+        std::abs(width - wide.chord) > kNarrowPatchMismatch * wide.chord) {
       os.str("");
       os << "the widest course's " << wide.laid.l.size() << " stitch(es) are " << width
          << " mm wide where the patch is " << wide.chord

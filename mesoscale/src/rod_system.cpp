@@ -260,7 +260,9 @@ RodSystem::AxialStretch RodSystem::min_axial_stretch(const Eigen::VectorXd& x) c
     for (const CollocationPoint& c : rods_[k].points) {
       const PointState s = state(k, c.xi, x);
       const double v = s.R.col(2).dot(s.r_xi) / s.jac;
-      if (first || !(v >= a.value)) a = {v, k, c.xi};
+      // A NaN is the smallest and stays (the review of session 50: `!(v >= NaN)` let a later
+      // finite value replace it).
+      if (first || std::isnan(v) || (!std::isnan(a.value) && v < a.value)) a = {v, k, c.xi};
       first = false;
     }
   return a;

@@ -123,9 +123,10 @@ def json_difference(a, b, ptr=""):
     """The JSON pointer of the first place where a and b differ, or None."""
     if isinstance(a, dict) and isinstance(b, dict):
         for k in sorted(set(a) | set(b)):
+            esc = str(k).replace("~", "~0").replace("/", "~1")  # RFC 6901
             if k not in a or k not in b:
-                return f"{ptr}/{k}"
-            d = json_difference(a[k], b[k], f"{ptr}/{k}")
+                return f"{ptr}/{esc}"
+            d = json_difference(a[k], b[k], f"{ptr}/{esc}")
             if d is not None:
                 return d
         return None
