@@ -76,6 +76,13 @@ void write(const fs::path& f, const std::string& text) {
   std::ofstream(f) << text;
 }
 
+/// `text` with its first `from` replaced by `to` (which must be there).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
 }  // namespace
 
 TEST_CASE("rod case: rollup.json follows the exact circle at every step", "[case]") {
@@ -352,11 +359,8 @@ TEST_CASE("rod case: a reversed end moment stops at the work cap, outputs of con
           "[unit]") {
   // Issue 14: rollup.json with its end moment reversed and ten times larger sub-stepped
   // forever. The load stepping now stops at its floor or work cap (exit 1) and says which.
-  std::string text = case_text("rollup.json");
-  const std::string m = "-2.4674011002723395e-3";
-  const auto at = text.find(m);
-  REQUIRE(at != std::string::npos);
-  text.replace(at, m.size(), "2.4674011002723395e-2");
+  const std::string text =
+      replaced(case_text("rollup.json"), "-2.4674011002723395e-3", "2.4674011002723395e-2");
   const fs::path f = kTmp / "reversed.json", out = kTmp / "reversed_out";
   fs::remove_all(out);
   write(f, text);
@@ -389,11 +393,8 @@ TEST_CASE("rod case: a stopped rerun says why on stderr and keeps the completed 
       in.close();
       write(out / ".knitscale-output", marker);
     }
-    std::string text = case_text("elastica.json");
-    const std::string steps = "\"steps\": { \"count\": 8 }";
-    const auto at = text.find(steps);
-    REQUIRE(at != std::string::npos);
-    text.replace(at, steps.size(), "\"steps\": { \"count\": 8, \"max_total_iterations\": 12 }");
+    const std::string text = replaced(case_text("elastica.json"), R"("steps": { "count": 8 })",
+                                      R"("steps": { "count": 8, "max_total_iterations": 12 })");
     const fs::path f = kTmp / "stopped_rerun.json", err = kTmp / "stopped_rerun.err";
     write(f, text);
     const int rc = std::system((kBin.string() + " rod " + f.string() + " -q -o " + out.string() +
@@ -454,13 +455,9 @@ TEST_CASE("rod case: a prescribed end rotation of a full turn rolls the rod up",
   // where a prescribed rotation of 2 pi is the identity, and refused this case (naming
   // /steps/tolerance). Rolled up by the end's rotation, the tip is back on the axis at
   // -u = L (1 - sin t / t) = 10 mm, w = L (1 - cos t) / t = 0 (t = 2 pi), as under the moment.
-  std::string text = case_text("rollup.json");
-  const std::string end =
-      R"("end": { "position": "free", "rotation": "free", "moment": [0, -2.4674011002723395e-3, 0] })";
-  const auto at = text.find(end);
-  REQUIRE(at != std::string::npos);
-  text.replace(
-      at, end.size(),
+  const std::string text = replaced(
+      case_text("rollup.json"),
+      R"("end": { "position": "free", "rotation": "free", "moment": [0, -2.4674011002723395e-3, 0] })",
       R"("end": {"position": "free", "rotation": "fixed", "rotation_vector": [0, -6.283185307179586, 0]})");
   const fs::path f = kTmp / "turn.json", out = kTmp / "turn_out";
   fs::remove_all(out);
@@ -487,15 +484,12 @@ TEST_CASE("rod case: a prescribed end rotation of a full turn rolls the rod up",
 namespace {
 /// cases/rod/elastica.json with its end condition and step count replaced.
 fs::path elastica_with(const std::string& name, const std::string& end, int steps) {
-  std::string text = case_text("elastica.json");
-  const std::string old_end =
-      R"("end": { "position": "free", "rotation": "free", "force": [0, 0, 1.5707963267948966e-4] })";
-  const auto at = text.find(old_end);
-  REQUIRE(at != std::string::npos);
-  text.replace(at, old_end.size(), R"("end": )" + end);
-  const auto st = text.find(R"("steps": { "count": 8 })");
-  REQUIRE(st != std::string::npos);
-  text.replace(st, 23, R"("steps": { "count": )" + std::to_string(steps) + " }");
+  const std::string text = replaced(
+      replaced(
+          case_text("elastica.json"),
+          R"("end": { "position": "free", "rotation": "free", "force": [0, 0, 1.5707963267948966e-4] })",
+          R"("end": )" + end),
+      R"("steps": { "count": 8 })", R"("steps": { "count": )" + std::to_string(steps) + " }");
   const fs::path f = kTmp / name;
   write(f, text);
   return f;
@@ -551,11 +545,7 @@ TEST_CASE("rod case: loads no tolerance resolves are not sent to /steps/toleranc
           "[unit]") {
   // Session 50's red team: with E = 1e300 the elastica's load was within the tolerance, and
   // the message said to lower it to 1.2e-18, which /steps/tolerance refuses (>= 2.2e-16).
-  std::string text = case_text("elastica.json");
-  const std::string sec = R"("E": 800.0)";
-  const auto at = text.find(sec);
-  REQUIRE(at != std::string::npos);
-  text.replace(at, sec.size(), R"("E": 1e300)");
+  const std::string text = replaced(case_text("elastica.json"), R"("E": 800.0)", R"("E": 1e300)");
   const fs::path f = kTmp / "stiff.json";
   write(f, text);
   const std::string e = load_error(f);
