@@ -170,13 +170,15 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
       std::vector<std::vector<double>> th;
       for (int k = 0; k < w.count; ++k) th.push_back(d.network.theta_row(w.j[k]));
       if (w.count == 3 && NetworkLanesAt::six_lane_kernel()) {
-        // One six-lane pass in the AVX-512 kernel (session 48: 2.6e6 per second, against 1.8e6
-        // for the split below).
+        // One six-lane pass in a wide kernel: AVX-512 (session 48: 2.6e6 per second, against
+        // 1.8e6 for the split below) or AVX2 with FMA (session 51: 1.72-1.79e6, against
+        // 1.45-1.48e6 for the split).
         lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], th[2],
                                 Eigen::Vector3d(w.c[0], w.c[1], w.c[2]));
       } else if (w.count == 3) {
-        // (c0 + c2) [(1 - t) W_j-1 + t W_j+1] in the four-lane evaluator (its AVX2 kernel),
-        // plus c1 W_j in a two-lane one (session 44: faster than one portable six-lane pass).
+        // Without a wide kernel: (c0 + c2) [(1 - t) W_j-1 + t W_j+1] in the four-lane
+        // evaluator plus c1 W_j in a two-lane one (session 44: faster than one portable
+        // six-lane pass).
         const double outer = w.c[0] + w.c[2];
         lanes_ = NetworkLanesAt(d.network.shape, th[0], th[2], w.c[2] / outer);
         lanes_scale_ = outer;

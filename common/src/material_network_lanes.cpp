@@ -5,6 +5,7 @@
 #include <emmintrin.h>
 #endif
 #include <stdexcept>
+#include <type_traits>
 
 #include "knit/material/network_lanes.hpp"
 
@@ -174,39 +175,116 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
 
 // ---- The four-wide kernel (session 17): unit-major, the 4 lanes of a unit in one 256-bit
 // vector, so every step is vertical (no horizontal sums). GCC's vector extension, compiled for
-// AVX2 only (target attribute on the entry point; without AVX GCC splits the vectors into SSE2
-// halves and it ran at half the portable code's rate, so a processor without AVX2 takes
-// lanes_sum). Contraction: GCC's default in C++ (-ffp-contract=fast; -std=c++20 does not turn
-// it off) cannot fuse in baseline x86-64 or AVX2 code (no FMA), so the AVX2 kernel does the
-// portable code's IEEE operations in another order; the AVX-512 kernels' target has FMA and
-// fuses multiply-adds (session 48's review). Both equal the portable code to round-off
-// (tested, 1e-13); without the fusion the six-lane kernel ran 2.21-2.25e6 instead of
-// 2.32-2.42e6 per second (the same hour), so it is kept.
+// AVX2 with FMA only (target attribute on the entry point; without AVX GCC splits the vectors
+// into SSE2 halves and it ran at half the portable code's rate, so a processor without AVX2 and
+// FMA takes lanes_sum). Contraction: GCC's default in C++ (-ffp-contract=fast; -std=c++20 does
+// not turn it off) cannot fuse in baseline x86-64 code (no FMA), so the portable code rounds
+// every product; the wide kernels' targets have FMA and fuse multiply-adds (AVX-512 since
+// session 48's review, AVX2 since session 51). Both equal the portable code to round-off
+// (tested, 1e-13); without the fusion the AVX-512 six-lane kernel ran 2.21-2.25e6 instead of
+// 2.32-2.42e6 per second (the same hour), and the AVX2 four-lane one at l = 5.25 mm 2.98e6
+// instead of 3.31e6 (session 51, an AMD EPYC without AVX-512).
 // -Wpsabi (GCC's note that a 256-bit vector passed by value without AVX changes the ABI) is
 // silenced for the rest of this translation unit (and its unity group; the note is issued at
 // its end): every function that takes or returns v4 or v8 is always_inline into an entry point.
 #pragma GCC diagnostic ignored "-Wpsabi"
+typedef double v2 __attribute__((vector_size(16)));
 typedef double v4 __attribute__((vector_size(32)));
 typedef double v8 __attribute__((vector_size(64)));
+
+/// Six lanes without AVX-512 (session 51): a unit's lanes 0-3 in a 256-bit vector and 4-5 in a
+/// 128-bit one, so that six lanes cost one and a half four-lane passes (GCC's v8 split into
+/// AVX2 halves computed eight and ran at 0.6e6 per second). Stored at the six-lane layout's
+/// stride of eight (kStride); the operators the kernel body uses, part by part.
+struct v6 {
+  v4 a;
+  v2 b;
+};
+#define KNIT_V6_OPERATOR(op)                                      \
+  [[gnu::always_inline]] inline v6 operator op(v6 x, v6 y) {      \
+    return {x.a op y.a, x.b op y.b};                              \
+  }                                                               \
+  [[gnu::always_inline]] inline v6 operator op(double x, v6 y) {  \
+    return {x op y.a, x op y.b};                                  \
+  }                                                               \
+  [[gnu::always_inline]] inline v6 operator op(v6 x, double y) {  \
+    return {x.a op y, x.b op y};                                  \
+  }                                                               \
+  [[gnu::always_inline]] inline v6& operator op##=(v6& x, v6 y) { \
+    x.a = x.a op y.a;                                             \
+    x.b = x.b op y.b;                                             \
+    return x;                                                     \
+  }
+KNIT_V6_OPERATOR(+)
+KNIT_V6_OPERATOR(-)
+KNIT_V6_OPERATOR(*)
+KNIT_V6_OPERATOR(/)
+#undef KNIT_V6_OPERATOR
+
+/// Doubles between one unit's consecutive lane vectors in the packed layout.
+template <class VT>
+constexpr int kStride = std::is_same_v<VT, v6> ? 8 : static_cast<int>(sizeof(VT) / sizeof(double));
 
 template <class VT>
 [[gnu::always_inline]] inline VT ldv(const double* p) {
   VT r;
-  std::memcpy(&r, p, sizeof r);
+  if constexpr (std::is_same_v<VT, v6>) {
+    std::memcpy(&r.a, p, sizeof r.a);
+    std::memcpy(&r.b, p + 4, sizeof r.b);
+  } else {
+    std::memcpy(&r, p, sizeof r);
+  }
   return r;
 }
 template <class VT>
+[[gnu::always_inline]] inline void stv(double* p, const VT& x) {
+  if constexpr (std::is_same_v<VT, v6>) {
+    std::memcpy(p, &x.a, sizeof x.a);
+    std::memcpy(p + 4, &x.b, sizeof x.b);
+  } else {
+    std::memcpy(p, &x, sizeof x);
+  }
+}
+template <class VT>
 [[gnu::always_inline]] inline VT splatv(double x) {
-  VT r;
-  for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l) r[l] = x;
-  return r;
+  if constexpr (std::is_same_v<VT, v6>) {
+    return {splatv<v4>(x), splatv<v2>(x)};
+  } else {
+    VT r;
+    for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l) r[l] = x;
+    return r;
+  }
+}
+/// Lane by lane: x < y ? a : b, and x > y ? a : b.
+template <class VT>
+[[gnu::always_inline]] inline VT where_less(VT x, VT y, VT a, VT b) {
+  if constexpr (std::is_same_v<VT, v6>)
+    return {where_less(x.a, y.a, a.a, b.a), where_less(x.b, y.b, a.b, b.b)};
+  else
+    return x < y ? a : b;
+}
+template <class VT>
+[[gnu::always_inline]] inline VT where_greater(VT x, VT y, VT a, VT b) {
+  return where_less(y, x, a, b);
+}
+/// True if every lane (the padding's too) is zero.
+template <class VT>
+[[gnu::always_inline]] inline bool all_zero(const VT& x) {
+  if constexpr (std::is_same_v<VT, v6>) {
+    return all_zero(x.a) && all_zero(x.b);
+  } else {
+    bool zero = true;
+    for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l)
+      zero = zero && x[l] == 0.0;
+    return zero;
+  }
 }
 
 template <class VT, int H1c, int H2c>
 [[gnu::always_inline]] inline void lanes4_body(int h1, int h2, int stiff1, int stiff2,
                                                const double* q, const double* e, double* out) {
   const int H1 = H1c > 0 ? H1c : h1, H2 = H2c > 0 ? H2c : h2;
-  constexpr int L = sizeof(VT) / sizeof(double);
+  constexpr int L = kStride<VT>;
   const auto ld4 = [](const double* p) __attribute__((always_inline)) {
     return ldv<VT>(p);
   };
@@ -230,15 +308,15 @@ template <class VT, int H1c, int H2c>
   const VT one = splat4(1.0), mone = splat4(-1.0), zero = splat4(0.0);
   const auto act = [&](VT x, bool stiff, VT& s, VT& ds, VT& dds) __attribute__((always_inline)) {
     if (!stiff) {
-      VT xc = x < mone ? mone : x;
-      xc = xc > one ? one : xc;
+      VT xc = where_less(x, mone, mone, x);
+      xc = where_greater(xc, one, one, xc);
       const VT x2 = xc * xc;
       s = 0.75 * (0.5 * x2 - x2 * x2 * (1.0 / 12.0)) + 0.5 * xc + 3.0 / 16.0 +
-          (x > one ? x - one : zero);
+          where_greater(x, one, x - one, zero);
       ds = 0.75 * (xc - x2 * xc * (1.0 / 3.0)) + 0.5;
       dds = 0.75 * (one - x2);
     } else {
-      const VT xp = x > zero ? x : zero;
+      const VT xp = where_greater(x, zero, x, zero);
       dds = xp;
       ds = 0.5 * xp * xp;
       s = ds * xp / 3.0;
@@ -276,9 +354,7 @@ template <class VT, int H1c, int H2c>
   // Second-layer curvature, for the units curved in some lane (c_j = 0 in the others).
   for (int j = 0; j < H2; ++j) {
     const VT cj = f2(4, j) * ddu[j];
-    bool flat = true;
-    for (int l = 0; l < L; ++l) flat = flat && cj[l] == 0.0;
-    if (flat) continue;
+    if (all_zero(cj)) continue;
     VT g0 = f2(0, j), g1 = f2(1, j), g2 = f2(2, j);
     for (int i = 0; i < H1; ++i) {
       const VT vd = vv(j, i) * dh[i];
@@ -305,23 +381,34 @@ template <class VT, int H1c, int H2c>
                       C[3] + Qm[3],
                       C[4] + Qm[4],
                       C[5] + Qm[5]};
-  for (int m = 0; m < 10; ++m) std::memcpy(out + L * m, &res[m], sizeof(VT));
+  for (int m = 0; m < 10; ++m) stv(out + L * m, res[m]);
 }
 
 /// The kernel's entry points: 12 / 6 units (the default) with compiled sizes, any other shape
-/// with the shape's; AVX2 where the processor has it (chosen at the build of a law).
+/// with the shape's; AVX2 with FMA where the processor has them (chosen at the build of a law).
 template <int H1c, int H2c>
-__attribute__((target("avx2"))) void lanes4_avx2(int h1, int h2, int stiff1, int stiff2,
-                                                 const double* q, const double* e, double* out) {
+__attribute__((target("avx2,fma"))) void lanes4_avx2(int h1, int h2, int stiff1, int stiff2,
+                                                     const double* q, const double* e,
+                                                     double* out) {
   lanes4_body<v4, H1c, H2c>(h1, h2, stiff1, stiff2, q, e, out);
+}
+
+/// Six lanes with AVX2 (v6: one 256-bit and one 128-bit vector per unit; session 51): at an
+/// inner knot's rounding window 1.72-1.79e6 evaluations per second instead of 1.45-1.48e6 for
+/// the four-lane AVX2 pass plus a two-lane portable one (AMD EPYC without AVX-512).
+template <int H1c, int H2c>
+__attribute__((target("avx2,fma"))) void lanes6_avx2(int h1, int h2, int stiff1, int stiff2,
+                                                     const double* q, const double* e,
+                                                     double* out) {
+  lanes4_body<v6, H1c, H2c>(h1, h2, stiff1, stiff2, q, e, out);
 }
 
 /// The same kernel with AVX-512 (session 48, this machine's AMD EPYC): four lanes in a 256-bit
 /// vector, with AVX-512VL's 32 vector registers (4.3e6 instead of 3.5e6 evaluations per second
 /// between knots), and six lanes (a rounding window's three knots) padded to eight in a 512-bit
 /// vector (2.6e6 instead of 1.8e6 for the four-lane AVX2 pass plus a two-lane portable one).
-/// Eight lanes with AVX2 alone (GCC splits each vector into two halves) ran at 0.6e6: there the
-/// six lanes keep the four-plus-two split (EnergyLawAt; NetworkLanesAt::six_lane_kernel()).
+/// Eight lanes with AVX2 alone (GCC splits each vector into two halves) ran at 0.6e6: there six
+/// lanes take v6 (lanes6_avx2).
 template <int H1c, int H2c>
 __attribute__((target("avx512f,avx512vl"))) void lanes4_avx512(int h1, int h2, int stiff1,
                                                                int stiff2, const double* q,
@@ -339,17 +426,21 @@ bool cpu_avx512() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
   return yes;
 }
+bool cpu_avx2_fma() {
+  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return yes;
+}
 
 /// The wide kernel for this shape, kernel choice and vector width (4 or 8 lanes), or nullptr
 /// where the processor has none (then the portable code evaluates).
 NetworkLanesAt::WideKernel wide_kernel(int h1, int h2, int width, LanesKernel kernel) {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
   const bool d = h1 == 12 && h2 == 6;
   if (kernel == LanesKernel::kAuto && cpu_avx512()) {
     if (width == 8) return d ? lanes8_avx512<12, 6> : lanes8_avx512<0, 0>;
     return d ? lanes4_avx512<12, 6> : lanes4_avx512<0, 0>;
   }
-  if (kernel == LanesKernel::kPortable || !avx2 || width != 4) return nullptr;
+  if (kernel == LanesKernel::kPortable || !cpu_avx2_fma()) return nullptr;
+  if (width == 8) return d ? lanes6_avx2<12, 6> : lanes6_avx2<0, 0>;
   return d ? lanes4_avx2<12, 6> : lanes4_avx2<0, 0>;
 }
 
@@ -464,7 +555,7 @@ void NetworkLanesAt::build(const NetworkShape& shape,
 }
 
 bool NetworkLanesAt::six_lane_kernel() {
-  return cpu_avx512();
+  return cpu_avx512() || cpu_avx2_fma();
 }
 
 NetworkResponse NetworkLanesAt::evaluate(const Eigen::Vector3d& e) const {

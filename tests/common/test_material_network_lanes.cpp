@@ -2,7 +2,7 @@
 // reference pass by pass (NetworkLawAt, itself tested against the formula written out in
 // test_material_convex_network.cpp): two lanes = the mirror-averaged law at one theta, four
 // lanes = the convex combination of two knots' laws, six = of three (every kernel: AVX-512,
-// AVX2 and portable, where the processor has them); on the compiled sizes (12 / 6) and the
+// AVX2 with FMA and portable, where the processor has them); on the compiled sizes (12 / 6) and the
 // general path (9 / 5, 16 / 8), with stiffening units and the exponential outer function.
 #include <catch2/catch.hpp>
 #include <random>
@@ -70,11 +70,13 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
   const NetworkLanesAt six(sh, ta, tb, tc, c, kernel);
   CHECK(four.lanes() == 4);
   CHECK(six.lanes() == 6);
-  const bool avx2 = __builtin_cpu_supports("avx2"), avx512 = NetworkLanesAt::six_lane_kernel();
-  CHECK(four.wide() == (kernel == LanesKernel::kAuto   ? avx2 || avx512
-                        : kernel == LanesKernel::kAvx2 ? avx2
-                                                       : false));
-  CHECK(six.wide() == (kernel == LanesKernel::kAuto && avx512));
+  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"),
+             avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+  const bool wide = kernel == LanesKernel::kAuto   ? avx2 || avx512
+                    : kernel == LanesKernel::kAvx2 ? avx2
+                                                   : false;
+  CHECK(four.wide() == wide);
+  CHECK(six.wide() == wide);  // AVX-512's eight-lane vectors, or AVX2's four plus two (v6)
   CHECK_FALSE(two.wide());
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> u(-0.7, 0.7);

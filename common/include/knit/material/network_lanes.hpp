@@ -14,7 +14,8 @@
 // all of them at once. The arithmetic is that of NetworkLawAt::evaluate (the reference, tested
 // equal to round-off); what is saved is the per-pass overhead and the serial dependence of one
 // small pass on the next (the lanes are independent, so their work interleaves). Four lanes
-// take an AVX2 kernel where the processor has it (LanesKernel below; docs/database.md).
+// and six lanes take a wide kernel where the processor has one (LanesKernel below;
+// docs/database.md).
 #pragma once
 
 #include <Eigen/Core>
@@ -25,11 +26,12 @@
 namespace knit::material {
 
 /// Which code evaluates four or six lanes: kAuto = the widest kernel the processor has: AVX-512
-/// (four lanes in a 256-bit vector, six in a 512-bit one; session 48), else AVX2 for four lanes
-/// (one 256-bit vector holds a unit's four lanes; +45 % on the default law between knots,
-/// session 17), else the portable one (Eigen, SSE2); kAvx2 = the AVX2 kernel for four lanes
-/// where the processor has AVX2, the portable one otherwise (tests); kPortable = always the
-/// portable one (tests). Two lanes always take the portable one (faster there).
+/// (four lanes in a 256-bit vector, six in a 512-bit one; session 48), else AVX2 with FMA (one
+/// 256-bit vector holds a unit's four lanes, +45 % on the default law between knots, session
+/// 17; six lanes in a 256-bit and a 128-bit vector, session 51), else the portable one (Eigen,
+/// SSE2); kAvx2 = the AVX2 kernels where the processor has AVX2 and FMA, the portable one
+/// otherwise (tests); kPortable = always the portable one (tests). Two lanes always take the
+/// portable one (faster there).
 enum class LanesKernel { kAuto, kAvx2, kPortable };
 
 class NetworkLanesAt {
@@ -53,8 +55,8 @@ class NetworkLanesAt {
   int lanes() const { return K_; }
   /// True if evaluate() runs a wide (AVX2 or AVX-512) kernel.
   bool wide() const { return wide_ != nullptr; }
-  /// True if this processor has the six-lane kernel (AVX-512); without it six lanes are
-  /// slower than four plus two (EnergyLawAt).
+  /// True if this processor has a six-lane kernel (AVX-512, or AVX2 with FMA); without one six
+  /// portable lanes are slower than four plus two (EnergyLawAt).
   static bool six_lane_kernel();
 
  private:
