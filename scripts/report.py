@@ -449,11 +449,10 @@ class Data:
             return "exit code 0 although its summary says it stopped"
         # Results of another database (session 38's red team: results older than the database
         # were judged as its own): knit-macro run records the date_utc of the database it read.
-        if self.db_date is not None:
-            used = r.database_date()
-            if used is not None and used != self.db_date:
-                return (f"its results were computed with the database written {used}; the "
-                        f"database is of {self.db_date} (stale: rerun the case)")
+        if r.database_date() is not None:
+            why = stale_against(r.database_date(), self.db_date, "the run", "rerun the case")
+            if why:
+                return why
         # Results that do not say which database they read (no material_database_date_utc:
         # written before session 38, or changed since) are not judged as this database's
         # (session 42's red team: with the attribute deleted, a stale run passed).
@@ -1045,18 +1044,24 @@ DESIGNS_DIR = None
 DATABASE_DATE = None
 
 
-def stale_output(used, what):
+def stale_against(used, current, what, rerun="rerun it"):
     """Why an output computed with the database of date `used` (None: it does not say) is not
-    the current database's, or None (no database date known, or the same one)."""
-    if DATABASE_DATE is None:
+    the database of date `current`, or None (`current` unknown, or the same date). The one
+    rule for case runs (Data.run_defect), designs and knitting maps (session 51's review)."""
+    if current is None:
         return None
     if used is None:
         return (f"{what} does not say which database it read (written before it recorded the "
-                f"date; rerun it)")
-    if used != DATABASE_DATE:
+                f"date; {rerun})")
+    if used != current:
         return (f"stale: {what} was computed with the database written {used}; the database "
-                f"is of {DATABASE_DATE} (rerun it)")
+                f"is of {current} ({rerun})")
     return None
+
+
+def stale_output(used, what):
+    """stale_against() the pipeline's database (DATABASE_DATE)."""
+    return stale_against(used, DATABASE_DATE, what)
 
 
 def design_stale(out, name):
@@ -1421,12 +1426,12 @@ def main():
     a = ap.parse_args()
     global EXPECTED_DESIGNS, DESIGNS_DIR, DATABASE_DATE
     EXPECTED_DESIGNS, DESIGNS_DIR = a.expect_designs.split(), a.designs_dir
-    DATABASE_DATE = database_date(a.database)
     if not glob.glob(os.path.join(a.cases_dir, "*.json")):
         print(f"report: error: --cases-dir {a.cases_dir}: holds no case file (*.json)",
               file=sys.stderr)
         sys.exit(2)
     rep = Report(a.out_dir, a.sensitivity, a.cases_dir, a.database)
+    DATABASE_DATE = rep.data.db_date  # read once, by Report
     rep.expected_figures = a.expect_figures.split()
     if not any(rep.r(n).ok for n in rep.names):
         # Nothing to judge: a report of 0 passes would read as a result (session 30: exit 0).
