@@ -376,7 +376,11 @@ AtomicDirectory::AtomicDirectory(fs::path target, OnAbandon on_abandon, std::str
   // put an earlier output back in place), then check again what the target holds.
   remove_stale_siblings(target_);
   check_output_target(target_, OutputKind::kDirectory, option);
-  if (const auto m = read_output_marker(target_)) earlier_completed_ = m->completed;
+  if (const auto m = read_output_marker(target_)) {
+    earlier_completed_ = m->completed;
+    earlier_marked_ = true;
+    earlier_recorded_ = m->completed_recorded;
+  }
   partial_ = target_;
   partial_ += ".partial-";
   partial_ += std::to_string(::getpid());
@@ -420,6 +424,8 @@ AtomicDirectory::AtomicDirectory(AtomicDirectory&& o) noexcept
       replaced_kept_in_(std::move(o.replaced_kept_in_)),
       completed_flag_(o.completed_flag_),
       earlier_completed_(o.earlier_completed_),
+      earlier_marked_(o.earlier_marked_),
+      earlier_recorded_(o.earlier_recorded_),
       on_abandon_(o.on_abandon_),
       committed_(o.committed_),
       active_(o.active_) {

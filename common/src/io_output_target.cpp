@@ -122,8 +122,9 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
       if (end && *end == '\0' && pid > 0) m.replaced_by_pid = pid;
     } else if (line.rfind("input: ", 0) == 0) {
       m.input_absolute = line.substr(7);
-    } else if (line == "completed: yes") {
-      m.completed = true;
+    } else if (line == "completed: yes" || line == "completed: no") {
+      m.completed = line == "completed: yes";
+      m.completed_recorded = true;
     } else if (line.rfind("pid ", 0) == 0) {
       char* end = nullptr;
       const long pid = std::strtol(line.c_str() + 4, &end, 10);

@@ -119,16 +119,16 @@ knit::cli::SubcommandRegistrar reg(
         // An earlier design written before the marker said whether it completed (session 49):
         // judged from its summary.txt, as design_verdict() judged it (a status other than
         // "iteration limit" and "failed", and a final run that completed).
-        if (!out.earlier_completed()) {
-          std::ifstream in(dir / "summary.txt");
+        out.judge_earlier_by_files([](const std::filesystem::path& earlier) {
+          std::ifstream in(earlier / "summary.txt");
           std::string line;
           bool status_ok = false, final_ok = false;
           if (std::getline(in, line))
             status_ok = line.rfind("status: ", 0) == 0 && line != "status: iteration limit" &&
                         line != "status: failed";
           while (std::getline(in, line)) final_ok = final_ok || line == "final run: completed";
-          out.set_earlier_completed(status_ok && final_ok);
-        }
+          return status_ok && final_ok;
+        });
         // The twin's targets: the case solved at the twin's values (not for --check).
         if (const std::string why = knit::macro::set_twin_targets(d); !why.empty()) {
           std::cerr << "knit-macro design: " << o->file << ": " << why << "\n";

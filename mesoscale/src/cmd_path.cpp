@@ -42,7 +42,7 @@ namespace {
 
 /// Whether the path.csv of an earlier output ends at lambda = 1 (its path completed): the
 /// second column of its last data row; false when it cannot be read.
-bool path_csv_completed(const std::string& csv) {
+bool path_csv_completed(const std::filesystem::path& csv) {
   std::ifstream in(csv);
   std::string line, last;
   bool header = true;
@@ -196,7 +196,8 @@ int run(const Options& o) {
   // judged from its path.csv: a path output holds at least one converged step, and the path
   // completed when its last row is at lambda = 1 (session 50; before, such outputs were
   // replaced by a stopped rerun).
-  if (!dir.earlier_completed()) dir.set_earlier_completed(path_csv_completed(o.out + "/path.csv"));
+  dir.judge_earlier_by_files(
+      [](const std::filesystem::path& out) { return path_csv_completed(out / "path.csv"); });
   // The outputs' size, estimated before the run from one VTP of the reference state (session
   // 41's red team: --steps 100000 started writing about 5.9 GB without a word; knit-meso rod
   // and knit-macro run have the same cap).

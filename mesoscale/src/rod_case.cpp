@@ -369,9 +369,8 @@ RodCase load_rod_case(const std::filesystem::path& path) {
                "vector is in radians (its length the angle, its direction the axis)";
           R.fail(ptr, o.str());
         }
-        o << "/rods/" << k << "/" << where << "/rotation_vector turns its end by " << turn
-          << " rad, " << turn / steps << " rad in each of " << steps
-          << " load step(s): more than a third of a turn per step (" << kMaxStepRotation
+        o << ptr << " turns its end by " << turn << " rad, " << turn / steps << " rad in each of "
+          << steps << " load step(s): more than a third of a turn per step (" << kMaxStepRotation
           << " rad); an end rotation is reached modulo a full turn, so a "
              "step of pi or more is solved the shorter way round (the rod curls the other way, "
              "or not at all at a full turn); use at least "
@@ -468,6 +467,14 @@ void check_output_size(const RodCase& c, std::uint64_t max_bytes) {
   }
 }
 
+namespace {
+/// The end of the rod CSV's second comment: how the path ended (PathReport::message), by which
+/// a later run judges an output written before its marker said whether it completed.
+std::string path_end_comment(const std::string& message) {
+  return "; path: " + message;
+}
+}  // namespace
+
 CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdir,
                             std::ostream* log) {
   const RodSystem& sys = c.system;
@@ -479,13 +486,14 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
   // judged from its load_displacement.csv, whose comment has said how the path ended since the
   // first rod outputs ("...; path: completed"; session 50: before, such outputs were replaced
   // by a stopped rerun).
-  if (!dir.earlier_completed()) {
-    std::ifstream in(outdir / "load_displacement.csv");
+  dir.judge_earlier_by_files([](const std::filesystem::path& out) {
+    std::ifstream in(out / "load_displacement.csv");
+    const std::string done = path_end_comment(to_string(PathStop::kCompleted));
     bool completed = false;
     for (std::string line; std::getline(in, line) && (line.empty() || line[0] == '#');)
-      completed = completed || line.ends_with("; path: completed");
-    dir.set_earlier_completed(completed);
-  }
+      completed = completed || line.ends_with(done);
+    return completed;
+  });
 
   std::vector<std::string> header{"step", "lambda", "iterations"};
   for (const auto& p : c.points)
@@ -552,7 +560,8 @@ CasePathReport run_rod_case(const RodCase& c, const std::filesystem::path& outdi
   }
   io::CsvWriter csv(dir / "load_displacement.csv", header);
   csv.add_comment("provenance: " + provenance);
-  csv.add_comment("displacements u = r - r0 [mm] of the named points; path: " + rep.message);
+  csv.add_comment("displacements u = r - r0 [mm] of the named points" +
+                  path_end_comment(rep.message));
   if (rep.resolution)
     csv.add_comment("resolution: " + rep.resolution->describe() + " (tolerance " +
                     std::to_string(static_cast<int>(100 * kResolutionTolerance)) + " %)");

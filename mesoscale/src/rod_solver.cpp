@@ -241,7 +241,7 @@ PathReport solve_path(const RodSystem& sys, Eigen::VectorXd& x, const PathOption
   }
   rep.completed = true;
   rep.stop = PathStop::kCompleted;
-  rep.message = "completed";
+  rep.message = to_string(PathStop::kCompleted);
   return rep;
 }
 

@@ -1059,6 +1059,50 @@ TEST_CASE("AtomicDirectory: a stopped output keeps the completed one it replaces
   fs::remove_all(d);
 }
 
+// Session 51's review: the judgement of an earlier output from its files (knit-meso path and rod,
+// knit-macro design) applies only where the marker does not say (no "completed:" line); a
+// marker's "completed: no" is not overridden, and without an earlier output nothing is judged.
+TEST_CASE(
+    "AtomicDirectory: an earlier output is judged from its files only where its marker "
+    "does not say",
+    "[unit][io][atomic]") {
+  const fs::path d = scratch("judge_earlier");
+  const fs::path target = d / "out", kept = d / "out.last-completed";
+  int calls = 0;
+  const auto judge = [&](const fs::path& dir) {
+    ++calls;
+    CHECK(dir == target);
+    return true;  // the files say: completed
+  };
+  // A stopped output into target, after the judgement: whether the earlier output counted as
+  // completed, and where it was kept.
+  const auto stopped = [&]() {
+    knit::io::AtomicDirectory a(target);
+    a.judge_earlier_by_files(judge);
+    const bool earlier = a.earlier_completed();
+    a.set_completed(false);
+    a.commit();
+    return std::pair{earlier, a.replaced_kept_in()};
+  };
+  // Without an earlier output: nothing to judge.
+  CHECK(stopped() == std::pair{false, fs::path()});
+  CHECK(calls == 0);
+  // The marker says "completed: no": its files do not override it.
+  CHECK(stopped() == std::pair{false, fs::path()});
+  CHECK(calls == 0);
+  // A marker without the line (an output written before session 49): judged from its files,
+  // and kept when a stopped output replaces it.
+  {
+    knit::io::AtomicDirectory a(target);
+    a.commit();  // set_completed not called: no line
+  }
+  CHECK_FALSE(knit::io::read_output_marker(target)->completed_recorded);
+  CHECK(stopped() == std::pair{true, kept});
+  CHECK(calls == 1);
+  CHECK(knit::io::read_output_marker(target)->completed_recorded);
+  fs::remove_all(d);
+}
+
 TEST_CASE("a marker never holds a line forged by its input's name", "[unit][io][atomic]") {
   // Session 48's red team: the input's absolute path is a marker line, and "x\nfile: notes.txt"
   // became two lines, the second listing notes.txt as the output's own. read_input_file refuses

@@ -1003,6 +1003,43 @@ TEST_CASE("design: the final run names its case by the committed path", "[unit]"
   fs::remove_all(out);
 }
 
+// Session 49: a design rerun that stops keeps the completed design it replaces as
+// DIR.last-completed. Session 51's review: an older design (its marker without the "completed:"
+// line) is judged from its summary.txt (AtomicDirectory::judge_earlier_by_files); a marker's
+// "completed: no" is not overridden by the files.
+TEST_CASE("design: a stopped rerun keeps a completed older design, judged from its summary",
+          "[unit]") {
+  write_case();
+  write(kDir / "done.json",
+        R"({"case": "case.json",
+            "variables": [{"field": "stitch_value", "indices": [0, 1], "lower": 4.5, "upper": 6.5}],
+            "objectives": [{"type": "reaction", "reaction": "fy", "at_strain": [0.2],
+                            "target": [0]}]})");
+  write(kDir / "stops.json", R"({"case": "case.json", "variables": )" + kVars +
+                                 R"(, "objectives": )" + kObjs +
+                                 R"(, "optimizer": {"max_iterations": 1}})");
+  const fs::path out = kDir / "older_out", kept = kDir / "older_out.last-completed";
+  for (const std::string marker : {"older", "completed: no"}) {
+    INFO(marker);
+    fs::remove_all(out);
+    fs::remove_all(kept);
+    REQUIRE(design_into(kDir / "done.json", out) == 0);
+    const std::string summary = knit_test::read_text(out / "summary.txt");
+    knit_test::strip_completed_line(out);  // the marker as session 48 wrote it
+    if (marker != "older")
+      std::ofstream(out / ".knitscale-output", std::ios::app) << marker << "\n";
+    CHECK(design_into(kDir / "stops.json", out) == 1);  // the iteration limit
+    if (marker == "older") {
+      REQUIRE(fs::exists(kept / "summary.txt"));
+      CHECK(knit_test::read_text(kept / "summary.txt") == summary);
+    } else {
+      CHECK_FALSE(fs::exists(kept));  // the marker said it had not completed
+    }
+  }
+  fs::remove_all(out);
+  fs::remove_all(kept);
+}
+
 // Session 34 (the design audit's mutant 85): case.json names the database by its absolute
 // path (docs/design.md), so that it runs wherever it is written: a case that names it relative
 // to itself, designed into a directory two levels below the case's, left it relative (the

@@ -14,6 +14,8 @@
 #include <tuple>
 
 #include <vector>
+
+#include "../output_test_util.hpp"
 #include "knit/meso/cell/geometry.hpp"
 
 namespace fs = std::filesystem;
@@ -314,14 +316,7 @@ TEST_CASE("knit-meso path: a stopped rerun keeps the completed earlier output", 
     const std::string exe = "timeout 60 " + std::string(KNIT_BIN_DIR) +
                             "/knit-meso path --elements 12 --loop-length 4.5 --no-vtp --out " + out;
     REQUIRE(std::system((exe + " --biaxial 0.05 0.05 --steps 1 > /dev/null 2>&1").c_str()) == 0);
-    if (older) {  // the marker as session 48 wrote it
-      std::ifstream in(out + "/.knitscale-output");
-      std::string marker, line;
-      while (std::getline(in, line))
-        if (line.rfind("completed:", 0) != 0) marker += line + "\n";
-      in.close();
-      std::ofstream(out + "/.knitscale-output") << marker;
-    }
+    if (older) knit_test::strip_completed_line(out);  // the marker as session 48 wrote it
     std::ifstream first(out + "/path.csv");
     const std::string before((std::istreambuf_iterator<char>(first)), {});
     // Equibiaxial 1.2 in 4 steps: step 1 converges, step 2 cannot (the pass-through guard).

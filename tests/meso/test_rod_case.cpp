@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../output_test_util.hpp"
 #include "../process_tmp.hpp"
 #include "knit/core/errors.hpp"
 #include "knit/meso/rod/rod_case.hpp"
@@ -385,14 +386,7 @@ TEST_CASE("rod case: a stopped rerun says why on stderr and keeps the completed 
     fs::remove_all(out);
     fs::remove_all(kept);
     REQUIRE(run("rod " + (kCases / "elastica.json").string() + " -q -o " + out.string()) == 0);
-    if (older) {  // the marker as session 48 wrote it
-      std::ifstream in(out / ".knitscale-output");
-      std::string marker, line;
-      while (std::getline(in, line))
-        if (line.rfind("completed:", 0) != 0) marker += line + "\n";
-      in.close();
-      write(out / ".knitscale-output", marker);
-    }
+    if (older) knit_test::strip_completed_line(out);  // the marker as session 48 wrote it
     const std::string text = replaced(case_text("elastica.json"), R"("steps": { "count": 8 })",
                                       R"("steps": { "count": 8, "max_total_iterations": 12 })");
     const fs::path f = kTmp / "stopped_rerun.json", err = kTmp / "stopped_rerun.err";

@@ -20,6 +20,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -130,14 +131,21 @@ class AtomicDirectory {
   /// "DIR.last-completed" (keep_replaced_as) unless another suffix was set: a failed rerun of
   /// knit-macro design or knit-meso path or rod does not cost a completed output written since
   /// session 49 (its red team; an older output has no such line: a command may judge it from
-  /// its files, set_earlier_completed; knit-macro run judges from summary.txt since session 46
+  /// its files, judge_earlier_by_files; knit-macro run judges from summary.txt since session 46
   /// and does not call this).
   void set_completed(bool completed) { completed_flag_ = completed ? 1 : 0; }
   /// The output in DIR when this one was started was a completed one (its marker said so).
   bool earlier_completed() const { return earlier_completed_; }
-  /// The command's own judgement of the earlier output (one written before the marker had the
-  /// line: knit-macro design reads its summary.txt).
-  void set_earlier_completed(bool completed) { earlier_completed_ = completed; }
+  /// An earlier output whose marker does not say whether it completed (no "completed:" line:
+  /// written before session 49) is judged by the command from its files:
+  /// completed_by_files(DIR) (knit-meso path reads its path.csv, rod its CSV's comment,
+  /// knit-macro design its summary.txt). A marker's "completed: no" is not overridden, and
+  /// without a marker there is nothing to judge (session 51's review: the rule was written out
+  /// by each of the three callers, and overrode "completed: no").
+  void judge_earlier_by_files(
+      const std::function<bool(const std::filesystem::path&)>& completed_by_files) {
+    if (earlier_marked_ && !earlier_recorded_) earlier_completed_ = completed_by_files(target_);
+  }
 
  private:
   /// Removes the replaced output `old` (now beside the target), or keeps it (keep_replaced_as).
@@ -150,6 +158,8 @@ class AtomicDirectory {
   std::filesystem::path replaced_kept_in_;
   int completed_flag_ = -1;  ///< set_completed: 1 yes, 0 no, -1 not said
   bool earlier_completed_ = false;
+  bool earlier_marked_ = false;    ///< DIR held an output with a marker when this one started
+  bool earlier_recorded_ = false;  ///< ... whose marker had a "completed:" line
   OnAbandon on_abandon_;
   bool committed_ = false;
   bool active_ = true;

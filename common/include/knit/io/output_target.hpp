@@ -66,6 +66,9 @@ struct OutputMarker {
   /// A "completed: yes" line (since session 49): the command that wrote it ended with its work
   /// done (AtomicDirectory::set_completed); false with "completed: no" or without the line.
   bool completed = false;
+  /// The marker has a "completed:" line, yes or no (an output written before session 49, or by
+  /// knit-macro run, has none).
+  bool completed_recorded = false;
 };
 /// The marker of `dir`, read; nothing without a marker.
 std::optional<OutputMarker> read_output_marker(const std::filesystem::path& dir);
