@@ -4,13 +4,24 @@
 # This is the README's second command and what CI runs (.ci/run).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# Each phase's wall time, printed at the end (session 51: the suite's ~15-minute aim is kept
+# in view phase by phase; docs/build.md).
+times=()
+phase_start=$SECONDS
+phase() {  # phase NAME: closes the running phase's clock under NAME
+  times+=("$1 $((SECONDS - phase_start)) s")
+  phase_start=$SECONDS
+}
 KNIT_SETUP_TESTS=1 "$root/scripts/setup.sh"   # python3-vtk9 too, for CTest vtk_check
+phase "setup"
 jobs="$(nproc)"
 
 echo "== build (Release) =="
 "$root/scripts/build.sh" "$root/build"
+phase "build"
 echo "== tests (Release) =="
 (cd "$root/build" && ctest --output-on-failure --parallel "$jobs")
+phase "tests"
 
 echo "== unit tests under ASan + UBSan =="
 # Only test files with a [unit] test are compiled in this build (tests/CMakeLists.txt).
@@ -28,9 +39,14 @@ command -v ninja >/dev/null && [ ! -f "$san/Makefile" ] && gen=(-G Ninja)
 cmake -S "$root" -B "$san" "${gen[@]}" -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
   -DKNIT_OPT_COLD=-Og -DKNIT_OPT_TESTS=-Og -DKNIT_SANITIZE=ON >/dev/null
 cmake --build "$san" --parallel "$jobs"
+phase "sanitizer build"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 (cd "$san" && ctest --output-on-failure --parallel "$jobs")
+phase "sanitizer tests"
 
 echo "== formatting (.clang-format) =="
 "$root/scripts/check_format.sh"
+phase "format"
+printf -v joined '%s, ' "${times[@]}"
+echo "== suite: ${joined%, }; total ${SECONDS} s on $jobs core(s) =="
