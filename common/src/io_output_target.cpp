@@ -497,7 +497,8 @@ std::uint64_t parse_size(std::string_view text, std::string_view option) {
     throw InputError("", std::string(option),
                      "\"" + s + "\" is not a size (a number with an optional k, M, G or T: 500M)");
   };
-  if (s.empty()) return bad();
+  // No sign: "-0" was read as 0, which means no cap (session 51).
+  if (s.empty() || s[0] == '-' || s[0] == '+') return bad();
   // A decimal number only: strtod also reads hexadecimal ("0x10", 16 bytes; session 50's red
   // team), "inf", "nan" and leading blanks.
   // strtod must read exactly the leading run of decimal characters.

@@ -861,7 +861,9 @@ TEST_CASE("Output sizes: parsed from the command line, printed in decimal units"
   CHECK_THROWS_AS(knit::io::parse_size("0.5", "--max"), knit::InputError);
   CHECK(knit::io::parse_size("0", "--max") == 0u);
   // Session 50's red team: strtod read "0x10" as 16 bytes; a size is a decimal number.
-  for (const char* bad : {"", "G", "-1", "nan", "1Q", "1e30", "0x10", "0X1p4", " 5", "inf", "5e"})
+  // Session 51: "-0" was 0, no cap; a size has no sign.
+  for (const char* bad :
+       {"", "G", "-1", "nan", "1Q", "1e30", "0x10", "0X1p4", " 5", "inf", "5e", "-0", "-0k", "+5"})
     CHECK_THROWS_WITH(knit::io::parse_size(bad, "--max"), Catch::Contains("--max"));
   CHECK(knit::io::format_bytes(7'800'000'000u) == "7.8 GB");
   CHECK(knit::io::format_bytes(350'000'000u) == "350 MB");
