@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "knit/meso/rod/builders.hpp"
@@ -84,6 +85,29 @@ TEST_CASE("rod: reference state is an exact equilibrium (stress free)", "[unit]"
     const PointState st = sys.state(0, xi, x);
     CHECK((st.R.col(2) - st.r_xi.normalized()).norm() < 1e-3);
   }
+}
+
+// Session 50's red team: a rod pushed through zero length "completed" at an axial strain of
+// -3; a converged increment whose smallest stretch is <= 0 now fails (RodSystem::
+// min_axial_stretch). Its review: a NaN stays the smallest, also when finite points follow.
+TEST_CASE("rod: the smallest axial stretch: 1 in the reference, negative reversed, NaN kept",
+          "[unit]") {
+  RodSystem sys;
+  sys.add_rod(helix_rod(4, 8));
+  const Eigen::VectorXd x0 = sys.initial_state();
+  CHECK(sys.min_axial_stretch(x0).value == Approx(1.0).epsilon(1e-3));
+  // The centerline reflected through its first control point: r' reversed, d3 not.
+  Eigen::VectorXd x = x0;
+  const Eigen::Vector3d r0 = x0.segment<3>(sys.dof(0, 0, kFieldR));
+  for (int a = 0; a < sys.num_control_points(0); ++a)
+    x.segment<3>(sys.dof(0, a, kFieldR)) = 2.0 * r0 - x0.segment<3>(sys.dof(0, a, kFieldR));
+  CHECK(sys.min_axial_stretch(x).value == Approx(-1.0).epsilon(1e-3));
+  // A NaN at the first control point: the first collocation points are NaN, the later finite.
+  x = x0;
+  x(sys.dof(0, 0, kFieldR)) = std::numeric_limits<double>::quiet_NaN();
+  const RodSystem::AxialStretch a = sys.min_axial_stretch(x);
+  CHECK(std::isnan(a.value));
+  CHECK(a.xi < 0.5);
 }
 
 TEST_CASE("rod: Jacobian matches central finite differences", "[unit]") {
