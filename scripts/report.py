@@ -449,7 +449,7 @@ class Data:
             return "exit code 0 although its summary says it stopped"
         # Results of another database (session 38's red team: results older than the database
         # were judged as its own): knit-macro run records the date_utc of the database it read.
-        if r.database_date() is not None:
+        if r.database_date() is not None or self.db_date == UNDATED:
             why = stale_against(r.database_date(), self.db_date, "the run", "rerun the case")
             if why:
                 return why
@@ -743,10 +743,19 @@ def case_names(cases_dir, res_dir):
     return sorted(names)
 
 
+# The date of a database file that does not say when it was written (no date_utc attribute:
+# every database knit-meso writes has one; session 51's red team: with it deleted, every stale
+# check was off and runs of another database passed).
+UNDATED = ""
+
+
 def database_date(db_path):
-    """The database file's date_utc attribute (when it was written), or None (no database, no
-    attribute, unreadable)."""
-    return root_text_attribute(db_path, "date_utc") if db_path else None
+    """The database file's date_utc attribute (when it was written); UNDATED for a file without
+    it (or unreadable); None without a database."""
+    if not db_path:
+        return None
+    date = root_text_attribute(db_path, "date_utc")
+    return UNDATED if date is None else date
 
 
 def is_run_check(c):
@@ -1047,9 +1056,14 @@ DATABASE_DATE = None
 def stale_against(used, current, what, rerun="rerun it"):
     """Why an output computed with the database of date `used` (None: it does not say) is not
     the database of date `current`, or None (`current` unknown, or the same date). The one
-    rule for case runs (Data.run_defect), designs and knitting maps (session 51's review)."""
+    rule for case runs (Data.run_defect), designs and knitting maps (session 51's review).
+    An UNDATED database tells no output apart from one of another database."""
     if current is None:
         return None
+    if current == UNDATED:
+        return (f"the database does not say when it was written (no date_utc attribute), so "
+                f"{what} cannot be told apart from one computed with another database (use a "
+                f"database knit-meso wrote, then {rerun})")
     if used is None:
         return (f"{what} does not say which database it read (written before it recorded the "
                 f"date; {rerun})")

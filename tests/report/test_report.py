@@ -846,6 +846,10 @@ def unusable_result_failures(tmp):
     unknown = report.Data(res, None).run_defect("a")
     if same is not None or unknown is not None or other is None or "stale" not in other:
         out.append(f"stale results: same date {same!r}, another {other!r}, no date {unknown!r}")
+    # A database without its date_utc (session 51's red team: every stale check was off).
+    undated = report.Data(res, report.UNDATED).run_defect("a")
+    if undated is None or "does not say when it was written" not in undated:
+        out.append(f"stale results: a database without date_utc: {undated!r}")
     # The case the run was computed from (session 50's red team: another case's results.h5
     # copied in turned two FAILs into passes): results.h5's /case_json against the pipeline's
     # copy OUT/cases/NAME.json beside OUT/results.
