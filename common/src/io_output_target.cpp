@@ -103,6 +103,7 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
   std::ifstream in(dir / kOutputMarker, std::ios::binary);
   OutputMarker m;
   std::string line;
+  bool said_yes = false, said_no = false;
   for (int k = 0; std::getline(in, line); ++k) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (k == 1) {  // the provenance (JSON); its input file, if it names one
@@ -123,14 +124,18 @@ std::optional<OutputMarker> read_output_marker(const fs::path& dir) {
     } else if (line.rfind("input: ", 0) == 0) {
       m.input_absolute = line.substr(7);
     } else if (line == "completed: yes" || line == "completed: no") {
-      m.completed = line == "completed: yes";
-      m.completed_recorded = true;
+      (line == "completed: yes" ? said_yes : said_no) = true;
     } else if (line.rfind("pid ", 0) == 0) {
       char* end = nullptr;
       const long pid = std::strtol(line.c_str() + 4, &end, 10);
       if (end && *end == '\0' && pid > 0) m.writer_pid = pid;
     }
   }
+  // Both "completed: yes" and "no" (never written so; a marker edited by hand or corrupted)
+  // say nothing: the command judges the output from its files (session 51's red team: the
+  // last line won, and a stopped rerun removed a completed output whose marker ended "no").
+  m.completed_recorded = said_yes != said_no;
+  m.completed = said_yes && !said_no;
   return m;
 }
 

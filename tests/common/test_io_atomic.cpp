@@ -1101,6 +1101,13 @@ TEST_CASE(
   CHECK_FALSE(knit::io::read_output_marker(target)->completed_recorded);
   CHECK(stopped() == std::pair{true, kept});
   CHECK(calls == 1);
+  // A marker that says both (session 51's red team: the last line won, "no", and the completed
+  // output was removed): it says nothing, so the files judge.
+  std::ofstream(target / ".knitscale-output", std::ios::app) << "completed: yes\n";
+  CHECK_FALSE(knit::io::read_output_marker(target)->completed_recorded);
+  fs::remove_all(kept);
+  CHECK(stopped() == std::pair{true, kept});
+  CHECK(calls == 2);
   CHECK(knit::io::read_output_marker(target)->completed_recorded);
   fs::remove_all(d);
 }

@@ -67,7 +67,7 @@ struct OutputMarker {
   /// done (AtomicDirectory::set_completed); false with "completed: no" or without the line.
   bool completed = false;
   /// The marker has a "completed:" line, yes or no (an output written before session 49, or by
-  /// knit-macro run, has none).
+  /// knit-macro run, has none); false when it has both (contradictory: it says nothing).
   bool completed_recorded = false;
 };
 /// The marker of `dir`, read; nothing without a marker.
