@@ -449,15 +449,15 @@ class Data:
             return "exit code 0 although its summary says it stopped"
         # Results of another database (session 38's red team: results older than the database
         # were judged as its own): knit-macro run records the date_utc of the database it read.
-        if r.database_date() is not None or self.db_date == UNDATED:
+        knit = r.case.get("material", {}).get("type") == "knit"
+        if r.database_date() is not None or (self.db_date == UNDATED and knit):
             why = stale_against(r.database_date(), self.db_date, "the run", "rerun the case")
             if why:
                 return why
         # Results that do not say which database they read (no material_database_date_utc:
         # written before session 38, or changed since) are not judged as this database's
         # (session 42's red team: with the attribute deleted, a stale run passed).
-        if self.db_date is not None and r.database_date() is None and \
-                r.case.get("material", {}).get("type") == "knit":
+        if self.db_date is not None and r.database_date() is None and knit:
             return ("its results.h5 does not say which database it read (no "
                     "material_database_date_utc: written before session 38, changed since, or "
                     "no results.h5, which the report needs for a knit run: rerun the case with "
@@ -750,12 +750,20 @@ UNDATED = ""
 
 
 def database_date(db_path):
-    """The database file's date_utc attribute (when it was written); UNDATED for a file without
-    it (or unreadable); None without a database."""
+    """The database file's date_utc attribute (when it was written); UNDATED for an HDF5 file
+    that opens without it (or with an empty one); None without a database, or where it cannot
+    be read (missing, not HDF5, no h5py: the report says so elsewhere)."""
     if not db_path:
         return None
     date = root_text_attribute(db_path, "date_utc")
-    return UNDATED if date is None else date
+    if date is not None:
+        return date
+    try:
+        import h5py
+        with h5py.File(db_path, "r"):
+            return UNDATED
+    except (OSError, ValueError, ImportError):
+        return None
 
 
 def is_run_check(c):

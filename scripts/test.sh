@@ -4,14 +4,20 @@
 # This is the README's second command and what CI runs (.ci/run).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-# Each phase's wall time, printed at the end (session 51: the suite's ~15-minute aim is kept
-# in view phase by phase; docs/build.md).
-times=()
+# Each phase's wall time, printed at the end, also when a phase fails (session 51: the
+# suite's ~15-minute aim is kept in view phase by phase; docs/build.md).
+phase_times=()
 phase_start=$SECONDS
 phase() {  # phase NAME: closes the running phase's clock under NAME
-  times+=("$1 $((SECONDS - phase_start)) s")
+  phase_times+=("$1 $((SECONDS - phase_start)) s")
   phase_start=$SECONDS
 }
+print_phase_times() {
+  local joined=""
+  ((${#phase_times[@]})) && printf -v joined '%s, ' "${phase_times[@]}"
+  echo "== suite: ${joined}total ${SECONDS} s on $(nproc) core(s) =="
+}
+trap print_phase_times EXIT
 KNIT_SETUP_TESTS=1 "$root/scripts/setup.sh"   # python3-vtk9 too, for CTest vtk_check
 phase "setup"
 jobs="$(nproc)"
@@ -48,5 +54,3 @@ phase "sanitizer tests"
 echo "== formatting (.clang-format) =="
 "$root/scripts/check_format.sh"
 phase "format"
-printf -v joined '%s, ' "${times[@]}"
-echo "== suite: ${joined%, }; total ${SECONDS} s on $jobs core(s) =="

@@ -186,7 +186,8 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
 // instead of 3.31e6 (session 51, an AMD EPYC without AVX-512).
 // -Wpsabi (GCC's note that a 256-bit vector passed by value without AVX changes the ABI) is
 // silenced for the rest of this translation unit (and its unity group; the note is issued at
-// its end): every function that takes or returns v4 or v8 is always_inline into an entry point.
+// its end): every function that takes or returns v4, v6 or v8 is always_inline into an entry
+// point.
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double v2 __attribute__((vector_size(16)));
 typedef double v4 __attribute__((vector_size(32)));
@@ -267,7 +268,8 @@ template <class VT>
 [[gnu::always_inline]] inline VT where_greater(VT x, VT y, VT a, VT b) {
   return where_less(y, x, a, b);
 }
-/// True if every lane (the padding's too) is zero.
+/// True if every lane of x is zero: v8's padding lanes (copies of lane 0) too, which never
+/// changes the answer; v6 has no padding lanes.
 template <class VT>
 [[gnu::always_inline]] inline bool all_zero(const VT& x) {
   if constexpr (std::is_same_v<VT, v6>) {
@@ -394,7 +396,7 @@ __attribute__((target("avx2,fma"))) void lanes4_avx2(int h1, int h2, int stiff1,
 }
 
 /// Six lanes with AVX2 (v6: one 256-bit and one 128-bit vector per unit; session 51): at an
-/// inner knot's rounding window 1.72-1.79e6 evaluations per second instead of 1.45-1.48e6 for
+/// inner knot's rounding window 1.78-1.79e6 evaluations per second instead of 1.45-1.48e6 for
 /// the four-lane AVX2 pass plus a two-lane portable one (AMD EPYC without AVX-512).
 template <int H1c, int H2c>
 __attribute__((target("avx2,fma"))) void lanes6_avx2(int h1, int h2, int stiff1, int stiff2,

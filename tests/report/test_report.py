@@ -850,6 +850,15 @@ def unusable_result_failures(tmp):
     undated = report.Data(res, report.UNDATED).run_defect("a")
     if undated is None or "does not say when it was written" not in undated:
         out.append(f"stale results: a database without date_utc: {undated!r}")
+    # UNDATED only for a file that opens without the attribute (the review of session 51: a
+    # missing file was named "no date_utc attribute"); None where it cannot be read.
+    no_date = os.path.join(res, "no_date.h5")
+    with h5py.File(no_date, "w") as h:
+        h.attrs["generator"] = "sweep"
+    got = (report.database_date(no_date), report.database_date(os.path.join(res, "none.h5")),
+           report.database_date(os.path.join(res, "a", "summary.txt")))
+    if got != (report.UNDATED, None, None):
+        out.append(f"database_date of a file without date_utc, a missing one, a text file: {got!r}")
     # The case the run was computed from (session 50's red team: another case's results.h5
     # copied in turned two FAILs into passes): results.h5's /case_json against the pipeline's
     # copy OUT/cases/NAME.json beside OUT/results.

@@ -134,7 +134,8 @@ class AtomicDirectory {
   /// its files, judge_earlier_by_files; knit-macro run judges from summary.txt since session 46
   /// and does not call this).
   void set_completed(bool completed) { completed_flag_ = completed ? 1 : 0; }
-  /// The output in DIR when this one was started was a completed one (its marker said so).
+  /// The output in DIR when this one was started was a completed one (its marker said so, or,
+  /// where it does not say, the command's judge_earlier_by_files).
   bool earlier_completed() const { return earlier_completed_; }
   /// An earlier output whose marker does not say whether it completed (no "completed:" line:
   /// written before session 49) is judged by the command from its files:
