@@ -43,6 +43,29 @@ spline::SplineSurface make_scalar_field(const ScalarFieldSpec& spec) {
   return spline::SplineSurface(bu, bv, P);
 }
 
+namespace {
+/// The angle in the tangent plane at (u, v) from e1 = a1 / |a1| to v projected on it, or NaN
+/// where v is normal to the surface.
+double angle_to(const spline::SplineSurface& geometry, double u, double v,
+                const Eigen::Vector3d& dir) {
+  const Eigen::MatrixXd D = geometry.derivatives(u, v, 1);
+  const Eigen::Vector3d a1 = D.row(1).transpose(), a2 = D.row(2).transpose();
+  const Eigen::Vector3d a3 = a1.cross(a2).normalized();
+  const Eigen::Vector3d e1 = a1.normalized();
+  const Eigen::Vector3d vt = dir - dir.dot(a3) * a3;
+  if (vt.norm() < 1e-12) return std::numeric_limits<double>::quiet_NaN();
+  return std::atan2(e1.cross(vt).dot(a3), e1.dot(vt));
+}
+/// Sample parameters over the range of `a`: 8 per element of a or b (the finer), at least 33.
+std::vector<double> samples(const spline::BSplineBasis& a, const spline::BSplineBasis& b) {
+  const double lo = a.lo(), hi = a.hi();
+  const int n = std::max(33, 8 * std::max(a.num_elements(), b.num_elements()) + 1);
+  std::vector<double> s(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) s[static_cast<std::size_t>(k)] = lo + (hi - lo) * k / (n - 1);
+  return s;
+}
+}  // namespace
+
 spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, int degree_u,
                                         std::vector<double> knots_u, int degree_v,
                                         std::vector<double> knots_v, const Eigen::Vector3d& v_in) {
@@ -60,15 +83,10 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
   Eigen::MatrixXd A(nu, nv);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
-      const Eigen::MatrixXd D = geometry.derivatives(gu[i], gv[j], 1);
-      const Eigen::Vector3d a1 = D.row(1).transpose(), a2 = D.row(2).transpose();
-      const Eigen::Vector3d a3 = a1.cross(a2).normalized();
-      const Eigen::Vector3d e1 = a1.normalized();
-      const Eigen::Vector3d vt = v - v.dot(a3) * a3;
-      if (vt.norm() < 1e-12)
+      double ang = angle_to(geometry, gu[i], gv[j], v);
+      if (std::isnan(ang))
         throw std::invalid_argument(
             "align: the vector v is normal to the surface at a Greville point");
-      double ang = std::atan2(e1.cross(vt).dot(a3), e1.dot(vt));
       const double ref = i > 0 ? A(i - 1, j) : (j > 0 ? A(0, j - 1) : ang);
       while (ang - ref > std::numbers::pi) ang -= 2 * std::numbers::pi;
       while (ang - ref < -std::numbers::pi) ang += 2 * std::numbers::pi;
@@ -80,6 +98,20 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
     for (int i = 0; i < nu; ++i) values(i + nu * j, 0) = A(i, j);
   const Eigen::MatrixXd P = spline::interpolate_at_greville(bu, bv, values);
   return spline::SplineSurface(bu, bv, P);
+}
+
+AlignDeviation align_deviation(const spline::SplineSurface& geometry,
+                               const spline::SplineSurface& alpha, const Eigen::Vector3d& v) {
+  AlignDeviation worst;
+  const Eigen::Vector3d dir = v / v.stableNorm();
+  for (const double u : samples(alpha.basis_u(), geometry.basis_u()))
+    for (const double w : samples(alpha.basis_v(), geometry.basis_v())) {
+      const double want = angle_to(geometry, u, w, dir);
+      if (std::isnan(want)) continue;
+      const double d = std::remainder(alpha.eval(u, w)(0) - want, std::numbers::pi);
+      if (!(std::abs(d) <= worst.radians)) worst = {std::abs(d), u, w};  // NaN: the worst
+    }
+  return worst;
 }
 
 KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,

@@ -369,6 +369,25 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // of another database (session 38's red team).
   src.database_date_utc = data.provenance.date_utc;
   src.input_warning = small_patch;
+  // An align_with field follows its direction only as far as its basis can (session 51's red
+  // team: a constant field on a half-annulus turned the courses up to 90 deg off, exit 0).
+  if (m.contains("knitting_angle") && m.at("knitting_angle").is_object() &&
+      m.at("knitting_angle").contains("align_with")) {
+    const auto& w = m.at("knitting_angle").at("align_with");
+    const AlignDeviation d = align_deviation(
+        *ctx.patch, a, Eigen::Vector3d(w[0].get<double>(), w[1].get<double>(), w[2].get<double>()));
+    if (!(d.radians <= kAlignWarning)) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "warning: " << ctx.file << ": " << p
+         << "/knitting_angle: the fitted angle field turns the courses up to "
+         << d.radians * 180.0 / std::numbers::pi << " deg off align_with (at (theta1, theta2) = ("
+         << d.u << ", " << d.v << "); more than " << kAlignWarning * 180.0 / std::numbers::pi
+         << " deg): it interpolates the direction at its Greville points only; give it more "
+            "knots (knots_u, knots_v) or a higher degree (degrees)";
+      src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
+    }
+  }
   if (data.sweep_failed_cases > 0) {
     // Session 48's walkthrough: a case ran on a failed sweep's database with exit 0 and no
     // word of the cases that failed.

@@ -155,6 +155,38 @@ TEST_CASE("knit material: alpha aligned with a vector at the Greville points", "
                     "align: the vector v is normal to the surface at a Greville point");
 }
 
+// Session 51's red team: a constant align_with field on a half-annulus turned the courses up to
+// 90 deg off the requested direction, exit 0 and no word. align_deviation measures it (the
+// case gets a warning beyond kAlignWarning).
+TEST_CASE("knit material: how far an aligned alpha field follows its direction", "[unit]") {
+  // A parabolic arc in u (its tangent at u = 0 and 1 at +-atan 2 from x, along x at u = 0.5),
+  // straight in v.
+  const Eigen::MatrixXd P{{-40, 0, 0},   {0, 80, 0}, {40, 0, 0},
+                          {-40, -20, 0}, {0, 60, 0}, {40, -20, 0}};
+  const knit::spline::SplineSurface geo(knit::spline::BSplineBasis(2, {0, 0, 0, 1, 1, 1}),
+                                        knit::spline::BSplineBasis(1, {0, 0, 1, 1}), P);
+  const Eigen::Vector3d x(1, 0, 0);
+  // One Greville point (u = 0.5): alpha = 0 everywhere, atan 2 = 63.4 deg off at the ends.
+  const auto coarse = align_alpha_field(geo, 0, {0, 1}, 0, {0, 1}, x);
+  const AlignDeviation d = align_deviation(geo, coarse, x);
+  CHECK(d.radians == Approx(std::atan(2.0)).epsilon(1e-12));
+  CHECK((d.u == 0.0 || d.u == 1.0));
+  CHECK(d.radians > kAlignWarning);
+  // Cubic in u on 4 spans: within 2 deg (1.5), well inside the warning.
+  const auto fine =
+      align_alpha_field(geo, 3, {0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1}, 0, {0, 1}, x);
+  CHECK(align_deviation(geo, fine, x).radians < 2.0 * std::numbers::pi / 180.0);
+  // The reverse direction knits the same fabric: the deviation is modulo pi.
+  CHECK(align_deviation(geo, fine, -x).radians < 2.0 * std::numbers::pi / 180.0);
+  // A flat square follows any direction exactly with a constant field.
+  const Eigen::MatrixXd Q{{0, 0, 0}, {50, 0, 0}, {0, 50, 0}, {50, 50, 0}};
+  const knit::spline::SplineSurface square(knit::spline::BSplineBasis(1, {0, 0, 1, 1}),
+                                           knit::spline::BSplineBasis(1, {0, 0, 1, 1}), Q);
+  const Eigen::Vector3d diagonal(1, 1, 0);
+  CHECK(align_deviation(square, align_alpha_field(square, 0, {0, 1}, 0, {0, 1}, diagonal), diagonal)
+            .radians < 1e-12);
+}
+
 TEST_CASE("knit material: alpha aligned across the branch cut at +-pi is not torn", "[unit]") {
   // A bilinear patch whose a1 = (50, 5 - 10 v) turns through the x axis; aligned with v =
   // (-1, 0, 0) the raw angles are +3.042 at v = 0 and -3.042 at v = 1, either side of +-pi. The

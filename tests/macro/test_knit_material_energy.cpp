@@ -309,6 +309,28 @@ TEST_CASE("knit material: the case key /material/law", "[unit]") {
                         Catch::Contains("has no fitted response surface"));
 }
 
+// Session 51's red team: an align_with field that its basis cannot follow (a constant field on a
+// half-annulus: the courses up to 90 deg off) ran with exit 0 and no word. Here a bilinear patch
+// whose a1 turns by 45 deg across v: a constant field is 26.6 deg off at v = 0 (a warning), a
+// linear one in v at most 4.1 deg (none).
+TEST_CASE("knit material: an align_with field that does not follow its direction is warned about",
+          "[unit]") {
+  const std::string db = db_file("align.h5", true, kDatabaseFormatVersion);
+  const auto with_angle = [&](const std::string& degrees, const std::string& knots_v) {
+    nlohmann::json j = nlohmann::json::parse(square_case(
+        R"({"type": "knit", "database": ")" + db +
+        R"(", "stitch_value": 5, "knitting_angle": {"align_with": [1, 0, 0], "degrees": )" +
+        degrees + R"(, "knots_u": [0, 1], "knots_v": )" + knots_v + "}}"));
+    j["geometry"]["control_points"][3] = {50.0, 100.0, 0.0};
+    return parse_case(j.dump(), "c.json").material->warning();
+  };
+  CHECK_THAT(with_angle("[0, 0]", "[0, 1]"),
+             Catch::Contains("warning: c.json: /material/knitting_angle: the fitted angle field "
+                             "turns the courses up to 26.6 deg off align_with") &&
+                 Catch::Contains("give it more knots"));
+  CHECK(with_angle("[0, 1]", "[0, 0, 1, 1]").empty());
+}
+
 // Session 22: a knit case in other units ran with exit 0 (the database is in mm, N, MPa).
 TEST_CASE("knit material: a case in other units is refused", "[unit]") {
   const std::string db = db_file("units.h5", true, kDatabaseFormatVersion);

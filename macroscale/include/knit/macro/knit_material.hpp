@@ -72,6 +72,21 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
                                         std::vector<double> knots_u, int degree_v,
                                         std::vector<double> knots_v, const Eigen::Vector3d& v);
 
+/// How far an alpha field follows the direction v (session 51's red team: a constant field
+/// fitted at one Greville point of a half-annulus turned the courses up to 90 deg off v with
+/// no word): the largest angle between the course direction of `alpha` and v projected on the
+/// tangent plane, modulo pi (a course direction and its reverse knit the same fabric), on a
+/// grid of 8 samples per element of alpha or of the geometry (the finer) in each direction, at
+/// least 33, and where. Where v is normal to the surface the sample is skipped.
+struct AlignDeviation {
+  double radians = 0.0;
+  double u = 0.0, v = 0.0;
+};
+AlignDeviation align_deviation(const spline::SplineSurface& geometry,
+                               const spline::SplineSurface& alpha, const Eigen::Vector3d& v);
+/// The deviation above which a case's align_with field is warned about (5 deg).
+inline constexpr double kAlignWarning = 5.0 * 3.14159265358979323846 / 180.0;
+
 /// Where the fields came from, for error messages (case file and JSON pointers).
 struct KnitMaterialSource {
   std::string file, stitch_pointer = "/material/stitch_value",
