@@ -56,10 +56,11 @@ double angle_to(const spline::SplineSurface& geometry, double u, double v,
   if (vt.norm() < 1e-12) return std::numeric_limits<double>::quiet_NaN();
   return std::atan2(e1.cross(vt).dot(a3), e1.dot(vt));
 }
-/// Sample parameters over the range of `a`: 8 per element of a or b (the finer), at least 33.
+/// Sample parameters over the range of `a`: 8 per element of a or b (the finer), at least 33
+/// and at most 257 (a field of 1000 knots would otherwise take 64 million samples).
 std::vector<double> samples(const spline::BSplineBasis& a, const spline::BSplineBasis& b) {
   const double lo = a.lo(), hi = a.hi();
-  const int n = std::max(33, 8 * std::max(a.num_elements(), b.num_elements()) + 1);
+  const int n = std::clamp(8 * std::max(a.num_elements(), b.num_elements()) + 1, 33, 257);
   std::vector<double> s(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) s[static_cast<std::size_t>(k)] = lo + (hi - lo) * k / (n - 1);
   return s;

@@ -37,6 +37,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -77,7 +78,7 @@ spline::SplineSurface align_alpha_field(const spline::SplineSurface& geometry, i
 /// no word): the largest angle between the course direction of `alpha` and v projected on the
 /// tangent plane, modulo pi (a course direction and its reverse knit the same fabric), on a
 /// grid of 8 samples per element of alpha or of the geometry (the finer) in each direction, at
-/// least 33, and where. Where v is normal to the surface the sample is skipped.
+/// least 33 and at most 257, and where. Where v is normal to the surface the sample is skipped.
 struct AlignDeviation {
   double radians = 0.0;
   double u = 0.0, v = 0.0;
@@ -85,7 +86,7 @@ struct AlignDeviation {
 AlignDeviation align_deviation(const spline::SplineSurface& geometry,
                                const spline::SplineSurface& alpha, const Eigen::Vector3d& v);
 /// The deviation above which a case's align_with field is warned about (5 deg).
-inline constexpr double kAlignWarning = 5.0 * 3.14159265358979323846 / 180.0;
+inline constexpr double kAlignWarning = 5.0 * std::numbers::pi / 180.0;
 
 /// Where the fields came from, for error messages (case file and JSON pointers).
 struct KnitMaterialSource {
