@@ -8,6 +8,8 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "knit/core/errors.hpp"
 #include "knit/macro/knit_material.hpp"
@@ -152,6 +154,34 @@ std::vector<double> crossings(const std::vector<Eigen::Vector2d>& poly, double t
   return s;
 }
 
+/// The most times the patch covers a stretch of the line t = tc wider than `tiny` (the
+/// boundary's winding number there, summed over its signed crossings), and the middle and width
+/// of the widest such stretch; 1 where the crossings do not close (a boundary vertex on the line).
+int largest_cover(const std::vector<Eigen::Vector2d>& poly, double tc, double tiny, double& at,
+                  double& width) {
+  std::vector<std::pair<double, int>> x;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector2d& a = poly[i];
+    const Eigen::Vector2d& b = poly[(i + 1) % poly.size()];
+    if ((a.y() - tc) * (b.y() - tc) > 0 || a.y() == b.y() || b.y() == tc) continue;
+    x.emplace_back(a.x() + (b.x() - a.x()) * (tc - a.y()) / (b.y() - a.y()),
+                   b.y() > a.y() ? 1 : -1);
+  }
+  std::sort(x.begin(), x.end());
+  int w = 0, most = 1;
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+    w += x[i].second;
+    const double dx = x[i + 1].first - x[i].first;
+    if (dx > tiny && (std::abs(w) > most || (std::abs(w) == most && most > 1 && dx > width))) {
+      most = std::abs(w);
+      at = 0.5 * (x[i].first + x[i + 1].first);
+      width = dx;
+    }
+  }
+  if (!x.empty()) w += x.back().second;
+  return w == 0 ? most : 1;
+}
+
 struct Laid {
   std::vector<double> s, l;
 };
@@ -215,6 +245,38 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     t_max = std::max(t_max, q.y());
   }
   const double s_mid = 0.5 * (s_min + s_max);
+  // A patch that overlaps itself in the plane (an annulus swept past 360 deg; session 51's red
+  // team) covers some points twice, and a map would knit them twice. Its course lines were
+  // refused for crossing the boundary four times, "not convex", which names the wrong fix.
+  // Course lines at every half of the smallest course height, at most boundary_samples of them.
+  {
+    const int lines =
+        static_cast<int>(std::clamp(std::ceil(2.0 * (t_max - t_min) / cells.min_course_height()),
+                                    1.0, static_cast<double>(std::max(4, opt.boundary_samples))));
+    int most = 1;
+    double widest = 0.0;
+    Eigen::Vector2d where(0.0, 0.0);
+    for (int k = 0; k < lines; ++k) {
+      const double tc = t_min + (t_max - t_min) * (k + 0.5) / lines;
+      double at = 0.0, width = 0.0;
+      const int cover = largest_cover(poly, tc, 1e-9 * (s_max - s_min), at, width);
+      if (cover > most || (cover == most && cover > 1 && width > widest)) {
+        most = cover;
+        widest = width;
+        where = R.transpose() * Eigen::Vector2d(at, tc);
+      }
+    }
+    if (most > 1) {
+      std::ostringstream os;
+      os.precision(4);
+      os << "the patch overlaps itself in the plane: it covers the point x = " << where.x()
+         << ", y = " << where.y() << " mm " << most
+         << " times (its boundary winds around it), and a map would knit the stitches there "
+            "more than once; a knitting map needs a patch that covers each point once (split it "
+            "into cases that do not overlap)";
+      throw InputError(c.file, "/geometry", os.str());
+    }
+  }
   {
     const double estimate = std::ceil((s_max - s_min) / cells.min_wale_width()) *
                             std::ceil((t_max - t_min) / cells.min_course_height());

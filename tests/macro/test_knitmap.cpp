@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -533,6 +535,59 @@ TEST_CASE("knitmap: a course line that leaves the patch and comes back is refuse
   fs::remove_all(out);
   CHECK(run_knitmap(arch + " --output " + out.string()) == 2);
   CHECK(!fs::exists(out));
+}
+
+// Session 51's red team: an annulus swept past 360 deg covers a wedge twice; the map refused it
+// for crossing the boundary four times ("not convex along its courses"), a fix that does not
+// apply. A quadratic ring of 21 x 2 control points, radii 20 and 35 mm, swept through 400 deg
+// (the wedge from 0 to 40 deg covered twice), courses along x; swept through 300 deg it does
+// not overlap and keeps the non-convex refusal (the course lines through its hole).
+TEST_CASE("knitmap: a patch that overlaps itself in the plane is refused as such", "[case]") {
+  const std::string db = database();
+  auto ring = [&](const std::string& name, double sweep_deg) {
+    const int n = 21;
+    std::ostringstream os;
+    os.precision(17);
+    os << R"({"geometry": {"degrees": [2, 1], "knots_v": [0, 0, 1, 1], "knots_u": [0, 0, 0)";
+    for (int k = 1; k < n - 2; ++k) os << ", " << k / (n - 2.0);
+    os << R"(, 1, 1, 1], "control_points": [)";
+    for (const double r : {20.0, 35.0})
+      for (int k = 0; k < n; ++k) {
+        const double th = sweep_deg * std::numbers::pi / 180.0 * k / (n - 1.0);
+        os << (r == 20.0 && k == 0 ? "" : ", ") << "[" << r * std::cos(th) << ", "
+           << r * std::sin(th) << ", 0]";
+      }
+    os << R"(], "thickness": 0.76}, "refinement": {"degree": 2, "elements": [1, 1]},
+      "material": {"type": "knit", "database": ")"
+       << db << R"(", "stitch_value": 5.0, "knitting_angle": {"align_with": [1, 0, 0],
+        "degrees": [2, 0], "knots_v": [0, 1], "knots_u": [0, 0, 0)";
+    for (int k = 1; k < 60; ++k) os << ", " << k / 60.0;
+    os << R"(, 1, 1, 1]}},
+      "boundary_conditions": [{"all": true, "fix": ["z"]}, {"edge": "v0", "fix": ["x", "y"]}],
+      "output": {"vtk": false, "hdf5": false}})";
+    return write_case(name, os.str());
+  };
+  const std::string over = ring("ring400.json", 400.0);
+  const knit::InputError e = map_error(over);
+  CHECK(e.file() == over);
+  CHECK(e.pointer() == "/geometry");
+  CHECK_THAT(e.message(), Catch::Contains("overlaps itself in the plane") &&
+                              Catch::Contains(" 2 times") && !Catch::Contains("not convex"));
+  // The point named lies in the doubly covered wedge: between the radii, at 0 ... 40 deg.
+  double x = 0, y = 0;
+  const std::string m = e.message();
+  REQUIRE(std::sscanf(m.c_str() + m.find("the point x = "), "the point x = %lf, y = %lf", &x, &y) ==
+          2);
+  const double r = std::hypot(x, y), phi = std::atan2(y, x) * 180.0 / std::numbers::pi;
+  CHECK((r > 20.0 && r < 35.0));
+  CHECK((phi > 0.0 && phi < 40.0));
+  const fs::path out = kDir / "ring400_out";
+  fs::remove_all(out);
+  CHECK(run_knitmap(over + " --output " + out.string()) == 2);
+  CHECK(!fs::exists(out));
+  CHECK_THAT(
+      map_error(ring("ring300.json", 300.0)).message(),
+      Catch::Contains("not convex along its courses") && !Catch::Contains("overlaps itself"));
 }
 
 TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothing", "[case]") {
