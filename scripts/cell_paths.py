@@ -67,6 +67,40 @@ def load_paths(f, loop):
     return out
 
 
+def fit_min_cos(f):
+    """The energy fit's stable_min_cos, from /energy_law/diagnostics@options_json of the open
+    database `f` (0, the fit's default, when the record is absent)."""
+    import json
+    d = f.get("energy_law/diagnostics")
+    if d is None or "options_json" not in d.attrs:
+        return 0.0
+    return float(json.loads(attr_text(d.attrs["options_json"])).get("stable_min_cos", 0.0))
+
+
+def fit_states(paths, min_cos=0.0):
+    """`paths` (load_paths) with each fitted path cut where knit-meso fit leaves it out: from
+    the first converged state where the cell gives way, cos(dS, de) < min_cos (de and dS from
+    the previous converged state, the first from the stress-free reference; the rule of
+    fit_energy.cpp's collect, off for min_cos < -1). Held-out paths are kept whole. The report
+    re-evaluates the law at exactly the fit's states (session 52's red team: a loop length
+    whose stored count differed was not compared, and a capped largest error passed)."""
+    out = []
+    for p in paths:
+        s, e, S = p[0], p[1], p[2]
+        n = len(e)
+        if s != "holdout" and min_cos >= -1.0:
+            prev_e, prev_S = np.zeros(3), np.zeros(3)
+            for i in range(len(e)):
+                de, dS = e[i] - prev_e, S[i] - prev_S
+                norm = np.linalg.norm(de) * np.linalg.norm(dS)
+                if norm > 0 and de @ dS < min_cos * norm:
+                    n = i
+                    break
+                prev_e, prev_S = e[i], S[i]
+        out.append((s, e[:n], S[:n]) + tuple(p[3:]))
+    return out
+
+
 def stress_range(paths):
     """The loop length's stress range of docs/database.md: the largest max - min of a stress
     component over its fit data (every path but the held-out ones)."""

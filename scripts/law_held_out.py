@@ -23,7 +23,8 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, open_database, positive_number, stress_range  # noqa: E402
+from cell_paths import (fit_min_cos, fit_states, load_paths, open_database,  # noqa: E402
+                        positive_number, stress_range)
 from energy_law import load_law  # noqa: E402
 
 BOUND = 0.05  # issue 11: within 5 % of the stress range
@@ -43,13 +44,14 @@ def held_out_misses(db_path, bound=BOUND):
         a = f["energy_law/diagnostics"].attrs if "energy_law/diagnostics" in f else {}
         stored = ((int(a["holdout_points"]), int(a["holdout_within_5_percent"]))
                   if "holdout_points" in a and "holdout_within_5_percent" in a else None)
+        min_cos = fit_min_cos(f)
         for k, l in enumerate(np.asarray(f["loop_lengths"], dtype=float)):
             names = sorted(f[f"loop_{k}/raw"])
             paths = load_paths(f, k)  # in the order of the sorted path names
             held = [(n, p) for n, p in zip(names, paths) if p[0] == "holdout" and len(p[1])]
             if not held:
                 continue
-            law, R = load_law(f["energy_law"], l), stress_range(paths)
+            law, R = load_law(f["energy_law"], l), stress_range(fit_states(paths, min_cos))
             for name, (_, e, S, _, _) in held:
                 err = np.abs(law.eval(e)[1] - S).max(axis=1) / R
                 if not np.all(np.isfinite(err)):
@@ -66,7 +68,8 @@ def held_out_misses(db_path, bound=BOUND):
 
 def fit_errors(db_path):
     """[(l, states, rms, largest)] per loop length: the stored energy law re-evaluated at its fit
-    states (the converged steps of every path that is not held out), as fractions of the loop
+    states (the converged steps of every path that is not held out, up to where the cell gives
+    way: cell_paths.fit_states), as fractions of the loop
     length's stress range: rms is the largest of the three components' RMS errors, largest the
     largest error of a component at a state (the definitions of /energy_law/diagnostics'
     rms_relative and max_relative). Empty when the database has no energy law. Raises
@@ -77,8 +80,9 @@ def fit_errors(db_path):
     with h5py.File(db_path, "r") as f:
         if "energy_law" not in f:
             return out
+        min_cos = fit_min_cos(f)
         for k, l in enumerate(np.asarray(f["loop_lengths"], dtype=float)):
-            paths = load_paths(f, k)
+            paths = fit_states(load_paths(f, k), min_cos)  # the fit's own states
             law, R = load_law(f["energy_law"], l), stress_range(paths)
             err = [np.abs(law.eval(e)[1] - S) / R for s, e, S, _, _ in paths
                    if s != "holdout" and len(e)]

@@ -16,6 +16,7 @@ import sys
 import tempfile
 
 import h5py
+import numpy as np
 
 from checklist import Checklist  # tests/report/checklist.py, beside this file
 from fixtures import (call_refuses, linear_network_law, raw_path,  # tests/report/fixtures.py
@@ -86,6 +87,20 @@ def main():
         c(out.returncode != 0 and out.stderr.count("db.h5") == 1 and "path_02" in out.stderr
           and "Traceback" not in out.stderr,
           "... and by the script: %s" % out.stderr.strip()[-200:])
+        # The fit's own states (session 52): a fitted path is cut where the cell gives way,
+        # cos(dS, de) < stable_min_cos from the previous converged state, as knit-meso fit
+        # cuts it; held-out paths stay whole; min_cos < -1 turns the rule off.
+        from cell_paths import fit_states
+        e = np.array([[0.1, 0, 0], [0.2, 0, 0], [0.3, 0, 0], [0.4, 0, 0]])
+        S = np.array([[1.0, 0, 0], [2.0, 0, 0], [1.5, 0.5, 0], [3.0, 0, 0]])  # turns at step 3
+        paths = [("coverage", e, S, "biaxial", 0), ("holdout", e, S, "biaxial", 0)]
+        c([len(p[1]) for p in fit_states(paths, 0.0)] == [2, 4],
+          "fit_states: the fitted path cut at its third state (dS . de < 0), held out whole")
+        c([len(p[1]) for p in fit_states(paths, -2.0)] == [4, 4], "fit_states: min_cos -2 is off")
+        # cos(dS, de) at step 3 is -0.5 / sqrt(0.5) = -0.707: kept with -0.8, cut with -0.7.
+        c([len(p[1]) for p in fit_states(paths, -0.8)] == [4, 4]
+          and [len(p[1]) for p in fit_states(paths, -0.7)] == [2, 4],
+          "fit_states: the threshold is cos(dS, de) (cut at -0.7, kept at -0.8)")
         write_db(db, law=False)
         c(lho.held_out_misses(db) == (0, 0, [], None), "no energy law: nothing")
         c(lho.summary(lho.held_out_misses(db)) == "", "no energy law: no sentence")
