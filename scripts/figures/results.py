@@ -289,10 +289,20 @@ class Result:
         h5 = os.path.join(self.dir, "results.h5")
         if lf is not None and os.path.exists(h5):
             import h5py
+            # The CSV's other columns that /steps holds too, the loads above all (session 52's
+            # red team: a load column halved turned "4.5 mm much stiffer" to PASS, and both
+            # reactions of the finest diagonal mesh scaled by 0.93 its convergence check).
+            same = {"strain": "steps/strain",
+                    "applied_displacement_mm": "steps/applied_displacement"}
+            same.update({k: "steps/reactions/" + k[:-2] for k in c if k.endswith("_N")})
+            cols = {}
             try:
                 with h5py.File(h5, "r") as f:
                     steps = np.asarray(f["steps/load_factor"][()], dtype=float) \
                         if "steps/load_factor" in f else None
+                    for k, where in same.items():
+                        if k in c and where in f:
+                            cols[k] = (where, np.asarray(f[where][()], dtype=float))
             except OSError as err:
                 return f"{h5} cannot be read ({err})"
             if steps is not None and (len(steps) != len(lf) or not np.array_equal(steps, lf)
@@ -300,6 +310,16 @@ class Result:
                 return (f"results.h5 /steps holds {len(steps)} converged steps up to load factor "
                         f"{steps[-1] if len(steps) else float('nan'):g}, load_strain.csv "
                         f"{len(lf)} up to {lf[-1] if len(lf) else float('nan'):g}")
+            for k, (where, v) in cols.items():
+                # The CSV prints 10 significant digits: equal to 1e-8 of the column's largest.
+                w = c[k]
+                tol = 1e-8 * max(float(np.max(np.abs(v))) if len(v) else 0.0, 1e-12)
+                if len(v) != len(w) or not np.all(np.abs(v - w) <= tol):
+                    i = (int(np.argmax(~(np.abs(v - w) <= tol))) if len(v) == len(w)
+                         else min(len(v), len(w)))
+                    return (f"load_strain.csv column {k} row {i + 1} is not results.h5 /{where}"
+                            + (f" ({w[i]:.9g} against {v[i]:.9g})" if i < min(len(v), len(w))
+                               else f" ({len(w)} rows against {len(v)})"))
         if d is not None and e is not None and len(d):
             if not all(np.all(np.isfinite(v)) for v in (d, e) + ((lf,) if lf is not None else ())):
                 return "load_strain.csv holds a non-finite load factor, displacement or strain"

@@ -1113,6 +1113,28 @@ def consistency_failures(tmp):
         why = r.consistency_defect()
         if (why is not None) != defect or (defect and "results.h5 /steps holds" not in why):
             out.append(f"consistency, results.h5 /steps {steps} beside the CSV's [0.5, 1]: {why!r}")
+    # Session 52's red team: the CSV's load column halved passed "much stiffer"; results.h5's
+    # /steps holds the loads, strains and displacements too. The CSV's (2, 5 N; 0.05, 0.1; 1,
+    # 2 mm) pass, and each of them changed in one row is named.
+    for what, loads, strain, disp, needle in [
+            ("the CSV's own figures", [2.0, 5.0], [0.05, 0.1], [1.0, 2.0], None),
+            ("a load halved", [2.0, 10.0], [0.05, 0.1], [1.0, 2.0],
+             "column load_N row 2 is not results.h5 /steps/reactions/load (5 against 10)"),
+            ("another strain", [2.0, 5.0], [0.05, 0.12], [1.0, 2.0],
+             "column strain row 2 is not results.h5 /steps/strain"),
+            ("another displacement", [2.0, 5.0], [0.05, 0.1], [1.2, 2.0],
+             "column applied_displacement_mm row 1 is not results.h5 /steps/applied_displacement"),
+            ("one load more", [2.0, 5.0, 6.0], [0.05, 0.1], [1.0, 2.0],
+             "column load_N row 3 is not results.h5 /steps/reactions/load (2 rows against 3)")]:
+        r = fresh()
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            h["steps/load_factor"] = np.asarray([0.5, 1.0])
+            h["steps/reactions/load"] = np.asarray(loads)
+            h["steps/strain"] = np.asarray(strain)
+            h["steps/applied_displacement"] = np.asarray(disp)
+        why = r.consistency_defect()
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, results.h5 /steps with {what}: {why!r}")
     return out
 
 
