@@ -33,7 +33,8 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from results import Result, first_error_line, last_run_wrote, root_text_attribute  # noqa: E402
+from results import (Result, first_error_line, json_difference, last_run_wrote,  # noqa: E402
+                     root_text_attribute)
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
 from design import read_summary as read_design_summary  # noqa: E402
 
@@ -410,9 +411,10 @@ def small_strain_text(db_path):
 class Data:
     """The pipeline's results, loaded on demand: curves and fields by case name."""
 
-    def __init__(self, res_dir, db_date=None):
+    def __init__(self, res_dir, db_date=None, cases_src=None):
         self.res_dir = res_dir
         self.db_date = db_date  # the database's date_utc: results of another one are stale
+        self.cases_src = cases_src  # the checkout's cases (--cases-dir): the pipeline copies them
         self.cache = {}
         self.read = set()      # names read since the last take_read() (checks() attributes them)
         self.read_fields = set()  # ... of those, the names whose fields were read
@@ -490,6 +492,11 @@ class Data:
             why = r.case_defect(os.path.join(cases, name + ".json"))
             if why:
                 return why
+            if base == "results" and self.cases_src:
+                why = copy_defect(os.path.join(cases, name + ".json"),
+                                  os.path.join(self.cases_src, name + ".json"))
+                if why:
+                    return why
         # The run's own outputs against each other (session 42's red team: a doubled strain
         # column, another step's fields, a summary of fewer steps than the CSV).
         why = r.consistency_defect()
@@ -545,6 +552,31 @@ class Data:
 
     def case(self, name):
         return self.r(name).case
+
+
+def copy_defect(copy_file, src_file):
+    """Why the pipeline's copy of a case (OUT/cases/NAME.json) is not the checkout's case file
+    with the database the pipeline set (resolve_case.py: /material/database), or None; None
+    when either file is absent (the case's run says so elsewhere). Session 52's red team: a
+    paper-law run and its case, copied into OUT/results and OUT/cases, agreed with each other
+    and were judged as the default law's run."""
+    if not (os.path.exists(copy_file) and os.path.exists(src_file)):
+        return None
+    try:
+        with open(copy_file) as f:
+            copy = json.load(f)
+        with open(src_file) as f:
+            want = json.load(f)
+    except (OSError, ValueError) as e:
+        return f"its case cannot be compared with the checkout's ({e})"
+    mc, mw = copy.get("material"), want.get("material")
+    if isinstance(mc, dict) and isinstance(mw, dict) and "database" in mc:
+        mw["database"] = mc["database"]
+    ptr = json_difference(want, copy)
+    if ptr is None:
+        return None
+    return (f"its case {copy_file} is not the checkout's {src_file}: they differ at {ptr or '/'} "
+            "(only /material/database is the pipeline's to set; rerun the pipeline)")
 
 
 def _field(f, key):
@@ -801,7 +833,7 @@ class Report:
     def __init__(self, out_dir, sensitivity=None, cases_dir=CASES_DIR, database=None):
         self.out = out_dir
         self.res_dir = os.path.join(out_dir, "results")
-        self.data = Data(self.res_dir, database_date(database))
+        self.data = Data(self.res_dir, database_date(database), cases_dir)
         self.sensitivity = sensitivity
         self.names = case_names(cases_dir, self.res_dir)
         self.rows = []

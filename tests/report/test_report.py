@@ -1135,6 +1135,45 @@ def consistency_failures(tmp):
         why = r.consistency_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, results.h5 /steps with {what}: {why!r}")
+    # Session 52's red team: a paper-law run and its case copied into OUT/results and OUT/cases
+    # were judged as the default law's. The pipeline's copy must be the checkout's case with
+    # only /material/database set.
+    src = os.path.join(tmp, "consistency_src")
+    os.makedirs(src, exist_ok=True)
+    copy = os.path.join(tmp, "consistency_copy.json")
+    case = {"material": {"type": "knit", "database": "../database.h5", "stitch_value": 5.0}}
+    with open(os.path.join(src, "a.json"), "w") as f:
+        json.dump(case, f)
+    for what, change, needle in [
+            ("another database path", {"database": "elsewhere.h5"}, None),
+            ("the paper's law", {"law": "paper"}, "they differ at /material/law"),
+            ("another stitch value", {"stitch_value": 5.5}, "they differ at /material/stitch_value")]:
+        with open(copy, "w") as f:
+            json.dump({"material": dict(case["material"], **change)}, f)
+        why = report.copy_defect(copy, os.path.join(src, "a.json"))
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, the pipeline's copy with {what}: {why!r}")
+    # ... through Data.run_defect: OUT/cases/a.json beside OUT/results, cases_src the checkout.
+    out_dir = os.path.join(tmp, "consistency_out")
+    shutil.rmtree(out_dir, ignore_errors=True)
+    r = fresh()
+    with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+        h["case_json"] = json.dumps(r.case)
+    shutil.copytree(res, os.path.join(out_dir, "results"))
+    os.makedirs(os.path.join(out_dir, "cases"))
+    with open(os.path.join(out_dir, "cases", "a.json"), "w") as f:
+        json.dump(r.case, f)  # the run's own case: case_defect agrees
+    with open(os.path.join(src, "a.json"), "w") as f:
+        json.dump(r.case, f)
+    date = "2026-12-01T10:00:00Z"
+    why = report.Data(os.path.join(out_dir, "results"), date, src).run_defect("a")
+    if why is not None:
+        out.append(f"consistency: a run whose case is the checkout's has a defect: {why!r}")
+    with open(os.path.join(src, "a.json"), "w") as f:
+        json.dump(dict(r.case, material={"type": "knit", "law": "energy"}), f)
+    why = report.Data(os.path.join(out_dir, "results"), date, src).run_defect("a")
+    if why is None or "is not the checkout's" not in why:
+        out.append(f"consistency: a run whose case is not the checkout's: {why!r}")
     return out
 
 
