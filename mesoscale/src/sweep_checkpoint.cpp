@@ -166,9 +166,16 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     // manifest's temporary; session 36's red team): nothing to continue or to lose, so it is
     // discarded and the sweep starts afresh, with or without --resume.
     if (!holds_job_records(dir_)) {
-      remove();
-      if (fs::exists(fs::symlink_status(dir_, ec)))
-        throw InputError(dir_.string(), "", "cannot discard the empty checkpoint directory");
+      if (fs::is_empty(dir_, ec) && !ec) {
+        // An empty directory records nothing of a sweep, so nothing says it is ours (session
+        // 52's red team: a user's empty DB.h5.parts was deleted by a successful sweep). The
+        // sweep keeps its checkpoints in it and leaves it, emptied again, in place.
+        keep_dir_ = true;
+      } else {
+        remove();
+        if (fs::exists(fs::symlink_status(dir_, ec)))
+          throw InputError(dir_.string(), "", "cannot discard the empty checkpoint directory");
+      }
       resume = false;
     }
   }
@@ -179,11 +186,11 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     if (fs::exists(fs::symlink_status(dir_, ec)))
       throw InputError(dir_.string(), "", "cannot discard the finished sweep's checkpoints");
   }
-  if (fs::exists(fs::symlink_status(dir_, ec))) {
+  if (!keep_dir_ && fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
       throw InputError(dir_.string(), "",
-                       "checkpoints of an unfinished sweep exist: continue it with --resume, or "
-                       "discard them with --force");
+                       "checkpoints of an unfinished sweep (or kept by --keep-parts) exist: "
+                       "continue it with --resume, or discard them with --force");
     if (resume) {
       std::string have;
       nlohmann::json manifest;
@@ -370,7 +377,7 @@ void CheckpointStore::remove() const {
   std::stable_sort(ours.begin(), ours.end(),
                    [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });
   for (const auto& p : ours) fs::remove(p, ec);
-  fs::remove(dir_, ec);  // fails (and keeps it) unless empty
+  if (!keep_dir_) fs::remove(dir_, ec);  // fails (and keeps it) unless empty
 }
 
 }  // namespace knit::meso::sweep

@@ -866,6 +866,24 @@ TEST_CASE("sweep: --force discards only checkpoints the sweep wrote", "[unit]") 
     CHECK(fs::exists(parts / "job_00000.txt"));
   }
   fs::remove_all(parts);
+  // An empty directory of that name records nothing, so nothing says it is ours (session 52's
+  // red team: a successful sweep deleted the user's empty DB.h5.parts): the store uses it and
+  // leaves it in place, emptied of its own files, with or without --resume or --force.
+  for (const bool resume : {false, true})
+    for (const bool force : {false, true}) {
+      if (resume && force) continue;
+      INFO("resume " << resume << ", force " << force);
+      fs::create_directories(parts);
+      {
+        CheckpointStore store(out, in.job_definition(), n, resume, force);
+        store.store(run_job(jobs[0], in.retry, synthetic_runner()));
+        CHECK(fs::exists(parts / "job_00000.txt"));
+        store.remove();
+      }
+      CHECK(fs::is_directory(parts));
+      CHECK(fs::is_empty(parts));
+    }
+  fs::remove_all(parts);
 }
 
 TEST_CASE("sweep: a job file copied from another sweep's checkpoints is recomputed on --resume",
@@ -934,8 +952,9 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
   // With a record, the refusals stand.
   CheckpointStore(out, in.job_definition(), n, true, false)
       .store(run_job(make_jobs(in)[0], in.retry, synthetic_runner()));
-  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, false),
-                    Catch::Contains("checkpoints of an unfinished sweep exist"));
+  CHECK_THROWS_WITH(
+      CheckpointStore(out, in.job_definition(), n, false, false),
+      Catch::Contains("checkpoints of an unfinished sweep (or kept by --keep-parts) exist"));
   CHECK_THROWS_WITH(CheckpointStore(out, R"({"other": 1})", n, true, false),
                     Catch::Contains("different sweep input"));
   // The refusal says what differs, as pointers into the job definition with both values.
@@ -1019,8 +1038,9 @@ TEST_CASE("sweep: checkpoints without a finished case are discarded, with or wit
             .load_finished(make_jobs(in))
             .size() == 1);
   CHECK_FALSE(fs::exists(parts / "database_written"));
-  CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, false),
-                    Catch::Contains("checkpoints of an unfinished sweep exist"));
+  CHECK_THROWS_WITH(
+      CheckpointStore(out, in.job_definition(), n, false, false),
+      Catch::Contains("checkpoints of an unfinished sweep (or kept by --keep-parts) exist"));
   CheckpointStore(out, in.job_definition(), n, true, false).mark_written();
   CHECK_NOTHROW(CheckpointStore(out, in.job_definition(), n, false, false));
   CHECK(fs::exists(parts / "manifest.json"));  // the new sweep's

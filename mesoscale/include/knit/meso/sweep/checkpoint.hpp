@@ -63,7 +63,8 @@ class CheckpointStore {
   std::filesystem::path dir_;
   std::string fingerprint_;  ///< of the job definition; every record carries it
   std::vector<std::string> builds_;
-  bool resumed_ = false;  ///< opened with --resume on existing checkpoints
+  bool resumed_ = false;   ///< opened with --resume on existing checkpoints
+  bool keep_dir_ = false;  ///< the directory existed empty: not ours to remove (remove())
 };
 
 /// `text` cut to at most `max_bytes` bytes with "..." at the end, never inside a UTF-8
