@@ -425,6 +425,16 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
     }
     require_dataset("/loop_lengths");
     const auto ls = f.read_doubles("/loop_lengths");
+    // Session 52's red team: an old (unchecksummed) file with /loop_lengths = [] was refitted
+    // with exit 0 into a database that every reader refused; and /loop_1 beside a
+    // /loop_lengths of one entry was carried over as a user's group.
+    if (ls.empty())
+      throw InputError(fname, "/loop_lengths",
+                       "no loop length: a material database holds at least one");
+    if (f.exists(loop_group(ls.size())))
+      throw InputError(fname, loop_group(ls.size()),
+                       "a loop-length group beyond the " + std::to_string(ls.size()) +
+                           " entries of /loop_lengths");
     // Session 29 (a helper's fuzzing audit): [5, 4] was read, refitted and written back with
     // exit 0 (the family of eq. 25 throws on it later, naming no file).
     for (std::size_t k = 0; k < ls.size(); ++k)

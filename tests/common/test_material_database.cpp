@@ -468,6 +468,17 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
                         f.set_attribute("/loop_1", "loop_length", 5.25);
                       })),
                       Catch::Contains("/loop_1: loop_length 5.25"));
+    // Session 52's red team: /loop_lengths = [] was refitted with exit 0 into a file that
+    // every reader refused, and a /loop_1 beyond a shortened /loop_lengths was kept as a
+    // user's group.
+    CHECK_THROWS_WITH(read_database(mutate([](knit::io::H5File& f) {
+                        f.write("/loop_lengths", std::vector<double>{});
+                      })),
+                      Catch::Contains("/loop_lengths: no loop length"));
+    CHECK_THROWS_WITH(read_database(mutate([&](knit::io::H5File& f) {
+                        f.write("/loop_lengths", std::vector<double>{ls[0]});
+                      })),
+                      Catch::Contains("/loop_1: a loop-length group beyond the 1 entries"));
     CHECK_NOTHROW(read_database(mutate([](knit::io::H5File& f) {
       f.set_attribute("/loop_1", "wale_width", 0.0);  // 0: not known
     })));
