@@ -530,6 +530,21 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);
   const int P = design.P, ns = design.ns;
+  // The dense active-set solve grows with about the fourth power of the coefficients (session
+  // 52's red team, 15 functions x 2 loop lengths x (s_spans + 5), one core: 510 took 0.5 s, 900
+  // 5.1 s, 1650 63 s, 1950 121 s, and s_spans 200 would have run for hours without a word):
+  // refused beyond kMaxRidgeCoefficients (about two minutes), with what to lower.
+  constexpr int kMaxRidgeCoefficients = 2000;
+  if (P > kMaxRidgeCoefficients)
+    return refuse("invalid options: the ridge law would have " + std::to_string(P) +
+                  " coefficients (" + std::to_string(G) + " functions x " + std::to_string(nl) +
+                  " l control points x (s_spans + s_degree) = " + std::to_string(ns) +
+                  "), more than the " + std::to_string(kMaxRidgeCoefficients) +
+                  " its dense active-set solve takes in about two minutes (1650 took 63 s, 1950 "
+                  "121 s); lower "
+                  "s_spans, s_degree or l_control_points, or give fewer directions");
+  if (o.progress && P > 500)
+    std::fprintf(o.progress, "  ridge law: solving for %d coefficients (active set) ...\n", P);
   // Data weights (squared-residual weights): the set weight, and with weight_relative > 0 a
   // relative error measure, (1 + c) / (|S_p| / sS + c), so that the slack states (|S| of a few
   // 0.01 MPa, where the macroscale patches spend their first strains) are not drowned by the

@@ -629,6 +629,22 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     CHECK(s.status == FitStatus::kRefused);
     CHECK_THAT(s.reason, Catch::Contains("/loop_0/raw: only 0 converged steps"));
   }
+  SECTION("a ridge law too large to solve in minutes") {
+    // Session 52's red team: s_spans 200 (inside the schema's bound) would have run for hours
+    // without a word. 24 default directions make 15 functions; 2 loop lengths; s_spans 60 +
+    // s_degree 5: 15 x 2 x 65 = 1950 coefficients (about two minutes) pass the check, 61 + 5
+    // (1980) too, 62 + 5 (2010) does not.
+    Database db = synthetic_coverage_db({4.5, 6.5}, 4);
+    EnergyFitOptions ridge;
+    ridge.family = "ridge";
+    ridge.s_degree = 5;
+    ridge.s_spans = 62;
+    const auto s = fit_energy_law(db, ridge);
+    CHECK(s.status == FitStatus::kRefused);
+    CHECK_THAT(s.reason, Catch::Contains("the ridge law would have 2010 coefficients (15 "
+                                         "functions x 2 l control points") &&
+                             Catch::Contains("lower s_spans"));
+  }
   SECTION("no loop length") {
     const auto s = fit_energy_law(Database{}, {});
     CHECK(s.status == FitStatus::kRefused);
