@@ -257,6 +257,11 @@ RodCase load_rod_case(const std::filesystem::path& path) {
   const json& jr = j["rods"];
   if (!jr.is_array() || jr.empty()) R.fail("/rods", "must be a non-empty array");
   std::map<std::string, int> names;
+  // Memory and time grow with the elements of all rods (session 52's red team, one elastica:
+  // 2,000 took 6 s and 188 MB, 8,000 25 s and 610 MB, 100,000 more than 2 minutes; the
+  // schema's 1e6 would need about 70 GB and end by the OOM killer without a word).
+  constexpr long long kMaxRodElements = 20000;
+  long long elements = 0;
   for (size_t k = 0; k < jr.size(); ++k) {
     const std::string ptr = "/rods/" + std::to_string(k);
     R.object(jr[k], ptr,
@@ -268,6 +273,13 @@ RodCase load_rod_case(const std::filesystem::path& path) {
     Section s = sec;
     if (r.contains("section")) s = read_section(R, r["section"], ptr + "/section", sec);
     RodSpec spec = read_curve(R, r["curve"], ptr + "/curve", s);
+    elements += spec.basis.num_elements();
+    if (elements > kMaxRodElements)
+      R.fail(ptr + "/curve",
+             "the rods up to this one have " + std::to_string(elements) +
+                 " elements, more than the " + std::to_string(kMaxRodElements) +
+                 " a case may have (about 1.5 GB and a minute of solving; 8,000 took 610 MB and "
+                 "25 s): use fewer elements");
     spec.name = name;
     if (r.contains("d1")) spec.d1_hint = R.vec3(r["d1"], ptr + "/d1");
     spec.start = read_end(R, r["start"], ptr + "/start");

@@ -326,6 +326,14 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
           "start": {"position": "fixed", "rotation": "fixed"}, "end": {"position": "free",
           "rotation": "free"}}]})",
        "/rods/0/curve/refine/degree"},
+      // 20,000 elements in all at most (session 52's red team: the schema's 1e6 ended by the
+      // OOM killer): 20,000 + 1 over two rods is refused at the second rod's curve.
+      {R"({"rods": [{"name": "a", "curve": {"type": "line", "from": [0,0,0], "to": [1,0,0],
+          "degree": 2, "elements": 20000}, "start": {"position": "fixed", "rotation": "fixed"},
+          "end": {"position": "free", "rotation": "free"}}, )" +
+           good_rod.substr(0, good_rod.find("\"elements\": 2")) + R"("elements": 1}, )" +
+           good_rod.substr(good_rod.find("\"start\"")) + "]}",
+       "/rods/1/curve"},
       {R"({"rods": [)" + good_rod + R"(], "typo": 1})", ""},
       {R"({"rods": [ )", ""},
   };
