@@ -529,6 +529,10 @@ def law_check_failures(tmp):
 def law_check_variants(out, write, db, extrapolations, verdicts, law_held_out, agreeing_fit):
     """law_check_failures' variants, with the re-evaluations standing in."""
     write()
+    # Reports of a run that disagree (report.run_extrapolation, session 52) fail the row.
+    rows = report.law_checks(db, extrapolations(), ["b: its log reports 20 of 1000 ..."])
+    if rows[3][3] is not False or "reports that disagree: b: its log" not in rows[3][2]:
+        out.append(f"law checks: a conflict of reports does not fail the row: {rows[3]}")
     if verdicts() != [True, True, True, True]:
         out.append(f"law checks: the baseline gives {verdicts()}")
     variants = [("rms 6 %", dict(rms=(0.02, 0.06)), 0),
@@ -1016,6 +1020,48 @@ def held_out_agreement_failures(tmp):
     return out
 
 
+def run_extrapolation_failures(tmp):
+    """report.run_extrapolation: the log's report, checked against the run's summary.txt and
+    results.h5 @material_report (session 52's red team: summary.txt edited to 27 % extrapolated
+    beside a log of 0 % passed). Agreeing reports give the log's; one that counts otherwise is a
+    conflict, no report to judge by, and the law's extrapolation row FAILs naming it."""
+    import h5py
+    out = []
+    o = os.path.join(tmp, "extra_out")
+    shutil.rmtree(o, ignore_errors=True)
+    os.makedirs(os.path.join(o, "logs"))
+    os.makedirs(os.path.join(o, "results", "a"))
+    report_text = ("knit material (energy law): 1000 evaluations; 10 extrapolated (1 %, outside "
+                   "the data strain box ...)\n  at converged states: 0 of 100 evaluations "
+                   "extrapolated (0 %)\n")
+    with open(os.path.join(o, "logs", "a.log"), "w") as f:
+        f.write("step    1  load factor 1\n" + report_text)
+
+    def summary(text):
+        with open(os.path.join(o, "results", "a", "summary.txt"), "w") as f:
+            f.write("status: completed\nmaterial report: " + text + "converged steps: 1\n")
+
+    def h5(text):
+        with h5py.File(os.path.join(o, "results", "a", "results.h5"), "w") as f:
+            f.attrs["material_report"] = text
+
+    ex, why = report.run_extrapolation(o, "a")
+    if ex is None or ex[:2] != (1000, 10) or why is not None:
+        out.append(f"run_extrapolation: the log alone: {ex}, {why}")
+    summary(report_text)
+    h5(report_text)
+    ex, why = report.run_extrapolation(o, "a")
+    if ex is None or ex[:2] != (1000, 10) or why is not None:
+        out.append(f"run_extrapolation: three agreeing reports: {ex}, {why}")
+    for what, edit in (("summary.txt", summary), ("results.h5 @material_report", h5)):
+        edit(report_text.replace("10 extrapolated (1 %", "300 extrapolated (30 %"))
+        ex, why = report.run_extrapolation(o, "a")
+        if ex is not None or why is None or f"its {what} 300 of 1000" not in why:
+            out.append(f"run_extrapolation: {what} of 30 %: {ex}, {why}")
+        edit(report_text)
+    return out
+
+
 def consistency_failures(tmp):
     """A run's outputs that disagree with each other are a defect of the run (session 42's red
     team: a doubled strain column was judged at 60 %, step 10's fields copied into step 20 with
@@ -1315,6 +1361,7 @@ def main():
         failures.extend(held_out_agreement_failures(tmp))
         failures.extend(unusable_result_failures(tmp))
         failures.extend(consistency_failures(tmp))
+        failures.extend(run_extrapolation_failures(tmp))
         # -- the pure functions on arrays ---------------------------------------------------------
         e = np.array([0.0, 0.1, 0.15, 0.2, 0.3])
         if rc.largest_drop((e, np.array([0, 1, 2, 1.5, 3.0])))[0] != 0.5:
