@@ -217,6 +217,11 @@ def law_checks(db_path, extrapolations, conflicts=()):
     try:
         import h5py
         with h5py.File(db_path, "r") as f:
+            why = database_identity_defect(db_path)
+            if why:
+                return [("the material database", f"format {DATABASE_FORMAT!r} "
+                         f"{'/'.join(map(str, DATABASE_VERSIONS))}, units {DATABASE_UNITS!r}",
+                         why, False)]
             if "energy_law" not in f:
                 # Issue 11's law is the default: its absence is not a pass by silence (session
                 # 38's red team: /energy_law deleted, the whole table and its FAIL row went).
@@ -463,9 +468,10 @@ def small_strain_text(db_path):
 class Data:
     """The pipeline's results, loaded on demand: curves and fields by case name."""
 
-    def __init__(self, res_dir, db_date=None, cases_src=None):
+    def __init__(self, res_dir, db_date=None, cases_src=None, db_defect=None):
         self.res_dir = res_dir
         self.db_date = db_date  # the database's date_utc: results of another one are stale
+        self.db_defect = db_defect  # database_identity_defect(): knit runs are no data then
         self.cases_src = cases_src  # the checkout's cases (--cases-dir): the pipeline copies them
         self.cache = {}
         self.read = set()      # names read since the last take_read() (checks() attributes them)
@@ -522,6 +528,14 @@ class Data:
         # Results of another database (session 38's red team: results older than the database
         # were judged as its own): knit-macro run records the date_utc of the database it read.
         knit = r.case.get("material", {}).get("type") == "knit"
+        if knit and self.db_defect:
+            return f"the material database is not one this report can judge: {self.db_defect}"
+        # The run's own units where results.h5 states them (knit-macro run always does; session
+        # 52's red team: results.h5 @units "m, kN, GPa" passed).
+        units = root_text_attribute(os.path.join(r.dir, "results.h5"), "units")
+        if units is not None and units != RESULT_UNITS:
+            return (f"its results.h5 states units {units!r}, not {RESULT_UNITS!r} (the report "
+                    "reads mm, N and MPa)")
         if r.database_date() is not None or (self.db_date == UNDATED and knit):
             why = stale_against(r.database_date(), self.db_date, "the run", "rerun the case")
             if why:
@@ -868,6 +882,31 @@ def database_date(db_path):
         return None
 
 
+DATABASE_FORMAT = "knitscale-material-database"  # common/src/material_database_io.cpp
+DATABASE_VERSIONS = (1, 2, 3)                    # the formats knit-macro reads
+DATABASE_UNITS = "length mm, force N, stress MPa"
+RESULT_UNITS = "mm, N, MPa"                      # knit-macro run's results.h5 @units
+
+
+def database_identity_defect(db_path):
+    """Why the database file is not a knitscale material database in mm, N and MPa, by its
+    root attributes format, format_version and units, each judged where present (knit-macro
+    refuses a database without a format; the report's own hand-made test databases have none),
+    or None (also when it cannot be read: the report says so elsewhere). Session 52's red team:
+    units "length m, force kN, stress GPa", format "not-a-knitscale-db" and format_version 99
+    changed no verdict."""
+    if not db_path:
+        return None
+    got = {k: root_text_attribute(db_path, k) for k in ("format", "format_version", "units")}
+    if got["format"] not in (None, DATABASE_FORMAT):
+        return f"its format is {got['format']!r}, not {DATABASE_FORMAT!r}"
+    if got["format_version"] not in {None} | {str(v) for v in DATABASE_VERSIONS}:
+        return f"its format_version is {got['format_version']}, not one of {DATABASE_VERSIONS}"
+    if got["units"] not in (None, DATABASE_UNITS):
+        return f"its units are {got['units']!r}, not {DATABASE_UNITS!r}"
+    return None
+
+
 def is_run_check(c):
     """Whether a check row judges the run itself rather than a statement of the paper: the
     "runs" rows (reaches the paper's strain, monotone curve) and the kinematic bound on max E22
@@ -885,7 +924,8 @@ class Report:
     def __init__(self, out_dir, sensitivity=None, cases_dir=CASES_DIR, database=None):
         self.out = out_dir
         self.res_dir = os.path.join(out_dir, "results")
-        self.data = Data(self.res_dir, database_date(database), cases_dir)
+        self.data = Data(self.res_dir, database_date(database), cases_dir,
+                         database_identity_defect(database))
         self.sensitivity = sensitivity
         self.names = case_names(cases_dir, self.res_dir)
         self.rows = []

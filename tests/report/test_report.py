@@ -1181,6 +1181,43 @@ def consistency_failures(tmp):
         why = r.consistency_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, results.h5 /steps with {what}: {why!r}")
+    # Session 52's red team: results.h5 @units "m, kN, GPa", and a database whose units, format
+    # or format_version are not ours, changed no verdict. A run states mm, N, MPa or is no data;
+    # a database that states other units, format or version makes every knit run no data and
+    # the law's table one FAIL row.
+    r = fresh()
+    date = "2026-12-01T10:00:00Z"
+    with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+        h.attrs["units"] = "mm, N, MPa"
+    why = report.Data(res, date).run_defect("a")
+    if why is not None:
+        out.append(f"consistency: a run in mm, N, MPa has a defect: {why!r}")
+    with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+        h.attrs["units"] = "m, kN, GPa"
+    why = report.Data(res, date).run_defect("a")
+    if why is None or "states units 'm, kN, GPa'" not in why:
+        out.append(f"consistency: a run in m, kN, GPa: {why!r}")
+    fresh()
+    dbf = os.path.join(tmp, "identity.h5")
+    for attr, value, needle in [(None, None, None),
+                                ("units", "length m, force kN, stress GPa", "its units are"),
+                                ("format", "not-a-knitscale-db", "its format is"),
+                                ("format_version", 99, "its format_version is 99")]:
+        with h5py.File(dbf, "w") as f:
+            f.attrs["format"] = report.DATABASE_FORMAT
+            f.attrs["format_version"] = 3
+            f.attrs["units"] = report.DATABASE_UNITS
+            if attr:
+                f.attrs[attr] = value
+        why = report.database_identity_defect(dbf)
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"database identity, {attr} = {value!r}: {why!r}")
+        rd = report.Data(res, date, None, why).run_defect("a")
+        if (rd is None) != (needle is None):
+            out.append(f"database identity, {attr} = {value!r}: the knit run's defect {rd!r}")
+        rows = report.law_checks(dbf, {})
+        if needle and (len(rows) != 1 or rows[0][3] is not False or needle not in rows[0][2]):
+            out.append(f"database identity, {attr} = {value!r}: the law's rows {rows}")
     # Session 52's red team: a paper-law run and its case copied into OUT/results and OUT/cases
     # were judged as the default law's. The pipeline's copy must be the checkout's case with
     # only /material/database set.
