@@ -1231,12 +1231,65 @@ def stale_output(used, what):
 
 def design_stale(out, name):
     """stale_output() of design NAME's final run (design/NAME/run/results.h5's
-    material_database_date_utc), None when the design wrote no run."""
+    material_database_date_utc), or design_output_defect(); None when the design wrote no
+    run."""
     h5 = os.path.join(out, "design", name, "run", "results.h5")
     if not os.path.exists(h5):
         return None
-    return stale_output(root_text_attribute(h5, "material_database_date_utc"),
-                        "its final run")
+    return (stale_output(root_text_attribute(h5, "material_database_date_utc"), "its final run")
+            or design_output_defect(out, name))
+
+
+def design_output_defect(out, name):
+    """Why design NAME's outputs disagree with each other, or None: each variable's end value
+    in summary.txt ('variable NAME: START -> END in [LO, HI]') must be the designed case's
+    (design/NAME/case.json) field value at the variable's indices (design/inputs/NAME.json), to
+    the summary's six digits, and the final run's results.h5 /case_json must be that case
+    (session 52's red team: l = 5.0 written into case.json, run/case.json and history.csv beside
+    a summary of l = 6 still "recovered" the twin)."""
+    d = os.path.join(out, "design", name)
+    try:
+        with open(os.path.join(out, "design", "inputs", name + ".json")) as f:
+            variables = json.load(f).get("variables", [])
+        with open(os.path.join(d, "case.json")) as f:
+            case = json.load(f)
+    except (OSError, ValueError, AttributeError):
+        return None  # no input or no case: the design's own row says what is missing
+    summ = read_design_summary(os.path.join(d, "summary.txt"))
+    material = case.get("material", {}) if isinstance(case, dict) else {}
+    for v in variables if isinstance(variables, list) else []:
+        if not isinstance(v, dict) or "name" not in v or "field" not in v:
+            continue
+        m = re.match(r"^\S+ -> (\S+) in \[(\S+), (\S+)\]", summ.get("variable " + v["name"], ""))
+        field = material.get(v["field"])
+        values = field.get("values") if isinstance(field, dict) else [field]
+        if not m or not isinstance(values, list):
+            continue
+        try:
+            end, lo, hi = (float(x) for x in m.groups())
+        except ValueError:
+            continue
+        for i in v.get("indices", [0]):
+            got = values[i] if isinstance(i, int) and 0 <= i < len(values) else None
+            if not isinstance(got, (int, float)) or not abs(got - end) <= 1e-5 * max(
+                    abs(end), hi - lo):
+                return (f"its case.json has {v['field']} value {got} at index {i} where its "
+                        f"summary.txt ends variable {v['name']} at {end:g}: the outputs are "
+                        "not of one design")
+    h5 = os.path.join(d, "run", "results.h5")
+    try:
+        import h5py
+        with h5py.File(h5, "r") as f:
+            raw = np.asarray(f["case_json"][()]).ravel()[0] if "case_json" in f else None
+    except (OSError, ImportError, IndexError) as e:
+        return f"its final run's results.h5 cannot be read ({e})"
+    if raw is not None:
+        ptr = json_difference(case, json.loads(raw.decode() if isinstance(raw, bytes)
+                                               else str(raw)))
+        if ptr is not None:
+            return (f"its final run (run/results.h5 /case_json) differs from its case.json at "
+                    f"{ptr or '/'}")
+    return None
 
 
 def declared_twins(out):

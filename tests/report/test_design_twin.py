@@ -159,6 +159,43 @@ def main():
                   f"database of {date}: the map stale {recovered == 0}", maps)
         finally:
             report.DATABASE_DATE = None
+    # Session 52's red team: l = 5.0 written into the design's case.json, run/case.json and
+    # history.csv beside a summary ending l at 6 still recovered the twin. The designed case's
+    # field values at each variable's indices must be the summary's end values, and the final
+    # run's results.h5 /case_json the designed case.
+    import json
+    with tempfile.TemporaryDirectory(prefix="design_twin_test_") as out:
+        write_design(out, "twin", SUMMARY.format(status="converged", end="6", got="6"),
+                     twin='{"l": 6.0}')
+        with open(os.path.join(out, "design", "inputs", "twin.json"), "w") as f:
+            json.dump({"case": "c.json", "twin": {"l": 6.0}, "objectives": [],
+                       "variables": [{"name": "l", "field": "stitch_value",
+                                      "indices": [0, 2]}]}, f)
+        os.makedirs(os.path.join(out, "design", "twin", "run"))
+
+        def designed(values, run_values=None):
+            case = {"material": {"type": "knit", "stitch_value": {"values": values}}}
+            with open(os.path.join(out, "design", "twin", "case.json"), "w") as f:
+                json.dump(case, f)
+            run = {"material": {"type": "knit", "stitch_value": {"values": run_values or values}}}
+            with h5py.File(os.path.join(out, "design", "twin", "run", "results.h5"), "w") as h:
+                h["case_json"] = json.dumps(run)
+
+        for what, values, run_values, recovered, needle in [
+                ("the case of the summary", [6.000000000004, 5.5, 6.0], None, 1, None),
+                ("l = 5.0 in the case", [5.0, 5.5, 5.0], None, 0,
+                 "its case.json has stitch_value value 5.0 at index 0 where its summary.txt "
+                 "ends variable l at 6"),
+                ("a tied index off", [6.0, 5.5, 5.0], None, 0, "value 5.0 at index 2"),
+                ("a final run of another case", [6.0, 5.5, 6.0], [5.0, 5.5, 5.0], 0,
+                 "its final run (run/results.h5 /case_json) differs from its case.json at "
+                 "/material/stitch_value/values/0")]:
+            designed(values, run_values)
+            c(report.twin_counts(out) == (recovered, 1), f"{what}: {recovered} of 1 recovered",
+              repr(report.twin_counts(out)))
+            why = report.design_output_defect(out, "twin")
+            c((why is None) == (needle is None) and (needle is None or needle in why),
+              f"{what}: the design's defect", repr(why))
     return c.exit_code()
 
 
