@@ -154,16 +154,27 @@ std::vector<double> crossings(const std::vector<Eigen::Vector2d>& poly, double t
   return s;
 }
 
+struct Laid {
+  std::vector<double> s, l;
+};
+
+}  // namespace
+
+namespace detail {
+
 /// The most times the patch covers a stretch of the line t = tc wider than `tiny` (the
 /// boundary's winding number there, summed over its signed crossings), and the middle and width
-/// of the widest such stretch; 1 where the crossings do not close (a boundary vertex on the line).
+/// of the widest such stretch. An edge crosses when its ends lie on either side of the line,
+/// one at or below it and one above (the half-open rule: a vertex on the line counts as below,
+/// so a vertex that only touches the line adds no crossing or two; the review of session 52: a
+/// notch's tip on the line added one stray crossing, and two such tips read as covered twice).
 int largest_cover(const std::vector<Eigen::Vector2d>& poly, double tc, double tiny, double& at,
                   double& width) {
   std::vector<std::pair<double, int>> x;
   for (std::size_t i = 0; i < poly.size(); ++i) {
     const Eigen::Vector2d& a = poly[i];
     const Eigen::Vector2d& b = poly[(i + 1) % poly.size()];
-    if ((a.y() - tc) * (b.y() - tc) > 0 || a.y() == b.y() || b.y() == tc) continue;
+    if ((a.y() <= tc) == (b.y() <= tc)) continue;
     x.emplace_back(a.x() + (b.x() - a.x()) * (tc - a.y()) / (b.y() - a.y()),
                    b.y() > a.y() ? 1 : -1);
   }
@@ -178,15 +189,10 @@ int largest_cover(const std::vector<Eigen::Vector2d>& poly, double tc, double ti
       width = dx;
     }
   }
-  if (!x.empty()) w += x.back().second;
-  return w == 0 ? most : 1;
+  return most;
 }
 
-struct Laid {
-  std::vector<double> s, l;
-};
-
-}  // namespace
+}  // namespace detail
 
 KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions& opt) {
   const auto* mat = dynamic_cast<const KnitMaterial*>(c.material.get());
@@ -259,7 +265,7 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     for (int k = 0; k < lines; ++k) {
       const double tc = t_min + (t_max - t_min) * (k + 0.5) / lines;
       double at = 0.0, width = 0.0;
-      const int cover = largest_cover(poly, tc, 1e-9 * (s_max - s_min), at, width);
+      const int cover = detail::largest_cover(poly, tc, 1e-9 * (s_max - s_min), at, width);
       if (cover > most || (cover == most && cover > 1 && width > widest)) {
         most = cover;
         widest = width;

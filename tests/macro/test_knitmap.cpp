@@ -590,6 +590,29 @@ TEST_CASE("knitmap: a patch that overlaps itself in the plane is refused as such
       Catch::Contains("not convex along its courses") && !Catch::Contains("overlaps itself"));
 }
 
+// The review of session 52: a boundary vertex exactly on the course line (a notch's tip) added
+// one stray crossing, and two such tips made a simple polygon read as covered twice between
+// them. A 100 x 50 rectangle with a notch from the bottom (tip at (30, 25)) and one from the top
+// (tip at (70, 25)): the line t = 25 through both tips covers each point once; a ring of two
+// turns (a polygon that winds twice) covers twice.
+TEST_CASE("knitmap: the cover of a course line counts a vertex on the line once", "[unit]") {
+  using V = Eigen::Vector2d;
+  const std::vector<V> notched = {V(0, 0),    V(25, 0),  V(30, 25), V(35, 0),  V(100, 0),
+                                  V(100, 50), V(75, 50), V(70, 25), V(65, 50), V(0, 50)};
+  for (const double tc : {25.0, 25.0 + 1e-9, 25.0 - 1e-9, 10.0, 40.0}) {
+    double at = 0, width = 0;
+    INFO("t = " << tc);
+    CHECK(knit::macro::detail::largest_cover(notched, tc, 1e-9, at, width) == 1);
+  }
+  // Two turns of a square: every point inside is covered twice.
+  const std::vector<V> twice = {V(0, 0), V(10, 0), V(10, 10), V(0, 10),
+                                V(0, 0), V(10, 0), V(10, 10), V(0, 10)};
+  double at = 0, width = 0;
+  CHECK(knit::macro::detail::largest_cover(twice, 5.0, 1e-9, at, width) == 2);
+  CHECK(at == Approx(5.0));
+  CHECK(width == Approx(10.0));
+}
+
 TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothing", "[case]") {
   const std::string db = database();
   auto expect = [&](const std::string& name, const std::string& text, const std::string& ptr,

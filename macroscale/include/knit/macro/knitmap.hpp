@@ -135,4 +135,13 @@ std::string knitmap_summary(const KnitMap& map);
 void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir,
                    std::string_view option = "output directory");
 
+namespace detail {
+/// The most times the closed polygon `poly` (in the course frame (s, t)) covers a stretch of
+/// the course line t = tc wider than `tiny`, by the winding number of its signed crossings;
+/// `at` and `width` the middle and width of the widest such stretch (knitmap.cpp; exposed for
+/// its test). 1 for a line that crosses a simple polygon.
+int largest_cover(const std::vector<Eigen::Vector2d>& poly, double tc, double tiny, double& at,
+                  double& width);
+}  // namespace detail
+
 }  // namespace knit::macro
