@@ -69,12 +69,13 @@ def load_paths(f, loop):
 
 def fit_min_cos(f):
     """The energy fit's stable_min_cos, from /energy_law/diagnostics@options_json of the open
-    database `f` (0, the fit's default, when the record is absent)."""
+    database `f`; -2 (no cut) where the record or the key is absent: a fit from before the
+    option (session 14) cut nothing (the review of session 52)."""
     import json
     d = f.get("energy_law/diagnostics")
     if d is None or "options_json" not in d.attrs:
-        return 0.0
-    return float(json.loads(attr_text(d.attrs["options_json"])).get("stable_min_cos", 0.0))
+        return -2.0
+    return float(json.loads(attr_text(d.attrs["options_json"])).get("stable_min_cos", -2.0))
 
 
 def fit_states(paths, min_cos=0.0):

@@ -26,7 +26,8 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, open_database, positive_number, stress_range  # noqa: E402
+from cell_paths import (fit_min_cos, fit_states, load_paths, open_database,  # noqa: E402
+                        positive_number, stress_range)
 from energy_law import load_law  # noqa: E402
 from strain_box import current_results, read_case  # noqa: E402
 
@@ -85,7 +86,7 @@ def near_errors(db_path, results_dir, radius=RADIUS):
         if "energy_law" not in f:
             return []
         for k, l in enumerate(np.asarray(f["loop_lengths"], dtype=float)):
-            paths = load_paths(f, k)
+            paths = fit_states(load_paths(f, k), fit_min_cos(f))  # the fit's states and range
             R = stress_range(paths)
             law = load_law(f["energy_law"], l)
             row = {"l": float(l)}

@@ -123,8 +123,9 @@ def run_extrapolation(out, name):
     report (extrapolation()), and where its run's summary.txt or results.h5 (attribute
     material_report) also hold one, a conflict naming the first that counts other evaluations
     or extrapolations than the log (session 52's red team: the check read the log alone, and a
-    summary.txt edited to 27 % extrapolated beside it passed). With a conflict the extrapolation
-    is None: no report to judge by."""
+    summary.txt edited to 27 % extrapolated beside it passed). With a conflict the log's report
+    is returned beside it (the review of session 52: returning None called the run one without
+    a report); the law's row fails on any conflict."""
     ex = extrapolation(os.path.join(out, "logs", name + ".log"))
     run = os.path.join(out, "results", name)
     others = []
@@ -142,7 +143,7 @@ def run_extrapolation(out, name):
             with h5py.File(h5, "r") as f:
                 v = f.attrs.get("material_report")
             if v is not None:
-                text = v.decode() if isinstance(v, bytes) else str(v)
+                text = v.decode(errors="replace") if isinstance(v, bytes) else str(v)
                 others.append(("results.h5 @material_report",
                                extrapolation_of_lines(text.splitlines())))
         except (OSError, ImportError) as e:
@@ -151,8 +152,8 @@ def run_extrapolation(out, name):
         return None, None
     for where, o in others:
         if o is not None and o[:2] != ex[:2]:
-            return None, (f"{name}: its log reports {ex[1]} of {ex[0]} evaluations "
-                          f"extrapolated, its {where} {o[1]} of {o[0]}")
+            return ex, (f"{name}: its log reports {ex[1]} of {ex[0]} evaluations "
+                        f"extrapolated, its {where} {o[1]} of {o[0]}")
     return ex, None
 
 
@@ -386,16 +387,17 @@ def held_out_reference(db_path):
     same fit paths predicts within LAW_BOUND of the loop length's stress range. Returns
     (within, states, largest error) or None when the database holds no raw held-out paths."""
     import h5py
-    from cell_paths import load_paths, stress_range
+    from cell_paths import fit_min_cos, fit_states, load_paths, stress_range
     from free_fit import free_fits
     within, states, worst = 0, 0, 0.0
     with h5py.File(db_path, "r") as f:
         if "loop_lengths" not in f:
             return None
+        min_cos = fit_min_cos(f)
         for k in range(len(f["loop_lengths"])):
             if f"loop_{k}/raw" not in f:
                 return None
-            paths = load_paths(f, k)
+            paths = fit_states(load_paths(f, k), min_cos)  # the fit's own states and range
             fit = [p for p in paths if p[0] != "holdout" and len(p[1])]
             held = [p for p in paths if p[0] == "holdout" and len(p[1])]
             if not fit or not held:

@@ -313,6 +313,9 @@ class Result:
             for k, (where, v) in cols.items():
                 # The CSV prints 10 significant digits: equal to 1e-8 of the column's largest.
                 w = c[k]
+                if not (np.all(np.isfinite(v)) and np.all(np.isfinite(w))):
+                    return (f"load_strain.csv column {k} or results.h5 /{where} holds a "
+                            "non-finite value")
                 tol = 1e-8 * max(float(np.max(np.abs(v))) if len(v) else 0.0, 1e-12)
                 if len(v) != len(w) or not np.all(np.abs(v - w) <= tol):
                     i = (int(np.argmax(~(np.abs(v - w) <= tol))) if len(v) == len(w)

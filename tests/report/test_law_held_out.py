@@ -28,7 +28,7 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import law_held_out as lho  # noqa: E402
 
 
-def write_db(path, law=True, diagnostics=(4, 2)):
+def write_db(path, law=True, diagnostics=(4, 2), options=None, gives_way=False):
     with h5py.File(path, "w") as f:
         f["loop_lengths"] = [5.0]
         if law:
@@ -36,7 +36,15 @@ def write_db(path, law=True, diagnostics=(4, 2)):
             if diagnostics:
                 d = g.create_group("diagnostics")
                 d.attrs["holdout_points"], d.attrs["holdout_within_5_percent"] = diagnostics
-        raw_path(f, "path_00", "coverage", [[0, 0, 0], [5.0, 0, 0]], [[0, 0, 0], [10.0, 0, 0]])
+                if options is not None:
+                    d.attrs["options_json"] = options
+        # With `gives_way`, a third state where the cell gives way (S22 jumps to 40 MPa against a
+        # strain step along E11: cos(dS, de) < 0): the fit leaves it out, and with it the range
+        # stays 10 MPa.
+        E0, S0 = [[0, 0, 0], [5.0, 0, 0]], [[0, 0, 0], [10.0, 0, 0]]
+        if gives_way:
+            E0, S0 = E0 + [[6.0, 0, 0]], S0 + [[9.9, 40.0, 0]]
+        raw_path(f, "path_00", "coverage", E0, S0)
         raw_path(f, "path_01", "holdout", [[0.5, 0, 0], [1.0, 0.5, 0]], [[1, 0, 0], [2, 1, 0]])
         raw_path(f, "path_02", "holdout", [[0.5, 0, 0], [1.0, 0, 0]], [[1.6, 0, 0], [2.3, 0, 0]])
         # Tensor E12 = 0.25 (2E12 = 0.5): the law's S12 = 1.0; the cell's 1.8 is 8 % off.
@@ -101,6 +109,21 @@ def main():
         c([len(p[1]) for p in fit_states(paths, -0.8)] == [4, 4]
           and [len(p[1]) for p in fit_states(paths, -0.7)] == [2, 4],
           "fit_states: the threshold is cos(dS, de) (cut at -0.7, kept at -0.8)")
+        # The fit's stable_min_cos from the diagnostics' options (the review of session 52):
+        # with 0 the giving-way state is cut and the range stays 10 MPa (3 of 5 within, as
+        # above); a record without the key (a fit from before the option) cut nothing, and the
+        # range of 40 MPa puts every held-out state within 5 %.
+        from cell_paths import fit_min_cos
+        for options, want_cos, want_within in (('{"stable_min_cos": 0.0}', 0.0, 3),
+                                               ('{"stable_min_cos": 0.5}', 0.5, 3),
+                                               ("{}", -2.0, 5), (None, -2.0, 5)):
+            write_db(db, diagnostics=(5, want_within), options=options, gives_way=True)
+            with h5py.File(db, "r") as f:
+                got_cos = fit_min_cos(f)
+            r = lho.held_out_misses(db)
+            c(got_cos == want_cos and r[:2] == (5, want_within),
+              "options %s: stable_min_cos %g, %d of 5 within (got %s, %s)"
+              % (options, want_cos, want_within, got_cos, r[:2]))
         write_db(db, law=False)
         c(lho.held_out_misses(db) == (0, 0, [], None), "no energy law: nothing")
         c(lho.summary(lho.held_out_misses(db)) == "", "no energy law: no sentence")
