@@ -234,6 +234,34 @@ EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
 
 }  // namespace
 
+long long EnergyFitOptions::ridge_coefficients(int loop_lengths) const {
+  if (family != "ridge" || loop_lengths < 1) return 0;
+  EnergyLawData law;
+  try {
+    law.directions = directions.empty() ? material::default_ridge_directions()
+                                        : material::mirror_closed(directions);
+  } catch (const std::exception&) {
+    return 0;  // refused by validate()
+  }
+  return static_cast<long long>(law.functions()) * std::min(l_control_points, loop_lengths) *
+         (static_cast<long long>(s_spans) + s_degree);
+}
+
+std::string EnergyFitOptions::ridge_size_refusal(int loop_lengths) const {
+  // The dense active-set solve grows with about the fourth power of the coefficients (session
+  // 52's red team, 15 functions x 2 loop lengths x (s_spans + 5), one core: 510 took 0.5 s, 900
+  // 5.1 s, 1650 63 s, 1950 121 s, and s_spans 200 would have run for hours without a word).
+  const long long n = ridge_coefficients(loop_lengths);
+  if (n <= kMaxRidgeCoefficients) return "";
+  return "the ridge law would have " + std::to_string(n) + " coefficients (" +
+         std::to_string(n / (std::min(l_control_points, loop_lengths) * (s_spans + s_degree))) +
+         " functions x " + std::to_string(std::min(l_control_points, loop_lengths)) +
+         " l control points x (s_spans + s_degree) = " + std::to_string(s_spans + s_degree) +
+         "), more than the " + std::to_string(kMaxRidgeCoefficients) +
+         " its dense active-set solve takes in about two minutes (1650 took 63 s, 1950 121 s); "
+         "lower s_spans, s_degree or l_control_points, or give fewer directions";
+}
+
 std::string EnergyFitOptions::validate() const {
   if (s_degree < 0 || s_degree > 5) return "s_degree must be in 0..5";
   if (s_spans < 1 || s_spans > 200) return "s_spans must be in 1..200";
@@ -530,19 +558,13 @@ EnergyFitSummary fit_energy_law(const Database& db, const EnergyFitOptions& o) {
   // ---- normal equations ------------------------------------------------------------------
   const Design design(law);
   const int P = design.P, ns = design.ns;
-  // The dense active-set solve grows with about the fourth power of the coefficients (session
-  // 52's red team, 15 functions x 2 loop lengths x (s_spans + 5), one core: 510 took 0.5 s, 900
-  // 5.1 s, 1650 63 s, 1950 121 s, and s_spans 200 would have run for hours without a word):
-  // refused beyond kMaxRidgeCoefficients (about two minutes), with what to lower.
-  constexpr int kMaxRidgeCoefficients = 2000;
-  if (P > kMaxRidgeCoefficients)
+  // The sweep refuses it before its cases; `knit-meso fit` here (EnergyFitOptions::
+  // ridge_size_refusal). The law's own count is the backstop.
+  if (const std::string why = o.ridge_size_refusal(static_cast<int>(ls.size())); !why.empty())
+    return refuse("invalid options: " + why);
+  if (P > EnergyFitOptions::kMaxRidgeCoefficients)
     return refuse("invalid options: the ridge law would have " + std::to_string(P) +
-                  " coefficients (" + std::to_string(G) + " functions x " + std::to_string(nl) +
-                  " l control points x (s_spans + s_degree) = " + std::to_string(ns) +
-                  "), more than the " + std::to_string(kMaxRidgeCoefficients) +
-                  " its dense active-set solve takes in about two minutes (1650 took 63 s, 1950 "
-                  "121 s); lower "
-                  "s_spans, s_degree or l_control_points, or give fewer directions");
+                  " coefficients");
   if (o.progress && P > 500)
     std::fprintf(o.progress, "  ridge law: solving for %d coefficients (active set) ...\n", P);
   // Data weights (squared-residual weights): the set weight, and with weight_relative > 0 a

@@ -382,6 +382,12 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
       in.energy_fit = f.get<bool>();
     else
       in.energy_fit_options = fit::EnergyFitOptions::from_json(f.dump(), file, "/energy_fit");
+    // A ridge law too large to solve in minutes is refused before the cases (the review of
+    // session 52: the fit refused it only after the whole sweep).
+    if (const std::string why =
+            in.energy_fit_options.ridge_size_refusal(static_cast<int>(in.loop_lengths.size()));
+        !why.empty())
+      throw InputError(file, "/energy_fit/s_spans", why);
     // Options of a fit that is not made are refused, not ignored unread (session 44's red
     // team: "fit": false with an "energy_fit" object ran with exit 0 and no word; knit-meso fit
     // refuses --energy-options with --law paper the same way, session 38).

@@ -247,6 +247,20 @@ TEST_CASE("knit-meso sweep: a sweep input without energy_fit is told it got the 
   CHECK_FALSE(knit::meso::sweep::parse_sweep_input(
                   text.substr(0, text.size() - 1) + R"(, "energy_fit": {}})", "s.json")
                   .energy_fit_given);
+  // A ridge law too large to solve in minutes is refused before the cases (the review of
+  // session 52: the fit refused it only after the whole sweep): 24 default directions make 15
+  // functions; s_spans 200 + s_degree 5 at the input's loop lengths is over 2,000.
+  try {
+    (void)knit::meso::sweep::parse_sweep_input(
+        text.substr(0, text.size() - 1) +
+            R"(, "energy_fit": {"family": "ridge", "s_spans": 200, "s_degree": 5}})",
+        "s.json");
+    FAIL("a ridge law of more than 2,000 coefficients was accepted");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/energy_fit/s_spans");
+    CHECK_THAT(e.message(), Catch::Contains("coefficients (15 functions x") &&
+                                Catch::Contains("more than the 2000"));
+  }
   knit_test::write_text(s.dir / "bare.json", text);
   const fs::path log = s.dir / "bare.log", log2 = s.dir / "given.log";
   REQUIRE(shell(kExe + " sweep " + (s.dir / "bare.json").string() + " --output " +

@@ -146,6 +146,17 @@ struct EnergyFitOptions {
   double progress_seconds = 5.0;
 
   std::string validate() const;
+
+  /// Ridge family: the coefficients the law will have at `loop_lengths` loop lengths (functions
+  /// of the directions x min(l_control_points, loop_lengths) x (s_spans + s_degree)); 0 for the
+  /// network family. Its dense active-set solve grows with about the fourth power of it, so more
+  /// than kMaxRidgeCoefficients is refused, by the sweep before its cases (the review of session
+  /// 52) and by the fit.
+  long long ridge_coefficients(int loop_lengths) const;
+  static constexpr long long kMaxRidgeCoefficients = 2000;
+  /// Why the ridge law is too large to solve in minutes ("" if not): the count, its factors
+  /// and what to lower.
+  std::string ridge_size_refusal(int loop_lengths) const;
   std::string to_json() const;
   /// Parses the options (same keys as to_json()); errors name `file` and the JSON pointer
   /// below `pointer`.
