@@ -20,6 +20,9 @@ namespace {
 constexpr const char* kManifest = "manifest.json";
 /// Written once the database is in place (CheckpointStore::mark_written).
 constexpr const char* kWritten = "database_written";
+/// Marks a directory that existed empty before the sweep used it (keep_dir_): not ours to remove,
+/// also for a sweep that resumes it (the review of session 52).
+constexpr const char* kKeepDirectory = "directory_not_ours";
 
 /// The build that writes a manifest, as it is recorded there: "knit-meso VERSION (git REV)".
 std::string build_name() {
@@ -55,7 +58,7 @@ bool is_store_file(std::string name) {
     if (tmp == std::string::npos) return false;
     name = name.substr(1, tmp - 1);
   }
-  if (name == kManifest || name == kWritten) return true;
+  if (name == kManifest || name == kWritten || name == kKeepDirectory) return true;
   // job_%05d.txt: at least 5 digits (index 100000 has 6)
   if (name.size() < 13 || name.rfind("job_", 0) != 0 ||
       name.compare(name.size() - 4, 4, ".txt") != 0)
@@ -137,7 +140,9 @@ bool holds_job_records(const fs::path& dir) {
   for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator();
        it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name[0] != '.' && name != kManifest && name != kWritten && is_store_file(name)) return true;
+    if (name[0] != '.' && name != kManifest && name != kWritten && name != kKeepDirectory &&
+        is_store_file(name))
+      return true;
   }
   return false;
 }
@@ -154,6 +159,7 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     : dir_(parts_dir(database)), fingerprint_(fingerprint(job_definition)), builds_{build_name()} {
   const std::string& fp = fingerprint_;
   std::error_code ec;
+  bool fresh_in_kept = false;  // a kept directory (keep_dir_) that holds nothing of a sweep
   if (fs::exists(fs::symlink_status(dir_, ec))) {
     // Session 26 (found by a helper's audit): --force deleted a directory of that name with
     // the user's files in it (or a plain file), with exit 0.
@@ -165,12 +171,17 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
     // No finished case in it (a run stopped while it wrote its first manifest left only the
     // manifest's temporary; session 36's red team): nothing to continue or to lose, so it is
     // discarded and the sweep starts afresh, with or without --resume.
+    // A directory that existed empty before an earlier sweep used it stays the user's.
+    keep_dir_ = fs::exists(dir_ / kKeepDirectory, ec);
     if (!holds_job_records(dir_)) {
-      if (fs::is_empty(dir_, ec) && !ec) {
+      if ((fs::is_empty(dir_, ec) && !ec) || keep_dir_) {
         // An empty directory records nothing of a sweep, so nothing says it is ours (session
         // 52's red team: a user's empty DB.h5.parts was deleted by a successful sweep). The
-        // sweep keeps its checkpoints in it and leaves it, emptied again, in place.
+        // sweep keeps its checkpoints in it, marks it so (kKeepDirectory: a resumed sweep
+        // keeps it too), and leaves it, emptied again, in place.
         keep_dir_ = true;
+        remove();  // our files only (a marker, a manifest's temporary); the directory stays
+        fresh_in_kept = true;
       } else {
         remove();
         if (fs::exists(fs::symlink_status(dir_, ec)))
@@ -183,10 +194,12 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
   // an unfinished sweep to keep (--resume still takes them: every case is in them).
   if (!resume && fs::exists(dir_ / kWritten, ec)) {
     remove();
-    if (fs::exists(fs::symlink_status(dir_, ec)))
+    if (keep_dir_)
+      fresh_in_kept = true;
+    else if (fs::exists(fs::symlink_status(dir_, ec)))
       throw InputError(dir_.string(), "", "cannot discard the finished sweep's checkpoints");
   }
-  if (!keep_dir_ && fs::exists(fs::symlink_status(dir_, ec))) {
+  if (!fresh_in_kept && fs::exists(fs::symlink_status(dir_, ec))) {
     if (!resume && !force)
       throw InputError(dir_.string(), "",
                        "checkpoints of an unfinished sweep (or kept by --keep-parts) exist: "
@@ -240,10 +253,12 @@ CheckpointStore::CheckpointStore(const fs::path& database, const std::string& jo
       return;
     }
     remove();
-    if (fs::exists(fs::symlink_status(dir_, ec)))
+    if (!keep_dir_ && fs::exists(fs::symlink_status(dir_, ec)))
       throw InputError(dir_.string(), "", "--force: cannot discard the checkpoints");
   }
   fs::create_directories(dir_);
+  if (keep_dir_)
+    std::ofstream(dir_ / kKeepDirectory) << "this directory existed before the sweep\n";
   const nlohmann::json m = {{"format", "knit-sweep-parts"},
                             {"version", 1},
                             {"fingerprint", fp},
@@ -372,7 +387,10 @@ void CheckpointStore::remove() const {
   // The job files first, then the "database_written" mark (a stop before it leaves a store
   // the next sweep still discards as finished), the manifest last.
   const auto rank = [](const fs::path& p) {
-    return p.filename() == kManifest ? 2 : p.filename() == kWritten ? 1 : 0;
+    return p.filename() == kKeepDirectory ? 3
+           : p.filename() == kManifest    ? 2
+           : p.filename() == kWritten     ? 1
+                                          : 0;
   };
   std::stable_sort(ours.begin(), ours.end(),
                    [&](const fs::path& a, const fs::path& b) { return rank(a) < rank(b); });

@@ -883,6 +883,24 @@ TEST_CASE("sweep: --force discards only checkpoints the sweep wrote", "[unit]") 
       CHECK(fs::is_directory(parts));
       CHECK(fs::is_empty(parts));
     }
+  // ... also when the sweep that used it is interrupted and resumed (the review of session 52:
+  // the resumed sweep removed it): a plain rerun refuses its checkpoints, --resume continues
+  // them and leaves the directory in place, --force discards them and keeps it.
+  for (const bool force : {false, true}) {
+    INFO("force " << force);
+    fs::create_directories(parts);
+    CheckpointStore(out, in.job_definition(), n, false, false)
+        .store(run_job(jobs[0], in.retry, synthetic_runner()));  // interrupted here
+    CHECK_THROWS_WITH(CheckpointStore(out, in.job_definition(), n, false, false),
+                      Catch::Contains("exist: continue it with --resume"));
+    {
+      CheckpointStore store(out, in.job_definition(), n, !force, force);
+      CHECK(store.load_finished(jobs).size() == (force ? 0u : 1u));
+      store.remove();
+    }
+    CHECK(fs::is_directory(parts));
+    CHECK(fs::is_empty(parts));
+  }
   fs::remove_all(parts);
 }
 
