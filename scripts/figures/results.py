@@ -66,6 +66,37 @@ def read_vtu(path):
     return pts, fields
 
 
+def green_lagrange_on_grid(X, x):
+    """The membrane Green-Lagrange strain (nv x nu x 2 x 2, in the local Cartesian frame e1 =
+    A1/|A1|, e2 = n x e1) of the grid x (nv x nu x 3) over the reference grid X, by fourth-order
+    central differences in the grid's index directions (second order in the two outer rows);
+    None where the reference metric is singular."""
+    def diff(P, axis):
+        g = np.gradient(P, axis=axis, edge_order=2)
+        P, g = np.moveaxis(P, axis, 0), np.moveaxis(g, axis, 0)
+        g[2:-2] = (-P[4:] + 8.0 * P[3:-1] - 8.0 * P[1:-3] + P[:-4]) / 12.0
+        return np.moveaxis(g, 0, axis)
+
+    def metric(b1, b2):
+        dot = lambda p, q: np.sum(p * q, axis=-1)  # noqa: E731
+        return np.stack([np.stack([dot(b1, b1), dot(b1, b2)], -1),
+                         np.stack([dot(b2, b1), dot(b2, b2)], -1)], -2)
+    A1, A2, a1, a2 = diff(X, 1), diff(X, 0), diff(x, 1), diff(x, 0)
+    A = metric(A1, A2)
+    try:
+        Ainv = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        return None
+    e1 = A1 / np.linalg.norm(A1, axis=-1)[..., None]
+    n = np.cross(A1, A2)
+    n = n / np.linalg.norm(n, axis=-1)[..., None]
+    e2 = np.cross(n, e1)
+    G = [Ainv[..., a, 0, None] * A1 + Ainv[..., a, 1, None] * A2 for a in (0, 1)]
+    T = np.stack([np.stack([np.sum(G[a] * e, axis=-1) for e in (e1, e2)], -1) for a in (0, 1)],
+                 -2)  # T[a, i] = G^a . e_i
+    return np.einsum("...ai,...ab,...bj->...ij", T, 0.5 * (metric(a1, a2) - A), T)
+
+
 def root_text_attribute(path, name):
     """The text of the root attribute `name` of the HDF5 file `path` (bytes decoded), or None:
     no file, no attribute, an empty one, unreadable, or no h5py."""
@@ -356,7 +387,65 @@ class Result:
             if not abs(last - lf[-1]) <= 1e-6 * max(1.0, abs(lf[-1])):
                 return (f"summary.txt says last load factor {m.group(1)}, load_strain.csv "
                         f"{lf[-1]:.9g}")
-        return self._edge_displacement_defect(ad, d)
+        return self._edge_displacement_defect(ad, d) or self._strain_field_defect()
+
+    # Fields whose interior departs from the strain of the stored deformation by more than
+    # this fraction of the step's largest strain component are no data (session 52's red team).
+    STRAIN_FIELD_TOLERANCE = 0.01
+
+    def _strain_field_defect(self):
+        """Why an output step's membrane strains E11, E22, E12 (results.h5 fields/step_N, the
+        reference local Cartesian frame e1 = A1/|A1|) are not the Green-Lagrange strain of the
+        stored deformation x of X, or None. Recomputed by fourth-order central differences on
+        the output grid (two rows in from each edge; the edges' one-sided differences are too
+        coarse to judge), E = T^T (a_ab - A_ab)/2 T with T the contravariant basis in the local
+        frame. On the main job's 26 runs the two agree to 4.3e-4 of each step's largest strain
+        component; a departure beyond STRAIN_FIELD_TOLERANCE of it is a defect (session 52's
+        red team: E22 scaled by 0.8, or by 1.25 in the top third, turned two FAILs to passes
+        while the displacements stayed as they were)."""
+        path = os.path.join(self.dir, "results.h5")
+        if not os.path.exists(path):
+            return None
+        try:
+            import h5py
+        except ImportError:
+            return None
+        try:
+            with h5py.File(path, "r") as f:
+                for k, g in f.get("fields", {}).items():
+                    if not all(n in g for n in ("X", "x", "E11", "E22", "E12")) or \
+                            "grid_u" not in g.attrs or "grid_v" not in g.attrs:
+                        continue
+                    nu, nv = int(g.attrs["grid_u"]), int(g.attrs["grid_v"])
+                    if nu < 5 or nv < 5:
+                        continue
+                    E = green_lagrange_on_grid(np.asarray(g["X"], dtype=float).reshape(nv, nu, 3),
+                                               np.asarray(g["x"], dtype=float).reshape(nv, nu, 3))
+                    if E is None:
+                        continue
+                    fields = {n: np.asarray(g[n], dtype=float).reshape(nv, nu)
+                              for n in ("E11", "E22", "E12")}
+                    if not all(np.all(np.isfinite(v)) for v in fields.values()):
+                        continue  # named by the checks that read them
+                    scale = max(float(np.max(np.abs(v))) for v in fields.values())
+                    if not scale > 0:
+                        continue
+                    for n, (i, j) in (("E11", (0, 0)), ("E22", (1, 1)), ("E12", (0, 1))):
+                        off = np.abs(fields[n] - E[..., i, j])[2:-2, 2:-2]
+                        if not np.all(np.isfinite(off)):
+                            continue
+                        if off.max() > self.STRAIN_FIELD_TOLERANCE * scale:
+                            r, c = np.unravel_index(int(np.argmax(off)), off.shape)
+                            X = np.asarray(g["X"], dtype=float).reshape(nv, nu, 3)[r + 2, c + 2]
+                            return (f"results.h5 {k}: {n} at X = ({X[0]:.4g}, {X[1]:.4g}, "
+                                    f"{X[2]:.4g}) mm is {fields[n][r + 2, c + 2]:.6g}, the "
+                                    f"strain of its deformation {E[r + 2, c + 2, i, j]:.6g}: off "
+                                    f"by {100 * off.max() / scale:.3g} % of the step's largest "
+                                    f"strain, more than {100 * self.STRAIN_FIELD_TOLERANCE:g} % "
+                                    "(its fields are not of its deformation)")
+        except (OSError, KeyError, ValueError):
+            return None  # unreadable: the checks that read the fields say so
+        return None
 
     def _edge_displacement_defect(self, ad, d):
         # An edge's grid line, or a corner's grid sample (the diagonal and hyperbolic paraboloid

@@ -1183,6 +1183,32 @@ def consistency_failures(tmp):
         why = r.consistency_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, results.h5 /steps with {what}: {why!r}")
+    # Session 52's red team: E22 scaled by 0.8 in results.h5, the displacements left, passed.
+    # The interior's membrane strains must be those of the stored deformation: a 9 x 9 grid of
+    # a 20 x 10 mm patch stretched by 1.1 along y and 0.95 along x and sheared by 0.05 (E11 =
+    # (0.95^2 - 1)/2, E22 = (1.1^2 + 0.05^2 - 1)/2, E12 = 0.95 * 0.05 / 2), once as is, once with
+    # E22 scaled by 0.8, once with one edge sample changed (the edges are not judged).
+    for what, scale, edge, needle in [("the strains of its deformation", 1.0, False, None),
+                                      ("E22 scaled by 0.8", 0.8, False, "E22 at X = ("),
+                                      ("an edge sample changed", 1.0, True, None)]:
+        r = fresh()
+        nu = nv = 9
+        u, v = np.meshgrid(np.linspace(0, 20, nu), np.linspace(0, 10, nv))
+        X = np.stack([u, v, 0 * u], -1)
+        x = np.stack([0.95 * u + 0.05 * v, 1.1 * v, 0 * u], -1)
+        E11, E22, E12 = (0.95 ** 2 - 1) / 2, (1.1 ** 2 + 0.05 ** 2 - 1) / 2, 0.95 * 0.05 / 2
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            g = h.create_group("fields/step_0001")
+            g.attrs["grid_u"], g.attrs["grid_v"], g.attrs["load_factor"] = nu, nv, 0.5
+            g["X"], g["x"] = X.reshape(-1, 3), x.reshape(-1, 3)
+            g["E11"], g["E12"] = np.full(nu * nv, E11), np.full(nu * nv, E12)
+            e22 = np.full(nu * nv, E22 * scale)
+            if edge:
+                e22[0] = 0.5
+            g["E22"] = e22
+        why = r._strain_field_defect()
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, strain fields with {what}: {why!r}")
     # Session 52's red team: results.h5 @units "m, kN, GPa", and a database whose units, format
     # or format_version are not ours, changed no verdict. A run states mm, N, MPa or is no data;
     # a database that states other units, format or version makes every knit run no data and
