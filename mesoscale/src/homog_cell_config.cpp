@@ -116,7 +116,9 @@ std::optional<CellOptionError> CellOptions::validate() const {
     return CellOptionError{"/contact/allowance", m.str()};
   }
   return check_ranges({
-      {"/yarn/E", section.E, 0, inf, true, false},
+      // A yarn's Young's modulus in MPa (polymer fibres 1e2-1e5; steel 2e5): session 52's red
+      // team gave 1e-308, and the cell ended with "residual is not finite", naming no field.
+      {"/yarn/E", section.E, 1e-3, 1e8, false, false},
       {"/yarn/nu", section.nu, -1, 0.5, true, true},
       {"/yarn/d", section.d, 0, inf, true, false},
       {"/loop/gamma_over_w", geometry.gamma_over_w, 0, 1, false, false},
@@ -159,7 +161,7 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
   if (j.contains("yarn")) {
     const json& y = j["yarn"];
     R.object(y, "/yarn", {"E", "nu", "d"});
-    R.num(y, "/yarn", "E", o.section.E, 0, inf, true);
+    R.num(y, "/yarn", "E", o.section.E, 1e-3, 1e8, false);  // MPa (session 52)
     // (-1, 0.5) as schemas/cell.schema.json says (the bound was 0.4999999, which refused
     // 0.49999995 that the schema allows; session 25).
     R.num(y, "/yarn", "nu", o.section.nu, -1, 0.5, true, true);

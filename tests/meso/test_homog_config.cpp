@@ -176,6 +176,22 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
     FAIL("E = 1e308 accepted");
   } catch (const knit::InputError& e) {
     CHECK(e.pointer() == "/yarn/E");
-    CHECK(std::string(e.what()).find("finite (below 1e300)") != std::string::npos);
+    // (since session 52 the bound is 1e8 MPa: "must be <= 100000000.0")
+    CHECK(std::string(e.what()).find("must be <= 100000000") != std::string::npos);
   }
+  // Session 52's red team: E = 1e-308 ran into "residual is not finite", naming no field. A
+  // yarn's modulus lies in [1e-3, 1e8] MPa.
+  for (const char* E : {"1e-308", "0.0009", "1.1e8"}) {
+    INFO("E = " << E);
+    try {
+      read_cell_options(
+          write_tmp("cell_cfg_max.json", std::string(R"({"yarn": {"E": )") + E + "}}"));
+      FAIL("accepted");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == "/yarn/E");
+      CHECK((std::string(e.what()).find("must be >= 0.001") != std::string::npos ||
+             std::string(e.what()).find("must be <= 100000000") != std::string::npos));
+    }
+  }
+  CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e-3}})")));
 }
