@@ -150,6 +150,15 @@ def run_extrapolation(out, name):
             return None, f"{h5} cannot be read ({e})"
     if ex is None:
         return None, None
+    # knit-macro run writes the material's report into summary.txt and results.h5 of every
+    # knit run (the second red team of session 52 deleted both and edited the log alone).
+    if ex[3] in ("energy", "paper") and os.path.isdir(run):
+        have = {where for where, _ in others}
+        for where, what in (("summary.txt", os.path.join(run, "summary.txt")),
+                            ("results.h5 @material_report", h5)):
+            if os.path.exists(what) and where not in have:
+                return ex, (f"{name}: its log reports {ex[1]} of {ex[0]} evaluations "
+                            f"extrapolated, its {where} has no material report")
     for where, o in others:
         if o is not None and o[:2] != ex[:2]:
             return ex, (f"{name}: its log reports {ex[1]} of {ex[0]} evaluations "
@@ -625,10 +634,17 @@ class Data:
 def copy_defect(copy_file, src_file):
     """Why the pipeline's copy of a case (OUT/cases/NAME.json) is not the checkout's case file
     with the database the pipeline set (resolve_case.py: /material/database), or None; None
-    when either file is absent (the case's run says so elsewhere). Session 52's red team: a
-    paper-law run and its case, copied into OUT/results and OUT/cases, agreed with each other
-    and were judged as the default law's run."""
-    if not (os.path.exists(copy_file) and os.path.exists(src_file)):
+    without the checkout's file. Session 52's red team: a paper-law run and its case, copied
+    into OUT/results and OUT/cases, agreed with each other and were judged as the default law's
+    run; its second red team deleted the copy instead, which turned this and case_defect off:
+    a copy missing from the pipeline's OUT/cases beside a checkout case is a defect (an output
+    without OUT/cases at all, a hand-made one, is not judged by it)."""
+    if not os.path.exists(src_file):
+        return None
+    if not os.path.exists(copy_file) and os.path.isdir(os.path.dirname(copy_file)):
+        return (f"the pipeline's copy of its case, {copy_file}, is missing, so its results "
+                "cannot be tied to the checkout's case (rerun the pipeline)")
+    if not os.path.exists(copy_file):
         return None
     try:
         with open(copy_file) as f:
@@ -1271,7 +1287,8 @@ def design_output_defect(out, name):
             end, lo, hi = (float(x) for x in m.groups())
         except ValueError:
             continue
-        for i in v.get("indices", [0]):
+        indices = v.get("indices", [0])
+        for i in indices if isinstance(indices, list) else [indices]:
             got = values[i] if isinstance(i, int) and 0 <= i < len(values) else None
             if not isinstance(got, (int, float)) or not abs(got - end) <= 1e-5 * max(
                     abs(end), hi - lo):
@@ -1286,8 +1303,11 @@ def design_output_defect(out, name):
     except (OSError, ImportError, IndexError) as e:
         return f"its final run's results.h5 cannot be read ({e})"
     if raw is not None:
-        ptr = json_difference(case, json.loads(raw.decode() if isinstance(raw, bytes)
-                                               else str(raw)))
+        try:
+            held = json.loads(raw.decode() if isinstance(raw, bytes) else str(raw))
+        except (ValueError, UnicodeDecodeError) as e:
+            return f"its final run's results.h5 /case_json is not JSON ({e})"
+        ptr = json_difference(case, held)
         if ptr is not None:
             return (f"its final run (run/results.h5 /case_json) differs from its case.json at "
                     f"{ptr or '/'}")

@@ -196,6 +196,20 @@ def main():
             why = report.design_output_defect(out, "twin")
             c((why is None) == (needle is None) and (needle is None or needle in why),
               f"{what}: the design's defect", repr(why))
+        # The second red team of session 52: /case_json not JSON, or "indices": 0, raised.
+        designed([6.0, 5.5, 6.0])
+        with h5py.File(os.path.join(out, "design", "twin", "run", "results.h5"), "w") as h:
+            h["case_json"] = "{not json"
+        why = report.design_output_defect(out, "twin")
+        c(why is not None and "/case_json is not JSON" in why, "a /case_json that is not JSON",
+          repr(why))
+        with open(os.path.join(out, "design", "inputs", "twin.json"), "w") as f:
+            json.dump({"case": "c.json", "twin": {"l": 6.0}, "objectives": [],
+                       "variables": [{"name": "l", "field": "stitch_value", "indices": 0}]}, f)
+        designed([5.0, 5.5, 6.0])
+        why = report.design_output_defect(out, "twin")
+        c(why is not None and "value 5.0 at index 0" in why, "indices given as a number",
+          repr(why))
     return c.exit_code()
 
 

@@ -1054,6 +1054,13 @@ def run_extrapolation_failures(tmp):
     ex, why = report.run_extrapolation(o, "a")
     if ex is None or ex[:2] != (1000, 10) or why is not None:
         out.append(f"run_extrapolation: three agreeing reports: {ex}, {why}")
+    # The second red team of session 52 deleted the run's reports and edited the log alone.
+    with open(os.path.join(o, "results", "a", "summary.txt"), "w") as f:
+        f.write("status: completed\nconverged steps: 1\n")
+    ex, why = report.run_extrapolation(o, "a")
+    if why is None or "its summary.txt has no material report" not in why:
+        out.append(f"run_extrapolation: a summary.txt without the report: {ex}, {why}")
+    summary(report_text)
     for what, edit in (("summary.txt", summary), ("results.h5 @material_report", h5)):
         edit(report_text.replace("10 extrapolated (1 %", "300 extrapolated (30 %"))
         ex, why = report.run_extrapolation(o, "a")
@@ -1184,7 +1191,7 @@ def consistency_failures(tmp):
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, results.h5 /steps with {what}: {why!r}")
     # Session 52's red team: E22 scaled by 0.8 in results.h5, the displacements left, passed.
-    # The interior's membrane strains must be those of the stored deformation: a 9 x 9 grid of
+    # The interior's membrane strains must be those of the stored deformation: a 21 x 21 grid of
     # a 20 x 10 mm patch stretched by 1.1 along y and 0.95 along x and sheared by 0.05 (E11 =
     # (0.95^2 - 1)/2, E22 = (1.1^2 + 0.05^2 - 1)/2, E12 = 0.95 * 0.05 / 2), once as is, once with
     # E22 scaled by 0.8, once with one edge sample changed (the edges are not judged).
@@ -1192,7 +1199,7 @@ def consistency_failures(tmp):
                                       ("E22 scaled by 0.8", 0.8, False, "E22 at X = ("),
                                       ("an edge sample changed", 1.0, True, None)]:
         r = fresh()
-        nu = nv = 9
+        nu = nv = 21
         u, v = np.meshgrid(np.linspace(0, 20, nu), np.linspace(0, 10, nv))
         X = np.stack([u, v, 0 * u], -1)
         x = np.stack([0.95 * u + 0.05 * v, 1.1 * v, 0 * u], -1)
@@ -1200,12 +1207,40 @@ def consistency_failures(tmp):
         with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
             g = h.create_group("fields/step_0001")
             g.attrs["grid_u"], g.attrs["grid_v"], g.attrs["load_factor"] = nu, nv, 0.5
-            g["X"], g["x"] = X.reshape(-1, 3), x.reshape(-1, 3)
+            g["x"], g["displacement"] = x.reshape(-1, 3), (x - X).reshape(-1, 3)
             g["E11"], g["E12"] = np.full(nu * nv, E11), np.full(nu * nv, E12)
             e22 = np.full(nu * nv, E22 * scale)
             if edge:
                 e22[0] = 0.5
             g["E22"] = e22
+        why = r._strain_field_defect()
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, strain fields with {what}: {why!r}")
+    # The second red team of session 52: an outlier of 50 at a corner sample (where the bound
+    # took its scale) hid E22 x 1.25 in the top rows; without grid_u the check was off. Both
+    # are named now; a 9 x 9 grid (coarser than STRAIN_FIELD_MIN_GRID) is not judged.
+    for what, outlier, drop_grid, n, needle in [
+            ("an outlier beside E22 x 1.25 on top", True, False, 21, "E22 at X = ("),
+            ("no grid attributes (the case's /output/grid [3, 3] is not this grid)", False,
+             True, 21, "cannot be checked against its deformation"),
+            ("a 9 x 9 grid with E22 x 1.25 on top", False, False, 9, None)]:
+        r = fresh()
+        u, v = np.meshgrid(np.linspace(0, 20, n), np.linspace(0, 10, n))
+        X = np.stack([u, v, 0 * u], -1)
+        x = np.stack([0.95 * u + 0.05 * v, 1.1 * v, 0 * u], -1)
+        e22 = np.full((n, n), (1.1 ** 2 + 0.05 ** 2 - 1) / 2)
+        e22[n // 2:] *= 1.25
+        e12 = np.full((n, n), 0.95 * 0.05 / 2)
+        if outlier:
+            e12[0, 0] = 50.0
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            g = h.create_group("fields/step_0001")
+            if not drop_grid:
+                g.attrs["grid_u"], g.attrs["grid_v"] = n, n
+            g.attrs["load_factor"] = 0.5
+            g["x"], g["displacement"] = x.reshape(-1, 3), (x - X).reshape(-1, 3)
+            g["E11"], g["E22"], g["E12"] = (np.full(n * n, (0.95 ** 2 - 1) / 2), e22.ravel(),
+                                            e12.ravel())
         why = r._strain_field_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, strain fields with {what}: {why!r}")
@@ -1264,6 +1299,15 @@ def consistency_failures(tmp):
         why = report.copy_defect(copy, os.path.join(src, "a.json"))
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, the pipeline's copy with {what}: {why!r}")
+    # The second red team of session 52 deleted the copy: missing from a directory of copies it
+    # is a defect; an output without such a directory is not judged by it.
+    os.remove(copy)
+    why = report.copy_defect(copy, os.path.join(src, "a.json"))
+    if why is None or "is missing" not in why:
+        out.append(f"consistency, the pipeline's copy deleted: {why!r}")
+    if report.copy_defect(os.path.join(tmp, "no_such_dir", "a.json"),
+                          os.path.join(src, "a.json")) is not None:
+        out.append("consistency: an output without copies is judged by copy_defect")
     # ... through Data.run_defect: OUT/cases/a.json beside OUT/results, cases_src the checkout.
     out_dir = os.path.join(tmp, "consistency_out")
     shutil.rmtree(out_dir, ignore_errors=True)
