@@ -33,8 +33,8 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
-from results import (Result, first_error_line, json_difference, last_run_wrote,  # noqa: E402
-                     root_text_attribute)
+from results import (Result, case_json_of, first_error_line, json_difference,  # noqa: E402
+                     last_run_wrote, root_text_attribute)
 from sensitivity import FIGURE as SENSITIVITY_FIGURE, read_table as read_sensitivity  # noqa: E402
 from design import read_summary as read_design_summary  # noqa: E402
 
@@ -1295,18 +1295,11 @@ def design_output_defect(out, name):
                 return (f"its case.json has {v['field']} value {got} at index {i} where its "
                         f"summary.txt ends variable {v['name']} at {end:g}: the outputs are "
                         "not of one design")
-    h5 = os.path.join(d, "run", "results.h5")
     try:
-        import h5py
-        with h5py.File(h5, "r") as f:
-            raw = np.asarray(f["case_json"][()]).ravel()[0] if "case_json" in f else None
-    except (OSError, ImportError, IndexError) as e:
-        return f"its final run's results.h5 cannot be read ({e})"
-    if raw is not None:
-        try:
-            held = json.loads(raw.decode() if isinstance(raw, bytes) else str(raw))
-        except (ValueError, UnicodeDecodeError) as e:
-            return f"its final run's results.h5 /case_json is not JSON ({e})"
+        held = case_json_of(os.path.join(d, "run", "results.h5"))
+    except (ValueError, ImportError) as e:
+        return f"its final run's results.h5 /case_json is not JSON, or cannot be read ({e})"
+    if held is not None:
         ptr = json_difference(case, held)
         if ptr is not None:
             return (f"its final run (run/results.h5 /case_json) differs from its case.json at "

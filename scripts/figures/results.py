@@ -104,6 +104,21 @@ def green_lagrange_on_grid(X, x, order=4):
     return np.einsum("...ai,...ab,...bj->...ij", T, 0.5 * (metric(a1, a2) - A), T)
 
 
+def case_json_of(path):
+    """The case a knit-macro run stored in results.h5 `path` (/case_json), parsed; None when
+    the file has no /case_json. ValueError, saying why, when the file or the dataset cannot be
+    read or does not hold JSON (Result.case_defect, report.design_output_defect)."""
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            if "case_json" not in f:
+                return None
+            v = np.asarray(f["case_json"][()]).ravel()[0]
+        return json.loads(v.decode() if isinstance(v, bytes) else str(v))
+    except (OSError, IndexError, KeyError) as e:  # (JSON and UTF-8 errors are ValueErrors)
+        raise ValueError(str(e)) from e
+
+
 def root_text_attribute(path, name):
     """The text of the root attribute `name` of the HDF5 file `path` (bytes decoded), or None:
     no file, no attribute, an empty one, unreadable, or no h5py."""
@@ -285,14 +300,13 @@ class Result:
         held = []
         h5 = os.path.join(self.dir, "results.h5")
         if os.path.exists(h5):
-            import h5py
             try:
-                with h5py.File(h5, "r") as f:
-                    v = np.asarray(f["case_json"][()]).ravel()[0]
-                held.append((h5 + " /case_json", json.loads(v.decode() if isinstance(v, bytes)
-                                                            else str(v))))
-            except (OSError, KeyError, ValueError, IndexError) as e:
+                got = case_json_of(h5)
+            except ValueError as e:
                 return f"{h5} /case_json cannot be read ({e})"
+            if got is None:
+                return f"{h5} /case_json cannot be read (no such dataset)"
+            held.append((h5 + " /case_json", got))
         if self.case:
             held.append((os.path.join(self.dir, "case.json"), self.case))
         for where, got in held:
