@@ -156,7 +156,8 @@ Eigen::VectorXd EnergyLaw::ridge_coefficients(int g, double l, int derivative) c
   return a;
 }
 
-EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative)
+EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative,
+                         LanesKernel kernel)
     : l_(l), floor_(d.floor), P_(d.s_degree + 2), box_min_(d.box_min), box_max_(d.box_max) {
   const EnergyLaw law(d);
   if (d.family == EnergyFamily::kNetwork) {
@@ -169,23 +170,23 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
       const KnotWeights w = d.network.weights(l);
       std::vector<std::vector<double>> th;
       for (int k = 0; k < w.count; ++k) th.push_back(d.network.theta_row(w.j[k]));
-      if (w.count == 3 && NetworkLanesAt::six_lane_kernel()) {
+      if (w.count == 3 && kernel != LanesKernel::kPortable && NetworkLanesAt::six_lane_kernel()) {
         // One six-lane pass in a wide kernel: AVX-512 (session 48: 2.6e6 per second, against
         // 1.8e6 for the split below) or AVX2 with FMA (session 51: 1.78-1.79e6, against
         // 1.45-1.48e6 for the split).
         lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], th[2],
-                                Eigen::Vector3d(w.c[0], w.c[1], w.c[2]));
+                                Eigen::Vector3d(w.c[0], w.c[1], w.c[2]), kernel);
       } else if (w.count == 3) {
         // Without a wide kernel: (c0 + c2) [(1 - t) W_j-1 + t W_j+1] in the four-lane
         // evaluator plus c1 W_j in a two-lane one (session 44: faster than one portable
         // six-lane pass).
         const double outer = w.c[0] + w.c[2];
-        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[2], w.c[2] / outer);
+        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[2], w.c[2] / outer, kernel);
         lanes_scale_ = outer;
         middle_ = NetworkLanesAt(d.network.shape, th[1]);
         middle_scale_ = w.c[1];
       } else if (w.count == 2 && w.c[1] > 0.0 && w.c[0] > 0.0) {
-        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], w.c[1]);
+        lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], w.c[1], kernel);
       } else {  // one knot's law (at a knot: a span's t = 0 or 1)
         const int k = w.count == 2 && w.c[0] == 0.0 ? 1 : 0;
         lanes_ = NetworkLanesAt(d.network.shape, th[static_cast<std::size_t>(k)]);

@@ -5,7 +5,6 @@
 #include <emmintrin.h>
 #endif
 #include <stdexcept>
-#include <type_traits>
 
 #include "knit/material/network_lanes.hpp"
 
@@ -186,103 +185,114 @@ NetworkResponse lanes_sum(const NetworkShape& sh, int k_lanes, const double* q, 
 // instead of 3.31e6 (session 51, an AMD EPYC without AVX-512).
 // -Wpsabi (GCC's note that a 256-bit vector passed by value without AVX changes the ABI) is
 // silenced for the rest of this translation unit (and its unity group; the note is issued at
-// its end): every function that takes or returns v4, v6 or v8 is always_inline into an entry
+// its end): every function that takes or returns v4 or v8 is always_inline into an entry
 // point.
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double v2 __attribute__((vector_size(16)));
 typedef double v4 __attribute__((vector_size(32)));
 typedef double v8 __attribute__((vector_size(64)));
 
-/// Six lanes without AVX-512 (session 51): a unit's lanes 0-3 in a 256-bit vector and 4-5 in a
-/// 128-bit one, so that six lanes cost one and a half four-lane passes (GCC's v8 split into
-/// AVX2 halves computed eight and ran at 0.6e6 per second). Stored at the six-lane layout's
-/// stride of eight (kStride); the operators the kernel body uses, part by part.
-struct v6 {
-  v4 a;
-  v2 b;
-};
-#define KNIT_V6_OPERATOR(op)                                      \
-  [[gnu::always_inline]] inline v6 operator op(v6 x, v6 y) {      \
-    return {x.a op y.a, x.b op y.b};                              \
-  }                                                               \
-  [[gnu::always_inline]] inline v6 operator op(double x, v6 y) {  \
-    return {x op y.a, x op y.b};                                  \
-  }                                                               \
-  [[gnu::always_inline]] inline v6 operator op(v6 x, double y) {  \
-    return {x.a op y, x.b op y};                                  \
-  }                                                               \
-  [[gnu::always_inline]] inline v6& operator op##=(v6& x, v6 y) { \
-    x.a = x.a op y.a;                                             \
-    x.b = x.b op y.b;                                             \
-    return x;                                                     \
-  }
-KNIT_V6_OPERATOR(+)
-KNIT_V6_OPERATOR(-)
-KNIT_V6_OPERATOR(*)
-KNIT_V6_OPERATOR(/)
-#undef KNIT_V6_OPERATOR
-
 /// Doubles between one unit's consecutive lane vectors in the packed layout.
 template <class VT>
-constexpr int kStride = std::is_same_v<VT, v6> ? 8 : static_cast<int>(sizeof(VT) / sizeof(double));
+constexpr int kStride = static_cast<int>(sizeof(VT) / sizeof(double));
 
 template <class VT>
 [[gnu::always_inline]] inline VT ldv(const double* p) {
   VT r;
-  if constexpr (std::is_same_v<VT, v6>) {
-    std::memcpy(&r.a, p, sizeof r.a);
-    std::memcpy(&r.b, p + 4, sizeof r.b);
-  } else {
-    std::memcpy(&r, p, sizeof r);
-  }
+  std::memcpy(&r, p, sizeof r);
   return r;
 }
 template <class VT>
 [[gnu::always_inline]] inline void stv(double* p, const VT& x) {
-  if constexpr (std::is_same_v<VT, v6>) {
-    std::memcpy(p, &x.a, sizeof x.a);
-    std::memcpy(p + 4, &x.b, sizeof x.b);
-  } else {
-    std::memcpy(p, &x, sizeof x);
-  }
+  std::memcpy(p, &x, sizeof x);
 }
 template <class VT>
 [[gnu::always_inline]] inline VT splatv(double x) {
-  if constexpr (std::is_same_v<VT, v6>) {
-    return {splatv<v4>(x), splatv<v2>(x)};
-  } else {
-    VT r;
-    for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l) r[l] = x;
-    return r;
-  }
+  VT r;
+  for (int l = 0; l < kStride<VT>; ++l) r[l] = x;
+  return r;
 }
 /// Lane by lane: x < y ? a : b, and x > y ? a : b.
 template <class VT>
 [[gnu::always_inline]] inline VT where_less(VT x, VT y, VT a, VT b) {
-  if constexpr (std::is_same_v<VT, v6>)
-    return {where_less(x.a, y.a, a.a, b.a), where_less(x.b, y.b, a.b, b.b)};
-  else
-    return x < y ? a : b;
+  return x < y ? a : b;
 }
 template <class VT>
 [[gnu::always_inline]] inline VT where_greater(VT x, VT y, VT a, VT b) {
   return where_less(y, x, a, b);
 }
 /// True if every lane of x is zero: v8's padding lanes (copies of lane 0) too, which never
-/// changes the answer; v6 has no padding lanes.
+/// changes the answer.
 template <class VT>
 [[gnu::always_inline]] inline bool all_zero(const VT& x) {
-  if constexpr (std::is_same_v<VT, v6>) {
-    return all_zero(x.a) && all_zero(x.b);
+  bool zero = true;
+  for (int l = 0; l < kStride<VT>; ++l) zero = zero && x[l] == 0.0;
+  return zero;
+}
+
+/// The activation of a vector of units (lane by lane): sigma, or rho where `stiff`.
+template <class VT>
+[[gnu::always_inline]] inline void activate_units(VT x, bool stiff, VT& s, VT& ds, VT& dds) {
+  const VT one = splatv<VT>(1.0), mone = splatv<VT>(-1.0), zero = splatv<VT>(0.0);
+  if (!stiff) {
+    VT xc = where_less(x, mone, mone, x);
+    xc = where_greater(xc, one, one, xc);
+    const VT x2 = xc * xc;
+    s = 0.75 * (0.5 * x2 - x2 * x2 * (1.0 / 12.0)) + 0.5 * xc + 3.0 / 16.0 +
+        where_greater(x, one, x - one, zero);
+    ds = 0.75 * (xc - x2 * xc * (1.0 / 3.0)) + 0.5;
+    dds = 0.75 * (one - x2);
   } else {
-    bool zero = true;
-    for (int l = 0; l < static_cast<int>(sizeof(VT) / sizeof(double)); ++l)
-      zero = zero && x[l] == 0.0;
-    return zero;
+    const VT xp = where_greater(x, zero, x, zero);
+    dds = xp;
+    ds = 0.5 * xp * xp;
+    s = ds * xp / 3.0;
   }
 }
 
-template <class VT, int H1c, int H2c>
+/// The first layer's sums, over n unit vectors (units, or unit pairs): kappa_i = w1_i + sum_j
+/// V_ji (w u')_j, then W += w1 . h, S += kappa h' A0, C += kappa h'' (A0 A0^T) (upper
+/// triangle). f1(f, i), vv(j, i): the kernel's loads; wd(j): (w u')_j as a vector of the
+/// first layer's layout.
+template <class VT, class F1, class VV, class WD>
+[[gnu::always_inline]] inline void first_layer_sums(int n, int H2, F1 f1, VV vv, WD wd, const VT* h,
+                                                    const VT* dh, const VT* ddh, VT& W, VT& S0,
+                                                    VT& S1, VT& S2, VT* C) {
+  for (int i = 0; i < n; ++i) {
+    VT kappa = f1(4, i);
+    for (int j = 0; j < H2; ++j) kappa += vv(j, i) * wd(j);
+    const VT kd = kappa * dh[i], kdd = kappa * ddh[i];
+    W += f1(4, i) * h[i];
+    S0 += kd * f1(0, i);
+    S1 += kd * f1(1, i);
+    S2 += kd * f1(2, i);
+    for (int m = 0; m < 6; ++m) C[m] += kdd * f1(5 + m, i);
+  }
+}
+/// A second-layer unit vector's (w u')_r, with W += w u and S += (w u') A1_r.
+template <class VT, class F2>
+[[gnu::always_inline]] inline VT second_layer_sums(int r, F2 f2, VT u, VT du, VT& W, VT& S0, VT& S1,
+                                                   VT& S2) {
+  const VT w = f2(4, r), wd = w * du;
+  W += w * u;
+  S0 += wd * f2(0, r);
+  S1 += wd * f2(1, r);
+  S2 += wd * f2(2, r);
+  return wd;
+}
+/// sum_i V_ji h'_i A0_i over n unit vectors: the first layer's part of grad z_j.
+template <class VT, class F1, class VV>
+[[gnu::always_inline]] inline void grad_z_sums(int j, int n, F1 f1, VV vv, const VT* dh, VT& g0,
+                                               VT& g1, VT& g2) {
+  for (int i = 0; i < n; ++i) {
+    const VT vd = vv(j, i) * dh[i];
+    g0 += vd * f1(0, i);
+    g1 += vd * f1(1, i);
+    g2 += vd * f1(2, i);
+  }
+}
+
+template <class VT, int H1c, int H2c, int OS = kStride<VT>>
 [[gnu::always_inline]] inline void lanes4_body(int h1, int h2, int stiff1, int stiff2,
                                                const double* q, const double* e, double* out) {
   const int H1 = H1c > 0 ? H1c : h1, H2 = H2c > 0 ? H2c : h2;
@@ -307,22 +317,9 @@ template <class VT, int H1c, int H2c>
     return ld4(Vp + (j * H1 + i) * L);
   };
   const VT E0 = splat4(e[0]), E1 = splat4(e[1]), E2 = splat4(e[2]);
-  const VT one = splat4(1.0), mone = splat4(-1.0), zero = splat4(0.0);
-  const auto act = [&](VT x, bool stiff, VT& s, VT& ds, VT& dds) __attribute__((always_inline)) {
-    if (!stiff) {
-      VT xc = where_less(x, mone, mone, x);
-      xc = where_greater(xc, one, one, xc);
-      const VT x2 = xc * xc;
-      s = 0.75 * (0.5 * x2 - x2 * x2 * (1.0 / 12.0)) + 0.5 * xc + 3.0 / 16.0 +
-          where_greater(x, one, x - one, zero);
-      ds = 0.75 * (xc - x2 * xc * (1.0 / 3.0)) + 0.5;
-      dds = 0.75 * (one - x2);
-    } else {
-      const VT xp = where_greater(x, zero, x, zero);
-      dds = xp;
-      ds = 0.5 * xp * xp;
-      s = ds * xp / 3.0;
-    }
+  const VT zero = splat4(0.0);
+  const auto act = [](VT x, bool stiff, VT& s, VT& ds, VT& dds) __attribute__((always_inline)) {
+    activate_units(x, stiff, s, ds, dds);
   };
   VT h[kMaxUnitsPerLane], dh[kMaxUnitsPerLane], ddh[kMaxUnitsPerLane];
   for (int i = 0; i < H1; ++i)
@@ -335,35 +332,18 @@ template <class VT, int H1c, int H2c>
     for (int i = 0; i < H1; ++i) z += vv(j, i) * h[i];
     z += f2(0, j) * E0 + f2(1, j) * E1 + f2(2, j) * E2 + f2(3, j);
     act(z, j >= H2 - stiff2, u[j], du[j], ddu[j]);
-    const VT wj = f2(4, j);
-    wd[j] = wj * du[j];
-    W += wj * u[j];
-    S0 += wd[j] * f2(0, j);
-    S1 += wd[j] * f2(1, j);
-    S2 += wd[j] * f2(2, j);
+    wd[j] = second_layer_sums(j, f2, u[j], du[j], W, S0, S1, S2);
   }
   VT C[6] = {zero, zero, zero, zero, zero, zero};
-  for (int i = 0; i < H1; ++i) {
-    VT kappa = f1(4, i);
-    for (int j = 0; j < H2; ++j) kappa += vv(j, i) * wd[j];
-    const VT kd = kappa * dh[i], kdd = kappa * ddh[i];
-    W += f1(4, i) * h[i];
-    S0 += kd * f1(0, i);
-    S1 += kd * f1(1, i);
-    S2 += kd * f1(2, i);
-    for (int m = 0; m < 6; ++m) C[m] += kdd * f1(5 + m, i);
-  }
+  first_layer_sums(
+      H1, H2, f1, vv, [&](int j) __attribute__((always_inline)) { return wd[j]; }, h, dh, ddh, W,
+      S0, S1, S2, C);
   // Second-layer curvature, for the units curved in some lane (c_j = 0 in the others).
   for (int j = 0; j < H2; ++j) {
     const VT cj = f2(4, j) * ddu[j];
     if (all_zero(cj)) continue;
     VT g0 = f2(0, j), g1 = f2(1, j), g2 = f2(2, j);
-    for (int i = 0; i < H1; ++i) {
-      const VT vd = vv(j, i) * dh[i];
-      g0 += vd * f1(0, i);
-      g1 += vd * f1(1, i);
-      g2 += vd * f1(2, i);
-    }
+    grad_z_sums(j, H1, f1, vv, dh, g0, g1, g2);
     add_outer_upper(C, cj, g0, g1, g2);
   }
   // 1/2 e^T Q e.
@@ -383,7 +363,7 @@ template <class VT, int H1c, int H2c>
                       C[3] + Qm[3],
                       C[4] + Qm[4],
                       C[5] + Qm[5]};
-  for (int m = 0; m < 10; ++m) stv(out + L * m, res[m]);
+  for (int m = 0; m < 10; ++m) stv(out + OS * m, res[m]);
 }
 
 /// The kernel's entry points: 12 / 6 units (the default) with compiled sizes, any other shape
@@ -395,14 +375,147 @@ __attribute__((target("avx2,fma"))) void lanes4_avx2(int h1, int h2, int stiff1,
   lanes4_body<v4, H1c, H2c>(h1, h2, stiff1, stiff2, q, e, out);
 }
 
-/// Six lanes with AVX2 (v6: one 256-bit and one 128-bit vector per unit; session 51): at an
-/// inner knot's rounding window 1.78-1.79e6 evaluations per second instead of 1.45-1.48e6 for
-/// the four-lane AVX2 pass plus a two-lane portable one (AMD EPYC without AVX-512).
+/// Lanes 4 and 5 of a six-lane pass with AVX2, two units to a 256-bit vector (session 53): in
+/// session 51's six-lane kernel (v6) they took a 128-bit vector per unit, which costs a 256-bit
+/// vector's issue slot for half its work. Here the units are paired, [unit 2p lanes 4, 5 | unit 2p
+/// + 1 lanes 4, 5], in both layers (a layer of odd size ends with a zero unit, which adds nothing:
+/// its weights, inputs and products are zero); a sum over the paired index ends with a fold of the
+/// two halves, and a second-layer value that multiplies every first-layer pair is broadcast to both
+/// halves. The arithmetic is lanes4_body's, in another order of the sums (equal to round-off). `q`:
+/// [f][p][4] for the first layer's 11 fields, V as [j][p][4], the second layer's 5 fields as
+/// [f][r][4], Q as [m][2]; `out`: lanes 4 and 5 of the six-lane output (stride 8).
+[[gnu::always_inline]] inline v2 fold(v4 x) {
+  return __builtin_shufflevector(x, x, 0, 1) + __builtin_shufflevector(x, x, 2, 3);
+}
+/// Half s (0: the pair's first unit, 1: its second) of a pair vector.
+[[gnu::always_inline]] inline v2 half(v4 x, int s) {
+  return s == 0 ? __builtin_shufflevector(x, x, 0, 1) : __builtin_shufflevector(x, x, 2, 3);
+}
+/// A pair's activation: both units sigma, both rho, or (stiff units are a layer's last, so
+/// only the second can be rho alone) sigma then rho.
+[[gnu::always_inline]] inline void activate_pair(v4 x, int stiff_units, v4& s, v4& ds, v4& dds) {
+  if (stiff_units != 1) {
+    activate_units(x, stiff_units == 2, s, ds, dds);
+    return;
+  }
+  v4 s0, ds0, dds0, s1, ds1, dds1;
+  activate_units(x, false, s0, ds0, dds0);
+  activate_units(x, true, s1, ds1, dds1);
+  s = __builtin_shufflevector(s0, s1, 0, 1, 6, 7);
+  ds = __builtin_shufflevector(ds0, ds1, 0, 1, 6, 7);
+  dds = __builtin_shufflevector(dds0, dds1, 0, 1, 6, 7);
+}
+/// The first layer's pairs and the second layer's pairs of a shape.
+constexpr int pairs(int units) {
+  return (units + 1) / 2;
+}
+/// Stiff units in pair p of a layer of n units whose last `stiff` are rho (the zero unit that
+/// pads an odd layer counts as its partner's kind).
+inline int stiff_in_pair(int p, int n, int stiff) {
+  const int first = 2 * p, second = std::min(2 * p + 1, n - 1);
+  return (first >= n - stiff ? 1 : 0) + (second >= n - stiff ? 1 : 0);
+}
+
 template <int H1c, int H2c>
-__attribute__((target("avx2,fma"))) void lanes6_avx2(int h1, int h2, int stiff1, int stiff2,
-                                                     const double* q, const double* e,
-                                                     double* out) {
-  lanes4_body<v6, H1c, H2c>(h1, h2, stiff1, stiff2, q, e, out);
+[[gnu::always_inline]] inline void lanes2p_body(int h1, int h2, int stiff1, int stiff2,
+                                                const double* q, const double* e, double* out) {
+  const int H1 = H1c > 0 ? H1c : h1, H2 = H2c > 0 ? H2c : h2;
+  const int P1 = pairs(H1), P2 = pairs(H2);
+  const double* F1 = q;                 // [f][p][4], f: c0 c1 c2 b0 w1 p00 p01 p02 p11 p12 p22
+  const double* Vp = q + 11 * P1 * 4;   // [j][p][4]
+  const double* F2 = Vp + H2 * P1 * 4;  // [f][r][4], f: a10 a11 a12 b1 w
+  const double* Qp = F2 + 5 * P2 * 4;   // [m][2]
+  const auto f1 = [&](int f, int p) __attribute__((always_inline)) {
+    return ldv<v4>(F1 + (f * P1 + p) * 4);
+  };
+  const auto vv = [&](int j, int p) __attribute__((always_inline)) {
+    return ldv<v4>(Vp + (j * P1 + p) * 4);
+  };
+  const auto f2 = [&](int f, int r) __attribute__((always_inline)) {
+    return ldv<v4>(F2 + (f * P2 + r) * 4);
+  };
+  const v4 E0 = splatv<v4>(e[0]), E1 = splatv<v4>(e[1]), E2 = splatv<v4>(e[2]);
+  const v4 zero = splatv<v4>(0.0);
+  constexpr int kMaxPairs = kMaxUnitsPerLane / 2;
+  v4 h[kMaxPairs], dh[kMaxPairs], ddh[kMaxPairs];
+  for (int p = 0; p < P1; ++p)
+    activate_pair(f1(0, p) * E0 + f1(1, p) * E1 + f1(2, p) * E2 + f1(3, p),
+                  stiff_in_pair(p, H1, stiff1), h[p], dh[p], ddh[p]);
+  // Second layer: z_j = sum over the first layer's pairs, folded; then two units to a vector.
+  v4 zs[2 * kMaxPairs];
+  for (int j = 0; j < H2; ++j) {
+    v4 acc = zero;
+    for (int p = 0; p < P1; ++p) acc += vv(j, p) * h[p];
+    zs[j] = acc;
+  }
+  if (H2 % 2 == 1) zs[H2] = zero;
+  v4 u[kMaxPairs], du[kMaxPairs], ddu[kMaxPairs], wd[kMaxPairs];
+  v4 W = zero, S0 = zero, S1 = zero, S2 = zero;
+  for (int r = 0; r < P2; ++r) {
+    const v4 a = zs[2 * r], b = zs[2 * r + 1];
+    const v4 z = __builtin_shufflevector(a, b, 0, 1, 4, 5) +
+                 __builtin_shufflevector(a, b, 2, 3, 6, 7) + f2(0, r) * E0 + f2(1, r) * E1 +
+                 f2(2, r) * E2 + f2(3, r);
+    activate_pair(z, stiff_in_pair(r, H2, stiff2), u[r], du[r], ddu[r]);
+    wd[r] = second_layer_sums(r, f2, u[r], du[r], W, S0, S1, S2);
+  }
+  // w_j u'_j of each second-layer unit in both halves, for every first-layer pair.
+  v4 wdb[2 * kMaxPairs];
+  for (int j = 0; j < H2; ++j)
+    wdb[j] = j % 2 == 0 ? __builtin_shufflevector(wd[j / 2], wd[j / 2], 0, 1, 0, 1)
+                        : __builtin_shufflevector(wd[j / 2], wd[j / 2], 2, 3, 2, 3);
+  v4 C[6] = {zero, zero, zero, zero, zero, zero};
+  first_layer_sums(
+      P1, H2, f1, vv, [&](int j) __attribute__((always_inline)) { return wdb[j]; }, h, dh, ddh, W,
+      S0, S1, S2, C);
+  v2 Cf[6];
+  for (int m = 0; m < 6; ++m) Cf[m] = fold(C[m]);
+  // Second-layer curvature, for the units curved in lane 4 or 5.
+  for (int j = 0; j < H2; ++j) {
+    const int r = j / 2, s = j % 2;
+    const v2 cj = half(f2(4, r), s) * half(ddu[r], s);
+    if (all_zero(cj)) continue;
+    v4 g0 = zero, g1 = zero, g2 = zero;
+    grad_z_sums(j, P1, f1, vv, dh, g0, g1, g2);
+    add_outer_upper(Cf, cj, fold(g0) + half(f2(0, r), s), fold(g1) + half(f2(1, r), s),
+                    fold(g2) + half(f2(2, r), s));
+  }
+  // 1/2 e^T Q e.
+  v2 Qm[6];
+  for (int m = 0; m < 6; ++m) Qm[m] = ldv<v2>(Qp + 2 * m);
+  const v2 e0 = splatv<v2>(e[0]), e1 = splatv<v2>(e[1]), e2 = splatv<v2>(e[2]);
+  const v2 Qe0 = Qm[0] * e0 + Qm[1] * e1 + Qm[2] * e2;
+  const v2 Qe1 = Qm[1] * e0 + Qm[3] * e1 + Qm[4] * e2;
+  const v2 Qe2 = Qm[2] * e0 + Qm[4] * e1 + Qm[5] * e2;
+  const v2 res[10] = {fold(W) + 0.5 * (e0 * Qe0 + e1 * Qe1 + e2 * Qe2),
+                      fold(S0) + Qe0,
+                      fold(S1) + Qe1,
+                      fold(S2) + Qe2,
+                      Cf[0] + Qm[0],
+                      Cf[1] + Qm[1],
+                      Cf[2] + Qm[2],
+                      Cf[3] + Qm[3],
+                      Cf[4] + Qm[4],
+                      Cf[5] + Qm[5]};
+  for (int m = 0; m < 10; ++m) stv(out + 8 * m + 4, res[m]);
+}
+
+/// Doubles of the four-lane block of the split six-lane layout (lanes4_body's, L = 4).
+inline int split_block_a(int h1, int h2) {
+  return 4 * (11 * h1 + h2 * h1 + 5 * h2 + 6);
+}
+
+/// Six lanes with AVX2, split (session 53): lanes 0-3 in lanes4_body's four-lane layout, then
+/// lanes 4 and 5 two units to a vector (lanes2p_body). In a rounding window 2.72-2.76e6
+/// evaluations of the law per second against 2.28-2.31e6 for v6 (a unit's six lanes in a
+/// 256-bit and a 128-bit vector; the same hour, AVX2 kernels forced on an AMD EPYC with
+/// AVX-512; docs/database.md "Without AVX-512").
+template <int H1c, int H2c>
+__attribute__((target("avx2,fma"))) void lanes6s_avx2(int h1, int h2, int stiff1, int stiff2,
+                                                      const double* q, const double* e,
+                                                      double* out) {
+  lanes4_body<v4, H1c, H2c, 8>(h1, h2, stiff1, stiff2, q, e, out);
+  lanes2p_body<H1c, H2c>(h1, h2, stiff1, stiff2, q + split_block_a(h1, h2), e, out);
 }
 
 /// The same kernel with AVX-512 (session 48, this machine's AMD EPYC): four lanes in a 256-bit
@@ -410,7 +523,8 @@ __attribute__((target("avx2,fma"))) void lanes6_avx2(int h1, int h2, int stiff1,
 /// between knots), and six lanes (a rounding window's three knots) padded to eight in a 512-bit
 /// vector (2.6e6 instead of 1.8e6 for the four-lane AVX2 pass plus a two-lane portable one).
 /// Eight lanes with AVX2 alone (GCC splits each vector into two halves) ran at 0.6e6: there six
-/// lanes take v6 (lanes6_avx2).
+/// lanes take lanes6s_avx2. That split kernel with AVX-512's registers ran no faster than the
+/// eight-lane one (session 53: 2.97-3.11e6 against 3.03-3.37e6 per second in a window).
 template <int H1c, int H2c>
 __attribute__((target("avx512f,avx512vl"))) void lanes4_avx512(int h1, int h2, int stiff1,
                                                                int stiff2, const double* q,
@@ -435,14 +549,18 @@ bool cpu_avx2_fma() {
 
 /// The wide kernel for this shape, kernel choice and vector width (4 or 8 lanes), or nullptr
 /// where the processor has none (then the portable code evaluates).
-NetworkLanesAt::WideKernel wide_kernel(int h1, int h2, int width, LanesKernel kernel) {
+NetworkLanesAt::WideKernel wide_kernel(int h1, int h2, int width, LanesKernel kernel, bool& split) {
   const bool d = h1 == 12 && h2 == 6;
+  split = false;
   if (kernel == LanesKernel::kAuto && cpu_avx512()) {
     if (width == 8) return d ? lanes8_avx512<12, 6> : lanes8_avx512<0, 0>;
     return d ? lanes4_avx512<12, 6> : lanes4_avx512<0, 0>;
   }
   if (kernel == LanesKernel::kPortable || !cpu_avx2_fma()) return nullptr;
-  if (width == 8) return d ? lanes6_avx2<12, 6> : lanes6_avx2<0, 0>;
+  if (width == 8) {
+    split = true;
+    return d ? lanes6s_avx2<12, 6> : lanes6s_avx2<0, 0>;
+  }
   return d ? lanes4_avx2<12, 6> : lanes4_avx2<0, 0>;
 }
 
@@ -528,9 +646,47 @@ void NetworkLanesAt::build(const NetworkShape& shape,
   }
   // The wide kernel's layout (four lanes in four, six in eight, where the processor has one).
   width_ = K_ == 4 ? 4 : 8;
-  wide_ = K_ >= 4 ? wide_kernel(H1, H2, width_, kernel) : nullptr;
+  bool split = false;
+  wide_ = K_ >= 4 ? wide_kernel(H1, H2, width_, kernel, split) : nullptr;
   packed4_.clear();
-  if (wide_) {
+  if (wide_ && split) {
+    // Lanes 0-3 unit-major four wide, then lanes 4 and 5 two units to a vector (lanes6s_avx2).
+    const int P1 = pairs(H1), P2 = pairs(H2);
+    packed4_.assign(
+        static_cast<std::size_t>(split_block_a(H1, H2) + 4 * (11 * P1 + H2 * P1 + 5 * P2) + 12),
+        0.0);
+    double* F1 = packed4_.data();
+    double* V4 = F1 + 11 * H1 * 4;
+    double* F2 = V4 + H2 * H1 * 4;
+    double* Q4 = F2 + 5 * H2 * 4;
+    for (int k = 0; k < 4; ++k) {
+      for (int f = 0; f < 11; ++f)
+        for (int i = 0; i < H1; ++i) F1[(f * H1 + i) * 4 + k] = q[f * N1 + k * H1 + i];
+      for (int j = 0; j < H2; ++j)
+        for (int i = 0; i < H1; ++i) V4[(j * H1 + i) * 4 + k] = V[(k * H2 + j) * H1 + i];
+      for (int f = 0; f < 5; ++f)
+        for (int j = 0; j < H2; ++j) F2[(f * H2 + j) * 4 + k] = a1[f * N2 + k * H2 + j];
+      for (int m = 0; m < 6; ++m) Q4[m * 4 + k] = Q_[static_cast<std::size_t>(6 * k + m)];
+    }
+    // Pair vectors [unit 2p lanes 4, 5 | unit 2p + 1 lanes 4, 5]; a padding unit stays zero.
+    double* B1 = packed4_.data() + split_block_a(H1, H2);
+    double* VB = B1 + 11 * P1 * 4;
+    double* B2 = VB + H2 * P1 * 4;
+    double* QB = B2 + 5 * P2 * 4;
+    for (int k = 4; k < 6; ++k) {
+      const int l = k - 4;
+      for (int f = 0; f < 11; ++f)
+        for (int i = 0; i < H1; ++i)
+          B1[(f * P1 + i / 2) * 4 + 2 * (i % 2) + l] = q[f * N1 + k * H1 + i];
+      for (int j = 0; j < H2; ++j)
+        for (int i = 0; i < H1; ++i)
+          VB[(j * P1 + i / 2) * 4 + 2 * (i % 2) + l] = V[(k * H2 + j) * H1 + i];
+      for (int f = 0; f < 5; ++f)
+        for (int j = 0; j < H2; ++j)
+          B2[(f * P2 + j / 2) * 4 + 2 * (j % 2) + l] = a1[f * N2 + k * H2 + j];
+      for (int m = 0; m < 6; ++m) QB[m * 2 + l] = Q_[static_cast<std::size_t>(6 * k + m)];
+    }
+  } else if (wide_) {
     const int L = width_;
     packed4_.assign(static_cast<std::size_t>(L * (11 * H1 + H2 * H1 + 5 * H2 + 6)), 0.0);
     double* F1 = packed4_.data();

@@ -13,6 +13,8 @@ db="${KNIT_BENCH_DATABASE:-$root/out/database.h5}"
   grep "^material evaluation" || echo "material evaluation: n/a (test_common missing)"
 "$bin/test_common" "bench: energy-law evaluations per second" 2>/dev/null |
   grep "^energy-law evaluation" || echo "energy-law evaluation: n/a (test_common missing)"
+"$bin/test_common" "bench: six-lane kernels" 2>/dev/null |
+  grep "^six-lane kernel" || echo "six-lane kernels: n/a (test_common missing)"
 "$bin/test_common" "bench: loading the material database" 2>/dev/null |
   grep "^database load" || echo "database load: n/a (needs knit/io)"
 if [[ -x "$bin/test_macro" ]]; then

@@ -91,8 +91,9 @@ TEST_CASE("bench: loading the material database", "[.bench]") {
 namespace {
 /// W, S and C evaluations per second (CPU time, this thread) of `law` at l, strains uniform in
 /// [-0.4, 0.5]^3 (e3 = 2 E12).
-double energy_law_rate(const EnergyLaw& law, double l, double& sink) {
-  const EnergyLawAt at = law.at(l);
+double energy_law_rate(const EnergyLaw& law, double l, double& sink,
+                       LanesKernel kernel = LanesKernel::kAuto) {
+  const EnergyLawAt at(law.data(), l, false, kernel);
   std::mt19937 gen(1);
   std::uniform_real_distribution<double> u(-0.4, 0.5);
   std::vector<Eigen::Vector3d> E;
@@ -148,19 +149,74 @@ TEST_CASE("bench: energy-law evaluations per second", "[.bench]") {
         n > 1 ? 0.5 * (db.entries[m == 0 ? 0 : m - 1].loop_length + db.entries[m].loop_length)
               : l_mid;
     // And at the first loop length, an end knot: one law, two passes (session 50).
-    for (const double l : {l_mid, l_between, db.entries.front().loop_length}) {
-      double sink = 0.0;
-      const double rate = energy_law_rate(law, l, sink);
-      const EnergyLawData& d = law.data();
-      const int laws =
-          d.family == EnergyFamily::kNetwork && d.network.l_interpolation == LInterpolation::kEnergy
-              ? nonzero_weights(d.network.weights(l))
-              : 1;
-      std::printf(
-          "energy-law evaluation (%s, l = %g mm, %d knot law%s): %.3g per second per core (W, S, "
-          "C; target >= 2e6) [sink %g]\n",
-          file, l, laws, laws == 1 ? "" : "s", rate, sink);
-      CHECK(rate > 0);
+    // Each also with the AVX2 kernels forced (session 53): on a processor with AVX-512 the
+    // rate that one without it, but with AVX2 and FMA, would see (the same on other ones).
+    for (const double l : {l_mid, l_between, db.entries.front().loop_length})
+      for (const LanesKernel kernel : {LanesKernel::kAuto, LanesKernel::kAvx2}) {
+        double sink = 0.0;
+        const double rate = energy_law_rate(law, l, sink, kernel);
+        const EnergyLawData& d = law.data();
+        const int laws = d.family == EnergyFamily::kNetwork &&
+                                 d.network.l_interpolation == LInterpolation::kEnergy
+                             ? nonzero_weights(d.network.weights(l))
+                             : 1;
+        std::printf(
+            "energy-law evaluation (%s, l = %g mm, %d knot law%s%s): %.3g per second per core "
+            "(W, S, C; target >= 2e6) [sink %g]\n",
+            file, l, laws, laws == 1 ? "" : "s",
+            kernel == LanesKernel::kAvx2 ? ", AVX2 kernels" : "", rate, sink);
+        CHECK(rate > 0);
+      }
+  }
+}
+
+#include "knit/material/network_lanes.hpp"
+
+TEST_CASE("bench: six-lane kernels", "[.bench]") {
+  // The six-lane pass of a rounding window (three knot laws) by each kernel this processor has,
+  // so that a machine with AVX-512 also measures the AVX2 kernel that processors without it run
+  // (session 53). The knot laws of KNIT_BENCH_DATABASE at its middle loop length, else the test
+  // network law's theta three times.
+  std::vector<std::vector<double>> th;
+  NetworkShape shape;
+  Eigen::Vector3d c(0.25, 0.5, 0.25);
+  const char* file = std::getenv("KNIT_BENCH_DATABASE");
+  if (file) {
+    const Database db = read_database(file, false);
+    const EnergyLawData d = require_energy_law(db, file);
+    const double l_mid = 0.5 * (db.entries.front().loop_length + db.entries.back().loop_length);
+    const KnotWeights w = d.network.weights(l_mid);
+    if (w.count == 3) {
+      shape = d.network.shape;
+      for (int k = 0; k < 3; ++k) th.push_back(d.network.theta_row(w.j[k]));
+      c = Eigen::Vector3d(w.c[0], w.c[1], w.c[2]);
     }
+  }
+  if (th.empty()) {
+    const EnergyLawData d = testing::make_test_network_law(7, 0.02, 12, 6);
+    shape = d.network.shape;
+    for (int k = 0; k < 3; ++k) th.push_back(d.network.theta_row(std::min(k, 1)));
+  }
+  std::mt19937 gen(1);
+  std::uniform_real_distribution<double> u(-0.4, 0.5);
+  std::vector<Eigen::Vector3d> E;
+  for (int k = 0; k < 4096; ++k) E.emplace_back(u(gen), u(gen), u(gen));
+  for (const LanesKernel kernel :
+       {LanesKernel::kAuto, LanesKernel::kAvx2, LanesKernel::kPortable}) {
+    const NetworkLanesAt lanes(shape, th[0], th[1], th[2], c, kernel);
+    const int n = 2'000'000;
+    double sink = 0.0;
+    const double c0 = thread_cpu_seconds();
+    for (int k = 0; k < n; ++k) {
+      const NetworkResponse r = lanes.evaluate(E[k & 4095]);
+      sink += r.W + r.S(0) + r.C(0, 1);
+    }
+    const double rate = n / (thread_cpu_seconds() - c0);
+    std::printf("six-lane kernel (%s%s): %.3g passes per second per core [sink %g]\n",
+                kernel == LanesKernel::kAuto   ? "auto"
+                : kernel == LanesKernel::kAvx2 ? "AVX2"
+                                               : "portable",
+                lanes.wide() ? "" : ", portable code", rate, sink);
+    CHECK(rate > 0);
   }
 }

@@ -76,7 +76,7 @@ TEST_CASE("network lanes: two lanes equal the mirror-averaged law, four its blen
                     : kernel == LanesKernel::kAvx2 ? avx2
                                                    : false;
   CHECK(four.wide() == wide);
-  CHECK(six.wide() == wide);  // AVX-512's eight-lane vectors, or AVX2's four plus two (v6)
+  CHECK(six.wide() == wide);  // AVX-512's eight-lane vectors, or AVX2's split
   CHECK_FALSE(two.wide());
   std::mt19937 gen(17);
   std::uniform_real_distribution<double> u(-0.7, 0.7);

@@ -104,8 +104,11 @@ struct EnergyResponse {
 /// The law at one loop length. Immutable; evaluate() is thread-safe and allocation-free.
 class EnergyLawAt {
  public:
-  /// with_l_derivative: also build d/dl of every ridge function (for dS_dl()).
-  EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative = false);
+  /// with_l_derivative: also build d/dl of every ridge function (for dS_dl()). kernel: which
+  /// code evaluates the network law's four and six lanes (LanesKernel; other than kAuto in tests
+  /// and benchmarks only: kAvx2 measures on a processor with AVX-512 what one without it runs).
+  EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivative = false,
+              LanesKernel kernel = LanesKernel::kAuto);
 
   double loop_length() const { return l_; }
   double floor() const { return floor_; }

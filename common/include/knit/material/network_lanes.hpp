@@ -28,9 +28,10 @@ namespace knit::material {
 /// Which code evaluates four or six lanes: kAuto = the widest kernel the processor has: AVX-512
 /// (four lanes in a 256-bit vector, six in a 512-bit one; session 48), else AVX2 with FMA (one
 /// 256-bit vector holds a unit's four lanes, +45 % on the default law between knots, session
-/// 17; six lanes in a 256-bit and a 128-bit vector, session 51), else the portable one (Eigen,
+/// 17; six lanes as four in one 256-bit vector per unit and two per unit pair in another,
+/// session 53), else the portable one (Eigen,
 /// SSE2); kAvx2 = the AVX2 kernels where the processor has AVX2 and FMA, the portable one
-/// otherwise (tests); kPortable = always the portable one (tests). Two lanes always take the
+/// otherwise (tests, benchmarks); kPortable = always the portable one (tests). Two lanes take the
 /// portable one (faster there).
 enum class LanesKernel { kAuto, kAvx2, kPortable };
 
