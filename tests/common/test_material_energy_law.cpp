@@ -400,6 +400,32 @@ TEST_CASE("energy law: l_blend rounds the kink at an inner knot (C1 in l, convex
   }
 }
 
+TEST_CASE("energy law: every lanes kernel evaluates the same law", "[unit]") {
+  // EnergyLawAt's kernel argument (session 53): kAuto (AVX-512 or AVX2 where the processor has
+  // them), kAvx2, and kPortable, which also takes a rounding window's three laws as a four-lane
+  // pass plus a two-lane one (the path of a processor without AVX2), equal to round-off in a
+  // window, between knots and at a knot.
+  EnergyLawData d = testing::make_test_network_law();
+  d.network.l_interpolation = LInterpolation::kEnergy;
+  d.network.l_blend = 0.2;
+  std::mt19937 gen(53);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (const double l : {5.45, 5.5, 5.0, 4.5}) {
+    const EnergyLawAt ref(d, l, false, LanesKernel::kPortable);
+    for (const LanesKernel kernel : {LanesKernel::kAuto, LanesKernel::kAvx2}) {
+      const EnergyLawAt at(d, l, false, kernel);
+      for (int k = 0; k < 50; ++k) {
+        const Eigen::Vector3d e(u(gen), u(gen), u(gen));
+        INFO("l = " << l << ", e = " << e.transpose());
+        const EnergyResponse a = at.evaluate(e), b = ref.evaluate(e);
+        REQUIRE(std::abs(a.W - b.W) <= 1e-13 * (1 + std::abs(b.W)));
+        REQUIRE((a.S - b.S).norm() <= 1e-13 * (1 + b.S.norm()));
+        REQUIRE((a.C - b.C).norm() <= 1e-13 * (1 + b.C.norm()));
+      }
+    }
+  }
+}
+
 TEST_CASE("energy law: validation refuses bad data", "[unit]") {
   const EnergyLawData good = testing::make_test_energy_law();
   CHECK_NOTHROW(validate(good));
