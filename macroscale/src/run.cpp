@@ -15,6 +15,44 @@
 
 namespace knit::macro {
 
+std::string gauge_length_warning(const Case& c) {
+  if (!c.output.applied || !c.output.applied->at_edge) return {};
+  const AppliedDisplacement& a = *c.output.applied;
+  const int i = a.component;
+  const Edge opposite = a.edge == Edge::kU0   ? Edge::kU1
+                        : a.edge == Edge::kU1 ? Edge::kU0
+                        : a.edge == Edge::kV0 ? Edge::kV1
+                                              : Edge::kV0;
+  bool held = false;
+  for (const BoundaryCondition& bc : c.bcs)
+    held = held || (bc.target == BoundaryCondition::Target::kEdge && bc.edge == opposite &&
+                    (bc.fix[static_cast<std::size_t>(i)] ||
+                     bc.prescribe[static_cast<std::size_t>(i)].has_value()));
+  if (!held) return {};
+  const Eigen::MatrixXd& P = c.surface.control_points();
+  const int nu = c.surface.size_u(), nv = c.surface.size_v();
+  const auto mean = [&](Edge e) {
+    const std::vector<int> row = edge_row(nu, nv, e, 0);
+    double sum = 0.0;
+    for (int k : row) sum += P(k, i);
+    return sum / static_cast<double>(row.size());
+  };
+  const double d = std::abs(mean(a.edge) - mean(opposite));
+  if (!(d > 0.0) || std::abs(a.gauge_length - d) <= kGaugeJawTolerance * d) return {};
+  const std::string length = unit_labels(c.units).of("mm");
+  std::ostringstream s;
+  s.precision(6);
+  s << "/output/applied_displacement/gauge_length: " << a.gauge_length << " " << length
+    << ", but the loaded edge " << edge_name(a.edge) << " lies " << d << " " << length
+    << " from the held edge " << edge_name(opposite) << " along "
+    << "xyz"[i] << " (more than " << 100 * kGaugeJawTolerance
+    << " % apart): the curve's strain is the applied displacement over the gauge length, "
+       "here "
+    << d / a.gauge_length << " times the strain between the jaws; give " << d
+    << " if the jaws hold these edges";
+  return s.str();
+}
+
 Problem setup_problem(const Case& c) {
   Problem p;
   ShellOptions so;
@@ -160,6 +198,7 @@ Problem setup_problem(const Case& c) {
                            "does not feel it; load another edge, or free those components");
     p.fext += f;
   }
+  if (std::string w = gauge_length_warning(c); !w.empty()) p.warnings.push_back(std::move(w));
   // One row of a clamped edge leaves out the support force its second row carries (session 46's
   // walkthrough: 5.72 N against 14.78 N for a clamped jaw, exit 0). Without "rows" a clamped
   // edge's reaction takes both (case_loader); an explicit 1 is named here.

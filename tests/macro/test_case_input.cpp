@@ -1601,6 +1601,32 @@ TEST_CASE("a load on held degrees of freedom only is named as a warning", "[unit
             .warnings.empty());
 }
 
+TEST_CASE("a gauge length other than the jaws' distance is named as a warning", "[unit]") {
+  // Session 53: the curve's strain is the applied displacement over gauge_length, and nothing
+  // compared it with the patch. The tensile case pulls v1 along y; v0, fixed in y, lies 50 mm
+  // away (its gauge length 50).
+  json j = verification_case("tensile_svk.json");
+  REQUIRE(j["output"]["applied_displacement"]["gauge_length"] == 50.0);
+  CHECK(gauge_length_warning(parse_case(j.dump(), "ok.json")).empty());
+  // Within the tolerance (1 %) and beyond it, both ways.
+  j["output"]["applied_displacement"]["gauge_length"] = 50.4;
+  CHECK(gauge_length_warning(parse_case(j.dump(), "close.json")).empty());
+  for (const std::string L : {"40", "50.6", "100"}) {
+    j["output"]["applied_displacement"]["gauge_length"] = std::stod(L);
+    const Problem p = setup_problem(parse_case(j.dump(), "gauge.json"));
+    INFO("gauge length " << L);
+    REQUIRE(p.warnings.size() == 1);
+    CHECK_THAT(p.warnings[0],
+               Catch::StartsWith("/output/applied_displacement/gauge_length: " + L +
+                                 " mm, but the loaded edge v1 lies 50 mm from the held edge v0 "
+                                 "along y (more than 1 % apart)"));
+  }
+  // Not judged: the opposite edge not held in that component (no second jaw in the patch).
+  j["boundary_conditions"][0]["fix"] = json::array({"x", "z"});
+  j["boundary_conditions"].push_back(json::parse(R"({"corner": "u0v0", "fix": ["y"]})"));
+  CHECK(gauge_length_warning(parse_case(j.dump(), "half.json")).empty());
+}
+
 // Session 46's walkthrough: a clamped jaw's reaction over one row read 5.72 N against 14.78 N
 // over both, exit 0 and no word. Without "rows" a clamped edge's reaction now takes both, an
 // unclamped edge's one; an explicit 1 on a clamped edge is a warning.

@@ -39,6 +39,17 @@ struct Problem {
   std::vector<std::string> warnings;
 };
 
+/// The gauge length against the jaws (session 53): for an applied displacement on an edge whose
+/// opposite edge an edge condition fixes or prescribes in the same component, "POINTER: what"
+/// if the gauge length differs from the distance between the two edges along that component
+/// (the mean of each edge's control points) by more than kGaugeJawTolerance of it, else empty.
+/// The strain in load_strain.csv is the applied displacement over the gauge length, so a gauge
+/// that is not the jaws' distance scales every strain of the curve without a word. Not judged:
+/// a corner (the paper's corner-loaded cases take half the diagonal), an opposite edge held by
+/// a symmetry plane or not held (a half model's jaws are not both in the patch).
+std::string gauge_length_warning(const Case& c);
+inline constexpr double kGaugeJawTolerance = 0.01;
+
 /// Builds the model, constraints and loads. Throws knit::InputError for a degenerate geometry
 /// (zero Jacobian, with its location), contradictory constraints and missing supports (an
 /// unconstrained rigid-body motion).
