@@ -35,6 +35,68 @@ std::string raw_step_problem(const char* d, const RowMatrixX& m, Eigen::Index s)
   const double v = m.row(s).cwiseAbs().maxCoeff();
   if (v > bound)
     return "holds |value| " + io::format_number(v) + " (F, E at most 1e3; P, S at most 1e9 MPa)";
+  // A deformation gradient keeps the cell's area ratio J = det F > 0 (F11 F22 - F12 F21 in the
+  // row's order F11, F12, F21, F22): J <= 0 is a cell turned inside out or collapsed, and an F
+  // of zeros is none at all (a red team after session 52: F = 0 in a format-2 file was
+  // refitted with exit 0).
+  if (*d == 'F' && m.cols() == 4) {
+    const double J = m(s, 0) * m(s, 3) - m(s, 1) * m(s, 2);
+    if (!(J > 0.0))
+      return "has det F = " + io::format_number(J) +
+             " (a deformation gradient keeps the area ratio det F > 0)";
+  }
+  return {};
+}
+
+/// The bounds a sweep input allows for a path's end (schemas/sweep.schema.json): Green-Lagrange
+/// end strains of biaxial and uniaxial paths in (-0.5, 2] (1 + 2E > 0: a real stretch), the
+/// shear angle of a pure-shear path in (0, 80) degrees. Every writer (sweep, synth, fit) puts 0
+/// into the components a kind does not use (load_paths.hpp).
+constexpr double kMinEndStrain = -0.5;  // excluded
+constexpr double kMaxEndStrain = 2.0;
+constexpr double kMaxShearAngle = 80.0 * 3.14159265358979323846 / 180.0;  // rad, excluded
+
+/// Why the end of path `p` (its attributes target, axis and H, read from the file) is none a
+/// sweep runs, in the words of the reader's message ("attribute target[0] is 1e+300, ..."), or
+/// "" when it is one. A red team after session 52: a target of 1e300, an axis of 99 on an
+/// old-format database went through `knit-meso fit` into the refitted file with exit 0.
+std::string path_end_problem(const LoadPath& p) {
+  const auto num = [](double v) { return io::format_number(v); };
+  if (p.axis != 0 && p.axis != 1)
+    return "attribute axis is " + std::to_string(p.axis) +
+           ": it must be 0 (course) or 1 (wale) (a uniaxial path's prescribed direction; 0 on "
+           "other paths)";
+  // Which target components the kind uses, and their range.
+  bool used[2] = {false, false};
+  if (p.kind == PathKind::kBiaxial) used[0] = used[1] = true;
+  if (p.kind == PathKind::kShear || p.kind == PathKind::kUniaxial) used[0] = true;
+  for (int c = 0; c < 2; ++c) {
+    const double t = p.target(c);
+    const std::string at = "attribute target[" + std::to_string(c) + "] is " + num(t);
+    if (!used[c]) {
+      if (t != 0.0)
+        return at + ", but a " + to_string(p.kind) + " path does not use it (written as 0)";
+    } else if (p.kind == PathKind::kShear) {
+      if (!(t > 0.0 && t < kMaxShearAngle))
+        return at + ": a shear path's end angle must be in (0, " + num(kMaxShearAngle) +
+               ") rad, (0, 80) degrees (schemas/sweep.schema.json)";
+    } else if (!(t > kMinEndStrain && t <= kMaxEndStrain)) {
+      return at + ": a " + to_string(p.kind) + " path's end Green-Lagrange strain must be in (" +
+             num(kMinEndStrain) + ", " + num(kMaxEndStrain) + "] (schemas/sweep.schema.json)";
+    }
+  }
+  // H: F = I + t H on a gradient path, zeros elsewhere. Its end must be a deformation
+  // (det(I + H) > 0) within the bound of a database's F.
+  if (p.H.cwiseAbs().maxCoeff() > kMaxRawKinematic)
+    return "attribute H holds |value| " + num(p.H.cwiseAbs().maxCoeff()) + " (at most 1e3, as F)";
+  if (p.kind == PathKind::kGradient) {
+    const double J = (1.0 + p.H(0, 0)) * (1.0 + p.H(1, 1)) - p.H(0, 1) * p.H(1, 0);
+    if (!(J > 0.0))
+      return "attribute H ends the gradient path at det(I + H) = " + num(J) +
+             " (a deformation keeps det F > 0)";
+  } else if (!p.H.isZero(0.0)) {
+    return "attribute H is not zero, but a " + to_string(p.kind) + " path does not use it";
+  }
   return {};
 }
 
@@ -508,13 +570,14 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
             throw InputError(
                 fname, p,
                 "attribute set '" + r.path.set + "' is not one of paper, coverage, holdout");
-          if (r.path.kind == PathKind::kUniaxial && r.path.axis != 0 && r.path.axis != 1)
-            throw InputError(fname, p, "attribute axis must be 0 or 1 for a uniaxial path");
           const auto t = f.attribute_doubles(p, "target");
           if (t.size() != 2) throw InputError(fname, p, "attribute target must have 2 values");
           r.path.target = {t[0], t[1]};
           if (!r.path.target.allFinite())
             throw InputError(fname, p, "attribute target must be finite");
+          // Every format version (format 3 files edited with checksums kept included).
+          if (const std::string why = path_end_problem(r.path); !why.empty())
+            throw InputError(fname, p, why + ": a damaged database");
           r.path.steps = f.attribute_int(p, "steps");
           for (const char* d : {"F", "P", "E", "S", "status"}) require_dataset(p + "/" + d);
           r.F = f.read_matrix(p + "/F");

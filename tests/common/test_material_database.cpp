@@ -38,7 +38,10 @@ Database small_db() {
     for (const auto& p : default_load_paths(4)) {
       RawPath r;
       r.path = p;
-      r.F = RowMatrixX::Random(4, 4);
+      // F near I: a deformation gradient (det F > 0), as the reader requires of a converged step.
+      r.F = 0.2 * RowMatrixX::Random(4, 4);
+      r.F.col(0).array() += 1.0;
+      r.F.col(3).array() += 1.0;
       r.P = RowMatrixX::Random(4, 4);
       r.E = RowMatrixX::Random(4, 3);
       r.S = RowMatrixX::Random(4, 3);
@@ -515,4 +518,84 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
     CHECK_THROWS_WITH(read_database(f, false).family(),
                       Catch::Contains("6.500000 mm has no fitted response surface"));
   }
+}
+
+// A red team after session 52: `knit-meso fit DB --law energy -o X` of an old-format database
+// (format_version 1 or 2: read unverified) carried into the refit a load-path target of 1e300,
+// an axis of 99 and a deformation gradient of zeros, exit 0. The reader refuses them in every
+// format version: here in a current-format file edited through knit's own HDF5 layer (which
+// keeps its checksums, as a program using it could), and the same file labelled 2 and 1.
+TEST_CASE("database: raw load paths and steps no sweep writes are refused, every format",
+          "[unit]") {
+  const auto good = tmp("raw_values_good.h5");
+  write_database(good, small_db());
+  const auto bad = tmp("raw_values.h5");
+  const std::string p3 = "/loop_1/raw/path_03", p12 = "/loop_1/raw/path_12";  // biaxial, shear
+  using Mutation = std::function<void(knit::io::H5File&)>;
+  auto attribute = [](const std::string& path, const char* name, std::vector<double> v) {
+    return Mutation([=](knit::io::H5File& f) { f.set_attribute(path, name, v); });
+  };
+  auto raw_F_row = [&](int row, std::vector<double> v) {
+    return Mutation([=](knit::io::H5File& f) {
+      RowMatrixX F = f.read_matrix(p3 + "/F");
+      for (int c = 0; c < 4; ++c) F(row, c) = v[static_cast<std::size_t>(c)];
+      f.write(p3 + "/F", F);
+    });
+  };
+  const std::vector<std::pair<Mutation, std::string>> cases = {
+      {[&](knit::io::H5File& f) { f.set_attribute(p3, "axis", 99); },
+       p3 + ": attribute axis is 99: it must be 0 (course) or 1 (wale)"},
+      {[&](knit::io::H5File& f) { f.set_attribute(p3, "axis", -1); },
+       p3 + ": attribute axis is -1"},
+      {attribute(p3, "target", {1e300, 0.1}),
+       p3 + ": attribute target[0] is 1e+300: a biaxial path's end Green-Lagrange strain must "
+            "be in (-0.5, 2] (schemas/sweep.schema.json): a damaged database"},
+      {attribute(p3, "target", {0.1, -0.5}), p3 + ": attribute target[1] is -0.5: a biaxial"},
+      {attribute(p12, "target", {-0.2, 0.0}),
+       p12 + ": attribute target[0] is -0.2: a shear path's end angle must be in (0, "},
+      {attribute(p12, "target", {0.5, 1e300}),
+       p12 + ": attribute target[1] is 1e+300, but a shear path does not use it"},
+      {attribute(p3, "H", {0.0, 0.5, 0.0, 0.0}),
+       p3 + ": attribute H is not zero, but a biaxial path does not use it"},
+      {[&](knit::io::H5File& f) {
+         f.set_attribute(p3, "kind", "gradient");
+         f.set_attribute(p3, "target", std::vector<double>{0.0, 0.0});
+         f.set_attribute(p3, "H", std::vector<double>{-2.0, 0.0, 0.0, 0.0});
+       },
+       p3 + ": attribute H ends the gradient path at det(I + H) = -1"},
+      {raw_F_row(0, {0, 0, 0, 0}),
+       p3 + "/F: step 1 has det F = 0 (a deformation gradient keeps the area ratio det F > 0): "
+            "a damaged database"},
+      {raw_F_row(1, {1.1, 0, 0, -0.9}), p3 + "/F: step 2 has det F = -0.99"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    for (const int version : {3, 2, 1}) {
+      INFO("case " << i << ", format_version " << version);
+      fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        cases[i].first(f);
+        f.set_attribute(".", "format_version", version);
+      }
+      CHECK_THROWS_WITH(read_database(bad),
+                        Catch::StartsWith(bad.string() + ": " + cases[i].second));
+    }
+  }
+  // The edges that stay: a step that did not converge (path_03's step 3, status 1) may hold
+  // any F, and a shear path's end just below 80 degrees and a strain of 2 are a sweep's.
+  for (const Mutation& m : {raw_F_row(2, {0, 0, 0, 0}), attribute(p12, "target", {1.396, 0.0}),
+                            attribute(p3, "target", {2.0, -0.499})}) {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(bad);
+      m(f);
+    }
+    CHECK_NOTHROW(read_database(bad));
+  }
+  // The writer keeps the reader's rule (first_unstorable_step): a converged F of zeros is not
+  // written.
+  Database db = small_db();
+  db.entries[0].raw[1].F.row(0).setZero();
+  CHECK_THROWS_WITH(write_database(tmp("raw_values_unwritten.h5"), db),
+                    Catch::Contains("/loop_0/raw/path_01/F: step 1 has det F = 0"));
 }

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -598,4 +599,48 @@ TEST_CASE("knit-meso synth does not replace a database swept on the cell", "[uni
                                                 "on the unit cell"));
   CHECK(bytes(db) == before);
   fs::remove(db);
+}
+
+// A red team after session 52: `knit-meso fit DB --law energy -o X` of a format-2 database
+// carried a load-path target of 1e300, an axis of 99 and a deformation gradient of zeros into
+// X, a new database with checksums of its own, exit 0. Refused now at the read: exit 2, the
+// file and the HDF5 path named, X not created.
+TEST_CASE("knit-meso fit: raw values no sweep writes are refused, nothing written", "[unit]") {
+  const fs::path dir = scratch_dir();
+  const fs::path good = dir / "cli_fit_raw_good.h5", db = dir / "cli_fit_raw.h5",
+                 out = dir / "cli_fit_raw_out.h5", err = dir / "cli_fit_raw.err";
+  REQUIRE(run("synth --no-fit --no-coverage --steps 4 --loop-lengths 4.5,6.5 --out " +
+              good.string()) == 0);
+  const std::string p = "/loop_1/raw/path_03";
+  const std::vector<std::pair<std::function<void(knit::io::H5File&)>, std::string>> cases = {
+      {[&](knit::io::H5File& f) {
+         f.set_attribute(p, "target", std::vector<double>{1e300, 0.1});
+       },
+       p + ": attribute target[0] is 1e+300"},
+      {[&](knit::io::H5File& f) { f.set_attribute(p, "axis", 99); }, p + ": attribute axis is 99"},
+      {[&](knit::io::H5File& f) {
+         auto F = f.read_matrix(p + "/F");
+         F.setZero();
+         f.write(p + "/F", F);
+       },
+       p + "/F: step 1 has det F = 0"},
+  };
+  for (const auto& [change, what] : cases) {
+    INFO(what);
+    fs::copy_file(good, db, fs::copy_options::overwrite_existing);
+    {
+      auto f = knit::io::H5File::open_rw(db);
+      change(f);
+      f.set_attribute(".", "format_version", 2);
+    }
+    fs::remove(out);
+    std::string e;
+    CHECK(run_with_stderr("fit " + db.string() + " --law energy -o " + out.string(), err, e) == 2);
+    CHECK(e.find(db.string() + ": " + what) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+  // The intact file, labelled format 2 as well, is read (each refusal is its change's).
+  fs::copy_file(good, db, fs::copy_options::overwrite_existing);
+  knit::io::H5File::open_rw(db).set_attribute(".", "format_version", 2);
+  CHECK_NOTHROW(knit::material::read_database(db));
 }
