@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <tuple>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/hdf5.hpp"
@@ -598,4 +599,54 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
   db.entries[0].raw[1].F.row(0).setZero();
   CHECK_THROWS_WITH(write_database(tmp("raw_values_unwritten.h5"), db),
                     Catch::Contains("/loop_0/raw/path_01/F: step 1 has det F = 0"));
+}
+
+// A red team after session 52: /yarn@youngs_modulus = -800 in a format-2 file was read by
+// knit-macro (read_database(file, false)) and refitted by knit-meso fit, exit 0; only
+// finiteness was checked. The ranges are the cell parameters' (schemas/cell.schema.json).
+TEST_CASE("database: yarn attributes outside their physical range are refused", "[unit]") {
+  Database db = small_db();
+  db.yarn = {
+      {"diameter", 0.38}, {"youngs_modulus", 800.0}, {"poisson_ratio", 0.3}, {"friction", 0.15}};
+  const auto good = tmp("yarn_good.h5");
+  write_database(good, db);
+  REQUIRE_NOTHROW(read_database(good, false));
+  const auto bad = tmp("yarn_bad.h5");
+  const std::vector<std::tuple<const char*, double, std::string>> cases = {
+      {"youngs_modulus", -800.0,
+       "/yarn: attribute youngs_modulus is -800, but a yarn's Young's modulus is in [0.001, "
+       "1e8] MPa: a damaged database"},
+      {"youngs_modulus", 0.0, "/yarn: attribute youngs_modulus is 0, but"},
+      {"youngs_modulus", 1e300, "/yarn: attribute youngs_modulus is 1e+300, but"},
+      {"diameter", 0.0, "/yarn: attribute diameter is 0, but a yarn diameter is > 0 mm"},
+      {"diameter", -0.38, "/yarn: attribute diameter is -0.38, but"},
+      {"poisson_ratio", 0.5,
+       "/yarn: attribute poisson_ratio is 0.5, but a Poisson ratio is in "
+       "(-1, 0.5)"},
+      {"poisson_ratio", -1.0, "/yarn: attribute poisson_ratio is -1, but"},
+      {"friction", -0.15, "/yarn: attribute friction is -0.15, but a friction coefficient is >= 0"},
+  };
+  for (const auto& [name, value, what] : cases)
+    for (const int version : {3, 2}) {
+      INFO(name << " = " << value << ", format_version " << version);
+      fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+      {
+        auto f = knit::io::H5File::open_rw(bad);
+        f.set_attribute("/yarn", name, value);
+        f.set_attribute(".", "format_version", version);
+      }
+      // knit-macro's read (no raw data) and knit-meso fit's.
+      CHECK_THROWS_WITH(read_database(bad, false), Catch::StartsWith(bad.string() + ": " + what));
+      CHECK_THROWS_WITH(read_database(bad), Catch::StartsWith(bad.string() + ": " + what));
+    }
+  // The edges inside: a tiny but positive modulus and diameter, an auxetic ratio, no friction.
+  for (const auto& [name, value] :
+       std::vector<std::pair<const char*, double>>{{"youngs_modulus", 1e-3},
+                                                   {"diameter", 1e-3},
+                                                   {"poisson_ratio", -0.99},
+                                                   {"friction", 0.0}}) {
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    knit::io::H5File::open_rw(bad).set_attribute("/yarn", name, value);
+    CHECK_NOTHROW(read_database(bad, false));
+  }
 }

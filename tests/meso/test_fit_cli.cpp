@@ -602,9 +602,9 @@ TEST_CASE("knit-meso synth does not replace a database swept on the cell", "[uni
 }
 
 // A red team after session 52: `knit-meso fit DB --law energy -o X` of a format-2 database
-// carried a load-path target of 1e300, an axis of 99 and a deformation gradient of zeros into
-// X, a new database with checksums of its own, exit 0. Refused now at the read: exit 2, the
-// file and the HDF5 path named, X not created.
+// carried a load-path target of 1e300, an axis of 99, a deformation gradient of zeros and a
+// negative yarn modulus into X, a new database with checksums of its own, exit 0. Refused now at
+// the read: exit 2, the file and the HDF5 path named, X not created.
 TEST_CASE("knit-meso fit: raw values no sweep writes are refused, nothing written", "[unit]") {
   const fs::path dir = scratch_dir();
   const fs::path good = dir / "cli_fit_raw_good.h5", db = dir / "cli_fit_raw.h5",
@@ -624,6 +624,11 @@ TEST_CASE("knit-meso fit: raw values no sweep writes are refused, nothing writte
          f.write(p + "/F", F);
        },
        p + "/F: step 1 has det F = 0"},
+      // and the yarn's modulus (knit-macro's read refuses it too: test_common, "database: yarn
+      // attributes outside their physical range are refused").
+      {[&](knit::io::H5File& f) { f.set_attribute("/yarn", "youngs_modulus", -800.0); },
+       "/yarn: attribute youngs_modulus is -800, but a yarn's Young's modulus is in [0.001, 1e8] "
+       "MPa"},
   };
   for (const auto& [change, what] : cases) {
     INFO(what);
