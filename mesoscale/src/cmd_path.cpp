@@ -307,8 +307,12 @@ knit::cli::SubcommandRegistrar reg(
       // The contact's flags have the bounds of the same keys in --config (finite: below
       // 1e300; session 36's red team: --penalty 1e308 was taken here, refused there).
       const double finite = 1e300;
-      auto* kn = sub.add_option("--penalty", o->k_N_arg, "normal penalty stiffness k_N (MPa)")
-                     ->check(number(0, finite, Ends::kOpenLow));
+      // k_N in the cell's physical range (CellOptions::kMinPenalty, kMaxPenalty: 25-40000 MPa;
+      // 1e-300 ran a cell without contact, exit 0).
+      auto* kn = sub.add_option("--penalty", o->k_N_arg,
+                                "normal penalty stiffness k_N (MPa, default 1000)")
+                     ->check(number(knit::meso::homog::CellOptions::kMinPenalty,
+                                    knit::meso::homog::CellOptions::kMaxPenalty));
       auto* g0 = sub.add_option("--allowance", o->g0_arg, "penetration allowance g0 (mm)")
                      ->check(number(0, finite));
       auto* dl = sub.add_option("--delta", o->delta_arg, "quadratic onset width delta (mm)")

@@ -126,7 +126,7 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/analysis/degree", double(degree), 2, kMaxDegree, false, false},
       {"/analysis/slave_points_per_element", double(contact.slave_points_per_element), 1,
        kMaxSlavePoints, false, false},
-      {"/contact/penalty", p.k_N, 0, inf, true, false},
+      {"/contact/penalty", p.k_N, kMinPenalty, kMaxPenalty, false, false},
       {"/contact/allowance", p.g0, 0, inf, false, false},
       {"/contact/delta", p.delta, 0, inf, true, false},
       {"/contact/soft_penalty", p.k_0, 0, inf, false, false},
@@ -192,7 +192,8 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
       o.contact.reference = r == "none" ? contact::ContactOptions::Reference::kNone
                                         : contact::ContactOptions::Reference::kInitialOverlap;
     }
-    R.num(c, "/contact", "penalty", o.contact.penalty.k_N, 0, inf, true);
+    R.num(c, "/contact", "penalty", o.contact.penalty.k_N, CellOptions::kMinPenalty,
+          CellOptions::kMaxPenalty, false);
     R.num(c, "/contact", "allowance", o.contact.penalty.g0, 0, inf, false);
     R.num(c, "/contact", "delta", o.contact.penalty.delta, 0, inf, true);
     R.num(c, "/contact", "soft_penalty", o.contact.penalty.k_0, 0, inf, false);

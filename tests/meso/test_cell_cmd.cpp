@@ -149,7 +149,13 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"cell --loop-length 4.5 --gamma-over-w 1.5", "--gamma-over-w", "in [0, 1]"},
       {"cell --loop-length inf", "--loop-length", "in (0, 50]"},
       {"cell --loop-length 4.5 --diameter -0.38", "--diameter", "> 0"},
-      {"path --loop-length 4.5 --shear 5 --penalty -5", "--penalty", "> 0"},
+      {"path --loop-length 4.5 --shear 5 --penalty -5", "--penalty", "in [25, 40000]"},
+      // A red team after session 52: 1e-300 ran a cell without contact, exit 0 (the range is
+      // CellOptions::kMinPenalty, kMaxPenalty: docs/unit-cell.md).
+      {"path --loop-length 4.5 --shear 5 --penalty 1e-300", "--penalty",
+       "--penalty: must be in [25, 40000], got 1e-300"},
+      {"path --loop-length 4.5 --shear 5 --penalty 24", "--penalty", "in [25, 40000], got 24"},
+      {"path --loop-length 4.5 --shear 5 --penalty 40001", "--penalty", "in [25, 40000]"},
       {"path --loop-length 4.5 --shear 5 --mu -1", "--mu", ">= 0"},
       // (session 38's red team: "must be a finite number >= 0 and finite (at most 1e300)")
       {"path --loop-length 4.5 --shear 5 --mu nan", "--mu",
@@ -178,8 +184,7 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"cell --loop-length 0x4", "--loop-length", "must be a number in (0, 50], got \"0x4\""},
       {"cell --loop-length ' 4.5'", "--loop-length", "must be a number in (0, 50]"},
       {"cell --loop-length 4.5 --diameter 0x1p-2", "--diameter", "got \"0x1p-2\""},
-      {"path --loop-length 4.5 --shear 5 --penalty 1e308", "--penalty",
-       "> 0 and finite (at most 1e300)"},
+      {"path --loop-length 4.5 --shear 5 --penalty 1e308", "--penalty", "in [25, 40000]"},
       {"path --loop-length 4.5 --shear 5 --mu 1e301", "--mu", ">= 0 and finite (at most 1e300)"},
       // Session 24: a NaN residual of the loop-length match passed its test (the cell was
       // written with a measured length of NaN, exit 0); a loop too short for its yarn was exit

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "knit/core/errors.hpp"
@@ -194,4 +195,36 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
     }
   }
   CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e-3}})")));
+}
+
+// A red team after session 52: `knit-meso path --penalty 1e-300` ran a cell without contact
+// and ended with exit 0 (k_N was only required > 0). The penalty's range is a factor 10
+// beyond the calibrated 250-4000 MPa (docs/unit-cell.md, "Ranges and sources"), in the cell
+// file, in validate() (the command line, the sweep's cell and PeriodicCell) and the schema.
+TEST_CASE("cell options: a contact penalty outside its physical range is refused", "[unit]") {
+  CHECK(CellOptions::kMinPenalty == 25.0);
+  CHECK(CellOptions::kMaxPenalty == 4e4);
+  for (const double k : {1e-300, 1.0, 24.99, 40000.5, 1e30}) {
+    INFO("k_N = " << k);
+    CellOptions o;
+    o.contact.penalty.k_N = k;
+    const auto bad = o.validate();
+    REQUIRE(bad.has_value());
+    CHECK(bad->pointer == "/contact/penalty");
+    CHECK(bad->message.find("in [25, 40000]") != std::string::npos);
+    CHECK_THROWS_AS(PeriodicCell(4.5, o), std::invalid_argument);
+    std::ostringstream text;
+    text << R"({"contact": {"penalty": )" << k << "}}";
+    const auto f = write_tmp("cell_cfg_penalty.json", text.str());
+    CHECK_THROWS_WITH(read_cell_options(f), Catch::StartsWith(f + ": /contact/penalty: must be"));
+  }
+  for (const double k : {25.0, 250.0, 4000.0, 40000.0}) {  // the ends and the calibrated range
+    CellOptions o;
+    o.contact.penalty.k_N = k;
+    CHECK_FALSE(o.validate().has_value());
+    std::ostringstream text;
+    text << R"({"contact": {"penalty": )" << k << "}}";
+    CHECK(read_cell_options(write_tmp("cell_cfg_penalty.json", text.str())).contact.penalty.k_N ==
+          k);
+  }
 }

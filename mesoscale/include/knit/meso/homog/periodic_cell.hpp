@@ -79,6 +79,16 @@ struct CellOptions {
   static constexpr int kMaxIterations = 1000;  ///< max_iterations and equilibration_steps
   static constexpr int kMaxCutbacks = 30;      ///< 2^-30 of a step
 
+  /// Range of the normal contact penalty k_N (MPa; schemas/cell.schema.json "penalty",
+  /// `knit-meso path --penalty`): a factor 10 beyond the range calibrated in docs/unit-cell.md
+  /// ("Ranges and sources": 250-4000 MPa, default 1000) on either side. A penalty is no
+  /// material value; below this the yarns sink into each other (at 250 MPa already 0.775 d on
+  /// the (0.4, 0.4) path at 4.5 mm), and 1e-300 ran a cell without contact with exit 0 (a red
+  /// team after session 52); above it the penalty is 50 times the yarn's modulus and only
+  /// stiffens the Newton iteration.
+  static constexpr double kMinPenalty = 25.0;
+  static constexpr double kMaxPenalty = 4.0e4;
+
   /// Checks every field for finiteness and against the range of schemas/cell.schema.json
   /// (implemented beside the JSON reader, homog_cell_config.cpp); the first bad field, or
   /// nothing. The reader, the command line and PeriodicCell use it, so no value is ever
