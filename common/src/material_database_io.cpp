@@ -37,7 +37,7 @@ std::string raw_step_problem(const char* d, const RowMatrixX& m, Eigen::Index s)
     return "holds |value| " + io::format_number(v) + " (F, E at most 1e3; P, S at most 1e9 MPa)";
   // A deformation gradient keeps the cell's area ratio J = det F > 0 (F11 F22 - F12 F21 in the
   // row's order F11, F12, F21, F22): J <= 0 is a cell turned inside out or collapsed, and an F
-  // of zeros is none at all (a red team after session 52: F = 0 in a format-2 file was
+  // of zeros is none at all (session 53's red team: F = 0 in a format-2 file was
   // refitted with exit 0).
   if (*d == 'F' && m.cols() == 4) {
     const double J = m(s, 0) * m(s, 3) - m(s, 1) * m(s, 2);
@@ -58,7 +58,7 @@ constexpr double kMaxShearAngle = 80.0 * 3.14159265358979323846 / 180.0;  // rad
 
 /// Why the end of path `p` (its attributes target, axis and H, read from the file) is none a
 /// sweep runs, in the words of the reader's message ("attribute target[0] is 1e+300, ..."), or
-/// "" when it is one. A red team after session 52: a target of 1e300, an axis of 99 on an
+/// "" when it is one. Session 53's red team: a target of 1e300, an axis of 99 on an
 /// old-format database went through `knit-meso fit` into the refitted file with exit 0.
 std::string path_end_problem(const LoadPath& p) {
   const auto num = [](double v) { return io::format_number(v); };
@@ -103,8 +103,8 @@ std::string path_end_problem(const LoadPath& p) {
 /// The range a yarn attribute (/yarn@name) must be in, when `v` is outside it; "" when it is
 /// inside. The ranges of the cell parameters the sweep takes them from (schemas/cell.schema.json,
 /// CellOptions::validate): diameter > 0 mm, youngs_modulus in [1e-3, 1e8] MPa, poisson_ratio in
-/// (-1, 0.5), friction >= 0. Other names (none is written today) need only be finite. A red
-/// team after session 52: youngs_modulus -800 in a format-2 file was read by knit-macro and
+/// (-1, 0.5), friction >= 0. Other names (none is written today) need only be finite. Session
+/// 53's red team: youngs_modulus -800 in a format-2 file was read by knit-macro and
 /// refitted by knit-meso fit into a new database, exit 0.
 std::string yarn_value_problem(const std::string& name, double v) {
   if (name == "diameter" && !(v > 0.0)) return "a yarn diameter is > 0 mm";

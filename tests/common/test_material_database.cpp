@@ -521,7 +521,7 @@ TEST_CASE("database: bad files give errors that name what is wrong", "[unit]") {
   }
 }
 
-// A red team after session 52: `knit-meso fit DB --law energy -o X` of an old-format database
+// Session 53's red team: `knit-meso fit DB --law energy -o X` of an old-format database
 // (format_version 1 or 2: read unverified) carried into the refit a load-path target of 1e300,
 // an axis of 99 and a deformation gradient of zeros, exit 0. The reader refuses them in every
 // format version: here in a current-format file edited through knit's own HDF5 layer (which
@@ -601,7 +601,7 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
                     Catch::Contains("/loop_0/raw/path_01/F: step 1 has det F = 0"));
 }
 
-// A red team after session 52: /yarn@youngs_modulus = -800 in a format-2 file was read by
+// Session 53's red team: /yarn@youngs_modulus = -800 in a format-2 file was read by
 // knit-macro (read_database(file, false)) and refitted by knit-meso fit, exit 0; only
 // finiteness was checked. The ranges are the cell parameters' (schemas/cell.schema.json).
 TEST_CASE("database: yarn attributes outside their physical range are refused", "[unit]") {

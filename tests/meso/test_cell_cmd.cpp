@@ -150,7 +150,7 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       {"cell --loop-length inf", "--loop-length", "in (0, 50]"},
       {"cell --loop-length 4.5 --diameter -0.38", "--diameter", "> 0"},
       {"path --loop-length 4.5 --shear 5 --penalty -5", "--penalty", "in [25, 40000]"},
-      // A red team after session 52: 1e-300 ran a cell without contact, exit 0 (the range is
+      // Session 53's red team: 1e-300 ran a cell without contact, exit 0 (the range is
       // CellOptions::kMinPenalty, kMaxPenalty: docs/unit-cell.md).
       {"path --loop-length 4.5 --shear 5 --penalty 1e-300", "--penalty",
        "--penalty: must be in [25, 40000], got 1e-300"},

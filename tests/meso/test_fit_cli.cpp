@@ -601,7 +601,7 @@ TEST_CASE("knit-meso synth does not replace a database swept on the cell", "[uni
   fs::remove(db);
 }
 
-// A red team after session 52: `knit-meso fit DB --law energy -o X` of a format-2 database
+// Session 53's red team: `knit-meso fit DB --law energy -o X` of a format-2 database
 // carried a load-path target of 1e300, an axis of 99, a deformation gradient of zeros and a
 // negative yarn modulus into X, a new database with checksums of its own, exit 0. Refused now at
 // the read: exit 2, the file and the HDF5 path named, X not created.

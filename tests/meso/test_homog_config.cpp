@@ -197,7 +197,7 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
   CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_max.json", R"({"yarn": {"E": 1e-3}})")));
 }
 
-// A red team after session 52: `knit-meso path --penalty 1e-300` ran a cell without contact
+// Session 53's red team: `knit-meso path --penalty 1e-300` ran a cell without contact
 // and ended with exit 0 (k_N was only required > 0). The penalty's range is a factor 10
 // beyond the calibrated 250-4000 MPa (docs/unit-cell.md, "Ranges and sources"), in the cell
 // file, in validate() (the command line, the sweep's cell and PeriodicCell) and the schema.

@@ -83,8 +83,8 @@ struct CellOptions {
   /// `knit-meso path --penalty`): a factor 10 beyond the range calibrated in docs/unit-cell.md
   /// ("Ranges and sources": 250-4000 MPa, default 1000) on either side. A penalty is no
   /// material value; below this the yarns sink into each other (at 250 MPa already 0.775 d on
-  /// the (0.4, 0.4) path at 4.5 mm), and 1e-300 ran a cell without contact with exit 0 (a red
-  /// team after session 52); above it the penalty is 50 times the yarn's modulus and only
+  /// the (0.4, 0.4) path at 4.5 mm), and 1e-300 ran a cell without contact with exit 0 (session
+  /// 53's red team); above it the penalty is 50 times the yarn's modulus and only
   /// stiffens the Newton iteration.
   static constexpr double kMinPenalty = 25.0;
   static constexpr double kMaxPenalty = 4.0e4;
