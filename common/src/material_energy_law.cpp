@@ -172,8 +172,10 @@ EnergyLawAt::EnergyLawAt(const EnergyLawData& d, double l, bool with_l_derivativ
       for (int k = 0; k < w.count; ++k) th.push_back(d.network.theta_row(w.j[k]));
       if (w.count == 3 && kernel != LanesKernel::kPortable && NetworkLanesAt::six_lane_kernel()) {
         // One six-lane pass in a wide kernel: AVX-512 (session 48: 2.6e6 per second, against
-        // 1.8e6 for the split below) or AVX2 with FMA (session 51: 1.78-1.79e6, against
-        // 1.45-1.48e6 for the split).
+        // 1.8e6 for the four-plus-two passes below) or AVX2 with FMA (lanes6s_avx2, session 53:
+        // 2.70-2.76e6 with the AVX2 kernels forced on a processor with AVX-512; session 51's
+        // six-lane AVX2 pass: 1.78-1.79e6 on one without it, against 1.45-1.48e6 for the four
+        // plus two).
         lanes_ = NetworkLanesAt(d.network.shape, th[0], th[1], th[2],
                                 Eigen::Vector3d(w.c[0], w.c[1], w.c[2]), kernel);
       } else if (w.count == 3) {

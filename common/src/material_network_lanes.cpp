@@ -506,7 +506,7 @@ inline int split_block_a(int h1, int h2) {
 }
 
 /// Six lanes with AVX2, split (session 53): lanes 0-3 in lanes4_body's four-lane layout, then
-/// lanes 4 and 5 two units to a vector (lanes2p_body). In a rounding window 2.72-2.76e6
+/// lanes 4 and 5 two units to a vector (lanes2p_body). In a rounding window 2.70-2.76e6
 /// evaluations of the law per second against 2.28-2.31e6 for v6 (a unit's six lanes in a
 /// 256-bit and a 128-bit vector; the same hour, AVX2 kernels forced on an AMD EPYC with
 /// AVX-512; docs/database.md "Without AVX-512").

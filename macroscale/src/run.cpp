@@ -18,36 +18,58 @@ namespace knit::macro {
 std::string gauge_length_warning(const Case& c) {
   if (!c.output.applied || !c.output.applied->at_edge) return {};
   const AppliedDisplacement& a = *c.output.applied;
-  const int i = a.component;
+  const auto i = static_cast<std::size_t>(a.component);
   const Edge opposite = a.edge == Edge::kU0   ? Edge::kU1
                         : a.edge == Edge::kU1 ? Edge::kU0
                         : a.edge == Edge::kV0 ? Edge::kV1
                                               : Edge::kV0;
-  bool held = false;
+  bool held = false, moving = false;
   for (const BoundaryCondition& bc : c.bcs)
-    held = held || (bc.target == BoundaryCondition::Target::kEdge && bc.edge == opposite &&
-                    (bc.fix[static_cast<std::size_t>(i)] ||
-                     bc.prescribe[static_cast<std::size_t>(i)].has_value()));
+    if (bc.target == BoundaryCondition::Target::kEdge && bc.edge == opposite) {
+      held = held || bc.fix[i] || bc.prescribe[i].has_value();
+      moving = moving || (!bc.fix[i] && bc.prescribe[i].has_value() && *bc.prescribe[i] != 0.0);
+    }
   if (!held) return {};
+  const std::string length = unit_labels(c.units).of("mm");
+  if (moving)  // (the review of session 53: two jaws pulled apart read half their strain)
+    return "/output/applied_displacement: the opposite edge " + edge_name(opposite) +
+           " is prescribed a displacement along " + "xyz"[i] +
+           " too: the curve's strain is this edge's displacement over the gauge length and "
+           "leaves the other jaw's out (two jaws pulled apart by equal amounts read half the "
+           "strain between them); hold the opposite edge, or read the strain accordingly";
+  // Each edge's control points: their mean, and their spread along the component.
   const Eigen::MatrixXd& P = c.surface.control_points();
   const int nu = c.surface.size_u(), nv = c.surface.size_v();
+  double spread = 0.0;
   const auto mean = [&](Edge e) {
     const std::vector<int> row = edge_row(nu, nv, e, 0);
-    double sum = 0.0;
-    for (int k : row) sum += P(k, i);
-    return sum / static_cast<double>(row.size());
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(P.cols());
+    double lo = P(row.front(), static_cast<Eigen::Index>(i)), hi = lo;
+    for (int k : row) {
+      sum += P.row(k).transpose();
+      lo = std::min(lo, P(k, static_cast<Eigen::Index>(i)));
+      hi = std::max(hi, P(k, static_cast<Eigen::Index>(i)));
+    }
+    spread = std::max(spread, hi - lo);
+    return Eigen::VectorXd(sum / static_cast<double>(row.size()));
   };
-  const double d = std::abs(mean(a.edge) - mean(opposite));
-  if (!(d > 0.0) || std::abs(a.gauge_length - d) <= kGaugeJawTolerance * d) return {};
-  const std::string length = unit_labels(c.units).of("mm");
+  const Eigen::VectorXd delta = mean(a.edge) - mean(opposite);
+  const double d = std::abs(delta(static_cast<Eigen::Index>(i)));
+  // Judged only where the component separates the edges (at least half their offset lies
+  // along it: a load along the edges, a shear, is not) and both edges are straight across it
+  // (their control points spread along it by at most the tolerance of d: a curved edge's mean
+  // depends on the refinement and the weights). The review of session 53: a top edge offset
+  // by 2 mm and pulled along itself was told to take 2 mm as its gauge length.
+  if (!(d > 0.0) || d < 0.5 * delta.norm() || spread > kGaugeJawTolerance * d ||
+      std::abs(a.gauge_length - d) <= kGaugeJawTolerance * d)
+    return {};
   std::ostringstream s;
   s.precision(6);
   s << "/output/applied_displacement/gauge_length: " << a.gauge_length << " " << length
     << ", but the loaded edge " << edge_name(a.edge) << " lies " << d << " " << length
     << " from the held edge " << edge_name(opposite) << " along "
     << "xyz"[i] << " (more than " << 100 * kGaugeJawTolerance
-    << " % apart): the curve's strain is the applied displacement over the gauge length, "
-       "here "
+    << " % apart): the curve's strain is the applied displacement over the gauge length, here "
     << d / a.gauge_length << " times the strain between the jaws; give " << d
     << " if the jaws hold these edges";
   return s.str();

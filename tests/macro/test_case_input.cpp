@@ -1621,6 +1621,33 @@ TEST_CASE("a gauge length other than the jaws' distance is named as a warning", 
                                  " mm, but the loaded edge v1 lies 50 mm from the held edge v0 "
                                  "along y (more than 1 % apart)"));
   }
+  // The review of session 53: a top edge offset by 2 mm in x and pulled along x (a shear) was
+  // told to take 2 mm as its gauge length; a load along the edges is not judged.
+  json shear = verification_case("tensile_svk.json");
+  shear["geometry"]["control_points"][2][0] = 2.0;
+  shear["geometry"]["control_points"][3][0] = 52.0;
+  shear["boundary_conditions"][1]["fix"] = json::array({"y", "z"});
+  shear["boundary_conditions"][1]["prescribe"] = json::parse(R"({"x": 5.0})");
+  shear["output"]["applied_displacement"]["component"] = "x";
+  CHECK(gauge_length_warning(parse_case(shear.dump(), "shear.json")).empty());
+  // Nor is a curved edge (its control points' mean depends on the refinement): v1 bulging to
+  // y = 60 through a quadratic edge, gauge 40.
+  json curved = verification_case("tensile_svk.json");
+  curved["geometry"]["degrees"] = json::array({2, 1});
+  curved["geometry"]["knots_u"] = json::array({0, 0, 0, 1, 1, 1});
+  curved["geometry"]["control_points"] = json::parse(
+      "[[0, 0, 0], [25, 0, 0], [50, 0, 0], "
+      "[0, 50, 0], [25, 70, 0], [50, 50, 0]]");
+  curved["output"]["applied_displacement"]["gauge_length"] = 40.0;
+  CHECK(gauge_length_warning(parse_case(curved.dump(), "curved.json")).empty());
+  // Two jaws pulled apart: the curve's strain leaves the other jaw's motion out.
+  json two = verification_case("tensile_svk.json");
+  two["boundary_conditions"][0]["fix"] = json::array({"x", "z"});
+  two["boundary_conditions"][0]["prescribe"] = json::parse(R"({"y": -7.5})");
+  two["boundary_conditions"].push_back(json::parse(R"({"corner": "u0v0", "fix": ["x"]})"));
+  CHECK_THAT(gauge_length_warning(parse_case(two.dump(), "two.json")),
+             Catch::StartsWith("/output/applied_displacement: the opposite edge v0 is prescribed "
+                               "a displacement along y too"));
   // Not judged: the opposite edge not held in that component (no second jaw in the patch).
   j["boundary_conditions"][0]["fix"] = json::array({"x", "z"});
   j["boundary_conditions"].push_back(json::parse(R"({"corner": "u0v0", "fix": ["y"]})"));

@@ -73,8 +73,11 @@ class NetworkLanesAt {
   std::vector<double> packed_;
   /// Per lane: weight omega_k and Q = L L^T (upper triangle: 00, 01, 02, 11, 12, 22).
   std::vector<double> omega_, Q_;
-  /// The same, unit-major for the wide kernel: [field][unit][lane], width_ lanes (the lanes
-  /// beyond K_ copies of lane 0, not summed; empty when the portable code evaluates).
+  /// The same for the wide kernel (empty when the portable code evaluates): unit-major,
+  /// [field][unit][lane], width_ lanes (the lanes beyond K_ copies of lane 0, not summed); for
+  /// six lanes in the AVX2 kernel (lanes6s_avx2) instead a four-lane block of lanes 0-3, then
+  /// lanes 4-5 two units to a vector ([field][unit pair][unit of the pair, lane]; a layer of
+  /// odd size padded with a zero unit), width_ 8 with no lanes 6-7 stored.
   std::vector<double> packed4_;
   WideKernel wide_ = nullptr;
   double W0_ = 0.0;

@@ -42,11 +42,14 @@ struct Problem {
 /// The gauge length against the jaws (session 53): for an applied displacement on an edge whose
 /// opposite edge an edge condition fixes or prescribes in the same component, "POINTER: what"
 /// if the gauge length differs from the distance between the two edges along that component
-/// (the mean of each edge's control points) by more than kGaugeJawTolerance of it, else empty.
-/// The strain in load_strain.csv is the applied displacement over the gauge length, so a gauge
-/// that is not the jaws' distance scales every strain of the curve without a word. Not judged:
-/// a corner (the paper's corner-loaded cases take half the diagonal), an opposite edge held by
-/// a symmetry plane or not held (a half model's jaws are not both in the patch).
+/// (the mean of each edge's control points) by more than kGaugeJawTolerance of it, or if the
+/// opposite edge is prescribed a nonzero displacement there too (the curve's strain leaves that
+/// jaw's motion out); else empty. The strain in load_strain.csv is the applied displacement
+/// over the gauge length, so a gauge that is not the jaws' distance scales every strain of the
+/// curve without a word. Not judged: a corner (the paper's corner-loaded cases take half the
+/// diagonal), an opposite edge held by a symmetry plane or not held (a half model's jaws are
+/// not both in the patch), a component that does not separate the edges (a load along them),
+/// and edges not straight across the component (a curved edge's control points).
 std::string gauge_length_warning(const Case& c);
 inline constexpr double kGaugeJawTolerance = 0.01;
 
