@@ -269,6 +269,33 @@ template <class VT, class F1, class VV, class WD>
     for (int m = 0; m < 6; ++m) C[m] += kdd * f1(5 + m, i);
   }
 }
+/// The kernel's output: W, S and C (upper triangle) plus the lanes' quadratic term 1/2 e^T Q e
+/// (Q's upper triangle at Qp, one vector per entry, `stride` doubles apart), stored as ten
+/// vectors `out_stride` doubles apart.
+template <class VT>
+[[gnu::always_inline]] inline void store_with_quadratic(const double* Qp, int stride,
+                                                        const double* e, VT W, VT S0, VT S1, VT S2,
+                                                        const VT* C, double* out, int out_stride) {
+  VT Qm[6];
+  for (int m = 0; m < 6; ++m) Qm[m] = ldv<VT>(Qp + stride * m);
+  const VT E0 = splatv<VT>(e[0]), E1 = splatv<VT>(e[1]), E2 = splatv<VT>(e[2]);
+  const VT Qe0 = Qm[0] * E0 + Qm[1] * E1 + Qm[2] * E2;
+  const VT Qe1 = Qm[1] * E0 + Qm[3] * E1 + Qm[4] * E2;
+  const VT Qe2 = Qm[2] * E0 + Qm[4] * E1 + Qm[5] * E2;
+  W += 0.5 * (E0 * Qe0 + E1 * Qe1 + E2 * Qe2);
+  const VT res[10] = {W,
+                      S0 + Qe0,
+                      S1 + Qe1,
+                      S2 + Qe2,
+                      C[0] + Qm[0],
+                      C[1] + Qm[1],
+                      C[2] + Qm[2],
+                      C[3] + Qm[3],
+                      C[4] + Qm[4],
+                      C[5] + Qm[5]};
+  for (int m = 0; m < 10; ++m) stv(out + out_stride * m, res[m]);
+}
+
 /// A second-layer unit vector's (w u')_r, with W += w u and S += (w u') A1_r.
 template <class VT, class F2>
 [[gnu::always_inline]] inline VT second_layer_sums(int r, F2 f2, VT u, VT du, VT& W, VT& S0, VT& S1,
@@ -346,24 +373,7 @@ template <class VT, int H1c, int H2c, int OS = kStride<VT>>
     grad_z_sums(j, H1, f1, vv, dh, g0, g1, g2);
     add_outer_upper(C, cj, g0, g1, g2);
   }
-  // 1/2 e^T Q e.
-  VT Qm[6];
-  for (int m = 0; m < 6; ++m) Qm[m] = ld4(Qp + L * m);
-  const VT Qe0 = Qm[0] * E0 + Qm[1] * E1 + Qm[2] * E2;
-  const VT Qe1 = Qm[1] * E0 + Qm[3] * E1 + Qm[4] * E2;
-  const VT Qe2 = Qm[2] * E0 + Qm[4] * E1 + Qm[5] * E2;
-  W += 0.5 * (E0 * Qe0 + E1 * Qe1 + E2 * Qe2);
-  const VT res[10] = {W,
-                      S0 + Qe0,
-                      S1 + Qe1,
-                      S2 + Qe2,
-                      C[0] + Qm[0],
-                      C[1] + Qm[1],
-                      C[2] + Qm[2],
-                      C[3] + Qm[3],
-                      C[4] + Qm[4],
-                      C[5] + Qm[5]};
-  for (int m = 0; m < 10; ++m) stv(out + OS * m, res[m]);
+  store_with_quadratic(Qp, L, e, W, S0, S1, S2, C, out, OS);
 }
 
 /// The kernel's entry points: 12 / 6 units (the default) with compiled sizes, any other shape
@@ -480,24 +490,7 @@ template <int H1c, int H2c>
     add_outer_upper(Cf, cj, fold(g0) + half(f2(0, r), s), fold(g1) + half(f2(1, r), s),
                     fold(g2) + half(f2(2, r), s));
   }
-  // 1/2 e^T Q e.
-  v2 Qm[6];
-  for (int m = 0; m < 6; ++m) Qm[m] = ldv<v2>(Qp + 2 * m);
-  const v2 e0 = splatv<v2>(e[0]), e1 = splatv<v2>(e[1]), e2 = splatv<v2>(e[2]);
-  const v2 Qe0 = Qm[0] * e0 + Qm[1] * e1 + Qm[2] * e2;
-  const v2 Qe1 = Qm[1] * e0 + Qm[3] * e1 + Qm[4] * e2;
-  const v2 Qe2 = Qm[2] * e0 + Qm[4] * e1 + Qm[5] * e2;
-  const v2 res[10] = {fold(W) + 0.5 * (e0 * Qe0 + e1 * Qe1 + e2 * Qe2),
-                      fold(S0) + Qe0,
-                      fold(S1) + Qe1,
-                      fold(S2) + Qe2,
-                      Cf[0] + Qm[0],
-                      Cf[1] + Qm[1],
-                      Cf[2] + Qm[2],
-                      Cf[3] + Qm[3],
-                      Cf[4] + Qm[4],
-                      Cf[5] + Qm[5]};
-  for (int m = 0; m < 10; ++m) stv(out + 8 * m + 4, res[m]);
+  store_with_quadratic(Qp, 2, e, fold(W), fold(S0), fold(S1), fold(S2), Cf, out + 4, 8);
 }
 
 /// Doubles of the four-lane block of the split six-lane layout (lanes4_body's, L = 4).
