@@ -319,8 +319,11 @@ knit::cli::SubcommandRegistrar reg(
                      ->check(number(0, finite, Ends::kOpenLow));
       auto* mu = sub.add_option("--mu", o->mu_arg, "Coulomb friction coefficient (default 0.15)")
                      ->check(number(0, finite));
-      auto* kt = sub.add_option("--stick", o->k_T_arg, "stick penalty k_T (MPa)")
-                     ->check(number(0, finite, Ends::kOpenLow));
+      // k_T likewise (kMinStickPenalty, kMaxStickPenalty: 2-40000 MPa; 1e-300 ran a
+      // frictionless cell, exit 0).
+      auto* kt = sub.add_option("--stick", o->k_T_arg, "stick penalty k_T (MPa, default 20)")
+                     ->check(number(knit::meso::homog::CellOptions::kMinStickPenalty,
+                                    knit::meso::homog::CellOptions::kMaxStickPenalty));
       sub.add_flag("--no-vtp", o->no_vtp, "skip the per-step VTP files");
       sub.add_option("--max-output-size", o->max_output_size,
                      "refuse the path before the run if its outputs are estimated above this "

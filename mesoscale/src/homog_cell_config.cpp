@@ -115,6 +115,18 @@ std::optional<CellOptionError> CellOptions::validate() const {
       << " (an allowance of a whole diameter lets yarns pass through each other without force)";
     return CellOptionError{"/contact/allowance", m.str()};
   }
+  // The onset widths likewise (session 54: /contact/delta 1e300 made the normal law's onset
+  // k x^2 / (2 delta) vanish and ran a cell without contact, exit 0; soft_delta 1e300 took the
+  // soft branch away): an onset as wide as the yarn is no onset.
+  for (const auto& [pointer, value] :
+       {std::pair{"/contact/delta", p.delta}, std::pair{"/contact/soft_delta", p.delta_0}}) {
+    if (std::isfinite(value) && std::isfinite(section.d) && section.d > 0 && value >= section.d) {
+      std::ostringstream m;
+      m << "must be smaller than the yarn diameter /yarn/d = " << section.d << " mm, got " << value
+        << " (an onset of a whole diameter leaves the yarns next to no contact force)";
+      return CellOptionError{pointer, m.str()};
+    }
+  }
   return check_ranges({
       // A yarn's Young's modulus in MPa (polymer fibres 1e2-1e5; steel 2e5): session 52's red
       // team gave 1e-308, and the cell ended with "residual is not finite", naming no field.
@@ -129,10 +141,10 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/contact/penalty", p.k_N, kMinPenalty, kMaxPenalty, false, false},
       {"/contact/allowance", p.g0, 0, inf, false, false},
       {"/contact/delta", p.delta, 0, inf, true, false},
-      {"/contact/soft_penalty", p.k_0, 0, inf, false, false},
+      {"/contact/soft_penalty", p.k_0, 0, kMaxSoftPenalty, false, false},
       {"/contact/soft_delta", p.delta_0, 0, inf, true, false},
       {"/contact/mu", f.mu, 0, inf, false, false},
-      {"/contact/stick_penalty", f.k_T, 0, inf, true, false},
+      {"/contact/stick_penalty", f.k_T, kMinStickPenalty, kMaxStickPenalty, false, false},
       {"/contact/margin", contact.margin, 0, inf, false, false},
       {"/contact/self_exclusion", contact.self_exclusion, 0, 1, true, false},
       {"/contact/max_overlap", contact.max_overlap, 0, 1, true, false},
@@ -196,10 +208,12 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
           CellOptions::kMaxPenalty, false);
     R.num(c, "/contact", "allowance", o.contact.penalty.g0, 0, inf, false);
     R.num(c, "/contact", "delta", o.contact.penalty.delta, 0, inf, true);
-    R.num(c, "/contact", "soft_penalty", o.contact.penalty.k_0, 0, inf, false);
+    R.num(c, "/contact", "soft_penalty", o.contact.penalty.k_0, 0, CellOptions::kMaxSoftPenalty,
+          false);
     R.num(c, "/contact", "soft_delta", o.contact.penalty.delta_0, 0, inf, true);
     R.num(c, "/contact", "mu", o.contact.friction.mu, 0, inf, false);
-    R.num(c, "/contact", "stick_penalty", o.contact.friction.k_T, 0, inf, true);
+    R.num(c, "/contact", "stick_penalty", o.contact.friction.k_T, CellOptions::kMinStickPenalty,
+          CellOptions::kMaxStickPenalty, false);
     R.num(c, "/contact", "margin", o.contact.margin, 0, inf, false);
     R.num(c, "/contact", "self_exclusion", o.contact.self_exclusion, 0, 1, true);
     R.num(c, "/contact", "max_overlap", o.contact.max_overlap, 0, 1, true);

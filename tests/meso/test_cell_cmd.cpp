@@ -176,7 +176,9 @@ TEST_CASE("knit-meso cell/path: every option is checked for finiteness and range
       // The cell's bound (CellOptions::kMaxElements, session 21), named as the flag.
       {"path --loop-length 4.5 --shear 5 --elements 2000", "--elements", "[4, 1024]"},
       {"path --loop-length 4.5 --shear 5 --allowance -0.1", "--allowance", ">= 0"},
-      {"path --loop-length 4.5 --shear 5 --stick 0", "--stick", "> 0"},
+      {"path --loop-length 4.5 --shear 5 --stick 0", "--stick", "in [2, 40000]"},
+      // Session 54: 1e-300 ran a frictionless cell with exit 0 (CellOptions::kMinStickPenalty).
+      {"path --loop-length 4.5 --shear 5 --stick 1e-300", "--stick", "in [2, 40000]"},
       {"path --loop-length 4.5 --shear 5 --delta 1e999", "--delta", "> 0"},
       {"sweep nothing.json --threads -3", "--threads", "[0, 4096]"},
       // Session 36's red team: hex and blanks were read by strtod ("0x4" as 4 mm), and the

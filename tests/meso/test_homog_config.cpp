@@ -228,3 +228,64 @@ TEST_CASE("cell options: a contact penalty outside its physical range is refused
           k);
   }
 }
+
+// Session 54 (the red team's list of session 53): `--stick 1e-300` ran a frictionless cell with
+// exit 0 (S22 on a 10 degree shear at 5.5 mm: 0.0156 MPa, as mu = 0, against 0.0406), a soft
+// branch of 1e300 MPa ended in "residual is not finite" naming no field, and an onset width
+// /contact/delta of 1e300 mm ran a cell without contact. Each field is refused now, in the cell
+// file (the schema and the reader), in validate() (the command line, the sweep's cell,
+// PeriodicCell), naming its pointer; the values at the ends of the ranges are taken.
+TEST_CASE(
+    "cell options: stick and soft penalties and onset widths outside their ranges are refused",
+    "[unit]") {
+  CHECK(CellOptions::kMinStickPenalty == 2.0);
+  CHECK(CellOptions::kMaxStickPenalty == 4e4);
+  CHECK(CellOptions::kMaxSoftPenalty == 5.0);
+  struct Bad {
+    const char* pointer;
+    double value;
+    void (*set)(CellOptions&, double);
+  };
+  const auto stick = [](CellOptions& o, double v) { o.contact.friction.k_T = v; };
+  const auto soft = [](CellOptions& o, double v) { o.contact.penalty.k_0 = v; };
+  const auto delta = [](CellOptions& o, double v) { o.contact.penalty.delta = v; };
+  const auto soft_delta = [](CellOptions& o, double v) { o.contact.penalty.delta_0 = v; };
+  const Bad bad[] = {{"/contact/stick_penalty", 1e-300, stick},
+                     {"/contact/stick_penalty", 1.99, stick},
+                     {"/contact/stick_penalty", 4.0001e4, stick},
+                     {"/contact/soft_penalty", 5.01, soft},
+                     {"/contact/soft_penalty", 1e300, soft},
+                     {"/contact/delta", 0.38, delta},
+                     {"/contact/delta", 1e300, delta},
+                     {"/contact/soft_delta", 0.5, soft_delta},
+                     {"/contact/soft_delta", 1e300, soft_delta}};
+  for (const Bad& b : bad) {
+    INFO(b.pointer << " = " << b.value);
+    CellOptions o;
+    b.set(o, b.value);
+    const auto why = o.validate();
+    REQUIRE(why.has_value());
+    CHECK(why->pointer == b.pointer);
+    CHECK_THROWS_AS(PeriodicCell(5.5, o), std::invalid_argument);
+    const std::string p = b.pointer;
+    const std::string key = p.substr(p.rfind('/') + 1);
+    std::ostringstream text;
+    text << R"({"contact": {")" << key << R"(": )" << b.value << "}}";
+    const auto f = write_tmp("cell_cfg_contact_range.json", text.str());
+    CHECK_THROWS_WITH(read_cell_options(f), Catch::StartsWith(f + ": " + p + ": must be"));
+  }
+  const Bad good[] = {
+      {"/contact/stick_penalty", 2.0, stick}, {"/contact/stick_penalty", 4e4, stick},
+      {"/contact/soft_penalty", 0.0, soft},   {"/contact/soft_penalty", 5.0, soft},
+      {"/contact/delta", 0.379, delta},       {"/contact/soft_delta", 0.379, soft_delta}};
+  for (const Bad& g : good) {
+    INFO(g.pointer << " = " << g.value);
+    CellOptions o;
+    g.set(o, g.value);
+    CHECK_FALSE(o.validate().has_value());
+    const std::string p = g.pointer;
+    std::ostringstream text;
+    text << R"({"contact": {")" << p.substr(p.rfind('/') + 1) << R"(": )" << g.value << "}}";
+    CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_contact_range.json", text.str())));
+  }
+}

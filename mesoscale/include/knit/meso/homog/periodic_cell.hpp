@@ -89,6 +89,22 @@ struct CellOptions {
   static constexpr double kMinPenalty = 25.0;
   static constexpr double kMaxPenalty = 4.0e4;
 
+  /// Range of the stick penalty k_T (MPa; schemas/cell.schema.json "stick_penalty", `knit-meso
+  /// path --stick`): a factor 10 below the default 20 MPa, up to k_N's bound. The elastic slip
+  /// before sliding is mu p / k_T: on a 10 degree shear at 5.5 mm, S22 is 0.0406 MPa at k_T =
+  /// 20-2000, 0.0235 at 2 and 0.0158 at 0.2, where mu = 0 gives 0.0156 (session 54); so below
+  /// this the regularization, not Coulomb's law, sets the friction, and 1e-300 ran a
+  /// frictionless cell with exit 0 (session 53's red team).
+  static constexpr double kMinStickPenalty = 2.0;
+  static constexpr double kMaxStickPenalty = 4.0e4;
+
+  /// Upper bound of the soft branch's slope k_0 inside the allowance (MPa; "soft_penalty"): a
+  /// factor 10 above the default 0.5 MPa. The branch is the "mild" penalty of the initial
+  /// penetrations (paper Sect. 2.1.2); on a 10 degree shear at 5.5 mm S22 is 0.041 MPa at
+  /// k_0 = 0.5, -0.005 at 5 and -0.019 at 50, and 1e300 ended in "residual is not finite"
+  /// naming no field (session 54). 0 (no soft branch) stays allowed.
+  static constexpr double kMaxSoftPenalty = 5.0;
+
   /// Checks every field for finiteness and against the range of schemas/cell.schema.json
   /// (implemented beside the JSON reader, homog_cell_config.cpp); the first bad field, or
   /// nothing. The reader, the command line and PeriodicCell use it, so no value is ever
