@@ -48,6 +48,41 @@ std::string raw_step_problem(const char* d, const RowMatrixX& m, Eigen::Index s)
   return {};
 }
 
+/// Why converged step s of `r` is no consistent state, in the words of the reader and the
+/// writer, or "" when it is one: its strain must be the Green-Lagrange strain of its F (eq. 9,
+/// E = (F^T F - I) / 2; columns E11, E22, E12) and its stress the second Piola-Kirchhoff stress
+/// of its F and P (eq. 9, S = sym(F^-1 P), as the sweep and synth write it; columns S11, S22,
+/// S12), to round-off (1e-9 of the terms' size). The fits take E and S, the report
+/// and the figures F and P: session 53's red team list, a hand-edited E or S was fitted with
+/// exit 0 while every plot of F and P showed the cell's curves. Called after raw_step_problem,
+/// so F is finite with det F > 0 and every number is bounded.
+std::string raw_consistency_problem(const RawPath& r, Eigen::Index s) {
+  if (r.F.cols() != 4 || r.P.cols() != 4 || r.E.cols() != 3 || r.S.cols() != 3) return {};
+  Eigen::Matrix2d F, P;
+  F << r.F(s, 0), r.F(s, 1), r.F(s, 2), r.F(s, 3);
+  P << r.P(s, 0), r.P(s, 1), r.P(s, 2), r.P(s, 3);
+  const auto num = [](double v) { return io::format_number(v); };
+  const Eigen::Matrix2d E = green_lagrange(F);
+  const Eigen::Vector3d e(E(0, 0), E(1, 1), E(0, 1));
+  const double de = (r.E.row(s).transpose() - e).cwiseAbs().maxCoeff();
+  if (!(de <= 1e-9 * (1.0 + F.cwiseAbs().maxCoeff() * F.cwiseAbs().maxCoeff())))
+    return "E: the stored strain differs by " + num(de) +
+           " from the Green-Lagrange strain of its F, (F^T F - I) / 2 = (" + num(e(0)) + ", " +
+           num(e(1)) + ", " + num(e(2)) + ") (E11, E22, E12; eq. 9)";
+  const Eigen::Matrix2d S = second_piola_kirchhoff(F, P);
+  const Eigen::Vector3d sv(S(0, 0), S(1, 1), S(0, 1));
+  const double ds = (r.S.row(s).transpose() - sv).cwiseAbs().maxCoeff();
+  // |F^-1| |P| bounds the round-off of F^-1 P (|F^-1| = |F| / det F for a 2 x 2 matrix).
+  const double J = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
+  const double size = F.cwiseAbs().rowwise().sum().maxCoeff() / J * P.cwiseAbs().maxCoeff() +
+                      r.S.row(s).cwiseAbs().maxCoeff();
+  if (!(ds <= 1e-9 * size))
+    return "S: the stored stress differs by " + num(ds) +
+           " MPa from the second Piola-Kirchhoff stress of its F and P, F^-1 P = (" + num(sv(0)) +
+           ", " + num(sv(1)) + ", " + num(sv(2)) + ") MPa (S11, S22, S12; eq. 9)";
+  return {};
+}
+
 /// The bounds a sweep input allows for a path's end (schemas/sweep.schema.json): Green-Lagrange
 /// end strains of biaxial and uniaxial paths in (-0.5, 2] (1 + 2E > 0: a real stretch), the
 /// shear angle of a pure-shear path in (0, 80) degrees. Every writer (sweep, synth, fit) puts 0
@@ -630,7 +665,17 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                     fname, p + "/" + d,
                     "step " + std::to_string(s + 1) + " " + why + ": a damaged database");
             }
+            if (const std::string why = raw_consistency_problem(r, s); !why.empty())
+              throw InputError(
+                  fname, p + "/" + why.substr(0, 1),
+                  "step " + std::to_string(s + 1) + ": " + why.substr(3) + ": a damaged database");
           }
+          // A path has at least one load step (schemas/sweep.schema.json: steps >= 1); one of
+          // no rows is no data (session 53's red team list: it was read).
+          if (n == 0)
+            throw InputError(fname, p + "/status",
+                             "the path has no load step (0 rows; a sweep's path has at least 1): "
+                             "a damaged database");
           // The path's planned steps are its rows (a stopped path keeps its unreached steps,
           // status 2): the red team's steps -3 on a 20-row path was read and written back.
           if (r.path.steps != n)
@@ -755,6 +800,11 @@ std::optional<std::string> first_unstorable_step(const Database& db) {
               return raw_path_location(k, q) + "/" + d + ": step " + std::to_string(s + 1) + " " +
                      (why == "not finite" ? "is not finite" : why);
           }
+        const bool complete = i < r.F.rows() && i < r.P.rows() && i < r.E.rows() && i < r.S.rows();
+        if (!complete) continue;
+        if (const std::string why = raw_consistency_problem(r, i); !why.empty())
+          return raw_path_location(k, q) + "/" + why.substr(0, 1) + ": step " +
+                 std::to_string(s + 1) + ": " + why.substr(3);
       }
     }
   return std::nullopt;

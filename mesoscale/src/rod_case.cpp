@@ -14,6 +14,7 @@
 #include "knit/io/atomic.hpp"
 #include "knit/io/csv.hpp"
 #include "knit/io/json_input.hpp"
+#include "knit/io/names.hpp"
 #include "knit/io/output_target.hpp"
 #include "knit/io/provenance.hpp"
 #include "knit/meso/rod/builders.hpp"
@@ -353,6 +354,9 @@ RodCase load_rod_case(const std::filesystem::path& path) {
         R.object(jp[i], ptr, {"name", "rod", "xi"}, {"name", "rod", "xi"});
         NamedPoint np;
         np.name = R.string(jp[i]["name"], ptr + "/name");
+        // A CSV column name (name_ux, ...): the same rule as knit-macro's output points
+        // (knit/io/names.hpp; session 54: "ti,p" passed here, refused there).
+        if (const auto problem = io::output_name_problem(np.name)) R.fail(ptr + "/name", *problem);
         if (!seen.insert(np.name).second)
           R.fail(ptr + "/name", "duplicate point name \"" + np.name + "\"");
         const std::string rod = R.string(jp[i]["rod"], ptr + "/rod");

@@ -31,8 +31,7 @@ TEST_CASE("fuzz: mutated database files load or throw InputError", "[unit][fuzz]
     r.F.col(1).setZero();  // F = 1.5 I: det F > 0, as the reader requires of a converged step
     r.F.col(2).setZero();
     r.P = RowMatrixX::Constant(2, 4, 0.25);
-    r.E = RowMatrixX::Constant(2, 3, 0.125);
-    r.S = RowMatrixX::Constant(2, 3, 2.0);
+    testing::set_strain_and_stress(r);  // E and S of F and P (eq. 9)
     r.status = {0, 1};
     e.raw.push_back(r);
   }

@@ -67,8 +67,7 @@ TEST_CASE("bench: loading the material database", "[.bench]") {
       r.F.col(0).array() += 1.0;
       r.F.col(3).array() += 1.0;
       r.P = RowMatrixX::Random(20, 4);
-      r.E = RowMatrixX::Random(20, 3);
-      r.S = RowMatrixX::Random(20, 3);
+      testing::set_strain_and_stress(r);  // E and S of F and P (eq. 9)
       r.status.assign(20, 0);
       e.raw.push_back(r);
     }

@@ -44,8 +44,7 @@ Database small_db() {
       r.F.col(0).array() += 1.0;
       r.F.col(3).array() += 1.0;
       r.P = RowMatrixX::Random(4, 4);
-      r.E = RowMatrixX::Random(4, 3);
-      r.S = RowMatrixX::Random(4, 3);
+      testing::set_strain_and_stress(r);  // E and S of F and P (eq. 9)
       r.status = {0, 0, 1, 0};
       e.raw.push_back(r);
     }
@@ -158,7 +157,13 @@ TEST_CASE("database: a converged step that is not finite is not written", "[unit
   CHECK_THAT(*first_unstorable_step(db),
              Catch::StartsWith("/loop_1/raw/path_03/S: step 2 holds |value| 1500000000 "));
   CHECK_THROWS(write_database(file, db));
-  db.entries[1].raw[3].S(1, 2) = 0.9e9;  // within the bound
+  db.entries[1].raw[3].S(1, 2) = 0.7e9;  // within the bound, and P = F S (eq. 9) to match
+  Eigen::Matrix2d F, S;
+  const auto& r = db.entries[1].raw[3];
+  F << r.F(1, 0), r.F(1, 1), r.F(1, 2), r.F(1, 3);
+  S << r.S(1, 0), r.S(1, 2), r.S(1, 2), r.S(1, 1);
+  const Eigen::Matrix2d P = first_piola_kirchhoff(F, S);
+  db.entries[1].raw[3].P.row(1) << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
   CHECK_FALSE(first_unstorable_step(db));
   CHECK(read_database(file).entries[1].raw[3].S.allFinite());
 }
@@ -543,6 +548,13 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
       f.write(p3 + "/F", F);
     });
   };
+  auto raw_add = [](const std::string& dataset, int row, int col, double dv) {
+    return Mutation([=](knit::io::H5File& f) {
+      RowMatrixX m = f.read_matrix(dataset);
+      m(row, col) += dv;
+      f.write(dataset, m);
+    });
+  };
   const std::vector<std::pair<Mutation, std::string>> cases = {
       {[&](knit::io::H5File& f) { f.set_attribute(p3, "axis", 99); },
        p3 + ": attribute axis is 99: it must be 0 (course) or 1 (wale)"},
@@ -568,6 +580,22 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
        p3 + "/F: step 1 has det F = 0 (a deformation gradient keeps the area ratio det F > 0): "
             "a damaged database"},
       {raw_F_row(1, {1.1, 0, 0, -0.9}), p3 + "/F: step 2 has det F = -0.99"},
+      // Session 54: E and S are F's and P's (eq. 9); the fits take E and S, the figures F and
+      // P, and an edited E or S was fitted with exit 0. A path of no rows was read.
+      {raw_add(p3 + "/E", 0, 2, 0.01),
+       p3 + "/E: step 1: the stored strain differs by 0.01 from the Green-Lagrange strain of its "
+            "F, (F^T F - I) / 2 = ("},
+      {raw_add(p3 + "/S", 1, 0, -0.02),
+       p3 + "/S: step 2: the stored stress differs by 0.02 MPa from the second Piola-Kirchhoff "
+            "stress of its F and P, F^-1 P = ("},
+      {raw_add(p3 + "/P", 3, 3, 0.05), p3 + "/S: step 4: the stored stress differs by "},
+      {[&](knit::io::H5File& f) {
+         f.set_attribute(p3, "steps", 0);
+         for (const char* d : {"F", "P"}) f.write(p3 + "/" + d, RowMatrixX(0, 4));
+         for (const char* d : {"E", "S"}) f.write(p3 + "/" + d, RowMatrixX(0, 3));
+         f.write(p3 + "/status", std::vector<int>{});
+       },
+       p3 + "/status: the path has no load step (0 rows"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     for (const int version : {3, 2, 1}) {

@@ -7,6 +7,7 @@
 #include "knit/io/hdf5.hpp"
 #include "knit/material/database.hpp"
 #include "knit/material/load_paths.hpp"
+#include "test_material_util.hpp"
 
 using namespace knit::material;
 namespace fs = std::filesystem;
@@ -229,10 +230,11 @@ RawPath raw(const LoadPath& p) {
   RawPath r;
   r.path = p;
   r.path.steps = 2;  // one row per planned step (the reader refuses others since session 47)
-  r.F = RowMatrixX::Random(2, 4);
+  r.F = 0.2 * RowMatrixX::Random(2, 4);  // near I: det F > 0 (session 53)
+  r.F.col(0).array() += 1.0;
+  r.F.col(3).array() += 1.0;
   r.P = RowMatrixX::Random(2, 4);
-  r.E = RowMatrixX::Random(2, 3);
-  r.S = RowMatrixX::Random(2, 3);
+  testing::set_strain_and_stress(r);  // E and S of F and P (eq. 9)
   r.status = {0, 1};
   return r;
 }

@@ -35,6 +35,22 @@ inline Eigen::Vector2d fan_strain(double xi1, double xi2) {
   return {E(0, 0), E(1, 1)};
 }
 
+/// Sets E and S of every row of `r` from its F and P (eq. 9: E = (F^T F - I) / 2, S =
+/// sym(F^-1 P)), as the sweep writes them: the reader refuses a converged step whose E or S
+/// is not its F's and P's (session 54).
+inline void set_strain_and_stress(RawPath& r) {
+  r.E.resize(r.F.rows(), 3);
+  r.S.resize(r.F.rows(), 3);
+  for (Eigen::Index s = 0; s < r.F.rows(); ++s) {
+    Eigen::Matrix2d F, P;
+    F << r.F(s, 0), r.F(s, 1), r.F(s, 2), r.F(s, 3);
+    P << r.P(s, 0), r.P(s, 1), r.P(s, 2), r.P(s, 3);
+    const Eigen::Matrix2d E = green_lagrange(F), S = second_piola_kirchhoff(F, P);
+    r.E.row(s) << E(0, 0), E(1, 1), E(0, 1);
+    r.S.row(s) << S(0, 0), S(1, 1), S(0, 1);
+  }
+}
+
 inline ResponseSurfaceData make_test_surface(double k = 1.0, int n = 11, int p = 3) {
   ResponseSurfaceData d;
   d.degree1 = d.degree2 = d.shear_degree = p;

@@ -301,6 +301,15 @@ TEST_CASE("rod case: bad input gives exit code 2, a JSON pointer and no output",
       {R"({"rods": [)" + good_rod +
            R"(], "output": {"points": [{"name": "t", "rod": "x", "xi": 1}]}})",
        "/output/points/0/rod"},
+      // A point name is a CSV column's prefix, ruled as knit-macro's output names (session 54:
+      // "t,ip" and ".t" passed here, the first caught only by the schema's pattern, now the
+      // loader's; knit/io/names.hpp).
+      {R"({"rods": [)" + good_rod +
+           R"(], "output": {"points": [{"name": ".t", "rod": "b", "xi": 1}]}})",
+       "/output/points/0/name"},
+      {R"({"rods": [)" + good_rod + R"(], "output": {"points": [{"name": ")" +
+           std::string(65, 't') + R"(", "rod": "b", "xi": 1}]}})",
+       "/output/points/0/name"},
       {R"({"rods": [{"name": "b", "curve": {"type": "bspline", "degree": 2, "knots": [0,0,0,1,1],
           "control_points": [[0,0,0],[1,0,0],[2,0,0]]}, "start": {"position": "fixed", "rotation": "fixed",
           "force": [1,0,0]}, "end": {"position": "free", "rotation": "free"}}]})",
