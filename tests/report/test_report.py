@@ -1393,6 +1393,9 @@ def main():
                 not in text:
             failures.append(f"summary line: '{summary}' (and {n_runs} run checks) not in the "
                             "report")
+        # --strict judges the runs (session 54): nothing to say on the baseline.
+        if rep.strict_problems():
+            failures.append(f"--strict on the baseline: {rep.strict_problems()}")
         if "Not yet measured" not in text:
             failures.append("no sensitivity table: the report must say 'Not yet measured'")
         # A figure script that failed leaves a placeholder dated 1970 (batch.py): the report
@@ -1411,6 +1414,15 @@ def main():
                 or "**1 figure script(s) failed** (placeholders below): fig_failed." not in text
                 or text.count("**The figure script failed**") != 1):
             failures.append("a failed figure's placeholder is not named in the report")
+        if rep.strict_problems() != ["1 figure scripts failed (placeholders)"]:
+            failures.append(f"--strict with a failed figure: {rep.strict_problems()}")
+        # ... and a failing check of a run is one (a row's verdict turned, then restored).
+        row = next(c for c in rep.rows if report.is_run_check(c) and c.ok is True)
+        row.ok = False
+        rep.write(os.path.join(tmp, "no-database.h5"), "")
+        if "1 checks of the runs themselves fail" not in rep.strict_problems():
+            failures.append(f"--strict with a failing run check: {rep.strict_problems()}")
+        row.ok = True
         # A figure the pipeline draws that is not there is named (session 38's red team: its
         # section vanished without a word).
         rep.expected_figures = ["fig_drawn.png", "fig_failed.png", "fig_gone.png"]
