@@ -156,6 +156,14 @@ std::optional<CellOptionError> CellOptions::validate() const {
 }
 
 CellOptions read_cell_options(const std::string& file, CellOptions o) {
+  // A sweep input given for a cell file (session 54: `path --config cases/sweep/default.json`
+  // said only 'unknown key "cell"'): its cell parameters are its /cell object.
+  if (const json whole = io::read_json_file(file);
+      whole.is_object() && whole.contains("cell") && whole.contains("loop_lengths"))
+    throw InputError(file, "/cell",
+                     "this is a sweep input (knit-meso sweep), not a cell parameter file: its cell "
+                     "parameters are this /cell object; write that object to a file of its own "
+                     "for --config (schemas/cell.schema.json)");
   // Schema first (schemas/cell.schema.json, embedded): types, ranges, unknown keys with
   // "did you mean", and line numbers from the file's text.
   const json j = io::load_and_validate(file, "cell");

@@ -289,3 +289,20 @@ TEST_CASE(
     CHECK_NOTHROW(read_cell_options(write_tmp("cell_cfg_contact_range.json", text.str())));
   }
 }
+
+// Session 54: a sweep input given as the cell file (`knit-meso path --config
+// cases/sweep/default.json`) said only 'unknown key "cell"'; it is named for what it is.
+TEST_CASE("cell config: a sweep input given as the cell file is named as one", "[unit]") {
+  const auto f = write_tmp("cell_cfg_sweep.json",
+                           R"({"loop_lengths": [5.0], "cell": {"contact": {"mu": 0.2}}})");
+  try {
+    read_cell_options(f);
+    FAIL("read");
+  } catch (const knit::InputError& e) {
+    CHECK(e.pointer() == "/cell");
+    CHECK_THAT(e.what(), Catch::Contains("this is a sweep input (knit-meso sweep)"));
+  }
+  // A cell file whose unknown key happens to be "cell" is still told of that key.
+  const auto g = write_tmp("cell_cfg_cell_key.json", R"({"cell": {}})");
+  CHECK_THROWS_WITH(read_cell_options(g), Catch::Contains("unknown key \"cell\""));
+}
