@@ -1,6 +1,8 @@
 // The design objective as residuals with their Jacobian (knit/macro/design_problem.hpp).
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "knit/macro/design_problem.hpp"
@@ -43,7 +45,8 @@ std::vector<Eigen::Vector2d> samples(const DesignObjective& o) {
   return t;
 }
 
-/// Second differences of the designed fields' control values along u and v.
+/// Second differences of the designed fields' control values along u and v, over their
+/// Greville abscissae (smoothness_weights), so that a linear grading is free.
 void smoothness(const DesignProblem& d, const std::vector<double>& x, Residuals& res) {
   const double s = std::sqrt(d.smoothness);
   const auto nv = static_cast<Eigen::Index>(d.variables.size());
@@ -56,26 +59,42 @@ void smoothness(const DesignProblem& d, const std::vector<double>& x, Residuals&
           v[static_cast<std::size_t>(i)] = x[k];
           owner[static_cast<std::size_t>(i)] = static_cast<int>(k);
         }
-    auto term = [&](int a, int b, int c) {
+    auto term = [&](int a, int b, int c, const std::vector<double>& gr, int i) {
+      const auto at = [&](int k) { return gr[static_cast<std::size_t>(k)]; };
+      const auto n = static_cast<int>(gr.size());
+      const auto w =
+          smoothness_weights(at(i - 1), at(i), at(i + 1), (gr.back() - gr.front()) / double(n - 1));
+      if (!w) return;  // a jump the knots put in: the field's own, not penalized
       Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv);
       const int idx[3] = {a, b, c};
-      const double w[3] = {1.0, -2.0, 1.0};
       double r = 0.0;
       for (int k = 0; k < 3; ++k) {
-        r += w[k] * v[static_cast<std::size_t>(idx[k])];
+        r += (*w)[static_cast<std::size_t>(k)] * v[static_cast<std::size_t>(idx[k])];
         if (owner[static_cast<std::size_t>(idx[k])] >= 0)
-          row(owner[static_cast<std::size_t>(idx[k])]) += s * w[k];
+          row(owner[static_cast<std::size_t>(idx[k])]) += s * (*w)[static_cast<std::size_t>(k)];
       }
       if (row.cwiseAbs().maxCoeff() > 0.0) res.add(s * r, row);
     };
     for (int j = 0; j < g.nv; ++j)
-      for (int i = 1; i + 1 < g.nu; ++i) term(j * g.nu + i - 1, j * g.nu + i, j * g.nu + i + 1);
+      for (int i = 1; i + 1 < g.nu; ++i)
+        term(j * g.nu + i - 1, j * g.nu + i, j * g.nu + i + 1, g.greville_u, i);
     for (int i = 0; i < g.nu; ++i)
-      for (int j = 1; j + 1 < g.nv; ++j) term((j - 1) * g.nu + i, j * g.nu + i, (j + 1) * g.nu + i);
+      for (int j = 1; j + 1 < g.nv; ++j)
+        term((j - 1) * g.nu + i, j * g.nu + i, (j + 1) * g.nu + i, g.greville_v, j);
   }
 }
 
 }  // namespace
+
+std::optional<std::array<double, 3>> smoothness_weights(double ga, double gb, double gc, double h) {
+  const double h1 = gb - ga, h2 = gc - gb;
+  // Abscissae closer than 1e-9 of the mean spacing: a repeated knot, i.e. a jump.
+  if (!(h1 > 1e-9 * h && h2 > 1e-9 * h)) return std::nullopt;
+  // The divided second difference 2 [(v_c - v_b) / h2 - (v_b - v_a) / h1] / (h1 + h2), times
+  // h^2: exact for quadratics, 0 for linear values, (1, -2, 1) at uniform spacing h.
+  const double k = 2.0 * h * h / (h1 + h2);
+  return std::array<double, 3>{k / h1, -k / h1 - k / h2, k / h2};
+}
 
 DesignEvaluation evaluate_design(const DesignProblem& d, const std::vector<double>& x,
                                  bool with_gradient) {

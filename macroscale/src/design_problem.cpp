@@ -67,6 +67,19 @@ std::vector<double> numbers(const json& j, const std::string& file, const std::s
 constexpr double kMaxStrainSamples = 250000;
 constexpr double kMaxStrainEntries = 5e6;
 
+/// The most applied strains off the design solve's load steps (over every term, each counted
+/// once): each is a solve of the whole case of its own per design evaluation (DesignSolve), so
+/// 20 of them cost 21 solves of the case. Session 54's red team: 3000 such strains took 17 s
+/// per evaluation on a case that solves in 0.006 s (about 30 min for a design), and `--check`
+/// said nothing.
+constexpr std::size_t kMaxOffStepStrains = 20;
+
+/// The most design variables: the Jacobian of the residuals (the smoothness rows grow with the
+/// variables) is dense, solved by dense QR, and each variable adds a sensitivity solve per load
+/// level. Session 54's red team: 2,500 variables took 6.7 s and 643 MB per iteration, 4,900
+/// ended in std::bad_alloc under a 2 GB limit. 1,000 is a 30 x 30 field designed value by value.
+constexpr std::size_t kMaxDesignVariables = 1000;
+
 /// `loop_lengths`: the case database's loop lengths, read by the first stitch-value variable
 /// and kept for the others (session 46's red team: read once per variable, 2,000 variables took
 /// 25 s of `--check`).
@@ -250,12 +263,17 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
               " mm over the gauge length " + fmt(c.output.applied->gauge_length) + " mm), got " +
               fmt(o.at_strain[k]));
     // One strain once (session 47's walkthrough: [0.2, 0.2] with targets [25, 20] passed
-    // --check and ended "target not met" between the two).
+    // --check and ended "target not met" between the two), within 1e-9 of the end strain, the
+    // tolerance at which the solver's steps take two levels as one (DesignSolve; session 54's
+    // red team: [0.2, 0.2000000000000001] passed and ended the same way).
     for (std::size_t i = 0; i < k; ++i)
-      if (o.at_strain[i] == o.at_strain[k])
+      if (std::abs(o.at_strain[i] - o.at_strain[k]) <= 1e-9 * std::abs(end))
         throw InputError(file, p + "/at_strain/" + std::to_string(k),
-                         "repeats the strain " + fmt(o.at_strain[k]) + " of /at_strain/" +
+                         "repeats the strain " + fmt(o.at_strain[i]) + " of /at_strain/" +
                              std::to_string(i) +
+                             (o.at_strain[i] == o.at_strain[k]
+                                  ? std::string()
+                                  : " (within 1e-9 of the case's end strain " + fmt(end) + ")") +
                              " (each strain once; its target or weight says how much it counts)");
   }
   const bool targets = o.kind != DesignObjective::Kind::kStrainVariance &&
@@ -357,6 +375,24 @@ DesignFieldGrid field_grid(const json& case_root, DesignVariable::Field field) {
   g.nu = static_cast<int>(f.at("knots_u").size()) - f.at("degrees")[0].get<int>() - 1;
   g.nv = static_cast<int>(f.at("knots_v").size()) - f.at("degrees")[1].get<int>() - 1;
   for (const auto& v : f.at("values")) g.values.push_back(v.get<double>());
+  // Greville abscissae g_i = (t_{i+1} + ... + t_{i+p}) / p (degree 0: the span's midpoint).
+  const auto greville = [](const json& knots, int p, int n) {
+    std::vector<double> t, out(static_cast<std::size_t>(n));
+    for (const auto& k : knots) t.push_back(k.get<double>());
+    for (int i = 0; i < n; ++i) {
+      double sum = 0.0;
+      if (p == 0) {
+        sum = 0.5 * (t[static_cast<std::size_t>(i)] + t[static_cast<std::size_t>(i) + 1]);
+      } else {
+        for (int k = 1; k <= p; ++k) sum += t[static_cast<std::size_t>(i + k)];
+        sum /= p;
+      }
+      out[static_cast<std::size_t>(i)] = sum;
+    }
+    return out;
+  };
+  g.greville_u = greville(f.at("knots_u"), f.at("degrees")[0].get<int>(), g.nu);
+  g.greville_v = greville(f.at("knots_v"), f.at("degrees")[1].get<int>(), g.nv);
   return g;
 }
 
@@ -591,6 +627,43 @@ DesignProblem load_design(const std::string& path) {
               " entries (about 50-70 bytes each) are allowed: fewer samples resolve a region's "
               "strain as well (the default is 11 x 11), or fewer variables or strains");
     }
+  }
+  if (d.variables.size() > kMaxDesignVariables)
+    throw InputError(path, "/variables",
+                     "has " + std::to_string(d.variables.size()) + " variables; at most " +
+                         std::to_string(kMaxDesignVariables) +
+                         " are allowed (the design's Jacobian is dense and each variable adds a "
+                         "sensitivity solve per load level): tie control values into one "
+                         "variable (\"indices\" with several entries) or design a coarser field");
+  // The applied strains off the solve's load steps: DesignSolve solves the case scaled to the
+  // largest level in its nominal steps (lambda_max k / steps) and each other level on its own.
+  if (d.c.output.applied && !d.objectives.empty()) {
+    const double end = d.c.output.applied->value / d.c.output.applied->gauge_length;
+    double largest = 0.0;
+    for (const DesignObjective& o : d.objectives)
+      for (double e : o.at_strain) largest = std::max(largest, e / end);
+    const double steps = d.c.solver.steps;
+    std::vector<double> off;  // load fractions, each once
+    for (std::size_t k = 0; k < d.objectives.size(); ++k)
+      for (std::size_t i = 0; i < d.objectives[k].at_strain.size(); ++i) {
+        const double lambda = d.objectives[k].at_strain[i] / end;
+        const double n = lambda / largest * steps;
+        if (std::abs(n - std::round(n)) <= 1e-9 * steps) continue;  // on a step
+        if (std::any_of(off.begin(), off.end(),
+                        [&](double l) { return std::abs(l - lambda) <= 1e-9 * largest; }))
+          continue;
+        off.push_back(lambda);
+        if (off.size() > kMaxOffStepStrains)
+          throw InputError(
+              path, "/objectives/" + std::to_string(k) + "/at_strain/" + std::to_string(i),
+              "is applied strain number " + std::to_string(off.size()) +
+                  " off the load steps (the case's /solver/steps = " +
+                  std::to_string(d.c.solver.steps) + " steps to the largest strain asked, " +
+                  fmt(largest * end) + ": multiples of " + fmt(largest * end / steps) +
+                  "); each such strain is a solve of the whole case per design evaluation, and " +
+                  "at most " + std::to_string(kMaxOffStepStrains) +
+                  " are allowed: put the strains on the steps, or ask for fewer");
+      }
   }
   if (twin && std::none_of(d.twin_targets.begin(), d.twin_targets.end(), [](bool b) { return b; }))
     throw InputError(path, "/twin",

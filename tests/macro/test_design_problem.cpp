@@ -1302,3 +1302,52 @@ TEST_CASE("design twin: a design started on the database's first or last loop le
     }
   }
 }
+
+// Session 54's red team: a repeat within round-off passed the "each strain once" rule and
+// ended "target not met" between its two targets; 3000 applied strains off the load steps made
+// one design evaluation take 17 s (each is a solve of the whole case), and 4,900 variables
+// ended in std::bad_alloc. Each is refused when the file is read, naming the entry.
+TEST_CASE("design file: near repeats, too many off-step strains or variables are refused",
+          "[unit]") {
+  write_case();
+  expect_refused("near_repeat.json", design(kVars, R"([{"type": "reaction", "reaction": "fy",
+                            "at_strain": [0.2, 0.2000000000000001], "target": [25, 20]}])"),
+                 "/objectives/0/at_strain/1");
+  // The case: end strain 4 / 20 = 0.2 in 10 steps (multiples of 0.02). 0.2 and then n strains
+  // 0.0051, 0.0061, ... off the steps.
+  const auto off_step = [](int n) {
+    std::string strains = "0.2", targets = "1";
+    for (int k = 0; k < n; ++k) {
+      strains += ", " + std::to_string(0.0051 + 0.001 * k);
+      targets += ", 1";
+    }
+    return design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [)" + strains +
+                             R"(], "target": [)" + targets + "]}]");
+  };
+  write(kDir / "off_step_20.json", off_step(20));
+  CHECK_NOTHROW(load_design((kDir / "off_step_20.json").string()));
+  expect_refused("off_step_21.json", off_step(21), "/objectives/0/at_strain/21");
+  // On the steps they are free: 0.02, 0.04, ..., 0.2 and 0.2 / 10 k again in another term.
+  write(kDir / "on_steps.json",
+        design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.02, 0.04, 0.06,
+             0.08, 0.1, 0.12, 0.14, 0.16, 0.18, 0.2], "target": [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]}])"));
+  CHECK_NOTHROW(load_design((kDir / "on_steps.json").string()));
+  // 1001 variables on a field of 1001 control values across u.
+  std::string c = knit_test::read_text(kDir / "case.json");
+  std::string knots = "0, 0", values, vars = "[";
+  for (int k = 1; k < 1000; ++k) knots += ", " + std::to_string(k / 1000.0);
+  knots += ", 1, 1";
+  for (int k = 0; k < 1001; ++k) {
+    values += std::string(k ? ", " : "") + "5.0";
+    vars += std::string(k ? ", " : "") + R"({"field": "stitch_value", "indices": [)" +
+            std::to_string(k) + R"(], "lower": 4.5, "upper": 6.5})";
+  }
+  vars += "]";
+  c.replace(c.find(R"("knots_u": [0, 0, 1, 1], "knots_v": [0, 1],)"), 43,
+            R"("knots_u": [)" + knots + R"(], "knots_v": [0, 1],)");
+  c.replace(c.find("[5.0, 5.0]"), 10, "[" + values + "]");
+  write(kDir / "case_fine.json", c);
+  std::string t = design(vars, kObjs);
+  t.replace(t.find("case.json"), 9, "case_fine.json");
+  expect_refused("many_variables.json", t, "/variables");
+}

@@ -819,3 +819,33 @@ TEST_CASE("design: the final run's missing steps at an objective's strain are no
                                        "last (/output/every): strain 0.1 of fy_at is its nominal "
                                        "step 1, which gets none"));
 }
+
+// Session 54's red team: the smoothness penalty took plain (1, -2, 1) differences of the
+// control values, so a linear grading of a clamped cubic field (control values at its Greville
+// abscissae, closer at the ends) cost 0.0105 at weight 1, where docs/design.md says a linear
+// grading is free. The weights are the divided second difference over the abscissae (times the
+// mean spacing squared): (1, -2, 1) at uniform spacing, 0 on linear values at any spacing, 2 h^2
+// on g^2, none across a repeated knot.
+TEST_CASE("design terms: the smoothness weights are second differences over Greville abscissae",
+          "[unit]") {
+  const auto uniform = smoothness_weights(0.0, 0.5, 1.0, 0.5);
+  REQUIRE(uniform);
+  CHECK((*uniform)[0] == Approx(1.0));
+  CHECK((*uniform)[1] == Approx(-2.0));
+  CHECK((*uniform)[2] == Approx(1.0));
+  // A clamped cubic on knots 0, 0.25, 0.5, 0.75, 1: abscissae 0, 1/12, 1/4, 1/2, 3/4, 11/12, 1.
+  const std::vector<double> g = {0.0, 1.0 / 12, 0.25, 0.5, 0.75, 11.0 / 12, 1.0};
+  const double h = 1.0 / 6;
+  for (std::size_t i = 1; i + 1 < g.size(); ++i) {
+    INFO("abscissae " << g[i - 1] << ", " << g[i] << ", " << g[i + 1]);
+    const auto w = smoothness_weights(g[i - 1], g[i], g[i + 1], h);
+    REQUIRE(w);
+    const auto apply = [&](auto f) {
+      return (*w)[0] * f(g[i - 1]) + (*w)[1] * f(g[i]) + (*w)[2] * f(g[i + 1]);
+    };
+    CHECK(apply([](double t) { return 4.5 + 2.0 * t; }) == Approx(0.0).margin(1e-13));
+    CHECK(apply([](double t) { return t * t; }) == Approx(2.0 * h * h).epsilon(1e-12));
+  }
+  CHECK_FALSE(smoothness_weights(0.0, 0.5, 0.5, 0.5));  // a double knot of a degree-1 field
+  CHECK_FALSE(smoothness_weights(0.5, 0.5, 1.0, 0.5));
+}

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -46,7 +47,20 @@ struct DesignFieldGrid {
   DesignVariable::Field field = DesignVariable::Field::kStitchValue;
   int nu = 1, nv = 1;
   std::vector<double> values;  ///< the case's values (those of no variable stay fixed)
+  /// Greville abscissae of the control values along u (nu) and v (nv): where a control value
+  /// sits, so that a field linear in (u, v) has control values linear in them (the smoothness
+  /// penalty's second differences are taken over them, session 54).
+  std::vector<double> greville_u, greville_v;
 };
+
+/// The weights (w_a, w_b, w_c) of the smoothness penalty's second difference of three
+/// neighbouring control values at Greville abscissae ga < gb < gc (docs/design.md, "smoothness"):
+/// the divided second difference times h^2, h the mean spacing of the field's abscissae, so
+/// that it is (1, -2, 1) at uniform spacing and 0 on a linear field at any spacing (session 54's
+/// red team: the plain (1, -2, 1) made the clamped ends of a linear grading cost 0.0105, while
+/// the docs said a linear grading is free). nullopt where two abscissae coincide (a repeated
+/// knot: a jump the field's knots put there, not penalized).
+std::optional<std::array<double, 3>> smoothness_weights(double ga, double gb, double gc, double h);
 
 /// `optimizer` of the design file.
 struct DesignOptimizerSpec {
