@@ -7,7 +7,10 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -42,6 +45,12 @@ double CellTable::min_wale_width() const {
 }
 double CellTable::min_course_height() const {
   return *std::min_element(c_.begin(), c_.end());
+}
+double CellTable::max_wale_width() const {
+  return *std::max_element(w_.begin(), w_.end());
+}
+double CellTable::max_course_height() const {
+  return *std::max_element(c_.begin(), c_.end());
 }
 
 double CellTable::interpolate(const std::vector<double>& y, double l) const {
@@ -154,9 +163,101 @@ std::vector<double> crossings(const std::vector<Eigen::Vector2d>& poly, double t
   return s;
 }
 
+/// The stitches of one course: centre s (after the centring of rule 4), loop length l, the
+/// point p where l was taken (before the centring; the centre but for a stitch on a jump) and
+/// whether the stitch lies on a jump (see centre_of); `shift` is the centring's move.
 struct Laid {
-  std::vector<double> s, l;
+  std::vector<double> s, l, p;
+  std::vector<char> jump;
+  double shift = 0.0;
 };
+
+/// The most fixed-point steps of rules 3 and 4 before the bracketing (centre_of).
+constexpr int kFixedPointSteps = 30;
+
+/// Where an item of the layout that begins at e lies: a stitch along its course (rule 4, F the
+/// wale width w(l)) or a course across the courses (rule 3, F the mean course height c(l) of
+/// its stitches). Its centre p solves p = e + F(p)/2: the item is as wide (tall) as the cell
+/// size at its own centre, so neighbours lie the mean of their sizes apart.
+struct Centre {
+  double p = 0.0;     ///< where F (and l) is taken
+  double size = 0.0;  ///< F(p)
+  bool valid = true;  ///< false: no item can lie at p (size_at gave nullopt; size = the guess)
+  bool jump = false;  ///< no fixed point: F jumps down across it (see centre_of)
+};
+
+/// Solves p = e + F(p)/2 (rules 3, 4); `size_at(p)` is F(p), or nullopt where no item can lie
+/// (past the chord's end, a course line outside the patch or holding no stitch), and F lies
+/// in [size_min, size_max]. First the fixed-point iteration p <- e + F(p)/2 from the previous
+/// item's size (what every map did until session 54, unchanged where it converges). Where F
+/// drops across the jump of a discontinuous l field (l falling in the laying direction) no p
+/// solves it: with the size before the jump the centre lies past it, with the size after it
+/// before it, and the iteration swung between the two for its 30 steps and kept a pair that
+/// broke the rules (session 54's red team: a stitch w(6.5) = 1.41 mm wide with l = 4.5, and a
+/// course centred 0.38 mm into its neighbour). Then the residual r(p) = e + F(p)/2 - p, >= 0
+/// at e + size_min/2 and <= 0 at e + size_max/2, is bisected to the resolution of the
+/// doubles: a root of r (a fixed point, also of a steep continuous field where the iteration
+/// diverges) is taken; otherwise r changes sign at a jump J of F, and CHOICE: the item takes
+/// the field on the jump's start side (p just before J, by the round-off tolerance: its l,
+/// its size), so its centre
+/// e + F/2 lies past J by less than half the jump of F. Every printed l and size pair then
+/// keeps rules 3 and 4 (the size is F at the l printed, neighbours the mean of their sizes
+/// apart), and only the field at such an item's centre differs from its l (docs/design.md,
+/// rule 7).
+template <class SizeAt>
+Centre centre_of(double e, double size0, double size_min, double size_max, SizeAt&& size_at) {
+  double size = size0;
+  // The bracket [lo, hi] of the root or jump: r(lo) > 0 (the centre lies beyond lo), r(hi) <= 0.
+  bool have_lo = false, have_hi = false, hi_valid = true;
+  double lo = 0.0, hi = 0.0, f_lo = 0.0, f_hi = 0.0;
+  for (int it = 0; it < kFixedPointSteps; ++it) {
+    const double p = e + 0.5 * size;
+    const std::optional<double> f = size_at(p);
+    if (!f) return {p, size, false, false};
+    if (std::abs(*f - size) <= 1e-13 * size) return {p, *f, true, false};
+    if (*f > size) {  // r(p) = (F(p) - size)/2 > 0
+      if (!have_lo || p > lo) std::tie(have_lo, lo, f_lo) = std::tuple(true, p, *f);
+    } else if (!have_hi || p < hi) {
+      std::tie(have_hi, hi, f_hi) = std::tuple(true, p, *f);
+    }
+    size = *f;
+  }
+  auto r = [e](double p, double f) { return e + 0.5 * f - p; };
+  if (!have_lo || (have_hi && lo >= hi)) {
+    lo = e + 0.5 * size_min;
+    const std::optional<double> f = size_at(lo);
+    if (!f) return {lo, size_min, false, false};
+    f_lo = *f;
+  }
+  if (!have_hi) {
+    hi = e + 0.5 * size_max;
+    const std::optional<double> f = size_at(hi);
+    hi_valid = f.has_value();
+    f_hi = f.value_or(size_max);
+  }
+  for (int it = 0; it < 200; ++it) {  // about 50 halvings from 0.1 mm to the doubles' spacing
+    const double mid = lo + 0.5 * (hi - lo);
+    if (!(mid > lo && mid < hi)) break;
+    const std::optional<double> f = size_at(mid);
+    if (f && r(mid, *f) > 0) {
+      lo = mid;
+      f_lo = *f;
+    } else {
+      hi = mid;
+      hi_valid = f.has_value();
+      f_hi = f.value_or(f_hi);
+    }
+  }
+  // A root: r within round-off (of the sizes, and of the coordinates' doubles far out).
+  const double tol =
+      1e-9 * size_max + 16 * std::numeric_limits<double>::epsilon() * (std::abs(e) + size_max);
+  if (hi_valid && std::abs(r(hi, f_hi)) <= tol) return {hi, f_hi, true, false};
+  if (std::abs(r(lo, f_lo)) <= tol) return {lo, f_lo, true, false};
+  if (!hi_valid) return {hi, f_lo, false, false};  // the item would reach past where none lies
+  // The start side, `tol` before the bisected jump: at lo itself, a double or so from J, the
+  // field taken again (the point's inversion warm-starts from the last) may be the other side's.
+  return {lo - tol, f_lo, true, true};
+}
 
 }  // namespace
 
@@ -301,25 +402,34 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
   auto l_at = [&](double s, double t) {
     return patch.stitch_value(patch.invert(R.transpose() * Eigen::Vector2d(s, t)));
   };
-  // Stitches of the chord [s0, s1] at t: side by side, each w(l) wide at its centre.
+  // Stitches of the chord [s0, s1] at t: side by side, each w(l) wide at its centre (rule 4,
+  // centre_of). l_at is evaluated once per point: the last point's l is kept for the stitch.
   auto lay = [&](double s0, double s1, double t) {
     Laid out;
     double s = s0, w = cells.wale_width(l_at(std::min(s0 + 1e-9, s1), t));
+    double last_p = 0.0, last_l = 0.0;
+    auto w_at = [&](double p) -> std::optional<double> {
+      if (!(p < s1)) return std::nullopt;
+      last_p = p;
+      last_l = l_at(p, t);
+      return cells.wale_width(last_l);
+    };
     for (;;) {
-      for (int it = 0; it < 30 && s + 0.5 * w < s1; ++it) {
-        const double wn = cells.wale_width(l_at(s + 0.5 * w, t));
-        if (std::abs(wn - w) <= 1e-13 * w) break;
-        w = wn;
-      }
+      const Centre at = centre_of(s, w, cells.min_wale_width(), cells.max_wale_width(), w_at);
+      if (!at.valid) break;
+      const double l = at.p == last_p ? last_l : l_at(at.p, t);
+      w = cells.wale_width(l);  // the width printed with this l, exactly
       if (!(s + 0.5 * w < s1)) break;
       out.s.push_back(s + 0.5 * w);
-      out.l.push_back(l_at(s + 0.5 * w, t));
+      out.l.push_back(l);
+      out.p.push_back(at.p);
+      out.jump.push_back(at.jump);
       s += w;
     }
     // Centre the stitches on the chord (their total width differs from it by less than one
     // stitch); each keeps the l it was laid with.
-    const double shift = 0.5 * (s1 - s);
-    for (double& x : out.s) x += shift;
+    out.shift = 0.5 * (s1 - s);
+    for (double& x : out.s) x += out.shift;
     return out;
   };
 
@@ -327,7 +437,9 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
     KnitCourse course;
     Laid laid;
     double r = 0;
-    double chord = 0;  ///< the patch's width along the course line (mm)
+    double chord = 0;   ///< the patch's width along the course line (mm)
+    double line = 0;    ///< the line t = const its stitches were laid on (centre_of)
+    bool jump = false;  ///< the course lies on a jump of its height (centre_of)
   };
   std::vector<Row> rows;
   double t = t_min;
@@ -341,87 +453,96 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
   int empty_start = 0, empty_pending = 0;
   double first_gap = 0.0;
   long empty_lines = 0;
-  for (;;) {
-    Row row;
-    bool done = false, empty = false;
-    for (int it = 0; it < 30; ++it) {
-      const double tc = t + 0.5 * height;
-      if (!(tc < t_max)) {
-        done = true;
-        break;
-      }
-      const auto cr = crossings(poly, tc);
-      if (cr.size() < 2) {
-        done = true;
-        break;
-      }
-      if (cr.size() > 2) {
-        // A course line that leaves the patch and comes back (a non-convex patch, an arch):
-        // its course would lay stitches across the gap, outside the fabric (session 42's red
-        // team: 727 of an arch's 1,098 stitches, exit 0 with a warning). A gap narrower than
-        // half a stitch (a shallow notch, a boundary's round-off) is knitted over; a wider one
-        // is refused, as the pieces between courses are (rule 3).
-        // The pairs (cr[2k], cr[2k+1]) are inside; with an odd count (the line through a
-        // boundary vertex that is a local extremum, counted once) they are not pairs, and the
-        // chord is taken whole (the review of session 42: the fabric beside such a vertex was
-        // taken for a gap).
-        double gap = 0.0, gap_at = 0.0;
-        for (std::size_t i = 1; cr.size() % 2 == 0 && i + 1 < cr.size(); i += 2)
-          if (cr[i + 1] - cr[i] > gap) {
-            gap = cr[i + 1] - cr[i];
-            gap_at = 0.5 * (cr[i] + cr[i + 1]);
-          }
-        if (gap > 0.5 * cells.min_wale_width()) {
-          const Eigen::Vector2d x = R.transpose() * Eigen::Vector2d(gap_at, tc);
-          std::ostringstream os;
-          os.precision(4);
-          os << "a course line " << tc - t_min
-             << " mm into the patch (across the courses) crosses its boundary " << cr.size()
-             << " times: the patch is not convex along its courses, and the course would be "
-                "laid across a gap of "
-             << gap << " mm outside the fabric (at x = " << x.x() << ", y = " << x.y()
-             << " mm), wider than half a stitch (" << 0.5 * cells.min_wale_width()
-             << " mm); a map knits each course as one piece of yarn: map the pieces as "
-                "separate cases, or turn the courses (the knitting angle) so that they cross "
-                "the patch once";
-          throw InputError(c.file, "/geometry", os.str());
+  enum class Line { kStitches, kOutside, kEmpty };
+  // The course on the line t = tc: its stitches (rule 4), or the line outside the patch (the
+  // map ends) or holding no stitch. The last line laid is kept (centre_of asks for it first).
+  Row line_row;
+  Line line_status = Line::kOutside;
+  double line_tc = std::numeric_limits<double>::quiet_NaN();
+  auto course_line = [&](double tc) -> Line {
+    if (tc == line_tc) return line_status;
+    line_tc = tc;
+    line_row = Row();
+    line_status = Line::kOutside;
+    if (!(tc < t_max)) return line_status;
+    const auto cr = crossings(poly, tc);
+    if (cr.size() < 2) return line_status;
+    if (cr.size() > 2) {
+      // A course line that leaves the patch and comes back (a non-convex patch, an arch):
+      // its course would lay stitches across the gap, outside the fabric (session 42's red
+      // team: 727 of an arch's 1,098 stitches, exit 0 with a warning). A gap narrower than
+      // half a stitch (a shallow notch, a boundary's round-off) is knitted over; a wider one
+      // is refused, as the pieces between courses are (rule 3).
+      // The pairs (cr[2k], cr[2k+1]) are inside; with an odd count (the line through a
+      // boundary vertex that is a local extremum, counted once) they are not pairs, and the
+      // chord is taken whole (the review of session 42: the fabric beside such a vertex was
+      // taken for a gap).
+      double gap = 0.0, gap_at = 0.0;
+      for (std::size_t i = 1; cr.size() % 2 == 0 && i + 1 < cr.size(); i += 2)
+        if (cr[i + 1] - cr[i] > gap) {
+          gap = cr[i + 1] - cr[i];
+          gap_at = 0.5 * (cr[i] + cr[i + 1]);
         }
-        if (gap > 0.0 && !nonconvex_warned) {
-          std::ostringstream os;
-          os.precision(3);
-          os << "a course line crosses the patch boundary " << cr.size()
-             << " times (a non-convex patch): its gap of up to " << gap
-             << " mm, less than half a stitch, is knitted over";
-          map.warnings.push_back(os.str());
-          nonconvex_warned = true;
-        }
+      if (gap > 0.5 * cells.min_wale_width()) {
+        const Eigen::Vector2d x = R.transpose() * Eigen::Vector2d(gap_at, tc);
+        std::ostringstream os;
+        os.precision(4);
+        os << "a course line " << tc - t_min
+           << " mm into the patch (across the courses) crosses its boundary " << cr.size()
+           << " times: the patch is not convex along its courses, and the course would be "
+              "laid across a gap of "
+           << gap << " mm outside the fabric (at x = " << x.x() << ", y = " << x.y()
+           << " mm), wider than half a stitch (" << 0.5 * cells.min_wale_width()
+           << " mm); a map knits each course as one piece of yarn: map the pieces as "
+              "separate cases, or turn the courses (the knitting angle) so that they cross "
+              "the patch once";
+        throw InputError(c.file, "/geometry", os.str());
       }
-      row.laid = lay(cr.front(), cr.back(), tc);
-      row.chord = cr.back() - cr.front();
-      row.course.t = tc - t_min;
-      if (row.laid.l.empty()) {
-        empty = true;
-        break;
+      if (gap > 0.0 && !nonconvex_warned) {
+        std::ostringstream os;
+        os.precision(3);
+        os << "a course line crosses the patch boundary " << cr.size()
+           << " times (a non-convex patch): its gap of up to " << gap
+           << " mm, less than half a stitch, is knitted over";
+        map.warnings.push_back(os.str());
+        nonconvex_warned = true;
       }
-      double sum = 0;
-      for (double l : row.laid.l) sum += cells.course_height(l);
-      const double hn = sum / double(row.laid.l.size());
-      const bool converged = std::abs(hn - height) <= 1e-13 * height;
-      height = hn;
-      if (converged) break;
     }
-    if (done) break;
-    if (empty) {
+    line_row.laid = lay(cr.front(), cr.back(), tc);
+    line_row.chord = cr.back() - cr.front();
+    line_row.line = tc;
+    line_status = line_row.laid.l.empty() ? Line::kEmpty : Line::kStitches;
+    return line_status;
+  };
+  // The course height of the line tc: the mean c(l) of its stitches (rule 3).
+  auto height_at = [&](double tc) -> std::optional<double> {
+    if (course_line(tc) != Line::kStitches) return std::nullopt;
+    double sum = 0;
+    for (double l : line_row.laid.l) sum += cells.course_height(l);
+    return sum / double(line_row.laid.l.size());
+  };
+  for (;;) {
+    const Centre at =
+        centre_of(t, height, cells.min_course_height(), cells.max_course_height(), height_at);
+    const Line status = course_line(at.p);
+    if (status == Line::kOutside) break;
+    if (status == Line::kEmpty) {
+      height = at.size;
       if (rows.empty()) {
         ++empty_start;
       } else if (empty_pending++ == 0) {
-        first_gap = t + 0.5 * height - t_min;
+        first_gap = at.p - t_min;
       }
       t += height;
       if (++empty_lines > 1000000)
         throw InputError(c.file, "/geometry", "more than 10^6 course lines hold no stitch");
       continue;
     }
+    Row row = line_row;
+    row.jump = at.jump;
+    // The height printed with these stitches, exactly (at.size within round-off).
+    height = *height_at(at.p);
+    row.course.t = t + 0.5 * height - t_min;
     if (empty_pending > 0) {
       char where[96];
       std::snprintf(where, sizeof where, "%.4g mm", first_gap);
@@ -456,6 +577,84 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
                            std::to_string(empty_pending) +
                            " at the end of the patch are narrower than one stitch and are "
                            "left out (the patch tapers below one stitch width there)");
+
+  // The layout's rules, verified on what is printed (session 54's red team: unconverged fixed
+  // points printed a stitch w(6.5) wide with l = 4.5 and overlapping courses, exit 0). A
+  // failure here is a defect of this file, not of the input: it ends the command (exit 1)
+  // instead of writing a map that breaks the rules. Tolerances: round-off of the sizes and of
+  // the coordinates' doubles (far from the origin they resolve only |s| * 2.2e-16).
+  {
+    const double eps = std::numeric_limits<double>::epsilon();
+    auto fail = [&](int course, int stitch, const std::string& what) {
+      std::ostringstream os;
+      os.precision(10);
+      os << "knitmap: internal error: the layout of " << c.file << " breaks " << what
+         << " at course " << course << (stitch > 0 ? ", stitch " + std::to_string(stitch) : "")
+         << " (a defect of knit-macro, not of the case: please report it with the case file)";
+      throw std::logic_error(os.str());
+    };
+    long jump_stitches = 0, jump_courses = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& row = rows[k];
+      const Laid& a = row.laid;
+      const int kc = static_cast<int>(k) + 1;
+      const double tk = t_min + row.course.t;
+      // Rule 3: the course height is the mean c(l) of its stitches, and neighbouring courses
+      // lie the mean of their heights apart.
+      double sum = 0;
+      for (double l : a.l) sum += cells.course_height(l);
+      if (!(std::abs(row.course.height - sum / double(a.l.size())) <= 1e-12 * row.course.height))
+        fail(kc, 0, "rule 3 (its height is not the mean c(l) of its stitches)");
+      if (k > 0) {
+        const Row& prev = rows[k - 1];
+        const double gap = row.course.t - prev.course.t;
+        const double want = 0.5 * (prev.course.height + row.course.height);
+        if (!(std::abs(gap - want) <= 1e-9 * want + 16 * eps * std::abs(tk)))
+          fail(kc, 0,
+               "rule 3 (its centre line is " + std::to_string(gap) +
+                   " mm from the previous one, the mean of their heights is " +
+                   std::to_string(want) + " mm)");
+      }
+      // Rule 3's line: the stitches were laid on the course's centre line, or on a jump's
+      // start side before it (centre_of).
+      const double hk = row.course.height;
+      if (row.jump ? !(row.line < tk && tk - row.line < 0.5 * hk)
+                   : !(std::abs(row.line - tk) <= 1e-9 * hk + 16 * eps * std::abs(tk)))
+        fail(kc, 0, "rule 3 (its stitches were not laid on its centre line)");
+      jump_courses += row.jump;
+      for (std::size_t i = 0; i < a.l.size(); ++i) {
+        const int ic = static_cast<int>(i) + 1;
+        const double wi = cells.wale_width(a.l[i]);
+        // Rule 4: neighbours lie the mean of their widths w(l) apart.
+        if (i > 0) {
+          const double want = 0.5 * (cells.wale_width(a.l[i - 1]) + wi);
+          if (!(std::abs(a.s[i] - a.s[i - 1] - want) <= 1e-9 * want + 16 * eps * std::abs(a.s[i])))
+            fail(kc, ic,
+                 "rule 4 (its centre is not the mean of the widths w(l) from its neighbour's)");
+        }
+        // Rule 7: the stitch's l is the field's at its centre as laid (before the centring),
+        // or, on a jump, at the jump's start side, less than half its width before the centre.
+        const double centre = a.s[i] - a.shift;
+        const double tol_s = 1e-9 * wi + 16 * eps * std::abs(centre);
+        const bool placed = a.jump[i] ? a.p[i] < centre && centre - a.p[i] < 0.5 * wi
+                                      : std::abs(a.p[i] - centre) <= tol_s;
+        if (!placed || !(std::abs(l_at(a.p[i], row.line) - a.l[i]) <= 1e-9 * a.l[i]))
+          fail(kc, ic, "rule 7 (its loop length is not the field's where it was laid)");
+        jump_stitches += a.jump[i];
+      }
+    }
+    if (jump_stitches > 0 || jump_courses > 0) {
+      std::ostringstream os;
+      if (jump_stitches > 0) os << jump_stitches << " stitch(es)";
+      if (jump_stitches > 0 && jump_courses > 0) os << " and ";
+      if (jump_courses > 0) os << jump_courses << " course(s)";
+      os << " lie on a jump of the stitch-value field where l falls in the laying direction "
+            "and no width w(l) (height c(l)) fits the l at the centre: each takes the l just "
+            "before the jump, and its centre lies past the jump by less than half its size "
+            "(docs/design.md, rule 7)";
+      map.warnings.push_back(os.str());
+    }
+  }
 
   // The course direction at every stitch (session 46's red team: the 21 x 21 grid above missed
   // a knitting angle that turns between its points, e.g. a band of 1 rad a few stitches wide,

@@ -907,3 +907,85 @@ TEST_CASE("knitmap: the output is named as the command line gave it", "[unit]") 
                     Catch::Contains(": output directory: is a non-empty directory"));
   CHECK(fs::exists(foreign / "notes.txt"));
 }
+
+namespace {
+
+/// Rules 3 and 4 (docs/design.md) on every neighbour pair of a map, from its printed values:
+/// stitches of a course lie the mean of their widths w(l) apart along d1 and on the course's
+/// centre line; a course is the mean c(l) of its stitches tall, and neighbouring courses lie
+/// the mean of their heights apart.
+void check_neighbour_rules(const KnitMap& m, const CellTable& cells) {
+  const double phi = m.course_direction_deg * std::numbers::pi / 180;
+  const Eigen::Vector2d d1(std::cos(phi), std::sin(phi)), d2(-std::sin(phi), std::cos(phi));
+  for (std::size_t k = 0; k < m.courses.size(); ++k) {
+    const KnitCourse& cr = m.courses[k];
+    const auto st = course_stitches(m, cr.index);
+    REQUIRE(st.size() == std::size_t(cr.stitches));
+    double sum = 0;
+    for (const auto& s : st) sum += cells.course_height(s.l);
+    CHECK(cr.height == Approx(sum / double(st.size())).epsilon(1e-12));
+    if (k > 0) {
+      INFO("courses " << cr.index - 1 << " -> " << cr.index);
+      CHECK(cr.t - m.courses[k - 1].t ==
+            Approx(0.5 * (cr.height + m.courses[k - 1].height)).epsilon(1e-9));
+    }
+    for (std::size_t i = 1; i < st.size(); ++i) {
+      INFO("course " << cr.index << ", needles " << st[i - 1].needle << " -> " << st[i].needle
+                     << ", l " << st[i - 1].l << " -> " << st[i].l);
+      const Eigen::Vector2d step = st[i].position - st[i - 1].position;
+      CHECK(
+          step.dot(d1) ==
+          Approx(0.5 * (cells.wale_width(st[i - 1].l) + cells.wale_width(st[i].l))).epsilon(1e-9));
+      CHECK(std::abs(step.dot(d2)) < 1e-9);
+    }
+  }
+}
+
+}  // namespace
+
+// Session 54's red team: where l falls across a jump in the laying direction, the fixed point
+// of rule 4 (rule 3) has no solution, and the 30 steps of its iteration swung between the two
+// sides: every course of the s313 patch with its halves swapped (6.5 | 4.5) printed a stitch
+// w(6.5) = 1.41 mm wide with l = 4.5 (needles 17 -> 18 1.41 mm apart, the mean of their widths
+// being 1.335), and across the courses a course centred 0.38 mm into the one before, exit 0.
+// The jumps here lie where the stitch (course) that reaches them has no fixed point: after 10
+// stitches (courses) of l = 6.5 from the patch's edge, e = 10 w(6.5) (10 c(6.5)), at e + 0.67
+// along (w(4.5)/2 = 0.63 < 0.67 < w(6.5)/2 = 0.705) and at e + 0.6 mm across (0.44 < 0.6 <
+// 0.82). CHOICE (centre_of): that stitch (course) takes the l before the jump, 6.5.
+TEST_CASE("knitmap: on a jump where l falls, neighbours lie the mean of their sizes apart",
+          "[unit]") {
+  const std::string db = database();
+  const double W = 30.0, H = 20.0;
+  std::ostringstream knots;
+  knots.precision(17);
+  SECTION("along the courses") {
+    const double J = 10 * w_of(6.5) + 0.67;
+    knots << R"({"degrees": [0, 0], "knots_u": [0, )" << J / W
+          << R"(, 1], "knots_v": [0, 1], "values": [6.5, 4.5]})";
+    const auto in = load_knitmap_input(
+        write_case("jump_along.json", case_text(knit_material(db, knots.str()), W, H)));
+    const KnitMap m = make_knitmap(in.c, in.cells);
+    check_neighbour_rules(m, in.cells);
+    for (const auto& cr : m.courses) {
+      const auto st = course_stitches(m, cr.index);
+      CHECK(std::count_if(st.begin(), st.end(), [](const KnitStitch& s) { return s.l == 6.5; }) ==
+            11);
+    }
+    REQUIRE(!m.warnings.empty());
+    CHECK(m.warnings.front().find(std::to_string(m.courses.size()) + " stitch(es) lie on a jump") ==
+          0);
+  }
+  SECTION("across the courses") {
+    const double J = 10 * c_of(6.5) + 0.6;
+    knots << R"({"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, )" << J / H
+          << R"(, 1], "values": [6.5, 4.5]})";
+    const auto in = load_knitmap_input(
+        write_case("jump_across.json", case_text(knit_material(db, knots.str()), W, H)));
+    const KnitMap m = make_knitmap(in.c, in.cells);
+    check_neighbour_rules(m, in.cells);
+    REQUIRE(m.courses.size() > 11);
+    for (const auto& cr : m.courses) CHECK(cr.height == Approx(c_of(cr.index <= 11 ? 6.5 : 4.5)));
+    REQUIRE(m.warnings.size() == 1);
+    CHECK(m.warnings.front().find("1 course(s) lie on a jump") == 0);
+  }
+}

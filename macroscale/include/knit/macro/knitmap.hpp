@@ -48,6 +48,9 @@ class CellTable {
   /// The smallest w and c of the table (piecewise linear: no smaller value in between).
   double min_wale_width() const;
   double min_course_height() const;
+  /// The largest w and c of the table (the bracket of the layout's fixed points).
+  double max_wale_width() const;
+  double max_course_height() const;
   const std::vector<double>& loop_lengths() const { return l_; }
   /// The cell parameters' sane range (mm): a stitch is a yarn loop of a textile; anything
   /// outside is a damaged database (session 29: w = 1e-9 mm made the map run without end).
