@@ -1,7 +1,11 @@
 // Input and output of the knitting map (knit/macro/knitmap.hpp): the case is read by
 // load_case (its knit material by knit_material_factory.cpp); here only the database's cell
 // parameters are read again, for w(l) and c(l). Outputs go to an atomic directory.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "knit/core/errors.hpp"
 #include "knit/io/atomic.hpp"
@@ -35,6 +39,30 @@ KnitMapInput load_knitmap_input(const std::string& case_file) {
   return in;
 }
 
+namespace {
+
+/// The significant digits that resolve kCoordinateResolution mm at the map's largest coordinate:
+/// io::format_number's 10 (every other CSV's) for a patch within 1e5 mm of the origin, up to a
+/// double's 17. Session 54's red team: a patch moved to (2e9, 2e9) mm (the loader allows 1e8
+/// times the patch's size) printed x = 2000000000, 2000000002, 2000000003 for stitches 1.26 mm
+/// apart, and 240 stitch centres twice.
+constexpr double kCoordinateResolution = 1e-4;
+int coordinate_digits(const KnitMap& map) {
+  double far = 0.0;
+  for (const auto& s : map.stitches) far = std::max(far, s.position.cwiseAbs().maxCoeff());
+  // log10(far / resolution) digits reach the resolution; one more keeps the rounding below it.
+  const double d = std::ceil(std::log10(std::max(far, 1.0) / kCoordinateResolution)) + 1;
+  return static_cast<int>(std::clamp(d, 10.0, 17.0));
+}
+
+std::string coordinate(double x, int digits) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
+}
+
+}  // namespace
+
 void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesystem::path& dir,
                    std::string_view option) {
   io::AtomicDirectory out(dir, io::AtomicDirectory::OnAbandon::Remove, option, in.c.file);
@@ -43,8 +71,10 @@ void write_knitmap(const KnitMap& map, const KnitMapInput& in, const std::filesy
     io::CsvWriter csv(out / "knitmap.csv", {"course", "needle", "l_mm", "x_mm", "y_mm"});
     csv.add_comment(prov);
     csv.add_comment("database: " + in.database);
+    const int digits = coordinate_digits(map);
     for (const auto& s : map.stitches)
-      csv.add_row({s.course, s.needle, s.l, s.position.x(), s.position.y()});
+      csv.add_row({s.course, s.needle, s.l, coordinate(s.position.x(), digits),
+                   coordinate(s.position.y(), digits)});
     csv.commit();
   }
   {

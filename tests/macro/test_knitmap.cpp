@@ -47,14 +47,17 @@ std::string database(bool with_cells = true) {
 }
 
 /// A W x H rectangle rotated by beta in the plane z = z0 (z1 for the last control point);
-/// with `shear`, a parallelogram whose upper edge is moved by `shear` along x (before turning).
+/// with `shear`, a parallelogram whose upper edge is moved by `shear` along x (before turning);
+/// moved by `offset` (after turning).
 std::string case_text(const std::string& material, double W, double H, double beta = 0.0,
-                      double z1 = 0.0, double shear = 0.0) {
+                      double z1 = 0.0, double shear = 0.0,
+                      const Eigen::Vector2d& offset = Eigen::Vector2d::Zero()) {
   const double c = std::cos(beta), s = std::sin(beta);
   std::ostringstream os;
   os.precision(17);
   auto pt = [&](double x, double y, double z) {
-    os << "[" << c * x - s * y << ", " << s * x + c * y << ", " << z << "]";
+    os << "[" << c * x - s * y + offset.x() << ", " << s * x + c * y + offset.y() << ", " << z
+       << "]";
   };
   os << R"({"geometry": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
                           "control_points": [)";
@@ -988,4 +991,33 @@ TEST_CASE("knitmap: on a jump where l falls, neighbours lie the mean of their si
     REQUIRE(m.warnings.size() == 1);
     CHECK(m.warnings.front().find("1 course(s) lie on a jump") == 0);
   }
+}
+
+// Session 54's red team: knitmap.csv printed the stitch centres with io::format_number's 10
+// significant digits, so a patch moved to (2e9, 2e9) mm (the loader allows 1e8 times its size)
+// had x = 2000000000, 2000000002, 2000000003 for stitches 1.26 mm apart and 240 centres twice.
+// The coordinates now resolve 1e-4 mm at the patch's offset (knitmap_io.cpp).
+TEST_CASE("knitmap: a patch far from the origin prints distinct stitch centres", "[unit]") {
+  const std::string db = database();
+  const double W = 20.0, H = 10.0, x0 = 2e9, y0 = 2e9;  // 22.4 mm: up to 2.2e9 mm out
+  const auto in = load_knitmap_input(
+      write_case("far.json", case_text(knit_material(db, "4.5"), W, H, 0.0, 0.0, 0.0, {x0, y0})));
+  const KnitMap m = make_knitmap(in.c, in.cells);
+  const fs::path out = kDir / "far_out";
+  fs::remove_all(out);
+  write_knitmap(m, in, out);
+  const auto rows = csv_rows(out / "knitmap.csv");  // course, needle, l_mm, x_mm, y_mm
+  REQUIRE(rows.size() == m.stitches.size());
+  REQUIRE(rows.size() > 2 * m.courses.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    INFO("stitch " << rows[i][0] << ", " << rows[i][1]);
+    CHECK(std::abs(rows[i][3] - m.stitches[i].position.x()) < 1e-4);
+    CHECK(std::abs(rows[i][4] - m.stitches[i].position.y()) < 1e-4);
+    if (i > 0 && rows[i][0] == rows[i - 1][0]) {
+      CHECK(rows[i][3] - rows[i - 1][3] == Approx(w_of(4.5)).margin(1e-4));
+      CHECK(rows[i][4] == Approx(rows[i - 1][4]).margin(1e-4));
+    }
+  }
+  // The first course's centre line, half a course above the patch's edge.
+  CHECK(rows.front()[4] - y0 == Approx(0.5 * c_of(4.5)).margin(1e-4));
 }
