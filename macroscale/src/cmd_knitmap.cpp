@@ -39,11 +39,15 @@ knit::cli::SubcommandRegistrar reg(
                      "output directory (default: the case file's name without its extension + "
                      "\"_knitmap\", in the current directory)");
       sub.add_option("--angle-tolerance", o->angle_tolerance,
-                     "largest deviation of the course direction from its mean (deg; default " +
+                     "largest deviation of the course direction from its mean, between lines "
+                     "(at most 90 deg: 90 would accept any direction; deg, default " +
                          knit::io::format_number(o->angle_tolerance) + ")")
-          // A finite angle in (0, 180]: CLI::PositiveNumber let "nan" through, which passed
-          // every patch (session 21).
-          ->check(knit::cli::number(0, 180, knit::cli::Ends::kOpenLow));
+          // A finite angle in (0, 90): CLI::PositiveNumber let "nan" through, which passed
+          // every patch (session 21). The deviation is measured between lines (modulo 180 deg),
+          // so it is at most 90 deg: a tolerance of 90 or more accepted any direction field
+          // (session 54's red team: (0, 180] allowed 90..180, and a field turning by 90 deg was
+          // knitted in straight courses at 45 deg, exit 0).
+          ->check(knit::cli::number(0, 90, knit::cli::Ends::kOpen));
       sub.add_option("--max-stitches", o->max_stitches,
                      "largest number of stitches of the map, estimated before the layout from "
                      "the patch's extent and the smallest stitch (default 1e7)")

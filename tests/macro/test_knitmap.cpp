@@ -657,16 +657,17 @@ TEST_CASE("knitmap: bad input names the file and pointer, exits 2, writes nothin
   }
   CHECK(run_knitmap(file + " --output " + (kDir / "nocells_out").string()) == 2);
   CHECK(!fs::exists(kDir / "nocells_out"));
-  // --angle-tolerance must be a finite angle in (0, 180] deg: "nan" passed every patch
-  // (session 21, found by fuzzing the flags).
+  // --angle-tolerance must be a finite angle in (0, 90) deg: "nan" passed every patch
+  // (session 21, found by fuzzing the flags); 90..180 passed every direction field, the
+  // deviation between lines being at most 90 deg (session 54's red team).
   const std::string ok = write_case("tol.json", case_text(knit_material(db, "5.0"), 10, 10));
-  for (const char* bad : {"nan", "inf", "0", "-1", "181", "x"}) {
+  for (const char* bad : {"nan", "inf", "0", "-1", "90", "90.0", "120", "180", "181", "x"}) {
     INFO(bad);
     CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance " +
                       bad) == 2);
     CHECK(!fs::exists(kDir / "tol_out"));
   }
-  CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance 180") ==
+  CHECK(run_knitmap(ok + " --output " + (kDir / "tol_out").string() + " --angle-tolerance 89.9") ==
         0);
   // More stitches than a map may have, estimated before the layout (session 29: a 500 m x 500 m
   // patch ran without limit in time and memory): the 10 x 10 mm patch holds about 80 stitches.

@@ -62,7 +62,8 @@ class CellTable {
 };
 
 struct KnitMapOptions {
-  /// Largest allowed deviation of the course direction from its mean over the patch (deg).
+  /// Largest allowed deviation of the course direction from its mean over the patch (deg), in
+  /// (0, 90): deviations are between lines, at most 90 deg (`--angle-tolerance` checks it).
   double angle_tolerance_deg = 2.0;
   /// Samples per patch edge for the boundary polygon (chords of the courses).
   int boundary_samples = 400;
