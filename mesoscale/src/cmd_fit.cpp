@@ -288,8 +288,9 @@ static knit::cli::SubcommandRegistrar reg_fit(
         }
         EnergyFitOptions eo;
         if (!o->energy_options.empty()) {
-          eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
-                                           o->energy_options);
+          const std::string text = read_text_file(o->energy_options, "--energy-options");
+          eo = EnergyFitOptions::from_json(text, o->energy_options);
+          EnergyFitOptions::refuse_other_family_keys(text, o->energy_options);
         } else if (energy && !stored_energy.empty()) {
           eo = from_stored(EnergyFitOptions{}, stored_energy, "energy law",
                            "/energy_law/diagnostics", "--energy-options");
@@ -301,6 +302,9 @@ static knit::cli::SubcommandRegistrar reg_fit(
         if (paper) {
           const auto fits = fit_paper_law(db, fo);
           print_fit_summaries(std::cout, db, fits);
+          if (const std::string w = knit::meso::fit::paper_fit_warning(db.loop_lengths(), fits);
+              !w.empty())
+            std::cerr << "knit-meso fit: " << w << "\n";
           first_failure = knit::meso::fit::first_fit_failure(db, fits);
           if (!first_failure.empty()) rc = knit::kExitFailure;
         }

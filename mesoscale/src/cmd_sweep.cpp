@@ -28,6 +28,7 @@
 #include "knit/io/output_target.hpp"
 #include "knit/material/database.hpp"
 #include "knit/meso/cell/geometry.hpp"
+#include "knit/meso/fit/report.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
 // A named namespace per command: the cmd_*.cpp files share one unity translation unit
@@ -68,14 +69,18 @@ void print_summary(const knit::meso::sweep::SweepInput& in,
     const auto& f = rep.fits[k];
     if (f.ok())
       std::printf(
-          "fit l=%.2f mm: ok, max |dS| %.4g MPa (%.2f%% of the range), %d points used, "
+          "fit l=%.2f mm: %s, max |dS| %.4g MPa (%.2f%% of the range), %d points used, "
           "%d skipped\n",
-          in.loop_lengths[k], f.diagnostics.max.tail<3>().maxCoeff(),
-          100 * f.diagnostics.max_relative, f.diagnostics.points_used,
-          f.diagnostics.points_skipped);
+          in.loop_lengths[k],
+          f.diagnostics.max_relative > knit::meso::fit::kPaperFitWarnRelative ? "POOR" : "ok",
+          f.diagnostics.max.tail<3>().maxCoeff(), 100 * f.diagnostics.max_relative,
+          f.diagnostics.points_used, f.diagnostics.points_skipped);
     else
       std::printf("fit l=%.2f mm: NOT FITTED: %s\n", in.loop_lengths[k], f.reason.c_str());
   }
+  if (const std::string w = knit::meso::fit::paper_fit_warning(in.loop_lengths, rep.fits);
+      !w.empty())
+    std::fprintf(stderr, "knit-meso sweep: %s\n", w.c_str());
   if (rep.energy_fit) {
     std::printf("%s", knit::meso::fit::energy_fit_report(*rep.energy_fit).c_str());
     if (const std::string w = knit::meso::fit::energy_fit_warning(*rep.energy_fit); !w.empty())

@@ -88,9 +88,11 @@ static knit::cli::SubcommandRegistrar reg_synth(
                                                           o->fit_options);
         EnergyFitOptions eo;
         eo.family = "ridge";
-        if (!o->energy_options.empty())
-          eo = EnergyFitOptions::from_json(read_text_file(o->energy_options, "--energy-options"),
-                                           o->energy_options);
+        if (!o->energy_options.empty()) {
+          const std::string text = read_text_file(o->energy_options, "--energy-options");
+          eo = EnergyFitOptions::from_json(text, o->energy_options);
+          EnergyFitOptions::refuse_other_family_keys(text, o->energy_options);
+        }
         auto db = synthetic_database(so);
         // The stand-in's stiffness k = (4.5 / l)^2 overflows for a tiny l: its stresses were
         // written as inf and NaN with exit 0 (session 21, --loop-lengths 1e-300), and beyond
@@ -106,6 +108,9 @@ static knit::cli::SubcommandRegistrar reg_synth(
           const auto fits = fit_paper_law(db, fo);
           std::cout << "knit-meso synth: fitted " << fits.size() << " loop lengths\n";
           knit::meso::fit::print_fit_summaries(std::cout, db, fits);
+          if (const std::string w = knit::meso::fit::paper_fit_warning(db.loop_lengths(), fits);
+              !w.empty())
+            std::cerr << "knit-meso synth: " << w << "\n";
           first_failure = knit::meso::fit::first_fit_failure(db, fits);
           if (!first_failure.empty()) rc = knit::kExitFailure;
           const auto es = fit_energy_database(db, eo);

@@ -7,6 +7,23 @@
 
 namespace knit::meso::fit {
 
+std::string paper_fit_warning(const std::vector<double>& loop_lengths,
+                              const std::vector<FitSummary>& fits) {
+  std::size_t worst = fits.size();
+  for (std::size_t k = 0; k < fits.size() && k < loop_lengths.size(); ++k)
+    if (fits[k].ok() && fits[k].diagnostics.max_relative > kPaperFitWarnRelative &&
+        (worst == fits.size() ||
+         fits[k].diagnostics.max_relative > fits[worst].diagnostics.max_relative))
+      worst = k;
+  if (worst == fits.size()) return {};
+  return "warning: the paper law's surfaces miss their fit data by up to " +
+         io::format_number(100 * fits[worst].diagnostics.max_relative) +
+         " % of the stress range (at l = " + io::format_number(loop_lengths[worst]) +
+         " mm; more than " + io::format_number(100 * kPaperFitWarnRelative) +
+         " %): their fit options do not suit these data (the code's defaults give 0.3-0.4 %; "
+         "look at smoothing, the control points and the loss)";
+}
+
 std::string first_fit_failure(const material::Database& db, const std::vector<FitSummary>& fits) {
   for (std::size_t k = 0; k < fits.size() && k < db.entries.size(); ++k)
     if (!fits[k].ok())

@@ -380,8 +380,10 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     in.energy_fit_given = f.is_object() && !f.empty();
     if (f.is_boolean())
       in.energy_fit = f.get<bool>();
-    else
+    else {
       in.energy_fit_options = fit::EnergyFitOptions::from_json(f.dump(), file, "/energy_fit");
+      fit::EnergyFitOptions::refuse_other_family_keys(f.dump(), file, "/energy_fit");
+    }
     // A ridge law too large to solve in minutes is refused before the cases (the review of
     // session 52: the fit refused it only after the whole sweep).
     if (const std::string why =

@@ -722,7 +722,13 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
         Catch::Contains("/directions: directions must not hold parallel ones"));
     CHECK_THROWS_WITH(
         EnergyFitOptions::from_json(R"({"directions": [[1e308, 1e308, 1e308]]})", "f.json"),
-        "f.json: /directions: directions must be finite and non-zero, with a finite length");
+        "f.json: /directions: directions must be finite and non-zero, with a length that can be "
+        "normalized (not below about 1e-150 or above 1e150)");
+    // Session 54's red team: 1e-160 passed (its norm underflowed to a finite subnormal) and the
+    // sweep ended after all its cases with "direction 0 is not a unit vector".
+    CHECK_THROWS_WITH(
+        EnergyFitOptions::from_json(R"({"directions": [[1e-160, 0, 0], [0, 1, 0]]})", "f.json"),
+        Catch::StartsWith("f.json: /directions: directions must be finite and non-zero"));
     CHECK_NOTHROW(
         EnergyFitOptions::from_json(R"({"directions": [[1e150, 0, 1], [0, 1, 1]]})", "f.json"));
     EnergyFitOptions o;
@@ -887,6 +893,38 @@ TEST_CASE("energy fit: steps that did not converge are skipped, counted, and too
   CHECK(cut.status == FitStatus::kRefused);
   CHECK_THAT(cut.reason, Catch::Contains("the option stable_min_cos 1.000000 left out ") &&
                              Catch::Contains("lower it"));
+  // Session 54's red team: with enough steps left (here every fitted path's first) the law was
+  // fitted to the few the option kept and written with exit 0. More than half left out at a
+  // loop length is refused, naming the option.
+  Database db3 = synthetic_coverage_db({4.5, 6.5}, 6);
+  for (auto& r : db3.entries[0].raw)
+    for (int s = 0; s < r.steps(); ++s) r.S(s, 2) += s % 2 ? 1e-3 : -1e-3;
+  const EnergyFitSummary most = fit_energy_law(db3, strict);
+  CHECK(most.status == FitStatus::kRefused);
+  CHECK_THAT(most.reason, Catch::StartsWith("/loop_0/raw: the option stable_min_cos 1 left out ") &&
+                              Catch::Contains("converged fit states as steps where the cell gives "
+                                              "way, more than half"));
+  CHECK(fit_energy_law(db3, ridge_options()).ok());  // the default threshold keeps them
+}
+
+// Session 54's red team: options of the other family were accepted and ignored ("tube" with
+// "family": "ridge" gave a law equal to the bit to the one without), and recorded as used.
+TEST_CASE("energy fit options: a key of the other family is refused, naming it", "[unit]") {
+  CHECK_THROWS_WITH(EnergyFitOptions::refuse_other_family_keys(
+                        R"({"family": "ridge", "tube": 0.5})", "o.json", "/energy_fit"),
+                    Catch::StartsWith("o.json: /energy_fit/tube: is an option of the network "
+                                      "family's fit, but \"family\" is \"ridge\": it would be "
+                                      "ignored"));
+  CHECK_THROWS_WITH(
+      EnergyFitOptions::refuse_other_family_keys(R"({"s_spans": 20})", "o.json"),
+      Catch::StartsWith("o.json: /s_spans: is an option of the ridge family's fit, but "
+                        "\"family\" is \"network\" (the default)"));
+  for (const char* ok : {R"({"family": "ridge", "s_spans": 20, "floor": 0.2})",
+                         R"({"tube": 0.05, "weight_uniaxial": 10, "stable_min_cos": 0})",
+                         R"({"family": "network", "max_iterations": 100})", R"({})"})
+    CHECK_NOTHROW(EnergyFitOptions::refuse_other_family_keys(ok, "o.json"));
+  // A database's stored options hold every key (to_json): read as before.
+  CHECK_NOTHROW(EnergyFitOptions::from_json(EnergyFitOptions().to_json(), "db.h5"));
 }
 
 TEST_CASE("energy fit: the give-way threshold is cos(dS, de) itself, near zero included",

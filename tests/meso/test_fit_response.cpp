@@ -373,6 +373,24 @@ TEST_CASE("fit: the summary line names each stress component with its own figure
     CHECK_THAT(text, Catch::Contains(part));
 }
 
+// Session 54's red team: the paper law with smoothing 1000 missed its data by 62 % of the
+// stress range and the sweep printed "ok", with nothing on stderr. Above 10 % it is a warning
+// (and "POOR" in the sweep's line), at the worst loop length among the fits that succeeded.
+TEST_CASE("fit: a paper law far from its data is a warning", "[unit]") {
+  std::vector<FitSummary> fits(3);
+  fits[0].diagnostics.max_relative = 0.004;
+  fits[1].diagnostics.max_relative = 0.6226;
+  fits[2].diagnostics.max_relative = 0.9;
+  fits[2].status = FitStatus::kRefused;  // a failed fit is an error of its own, not counted
+  const std::string w = paper_fit_warning({4.5, 5.0, 6.5}, fits);
+  CHECK_THAT(w, Catch::StartsWith("warning: the paper law's surfaces miss their fit data by up "
+                                  "to 62.26 % of the stress range (at l = 5 mm; more than 10 %)"));
+  fits[1].diagnostics.max_relative = 0.1;  // the bound itself passes
+  CHECK(paper_fit_warning({4.5, 5.0, 6.5}, fits).empty());
+  fits[1].diagnostics.max_relative = 0.1001;
+  CHECK_FALSE(paper_fit_warning({4.5, 5.0, 6.5}, fits).empty());
+}
+
 TEST_CASE("fit: a loop length whose refit fails keeps no law from before", "[unit]") {
   // fit_database replaces every entry's law: one whose refit fails loses its old surface and
   // diagnostics, so no stale law is written beside the new ones (cmd_fit writes nothing then

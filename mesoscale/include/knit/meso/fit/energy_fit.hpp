@@ -162,6 +162,12 @@ struct EnergyFitOptions {
   /// below `pointer`.
   static EnergyFitOptions from_json(const std::string& text, const std::string& file = "<options>",
                                     const std::string& pointer = "");
+  /// Throws InputError (file, pointer/key) for a key in the options `text` that only the other
+  /// family reads ("tube" with "family": "ridge", "s_spans" with the default network): it
+  /// would be ignored. Applied to what a user gives (--energy-options, a sweep's energy_fit),
+  /// not to a database's stored options_json, which to_json() writes with every key.
+  static void refuse_other_family_keys(const std::string& text, const std::string& file,
+                                       const std::string& pointer = "");
 };
 
 struct EnergyFitSummary {
