@@ -295,6 +295,8 @@ static knit::cli::SubcommandRegistrar reg_fit(
           eo = from_stored(EnergyFitOptions{}, stored_energy, "energy law",
                            "/energy_law/diagnostics", "--energy-options");
         }
+        knit::meso::fit::refuse_unfittable_options(db, fo, paper ? o->options : "", eo,
+                                                   energy ? o->energy_options : "");
         int rc = knit::kExitOk;
         std::string first_failure;  // for stderr (session 36: only stdout said why)
         std::cout << "knit-meso fit: " << o->db << " (" << db.entries.size()

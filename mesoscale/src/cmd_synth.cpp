@@ -102,6 +102,8 @@ static knit::cli::SubcommandRegistrar reg_synth(
                                  "the stand-in law's stress cannot be stored (" + *bad +
                                      "): its stiffness (4.5 / l)^2 MPa is too large; give loop "
                                      "lengths of a knit (a few mm)");
+        if (!o->no_fit)
+          knit::meso::fit::refuse_unfittable_options(db, fo, o->fit_options, eo, o->energy_options);
         int rc = knit::kExitOk;
         std::string first_failure;
         if (!o->no_fit) {

@@ -24,6 +24,24 @@ std::string paper_fit_warning(const std::vector<double>& loop_lengths,
          "look at smoothing, the control points and the loss)";
 }
 
+void refuse_unfittable_options(const material::Database& db, const FitOptions& fo,
+                               const std::string& fo_file, const EnergyFitOptions& eo,
+                               const std::string& eo_file) {
+  if (db.entries.empty()) return;  // the fits say so themselves
+  if (!fo_file.empty()) {
+    std::vector<material::LoadPath> paths;
+    for (const auto& r : db.entries.front().raw) paths.push_back(r.path);
+    if (const std::string why = check_feasible(fo, paths); !why.empty())
+      throw InputError(
+          fo_file, "",
+          "these options cannot fit the paper law to the database's load paths: " + why);
+  }
+  if (!eo_file.empty())
+    if (const std::string why = eo.ridge_size_refusal(static_cast<int>(db.entries.size()));
+        !why.empty())
+      throw InputError(eo_file, "/s_spans", why);
+}
+
 std::string first_fit_failure(const material::Database& db, const std::vector<FitSummary>& fits) {
   for (std::size_t k = 0; k < fits.size() && k < db.entries.size(); ++k)
     if (!fits[k].ok())

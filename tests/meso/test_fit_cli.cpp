@@ -166,9 +166,11 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   fs::remove(out);
   CHECK(run("fit " + db.string() + energy + " -o " + out.string()) == 2);
   CHECK_FALSE(fs::exists(out));
-  // A paper fit that fails (15 control points without smoothing: too few steps to determine
-  // them) exits 1, and an energy law refused for its options exits 2; neither writes (session
-  // 33, a helper's audit: a failed paper fit that left the exit code 0 passed the suite).
+  // Paper options that cannot fit these paths (15 control points without smoothing: too few
+  // steps to determine them) are bad input since session 54, refused before any fit naming the
+  // options file (exit 2; before, exit 1 after the fit, naming the database); an energy law
+  // refused for its options exits 2 too; neither writes (session 33, a helper's audit: a failed
+  // paper fit that left the exit code 0 passed the suite).
   const fs::path clean = dir / "cli_fit_fails_clean.h5";
   REQUIRE(run("synth --no-fit --steps 6 --loop-lengths 4.5,6.5 --out " + clean.string()) == 0);
   const std::string clean_before = bytes(clean);
@@ -176,13 +178,11 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
   std::ofstream(bad_paper) << R"({"smoothing": 0, "control_points_1": 15})";
   std::string err;
   CHECK(run_with_stderr("fit " + clean.string() + " --law paper --options " + bad_paper.string(),
-                        dir / "cli_fit_fails_paper.err", err) == 1);
+                        dir / "cli_fit_fails_paper.err", err) == 2);
   CHECK(bytes(clean) == clean_before);
-  // The reason on stderr too (session 36's red team: stderr was empty, only stdout said why).
-  CHECK_THAT(
-      err,
-      Catch::StartsWith("knit-meso fit: error: the paper law at l = 4.5 mm (/loop_0): ") &&
-          Catch::EndsWith(clean.string() + " is left as it was (the fit's report is on stdout)\n"));
+  CHECK_THAT(err, Catch::StartsWith("knit-meso fit: error: " + bad_paper.string() +
+                                    ": these options cannot fit the paper law to the "
+                                    "database's load paths: without smoothing, 15 x "));
   // A paper path without a converged step is named as the file names it (session 48's red
   // team: "path 3" counted the paper paths alone, not /loop_1/raw's groups).
   {
@@ -200,10 +200,15 @@ TEST_CASE("knit-meso fit: a fit that fails writes nothing and leaves the databas
       std::fill(status.begin(), status.end(), 1);
       f.write(st, status);
     }
+    // A fit that fails on the data exits 1, the reason on stderr too (session 36's red team:
+    // stderr was empty, only stdout said why).
     CHECK(run_with_stderr("fit " + stalled.string() + " --law paper",
-                          dir / "cli_fit_fails_stalled.err", err) != 0);
-    CHECK_THAT(err, Catch::Contains("the paper law at l = 6.5 mm (/loop_1): raw/" + name +
-                                    " has no converged step"));
+                          dir / "cli_fit_fails_stalled.err", err) == 1);
+    CHECK_THAT(err, Catch::StartsWith("knit-meso fit: error: the paper law at l = 6.5 mm "
+                                      "(/loop_1): raw/" +
+                                      name + " has no converged step") &&
+                        Catch::EndsWith(stalled.string() +
+                                        " is left as it was (the fit's report is on stdout)\n"));
   }
   const fs::path bad_energy = dir / "cli_fit_fails_directions.json";
   std::ofstream(bad_energy) << R"({"family": "ridge", "directions": [[1, 0, 0], [2, 0, 0]]})";

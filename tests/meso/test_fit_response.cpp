@@ -489,3 +489,30 @@ TEST_CASE("fit: the diagnostics count the paper's converged steps, each error in
   raw.push_back(outside);
   CHECK(diagnose(fs.surface, raw).points_used == steps - 1);
 }
+
+// Session 54's red team: options the sweep refuses before its cases (a degree-9 surface on
+// 6-step paths, a ridge law of 6090 coefficients) were refused by `knit-meso fit` naming the
+// database (exit 2 or 1) and by synth naming neither file nor key. They are refused before any
+// fit, naming the options file (and /s_spans for the ridge's size); options not from a file
+// are not judged.
+TEST_CASE("fit: options that cannot fit the database are refused naming their file", "[unit]") {
+  SyntheticOptions so;
+  so.loop_lengths = {4.5, 5.0};
+  so.paths = default_load_paths(6);
+  const Database db = synthetic_database(so);
+  FitOptions fo;
+  fo.degree2 = 9;
+  EnergyFitOptions eo;
+  CHECK_THROWS_WITH(refuse_unfittable_options(db, fo, "fo.json", eo, ""),
+                    Catch::StartsWith("fo.json: these options cannot fit the paper law to the "
+                                      "database's load paths: paths with 6 steps cannot "
+                                      "determine a degree-9 surface"));
+  CHECK_NOTHROW(refuse_unfittable_options(db, fo, "", eo, ""));
+  eo.family = "ridge";
+  eo.s_spans = 200;
+  eo.l_control_points = 50;
+  CHECK_THROWS_WITH(refuse_unfittable_options(db, FitOptions{}, "", eo, "eo.json"),
+                    Catch::StartsWith("eo.json: /s_spans: the ridge law would have "));
+  CHECK_NOTHROW(
+      refuse_unfittable_options(db, FitOptions{}, "fo.json", EnergyFitOptions{}, "eo.json"));
+}

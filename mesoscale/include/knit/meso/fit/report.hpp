@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "knit/meso/fit/energy_fit.hpp"
 #include "knit/meso/fit/response_fit.hpp"
 
 namespace knit::meso::fit {
@@ -28,6 +29,16 @@ inline constexpr double kPaperFitWarnRelative = 0.10;
 /// among the fits that succeeded; "" if none.
 std::string paper_fit_warning(const std::vector<double>& loop_lengths,
                               const std::vector<FitSummary>& fits);
+
+/// Before any fit of knit-meso fit and synth: throws knit::InputError naming an options file
+/// the user gave (`fo_file`, `eo_file`; "" for options not from a file, which are not judged)
+/// when its options cannot fit db's load paths (check_feasible) or make a ridge law too large
+/// to solve (ridge_size_refusal): what the sweep refuses before its cases. Session 54's red
+/// team: fit named the database ("energy law refused", exit 2; "(/loop_0)", exit 1) and synth
+/// neither file nor key.
+void refuse_unfittable_options(const material::Database& db, const FitOptions& fo,
+                               const std::string& fo_file, const EnergyFitOptions& eo,
+                               const std::string& eo_file);
 
 /// Fits the paper's law (eq. 17) of every loop length from the raw paths of the "paper" set
 /// only (the coverage and held-out paths are the energy law's), and stores it in db.
