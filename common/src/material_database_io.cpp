@@ -66,7 +66,7 @@ std::string raw_consistency_problem(const RawPath& r, Eigen::Index s) {
   const Eigen::Vector3d e(E(0, 0), E(1, 1), E(0, 1));
   const double de = (r.E.row(s).transpose() - e).cwiseAbs().maxCoeff();
   if (!(de <= 1e-9 * (1.0 + F.cwiseAbs().maxCoeff() * F.cwiseAbs().maxCoeff())))
-    return "E: the stored strain differs by " + num(de) +
+    return "E and F disagree: the stored strain differs by " + num(de) +
            " from the Green-Lagrange strain of its F, (F^T F - I) / 2 = (" + num(e(0)) + ", " +
            num(e(1)) + ", " + num(e(2)) + ") (E11, E22, E12; eq. 9)";
   const Eigen::Matrix2d S = second_piola_kirchhoff(F, P);
@@ -77,9 +77,9 @@ std::string raw_consistency_problem(const RawPath& r, Eigen::Index s) {
   const double size = F.cwiseAbs().rowwise().sum().maxCoeff() / J * P.cwiseAbs().maxCoeff() +
                       r.S.row(s).cwiseAbs().maxCoeff();
   if (!(ds <= 1e-9 * size))
-    return "S: the stored stress differs by " + num(ds) +
-           " MPa from the second Piola-Kirchhoff stress of its F and P, F^-1 P = (" + num(sv(0)) +
-           ", " + num(sv(1)) + ", " + num(sv(2)) + ") MPa (S11, S22, S12; eq. 9)";
+    return "S and F, P disagree: the stored stress differs by " + num(ds) +
+           " MPa from the second Piola-Kirchhoff stress of its F and P, sym(F^-1 P) = (" +
+           num(sv(0)) + ", " + num(sv(1)) + ", " + num(sv(2)) + ") MPa (S11, S22, S12; eq. 9)";
   return {};
 }
 
@@ -665,10 +665,10 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
                     fname, p + "/" + d,
                     "step " + std::to_string(s + 1) + " " + why + ": a damaged database");
             }
+            // Named at the path: which of the datasets was changed cannot be told.
             if (const std::string why = raw_consistency_problem(r, s); !why.empty())
               throw InputError(
-                  fname, p + "/" + why.substr(0, 1),
-                  "step " + std::to_string(s + 1) + ": " + why.substr(3) + ": a damaged database");
+                  fname, p, "step " + std::to_string(s + 1) + ": " + why + ": a damaged database");
           }
           // A path has at least one load step (schemas/sweep.schema.json: steps >= 1); one of
           // no rows is no data (session 53's red team list: it was read).
@@ -790,6 +790,9 @@ std::optional<std::string> first_unstorable_step(const Database& db) {
   for (std::size_t k = 0; k < db.entries.size(); ++k)
     for (std::size_t q = 0; q < db.entries[k].raw.size(); ++q) {
       const RawPath& r = db.entries[k].raw[q];
+      // The reader's rule (a path has at least one load step): the review of session 54.
+      if (r.status.empty())
+        return raw_path_location(k, q) + "/status: the path has no load step (0 rows)";
       for (std::size_t s = 0; s < r.status.size(); ++s) {
         if (r.status[s] != 0) continue;
         const auto i = static_cast<Eigen::Index>(s);
@@ -803,8 +806,7 @@ std::optional<std::string> first_unstorable_step(const Database& db) {
         const bool complete = i < r.F.rows() && i < r.P.rows() && i < r.E.rows() && i < r.S.rows();
         if (!complete) continue;
         if (const std::string why = raw_consistency_problem(r, i); !why.empty())
-          return raw_path_location(k, q) + "/" + why.substr(0, 1) + ": step " +
-                 std::to_string(s + 1) + ": " + why.substr(3);
+          return raw_path_location(k, q) + ": step " + std::to_string(s + 1) + ": " + why;
       }
     }
   return std::nullopt;

@@ -17,6 +17,7 @@
 #include "knit/io/names.hpp"
 #include "knit/macro/knit_material.hpp"
 #include "knit/material/database.hpp"
+#include "knit/spline/bspline_basis.hpp"
 
 namespace knit::macro {
 
@@ -375,24 +376,13 @@ DesignFieldGrid field_grid(const json& case_root, DesignVariable::Field field) {
   g.nu = static_cast<int>(f.at("knots_u").size()) - f.at("degrees")[0].get<int>() - 1;
   g.nv = static_cast<int>(f.at("knots_v").size()) - f.at("degrees")[1].get<int>() - 1;
   for (const auto& v : f.at("values")) g.values.push_back(v.get<double>());
-  // Greville abscissae g_i = (t_{i+1} + ... + t_{i+p}) / p (degree 0: the span's midpoint).
-  const auto greville = [](const json& knots, int p, int n) {
-    std::vector<double> t, out(static_cast<std::size_t>(n));
-    for (const auto& k : knots) t.push_back(k.get<double>());
-    for (int i = 0; i < n; ++i) {
-      double sum = 0.0;
-      if (p == 0) {
-        sum = 0.5 * (t[static_cast<std::size_t>(i)] + t[static_cast<std::size_t>(i) + 1]);
-      } else {
-        for (int k = 1; k <= p; ++k) sum += t[static_cast<std::size_t>(i + k)];
-        sum /= p;
-      }
-      out[static_cast<std::size_t>(i)] = sum;
-    }
-    return out;
+  // Where each control value sits (the smoothness penalty's abscissae): the case loader has
+  // checked the knots, as a B-spline basis does.
+  const auto greville = [](const json& knots, int p) {
+    return spline::BSplineBasis(p, knots.get<std::vector<double>>()).greville();
   };
-  g.greville_u = greville(f.at("knots_u"), f.at("degrees")[0].get<int>(), g.nu);
-  g.greville_v = greville(f.at("knots_v"), f.at("degrees")[1].get<int>(), g.nv);
+  g.greville_u = greville(f.at("knots_u"), f.at("degrees")[0].get<int>());
+  g.greville_v = greville(f.at("knots_v"), f.at("degrees")[1].get<int>());
   return g;
 }
 

@@ -204,6 +204,14 @@ struct Centre {
 /// keeps rules 3 and 4 (the size is F at the l printed, neighbours the mean of their sizes
 /// apart), and only the field at such an item's centre differs from its l (docs/design.md,
 /// rule 7).
+/// The round-off within which centre_of takes r(p) = e + F(p)/2 - p as 0 for an item that
+/// begins at e, F at most size_max. The layout's check (make_knitmap) accepts a centre this far
+/// from where its l was taken, with e bounded by the centre's |c| + size_max (the review of
+/// session 54: a check stricter than the solver's acceptance could fail a valid map).
+double fixed_point_tolerance(double e, double size_max) {
+  return 1e-9 * size_max + 16 * std::numeric_limits<double>::epsilon() * (std::abs(e) + size_max);
+}
+
 template <class SizeAt>
 Centre centre_of(double e, double size0, double size_min, double size_max, SizeAt&& size_at) {
   double size = size0;
@@ -249,8 +257,7 @@ Centre centre_of(double e, double size0, double size_min, double size_max, SizeA
     }
   }
   // A root: r within round-off (of the sizes, and of the coordinates' doubles far out).
-  const double tol =
-      1e-9 * size_max + 16 * std::numeric_limits<double>::epsilon() * (std::abs(e) + size_max);
+  const double tol = fixed_point_tolerance(e, size_max);
   if (hi_valid && std::abs(r(hi, f_hi)) <= tol) return {hi, f_hi, true, false};
   if (std::abs(r(lo, f_lo)) <= tol) return {lo, f_lo, true, false};
   if (!hi_valid) return {hi, f_lo, false, false};  // the item would reach past where none lies
@@ -618,8 +625,9 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
       // Rule 3's line: the stitches were laid on the course's centre line, or on a jump's
       // start side before it (centre_of).
       const double hk = row.course.height;
+      const double hmax = cells.max_course_height();
       if (row.jump ? !(row.line < tk && tk - row.line < 0.5 * hk)
-                   : !(std::abs(row.line - tk) <= 1e-9 * hk + 16 * eps * std::abs(tk)))
+                   : !(std::abs(row.line - tk) <= fixed_point_tolerance(std::abs(tk) + hmax, hmax)))
         fail(kc, 0, "rule 3 (its stitches were not laid on its centre line)");
       jump_courses += row.jump;
       for (std::size_t i = 0; i < a.l.size(); ++i) {
@@ -635,7 +643,8 @@ KnitMap make_knitmap(const Case& c, const CellTable& cells, const KnitMapOptions
         // Rule 7: the stitch's l is the field's at its centre as laid (before the centring),
         // or, on a jump, at the jump's start side, less than half its width before the centre.
         const double centre = a.s[i] - a.shift;
-        const double tol_s = 1e-9 * wi + 16 * eps * std::abs(centre);
+        const double wmax = cells.max_wale_width();
+        const double tol_s = fixed_point_tolerance(std::abs(centre) + wmax, wmax);
         const bool placed = a.jump[i] ? a.p[i] < centre && centre - a.p[i] < 0.5 * wi
                                       : std::abs(a.p[i] - centre) <= tol_s;
         if (!placed || !(std::abs(l_at(a.p[i], row.line) - a.l[i]) <= 1e-9 * a.l[i]))

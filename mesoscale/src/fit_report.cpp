@@ -31,7 +31,10 @@ void refuse_unfittable_options(const material::Database& db, const FitOptions& f
   if (!fo_file.empty()) {
     std::vector<material::LoadPath> paths;
     for (const auto& r : db.entries.front().raw) paths.push_back(r.path);
-    if (const std::string why = check_feasible(fo, paths); !why.empty())
+    // Only when the code's defaults could fit these paths: otherwise the database's paths
+    // are the cause, which the fit names (exit 1), not the file (the review of session 54).
+    if (const std::string why = check_feasible(fo, paths);
+        !why.empty() && check_feasible(FitOptions{}, paths).empty())
       throw InputError(
           fo_file, "",
           "these options cannot fit the paper law to the database's load paths: " + why);

@@ -583,12 +583,12 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
       // Session 54: E and S are F's and P's (eq. 9); the fits take E and S, the figures F and
       // P, and an edited E or S was fitted with exit 0. A path of no rows was read.
       {raw_add(p3 + "/E", 0, 2, 0.01),
-       p3 + "/E: step 1: the stored strain differs by 0.01 from the Green-Lagrange strain of its "
-            "F, (F^T F - I) / 2 = ("},
+       p3 + ": step 1: E and F disagree: the stored strain differs by 0.01 from the "
+            "Green-Lagrange strain of its F, (F^T F - I) / 2 = ("},
       {raw_add(p3 + "/S", 1, 0, -0.02),
-       p3 + "/S: step 2: the stored stress differs by 0.02 MPa from the second Piola-Kirchhoff "
-            "stress of its F and P, F^-1 P = ("},
-      {raw_add(p3 + "/P", 3, 3, 0.05), p3 + "/S: step 4: the stored stress differs by "},
+       p3 + ": step 2: S and F, P disagree: the stored stress differs by 0.02 MPa from the "
+            "second Piola-Kirchhoff stress of its F and P, sym(F^-1 P) = ("},
+      {raw_add(p3 + "/P", 3, 3, 0.05), p3 + ": step 4: S and F, P disagree: "},
       {[&](knit::io::H5File& f) {
          f.set_attribute(p3, "steps", 0);
          for (const char* d : {"F", "P"}) f.write(p3 + "/" + d, RowMatrixX(0, 4));
@@ -627,6 +627,18 @@ TEST_CASE("database: raw load paths and steps no sweep writes are refused, every
   db.entries[0].raw[1].F.row(0).setZero();
   CHECK_THROWS_WITH(write_database(tmp("raw_values_unwritten.h5"), db),
                     Catch::Contains("/loop_0/raw/path_01/F: step 1 has det F = 0"));
+  // ... nor a path of no rows (the review of session 54: the reader refused it, the writer not).
+  Database empty = small_db();
+  RawPath& r0 = empty.entries[0].raw[2];
+  r0.F.resize(0, 4);
+  r0.P.resize(0, 4);
+  r0.E.resize(0, 3);
+  r0.S.resize(0, 3);
+  r0.status.clear();
+  r0.path.steps = 0;
+  REQUIRE(first_unstorable_step(empty));
+  CHECK(*first_unstorable_step(empty) ==
+        "/loop_0/raw/path_02/status: the path has no load step (0 rows)");
 }
 
 // Session 53's red team: /yarn@youngs_modulus = -800 in a format-2 file was read by

@@ -849,3 +849,39 @@ TEST_CASE("design terms: the smoothness weights are second differences over Grev
   CHECK_FALSE(smoothness_weights(0.0, 0.5, 0.5, 0.5));  // a double knot of a degree-1 field
   CHECK_FALSE(smoothness_weights(0.5, 0.5, 1.0, 0.5));
 }
+
+// The review of session 54: the weights above were tested alone, and smoothness() passing the
+// abscissae (field_grid's Greville points) was not: a clamped cubic l field with a linear
+// grading (control values 4.5 + 2 g at its abscissae 0, 1/6, 1/2, 5/6, 1) costs nothing (with
+// plain (1, -2, 1) differences the ends' unequal spacing costs 2/9 here); a kink at the
+// middle value costs its divided differences.
+TEST_CASE("design terms: a linear grading of a clamped cubic field is free of smoothness",
+          "[unit]") {
+  const std::string c = write_case_variant(
+      "case_cubic.json",
+      R"("stitch_value": {"degrees": [2, 0], "knots_u": [0, 0, 0, 1, 1, 1], "knots_v": [0, 1],
+                       "values": [5.0, 5.6, 6.1]},)",
+      R"("stitch_value": {"degrees": [3, 0], "knots_u": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+                       "knots_v": [0, 1], "values": [5.0, 5.0, 5.0, 5.0, 5.0]},)");
+  const std::string vars =
+      R"([{"field": "stitch_value", "indices": [0], "lower": 4.5, "upper": 6.5},
+          {"field": "stitch_value", "indices": [1], "lower": 4.5, "upper": 6.5},
+          {"field": "stitch_value", "indices": [2], "lower": 4.5, "upper": 6.5},
+          {"field": "stitch_value", "indices": [3], "lower": 4.5, "upper": 6.5},
+          {"field": "stitch_value", "indices": [4], "lower": 4.5, "upper": 6.5}])";
+  const DesignProblem d = problem(c, "smooth_cubic.json", R"([{"type": "reaction",
+      "reaction": "fy", "at_strain": [0.2], "target": [0.0], "weight": 1e-300}])",
+                                  1.0, vars);
+  const std::vector<double> g = {0.0, 1.0 / 6, 0.5, 5.0 / 6, 1.0};
+  std::vector<double> linear;
+  for (double t : g) linear.push_back(4.5 + 2.0 * t);
+  const DesignEvaluation e = evaluate_design(d, linear, false);
+  REQUIRE(e.status == RunStatus::kCompleted);
+  REQUIRE(e.terms.size() == 2);
+  CHECK(e.terms[1].first == "smoothness");
+  CHECK(e.terms[1].second == Approx(0.0).margin(1e-20));
+  // The middle value raised by 0.1: the three terms that hold it are not 0.
+  std::vector<double> kinked = linear;
+  kinked[2] += 0.1;
+  CHECK(evaluate_design(d, kinked, false).terms[1].second > 1e-4);
+}

@@ -1,4 +1,5 @@
 // Ceres fit of the response surfaces (eq. 17) against a synthetic, known law.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
@@ -508,6 +509,13 @@ TEST_CASE("fit: options that cannot fit the database are refused naming their fi
                                       "database's load paths: paths with 6 steps cannot "
                                       "determine a degree-9 surface"));
   CHECK_NOTHROW(refuse_unfittable_options(db, fo, "", eo, ""));
+  // Paths no options could fit (no paper path) are the database's doing: the fit says so.
+  Database no_paper = db;
+  for (auto& e : no_paper.entries)
+    e.raw.erase(std::remove_if(e.raw.begin(), e.raw.end(),
+                               [](const RawPath& r) { return r.path.set == "paper"; }),
+                e.raw.end());
+  CHECK_NOTHROW(refuse_unfittable_options(no_paper, fo, "fo.json", eo, ""));
   eo.family = "ridge";
   eo.s_spans = 200;
   eo.l_control_points = 50;
