@@ -420,8 +420,7 @@ void EnergyFitOptions::refuse_other_family_keys(const std::string& text, const s
                          std::string("is an option of the ") + whose +
                              " family's fit, but \"family\" is \"" + family + "\"" +
                              (j.contains("family") ? "" : " (the default)") +
-                             ": it would be ignored (session 54: such keys were recorded as "
-                             "used); leave it out, or set \"family\" to \"" +
+                             ": it would be ignored; leave it out, or set \"family\" to \"" +
                              (ridge ? "network" : "ridge") + "\"");
   };
   if (ridge)
