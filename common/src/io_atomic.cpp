@@ -3,7 +3,8 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <stdio.h>  // renameat2 (glibc >= 2.28, _GNU_SOURCE is defined by g++)
+#include <stdio.h>   // renameat2 (glibc >= 2.28, _GNU_SOURCE is defined by g++)
+#include <stdlib.h>  // mkstemps
 #include <unistd.h>
 
 #include <algorithm>
@@ -222,6 +223,32 @@ void AtomicFile::commit() {
   release_live(live_slot_);  // renamed: a signal from here on must not unlink a new temporary
   live_slot_ = -1;
   fsync_path(parent_or_dot(target_), true);  // best effort: makes the rename durable
+}
+
+// ---- ScratchFile ----------------------------------------------------------------------------
+
+ScratchFile::ScratchFile(const fs::path& dir, std::string_view stem, std::string_view suffix) {
+  std::string name = (dir / stem).string();
+  name += "XXXXXX";
+  name += suffix;
+  // Blocked while the file is created and registered: a signal in between would leave it.
+  sigset_t all, old;
+  sigfillset(&all);
+  pthread_sigmask(SIG_BLOCK, &all, &old);
+  const int fd = ::mkstemps(name.data(), static_cast<int>(suffix.size()));
+  if (fd >= 0) {
+    ::close(fd);
+    path_ = name;
+    live_slot_ = register_live(path_);
+  }
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+}
+
+ScratchFile::~ScratchFile() {
+  if (path_.empty()) return;
+  std::error_code ec;
+  fs::remove(path_, ec);
+  release_live(live_slot_);
 }
 
 void write_file_atomically(const fs::path& target, std::string_view content) {

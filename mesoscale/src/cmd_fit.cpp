@@ -101,19 +101,11 @@ std::vector<std::string> items_lost_by_refit(const knit::material::Database& db,
   if (tmp_ec) return {};
   // A name of its own, created exclusively (session 44's red team: a user's file named
   // knit-meso-fit-check-<pid>.h5 was overwritten, then deleted). write_database replaces this
-  // empty file of ours by rename; the Remove below removes only what was created here.
-  std::string name = (tmp / "knit-meso-fit-check-XXXXXX.h5").string();
-  const int fd = ::mkstemps(name.data(), 3);
-  if (fd < 0) return {};  // as without a temporary directory
-  ::close(fd);
-  const fs::path scratch = name;
-  struct Remove {
-    fs::path p;
-    ~Remove() {
-      std::error_code ec;
-      fs::remove(p, ec);
-    }
-  } remove{scratch};
+  // empty file of ours by rename; ScratchFile removes only what was created here, also when a
+  // signal ends the refit (session 54's red team: Ctrl-C here left the file in TMPDIR).
+  const knit::io::ScratchFile scratch_file(tmp, "knit-meso-fit-check-", ".h5");
+  if (!scratch_file.valid()) return {};  // as without a temporary directory
+  const fs::path& scratch = scratch_file.path();
   std::vector<std::string> lost;
   bool changed = false;
   try {

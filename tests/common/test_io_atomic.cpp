@@ -42,6 +42,22 @@ std::size_t entries(const fs::path& dir) {
   return static_cast<std::size_t>(
       std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
+// Runs `body` (which raises `sig`) in a child with the CLI's interrupt handler installed and
+// checks that the child ended by that signal (the handler's clean-up, then its default action).
+template <class Body>
+void expect_ended_by(int sig, Body body) {
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    knit::cli::on_interrupt_say("interrupted (test)");
+    body();
+    ::_exit(3);  // not reached: the handler ends the process by the signal
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  CHECK(WIFSIGNALED(status));
+  CHECK(WTERMSIG(status) == sig);
+}
 }  // namespace
 
 TEST_CASE("AtomicFile replaces the target only on commit", "[unit][io][atomic]") {
@@ -890,21 +906,48 @@ TEST_CASE("a signal that ends the program unlinks the temporaries not yet commit
   }
   // A program interrupted while it writes (the CLI's handler, then the signal's default).
   for (const int sig : {SIGINT, SIGTERM}) {
-    const pid_t child = ::fork();
-    REQUIRE(child >= 0);
-    if (child == 0) {
-      knit::cli::on_interrupt_say("interrupted (test)");
+    expect_ended_by(sig, [&] {
       knit::io::AtomicFile f(d / "db.h5");
       f.stream() << "partial" << std::flush;
       ::raise(sig);
-      ::_exit(3);  // not reached: the handler ends the process by the signal
-    }
-    int status = 0;
-    REQUIRE(::waitpid(child, &status, 0) == child);
-    CHECK(WIFSIGNALED(status));
-    CHECK(WTERMSIG(status) == sig);
+    });
   }
   CHECK(entries(d) == 1);  // done.txt only: no ".db.h5.tmp-<pid>-<n>", no ".open.txt.tmp-..."
+  fs::remove_all(d);
+}
+
+// Session 54's red team: `knit-meso fit DB.h5` interrupted during its in-place pre-check left its
+// empty scratch file "knit-meso-fit-check-XXXXXX.h5" in TMPDIR for good.
+TEST_CASE("a scratch file is removed by its owner and by a signal that ends the program",
+          "[unit][io][atomic]") {
+  const fs::path d = scratch("scratch_file");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  {  // Created exclusively under a name of its own; replaced by rename, it is still removed.
+    const knit::io::ScratchFile a(d, "check-", ".h5");
+    const knit::io::ScratchFile b(d, "check-", ".h5");
+    REQUIRE(a.valid());
+    REQUIRE(b.valid());
+    CHECK(a.path() != b.path());
+    CHECK(a.path().filename().string().rfind("check-", 0) == 0);
+    CHECK(a.path().extension() == ".h5");
+    CHECK(fs::file_size(a.path()) == 0);
+    knit::io::write_file_atomically(a.path(), "a database");
+    CHECK(entries(d) == 2);
+  }
+  CHECK(entries(d) == 0);
+  CHECK_FALSE(knit::io::ScratchFile(d / "missing", "check-", ".h5").valid());
+  {  // The handler's unlink takes it; the owner's removal after that is harmless.
+    const knit::io::ScratchFile a(d, "check-", ".h5");
+    knit::io::unlink_live_temporaries();
+    CHECK_FALSE(fs::exists(a.path()));
+  }
+  for (const int sig : {SIGINT, SIGTERM})
+    expect_ended_by(sig, [&] {
+      const knit::io::ScratchFile f(d, "check-", ".h5");
+      ::raise(sig);
+    });
+  CHECK(entries(d) == 0);
   fs::remove_all(d);
 }
 

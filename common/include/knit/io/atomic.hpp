@@ -68,6 +68,26 @@ class AtomicFile {
 /// until the next run into it (session 43's red team).
 void unlink_live_temporaries() noexcept;
 
+/// A scratch file of this process, created exclusively (mkstemps) from a name pattern ending in
+/// "XXXXXX" + `suffix` in `dir`, and removed by the destructor and by unlink_live_temporaries()
+/// on a signal (session 54's red team: a `knit-meso fit` interrupted during its in-place
+/// pre-check left its empty "knit-meso-fit-check-XXXXXX.h5" in TMPDIR for good). The file may be
+/// replaced by rename (a database written over it) and is still removed: the name is tracked,
+/// not the inode. valid() is false when it could not be created (no slot is then held).
+class ScratchFile {
+ public:
+  ScratchFile(const std::filesystem::path& dir, std::string_view stem, std::string_view suffix);
+  ~ScratchFile();
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  bool valid() const { return !path_.empty(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  int live_slot_ = -1;
+};
+
 /// Writes `content` to `target` atomically.
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
 
