@@ -479,6 +479,7 @@ Database read_database(const std::filesystem::path& file, bool with_raw) {
           "the "
           "database as knit-meso wrote it (a copy made with cp keeps the checksum), or write a "
           "new one (knit-meso sweep, or knit-meso fit from the original)");
+    db.checksummed = f.any_checksum();
     db.format_version = f.attribute_int(".", "format_version");
     if (db.format_version < kOldestReadableVersion || db.format_version > kDatabaseFormatVersion)
       throw InputError(fname, "/",

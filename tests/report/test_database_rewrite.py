@@ -137,6 +137,11 @@ def main():
         rewrite_without_checksums(made["ridge"], old, version=2)
         rc, err = run_case(tmp, old, "old")
         c(rc == 0, "an intact old (format 2, checksum-free) ridge database runs", err[-800:])
+        # ... and says that its contents were not verified (session 54: it said nothing).
+        c("warning: " + old + ": written without checksums (format_version 2" in err,
+          "knit-macro warns that an old file's contents are not verified", err[-800:])
+        c("written without checksums" not in run_case(tmp, made["ridge"], "sealed")[1],
+          "a database with checksums is not warned of", "")
         # A refit of the old file says that its contents were not verified.
         r = subprocess.run([os.path.join(BIN, "knit-meso"), "fit", old, "--law", "paper", "-o",
                             os.path.join(tmp, "refit.h5")], capture_output=True, text=True)

@@ -162,6 +162,9 @@ struct Database {
   /// /sweep/report@failed_cases when the file has it (read only): above 0, the sweep that
   /// wrote this database failed, and wrote it for the diagnosis (knit-meso sweep, exit 1).
   int sweep_failed_cases = 0;
+  /// Read only: false for a file written before the checksums (issue 14; format versions 1-2),
+  /// whose contents the reader cannot verify. Such a file is read, and said so by its users.
+  bool checksummed = true;
   std::map<std::string, double> yarn;    ///< e.g. diameter, youngs_modulus, poisson_ratio
   std::vector<LoopLengthEntry> entries;  ///< increasing loop length
   /// The energy-based law (format version 2, /energy_law); absent in version-1 files and
