@@ -402,7 +402,7 @@ meso: $(MESO_ONLY)
 $(OUT)/report.md: $(STATUS) $(FIGURES) $(DB) $(OUT)/database.source $(ROOT)/scripts/report.py \
   $(ROOT)/scripts/report_checks.py $(ROOT)/scripts/law_near_visited.py \
   $(ROOT)/scripts/cell_paths.py $(ROOT)/scripts/strain_box.py $(ROOT)/scripts/law_small_strain.py \
-  $(ROOT)/scripts/law_uniaxial.py \
+  $(ROOT)/scripts/law_uniaxial.py $(ROOT)/scripts/law_shear.py \
   $(ROOT)/scripts/law_held_out.py \
   $(FIGPY)/energy_law.py \
   $(FIGPY)/results.py $(FIGPY)/sensitivity.py $(wildcard $(SENSITIVITY))

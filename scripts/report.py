@@ -469,6 +469,13 @@ def uniaxial_text(db_path):
                        "the database has no energy law")
 
 
+def shear_text(db_path):
+    """The law along the cell's pure-shear paths (scripts/law_shear.py)."""
+    import law_shear as m
+    return beside_text("Pure shear", lambda: m.summary(m.shear_ratios(db_path)),
+                       "the database has no energy law or no shear path")
+
+
 def small_strain_text(db_path):
     """The law over the cell at small strains (scripts/law_small_strain.py)."""
     import law_small_strain as m
@@ -1089,6 +1096,7 @@ class Report:
             L.append(near_visited_text(db_path, os.path.join(self.out, "results")))
             L.append(small_strain_text(db_path))
             L.append(uniaxial_text(db_path))
+            L.append(shear_text(db_path))
         L.append("## Statements of the paper against our numbers\n")
         L.append("Each check is a function of the loaded results (scripts/report_checks.py; "
                  "thresholds and their reasons in docs/reproduction.md). Curves are compared at "
