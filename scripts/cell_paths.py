@@ -31,6 +31,24 @@ def positive_number(text):
     return v
 
 
+def share_script_main(doc, prog, compute, summary, default_share, kept, missing):
+    """The command line of the law-along-the-cell's-paths scripts (law_uniaxial.py,
+    law_shear.py): DATABASE and --min-share (default `default_share`, the smallest `kept` cell
+    stress, as a share of the path's largest); prints summary(compute(db, share), share), or
+    exits naming the database with `missing` when compute() finds nothing."""
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap.add_argument("database", help="material database (HDF5) with /energy_law")
+    ap.add_argument("--min-share", type=positive_number, default=default_share,
+                    help=f"smallest {kept} kept, as a share of the path's largest "
+                         f"(default {default_share})")
+    a = ap.parse_args()
+    open_database(a.database, prog).close()
+    result = compute(a.database, a.min_share)
+    if not result:
+        raise SystemExit(f"{prog}: {a.database}: {missing}")
+    print(summary(result, a.min_share))
+
+
 def attr_text(v):
     """An HDF5 string attribute as str (h5py gives bytes or str, depending on how it was
     written)."""

@@ -20,7 +20,6 @@ ORDER_MIN_GAP of the larger, and among them those where the law's S12 goes the o
 The law is re-evaluated by scripts/figures/energy_law.py, the cell states read by
 scripts/cell_paths.py.
 """
-import argparse
 import os
 import sys
 
@@ -30,7 +29,7 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, open_database, positive_number  # noqa: E402
+from cell_paths import load_paths, share_script_main  # noqa: E402
 from energy_law import load_law  # noqa: E402
 
 MIN_SHARE = 0.1  # states with a cell S12 of at least this share of the path's largest
@@ -136,17 +135,8 @@ def summary(result, min_share=MIN_SHARE):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("database", help="material database (HDF5) with /energy_law")
-    ap.add_argument("--min-share", type=positive_number, default=MIN_SHARE,
-                    help="smallest cell S12 kept, as a share of the path's largest "
-                         f"(default {MIN_SHARE})")
-    a = ap.parse_args()
-    open_database(a.database, "law_shear").close()
-    result = shear_ratios(a.database, a.min_share)
-    if not result:
-        sys.exit(f"law_shear: {a.database}: no /energy_law or no shear path")
-    print(summary(result, a.min_share))
+    share_script_main(__doc__, "law_shear", shear_ratios, summary, MIN_SHARE, "cell S12",
+                      "no /energy_law or no shear path")
 
 
 if __name__ == "__main__":

@@ -25,7 +25,6 @@ convexity makes that stress increase with the lateral strain, so bisection finds
 law's lateral strain beside the cell's (6.5 mm wale-wise on the default database: 2.6 times the
 cell at E22 = 0.25, where the law contracts to E11 = -0.116 and the cell to -0.152).
 """
-import argparse
 import os
 import sys
 
@@ -35,7 +34,7 @@ import numpy as np
 _here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(_here, "figures"))
 sys.path.insert(0, _here)
-from cell_paths import load_paths, open_database, positive_number  # noqa: E402
+from cell_paths import load_paths, share_script_main  # noqa: E402
 from energy_law import load_law  # noqa: E402
 
 MIN_SHARE = 0.1  # states with an axial cell stress of at least this share of the path's largest
@@ -154,17 +153,8 @@ def summary(rows, min_share=MIN_SHARE):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("database", help="material database (HDF5) with /energy_law")
-    ap.add_argument("--min-share", type=positive_number, default=MIN_SHARE,
-                    help="smallest axial cell stress kept, as a share of the path's largest "
-                         f"(default {MIN_SHARE})")
-    a = ap.parse_args()
-    open_database(a.database, "law_uniaxial").close()
-    rows = uniaxial_ratios(a.database, a.min_share)
-    if not rows:
-        sys.exit(f"law_uniaxial: {a.database}: no /energy_law or no uniaxial path")
-    print(summary(rows, a.min_share))
+    share_script_main(__doc__, "law_uniaxial", uniaxial_ratios, summary, MIN_SHARE,
+                      "axial cell stress", "no /energy_law or no uniaxial path")
 
 
 if __name__ == "__main__":
