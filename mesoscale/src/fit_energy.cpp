@@ -277,6 +277,29 @@ std::string EnergyFitOptions::ridge_size_refusal(int loop_lengths) const {
          "lower s_spans, s_degree or l_control_points, or give fewer directions";
 }
 
+std::string EnergyFitOptions::ridge_size_key(int loop_lengths) const {
+  // Each factor of the count over its value in the defaults; the largest is named (the review
+  // of session 54: the refusal always pointed at /s_spans, also when the directions were the
+  // cause). s_spans + s_degree is one factor: the larger of the two departures names it.
+  EnergyFitOptions d;
+  d.family = "ridge";
+  const double functions = static_cast<double>(ridge_coefficients(loop_lengths)) /
+                           (std::min(l_control_points, loop_lengths) * (s_spans + s_degree));
+  const double default_functions =
+      static_cast<double>(d.ridge_coefficients(loop_lengths)) /
+      (std::min(d.l_control_points, loop_lengths) * (d.s_spans + d.s_degree));
+  const std::pair<double, const char*> factors[] = {
+      {functions / default_functions, "/directions"},
+      {static_cast<double>(s_spans) / d.s_spans, "/s_spans"},
+      {static_cast<double>(s_degree + 1) / (d.s_degree + 1), "/s_degree"},
+      {static_cast<double>(std::min(l_control_points, loop_lengths)) /
+           std::min(d.l_control_points, loop_lengths),
+       "/l_control_points"}};
+  return std::max_element(std::begin(factors), std::end(factors),
+                          [](const auto& a, const auto& b) { return a.first < b.first; })
+      ->second;
+}
+
 /// The energy-fit options' keys, by the family that reads them (docs/database.md, "Options and
 /// defaults"): one table for the known keys (from_json) and for the refusal of the other
 /// family's (refuse_other_family_keys), so that a new key cannot be known to one and not the

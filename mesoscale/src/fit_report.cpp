@@ -42,7 +42,7 @@ void refuse_unfittable_options(const material::Database& db, const FitOptions& f
   if (!eo_file.empty())
     if (const std::string why = eo.ridge_size_refusal(static_cast<int>(db.entries.size()));
         !why.empty())
-      throw InputError(eo_file, "/s_spans", why);
+      throw InputError(eo_file, eo.ridge_size_key(static_cast<int>(db.entries.size())), why);
 }
 
 std::string first_fit_failure(const material::Database& db, const std::vector<FitSummary>& fits) {

@@ -389,7 +389,10 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     if (const std::string why =
             in.energy_fit_options.ridge_size_refusal(static_cast<int>(in.loop_lengths.size()));
         !why.empty())
-      throw InputError(file, "/energy_fit/s_spans", why);
+      throw InputError(file,
+                       "/energy_fit" + in.energy_fit_options.ridge_size_key(
+                                           static_cast<int>(in.loop_lengths.size())),
+                       why);
     // Options of a fit that is not made are refused, not ignored unread (session 44's red
     // team: "fit": false with an "energy_fit" object ran with exit 0 and no word; knit-meso fit
     // refuses --energy-options with --law paper the same way, session 38).

@@ -644,6 +644,21 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     CHECK_THAT(s.reason, Catch::Contains("the ridge law would have 2010 coefficients (15 "
                                          "functions x 2 l control points") &&
                              Catch::Contains("lower s_spans"));
+    // Where a refusal points: the factor farthest above the defaults' (the review of session
+    // 54: always /s_spans, also when the directions were the cause).
+    CHECK(ridge.ridge_size_key(2) == "/s_spans");  // 62 / 12 against (5 + 1) / (3 + 1)
+    ridge.s_spans = 12;
+    ridge.s_degree = 5;
+    CHECK(ridge.ridge_size_key(2) == "/s_degree");
+    ridge.s_degree = 3;
+    for (int k = 0; k < 80; ++k)  // 80 directions on a spiral of the half sphere
+      ridge.directions.emplace_back(std::cos(0.7 * k), std::sin(0.7 * k), 0.1 + k / 80.0);
+    INFO(ridge.ridge_size_refusal(2));
+    CHECK_FALSE(ridge.ridge_size_refusal(2).empty());
+    CHECK(ridge.ridge_size_key(2) == "/directions");
+    ridge.directions.clear();
+    ridge.l_control_points = 40;
+    CHECK(ridge.ridge_size_key(40) == "/l_control_points");
   }
   SECTION("no loop length") {
     const auto s = fit_energy_law(Database{}, {});

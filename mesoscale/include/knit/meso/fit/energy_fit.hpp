@@ -157,6 +157,9 @@ struct EnergyFitOptions {
   /// Why the ridge law is too large to solve in minutes ("" if not): the count, its factors
   /// and what to lower.
   std::string ridge_size_refusal(int loop_lengths) const;
+  /// The key ("/directions", "/s_spans", "/s_degree" or "/l_control_points") whose value is
+  /// farthest above the defaults' as a factor of the ridge law's size: where a refusal points.
+  std::string ridge_size_key(int loop_lengths) const;
   std::string to_json() const;
   /// Parses the options (same keys as to_json()); errors name `file` and the JSON pointer
   /// below `pointer`.
