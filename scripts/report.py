@@ -984,7 +984,7 @@ class Report:
         source = open(src_file).read().split() if os.path.exists(src_file) else []
         mode = source[0] if source else "?"
         tfile = os.path.join(self.out, "database.time")
-        db_seconds = json.load(open(tfile)).get("seconds") if os.path.exists(tfile) else None
+        db_seconds = database_seconds(tfile)
         generator, loops = "?", []
         try:
             import h5py
@@ -1042,6 +1042,12 @@ class Report:
                         if not os.path.exists(os.path.join(self.out, "figures", n))]
         if missing_figs:
             law_text += f"; {len(missing_figs)} figure(s) MISSING"
+        damaged_figs = [os.path.basename(p)[:-4]
+                        for p in sorted(glob.glob(os.path.join(self.out, "figures", "*.png")))
+                        if not figure_failed(p) and figure_damage(p)]
+        if damaged_figs:
+            law_text += (f"; {len(damaged_figs)} figure(s) DAMAGED (not complete PNG images: "
+                         f"{', '.join(damaged_figs)})")
         spass, sfail = npass - rpass, nfail - rfail
         # What --strict judges (strict_problems): the runs, not the paper's statements nor the
         # law's checks, which measure the method against the paper and may fail on a sound run.
@@ -1051,6 +1057,7 @@ class Report:
             "twin experiments not recovered": twins - twins_ok,
             "figure scripts failed (placeholders)": n_failed_figs,
             "figures missing": len(missing_figs),
+            "figures damaged (not complete PNG images)": len(damaged_figs),
         }
         L.append(f"**Summary:** {spass} of {spass + sfail} checks of the paper's statements pass, "
                  f"{sfail} fail, and {ninfo} more are listed with our numbers only (the paper "
@@ -1174,6 +1181,8 @@ class Report:
             if figure_failed(p):  # session 38's red team: embedded as if drawn
                 L.append(f"**The figure script failed**: this is its placeholder (log: "
                          f"logs/figures/{base[:-4]}.log).\n")
+            elif damage_note(p):
+                L.append(damage_note(p))
             L.append(f"![{base}](figures/{base})\n")
         if failed_figs:
             at = next(i for i, l in enumerate(L) if l.startswith("## Figures"))
@@ -1457,6 +1466,8 @@ def design_section(out):
         try:
             with open(os.path.join(out, "design", n + ".status")) as f:
                 st = json.load(f)
+            if not isinstance(st, dict):  # session 55's red team: "[0]" ended in a traceback
+                st = None
         except (OSError, ValueError):
             st = None  # unreadable
         missing = not os.path.exists(os.path.join(out, "design", n + ".status"))
@@ -1489,8 +1500,13 @@ def section_figures(out, names):
     empty line that ends the section's table."""
     L = [""]
     for fig in names:
-        if os.path.exists(os.path.join(out, "figures", fig)):
-            L.append(f"### {fig[:-4]}\n\n![{fig}](figures/{fig})\n")
+        path = os.path.join(out, "figures", fig)
+        if os.path.exists(path):
+            L.append(f"### {fig[:-4]}\n")
+            note = damage_note(path)
+            if note:
+                L.append(note)
+            L.append(f"![{fig}](figures/{fig})\n")
     return L
 
 
@@ -1622,6 +1638,18 @@ def twin_cell(summ, declared=None, exit_code=0, stale=None):
     return f"{verdict(t[0] and not stale)}: {t[1]}" + (f"; {stale}" if stale else "")
 
 
+def database_seconds(tfile):
+    """The database's build time from $(OUT)/database.time ({"seconds": ...}), or None when
+    the file is missing or is not such a record (session 55's red team: a truncated file ended
+    the report in a JSONDecodeError traceback, no report written)."""
+    try:
+        with open(tfile) as f:
+            v = json.load(f).get("seconds")
+        return float(v) if isinstance(v, (int, float)) else None
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
 def database_time_line(db_seconds, loops):
     """The database section's line on its build time: the paper's ~30 min per loop length
     only beside a database whose loop lengths were read (session 38's red team: with
@@ -1644,6 +1672,41 @@ def twin_counts(out):
            for n in sorted(names)]
     got = [(t, stale) for t, stale in got if t is not None]
     return sum(1 for (ok, _), stale in got if ok and not stale), len(got)
+
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"  # the IEND chunk: length 0, type, CRC
+
+
+def figure_damage(path):
+    """Why a figure file is not a complete PNG image, or None: its signature, a first IHDR
+    chunk of a positive size and the IEND chunk at its end (not a decode). Session 55's red
+    team: an empty file, a text file and a PNG cut to 200 bytes were embedded as drawn, and
+    --strict exited 0."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(24)
+            size = f.seek(0, os.SEEK_END)
+            f.seek(max(0, size - len(PNG_END)))
+            tail = f.read()
+    except OSError as e:
+        return f"unreadable ({e.strerror})"
+    if size == 0:
+        return "an empty file"
+    if head[:8] != PNG_SIGNATURE:
+        return "not a PNG image"
+    if len(head) < 24 or head[12:16] != b"IHDR" or min(int.from_bytes(head[16:20], "big"),
+                                                       int.from_bytes(head[20:24], "big")) == 0:
+        return "a PNG without an image header"
+    if tail != PNG_END:
+        return "a PNG cut short (no end chunk)"
+    return None
+
+
+def damage_note(path):
+    """The line put above a damaged figure (figure_damage), or None."""
+    why = figure_damage(path)
+    return f"**The figure file is damaged**: {why}; draw it again.\n" if why else None
 
 
 def figure_failed(path):
@@ -1682,8 +1745,8 @@ def main():
     ap.add_argument("--strict", action="store_true",
                     help="exit 3 (after writing report.md) when a check of the runs themselves "
                          "fails, a case did not complete, a twin experiment was not recovered "
-                         "or a figure failed or is missing; the paper's statements and the "
-                         "law's checks are reported, not judged here")
+                         "or a figure failed, is missing or is damaged; the paper's statements "
+                         "and the law's checks are reported, not judged here")
     a = ap.parse_args()
     global EXPECTED_DESIGNS, DESIGNS_DIR, DATABASE_DATE
     EXPECTED_DESIGNS, DESIGNS_DIR = a.expect_designs.split(), a.designs_dir

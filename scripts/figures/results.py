@@ -274,10 +274,24 @@ class Result:
         self.case = {}
         cp = os.path.join(self.dir, "case.json")
         if os.path.exists(cp):
-            with open(cp) as f:
-                self.case = json.load(f)
-        grid = self.case.get("output", {}).get("grid", [21, 21])
-        self.grid = (int(grid[0]), int(grid[1]))
+            # Session 55's red team: a truncated case.json ended the report in a traceback.
+            try:
+                with open(cp) as f:
+                    self.case = json.load(f)
+                if not isinstance(self.case, dict):
+                    raise ValueError("not a JSON object")
+            except (OSError, ValueError) as e:
+                self.case = {}
+                self.problem = self.problem or f"{cp} is unreadable ({e})"
+                self.ok = False
+        output = self.case.get("output", {})
+        grid = output.get("grid", [21, 21]) if isinstance(output, dict) else [21, 21]
+        try:
+            self.grid = (int(grid[0]), int(grid[1]))
+        except (TypeError, ValueError, IndexError, KeyError):
+            self.grid = (21, 21)
+            self.problem = self.problem or f"{cp}: /output/grid is not two integers: {grid!r}"
+            self.ok = False
         self._steps = self._read_pvd()
 
     # -- run facts ----------------------------------------------------------------------------

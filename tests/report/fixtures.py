@@ -42,3 +42,16 @@ def call_refuses(c, call, needle, what):
         c(needle in str(e), "%s: %s" % (what, e))
         return
     c(False, "%s: no error" % what)
+
+
+def write_tiny_png(path):
+    """A complete 1 x 1 grey PNG image at `path` (signature, IHDR, IDAT, IEND)."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 1, 1, 8, 0, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(b"\x00\x80")) + chunk(b"IEND", b""))

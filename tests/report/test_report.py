@@ -25,7 +25,7 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.join(ROOT, "scripts", "figures"))
 import report  # noqa: E402
 import report_checks as rc  # noqa: E402
-from fixtures import linear_network_law, raw_path  # noqa: E402  (tests/report/fixtures.py)
+from fixtures import linear_network_law, raw_path, write_tiny_png  # noqa: E402  (tests/report/fixtures.py)
 
 L = 50.0
 N = 11  # output grid n_u = n_v
@@ -880,6 +880,14 @@ def unusable_result_failures(tmp):
         "another case's CSV": (lambda d: open(os.path.join(d, "load_strain.csv"), "w").write(
             "# knit-macro results of /x/cases/b.json (knitscale 0.1.0, git 0)\n"
             "step,strain,load_N\n1,0.1,2.0\n"), "holds the results of b.json, not of a.json"),
+        # session 55's red team: a truncated case.json ended the report in a traceback
+        "a truncated case.json": (lambda d: open(os.path.join(d, "case.json"), "w").write(
+            '{"output": {"gri'), "case.json is unreadable"),
+        "a case.json that is no object": (lambda d: open(os.path.join(d, "case.json"), "w").write(
+            "[0]"), "case.json is unreadable (not a JSON object)"),
+        "a case.json whose grid is not two integers": (
+            lambda d: open(os.path.join(d, "case.json"), "w").write('{"output": {"grid": 7}}'),
+            "/output/grid is not two integers"),
     }
     # Results of another database (session 38's red team): results.h5 names the date_utc of
     # the database the run read; another date than the database's is a defect of the run.
@@ -1404,8 +1412,7 @@ def main():
         figs = os.path.join(tmp, "figures")
         os.makedirs(figs, exist_ok=True)
         for name, failed in (("fig_drawn", False), ("fig_failed", True)):
-            with open(os.path.join(figs, name + ".png"), "wb") as f:
-                f.write(b"png")
+            write_tiny_png(os.path.join(figs, name + ".png"))
             if failed:
                 os.utime(os.path.join(figs, name + ".png"), (0, 0))
         rep.write(os.path.join(tmp, "no-database.h5"), "")
@@ -1416,6 +1423,25 @@ def main():
             failures.append("a failed figure's placeholder is not named in the report")
         if rep.strict_problems() != ["1 figure scripts failed (placeholders)"]:
             failures.append(f"--strict with a failed figure: {rep.strict_problems()}")
+        # A figure file that is not a complete PNG image is named, above it and in the summary,
+        # and --strict fails on it (session 55's red team: empty, text and cut-short files were
+        # embedded as drawn, exit 0); a complete one (fig_drawn) is not.
+        drawn = os.path.join(figs, "fig_drawn.png")
+        whole = open(drawn, "rb").read()
+        for content, why in ((b"", "an empty file"), (b"not an image", "not a PNG image"),
+                             (whole[:-12], "a PNG cut short (no end chunk)"),
+                             (whole[:8] + whole[8:12] + b"IHDR" + bytes(8) + whole[24:],
+                              "a PNG without an image header")):
+            with open(drawn, "wb") as f:
+                f.write(content)
+            rep.write(os.path.join(tmp, "no-database.h5"), "")
+            text = open(os.path.join(tmp, "report.md")).read()
+            if ("1 figure(s) DAMAGED (not complete PNG images: fig_drawn)" not in text
+                    or f"**The figure file is damaged**: {why}; draw it again." not in text
+                    or "1 figures damaged (not complete PNG images)" not in rep.strict_problems()):
+                failures.append(f"a damaged figure ({why}) is not named: "
+                                f"{rep.strict_problems()}")
+        write_tiny_png(drawn)
         # ... and a failing check of a run is one (a row's verdict turned, then restored).
         row = next(c for c in rep.rows if report.is_run_check(c) and c.ok is True)
         row.ok = False
@@ -1626,6 +1652,30 @@ def main():
             failures.append(f"database time of five loop lengths: {line!r}")
         if "for 1 loop length," not in report.database_time_line(3.0, [4.5]):
             failures.append("database time of one loop length: not singular")
+        # $(OUT)/database.time truncated or not a record: no time, no traceback (session 55's
+        # red team: a JSONDecodeError ended the report, none written).
+        tfile = os.path.join(tmp, "database.time.test")
+        for content, want in (('{"seconds": 91.5}', 91.5), ('{"seco', None), ("[0]", None),
+                              ('{"seconds": "x"}', None)):
+            with open(tfile, "w") as f:
+                f.write(content)
+            if report.database_seconds(tfile) != want:
+                failures.append(f"database_seconds of {content!r}: "
+                                f"{report.database_seconds(tfile)!r}, not {want!r}")
+        if report.database_seconds(os.path.join(tmp, "none.time")) is not None:
+            failures.append("database_seconds of a missing file")
+        # A design's status file that is not a JSON object (session 55's red team: "[0]" ended
+        # the report in an AttributeError): read as unreadable.
+        dd = os.path.join(tmp, "design_status_test")
+        os.makedirs(os.path.join(dd, "design"))
+        with open(os.path.join(dd, "design", "ex.status"), "w") as f:
+            f.write("[0]")
+        try:
+            lines = "\n".join(report.design_section(dd))
+            if "? (status file unreadable)" not in lines:
+                failures.append(f"a design status of [0]: {lines[-300:]!r}")
+        except Exception as e:  # noqa: BLE001 (the point: no exception at all)
+            failures.append(f"a design status of [0]: {type(e).__name__}: {e}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     for f in failures:
