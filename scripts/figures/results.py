@@ -354,8 +354,10 @@ class Result:
         gauge length and the applied displacement proportional to the load factor, row by row;
         summary.txt's converged steps and last load factor equal the CSV's; and at every output
         step in results.h5 the displacement of the applied edge (its grid line) or corner (its
-        grid sample) equals the CSV's applied displacement (knit-macro prescribes it there);
-        and no non-finite load factor, displacement or strain."""
+        grid sample) equals the CSV's applied displacement (knit-macro prescribes it there),
+        and every component the case's boundary conditions fix or prescribe is that value
+        there (_boundary_condition_defect); and no non-finite load factor, displacement or
+        strain."""
         c = self.csv
         lf, d, e = c.get("load_factor"), c.get("applied_displacement_mm"), c.get("strain")
         ad = self.case.get("output", {}).get("applied_displacement") or {}
@@ -434,7 +436,8 @@ class Result:
             if not abs(last - lf[-1]) <= 1e-6 * max(1.0, abs(lf[-1])):
                 return (f"summary.txt says last load factor {m.group(1)}, load_strain.csv "
                         f"{lf[-1]:.9g}")
-        return self._edge_displacement_defect(ad, d) or self._strain_field_defect()
+        return (self._edge_displacement_defect(ad, d) or self._boundary_condition_defect(d)
+                or self._strain_field_defect())
 
     # A strain field may depart from the strain of the stored deformation by this fraction of
     # the step's largest recomputed strain, plus twice the differences' own error estimate.
@@ -554,6 +557,122 @@ class Result:
                                 f"applied displacement {by_step[s]:.9g} mm of load_strain.csv "
                                 f"for that step (its fields are not of that load)")
         except (OSError, KeyError, ValueError):
+            return None  # unreadable: the checks that read the fields say so
+        return None
+
+    # A target's samples on the output grid (rows v, columns u: knit-macro samples theta =
+    # (i / (n_u - 1), j / (n_v - 1)), so the edges and corners are the grid's outer rows and
+    # corner samples).
+    _GRID_TARGETS = {"u0": lambda u: u[:, 0], "u1": lambda u: u[:, -1], "v0": lambda u: u[0, :],
+                     "v1": lambda u: u[-1, :], "u0v0": lambda u: u[0, 0],
+                     "u1v0": lambda u: u[0, -1], "u0v1": lambda u: u[-1, 0],
+                     "u1v1": lambda u: u[-1, -1], "all": lambda u: u}
+
+    def _boundary_condition_targets(self):
+        """The case's boundary conditions that the output grid can judge: a list of (pointer,
+        target, component index, value at load factor 1, prescribed). Fixed components (`fix`,
+        and a symmetry plane's normal on its edge row) are 0, prescribed ones value x load
+        factor. Targets: an edge, a corner, a `point` at a corner ([0 or 1, 0 or 1]; the loader
+        refuses any other) and `all`. Not judged: `clamp` (it ties the second control-point
+        row to the edge row, a slope, not a displacement of a grid sample), a corner pad's
+        control points other than the corner's own (`radius`: their Greville points are no
+        grid samples; the corner sample is judged), and entries that are not of the schema's
+        grammar (the loader refuses them; the case's own check says so)."""
+        bcs = self.case.get("boundary_conditions") if isinstance(self.case, dict) else None
+        out = []
+        for i, bc in enumerate(bcs if isinstance(bcs, list) else []):
+            if not isinstance(bc, dict):
+                continue
+            target = None
+            if bc.get("edge") in ("u0", "u1", "v0", "v1"):
+                target = bc["edge"]
+            elif bc.get("corner") in ("u0v0", "u1v0", "u0v1", "u1v1"):
+                target = bc["corner"]
+            elif isinstance(bc.get("point"), list) and len(bc["point"]) == 2 \
+                    and all(t in (0, 1) and not isinstance(t, bool) for t in bc["point"]):
+                target = f"u{int(bc['point'][0])}v{int(bc['point'][1])}"
+            elif bc.get("all") is True:
+                target = "all"
+            if target is None:
+                continue  # not a target of the schema (refused by the loader): not judged
+            ptr = f"/boundary_conditions/{i}"
+            fixed = list(bc.get("fix") or []) if isinstance(bc.get("fix"), list) else []
+            if bc.get("symmetry") in ("x", "y", "z") and target in ("u0", "u1", "v0", "v1"):
+                fixed.append(bc["symmetry"])
+            for c in fixed:
+                if c in ("x", "y", "z"):
+                    out.append((ptr, target, "xyz".index(c), 0.0, False))
+            pre = bc.get("prescribe")
+            for c, v in (pre.items() if isinstance(pre, dict) else ()):
+                if c in ("x", "y", "z") and isinstance(v, (int, float)) \
+                        and not isinstance(v, bool) and math.isfinite(v):
+                    out.append((ptr, target, "xyz".index(c), float(v), True))
+        return out
+
+    def _boundary_condition_defect(self, d):
+        """Where a step's displacement field in results.h5 breaks one of the case's own
+        boundary conditions, or None (session 55's red team: the held edge v0 of
+        s312_uniform_45_wale slipped along y by 30 % of the applied displacement, x and the
+        strain fields changed to match, and every run check passed: only the applied edge was
+        compared). At every step, every fixed component (`fix`, a symmetry plane's normal) of
+        an edge's grid line, a corner's sample or (`all`) every sample must be 0, and every
+        prescribed one the prescribed value times load_strain.csv's load factor of that step
+        (steps the CSV lacks: the fixed components only), within 1e-6 x max(1, the largest
+        applied or prescribed displacement in mm), as for the applied edge. A fix holds control
+        points, and with the open knot vectors of every case the edge's control points are
+        its edge (the samples there are the constrained values, up to round-off): on the main
+        job's 26 runs (their 134 field steps) the largest |fixed component| was exactly 0 and
+        the largest prescribed departure 2.1e-14 mm (1.4e-15 of the prescribed value), at most
+        1.4e-9 of the tolerance (1e-6 x 5 to 20 mm there). What the grid cannot judge is listed in
+        _boundary_condition_targets. A step without a displacement (nor x and X) or whose grid
+        does not fit it is a defect when there is a condition to judge."""
+        targets = self._boundary_condition_targets()
+        path = os.path.join(self.dir, "results.h5")
+        if not targets or not os.path.exists(path):
+            return None
+        try:
+            import h5py
+        except ImportError:
+            return None
+        scale = max([1.0] + [abs(v) for _, _, _, v, _ in targets]
+                    + ([float(np.max(np.abs(d)))] if d is not None and len(d) else []))
+        if not math.isfinite(scale):
+            return None  # a non-finite applied displacement: consistency_defect names it
+        tol = 1e-6 * scale
+        grid = (self.case.get("output", {}) or {}).get("grid")
+        try:
+            with h5py.File(path, "r") as f:
+                for k, g in f.get("fields", {}).items():
+                    try:
+                        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
+                        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+                        if "displacement" in g:
+                            u = np.asarray(g["displacement"], dtype=float)
+                        else:
+                            u = np.asarray(g["x"], dtype=float) - np.asarray(g["X"], dtype=float)
+                        u = u.reshape(nv, nu, 3)
+                    except (KeyError, TypeError, ValueError, IndexError) as e:
+                        return (f"results.h5 {k}: its displacement cannot be checked against the "
+                                f"case's boundary conditions ({type(e).__name__}: {e})")
+                    try:
+                        lf = self.csv_load_factor(int(k.split("_")[-1]))
+                    except ValueError:
+                        lf = None
+                    for ptr, target, comp, value, prescribed in targets:
+                        if prescribed and lf is None:
+                            continue  # no load factor of this step to scale it with
+                        want = value * lf if prescribed else 0.0
+                        on = self._GRID_TARGETS[target](u[..., comp])
+                        off = float(np.max(np.abs(on - want)))
+                        if not off <= tol:
+                            what = (f"the {want:.9g} mm {ptr} prescribes at load factor "
+                                    f"{lf:.9g} (load_strain.csv)" if prescribed
+                                    else f"0 mm at which {ptr} holds it")
+                            return (f"results.h5 {k}: the displacement of "
+                                    f"{'every sample' if target == 'all' else target} along "
+                                    f"{'xyz'[comp]} is up to {off:.3g} mm off {what} (its "
+                                    "fields break the case's boundary conditions)")
+        except OSError:
             return None  # unreadable: the checks that read the fields say so
         return None
 

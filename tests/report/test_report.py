@@ -1091,7 +1091,7 @@ def consistency_failures(tmp):
     res = os.path.join(tmp, "consistency")
 
     def fresh(strain_scale=1.0, steps_line=2, last_lf="1", field_scale=1.0, date=True,
-              corner=False, d1="1", strain1=None, rows=True):
+              corner=False, d1="1", strain1=None, rows=True, bcs=None):
         shutil.rmtree(res, ignore_errors=True)
         d = os.path.join(res, "a")
         os.makedirs(d)
@@ -1104,7 +1104,8 @@ def consistency_failures(tmp):
             json.dump({"material": {"type": "knit"}, "output": {"grid": [3, 3],
                        "applied_displacement": {"corner" if corner else "edge":
                                                 "u1v1" if corner else "v1",
-                                                "component": "y", "gauge_length": 20}}}, f)
+                                                "component": "y", "gauge_length": 20}},
+                       **({} if bcs is None else {"boundary_conditions": bcs})}, f)
         with open(os.path.join(d, "summary.txt"), "w") as f:
             f.write(f"status: completed\nconverged steps: {steps_line}\n"
                     f"last load factor: {last_lf}\n")
@@ -1280,6 +1281,59 @@ def consistency_failures(tmp):
         why = r._strain_field_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, strain fields with {what}: {why!r}")
+    # Session 55's red team: the held edge v0 of s312_uniform_45_wale slipped along y by 30 % of
+    # the applied displacement in results.h5 (x and the strain fields changed to match) and
+    # every run check passed. The fixture's field (u_y 0, 1, 2 mm on the rows v0, middle, v1;
+    # u_x = u_z = 0) keeps the wale test's conditions; each change of a held or prescribed
+    # component is named with its target and component, and a change below the tolerance
+    # (1e-6 x max(1, 2 mm)) or of a free component is not a defect.
+    wale = [{"all": True, "fix": ["z"]}, {"edge": "v0", "fix": ["x", "y"]},
+            {"edge": "v1", "fix": ["x"], "prescribe": {"y": 2.0}}]
+    corner = [{"point": [0, 0], "fix": ["x", "y", "z"]}, {"corner": "u1v1", "radius": 5.0,
+                                                          "prescribe": {"x": 0.5, "y": 2.0}}]
+    sym = [{"edge": "u0", "symmetry": "x", "clamp": True}]
+    v0, mid, u0 = (0, slice(None)), (1, 1), (slice(None), 0)
+    for what, bcs, moves, needle in [
+            ("the wale test's conditions kept", wale, [], None),
+            ("v0 slipped along y by 30 % of the applied 2 mm", wale, [(v0, 1, 0.6)],
+             "step_0002: the displacement of v0 along y is up to 0.6 mm off 0 mm at which "
+             "/boundary_conditions/1 holds it"),
+            ("v0 slipped along x", wale, [(v0, 0, -0.01)],
+             "the displacement of v0 along x is up to 0.01 mm off 0 mm"),
+            ("v0 slipped by 1e-9 mm (round-off)", wale, [(v0, 1, 1e-9)], None),
+            ("the middle sample lifted out of the plane", wale, [(mid, 2, 0.1)],
+             "the displacement of every sample along z is up to 0.1 mm off 0 mm at which "
+             "/boundary_conditions/0 holds it"),
+            ("the middle sample moved along x (free there)", wale, [(mid, 0, 0.1)], None),
+            ("a corner pad's prescribed x kept", corner, [((-1, -1), 0, 0.5)], None),
+            ("a corner pad's prescribed x missed", corner, [((-1, -1), 0, 0.7)],
+             "the displacement of u1v1 along x is up to 0.2 mm off the 0.5 mm "
+             "/boundary_conditions/1 prescribes at load factor 1"),
+            ("the corner point [0, 0] moved", corner, [((-1, -1), 0, 0.5), ((0, 0), 2, 0.05)],
+             "the displacement of u0v0 along z is up to 0.05 mm off 0 mm"),
+            ("a symmetry plane's edge moved along its normal", sym, [(u0, 0, 0.3)],
+             "the displacement of u0 along x is up to 0.3 mm off 0 mm")]:
+        r = fresh(bcs=bcs)
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            g = h["fields/step_0002"]
+            u = np.asarray(g["displacement"]).reshape(3, 3, 3)
+            for where, comp, by in moves:
+                u[where + (comp,)] += by
+            g["displacement"][...] = u.reshape(-1, 3)
+            g["x"][...] = u.reshape(-1, 3)  # X = 0 here: x moves with it
+        why = r.consistency_defect()
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, boundary conditions with {what}: {why!r}")
+    # ... and such a run is no data to the report (Data.run_defect).
+    fresh(bcs=wale)
+    with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+        g = h["fields/step_0002"]
+        u = np.asarray(g["displacement"]).reshape(3, 3, 3)
+        u[0, :, 1] += 0.6
+        g["displacement"][...] = u.reshape(-1, 3)
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is None or "off 0 mm at which /boundary_conditions/1 holds it" not in why:
+        out.append(f"consistency, a slipped held edge through run_defect: {why!r}")
     # Session 52's red team: results.h5 @units "m, kN, GPa", and a database whose units, format
     # or format_version are not ours, changed no verdict. A run states mm, N, MPa or is no data;
     # a database that states other units, format or version makes every knit run no data and
