@@ -69,9 +69,10 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
           ++skipped;
           continue;
         }
-        const double sw = r.path.kind == material::PathKind::kUniaxial
-                              ? o.weight_uniaxial
-                              : (r.path.set == "paper" ? o.weight_paper : 1.0);
+        const double sw = r.path.kind == material::PathKind::kUniaxial ? o.weight_uniaxial
+                          : r.path.kind == material::PathKind::kShear  ? o.weight_shear
+                          : r.path.set == "paper"                      ? o.weight_paper
+                                                                       : 1.0;
         Point p{{r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)},
                 r.S.row(s).transpose(),
                 entry.loop_length,
@@ -305,9 +306,9 @@ std::string EnergyFitOptions::ridge_size_key(int loop_lengths) const {
 /// family's (refuse_other_family_keys), so that a new key cannot be known to one and not the
 /// other (the review of session 54). max_iterations, unused since session 14, is still accepted,
 /// as older files hold it.
-constexpr std::array<const char*, 8> kSharedKeys = {
-    "family",          "floor",           "floor_relative", "max_iterations",
-    "weight_relative", "weight_uniaxial", "weight_paper",   "stable_min_cos"};
+constexpr std::array<const char*, 9> kSharedKeys = {
+    "family",          "floor",        "floor_relative", "max_iterations", "weight_relative",
+    "weight_uniaxial", "weight_paper", "weight_shear",   "stable_min_cos"};
 constexpr std::array<const char*, 10> kRidgeOnlyKeys = {
     "directions", "s_degree",  "s_spans", "l_degree",   "l_control_points",
     "s_margin",   "smoothing", "loss",    "loss_scale", "loss_rounds"};
@@ -343,6 +344,7 @@ std::string EnergyFitOptions::validate() const {
   if (!(weight_uniaxial > 0.0 && weight_uniaxial <= 1e3))
     return "weight_uniaxial must be in (0, 1000]";
   if (!(weight_paper > 0.0 && weight_paper <= 1e3)) return "weight_paper must be in (0, 1000]";
+  if (!(weight_shear > 0.0 && weight_shear <= 1e3)) return "weight_shear must be in (0, 1000]";
   if (!(std::isfinite(stable_min_cos) && stable_min_cos <= 1.0))
     return "stable_min_cos must be finite and <= 1 (below -1: keep every state)";
   // The law normalizes each direction: its length must do so (session 54's red team: a
@@ -409,6 +411,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"weight_relative", weight_relative},
                       {"weight_uniaxial", weight_uniaxial},
                       {"weight_paper", weight_paper},
+                      {"weight_shear", weight_shear},
                       {"stable_min_cos", stable_min_cos},
                       {"family", family},
                       {"hidden1", hidden1},
@@ -489,6 +492,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("weight_relative", o.weight_relative);
   get_double("weight_uniaxial", o.weight_uniaxial);
   get_double("weight_paper", o.weight_paper);
+  get_double("weight_shear", o.weight_shear);
   get_double("stable_min_cos", o.stable_min_cos);
   get_int("hidden1", o.hidden1);
   get_int("hidden2", o.hidden2);

@@ -204,6 +204,55 @@ TEST_CASE("energy fit: the network fit gives the same law for every thread count
   CHECK(o.validate() == "threads must be >= 0 (0: all cores)");
 }
 
+// Session 55's red team: the default law's pure-shear stiffness was ordered wrongly in l (the
+// paper's shear path, one of 13 paths at weight_paper, is all the pure-shear data). weight_shear
+// weights the pure-shear paths' states alone: here the shear path's stresses are scaled by 1.5
+// (data the rest of the paths contradict), and the law follows them the more, the larger
+// weight_shear; weight_paper no longer reaches them.
+TEST_CASE("energy fit: weight_shear weights the pure-shear paths' states", "[unit]") {
+  Database db = synthetic_coverage_db({4.5, 6.5}, 4);
+  int shear_paths = 0;
+  for (auto& entry : db.entries)
+    for (auto& r : entry.raw)
+      if (r.path.kind == material::PathKind::kShear) {
+        ++shear_paths;
+        r.S *= 1.5;
+        r.P *= 1.5;
+      }
+  REQUIRE(shear_paths == 2);  // the paper's shear path at each loop length
+  // The largest |S_law - S_data| over the shear paths' states, and over the others.
+  auto misses = [&](const EnergyFitOptions& o) {
+    const EnergyFitSummary s = fit_energy_law(db, o);
+    INFO(s.reason);
+    REQUIRE(s.ok());
+    const material::EnergyLaw law(s.law);
+    std::pair<double, double> worst{0.0, 0.0};
+    for (const auto& entry : db.entries)
+      for (const auto& r : entry.raw)
+        for (int k = 0; k < r.steps(); ++k) {
+          const Eigen::Vector3d e(r.E(k, 0), r.E(k, 1), 2.0 * r.E(k, 2));
+          const double miss = (law.at(entry.loop_length).evaluate(e).S - r.S.row(k).transpose())
+                                  .cwiseAbs()
+                                  .maxCoeff();
+          double& w = r.path.kind == material::PathKind::kShear ? worst.first : worst.second;
+          w = std::max(w, miss);
+        }
+    return worst;
+  };
+  EnergyFitOptions low = ridge_options(), high = ridge_options(), paper = ridge_options();
+  low.weight_shear = 0.01;
+  high.weight_shear = 1000.0;
+  paper.weight_shear = 0.01;
+  paper.weight_paper = 1000.0;
+  const auto l = misses(low), h = misses(high), p = misses(paper);
+  INFO("shear paths: " << l.first << " / " << h.first << " / " << p.first << " MPa; others "
+                       << l.second << " / " << h.second << " / " << p.second);
+  CHECK(h.first < 0.5 * l.first);
+  CHECK(p.first > 0.9 * l.first);  // weight_paper does not weight the shear path any more
+  CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"weight_shear": 0})", "f.json"),
+                    Catch::Contains("weight_shear must be in (0, 1000]"));
+}
+
 TEST_CASE("energy fit: a floor or weights large enough to overflow are refused", "[unit]") {
   // floor 1e308 ended in "Initial cost and jacobian evaluation failed", naming no option.
   EnergyFitOptions o;
