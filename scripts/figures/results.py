@@ -10,6 +10,7 @@ import json
 import math
 import os
 import re
+import sys
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -114,6 +115,22 @@ def green_lagrange_on_grid(X, x, order=4):
     T = np.stack([np.stack([np.sum(G[a] * e, axis=-1) for e in (e1, e2)], -1) for a in (0, 1)],
                  -2)  # T[a, i] = G^a . e_i
     return np.einsum("...ai,...ab,...bj->...ij", T, 0.5 * (metric(a1, a2) - A), T)
+
+
+def nurbs_on_grid(geometry, nu, nv):
+    """A case's /geometry (NURBS patch: degrees, knots_u, knots_v, control_points u fastest,
+    optional weights) at the output grid's samples, (nv, nu, 3), by report_checks'
+    evaluator (Cox-de Boor with weights, scripts/report_checks.py nurbs_point_and_a1); None
+    when the patch cannot be evaluated (not of the case format: the loader refuses it)."""
+    scripts = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if scripts not in sys.path:
+        sys.path.insert(1, scripts)
+    import report_checks
+    try:
+        X = report_checks.exact_alignment_angle(geometry, nu, nv)[1]
+    except (AssertionError, KeyError, TypeError, ValueError, IndexError, ZeroDivisionError):
+        return None
+    return X if np.all(np.isfinite(X)) else None
 
 
 def case_json_of(path):
@@ -356,8 +373,9 @@ class Result:
         step in results.h5 the displacement of the applied edge (its grid line) or corner (its
         grid sample) equals the CSV's applied displacement (knit-macro prescribes it there),
         and every component the case's boundary conditions fix or prescribe is that value
-        there (_boundary_condition_defect); and no non-finite load factor, displacement or
-        strain."""
+        there (_boundary_condition_defect); x - X is the displacement and X the case's
+        patch, the same at every step (_reference_defect); and no non-finite load factor,
+        displacement or strain."""
         c = self.csv
         lf, d, e = c.get("load_factor"), c.get("applied_displacement_mm"), c.get("strain")
         ad = self.case.get("output", {}).get("applied_displacement") or {}
@@ -436,8 +454,115 @@ class Result:
             if not abs(last - lf[-1]) <= 1e-6 * max(1.0, abs(lf[-1])):
                 return (f"summary.txt says last load factor {m.group(1)}, load_strain.csv "
                         f"{lf[-1]:.9g}")
-        return (self._edge_displacement_defect(ad, d) or self._boundary_condition_defect(d)
-                or self._strain_field_defect())
+        return (self._edge_displacement_defect(ad, d) or self._reference_defect()
+                or self._boundary_condition_defect(d) or self._strain_field_defect())
+
+    # x - X may depart from the displacement, the reference grid between steps and from the
+    # case's NURBS patch by this fraction of the patch's size (see _reference_defect).
+    REFERENCE_TOLERANCE = 1e-9
+
+    def _reference_defect(self):
+        """Why results.h5's reference and deformed grids disagree with its displacements or
+        with the case's geometry, or None (session 55: nothing checked x = X + displacement or
+        X; x and the strain fields moved with the displacement left would have passed, since
+        the strain check reads x and X and the boundary-condition check the displacement). At
+        every output step (fields/step_N): where x, X and displacement are stored, x - X must
+        be the displacement; the reference grid (X, or x - displacement where X is not stored,
+        as the report reads it) must be the first step's, since the reference configuration
+        does not move; and where the case gives its /geometry (a NURBS patch) it must be that
+        patch at the output grid's samples (theta1, theta2) = (i / (n_u - 1), j / (n_v - 1))
+        (docs/case-format.md, results_writer.cpp), evaluated from the input patch: the
+        refinement (degree elevation, knot insertion) does not change the geometry. Each within
+        REFERENCE_TOLERANCE x the patch's size (the larger of its control net's bounding-box
+        diagonal and its largest |coordinate|; without a /geometry, of the first step's
+        reference grid). On the main job's 26 runs (135 field steps, 41 x 41 grids, degrees 3
+        to 7 by elevation of bilinear and rational cubic patches, up to 4 x 4 elements) x - X -
+        displacement and the change of X between steps were exactly 0, and X was at most
+        5.7e-14 mm (8.0e-16 of the 70.7 mm patch) off the input patch: the tolerance (7.1e-8
+        mm there) is 1.2e6 times that. A step whose reference grid cannot be read or does not
+        fit the grid is a defect."""
+        path = os.path.join(self.dir, "results.h5")
+        if not os.path.exists(path):
+            return None
+        try:
+            import h5py
+        except ImportError:
+            return None
+        case = self.case if isinstance(self.case, dict) else {}
+        geometry = case.get("geometry")
+        grid = (case.get("output", {}) or {}).get("grid")
+        size = None
+        try:
+            P = np.asarray(geometry["control_points"], dtype=float).reshape(-1, 3)
+            size = max(float(np.linalg.norm(P.max(0) - P.min(0))), float(np.max(np.abs(P))))
+        except (TypeError, KeyError, ValueError, IndexError):
+            geometry = None  # no NURBS patch to compare with (the loader refuses such a case)
+        surface = {}  # (nu, nv) -> the patch at that grid's samples, (nv, nu, 3)
+
+        def worst(a, b):  # the largest distance of two grids' samples, and its sample
+            off = np.linalg.norm(a - b, axis=1)
+            i = int(np.argmax(off)) if off.size else 0
+            return (float(off[i]) if off.size else 0.0), i
+
+        def at(i):  # sample i of the current step's grid (nu, nv)
+            return f"(theta1, theta2) = ({i % nu}/{nu - 1}, {i // nu}/{nv - 1})"
+        first = None  # (step name, reference grid)
+        try:
+            with h5py.File(path, "r") as f:
+                for k, g in sorted(f.get("fields", {}).items()):
+                    try:
+                        read = {n: np.asarray(g[n], dtype=float).reshape(-1, 3)
+                                for n in ("x", "X", "displacement") if n in g}
+                        x, X, u = (read.get(n) for n in ("x", "X", "displacement"))
+                        if X is None and (x is None or u is None):
+                            raise KeyError("neither X nor x and displacement")
+                        derived = X is None
+                        ref = x - u if derived else X
+                        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
+                        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+                        if any(a.shape[0] != nu * nv for a in read.values()):
+                            held = ", ".join(f"{n} {a.shape[0]}" for n, a in read.items())
+                            raise ValueError(f"{held} samples on a {nu} x {nv} grid")
+                    except (KeyError, TypeError, ValueError, IndexError) as e:
+                        return (f"results.h5 {k}: its reference grid cannot be checked "
+                                f"({type(e).__name__}: {e})")
+                    if size is None:
+                        size = float(np.max(np.abs(ref))) if ref.size else 0.0
+                        size = max(size, float(np.linalg.norm(ref.max(0) - ref.min(0)))
+                                   if ref.size else 0.0)
+                    tol = self.REFERENCE_TOLERANCE * size
+                    what = "x - displacement" if derived else "X"
+                    if not derived and x is not None and u is not None:
+                        off, i = worst(x - X, u)
+                        if not off <= tol:
+                            return (f"results.h5 {k}: x - X is {off:.3g} mm off its "
+                                    f"displacement at {at(i)} (tolerance {tol:.3g} mm): its "
+                                    "deformed or reference grid is not of its displacement")
+                    if first is None:
+                        first = (k, ref)
+                    elif first[1].shape != ref.shape:
+                        return (f"results.h5 {k}: its reference grid has {ref.shape[0]} "
+                                f"samples, {first[0]}'s {first[1].shape[0]}")
+                    else:
+                        off, i = worst(ref, first[1])
+                        if not off <= tol:
+                            return (f"results.h5 {k}: its reference grid ({what}) is {off:.3g} "
+                                    f"mm off {first[0]}'s at {at(i)} (tolerance {tol:.3g} mm): "
+                                    "the reference configuration moved between steps")
+                    if geometry is not None:
+                        if (nu, nv) not in surface:
+                            surface[(nu, nv)] = nurbs_on_grid(geometry, nu, nv)
+                        S = surface[(nu, nv)]
+                        if S is None:
+                            continue  # a patch the evaluator cannot take (the loader refuses it)
+                        off, i = worst(ref, S.reshape(-1, 3))
+                        if not off <= tol:
+                            return (f"results.h5 {k}: its reference grid ({what}) is {off:.3g} "
+                                    f"mm off the case's /geometry (its NURBS patch) at {at(i)} "
+                                    f"(tolerance {tol:.3g} mm): it is not the case's surface")
+        except OSError:
+            return None  # unreadable: the checks that read the fields say so
+        return None
 
     # A strain field may depart from the strain of the stored deformation by this fraction of
     # the step's largest recomputed strain, plus twice the differences' own error estimate.

@@ -1091,7 +1091,7 @@ def consistency_failures(tmp):
     res = os.path.join(tmp, "consistency")
 
     def fresh(strain_scale=1.0, steps_line=2, last_lf="1", field_scale=1.0, date=True,
-              corner=False, d1="1", strain1=None, rows=True, bcs=None):
+              corner=False, d1="1", strain1=None, rows=True, bcs=None, geometry=None):
         shutil.rmtree(res, ignore_errors=True)
         d = os.path.join(res, "a")
         os.makedirs(d)
@@ -1105,7 +1105,8 @@ def consistency_failures(tmp):
                        "applied_displacement": {"corner" if corner else "edge":
                                                 "u1v1" if corner else "v1",
                                                 "component": "y", "gauge_length": 20}},
-                       **({} if bcs is None else {"boundary_conditions": bcs})}, f)
+                       **({} if bcs is None else {"boundary_conditions": bcs}),
+                       **({} if geometry is None else {"geometry": geometry})}, f)
         with open(os.path.join(d, "summary.txt"), "w") as f:
             f.write(f"status: completed\nconverged steps: {steps_line}\n"
                     f"last load factor: {last_lf}\n")
@@ -1120,7 +1121,37 @@ def consistency_failures(tmp):
             u[:, :, 1] = np.linspace(0.0, 2.0, 3)[:, None] * field_scale  # v1 (last row): 2 mm
             g["displacement"] = u.reshape(-1, 3)
             g["x"] = u.reshape(-1, 3)
+            if geometry is not None:  # as knit-macro writes them: X the patch, x = X + u
+                X = QUARTER_X.reshape(-1, 3)
+                g["X"], g["x"][...] = X, X + u.reshape(-1, 3)
+                g = h.create_group("fields/step_0001")
+                g.attrs["grid_u"], g.attrs["grid_v"], g.attrs["load_factor"] = 3, 3, 0.5
+                g["X"], g["x"] = X, X + 0.5 * u.reshape(-1, 3)
+                g["displacement"] = 0.5 * u.reshape(-1, 3)
         return Result(res, "a")
+
+    # The case's patch for the reference grid's checks: a quarter cylinder of radius 20 mm
+    # (rational quadratic in u, weights 1, 1/sqrt(2), 1) and height 10 mm (linear in v), whose
+    # 3 x 3 grid samples are known: angles 0, 45 and 90 degrees at z = 0, 5, 10.
+    from results import nurbs_on_grid
+    c = 1 / SQ2
+    QUARTER = {"degrees": [2, 1], "knots_u": [0, 0, 0, 1, 1, 1], "knots_v": [0, 0, 1, 1],
+               "control_points": [[20, 0, 0], [20, 20, 0], [0, 20, 0],
+                                  [20, 0, 10], [20, 20, 10], [0, 20, 10]],
+               "weights": [1, c, 1, 1, c, 1], "thickness": 0.76}
+    QUARTER_X = np.array([[[20 * math.cos(a), 20 * math.sin(a), z]
+                           for a in (0.0, math.pi / 4, math.pi / 2)] for z in (0.0, 5.0, 10.0)])
+    # The evaluator itself (Cox-de Boor with weights): the bilinear square is its grid, the
+    # quarter circle's samples lie on the circle (its midpoint at 45 degrees).
+    S = nurbs_on_grid(SQUARE, 5, 3)
+    sq = np.stack(np.meshgrid(np.linspace(0, L, 5), np.linspace(0, L, 3)) + [np.zeros((3, 5))],
+                  -1)
+    if S is None or np.max(np.abs(S - sq)) > 1e-12:
+        out.append(f"nurbs_on_grid: the bilinear square is not its grid: {S}")
+    S = nurbs_on_grid(QUARTER, 9, 3)
+    if S is None or np.max(np.abs(np.hypot(S[..., 0], S[..., 1]) - 20.0)) > 1e-12 \
+            or np.max(np.abs(S[:, ::4] - QUARTER_X)) > 1e-12:
+        out.append(f"nurbs_on_grid: the quarter circle is off its circle: {S}")
 
     if fresh(corner=True).consistency_defect() is not None:
         out.append("consistency: a consistent corner-loaded run has a defect")
@@ -1334,6 +1365,71 @@ def consistency_failures(tmp):
     why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
     if why is None or "off 0 mm at which /boundary_conditions/1 holds it" not in why:
         out.append(f"consistency, a slipped held edge through run_defect: {why!r}")
+    # Session 55: nothing checked x = X + displacement or X itself; x (and the strain fields
+    # that the strain check derives from x and X) moved with the displacement left would pass
+    # the boundary-condition check, which reads the displacement. Outputs as knit-macro writes
+    # them (X the case's patch, the same at both steps, x = X + displacement) pass, also moved
+    # by round-off; x moved alone, X moved at one step, X off the case's patch at every step
+    # and, without a stored X, x moved alone at one or at every step are named.
+    mid = 4  # the middle sample (theta1, theta2) = (1/2, 1/2)
+
+    def move(h, steps, names, by=0.3, comp=0):
+        for st in steps:
+            g = h[f"fields/step_{st:04d}"]
+            for n in names:
+                v = np.asarray(g[n])
+                v[mid, comp] += by
+                g[n][...] = v
+
+    def drop_X(h):
+        for st in (1, 2):
+            del h[f"fields/step_{st:04d}/X"]
+
+    def short_X(h):  # step 1's X of 4 samples beside x and displacement of 9
+        del h["fields/step_0001/X"]
+        h["fields/step_0001/X"] = np.zeros((4, 3))
+    at_mid = "at (theta1, theta2) = (1/2, 1/2)"
+    for what, change, needle in [
+            ("as written", lambda h: None, None),
+            ("x moved by round-off", lambda h: move(h, (2,), ["x"], by=1e-9), None),
+            ("x and X moved by round-off", lambda h: move(h, (1, 2), ["x", "X"], by=1e-9), None),
+            ("x moved, the displacement left", lambda h: move(h, (2,), ["x"]),
+             f"results.h5 step_0002: x - X is 0.3 mm off its displacement {at_mid}"),
+            ("x and X moved at one step", lambda h: move(h, (2,), ["x", "X"]),
+             f"results.h5 step_0002: its reference grid (X) is 0.3 mm off step_0001's {at_mid}"),
+            ("x and X moved at every step", lambda h: move(h, (1, 2), ["x", "X"], comp=2),
+             "results.h5 step_0001: its reference grid (X) is 0.3 mm off the case's /geometry "
+             f"(its NURBS patch) {at_mid}"),
+            ("no X, x moved at one step", lambda h: (drop_X(h), move(h, (2,), ["x"])),
+             "results.h5 step_0002: its reference grid (x - displacement) is 0.3 mm off "
+             f"step_0001's {at_mid}"),
+            ("no X, x moved at every step", lambda h: (drop_X(h), move(h, (1, 2), ["x"])),
+             "results.h5 step_0001: its reference grid (x - displacement) is 0.3 mm off the "
+             "case's /geometry"),
+            ("X of another grid", short_X,
+             "results.h5 step_0001: its reference grid cannot be checked (ValueError: x 9, X 4, "
+             "displacement 9 samples on a 3 x 3 grid)")]:
+        r = fresh(geometry=QUARTER)
+        with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+            change(h)
+        why = r.consistency_defect()
+        if (why is None) != (needle is None) or (needle and needle not in why):
+            out.append(f"consistency, reference grid with {what}: {why!r}")
+    # ... another patch in the case (radius 20.3 mm), and a moved x through run_defect.
+    fresh(geometry=dict(QUARTER, control_points=[[p * 1.015 for p in q[:2]] + [q[2]]
+                                                 for q in QUARTER["control_points"]]))
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is None or "its reference grid (X) is 0.3 mm off the case's /geometry" not in why:
+        out.append(f"consistency, X off another case's patch through run_defect: {why!r}")
+    fresh(geometry=QUARTER)
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is not None:
+        out.append(f"consistency: an untouched run with its patch through run_defect: {why!r}")
+    with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+        move(h, (2,), ["x"])
+    why = report.Data(res, "2026-12-01T10:00:00Z").run_defect("a")
+    if why is None or "x - X is 0.3 mm off its displacement" not in why:
+        out.append(f"consistency, x moved alone through run_defect: {why!r}")
     # Session 52's red team: results.h5 @units "m, kN, GPa", and a database whose units, format
     # or format_version are not ours, changed no verdict. A run states mm, N, MPa or is no data;
     # a database that states other units, format or version makes every knit run no data and
