@@ -461,6 +461,18 @@ class Result:
     # case's NURBS patch by this fraction of the patch's size (see _reference_defect).
     REFERENCE_TOLERANCE = 1e-9
 
+    def _judged_h5(self):
+        """(results.h5 of this run, the h5py module), or (None, None) when the file is missing
+        or h5py is not installed: the consistency checks that read it judge nothing then."""
+        path = os.path.join(self.dir, "results.h5")
+        if not os.path.exists(path):
+            return None, None
+        try:
+            import h5py
+        except ImportError:
+            return None, None
+        return path, h5py
+
     def _reference_defect(self):
         """Why results.h5's reference and deformed grids disagree with its displacements or
         with the case's geometry, or None (session 55: nothing checked x = X + displacement or
@@ -481,12 +493,8 @@ class Result:
         5.7e-14 mm (8.0e-16 of the 70.7 mm patch) off the input patch: the tolerance (7.1e-8
         mm there) is 1.2e6 times that. A step whose reference grid cannot be read or does not
         fit the grid is a defect."""
-        path = os.path.join(self.dir, "results.h5")
-        if not os.path.exists(path):
-            return None
-        try:
-            import h5py
-        except ImportError:
+        path, h5py = self._judged_h5()
+        if path is None:
             return None
         case = self.case if isinstance(self.case, dict) else {}
         geometry = case.get("geometry")
@@ -592,12 +600,8 @@ class Result:
         second red team put one outlier where a bound took its scale from the fields, and
         deleted X or the grid's attributes, which turned a first version off. A step whose
         deformation or grid cannot be read beside its strain fields is a defect too."""
-        path = os.path.join(self.dir, "results.h5")
-        if not os.path.exists(path):
-            return None
-        try:
-            import h5py
-        except ImportError:
+        path, h5py = self._judged_h5()
+        if path is None:
             return None
         names = ("E11", "E22", "E12")
         grid = (self.case.get("output", {}) or {}).get("grid") if isinstance(self.case, dict) \
@@ -653,14 +657,12 @@ class Result:
         # cases; the review of session 42: they were left out).
         edge = ad.get("edge") or ad.get("corner")
         comp = "xyz".find(str(ad.get("component", "")))
-        path = os.path.join(self.dir, "results.h5")
         steps = self.csv.get("step")
         if edge not in ("u0", "u1", "v0", "v1", "u0v0", "u1v0", "u0v1", "u1v1") or comp < 0 \
-                or d is None or steps is None or not os.path.exists(path):
+                or d is None or steps is None:
             return None
-        try:
-            import h5py
-        except ImportError:
+        path, h5py = self._judged_h5()
+        if path is None:
             return None
         by_step = dict(zip(steps.astype(int), d))
         scale = max(1.0, float(np.max(np.abs(d)))) if len(d) else 1.0
@@ -746,18 +748,14 @@ class Result:
         applied or prescribed displacement in mm), as for the applied edge. A fix holds control
         points, and with the open knot vectors of every case the edge's control points are
         its edge (the samples there are the constrained values, up to round-off): on the main
-        job's 26 runs (their 134 field steps) the largest |fixed component| was exactly 0 and
+        job's 26 runs (their 134-135 field steps) the largest |fixed component| was exactly 0 and
         the largest prescribed departure 2.1e-14 mm (1.4e-15 of the prescribed value), at most
         1.4e-9 of the tolerance (1e-6 x 5 to 20 mm there). What the grid cannot judge is listed in
         _boundary_condition_targets. A step without a displacement (nor x and X) or whose grid
         does not fit it is a defect when there is a condition to judge."""
         targets = self._boundary_condition_targets()
-        path = os.path.join(self.dir, "results.h5")
-        if not targets or not os.path.exists(path):
-            return None
-        try:
-            import h5py
-        except ImportError:
+        path, h5py = self._judged_h5()
+        if not targets or path is None:
             return None
         scale = max([1.0] + [abs(v) for _, _, _, v, _ in targets]
                     + ([float(np.max(np.abs(d)))] if d is not None and len(d) else []))
