@@ -321,7 +321,9 @@ void write_database(const std::filesystem::path& file, const Database& db,
         p.set_attribute("P", "columns", "P11, P12, P21, P22 (MPa); rows: load steps 1..steps");
         p.set_attribute("E", "columns", "E11, E22, E12 (tensor); rows: load steps 1..steps");
         p.set_attribute("S", "columns", "S11, S22, S12 (MPa); rows: load steps 1..steps");
-        p.set_attribute("status", "values", "0 = converged");
+        p.set_attribute(
+            "status", "values",
+            "0 = converged, 1 = did not converge, 2 = not reached; the fits take only 0");
       }
       if (e.surface) {
         H5Group fg = g.create_group("fit");

@@ -362,6 +362,28 @@ SweepInput parse_sweep_input(const std::string& text, const std::string& file) {
     in.retry.substeps_coverage = s.value("coverage", in.retry.substeps_coverage);
     in.retry.substeps_holdout = s.value("holdout", in.retry.substeps_holdout);
   }
+  // The last retry's cell solves per path: steps x substeps x step_factor^retries, counted in
+  // 64 bits (session 55, from session 53's open list: max_retries 6 with step_factor 8 runs a
+  // path's last retry with 262,144 times its steps, days for a path the sweep then gives up
+  // on, and 10,000 steps x 16 substeps x 8^6 overflowed the attempt's int step count).
+  for (std::size_t p = 0; p < in.paths.size(); ++p) {
+    const material::LoadPath& lp = in.paths[p];
+    const int retries = in.retry.retries_for(lp);
+    long long solves = static_cast<long long>(lp.steps) * std::max(1, in.retry.substeps_for(lp));
+    const long long first = solves;
+    for (int a = 0; a < retries && solves <= kMaxCellSolvesPerAttempt; ++a)
+      solves *= in.retry.step_factor;
+    if (solves > kMaxCellSolvesPerAttempt)
+      throw InputError(
+          file, lp.set == "paper" ? "/retry/max_retries" : "/retry/max_retries_coverage",
+          "a " + lp.set + " path (" +
+              (p < in.path_fields.size() ? in.path_fields[p] : "/load_paths") + ", " +
+              std::to_string(first) + " cell solves on its first attempt) would take more than " +
+              std::to_string(kMaxCellSolvesPerAttempt) + " on its last retry (x step_factor " +
+              std::to_string(in.retry.step_factor) + " per retry, " + std::to_string(retries) +
+              " retries): hours for one path that did not converge at fewer steps; lower "
+              "max_retries or step_factor");
+  }
   if (j.contains("fit")) {
     const auto& f = j.at("fit");
     if (f.is_boolean()) {

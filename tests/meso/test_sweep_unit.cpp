@@ -219,6 +219,22 @@ TEST_CASE("sweep input: errors name the JSON pointer", "[unit]") {
     return std::string("<no error>");
   };
   CHECK(pointer_of(R"({"loop_lengths": [4.5, 4.0]})") == "/loop_lengths/1");
+  // Retries whose last attempt would run for hours are refused when the input is read (session
+  // 55: max_retries 6 x step_factor 8 is 262,144 times a path's steps; 10,000 steps x 16
+  // substeps x 8^6 overflowed the attempt's int). The default paths have 20 steps: 20 x 8^4 =
+  // 81,920 solves pass, 20 x 8^5 = 655,360 do not; coverage paths by their own retries.
+  CHECK(pointer_of(R"({"loop_lengths": [5], "retry": {"max_retries": 4, "step_factor": 8}})") ==
+        "<no error>");
+  CHECK(pointer_of(R"({"loop_lengths": [5], "retry": {"max_retries": 5, "step_factor": 8}})") ==
+        "/retry/max_retries");
+  CHECK(pointer_of(R"({"loop_lengths": [5], "retry": {"max_retries_coverage": 6, "step_factor": 8},
+      "load_paths": {"preset": "default", "extra": [{"kind": "uniaxial", "axis": "wale", "E": 0.2,
+      "steps": 4, "set": "coverage"}]}})") == "/retry/max_retries_coverage");  // 4 x 8^6
+  CHECK_THROWS_WITH(
+      parse_sweep_input(R"({"loop_lengths": [5], "retry": {"max_retries": 6, "step_factor": 8}})",
+                        "s.json"),
+      Catch::Contains("s.json: /retry/max_retries: a paper path (/steps, 20 cell solves on its "
+                      "first attempt) would take more than 200000 on its last retry"));
   CHECK(pointer_of(R"({"loop_lengths": [4.5, -1]})") == "/loop_lengths/1");
   // Session 36's red team: 4.5 and 4.500000000000001 were two loop lengths, both "l=4.50".
   CHECK_THROWS_WITH(parse_sweep_input(R"({"loop_lengths": [4.5, 4.500000000000001]})", "t.json"),
