@@ -39,7 +39,7 @@ SAME_STRAIN = 1e-9  # 2E12 of two loop lengths' states this close: the same shea
 
 def shear_states(db_path):
     """Per loop length: (l, e (n x 3, e3 = 2 E12), S (n x 3), S_law (n x 3), largest (n,: the
-    largest cell S12 of each state's path)) of its shear paths' converged states, in path
+    largest cell |S12| of each state's path)) of its shear paths' converged states, in path
     order. Empty when the database has no energy law."""
     out = []
     with h5py.File(db_path, "r") as f:
@@ -50,8 +50,9 @@ def shear_states(db_path):
             e = np.vstack([p[1] for p in paths]) if paths else np.zeros((0, 3))
             S = np.vstack([p[2] for p in paths]) if paths else np.zeros((0, 3))
             s_law = load_law(f["energy_law"], l).eval(e)[1] if len(e) else np.zeros((0, 3))
-            # Each path's own largest S12 for its cut.
-            largest = np.concatenate([np.full(len(p[2]), p[2][:, 2].max(initial=0.0))
+            # Each path's own largest |S12| for its cut (a path of negative shear: its
+            # magnitudes; the review of session 55: such a path was dropped without a word).
+            largest = np.concatenate([np.full(len(p[2]), np.abs(p[2][:, 2]).max(initial=0.0))
                                       for p in paths]) if paths else np.zeros(0)
             out.append((float(l), e, S, s_law, largest))
     return out
@@ -69,7 +70,7 @@ def shear_ratios(db_path, min_share=MIN_SHARE):
         return None
     rows = []
     for l, e, S, s_law, largest in states:
-        keep = (largest > 0) & (S[:, 2] >= min_share * largest)
+        keep = (largest > 0) & (np.abs(S[:, 2]) >= min_share * largest)
         row = {"l": l, "n": int(keep.sum())}
         if keep.any():
             ratio = s_law[keep, 2] / S[keep, 2]
@@ -86,10 +87,10 @@ def shear_ratios(db_path, min_share=MIN_SHARE):
         for l, e, S, s_law, largest in states:
             hit = np.flatnonzero(np.abs(e[:, 2] - g) <= SAME_STRAIN) if len(e) else []
             # The states the ratios keep, at every loop length.
-            if len(hit) == 0 or not S[hit[0], 2] >= min_share * largest[hit[0]] > 0:
+            if len(hit) == 0 or not abs(S[hit[0], 2]) >= min_share * largest[hit[0]] > 0:
                 break
             picks.append((l, S[hit[0], 2], s_law[hit[0], 2]))
-        if len(picks) != len(states) or g <= 0:
+        if len(picks) != len(states) or g == 0:
             continue
         n_rev = 0
         for (la, ca, wa), (lb, cb, wb) in zip(picks, picks[1:]):
@@ -127,7 +128,7 @@ def summary(result, min_share=MIN_SHARE):
         order += (f" (most at 2E12 = {x['g']:.3f}: cell {seq(x['cell'])} MPa, law "
                   f"{seq(x['law'])} MPa at l = {' / '.join(f'{l:g}' for l in x['l'])} mm)")
     return (f"Pure shear (not judged; `scripts/law_shear.py`): at the states of the database's "
-            f"pure-shear paths whose S12 is at least {100 * min_share:g} % of the path's "
+            f"pure-shear paths whose |S12| is at least {100 * min_share:g} % of the path's "
             f"largest, the law's S12 over the cell's is, median (farthest from 1): "
             f"{'; '.join(parts)}.{order}. The acceptance, relative to the range, does not see "
             f"this; cases with shear in the material frame (alpha not 0 or 90 deg, curved "

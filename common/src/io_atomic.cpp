@@ -227,25 +227,37 @@ void AtomicFile::commit() {
 
 // ---- ScratchFile ----------------------------------------------------------------------------
 
+namespace {
+/// Every signal blocked in this thread for the object's lifetime.
+struct SignalsBlocked {
+  sigset_t old;
+  SignalsBlocked() {
+    sigset_t all;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+  }
+  ~SignalsBlocked() { pthread_sigmask(SIG_SETMASK, &old, nullptr); }
+  SignalsBlocked(const SignalsBlocked&) = delete;
+  SignalsBlocked& operator=(const SignalsBlocked&) = delete;
+};
+}  // namespace
+
 ScratchFile::ScratchFile(const fs::path& dir, std::string_view stem, std::string_view suffix) {
   std::string name = (dir / stem).string();
   name += "XXXXXX";
   name += suffix;
-  // Blocked while the file is created and registered: a signal in between would leave it.
-  sigset_t all, old;
-  sigfillset(&all);
-  pthread_sigmask(SIG_BLOCK, &all, &old);
+  const SignalsBlocked blocked;  // created and registered as one step for a signal
   const int fd = ::mkstemps(name.data(), static_cast<int>(suffix.size()));
   if (fd >= 0) {
     ::close(fd);
     path_ = name;
     live_slot_ = register_live(path_);
   }
-  pthread_sigmask(SIG_SETMASK, &old, nullptr);
 }
 
 ScratchFile::~ScratchFile() {
   if (path_.empty()) return;
+  const SignalsBlocked blocked;  // removed and released as one step for a signal
   std::error_code ec;
   fs::remove(path_, ec);
   release_live(live_slot_);

@@ -69,10 +69,11 @@ std::string collect(const Database& db, std::vector<Point>& fit, std::vector<Poi
           ++skipped;
           continue;
         }
+        const double set_weight = r.path.set == "paper" ? o.weight_paper : 1.0;
         const double sw = r.path.kind == material::PathKind::kUniaxial ? o.weight_uniaxial
-                          : r.path.kind == material::PathKind::kShear  ? o.weight_shear
-                          : r.path.set == "paper"                      ? o.weight_paper
-                                                                       : 1.0;
+                          : r.path.kind == material::PathKind::kShear && o.weight_shear > 0.0
+                              ? o.weight_shear
+                              : set_weight;
         Point p{{r.E(s, 0), r.E(s, 1), 2.0 * r.E(s, 2)},
                 r.S.row(s).transpose(),
                 entry.loop_length,
@@ -281,7 +282,8 @@ std::string EnergyFitOptions::ridge_size_refusal(int loop_lengths) const {
 std::string EnergyFitOptions::ridge_size_key(int loop_lengths) const {
   // Each factor of the count over its value in the defaults; the largest is named (the review
   // of session 54: the refusal always pointed at /s_spans, also when the directions were the
-  // cause). s_spans + s_degree is one factor: the larger of the two departures names it.
+  // cause). s_spans + s_degree is one factor, compared as a whole (the review of session 55:
+  // s_spans alone overstated it); of its two keys, the one farther above its default names it.
   EnergyFitOptions d;
   d.family = "ridge";
   const double functions = static_cast<double>(ridge_coefficients(loop_lengths)) /
@@ -289,10 +291,13 @@ std::string EnergyFitOptions::ridge_size_key(int loop_lengths) const {
   const double default_functions =
       static_cast<double>(d.ridge_coefficients(loop_lengths)) /
       (std::min(d.l_control_points, loop_lengths) * (d.s_spans + d.s_degree));
+  const char* s_key = static_cast<double>(s_spans) / d.s_spans >=
+                              static_cast<double>(s_degree + 1) / (d.s_degree + 1)
+                          ? "/s_spans"
+                          : "/s_degree";
   const std::pair<double, const char*> factors[] = {
       {functions / default_functions, "/directions"},
-      {static_cast<double>(s_spans) / d.s_spans, "/s_spans"},
-      {static_cast<double>(s_degree + 1) / (d.s_degree + 1), "/s_degree"},
+      {static_cast<double>(s_spans + s_degree) / (d.s_spans + d.s_degree), s_key},
       {static_cast<double>(std::min(l_control_points, loop_lengths)) /
            std::min(d.l_control_points, loop_lengths),
        "/l_control_points"}};
@@ -344,7 +349,8 @@ std::string EnergyFitOptions::validate() const {
   if (!(weight_uniaxial > 0.0 && weight_uniaxial <= 1e3))
     return "weight_uniaxial must be in (0, 1000]";
   if (!(weight_paper > 0.0 && weight_paper <= 1e3)) return "weight_paper must be in (0, 1000]";
-  if (!(weight_shear > 0.0 && weight_shear <= 1e3)) return "weight_shear must be in (0, 1000]";
+  if (!(weight_shear == -1.0 || (weight_shear > 0.0 && weight_shear <= 1e3)))
+    return "weight_shear must be -1 (the path set's weight) or in (0, 1000]";
   if (!(std::isfinite(stable_min_cos) && stable_min_cos <= 1.0))
     return "stable_min_cos must be finite and <= 1 (below -1: keep every state)";
   // The law normalizes each direction: its length must do so (session 54's red team: a

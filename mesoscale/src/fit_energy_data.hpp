@@ -14,7 +14,7 @@ struct Point {
   Eigen::Vector3d e, S;  // Voigt strain, stress
   double l;
   std::size_t loop;   // entry index
-  double set_weight;  // weight_uniaxial / weight_paper / 1 (see EnergyFitOptions)
+  double set_weight;  // weight_uniaxial / weight_shear / weight_paper / 1 (see EnergyFitOptions)
   int axis = -1;      // a state of a uniaxial-stress path: its axis (0 course, 1 wale); else -1
 };
 

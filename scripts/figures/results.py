@@ -301,11 +301,20 @@ class Result:
                 self.case = {}
                 self.problem = self.problem or f"{cp} is unreadable ({e})"
                 self.ok = False
+        # The case's /output, an object (the review of session 55: a list here ended the
+        # consistency checks in an AttributeError), and its grid, two positive integers (a
+        # string "21" read as (2, 1), [true, true] as (1, 1)).
         output = self.case.get("output", {})
-        grid = output.get("grid", [21, 21]) if isinstance(output, dict) else [21, 21]
-        try:
-            self.grid = (int(grid[0]), int(grid[1]))
-        except (TypeError, ValueError, IndexError, KeyError):
+        if not isinstance(output, dict):
+            self.problem = self.problem or f"{cp}: /output is not a JSON object"
+            self.ok = False
+            output = {}
+        self.output = output
+        grid = output.get("grid", [21, 21])
+        if isinstance(grid, list) and len(grid) == 2 and all(
+                isinstance(n, int) and not isinstance(n, bool) and n > 0 for n in grid):
+            self.grid = (grid[0], grid[1])
+        else:
             self.grid = (21, 21)
             self.problem = self.problem or f"{cp}: /output/grid is not two integers: {grid!r}"
             self.ok = False
@@ -378,7 +387,7 @@ class Result:
         displacement or strain."""
         c = self.csv
         lf, d, e = c.get("load_factor"), c.get("applied_displacement_mm"), c.get("strain")
-        ad = self.case.get("output", {}).get("applied_displacement") or {}
+        ad = self.output.get("applied_displacement") or {}
         # knit-macro run writes summary.txt with every output, and results.h5's /steps holds the
         # CSV's rows (session 50's red team: summary.txt deleted and the CSV cut to 10 of its 20
         # rows was counted as a completed run and judged "monotone" on half its curve).
@@ -498,7 +507,7 @@ class Result:
             return None
         case = self.case if isinstance(self.case, dict) else {}
         geometry = case.get("geometry")
-        grid = (case.get("output", {}) or {}).get("grid")
+        grid = self.output.get("grid")
         size = None
         try:
             P = np.asarray(geometry["control_points"], dtype=float).reshape(-1, 3)
@@ -604,8 +613,7 @@ class Result:
         if path is None:
             return None
         names = ("E11", "E22", "E12")
-        grid = (self.case.get("output", {}) or {}).get("grid") if isinstance(self.case, dict) \
-            else None
+        grid = self.output.get("grid")
         try:
             with h5py.File(path, "r") as f:
                 for k, g in f.get("fields", {}).items():
@@ -748,7 +756,7 @@ class Result:
         applied or prescribed displacement in mm), as for the applied edge. A fix holds control
         points, and with the open knot vectors of every case the edge's control points are
         its edge (the samples there are the constrained values, up to round-off): on the main
-        job's 26 runs (their 134-135 field steps) the largest |fixed component| was exactly 0 and
+        job's 26 runs (their 135 field steps) the largest |fixed component| was exactly 0 and
         the largest prescribed departure 2.1e-14 mm (1.4e-15 of the prescribed value), at most
         1.4e-9 of the tolerance (1e-6 x 5 to 20 mm there). What the grid cannot judge is listed in
         _boundary_condition_targets. A step without a displacement (nor x and X) or whose grid
@@ -762,7 +770,7 @@ class Result:
         if not math.isfinite(scale):
             return None  # a non-finite applied displacement: consistency_defect names it
         tol = 1e-6 * scale
-        grid = (self.case.get("output", {}) or {}).get("grid")
+        grid = self.output.get("grid")
         try:
             with h5py.File(path, "r") as f:
                 for k, g in f.get("fields", {}).items():

@@ -250,7 +250,15 @@ TEST_CASE("energy fit: weight_shear weights the pure-shear paths' states", "[uni
   CHECK(h.first < 0.5 * l.first);
   CHECK(p.first > 0.9 * l.first);  // weight_paper does not weight the shear path any more
   CHECK_THROWS_WITH(EnergyFitOptions::from_json(R"({"weight_shear": 0})", "f.json"),
-                    Catch::Contains("weight_shear must be in (0, 1000]"));
+                    Catch::Contains("weight_shear must be -1 (the path set's weight) or in (0, "
+                                    "1000]"));
+  // -1, the default: the set's weight, as before the option (the review of session 55: a
+  // refit from options recorded without the key must weight as they were fitted).
+  EnergyFitOptions as_set = ridge_options(), explicit_paper = ridge_options();
+  as_set.weight_paper = explicit_paper.weight_paper = 7.0;
+  explicit_paper.weight_shear = 7.0;
+  CHECK(EnergyFitOptions{}.weight_shear == -1.0);
+  CHECK(misses(as_set) == misses(explicit_paper));
 }
 
 TEST_CASE("energy fit: a floor or weights large enough to overflow are refused", "[unit]") {
@@ -708,6 +716,16 @@ TEST_CASE("energy fit: refusals name the HDF5 path and the reason", "[unit]") {
     ridge.directions.clear();
     ridge.l_control_points = 40;
     CHECK(ridge.ridge_size_key(40) == "/l_control_points");
+    // The s factor as a whole: s_spans 24 + s_degree 3 is 27 / 15 = 1.8 times the default's
+    // size, below directions 1.9 times as many (the review of session 55: s_spans alone read 2).
+    // 29 directions off the E12 = 0 plane (each with its mirror, one function): 29 / 15 = 1.93.
+    ridge.l_control_points = 5;
+    ridge.s_spans = 24;
+    for (int k = 0; k < 29; ++k)
+      ridge.directions.emplace_back(std::cos(0.9 * k), std::sin(0.9 * k), 0.2 + k / 100.0);
+    CHECK(ridge.ridge_size_key(2) == "/directions");
+    ridge.s_spans = 30;  // 33 / 15 = 2.2: now the s factor
+    CHECK(ridge.ridge_size_key(2) == "/s_spans");
   }
   SECTION("no loop length") {
     const auto s = fit_energy_law(Database{}, {});

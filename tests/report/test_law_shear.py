@@ -32,8 +32,9 @@ G = [0.1, 0.2, 0.4]
 CELL = {0: [0.01, 0.3, 0.8], 1: [0.1, 0.2, 0.4]}
 
 
-def write_db(path, a=(1.0, 2.0), law=True):
-    """Loop lengths 4.5 and 6.5 mm, the law S12 = a(l)^2 2E12, a shear path per loop length."""
+def write_db(path, a=(1.0, 2.0), law=True, sign=1.0):
+    """Loop lengths 4.5 and 6.5 mm, the law S12 = a(l)^2 2E12, a shear path per loop length
+    (sign -1: its mirror image, negative shear)."""
     with h5py.File(path, "w") as f:
         f["loop_lengths"] = [4.5, 6.5]
         if law:
@@ -44,8 +45,8 @@ def write_db(path, a=(1.0, 2.0), law=True):
             theta[:, 19] = a  # L[2][2]: S12 = L22^2 e3
             g["theta"] = theta
         for loop in (0, 1):
-            E = [[0, 0, x / 2] for x in G]
-            S = [[0, 0, s] for s in CELL[loop]]
+            E = [[0, 0, sign * x / 2] for x in G]
+            S = [[0, 0, sign * s] for s in CELL[loop]]
             raw_path(f, "path_0", "paper", E, S, loop=loop).attrs["kind"] = "shear"
             raw_path(f, "path_1", "coverage", E, [[0, 0, 9]] * 3, loop=loop)  # not shear
 
@@ -86,6 +87,15 @@ def main():
         o = ls.shear_ratios(db, 0.5)
         c(o["rows"][0]["n"] == 1 and o["order"]["pairs"] == 1,
           "--min-share 0.5 keeps only 0.8 of 0.8 at 4.5 mm, and one common strain: %s" % o)
+        # A path of negative shear counts by its magnitudes (the review of session 55: it was
+        # dropped): the mirror image of db's path gives db's ratios and order.
+        mirrored = os.path.join(tmp, "mirrored.h5")
+        write_db(mirrored, sign=-1.0)
+        m = ls.shear_ratios(mirrored)
+        c(m is not None and [(x["n"], round(x["median"], 12)) for x in m["rows"]]
+          == [(x["n"], round(x["median"], 12)) for x in r["rows"]]
+          and m["order"]["reversed"] == 2,
+          "negative shear: the same states, ratios and reversals: %s" % m)
         bare = os.path.join(tmp, "bare.h5")
         write_db(bare, law=False)
         c(ls.shear_ratios(bare) is None, "no law: nothing")

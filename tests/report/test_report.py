@@ -888,6 +888,16 @@ def unusable_result_failures(tmp):
         "a case.json whose grid is not two integers": (
             lambda d: open(os.path.join(d, "case.json"), "w").write('{"output": {"grid": 7}}'),
             "/output/grid is not two integers"),
+        # the review of session 55: a list as /output, a string or booleans as the grid
+        "a case.json whose output is a list": (
+            lambda d: open(os.path.join(d, "case.json"), "w").write('{"output": [1]}'),
+            "/output is not a JSON object"),
+        "a case.json whose grid is a string": (
+            lambda d: open(os.path.join(d, "case.json"), "w").write('{"output": {"grid": "21"}}'),
+            "/output/grid is not two integers"),
+        "a case.json whose grid is booleans": (
+            lambda d: open(os.path.join(d, "case.json"), "w").write(
+                '{"output": {"grid": [true, true]}}'), "/output/grid is not two integers"),
     }
     # Results of another database (session 38's red team): results.h5 names the date_utc of
     # the database the run read; another date than the database's is a defect of the run.

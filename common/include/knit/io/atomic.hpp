@@ -74,6 +74,9 @@ void unlink_live_temporaries() noexcept;
 /// pre-check left its empty "knit-meso-fit-check-XXXXXX.h5" in TMPDIR for good). The file may be
 /// replaced by rename (a database written over it) and is still removed: the name is tracked,
 /// not the inode. valid() is false when it could not be created (no slot is then held).
+/// Signals are blocked in the calling thread while the file is created and registered, and
+/// while it is removed; a signal handled by another thread in that instant, or more than the 16
+/// live temporaries unlink_live_temporaries() tracks, leaves it to the owner's removal only.
 class ScratchFile {
  public:
   ScratchFile(const std::filesystem::path& dir, std::string_view stem, std::string_view suffix);

@@ -129,9 +129,10 @@ struct EnergyFitOptions {
   double weight_paper = 3.0;
   /// The set weight of the pure-shear paths' states (PathKind::kShear; the default sweep's one
   /// is the paper's path_12), in place of weight_paper or 1 (session 55: docs/database.md
-  /// "Weights"). The code's default keeps the law of before (weight_paper's 3); the default
-  /// sweep (cases/sweep/default.json) sets 30.
-  double weight_shear = 3.0;
+  /// "Weights"); -1, the code's default: the path set's weight, as before session 55, so that
+  /// options recorded without the key refit as they were fitted. The default sweep
+  /// (cases/sweep/default.json) sets 30.
+  double weight_shear = -1.0;
   /// Where the cell gives way (choice, docs/database.md "Stable states"): along a fitted path,
   /// a converged step whose stress increment dS makes with its strain increment de an angle
   /// with cos(dS, de) < stable_min_cos marks the cell as having lost stability there (0:
