@@ -1425,6 +1425,32 @@ def consistency_failures(tmp):
         why = r.consistency_defect()
         if (why is None) != (needle is None) or (needle and needle not in why):
             out.append(f"consistency, reference grid with {what}: {why!r}")
+    # Fine grids are compared with the patch on a sub-grid that keeps both ends (the review of
+    # session 55: the pure-Python evaluator would take a minute at 1001 x 1001): the strides,
+    # and at most 2 samples per direction (the corners) the middle sample moved at every step
+    # is not seen by the patch comparison, a corner is, named at its place in the full grid.
+    import results
+    strides = [results.grid_stride(n) for n in (41, 101, 102, 201, 1001)]
+    if strides != [1, 1, 101, 2, 10]:
+        out.append(f"grid_stride of 41, 101, 102, 201, 1001: {strides}")
+    kept = results.NURBS_CHECK_SAMPLES
+    try:
+        results.NURBS_CHECK_SAMPLES = 2
+        for sample, needle in ((mid, None), (8, "(its NURBS patch) at (theta1, theta2) = (2/2, 2/2)")):
+            r = fresh(geometry=QUARTER)
+            with h5py.File(os.path.join(res, "a", "results.h5"), "a") as h:
+                for st in (1, 2):
+                    g = h[f"fields/step_{st:04d}"]
+                    for n in ("x", "X"):
+                        v = np.asarray(g[n])
+                        v[sample, 2] += 0.3
+                        g[n][...] = v
+            why = r.consistency_defect()
+            if (why is None) != (needle is None) or (needle and needle not in why):
+                out.append(f"consistency, the patch on a 2 x 2 sub-grid, sample {sample} moved: "
+                           f"{why!r}")
+    finally:
+        results.NURBS_CHECK_SAMPLES = kept
     # ... another patch in the case (radius 20.3 mm), and a moved x through run_defect.
     fresh(geometry=dict(QUARTER, control_points=[[p * 1.015 for p in q[:2]] + [q[2]]
                                                  for q in QUARTER["control_points"]]))
