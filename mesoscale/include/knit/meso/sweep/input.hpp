@@ -23,14 +23,14 @@ enum class RunnerKind {
   kSynthetic  ///< the synthetic law of `knit-meso synth` (tests/demos of the orchestration)
 };
 
-/// Retry policy for a load case that does not converge: rerun with step_factor^a times more
-/// steps (a = 1..max_retries); the recorded steps (every step_factor^a-th) are unchanged,
-/// because F* is linear in the step fraction along every path.
 /// The most cell solves one attempt of a path may take (steps x substeps x step_factor^a):
 /// at about 30 ms a solve (the default sweep on this project's machine) about 1.7 hours.
 /// A sweep input whose last retry would take more is refused when it is read.
 inline constexpr long long kMaxCellSolvesPerAttempt = 200'000;
 
+/// Retry policy for a load case that does not converge: rerun with step_factor^a times more
+/// steps (a = 1..max_retries); the recorded steps (every step_factor^a-th) are unchanged,
+/// because F* is linear in the step fraction along every path.
 struct RetryPolicy {
   int max_retries = 2;
   int step_factor = 2;
