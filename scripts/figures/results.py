@@ -487,6 +487,14 @@ class Result:
     # case's NURBS patch by this fraction of the patch's size (see _reference_defect).
     REFERENCE_TOLERANCE = 1e-9
 
+    def _step_grid(self, g):
+        """(n_u, n_v) of a results.h5 fields/step_N group: its grid_u and grid_v attributes,
+        else the case's /output/grid (KeyError, TypeError or IndexError when neither says)."""
+        grid = self.output.get("grid")
+        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
+        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+        return nu, nv
+
     def _judged_h5(self):
         """(results.h5 of this run, the h5py module), or (None, None) when the file is missing
         or h5py is not installed: the consistency checks that read it judge nothing then."""
@@ -522,9 +530,7 @@ class Result:
         path, h5py = self._judged_h5()
         if path is None:
             return None
-        case = self.case if isinstance(self.case, dict) else {}
-        geometry = case.get("geometry")
-        grid = self.output.get("grid")
+        geometry = self.case.get("geometry")
         size = None
         try:
             P = np.asarray(geometry["control_points"], dtype=float).reshape(-1, 3)
@@ -552,8 +558,7 @@ class Result:
                             raise KeyError("neither X nor x and displacement")
                         derived = X is None
                         ref = x - u if derived else X
-                        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
-                        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+                        nu, nv = self._step_grid(g)
                         if any(a.shape[0] != nu * nv for a in read.values()):
                             held = ", ".join(f"{n} {a.shape[0]}" for n, a in read.items())
                             raise ValueError(f"{held} samples on a {nu} x {nv} grid")
@@ -634,15 +639,13 @@ class Result:
         if path is None:
             return None
         names = ("E11", "E22", "E12")
-        grid = self.output.get("grid")
         try:
             with h5py.File(path, "r") as f:
                 for k, g in f.get("fields", {}).items():
                     if not all(n in g for n in names):
                         continue
                     try:
-                        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
-                        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+                        nu, nv = self._step_grid(g)
                         x = np.asarray(g["x"], dtype=float).reshape(nv, nu, 3)
                         X = (np.asarray(g["X"], dtype=float) if "X" in g else
                              np.asarray(g["x"], dtype=float) - np.asarray(g["displacement"],
@@ -687,8 +690,8 @@ class Result:
         edge = ad.get("edge") or ad.get("corner")
         comp = "xyz".find(str(ad.get("component", "")))
         steps = self.csv.get("step")
-        if edge not in ("u0", "u1", "v0", "v1", "u0v0", "u1v0", "u0v1", "u1v1") or comp < 0 \
-                or d is None or steps is None:
+        if edge not in self._GRID_TARGETS or edge == "all" or comp < 0 or d is None \
+                or steps is None:
             return None
         path, h5py = self._judged_h5()
         if path is None:
@@ -703,9 +706,7 @@ class Result:
                         continue
                     nu, nv = int(g.attrs["grid_u"]), int(g.attrs["grid_v"])
                     u = np.array(g["displacement"], dtype=float).reshape(nv, nu, 3)[..., comp]
-                    line = {"u0": u[:, 0], "u1": u[:, -1], "v0": u[0, :], "v1": u[-1, :],
-                            "u0v0": u[0, 0], "u1v0": u[0, -1], "u0v1": u[-1, 0],
-                            "u1v1": u[-1, -1]}[edge]
+                    line = self._GRID_TARGETS[edge](u)
                     off = float(np.max(np.abs(line - by_step[s])))
                     if not off <= 1e-6 * scale:
                         return (f"results.h5 {k}: the displacement of {edge} along "
@@ -734,7 +735,7 @@ class Result:
         control points other than the corner's own (`radius`: their Greville points are no
         grid samples; the corner sample is judged), and entries that are not of the schema's
         grammar (the loader refuses them; the case's own check says so)."""
-        bcs = self.case.get("boundary_conditions") if isinstance(self.case, dict) else None
+        bcs = self.case.get("boundary_conditions")
         out = []
         for i, bc in enumerate(bcs if isinstance(bcs, list) else []):
             if not isinstance(bc, dict):
@@ -791,13 +792,11 @@ class Result:
         if not math.isfinite(scale):
             return None  # a non-finite applied displacement: consistency_defect names it
         tol = 1e-6 * scale
-        grid = self.output.get("grid")
         try:
             with h5py.File(path, "r") as f:
                 for k, g in f.get("fields", {}).items():
                     try:
-                        nu = int(g.attrs["grid_u"]) if "grid_u" in g.attrs else int(grid[0])
-                        nv = int(g.attrs["grid_v"]) if "grid_v" in g.attrs else int(grid[1])
+                        nu, nv = self._step_grid(g)
                         if "displacement" in g:
                             u = np.asarray(g["displacement"], dtype=float)
                         else:
