@@ -1181,8 +1181,8 @@ class Report:
             if figure_failed(p):  # session 38's red team: embedded as if drawn
                 L.append(f"**The figure script failed**: this is its placeholder (log: "
                          f"logs/figures/{base[:-4]}.log).\n")
-            elif damage_note(p):
-                L.append(damage_note(p))
+            elif note := damage_note(p):
+                L.append(note)
             L.append(f"![{base}](figures/{base})\n")
         if failed_figs:
             at = next(i for i, l in enumerate(L) if l.startswith("## Figures"))
