@@ -253,6 +253,14 @@ std::string with_line(std::string_view text, const std::vector<std::string>& poi
   return message;
 }
 
+std::optional<knit::InputError> error_with_line(const knit::InputError& e, std::string_view text,
+                                                const std::string& file) {
+  if (e.file() != file || e.pointer().empty()) return std::nullopt;
+  std::string msg = with_line(text, {e.pointer()}, e.message());
+  if (msg == e.message()) return std::nullopt;
+  return knit::InputError(file, e.pointer(), std::move(msg));
+}
+
 namespace {
 /// Line and column (1-based) of byte offset `at`.
 std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t at) {

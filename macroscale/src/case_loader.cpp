@@ -653,10 +653,8 @@ Case parse_case(const std::string& text, const std::string& file) {
     // The line of the field, as the schema-driven readers give it (session 25: a case file's
     // errors named the pointer only). An error inside another file (the database) keeps its
     // own location.
-    if (e.file() != file || e.pointer().empty()) throw;
-    std::string msg = io::with_line(text, {e.pointer()}, e.message());
-    if (msg == e.message()) throw;
-    throw InputError(file, e.pointer(), std::move(msg));
+    if (auto lined = io::error_with_line(e, text, file)) throw *lined;
+    throw;
   }
 }
 

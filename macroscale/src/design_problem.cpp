@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "knit/core/errors.hpp"
+#include "knit/io/input_file.hpp"
 #include "knit/io/json_input.hpp"
 #include "knit/io/names.hpp"
 #include "knit/macro/knit_material.hpp"
@@ -88,6 +89,10 @@ void read_variable(const json& j, const std::string& p, const json& case_root, c
                    const std::string& file, DesignVariableSpec& v,
                    std::optional<std::vector<double>>& loop_lengths) {
   if (!j.is_object()) throw InputError(file, p, "must be an object");
+  // An unknown key before a missing one (session 56's walkthrough: "uper" read "missing
+  // required key \"upper\"", the misspelt key unnamed), as the case loader does.
+  if (auto u = io::find_unknown_key(j, p, {"name", "field", "indices", "lower", "upper"}))
+    throw InputError(file, u->pointer, "unknown key" + u->note);
   for (const char* k : {"field", "indices", "lower", "upper"})
     if (!j.contains(k))
       throw InputError(file, p, std::string("missing required key \"") + k + "\"");
@@ -217,9 +222,11 @@ void read_objective(const json& j, const std::string& p, const Case& c, const st
     keys.insert(keys.end(), extra.begin(), extra.end());
     for (auto it = j.begin(); it != j.end(); ++it)
       if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
-        throw InputError(
-            file, p + "/" + io::json_pointer_escape(it.key()),
-            "not used by a " + type + " term (its keys: " + io::join_names(keys) + ")");
+        const std::string near = io::closest_key(it.key(), keys);
+        throw InputError(file, p + "/" + io::json_pointer_escape(it.key()),
+                         "not used by a " + type + " term (" +
+                             (near.empty() ? "" : "did you mean \"" + near + "\"? ") +
+                             "its keys: " + io::join_names(keys) + ")");
       }
   }
   o.name = j.contains("name") && j.at("name").is_string() ? j.at("name").get<std::string>() : type;
@@ -428,10 +435,27 @@ std::vector<DesignVariable> DesignProblem::expanded() const {
   return out;
 }
 
+namespace {
+DesignProblem load_design_json(const json& root, const std::string& path);
+}  // namespace
+
 DesignProblem load_design(const std::string& path) {
+  const std::string text = io::read_input_file(path, io::kMaxJsonInputBytes);
+  const json root = io::parse_json(text, path);
+  try {
+    return load_design_json(root, path);
+  } catch (const InputError& e) {
+    // The line of the field, as the case loader gives it (session 56's walkthrough: design-file
+    // errors named the pointer only). An error inside another file keeps its own location.
+    if (auto lined = io::error_with_line(e, text, path)) throw *lined;
+    throw;
+  }
+}
+
+namespace {
+DesignProblem load_design_json(const json& root, const std::string& path) {
   DesignProblem d;
   d.file = path;
-  const json root = io::read_json_file(path);
   if (!root.is_object()) throw InputError(path, "", "must be a JSON object");
   // A case file given for the design file (session 47's walkthrough: "/boundary_conditions:
   // unknown key" said nothing of what the file is).
@@ -669,6 +693,7 @@ DesignProblem load_design(const std::string& path) {
   io::JsonSchema::embedded("design").validate(root, path);
   return d;
 }
+}  // namespace
 
 }  // namespace knit::macro
 

@@ -181,8 +181,11 @@ std::string KnitMaterial::uniaxial_verdict() const {
 std::string KnitMaterial::uniaxial_warning() const {
   const auto& curves = source_.uniaxial;
   if (curves.empty() || audit_evaluations_.load() == 0) return {};
-  static const char* axis_name[2] = {"course (E11)", "wale (E22)"};
-  static const char* component[2] = {"E11", "E22"};
+  // The material frame's strains by the names results.h5 gives them (session 56's walkthrough:
+  // "wale (E22)" read as results.h5's E22, the x2 component, with alpha = 90 deg the course).
+  static const char* axis_name[2] = {"course (E_course, the material frame's E11)",
+                                     "wale (E_wale, the material frame's E22)"};
+  static const char* component[2] = {"E_course", "E_wale"};
   std::ostringstream os;
   os << std::setprecision(3);
   for (std::size_t ax = 0; ax < 2; ++ax) {

@@ -226,6 +226,25 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          design(kVars, R"([{"type": "reaction", "reaction": "fy", "at_strain": [0.1, 0.2, 0.1],
                             "target": [1.0, 2.5, 2.0]}])"),
          "/objectives/0/at_strain/2");
+  // Session 56's walkthrough: a misspelt required key read "missing required key", the
+  // misspelt key unnamed, and design-file errors gave no line. The unknown key comes first,
+  // with the closest allowed one and its line; an objective's key likewise.
+  for (const auto& [vars, objs, ptr, near, line] :
+       {std::tuple{std::string(R"([{"field": "stitch_value", "indices": [0],
+                                    "lower": 4.5, "uper": 6.5}])"),
+                   std::string(kObjs), "/variables/0/uper", "did you mean \"upper\"?", " (line 2)"},
+        std::tuple{std::string(kVars), std::string(R"([{"type": "reaction", "reaction": "fy",
+                                    "at_strain": [0.1], "targte": [1.0]}])"),
+                   "/objectives/0/targte", "did you mean \"target\"?", " (line 3)"}}) {
+    write(kDir / "misspelt.json", design(vars, objs));
+    try {
+      (void)load_design((kDir / "misspelt.json").string());
+      FAIL_CHECK("no error");
+    } catch (const knit::InputError& e) {
+      CHECK(e.pointer() == ptr);
+      CHECK_THAT(e.message(), Catch::Contains(near) && Catch::EndsWith(line));
+    }
+  }
   // Session 46's red team: a wrong type read "needs at least one design variable".
   for (const auto& [vars, objs, ptr] :
        {std::tuple{std::string(R"("l")"), std::string(kObjs), "/variables"},
@@ -295,7 +314,7 @@ TEST_CASE("design file: bad input is a JSON-pointer error and exit 2", "[unit]")
          {std::pair{"[-0.05, -0.1, -0.2]", ""},
           std::pair{"[-0.2, -0.1]",
                     "/objectives/0/at_strain/0: must be nearer 0 than the last "
-                    "strain (the line's end point, -0.1)"}}) {
+                    "strain (the line's end point, -0.1) (line 2)"}}) {
       INFO("at_strain " << strains);
       std::string d = design(kVars, std::string(R"([{"type": "reaction_linearity", "reaction": )"
                                                 R"("fy", "at_strain": )") +
@@ -1217,6 +1236,12 @@ TEST_CASE("design: summary.txt gives what the design reached, the final run's ow
   CHECK(summary.find("; Ceres: ") != std::string::npos);
   CHECK(summary.find("\nnote: the final run (run/) has no step at strain 0.15 of mean22") !=
         std::string::npos);
+  // Session 56's walkthrough: `seconds` was the last accepted iteration's time, less than the
+  // forward and gradient seconds it holds. It is the whole optimization's wall time now.
+  const double seconds = number_after(summary, "\nseconds: ");
+  CHECK(seconds >= number_after(summary, "\nseconds_to_last_accepted: "));
+  CHECK(seconds >= number_after(summary, "\nforward_seconds: ") +
+                       number_after(summary, "\ngradient_seconds: "));
   fs::remove_all(out);
 }
 

@@ -480,27 +480,28 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
     return report ? m.report() : m.warning();
   };
   auto all = [](const Eigen::Vector3d& E) { return std::array<Eigen::Vector3d, 3>{E, E, E}; };
-  // Graded 4.5 ... 6.5 mm, the converged states at E22 = 0.25: the 6.5 mm wale curve departs
+  // Graded 4.5 ... 6.5 mm, the converged states at E_wale = 0.25: the 6.5 mm wale curve departs
   // by 100 % from E22 = 0.2 on (the 5.5 mm one by 20 %, within the tolerance).
   const Eigen::Vector3d wale(0.0, 0.25, 0.0);
   CHECK(run(4.5, 6.5, all(wale)) ==
-        "warning: where the fabric is stretched uniaxially along the wale (E22), the material "
-        "law may be off by up to about these factors of its unit cell's stress (more than 25 % "
+        "warning: where the fabric is stretched uniaxially along the wale (E_wale, the material "
+        "frame's E22), the material law may be off by up to about these factors of its unit cell's "
+        "stress (more than 25 % "
         "off, /material/uniaxial_tolerance), at the strains this run's converged states "
-        "reached with each loop length: at l = 6.5 mm 2 times (at E22 = 0.2; reached 0.25) "
+        "reached with each loop length: at l = 6.5 mm 2 times (at E_wale = 0.2; reached 0.25) "
         "(db.h5, /energy_law/diagnostics/uniaxial; docs/database.md, \"The law's own uniaxial "
         "response\")");
   // A tolerance of 10 % names 5.5 mm as well; 150 % names nothing.
   CHECK_THAT(run(4.5, 6.5, all(wale), 0.1),
              Catch::Contains("more than 10 % off") &&
-                 Catch::Contains("at l = 5.5 mm 1.2 times (at E22 = 0.1; reached 0.25); at l = "
+                 Catch::Contains("at l = 5.5 mm 1.2 times (at E_wale = 0.1; reached 0.25); at l = "
                                  "6.5 mm 2 times"));
   CHECK(run(4.5, 6.5, all(wale), 1.5).empty());
   // Up to E22 = 0.1 only the first state is compared, where every law is within 25 %; up to
   // 0.15 the curves interpolated there are compared too (6.5 mm: 2.5 / 1.5).
   CHECK(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.1, 0.0))).empty());
   CHECK_THAT(run(4.5, 6.5, all(Eigen::Vector3d(0.0, 0.15, 0.0))),
-             Catch::Contains("at l = 6.5 mm 1.67 times (at E22 = 0.15; reached 0.15)"));
+             Catch::Contains("at l = 6.5 mm 1.67 times (at E_wale = 0.15; reached 0.15)"));
   // The strain each knot's law saw (session 41's review): the 4.5 mm end stretched to 0.25,
   // the point at 5.1 mm and the 6.5 mm end to 0.1 only, so the 6.5 mm law is not named.
   const Eigen::Vector3d low(0.0, 0.1, 0.0);
@@ -515,14 +516,14 @@ TEST_CASE("knit material, energy law: a warning where the law's own uniaxial res
   // Course-wise at 6.5 mm: 0.5 times the cell; the wale is compressed there (nothing to say).
   CHECK_THAT(run(6.5, 6.5, all(Eigen::Vector3d(0.25, -0.1, 0.0))),
              Catch::StartsWith("warning: where the fabric is stretched uniaxially along the "
-                               "course (E11)") &&
-                 Catch::Contains("at l = 6.5 mm 0.5 times (at E11 = 0.2; reached 0.25)") &&
-                 !Catch::Contains("wale (E22)"));
+                               "course (E_course, the material frame's E11)") &&
+                 Catch::Contains("at l = 6.5 mm 0.5 times (at E_course = 0.2; reached 0.25)") &&
+                 !Catch::Contains("wale (E_wale"));
   // Both directions stretched: two lines.
   CHECK_THAT(run(6.5, 6.5, all(Eigen::Vector3d(0.25, 0.25, 0.0))),
-             Catch::Contains("course (E11)") &&
+             Catch::Contains("course (E_course, the material frame's E11)") &&
                  Catch::Contains("\nwarning: where the fabric is stretched uniaxially along the "
-                                 "wale (E22)"));
+                                 "wale (E_wale"));
   // The material report says whether the check was made (a database without the curves said
   // nothing, which read as "checked, fine").
   auto report_of = [&]() {

@@ -124,7 +124,7 @@ def main():
       and plots.law_of_run("status: completed\n", "energy law") == "energy law",
       "law_of_run: the summary's material report, else the expected law")
     c(plots.uniaxial_warned("status: completed\nwarning: where the fabric is stretched "
-                            "uniaxially along the wale (E22), ...\n")
+                            "uniaxially along the wale (E_wale, the material frame's E22), ...\n")
       and not plots.uniaxial_warned("status: completed\nwarning: load drop: ...\n")
       and not plots.uniaxial_warned(""), "uniaxial_warned: knit-macro's uniaxial line only")
     # plots.py: a results directory or a case the pipeline never made is a command-line

@@ -39,6 +39,8 @@
 #include <string_view>
 #include <vector>
 
+#include "knit/core/errors.hpp"
+
 namespace knit::io {
 
 // ---- reading ---------------------------------------------------------------------------------
@@ -155,6 +157,13 @@ std::optional<UnknownKey> find_unknown_key(const nlohmann::json& j, const std::s
 /// or when the document is on one line (a generated file gains nothing from "(line 1)").
 std::string with_line(std::string_view text, const std::vector<std::string>& pointers,
                       std::string message);
+
+/// For a reader of the JSON file `file` whose text is `text`: `e` with the line of its pointer
+/// added (with_line), or nullopt when `e` names another file, no pointer, or no line is found
+/// (rethrow `e` as it is then). Used as `catch (const InputError& e) { if (auto l =
+/// error_with_line(e, text, file)) throw *l; throw; }` by the case and design loaders.
+std::optional<knit::InputError> error_with_line(const knit::InputError& e, std::string_view text,
+                                                const std::string& file);
 
 /// Line (1-based) where each value starts in JSON text, by JSON pointer ("" = the root). For
 /// object members, the line of the key. The text must be valid JSON.
