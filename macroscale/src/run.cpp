@@ -335,6 +335,27 @@ std::string run_failure_message(const RunResult& r) {
 
 namespace {
 
+/// A warning when steps converged on /solver/absolute_tolerance alone, out of balance by more
+/// than kLooseRelativeResidual of the reference force (RunReport::loose_steps; session 56's red
+/// team: a patch loaded by 2e-9 N ran 0.6-1 % off the exact jaw force, steps accepted with no
+/// iteration, exit 0 and no word). Empty when there is none.
+std::string loose_convergence_warning(const Case& c, const RunReport& r) {
+  if (r.loose_steps == 0) return {};
+  std::string unit = unit_labels(c.units).of("N");
+  if (unit.rfind("in ", 0) != 0) unit = "in " + unit;
+  std::ostringstream o;
+  o.precision(3);
+  o << r.loose_steps << " of " << r.converged_steps
+    << " converged steps were accepted by /solver/absolute_tolerance ("
+    << c.solver.absolute_tolerance << ") alone, out of balance by up to "
+    << 100.0 * r.loosest_relative_residual << " % of the reference force " << r.loosest_reference
+    << " (load factor " << r.loosest_lambda << "; forces " << unit
+    << "): the loads are too small for that tolerance; set /solver/absolute_tolerance well below "
+       "them (e.g. "
+    << c.solver.tolerance * r.loosest_reference << ", /solver/tolerance times that force)";
+  return o.str();
+}
+
 /// A warning when the applied displacement moved the patch without straining it (session 43's
 /// walkthrough: a tensile test without the support opposite the moving jaw translated as a rigid
 /// body, with a jaw force of 1e-14 N, strain 0.2 in the CSV and exit 0): the largest membrane
@@ -467,6 +488,10 @@ RunResult run_case(const Case& c, const RunOptions& opt) {
         load_drop_message(d, kLoadDropTolerance, unit_labels(c.units).of("N")));
   if (opt.warnings)
     for (const std::string& w : res.load_drops) *opt.warnings << "warning: " << w << std::endl;
+  if (std::string w = loose_convergence_warning(c, res.report); !w.empty()) {
+    if (opt.warnings) *opt.warnings << "warning: " << w << std::endl;
+    res.input_warnings.push_back(std::move(w));
+  }
   if (std::string w = unstrained_warning(c, m, res); !w.empty()) {
     if (opt.warnings) *opt.warnings << "warning: " << w << std::endl;
     res.input_warnings.push_back(std::move(w));

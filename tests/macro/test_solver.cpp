@@ -1002,3 +1002,40 @@ TEST_CASE("stability summary on the LU path: an unknown sign is not a positive o
   CHECK_THAT(stability_summary(r), Catch::Contains("det K < 0 from step 3 (load factor 0.6), at 2 "
                                                    "of 5 converged steps"));
 }
+
+// Session 56's red team: a patch loaded by about 2e-9 N (a tiny modulus, or a case in m and
+// MN) converged on /solver/absolute_tolerance (1e-10) alone, its jaw force 0.6-1 % off and
+// steps accepted with no iteration, exit 0 and no word. Such steps are warned of now. The
+// identity: under a prescribed displacement an SVK patch's reactions are linear in E.
+TEST_CASE("steps that the absolute tolerance alone accepts are warned of", "[unit]") {
+  json j = verification_case("tensile_svk.json");
+  j["solver"]["steps"] = 2;
+  const RunResult unit = run(j);
+  REQUIRE(unit.report.status == RunStatus::kCompleted);
+  CHECK(unit.report.loose_steps == 0);
+  // The smallest modulus a case takes (forces of about 2e-5 N) with an absolute tolerance of
+  // 1e-6 N: the red team's 2e-9 N against the default 1e-10 N.
+  constexpr double kE = 1e-6;
+  j["material"]["youngs_modulus"] = kE;
+  j["solver"]["absolute_tolerance"] = 1e-6;
+  const RunResult tiny = run(j);
+  REQUIRE(tiny.report.status == RunStatus::kCompleted);
+  CHECK(tiny.report.loose_steps > 0);
+  CHECK(tiny.report.loosest_relative_residual > kLooseRelativeResidual);
+  const auto warned = [](const RunResult& r) {
+    return std::any_of(r.input_warnings.begin(), r.input_warnings.end(), [](const std::string& w) {
+      return w.find("accepted by /solver/absolute_tolerance (1e-06) alone") != std::string::npos;
+    });
+  };
+  CHECK(warned(tiny));
+  CHECK_FALSE(warned(unit));
+  // The answer it warns of is off; with the tolerance below the loads it is the scaled one.
+  const double exact = kE * unit.rows.back().reactions[0];
+  CHECK(std::abs(tiny.rows.back().reactions[0] - exact) > 1e-4 * std::abs(exact));
+  j["solver"]["absolute_tolerance"] = 1e-20;
+  const RunResult fine = run(j);
+  REQUIRE(fine.report.status == RunStatus::kCompleted);
+  CHECK(fine.report.loose_steps == 0);
+  CHECK_FALSE(warned(fine));
+  CHECK(fine.rows.back().reactions[0] == Approx(exact).epsilon(1e-6));
+}

@@ -149,6 +149,11 @@ struct SolverStats {
   int threads = 1;  ///< assembly threads
 };
 
+/// The out-of-balance force, relative to the reference force, above which a step that the
+/// absolute tolerance alone accepted is reported (RunReport::loose_steps): 1e-6, a hundred times
+/// the default relative tolerance, far below anything a load-strain curve shows.
+inline constexpr double kLooseRelativeResidual = 1e-6;
+
 struct RunReport {
   RunStatus status = RunStatus::kCompleted;
   StopReason reason = StopReason::kNone;
@@ -167,6 +172,11 @@ struct RunReport {
   int negative_determinant_steps = 0;
   /// Converged steps whose tangent could not be factorized there (singular): sign unknown (0).
   int unknown_determinant_steps = 0;
+  /// Converged steps that only the absolute tolerance let through with an out-of-balance
+  /// force above kLooseRelativeResidual of the reference force (loads too small for
+  /// /solver/absolute_tolerance), the largest such ratio, its load factor and reference force.
+  int loose_steps = 0;
+  double loosest_relative_residual = 0.0, loosest_lambda = 0.0, loosest_reference = 0.0;
   SolverStats stats;
 };
 
