@@ -18,7 +18,10 @@ cell's uniaxial-stress paths along the course and the wale at l = 4.5 and 6.5 mm
   extensibility_<l>      E_at_0.5MPa course / wale: single jersey stretches about twice as far
                          widthwise (course) as lengthwise (wale) (textile handbooks, docs)
   reached_<dir>_<l>      the largest E_aa reached (a path that stops early is recorded here and
-                         its missing observables are left out, never invented)
+                         its missing observables are left out, never invented; each such path is
+                         named by a warning on stderr and counted at the end)
+  refused_<dir>_<l>      1: knit-meso refused the cell as input (exit 2, e.g. gamma/w = 0.10 at
+                         l = 6.5 mm does not interlock); the path has no other observable
 
 Output: the sensitivity table (CSV, parameter,value,observable,result; format:
 scripts/figures/sensitivity.py), read by the pipeline (SENSITIVITY, scripts/pipeline.mk).
@@ -28,14 +31,28 @@ The observable names group as <panel>@<line> (or <panel>_<line>) for the figure.
       --out cases/calibration/sensitivity.csv [--only g0,gamma] [--steps 12] [--work DIR]
   /usr/bin/python3 scripts/calibrate.py --bin ... --point gamma_over_w=0.25,g0=0.1  (one
       parameter set, observables printed: for trying a rule before adopting it)
+  /usr/bin/python3 scripts/calibrate.py --summarize TABLE.csv  (the docs' markdown table)
+
+--only takes the parameter names (g0, gamma_over_w, k_N, mu, d) or the table's (g0, gamma,
+normal_stiffness, friction, diameter); other names are refused. With --only, the other
+parameters' rows of an existing --out table are kept (merged), if that table was made with
+the same steps and base; an --out that is not such a table (header parameter,value,
+observable,result) is never overwritten. The study exits 1 and writes nothing when no path
+gave an observable beyond reached_* and refused_* (every path stopped at once or refused).
 
 Runs one knit-meso process at a time (the machine is shared); every path is cached in WORK by
-its parameters, so a rerun only computes what is new.
+the binary's sha256 and its parameters, so a rerun only computes what is new. A path counts as
+cached only when its knit-meso run ended (exit 0, or 1: stopped early, its converged steps
+kept): it runs into WORK/.../NAME.part and is renamed when done.
 """
 import argparse
+import collections
 import csv
+import hashlib
 import json
+import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -60,6 +77,26 @@ RANGES = {
 # Parameter names in the table (the figure puts g0 and gamma first).
 TABLE_NAME = {"g0": "g0", "gamma_over_w": "gamma", "k_N": "normal_stiffness", "mu": "friction",
               "d": "diameter"}
+HEADER = "parameter,value,observable,result"
+PROG = "calibrate.py"
+# Observables that say what happened to a path rather than measure it: a study whose rows are
+# all of these measured nothing.
+STATUS_PREFIXES = ("reached_", "refused_")
+
+# A path's outcome: its converged steps (E_aa, S_aa, E_lateral), step 0 included ([] when no
+# load step converged; None when refused), whether it reached lambda = 1, and knit-meso's
+# message when it refused the cell (exit 2).
+Path = collections.namedtuple("Path", "curve completed refused")
+
+
+def die(msg, code=2):
+    """One line on stderr and the exit code (2: bad command line or input, as knit-meso)."""
+    print(f"{PROG}: error: {msg}", file=sys.stderr)
+    sys.exit(code)
+
+
+def warn(msg):
+    print(f"{PROG}: warning: {msg}", file=sys.stderr)
 
 
 def cell_config(p):
@@ -76,27 +113,91 @@ def key(p):
     return "_".join(f"{k}{p[k]:.6g}" for k in sorted(p))
 
 
-def run_path(binary, work, p, loop, axis, steps):
-    """-> list of (E_aa, S_aa, E_lateral) of the converged steps (step 0 included)."""
-    d = os.path.join(work, f"{key(p)}_l{loop}_a{axis}_n{steps}")
-    csv_path = os.path.join(d, "path.csv")
-    if not os.path.exists(csv_path):
-        os.makedirs(work, exist_ok=True)
-        cfg = d + ".json"
-        with open(cfg, "w") as f:
-            json.dump(cell_config(p), f)
-        cmd = [binary, "path", "--loop-length", str(loop), "--uniaxial", str(axis), str(E_END),
-               "--steps", str(steps), "--no-vtp", "--config", cfg, "--out", d]
-        t0 = time.time()
-        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        last = (r.stdout.strip().splitlines() or ["?"])[-1]
-        print(f"  l={loop} axis={axis} {key(p)}: exit {r.returncode}, {time.time() - t0:.1f} s"
-              f"  {last[:90]}", file=sys.stderr)
-        if r.returncode not in (0, 1) or not os.path.exists(csv_path):
-            raise RuntimeError(f"knit-meso failed ({' '.join(cmd)}):\n{r.stdout}")
-    e, s, lat = ("E11", "S11_MPa", "E22") if axis == 0 else ("E22", "S22_MPa", "E11")
-    with open(csv_path) as f:
-        return [(float(row[e]), float(row[s]), float(row[lat])) for row in csv.DictReader(f)]
+class Runner:
+    """Runs knit-meso paths, caches them by the binary's identity and the parameters, and keeps
+    the count of the paths that stopped early or were refused."""
+
+    def __init__(self, binary, work, steps):
+        self.binary, self.steps = binary, steps
+        with open(binary, "rb") as f:
+            self.sha = hashlib.sha256(f.read()).hexdigest()
+        # A cache per binary (the audit of session 56: a filled WORK of another binary, or of
+        # none, was reused).
+        self.work = os.path.join(work, "knit-meso-" + self.sha[:16])
+        self.paths = 0
+        self.stopped = []   # (label, loop, axis, reached)
+        self.refused = []   # (label, loop, axis, message)
+
+    def run_path(self, p, loop, axis, label):
+        """-> Path of the uniaxial path along axis at loop length `loop` of parameter set p;
+        label names the parameter set in the messages."""
+        self.paths += 1
+        d = os.path.join(self.work, f"{key(p)}_l{loop}_a{axis}_n{self.steps}")
+        csv_path = os.path.join(d, "path.csv")
+        marker = os.path.join(d, "calibrate.json")
+        where = f"{label}, l = {loop:g} mm, axis {axis} ({DIRS[axis][0]})"
+        if not os.path.exists(marker):
+            # Into NAME.part, renamed when knit-meso has ended: a crashed run leaves no cached
+            # path (the audit: a partial path.csv was reused on the next run).
+            os.makedirs(self.work, exist_ok=True)
+            part = d + ".part"
+            shutil.rmtree(part, ignore_errors=True)
+            cfg = d + ".json"
+            with open(cfg, "w") as f:
+                json.dump(cell_config(p), f)
+            cmd = [self.binary, "path", "--loop-length", str(loop), "--uniaxial", str(axis),
+                   str(E_END), "--steps", str(self.steps), "--no-vtp", "--config", cfg,
+                   "--out", part]
+            t0 = time.time()
+            r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            lines = (r.stdout + r.stderr).strip().splitlines() or ["?"]
+            print(f"  l={loop} axis={axis} {key(p)}: exit {r.returncode}, "
+                  f"{time.time() - t0:.1f} s  {lines[-1][:90]}", file=sys.stderr)
+            errors = [x for x in r.stderr.splitlines() if "error" in x] or \
+                r.stderr.strip().splitlines() or ["(no message)"]
+            if r.returncode == 2:
+                # Refused as input (knit::kExitBadInput): recorded, the study goes on.
+                shutil.rmtree(part, ignore_errors=True)
+                msg = " ".join(x.strip() for x in errors)
+                print(f"{PROG}: refused: {where}: knit-meso exit 2: {msg}", file=sys.stderr)
+                self.refused.append((label, loop, axis, msg))
+                return Path(None, False, msg)
+            stopped_at_start = (r.returncode == 1 and not os.path.exists(
+                os.path.join(part, "path.csv")) and "no load step converged" in r.stderr)
+            if r.returncode not in (0, 1) or not (
+                    os.path.exists(os.path.join(part, "path.csv")) or stopped_at_start):
+                shutil.rmtree(part, ignore_errors=True)
+                tail = "\n".join((r.stdout + r.stderr).strip().splitlines()[-10:])
+                die(f"knit-meso failed on {where} (exit {r.returncode}; {' '.join(cmd)}):\n"
+                    f"{tail}\nnothing written", 1)
+            os.makedirs(part, exist_ok=True)
+            with open(os.path.join(part, "calibrate.json"), "w") as f:
+                json.dump({"exit": r.returncode, "binary": self.binary,
+                           "binary_sha256": self.sha, "command": cmd}, f)
+            shutil.rmtree(d, ignore_errors=True)  # an earlier, unfinished cache entry
+            os.rename(part, d)
+        curve, completed = [], False
+        if os.path.exists(csv_path):
+            e, s, lat = ("E11", "S11_MPa", "E22") if axis == 0 else ("E22", "S22_MPa", "E11")
+            with open(csv_path) as f:
+                rows = list(csv.DictReader(f))
+            curve = [(float(row[e]), float(row[s]), float(row[lat])) for row in rows]
+            completed = bool(rows) and float(rows[-1]["lambda"]) >= 1 - 1e-9
+        if not completed:
+            reached = max((c[0] for c in curve), default=0.0)
+            warn(f"{where}: the path stopped at E = {reached:.4g} before {E_END:g}; its "
+                 "observables beyond it are left out")
+            self.stopped.append((label, loop, axis, reached))
+        return Path(curve, completed, None)
+
+    def measure(self, p, label):
+        return observables({(dname, loop): self.run_path(p, loop, axis, label)
+                            for dname, axis in DIRS for loop in LOOPS})
+
+    def summary(self):
+        """The closing count (stderr)."""
+        print(f"{PROG}: {self.paths} paths: {len(self.stopped)} stopped before E = {E_END:g}, "
+              f"{len(self.refused)} refused by knit-meso", file=sys.stderr)
 
 
 def interp(curve, e, col):
@@ -117,14 +218,20 @@ def strain_at_stress(curve, s):
     return None
 
 
-def observables(curves):
-    """curves[(dir, loop)] -> {observable: value} (missing ones left out)."""
+def observables(paths):
+    """paths[(dir, loop)] (Path) -> {observable: value} (missing ones left out; a refused path
+    gives refused_<dir>_<l> = 1 and nothing else)."""
     out = {}
+    curves = {}
     for dname, _ in DIRS:
         for loop in LOOPS:
-            c = curves[(dname, loop)]
+            path = paths[(dname, loop)]
             tag = f"{dname}_{int(round(loop * 10))}"
-            out[f"reached_{tag}"] = max(e for e, _, _ in c)
+            if path.refused is not None:
+                out[f"refused_{tag}"] = 1.0
+                continue
+            c = curves[(dname, loop)] = path.curve
+            out[f"reached_{tag}"] = max((e for e, _, _ in c), default=0.0)
             for e in E_OBS:
                 s = interp(c, e, 1)
                 if s is not None:
@@ -138,7 +245,9 @@ def observables(curves):
             ext = strain_at_stress(c, S_EXT)
             if ext is not None:
                 out[f"E_at_{S_EXT:g}MPa_{tag}"] = ext
-        c45, c65 = curves[(dname, 4.5)], curves[(dname, 6.5)]
+        c45, c65 = curves.get((dname, 4.5)), curves.get((dname, 6.5))
+        if c45 is None or c65 is None:
+            continue
         ratios = []
         for e in E_GRID:
             s45, s65 = interp(c45, e, 1), interp(c65, e, 1)
@@ -159,12 +268,9 @@ def observables(curves):
     return out
 
 
-def measure(binary, work, p, steps):
-    curves = {}
-    for dname, axis in DIRS:
-        for loop in LOOPS:
-            curves[(dname, loop)] = run_path(binary, work, p, loop, axis, steps)
-    return observables(curves)
+def measured(obs):
+    """Whether observables hold anything beyond the paths' status (reached_*, refused_*)."""
+    return any(not o.startswith(STATUS_PREFIXES) for o in obs)
 
 
 SUMMARY = ["ratio_wale@E0.2", "ratio_wale@E0.3", "ratio_wale@E0.4", "min_ratio_wale",
@@ -173,13 +279,19 @@ SUMMARY = ["ratio_wale@E0.2", "ratio_wale@E0.3", "ratio_wale@E0.4", "min_ratio_w
 
 
 def summarize(path):
-    """A markdown table of the headline observables of a sensitivity table (docs)."""
+    """A markdown table of the headline observables of a sensitivity table (docs), and a line
+    per parameter value whose paths knit-meso refused."""
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "figures"))
     from sensitivity import read_table
-    rows = read_table(path)
+    try:
+        rows = read_table(path)
+    except (OSError, ValueError) as e:
+        die(f"--summarize: {e}")
     res = {(p, v, o): r for p, v, o, r in rows}
-    points = sorted({(p, v) for p, v, _, _ in rows}, key=lambda t: (list(TABLE_NAME.values())
-                                                                   .index(t[0]), t[1]))
+    order = list(TABLE_NAME.values())
+    points = sorted({(p, v) for p, v, _, _ in rows},
+                    key=lambda t: (order.index(t[0]) if t[0] in order else len(order), t[0],
+                                   t[1]))
     short = [o.replace("ratio_", "r_").replace("stiffening_", "stf_").replace("lateral_", "lat_")
              .replace("extensibility_", "ext_")
              for o in SUMMARY]
@@ -188,16 +300,120 @@ def summarize(path):
     for p, v in points:
         cells = [f"{res[(p, v, o)]:.3g}" if (p, v, o) in res else "–" for o in SUMMARY]
         print(f"| {p} | {v:g} | " + " | ".join(cells) + " |")
+    for p, v in points:
+        refused = sorted(o[len("refused_"):] for (q, w, o) in res
+                         if (q, w) == (p, v) and o.startswith("refused_"))
+        if refused:
+            print(f"\nrefused by knit-meso: {p} = {v:g}: {', '.join(refused)}")
 
 
-def parse_point(text):
+def parse_point(text, option):
+    """k=v,... over the defaults; a bad item exits 2 naming `option`."""
     p = dict(DEFAULTS)
     for item in filter(None, text.split(",")):
-        k, v = item.split("=")
+        k, eq, v = item.partition("=")
+        k = k.strip()
+        if not eq:
+            die(f"{option}: '{item}' is not NAME=VALUE (e.g. {option} g0=0.1)")
         if k not in p:
-            raise SystemExit(f"--point: unknown parameter {k} (known: {', '.join(p)})")
-        p[k] = float(v)
+            die(f"{option}: unknown parameter {k} (known: {', '.join(p)})")
+        try:
+            p[k] = float(v)
+        except ValueError:
+            die(f"{option}: {k}: '{v}' is not a number")
+        if not math.isfinite(p[k]):
+            die(f"{option}: {k}: {v} is not finite")
     return p
+
+
+def parse_only(text):
+    """--only: -> the parameter names (RANGES order); unknown names exit 2 naming the allowed."""
+    by_name = {n: n for n in RANGES}
+    by_name.update({t: n for n, t in TABLE_NAME.items()})
+    names = [x.strip() for x in text.split(",") if x.strip()]
+    if not text:
+        return list(RANGES)
+    unknown = [x for x in names if x not in by_name]
+    if unknown or not names:
+        die(f"--only: unknown parameter {', '.join(unknown) or repr(text)} (allowed: "
+            f"{', '.join(RANGES)}, or the table's names {', '.join(TABLE_NAME.values())})")
+    wanted = {by_name[x] for x in names}
+    return [n for n in RANGES if n in wanted]
+
+
+def read_own_table(path):
+    """-> (settings comment lines, rows as (parameter, value text, observable, result text)) of
+    an existing table of ours; None when `path` is not one (no header parameter,value,
+    observable,result before its first data line)."""
+    comments, rows, header = [], [], False
+    try:
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                line = line.strip()
+                if not line:
+                    continue
+                if line.startswith("#"):
+                    comments.append(line)
+                    continue
+                if not header:
+                    if line.replace(" ", "") != HEADER:
+                        return None
+                    header = True
+                    continue
+                cells = [c.strip() for c in line.split(",")]
+                if len(cells) != 4:
+                    return None
+                rows.append(tuple(cells))
+    except (OSError, UnicodeDecodeError):
+        return None
+    return (comments, rows) if header else None
+
+
+def settings_lines(steps, base):
+    """The comment lines of a table: what made it (compared when merging)."""
+    return ["# Sensitivity of the unit cell's observables (scripts/calibrate.py, issue 12);",
+            f"# uniaxial-stress paths to E = {E_END} in {steps} steps, l = 4.5 and 6.5 mm;",
+            "# one parameter varied at a time, the others at "
+            + " ".join(f"{k}={base[k]:.6g}" for k in sorted(base))]
+
+
+def check_out(out, merging, steps, base):
+    """Before any run: --out must be a new file or a table of ours (never overwrite anything
+    else); with --only (merging) -> the existing table's rows to keep, else []."""
+    if os.path.isdir(out):
+        die(f"--out: {out} is a directory; name the table file")
+    if not os.path.exists(out):
+        return []
+    own = read_own_table(out)
+    if own is None:
+        die(f"--out: {out} exists and is not a sensitivity table (no header {HEADER}): "
+            "not overwritten; name a new file or remove it")
+    if not merging:
+        return []
+    comments, rows = own
+    mine = settings_lines(steps, base)[1:]
+    theirs = [c for c in comments if c.startswith(("# uniaxial-stress", "# one parameter"))]
+    if theirs and theirs != mine:
+        die(f"--out: {out} was made with other settings ({' '.join(theirs)}) than this run "
+            f"({' '.join(mine)}): its rows cannot be merged with --only; name another --out")
+    return rows
+
+
+def write_table(out, rows, steps, base):
+    """rows (parameter, value text, observable, result text) -> out, atomically."""
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    tmp = out + ".tmp"
+    try:
+        with open(tmp, "w") as f:
+            f.write("\n".join(settings_lines(steps, base)) + "\n")
+            f.write(HEADER + "\n")
+            for r in rows:
+                f.write(",".join(r) + "\n")
+        os.replace(tmp, out)
+    except OSError as e:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        die(f"--out: {out}: {e}", 1)
 
 
 def main():
@@ -206,7 +422,10 @@ def main():
     ap.add_argument("--out", default="cases/calibration/sensitivity.csv")
     ap.add_argument("--work", default="/tmp/knit_calibration")
     ap.add_argument("--steps", type=int, default=12, help="steps of each uniaxial path")
-    ap.add_argument("--only", default="", help="comma-separated subset of " + ",".join(RANGES))
+    ap.add_argument("--only", default="",
+                    help="comma-separated subset of " + ",".join(RANGES) + " (or the table's "
+                    "names " + ",".join(TABLE_NAME.values()) + "); the other parameters' rows "
+                    "of an existing --out are kept")
     ap.add_argument("--point", default=None,
                     help="one parameter set k=v,... over the defaults: print its observables")
     ap.add_argument("--base", default="",
@@ -216,35 +435,59 @@ def main():
     a = ap.parse_args()
     if a.summarize:
         summarize(a.summarize)
-        return
-    if a.point is not None:
-        obs = measure(a.bin, a.work, parse_point(a.point), a.steps)
+        return 0
+    if a.steps < 1:
+        die(f"--steps: must be at least 1, got {a.steps}")
+    # Everything the command line says is checked before the first run.
+    point = parse_point(a.point, "--point") if a.point is not None else None
+    base = parse_point(a.base, "--base")
+    names = parse_only(a.only)
+    binary = shutil.which(a.bin)
+    if binary is None:
+        die(f"--bin: {a.bin} is not an executable file (build knit-meso, or name it)")
+    if point is not None:
+        runner = Runner(binary, a.work, a.steps)
+        obs = runner.measure(point, "--point " + a.point)
+        runner.summary()
         for k in sorted(obs):
             print(f"{k:28s} {obs[k]:.4f}")
-        return
-    base = parse_point(a.base)
-    names = [n for n in RANGES if not a.only or n in a.only.split(",")]
-    rows = []
+        if not measured(obs):
+            die("no path gave an observable beyond reached_* / refused_*", 1)
+        return 0
+    kept = check_out(a.out, bool(a.only), a.steps, base)
+    runner = Runner(binary, a.work, a.steps)
+    new = {}
+    any_measured = False
     for n in names:
+        rows = new[TABLE_NAME[n]] = []
         for v in RANGES[n]:
             p = dict(base)
             p[n] = v
             print(f"{n} = {v}", file=sys.stderr)
-            for o, r in sorted(measure(a.bin, a.work, p, a.steps).items()):
-                rows.append((TABLE_NAME[n], v, o, r))
-    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("# Sensitivity of the unit cell's observables (scripts/calibrate.py, issue 12);\n")
-        f.write(f"# uniaxial-stress paths to E = {E_END} in {a.steps} steps, l = 4.5 and 6.5 mm;\n")
-        f.write("# one parameter varied at a time, the others at "
-                + " ".join(f"{k}={base[k]:.6g}" for k in sorted(base)) + "\n")
-        f.write("parameter,value,observable,result\n")
-        for r in rows:
-            f.write(f"{r[0]},{r[1]:.6g},{r[2]},{r[3]:.6g}\n")
-    os.replace(tmp, a.out)
+            obs = runner.measure(p, f"{n} = {v:g}")
+            any_measured = any_measured or measured(obs)
+            for o, r in sorted(obs.items()):
+                rows.append((TABLE_NAME[n], f"{v:.6g}", o, f"{r:.6g}"))
+    runner.summary()
+    if not any_measured:
+        die(f"no path gave an observable beyond reached_* / refused_* (every path stopped at "
+            f"once or was refused): nothing written to {a.out}", 1)
+    # --only: the other parameters' rows of the existing table, in the table's order.
+    old = collections.OrderedDict()
+    for r in kept:
+        if r[0] not in new:
+            old.setdefault(r[0], []).append(r)
+    if old:
+        print(f"kept from {a.out}: {sum(len(x) for x in old.values())} rows of "
+              f"{', '.join(old)} (not rerun: --only {a.only})")
+    order = list(TABLE_NAME.values())
+    groups = sorted(list(new.items()) + list(old.items()),
+                    key=lambda t: order.index(t[0]) if t[0] in order else len(order))
+    rows = [r for _, g in groups for r in g]
+    write_table(a.out, rows, a.steps, base)
     print(f"{len(rows)} results -> {a.out}", file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -22,7 +22,9 @@ result: the measured number. One row per (parameter, value, observable).
       panel whose values span more than a factor 20 (all positive) is drawn on a log scale.
       Parameter names head the columns; panels are labelled with units (panel_label); a panel
       whose every value is the same number (reached_*: the paths' end strain) is left out and
-      named in a note at the bottom.
+      named in a note at the bottom. Rows refused_<dir>_<l> (= 1: knit-meso refused that cell
+      as input, scripts/calibrate.py, so the parameter value has no observable on that path)
+      are no panel: the note names the parameter values and paths.
 """
 import argparse
 import math
@@ -141,6 +143,31 @@ def constant_panels(rows, panels):
     return out
 
 
+REFUSED = "refused_"
+
+
+def split_refused(rows):
+    """-> (the rows that are observables, {(parameter, value): [path, ...]} of the refused_*
+    rows; path as in the observable name, e.g. course_65)."""
+    kept, refused = [], {}
+    for r in rows:
+        if r[2].startswith(REFUSED):
+            refused.setdefault((r[0], r[1]), []).append(r[2][len(REFUSED):])
+        else:
+            kept.append(r)
+    return kept, refused
+
+
+def refused_note(refused):
+    """The figure's note on the refused paths ("" if none): gamma = 0.1 (course, l = 6.5 mm;
+    wale, l = 6.5 mm)."""
+    def path(tag):
+        d, ln = panel_of(tag)
+        return f"{d}, {line_label(ln)}" if ln in ("45", "65") else tag
+    return "; ".join(f"{p} = {v:g} ({'; '.join(path(t) for t in sorted(tags))})"
+                     for (p, v), tags in sorted(refused.items()))
+
+
 def draw(rows, out, params=None):
     import matplotlib
     matplotlib.use("Agg")
@@ -149,7 +176,7 @@ def draw(rows, out, params=None):
     allp = sorted({r[0] for r in rows}, key=lambda p: (p not in FIRST, FIRST.index(p)
                                                          if p in FIRST else 0, p))
     params = [p for p in allp if not params or p in params] or allp
-    rows = [r for r in rows if r[0] in params]
+    rows, refused = split_refused([r for r in rows if r[0] in params])
     panels = sorted({panel_of(r[2])[0] for r in rows},
                     key=lambda q: (PANEL_ORDER.index(q) if q in PANEL_ORDER else len(PANEL_ORDER),
                                    q))
@@ -160,7 +187,14 @@ def draw(rows, out, params=None):
         panels = [q for q in panels if q not in constant]
     else:  # all constant: draw them rather than nothing
         constant = {}
-    note_h = 0.45 if constant else 0.0
+    notes = []
+    if constant:
+        notes.append("Not drawn, constant for every parameter value: " + "; ".join(
+            f"{panel_label(q).replace(chr(10), ' ').replace(' [-]', '')} = {v:g}"
+            for q, v in constant.items()))
+    if refused:
+        notes.append("Refused by knit-meso as input (no observables): " + refused_note(refused))
+    note_h = 0.3 * len(notes) + (0.15 if notes else 0.0)
     height = 2.3 * len(panels) + note_h
     width = 3.2 * len(params)
     fig, axes = plt.subplots(len(panels), len(params), figsize=(width, height), squeeze=False)
@@ -199,11 +233,9 @@ def draw(rows, out, params=None):
                         left=0.95 / width, right=1 - 0.15 / width, hspace=0.3, wspace=0.3)
     fig.suptitle("Observables against the unit-cell parameters (one varied per column, the "
                  "others at their defaults)", y=1 - 0.15 / height)
-    if constant:
-        fig.text(0.5, 0.15 / height, "Not drawn, constant for every parameter value: "
-                 + "; ".join(f"{panel_label(q).replace(chr(10), ' ').replace(' [-]', '')} = {v:g}"
-                             for q, v in constant.items()),
-                 ha="center", va="bottom", fontsize=9, style="italic")
+    for k, text in enumerate(reversed(notes)):
+        fig.text(0.5, (0.15 + 0.3 * k) / height, text, ha="center", va="bottom", fontsize=9,
+                 style="italic")
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     tmp = out + ".tmp.png"
     fig.savefig(tmp, dpi=120)
