@@ -150,9 +150,10 @@ struct SolverStats {
 };
 
 /// The out-of-balance force, relative to the reference force, above which a step that the
-/// absolute tolerance alone accepted is reported (RunReport::loose_steps): 1e-6, a hundred times
-/// the default relative tolerance, far below anything a load-strain curve shows.
-inline constexpr double kLooseRelativeResidual = 1e-6;
+/// absolute tolerance alone accepted is reported (RunReport::loose_steps): 1e-4, 0.01 %, below
+/// what a load-strain curve shows (s323_hypar_compression's first steps, at 1.65e-6 of their
+/// 2.8e-5 N, are not reported; the red team's 2e-9 N patch, at up to 2.7 %, is).
+inline constexpr double kLooseRelativeResidual = 1e-4;
 
 struct RunReport {
   RunStatus status = RunStatus::kCompleted;
