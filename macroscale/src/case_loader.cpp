@@ -2,6 +2,7 @@
 // are errors at every level (the same rules as schemas/case.schema.json).
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -162,6 +163,37 @@ class Reader {
   std::string file_;
 };
 
+/// Smallest non-empty knot span relative to the largest one (session 56's red team: a first
+/// span of 1e-13 read "missing support: rigid-body rotation" on a clamped plate; 0.5 and
+/// 0.5 + 1e-14 blamed the area quadrature on the surface's curvature; spans of 1e-5 to 1e-8
+/// ended in "singular tangent stiffness"; a span of 1e-4 of the largest still converged).
+constexpr double kMinKnotSpanRatio = 1e-4;
+
+/// "" or why the knot vector U has a non-empty span shorter than kMinKnotSpanRatio of its
+/// largest: the span, its knots' indices and the ratio.
+std::string short_span(const std::vector<double>& U) {
+  double largest = 0.0;
+  for (std::size_t i = 1; i < U.size(); ++i) largest = std::max(largest, U[i] - U[i - 1]);
+  for (std::size_t i = 1; i < U.size(); ++i) {
+    const double h = U[i] - U[i - 1];
+    if (h > 0.0 && h < kMinKnotSpanRatio * largest) {
+      // The knots as written (the shortest text that reads back the same double).
+      const auto exact = [](double x) {
+        char buf[32];
+        return std::string(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+      };
+      std::ostringstream os;
+      os.precision(3);
+      os << "the knot span [" << exact(U[i - 1]) << ", " << exact(U[i]) << "] (knots " << i - 1
+         << " and " << i << ") is ";
+      os << h / largest << " of the largest span, below " << kMinKnotSpanRatio
+         << ": its elements are degenerate (singular tangents, quadrature off)";
+      return os.str();
+    }
+  }
+  return {};
+}
+
 spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const char* key) {
   const std::string ptr = std::string("/geometry/") + key;
   const std::vector<double> U = r.numbers(g.at(key), ptr);
@@ -173,6 +205,9 @@ spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const cha
   if (U.front() != 0.0 || U.back() != 1.0)
     r.fail(ptr,
            "the knot vector must run from 0 to 1 (parametric points and edges refer to [0,1]^2)");
+  if (const std::string why = short_span(U); !why.empty())
+    r.fail(ptr,
+           why + "; repeat the knot exactly (a multiplicity) or space the knots farther apart");
   // The Kirchhoff-Love shell needs a C^1 geometry (eqs. 10-15: curvatures from second
   // derivatives). An interior knot of multiplicity m >= p leaves the surface C^(p-m) there,
   // and refinement keeps that continuity: C^0 acts as a hinge (session 27: a kinked plate
@@ -302,6 +337,13 @@ void read_geometry(const Reader& r, const json& root, Case& c) {
                  " available (KNIT_MAX_MEMORY_MB overrides); use fewer elements or a lower "
                  "degree");
     c.surface = refine_patch(c.input_surface, p, eu, ev);
+    // The refinement's uniform knots can fall just beside an input knot.
+    for (const auto& [basis, k] : {std::pair{&c.surface.basis_u(), 0}, {&c.surface.basis_v(), 1}})
+      if (const std::string why = short_span(basis->knots()); !why.empty())
+        r.fail("/refinement/elements/" + std::to_string(k),
+               "after refinement " + why +
+                   ": a uniform knot of the refinement falls beside an input knot; choose a "
+                   "number of elements whose knots meet the input knots, or move the input knot");
   }
   // The analysis basis must be C^1 everywhere, which degree 1 is not between elements (session
   // 28: "refinement" to degree 1 put C^0 hinge lines inside the C^1 rule of the input knots),

@@ -958,6 +958,24 @@ TEST_CASE("a geometry that is not C1 is refused at load, naming the knot vector"
                           0) == 0);
   j["geometry"]["knots_u"] = {0, 0, 0, 0.25, 0.5, 1, 1, 1};  // C^1 everywhere: accepted
   CHECK(error_of(j).empty());
+  // Session 56's red team: a span of 1e-9 beside 0.5 read as a quadrature or support problem,
+  // or ended in a singular tangent. Refused at the knot vector below 1e-4 of the largest span.
+  j["geometry"]["knots_u"] = {0, 0, 0, 0.5, 0.5 + 1e-9, 1, 1, 1};
+  CHECK_THAT(error_of(j),
+             Catch::StartsWith("kink.json: /geometry/knots_u: the knot span [0.5, 0.500000001] "
+                               "(knots 3 and 4) is 2e-09 of the largest span, below 0.0001"));
+  j["geometry"]["knots_u"] = {0, 0, 0, 0.5, 0.5 + 1e-4, 1, 1, 1};  // 2e-4 of the largest: accepted
+  CHECK(error_of(j).empty());
+  // The refinement's uniform knots (1/3, 2/3 for 3 elements) beside an input knot 0.33334.
+  {
+    json r = j;
+    r["geometry"]["knots_u"] = {0, 0, 0, 0.33334, 0.5, 1, 1, 1};
+    r["refinement"] = {{"degree", 3}, {"elements", {3, 1}}};
+    CHECK_THAT(error_of(r), Catch::StartsWith("kink.json: /refinement/elements/0: after refinement "
+                                              "the knot span [0.3333333333333333, 0.33334]"));
+    r["refinement"]["elements"] = {2, 1};
+    CHECK(error_of(r).empty());
+  }
   j = verification_case("tensile_svk.json");
   j["geometry"]["knots_v"] = {0, 0, 0.5, 0.5, 1, 1};
   cp = json::array();
