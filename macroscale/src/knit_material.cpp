@@ -115,6 +115,26 @@ AlignDeviation align_deviation(const spline::SplineSurface& geometry,
   return worst;
 }
 
+AlignDeviation course_turn(const spline::SplineSurface& geometry) {
+  const auto su = samples(geometry.basis_u(), geometry.basis_u());
+  const auto sv = samples(geometry.basis_v(), geometry.basis_v());
+  const double uc = 0.5 * (su.front() + su.back()), vc = 0.5 * (sv.front() + sv.back());
+  const Eigen::MatrixXd D0 = geometry.derivatives(uc, vc, 1);
+  const Eigen::Vector3d a1 = D0.row(1).transpose();
+  const Eigen::Vector3d n0 = a1.cross(Eigen::Vector3d(D0.row(2).transpose())).normalized();
+  AlignDeviation worst;
+  for (const double u : su)
+    for (const double w : sv) {
+      const Eigen::MatrixXd D = geometry.derivatives(u, w, 1);
+      const Eigen::Vector3d n =
+          Eigen::Vector3d(D.row(1).transpose()).cross(Eigen::Vector3d(D.row(2).transpose()));
+      if (!(n.normalized().cross(n0).norm() <= 1e-6)) return {};  // not flat (or degenerate)
+      const double d = std::abs(angle_to(geometry, u, w, a1));
+      if (d > worst.radians) worst = {d, u, w};
+    }
+  return worst;
+}
+
 KnitMaterial::KnitMaterial(std::shared_ptr<const material::LoopLengthFamily> family,
                            spline::SplineSurface stitch_value, spline::SplineSurface knitting_angle,
                            Source source)

@@ -388,6 +388,27 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
       src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
     }
   }
+  // A constant angle follows A1 (eq. 19): on a flat patch whose A1 turns, the courses fan out
+  // (session 56's red team: NURBS weights 1, 2, 3, 1 on a flat square, 22.6 deg, 23 % more
+  // jaw force, no word).
+  if (!m.contains("knitting_angle") || m.at("knitting_angle").is_number()) {
+    const AlignDeviation t = course_turn(*ctx.patch);
+    if (t.radians > kAlignWarning) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "warning: " << ctx.file << ": " << p
+         << "/knitting_angle: the angle is constant, measured from A1 = dX/dtheta1 (eq. 19), and "
+            "A1 turns up to "
+         << t.radians * 180.0 / std::numbers::pi
+         << " deg across this flat patch (against its direction at the patch's centre; at "
+            "(theta1, theta2) = ("
+         << t.u << ", " << t.v << "); more than " << kAlignWarning * 180.0 / std::numbers::pi
+         << " deg), so the courses fan out with it; for straight courses give "
+            "\"knitting_angle\": {\"align_with\": [x, y, z], \"degrees\": ..., \"knots_u\": ..., "
+            "\"knots_v\": ...} (docs/case-format.md)";
+      src.input_warning += (src.input_warning.empty() ? "" : "\n") + os.str();
+    }
+  }
   // An old file is read unverified (session 54: knit-meso fit said so, knit-macro said nothing).
   if (!data.checksummed) {
     std::ostringstream os;

@@ -331,6 +331,36 @@ TEST_CASE("knit material: an align_with field that does not follow its direction
   CHECK(with_angle("[0, 1]", "[0, 0, 1, 1]").empty());
 }
 
+// Session 56's red team: alpha is measured from A1 (eq. 19), so a constant angle on a flat
+// patch whose A1 turns (NURBS weights 1, 2, 3, 1 on a square: 22.6 deg) knits fanning courses;
+// it ran with 23 % more jaw force than the plain square and no word. The bilinear patch of the
+// test above: A1 turns from 0 to 45 deg across v, the centre's at 26.6: 26.6 deg at v = 0.
+TEST_CASE("knit material: a constant angle on a flat patch whose A1 turns is warned about",
+          "[unit]") {
+  const std::string db = db_file("fan.h5", true, kDatabaseFormatVersion);
+  const auto warning = [&](const std::string& angle, const Eigen::Vector3d& corner) {
+    nlohmann::json j = nlohmann::json::parse(square_case(R"({"type": "knit", "database": ")" + db +
+                                                         R"(", "stitch_value": 5)" + angle + "}"));
+    j["geometry"]["control_points"][3] = {corner(0), corner(1), corner(2)};
+    return parse_case(j.dump(), "c.json").material->warning();
+  };
+  const Eigen::Vector3d fan(50.0, 100.0, 0.0), square(50.0, 50.0, 0.0), lifted(50.0, 100.0, 20.0);
+  for (const std::string angle : {"", R"(, "knitting_angle": 0.3)"})
+    CHECK_THAT(warning(angle, fan),
+               Catch::Contains("warning: c.json: /material/knitting_angle: the angle is constant, "
+                               "measured from A1 = dX/dtheta1 (eq. 19), and A1 turns up to 26.6 "
+                               "deg across this flat patch") &&
+                   Catch::Contains("so the courses fan out with it"));
+  CHECK(warning("", square).empty());
+  // A curved patch: A1 turns with the geometry, which no course direction is straighter than.
+  CHECK(warning("", lifted).find("fan out") == std::string::npos);
+  // A field is the case's own choice (the align_with test above warns of its own kind).
+  CHECK(warning(R"(, "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1],
+                                        "values": [0]})",
+                fan)
+            .find("fan out") == std::string::npos);
+}
+
 // Session 22: a knit case in other units ran with exit 0 (the database is in mm, N, MPa).
 TEST_CASE("knit material: a case in other units is refused", "[unit]") {
   const std::string db = db_file("units.h5", true, kDatabaseFormatVersion);

@@ -85,6 +85,14 @@ struct AlignDeviation {
 };
 AlignDeviation align_deviation(const spline::SplineSurface& geometry,
                                const spline::SplineSurface& alpha, const Eigen::Vector3d& v);
+/// How far the courses of a constant knitting angle turn across a flat patch (session 56's red
+/// team: alpha is measured from A1, eq. 19, and on a flat square with NURBS weights 1, 2, 3, 1
+/// A1 fans out by 22.6 deg, so a constant alpha = 0 knitted fanning courses, 23 % more jaw
+/// force than the plain square, with no word): the largest angle between A1 and A1 at the
+/// patch's parameter centre on align_deviation's grid, and where. radians = 0 for a patch
+/// that is not flat (its normal turns by more than 1e-6 rad on the grid), where A1 turning is
+/// the geometry's and no course direction is straighter than another.
+AlignDeviation course_turn(const spline::SplineSurface& geometry);
 /// The deviation above which a case's align_with field is warned about (5 deg).
 inline constexpr double kAlignWarning = 5.0 * std::numbers::pi / 180.0;
 
