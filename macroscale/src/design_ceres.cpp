@@ -201,8 +201,12 @@ DesignResult optimize_design_ceres(const DesignProblem& d, const OptimizeOptions
                   res);
   if (res.message.empty() && summary.termination_type != ceres::CONVERGENCE)
     res.message = summary.message;
-  else if (res.status != DesignStatus::kConverged && !failed)  // why it stopped (session 40)
-    res.message += (res.message.empty() ? "" : "; ") + ("Ceres: " + summary.message);
+  else if (res.status != DesignStatus::kConverged && !failed) {  // why it stopped (session 40)
+    // Without Ceres' final period: the message goes on ("...: 50.; outputs in", session 56).
+    std::string said = summary.message;
+    while (!said.empty() && (said.back() == '.' || said.back() == ' ')) said.pop_back();
+    res.message += (res.message.empty() ? "" : "; ") + ("Ceres: " + said);
+  }
   return res;
 }
 

@@ -610,6 +610,12 @@ TEST_CASE("design optimizer: max_iterations 1 ends at the iteration limit", "[un
     CHECK(r.status == DesignStatus::kIterationLimit);
     CHECK(r.history.size() <= 2);
     CHECK(r.J < r.J0);
+    // How far it got, in the message (session 56's walkthrough: Ceres' "Maximum number of
+    // iterations reached." alone), which goes on without a final period (".; outputs in").
+    CHECK_THAT(r.message, Catch::StartsWith("J fell from ") &&
+                              Catch::Contains(" of its start) in 1 iteration") &&
+                              !Catch::Contains("1 iterations"));
+    CHECK(r.message.back() != '.');
   }
 }
 
