@@ -199,9 +199,12 @@ int run_main(int argc, char** argv, const std::string& program, const std::strin
   }
   // The markers of this run's output directories name it (knit/io/output_target.hpp).
   io::set_output_owner(who());
+  // What the interrupt leaves beside an output, and who removes it (session 56's walkthrough:
+  // DIR.partial-<pid> and DIR.lock were found after Ctrl-C, unexplained; docs/io.md).
   on_interrupt_say(who() +
                    ": interrupted; outputs not yet complete are not written, earlier outputs "
-                   "stay as they were");
+                   "stay as they were; a left-over OUTPUT.lock and OUTPUT.partial-<pid> beside "
+                   "an output are removed by the next run into it");
   try {
     for (auto& [sub, run] : subs)
       if (sub->parsed()) return run();

@@ -212,8 +212,24 @@ TEST_CASE("knit-macro run: an interrupt says what became of the outputs", "[unit
   CHECK(r.rc == 130);  // 128 + SIGINT: ended by the signal
   CHECK(knit_test::contains(r.output,
                             "knit-macro run: interrupted; outputs not yet complete "
-                            "are not written, earlier outputs stay as they were"));
+                            "are not written, earlier outputs stay as they were; a "
+                            "left-over OUTPUT.lock and OUTPUT.partial-<pid> beside an output "
+                            "are removed by the next run into it"));
   CHECK_FALSE(fs::exists(d / "out"));
+  // What the line says is left (session 56's walkthrough), and that the next run removes it.
+  CHECK(fs::exists(d / "out.lock"));
+  const auto partial = [&] {
+    for (const auto& e : fs::directory_iterator(d))
+      if (e.path().filename().string().rfind("out.partial-", 0) == 0) return true;
+    return false;
+  };
+  CHECK(partial());
+  const std::string quick = small_case(d, 5, 2);
+  REQUIRE(knit_test::run_command(std::string(KNIT_BIN_DIR) + "/knit-macro run " + quick +
+                                 " --output " + (d / "out").string())
+              .rc == 0);
+  CHECK_FALSE(fs::exists(d / "out.lock"));
+  CHECK_FALSE(partial());
   fs::remove_all(d);
 }
 
