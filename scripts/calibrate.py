@@ -43,7 +43,9 @@ gave an observable beyond reached_* and refused_* (every path stopped at once or
 Runs one knit-meso process at a time (the machine is shared); every path is cached in WORK by
 the binary's sha256 and its parameters, so a rerun only computes what is new. A path counts as
 cached only when its knit-meso run ended (exit 0, or 1: stopped early, its converged steps
-kept): it runs into WORK/.../NAME.part and is renamed when done.
+kept): it runs into WORK/.../NAME.part and is renamed when done. A path knit-meso refuses is
+not cached (asked again on a rerun: 0.06 s). The key is the parameters and the steps; E_END
+and the cell's fixed settings (cell_config) are constants of this script.
 """
 import argparse
 import collections
@@ -119,8 +121,7 @@ class Runner:
 
     def __init__(self, binary, work, steps):
         self.binary, self.steps = binary, steps
-        with open(binary, "rb") as f:
-            self.sha = hashlib.sha256(f.read()).hexdigest()
+        self.sha = binary_sha(binary)
         # A cache per binary (the audit of session 56: a filled WORK of another binary, or of
         # none, was reused).
         self.work = os.path.join(work, "knit-meso-" + self.sha[:16])
@@ -369,15 +370,23 @@ def read_own_table(path):
     return (comments, rows) if header else None
 
 
-def settings_lines(steps, base):
-    """The comment lines of a table: what made it (compared when merging)."""
+def binary_sha(binary):
+    """sha256 of the knit-meso binary's bytes (hex): which build made a path or a table."""
+    with open(binary, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def settings_lines(steps, base, sha):
+    """The comment lines of a table: what made it (compared when merging), the knit-meso build
+    by its sha256 (the review of session 56: --only merged rows of two builds silently)."""
     return ["# Sensitivity of the unit cell's observables (scripts/calibrate.py, issue 12);",
             f"# uniaxial-stress paths to E = {E_END} in {steps} steps, l = 4.5 and 6.5 mm;",
             "# one parameter varied at a time, the others at "
-            + " ".join(f"{k}={base[k]:.6g}" for k in sorted(base))]
+            + " ".join(f"{k}={base[k]:.6g}" for k in sorted(base)),
+            f"# knit-meso sha256 {sha[:16]}"]
 
 
-def check_out(out, merging, steps, base):
+def check_out(out, merging, steps, base, sha):
     """Before any run: --out must be a new file or a table of ours (never overwrite anything
     else); with --only (merging) -> the existing table's rows to keep, else []."""
     if os.path.isdir(out):
@@ -391,21 +400,28 @@ def check_out(out, merging, steps, base):
     if not merging:
         return []
     comments, rows = own
-    mine = settings_lines(steps, base)[1:]
+    mine = settings_lines(steps, base, sha)[1:3]
     theirs = [c for c in comments if c.startswith(("# uniaxial-stress", "# one parameter"))]
     if theirs and theirs != mine:
         die(f"--out: {out} was made with other settings ({' '.join(theirs)}) than this run "
             f"({' '.join(mine)}): its rows cannot be merged with --only; name another --out")
+    build = settings_lines(steps, base, sha)[3]
+    made_by = [c for c in comments if c.startswith("# knit-meso sha256 ")]
+    if made_by != [build]:
+        said = made_by[0][len("# knit-meso "):] if made_by else "no recorded build"
+        die(f"--out: {out} was made by another knit-meso ({said}) than this run's "
+            f"({build[len('# knit-meso '):]}): --only would mix the rows of two builds; run the "
+            "whole study without --only (about 2 minutes), or name another --out")
     return rows
 
 
-def write_table(out, rows, steps, base):
+def write_table(out, rows, steps, base, sha):
     """rows (parameter, value text, observable, result text) -> out, atomically."""
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     tmp = out + ".tmp"
     try:
         with open(tmp, "w") as f:
-            f.write("\n".join(settings_lines(steps, base)) + "\n")
+            f.write("\n".join(settings_lines(steps, base, sha)) + "\n")
             f.write(HEADER + "\n")
             for r in rows:
                 f.write(",".join(r) + "\n")
@@ -454,7 +470,7 @@ def main():
         if not measured(obs):
             die("no path gave an observable beyond reached_* / refused_*", 1)
         return 0
-    kept = check_out(a.out, bool(a.only), a.steps, base)
+    kept = check_out(a.out, bool(a.only), a.steps, base, binary_sha(binary))
     runner = Runner(binary, a.work, a.steps)
     new = {}
     any_measured = False
@@ -484,7 +500,7 @@ def main():
     groups = sorted(list(new.items()) + list(old.items()),
                     key=lambda t: order.index(t[0]) if t[0] in order else len(order))
     rows = [r for _, g in groups for r in g]
-    write_table(a.out, rows, a.steps, base)
+    write_table(a.out, rows, a.steps, base, runner.sha)
     print(f"{len(rows)} results -> {a.out}", file=sys.stderr)
     return 0
 

@@ -207,7 +207,9 @@ spline::BSplineBasis read_basis(const Reader& r, const json& g, int p, const cha
            "the knot vector must run from 0 to 1 (parametric points and edges refer to [0,1]^2)");
   if (const std::string why = short_span(U); !why.empty())
     r.fail(ptr,
-           why + "; repeat the knot exactly (a multiplicity) or space the knots farther apart");
+           why +
+               "; merge the two knots into one (its multiplicity at most the degree - 1) or space "
+               "them farther apart");
   // The Kirchhoff-Love shell needs a C^1 geometry (eqs. 10-15: curvatures from second
   // derivatives). An interior knot of multiplicity m >= p leaves the surface C^(p-m) there,
   // and refinement keeps that continuity: C^0 acts as a hinge (session 27: a kinked plate

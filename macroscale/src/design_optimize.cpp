@@ -78,15 +78,21 @@ void classify_result(const DesignProblem& d, const OptimizeOptions& opt, SolverE
   if (end == SolverEnd::kIterationLimit) {
     r.status = DesignStatus::kIterationLimit;
     // How far it got (session 56's walkthrough: J fell by 2 % in 50 iterations, and the
-    // message was Ceres' "Maximum number of iterations reached" alone).
+    // message was Ceres' "Maximum number of iterations reached" alone). The history holds the
+    // start and the accepted iterations (a rejected step is no row; the optimizer's own count,
+    // rejected steps included, follows from Ceres).
     if (r.J0 > 0.0 && std::isfinite(r.J) && std::isfinite(r.J0)) {
-      const int n = r.history.empty() ? 0 : r.history.back().iteration;
+      const std::size_t accepted = r.history.empty() ? 0 : r.history.size() - 1;
       char buf[200];
-      std::snprintf(buf, sizeof buf,
-                    "J fell from %.6g to %.6g (%.3g of its start) in %d iteration%s", r.J0, r.J,
-                    r.J / r.J0, n, n == 1 ? "" : "s");
+      if (accepted == 0)
+        std::snprintf(buf, sizeof buf, "no iteration was accepted: J stays at %.6g", r.J0);
+      else
+        std::snprintf(buf, sizeof buf,
+                      "J fell from %.6g to %.6g (%.3g of its start) over %zu accepted iteration%s",
+                      r.J0, r.J, r.J / r.J0, accepted, accepted == 1 ? "" : "s");
       r.message = buf;
-      if (r.J > 0.5 * r.J0)
+      // Little progress over many iterations (not after a few: max_iterations 1 is a choice).
+      if (accepted >= 10 && r.J > 0.5 * r.J0)
         r.message +=
             ": little progress, so more iterations may not help either; a flat J is one the "
             "variables barely move (do the objectives' regions and strains respond to them? two "

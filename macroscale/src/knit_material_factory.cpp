@@ -391,7 +391,11 @@ std::unique_ptr<Material> make_knit_material(const nlohmann::json& m, const Case
   // A constant angle follows A1 (eq. 19): on a flat patch whose A1 turns, the courses fan out
   // (session 56's red team: NURBS weights 1, 2, 3, 1 on a flat square, 22.6 deg, 23 % more
   // jaw force, no word).
-  if (!m.contains("knitting_angle") || m.at("knitting_angle").is_number()) {
+  // Constant: a number, absent, or a field whose values are all one (the review of session 56:
+  // the one-value field that design files vary); an align_with field is warned of above.
+  const bool align = m.contains("knitting_angle") && m.at("knitting_angle").is_object() &&
+                     m.at("knitting_angle").contains("align_with");
+  if (!align && a.control_points().maxCoeff() == a.control_points().minCoeff()) {
     const AlignDeviation t = course_turn(*ctx.patch);
     if (t.radians > kAlignWarning) {
       std::ostringstream os;

@@ -612,9 +612,12 @@ TEST_CASE("design optimizer: max_iterations 1 ends at the iteration limit", "[un
     CHECK(r.J < r.J0);
     // How far it got, in the message (session 56's walkthrough: Ceres' "Maximum number of
     // iterations reached." alone), which goes on without a final period (".; outputs in").
-    CHECK_THAT(r.message, Catch::StartsWith("J fell from ") &&
-                              Catch::Contains(" of its start) in 1 iteration") &&
-                              !Catch::Contains("1 iterations"));
+    CHECK_THAT(r.message, (Catch::StartsWith("J fell from ") &&
+                           Catch::Contains(" of its start) over 1 accepted iteration; raise "
+                                           "/optimizer/max_iterations to go on")) ||
+                              Catch::StartsWith("no iteration was accepted: J stays at "));
+    // One iteration is the case's choice: no claim that more would not help.
+    CHECK_THAT(r.message, !Catch::Contains("little progress"));
     CHECK(r.message.back() != '.');
   }
 }

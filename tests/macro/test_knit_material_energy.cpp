@@ -354,9 +354,15 @@ TEST_CASE("knit material: a constant angle on a flat patch whose A1 turns is war
   CHECK(warning("", square).empty());
   // A curved patch: A1 turns with the geometry, which no course direction is straighter than.
   CHECK(warning("", lifted).find("fan out") == std::string::npos);
-  // A field is the case's own choice (the align_with test above warns of its own kind).
-  CHECK(warning(R"(, "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1], "knots_v": [0, 1],
-                                        "values": [0]})",
+  // A one-value field is a constant angle too (the review of session 56: the form design files
+  // vary); a field that varies is the case's own choice, and an align_with field is warned of
+  // in its own terms (the test above).
+  CHECK_THAT(warning(R"(, "knitting_angle": {"degrees": [0, 0], "knots_u": [0, 1],
+                                             "knots_v": [0, 1], "values": [0]})",
+                     fan),
+             Catch::Contains("fan out"));
+  CHECK(warning(R"(, "knitting_angle": {"degrees": [0, 1], "knots_u": [0, 1],
+                                        "knots_v": [0, 0, 1, 1], "values": [0, 0.4]})",
                 fan)
             .find("fan out") == std::string::npos);
 }

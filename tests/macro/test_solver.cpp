@@ -1024,10 +1024,12 @@ TEST_CASE("steps that the absolute tolerance alone accepts are warned of", "[uni
   CHECK(tiny.report.loosest_relative_residual > kLooseRelativeResidual);
   const auto warned = [](const RunResult& r) {
     return std::any_of(r.input_warnings.begin(), r.input_warnings.end(), [](const std::string& w) {
-      return w.find("accepted by /solver/absolute_tolerance (1e-06) alone") != std::string::npos;
+      return w.find("accepted by /solver/absolute_tolerance (") != std::string::npos;
     });
   };
   CHECK(warned(tiny));
+  CHECK(tiny.input_warnings.back().find("/solver/absolute_tolerance (1e-06) alone") !=
+        std::string::npos);
   CHECK_FALSE(warned(unit));
   // The answer it warns of is off; with the tolerance below the loads it is the scaled one.
   const double exact = kE * unit.rows.back().reactions[0];
@@ -1038,4 +1040,13 @@ TEST_CASE("steps that the absolute tolerance alone accepts are warned of", "[uni
   CHECK(fine.report.loose_steps == 0);
   CHECK_FALSE(warned(fine));
   CHECK(fine.rows.back().reactions[0] == Approx(exact).epsilon(1e-6));
+  // No load: the undeformed state is the answer by right, whatever round-off its internal forces
+  // carry (the review of session 56: the Scordelis-Lo roof without its load was told "523 %
+  // off ... the loads are too small").
+  json roof = verification_case("scordelis_lo.json");
+  roof["loads"][0]["force_per_area"] = {0.0, 0.0, 0.0};
+  const RunResult unloaded = run(roof);
+  REQUIRE(unloaded.report.status == RunStatus::kCompleted);
+  CHECK(unloaded.report.loose_steps == 0);
+  CHECK_FALSE(warned(unloaded));
 }

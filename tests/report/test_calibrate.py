@@ -239,7 +239,15 @@ def main():
         other = os.path.join(tmp, "other", "knit-meso")
         os.mkdir(os.path.dirname(other))
         write_fake(other, "# another build\n")
+        # Into the table of the first binary: refused, not merged (the review of session 56:
+        # the rows of two builds were mixed without a word).
+        before_other = text(out)
         r = study(out, "--only", "mu", binary=other)
+        c(clean(r, 2) and "another knit-meso" in r.stderr and text(out) == before_other
+          and calls(log) == n2,
+          "--only with another knit-meso than the table's: refused before any run, the table "
+          "untouched", r.stderr[-600:])
+        r = study(os.path.join(tmp, "other.csv"), "--only", "mu", binary=other)
         # 16 = mu's 5 values x 4 paths, less mu = 0.15 (the defaults, cached by the g0 study)
         c(clean(r, 0) and (n1 - n0, n2 - n1, calls(log) - n2) == (16, 0, 20),
           "the cache is the binary's: the same binary reruns nothing, another reruns all: "
