@@ -260,6 +260,7 @@ std::vector<ActivePair> ContactSet::active_pairs(const rod::RodSystem& sys,
     a.point = f.point;
     a.xi = xi_[f.point];
     a.course = f.course;
+    a.k = f.pr.k;
     a.u = r.u;
     a.gap = r.gap;
     a.p = r.p;

@@ -254,17 +254,29 @@ StepResult PeriodicCell::homogenize(const Matrix2d& F) {
   const Vector3d nA = sys_.state(0, b.lo(), x_).n, nB = sys_.state(0, b.hi(), x_).n;
   r.n1 = 0.5 * (nA + nB);
   r.imbalance = (nB - nA).norm();
-  Vector3d up = Vector3d::Zero(), down = Vector3d::Zero();
+  // The contacts with the periodic images carry force across the cell's faces (eqs. 8-9): a
+  // pair between the cell's yarn and the image shifted by k A1 + j A2 (A1 = (w, 0), A2 = (0, c):
+  // copy k along the course of course j) adds f (x) (k A1 + j A2) to V P, half from each of its
+  // two passes (the virial of the lattice shift: P = (1/V) dU/dF). Across the horizontal faces
+  // (the courses above and below, j = +-1) for n2; across the vertical faces (the stitches left
+  // and right, k = +-1, of any course) for n1, beside the yarn's own force where it crosses
+  // (session 56's red team: n1 had the yarn force alone, so where neighbouring stitches of a
+  // course press on each other P11 missed their contact force: at the end of the 4.5 mm
+  // uniaxial wale path, E22 = 0.35, dU/dF11 / V = -2.17 MPa against a reported -0.10; 21 % of
+  // the work along that path was missing, and the shear stress was unsymmetric, S12 2.33
+  // against S21 1.07 at 60 deg with mu = 0).
+  Vector3d across2 = Vector3d::Zero(), across1 = Vector3d::Zero();
   r.min_gap = 1e300;
   const auto pairs = contact_->active_pairs(sys_, x_);
   for (const auto& p : pairs) {
-    if (p.course == 1) up += p.weight * p.f;
-    if (p.course == -1) down += p.weight * p.f;
+    across2 += static_cast<double>(p.course) * p.weight * p.f;
+    across1 += static_cast<double>(p.k) * p.weight * p.f;
     r.min_gap = std::min(r.min_gap, p.gap);
   }
   if (pairs.empty()) r.min_gap = 0;
   r.active_contacts = static_cast<int>(pairs.size());
-  r.n2 = 0.5 * (up - down);
+  r.n1 += 0.5 * across1;
+  r.n2 = 0.5 * across2;
   const double t = thickness();
   const double A1 = dim_.c * t, A2 = dim_.w * t;
   r.P << r.n1(0) / A1, r.n2(0) / A2, r.n1(1) / A1, r.n2(1) / A2;

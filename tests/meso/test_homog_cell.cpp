@@ -319,3 +319,54 @@ TEST_CASE("homogenization: n2 is the mean of the forces from the courses above a
   // against 0.64 N here).
   CHECK(s.imbalance < 0.1 * s.n1.norm());
 }
+
+// Session 56's red team: n1 held the yarn's force where it crosses the cell's vertical faces,
+// but not the contact forces between the cell's yarn and the stitches left and right of it
+// (copies k = +-1 along the course), which cross those faces too. Where stitches of a course
+// press on each other (laterally compressed, at the end of the 4.5 mm uniaxial wale path) P11
+// was -0.0009 MPa where dU/dF11 / V is -2.11. The identity (mu = 0, elastic): P = (1/V) dU/dF,
+// U the rods' strain energy plus the contact energy, by central differences; collocation is not
+// variational, so within a few % (1.6 % at 32 elements, 1.0 % at 64).
+TEST_CASE(
+    "homogenization: P is the derivative of the cell's energy where stitches press on "
+    "each other",
+    "[unit]") {
+  CellOptions o = fast_options();
+  o.elements = 32;
+  o.contact.friction.mu = 0.0;
+  PeriodicCell cell(4.5, o);
+  REQUIRE(cell.equilibrate().converged);
+  Eigen::Matrix2d F;
+  F << 0.81255, 0.0, 0.0, 1.30384;  // (E11, E22) = (-0.17, 0.35)
+  StepResult s;
+  for (int k = 1; k <= 10; ++k) {
+    s = cell.solve(Eigen::Matrix2d::Identity() + (F - Eigen::Matrix2d::Identity()) * (k / 10.0));
+    REQUIRE(s.converged);
+  }
+  int across = 0;  // pairs with the stitches left and right that carry force
+  for (const auto& p : cell.contacts().active_pairs(cell.system(), cell.state()))
+    across += p.k != 0 && p.f.norm() > 0.0;
+  REQUIRE(across > 0);
+  const auto& d = cell.dimensions();
+  const double V = d.w * d.c * cell.thickness(), h = 1e-4;
+  const auto energy = [&] {
+    return cell.strain_energy() + cell.contacts().energy(cell.system(), cell.state());
+  };
+  const auto snap = cell.snapshot();
+  Eigen::Matrix2d dU = Eigen::Matrix2d::Zero();
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      double U[2];
+      for (int side = 0; side < 2; ++side) {
+        cell.restore(snap);
+        Eigen::Matrix2d G = F;
+        G(i, j) += side == 0 ? h : -h;
+        REQUIRE(cell.solve(G).converged);
+        U[side] = energy();
+      }
+      dU(i, j) = (U[0] - U[1]) / (2.0 * h * V);
+    }
+  INFO("P =\n" << s.P << "\n(1/V) dU/dF =\n" << dU);
+  CHECK(dU(0, 0) < -1.0);  // the lateral compression is carried (MPa)
+  CHECK((s.P - dU).cwiseAbs().maxCoeff() <= 0.03 * s.P.cwiseAbs().maxCoeff());
+}

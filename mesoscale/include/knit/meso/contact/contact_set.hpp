@@ -78,6 +78,7 @@ struct ActivePair {
   int point = 0;   ///< slave (Gauss) point
   double xi = 0;   ///< its parameter
   int course = 0;  ///< -1, 0, +1
+  int k = 0;       ///< the master's copy along the course: -1, 0, +1 (its period F* (w, 0, 0))
   double u = 0, gap = 0, p = 0, f_T = 0;
   bool slip = false;
   Eigen::Vector3d f = Eigen::Vector3d::Zero();  ///< line load on the slave [N/mm]
