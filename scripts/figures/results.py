@@ -240,6 +240,19 @@ def json_difference(a, b, ptr=""):
     return None if a == b and type(a) is type(b) else ptr
 
 
+def read_json_object(path):
+    """(the JSON object in the file `path`, "") or ({}, why it cannot be taken: unreadable, not
+    JSON, or JSON that is not an object)."""
+    try:
+        with open(path) as f:
+            value = json.load(f)
+    except (OSError, ValueError) as e:
+        return {}, str(e)
+    if not isinstance(value, dict):
+        return {}, "not a JSON object"
+    return value, ""
+
+
 class Result:
     """One case's output directory plus the pipeline's status file next to it."""
 
@@ -253,14 +266,9 @@ class Result:
         self.status = {}
         sp = os.path.join(results_dir, name + ".status")
         if os.path.exists(sp):
-            try:
-                with open(sp) as f:
-                    self.status = json.load(f)
-                if not isinstance(self.status, dict):
-                    raise ValueError("not a JSON object")
-            except (OSError, ValueError) as e:
-                self.status = {}
-                self.problem = f"{sp} is unreadable ({e}); delete it to rerun the case"
+            self.status, why = read_json_object(sp)
+            if why:
+                self.problem = f"{sp} is unreadable ({why}); delete it to rerun the case"
         self.ok = os.path.isdir(self.dir) and os.path.exists(os.path.join(self.dir, "load_strain.csv"))
         # A last run that wrote nothing (exit code 2 or more: refused, e.g. a loop length the
         # database does not cover): NAME/ is an earlier run's output, not this run's (session
@@ -309,14 +317,9 @@ class Result:
         cp = os.path.join(self.dir, "case.json")
         if os.path.exists(cp):
             # Session 55's red team: a truncated case.json ended the report in a traceback.
-            try:
-                with open(cp) as f:
-                    self.case = json.load(f)
-                if not isinstance(self.case, dict):
-                    raise ValueError("not a JSON object")
-            except (OSError, ValueError) as e:
-                self.case = {}
-                self.problem = self.problem or f"{cp} is unreadable ({e})"
+            self.case, why = read_json_object(cp)
+            if why:
+                self.problem = self.problem or f"{cp} is unreadable ({why})"
                 self.ok = False
         # The case's /output, an object (the review of session 55: a list here ended the
         # consistency checks in an AttributeError), and its grid, two positive integers (a
