@@ -244,8 +244,8 @@ EnergyFitSummary& finish_network(const Database& db, const EnergyFitOptions& o,
                                  double sS, double sE, int skipped, EnergyFitSummary& out) {
   EnergyLawData& law = out.law;  // the ridge fields stay empty (the network comes first)
   law.family = material::EnergyFamily::kNetwork;
-  const std::string why =
-      detail::fit_network(law, ls, pts, data_weights(pts, o, sS), sS, sE, o, out.ceres_iterations);
+  const std::string why = detail::fit_network(law, ls, pts, data_weights(pts, o, sS), sS, sE, o,
+                                              out.ceres_iterations, out.objective, out.seed);
   return finish_fit(db, o, skipped, why, out);
 }
 
@@ -317,14 +317,23 @@ constexpr std::array<const char*, 9> kSharedKeys = {
 constexpr std::array<const char*, 10> kRidgeOnlyKeys = {
     "directions", "s_degree",  "s_spans", "l_degree",   "l_control_points",
     "s_margin",   "smoothing", "loss",    "loss_scale", "loss_rounds"};
-constexpr std::array<const char*, 16> kNetworkOnlyKeys = {"hidden1",       "hidden2",
-                                                          "stiff1",        "stiff2",
-                                                          "outer",         "l_interpolation",
-                                                          "l_blend",       "l_coupling",
-                                                          "seed",          "network_iterations",
-                                                          "tube",          "tube_weight",
-                                                          "tube_uniaxial", "tube_uniaxial_weight",
-                                                          "prior_points",  "prior_weight"};
+constexpr std::array<const char*, 17> kNetworkOnlyKeys = {"hidden1",
+                                                          "hidden2",
+                                                          "stiff1",
+                                                          "stiff2",
+                                                          "outer",
+                                                          "l_interpolation",
+                                                          "l_blend",
+                                                          "l_coupling",
+                                                          "seed",
+                                                          "starts",
+                                                          "network_iterations",
+                                                          "tube",
+                                                          "tube_weight",
+                                                          "tube_uniaxial",
+                                                          "tube_uniaxial_weight",
+                                                          "prior_points",
+                                                          "prior_weight"};
 
 std::string EnergyFitOptions::validate() const {
   if (s_degree < 0 || s_degree > 5) return "s_degree must be in 0..5";
@@ -388,6 +397,9 @@ std::string EnergyFitOptions::validate() const {
     return "l_blend needs l_interpolation \"energy\"";
   if (!(l_coupling >= 0.0 && l_coupling <= 1e6)) return "l_coupling must be in [0, 1e6]";
   if (seed < 0) return "seed must be >= 0";
+  if (starts < 1 || starts > 64) return "starts must be in 1..64";
+  if (seed > std::numeric_limits<int>::max() - (starts - 1))
+    return "seed + starts - 1 must fit an int";
   if (network_iterations < 1 || network_iterations > 1000000)
     return "network_iterations must be in 1..1000000";
   if (!(tube >= 0.0 && tube <= 1.0))
@@ -429,6 +441,7 @@ std::string EnergyFitOptions::to_json() const {
                       {"l_blend", l_blend},
                       {"l_coupling", l_coupling},
                       {"seed", seed},
+                      {"starts", starts},
                       {"network_iterations", network_iterations},
                       {"tube", tube},
                       {"tube_weight", tube_weight},
@@ -507,6 +520,7 @@ EnergyFitOptions EnergyFitOptions::from_json(const std::string& text, const std:
   get_double("l_blend", o.l_blend);
   get_double("l_coupling", o.l_coupling);
   get_int("seed", o.seed);
+  get_int("starts", o.starts);
   get_int("network_iterations", o.network_iterations);
   get_double("tube", o.tube);
   get_double("tube_weight", o.tube_weight);
@@ -887,6 +901,7 @@ std::string energy_fit_report(const EnergyFitSummary& s) {
     if (sh.outer == 1)
       os << " (outer exp, scale " << sh.outer_scale << " MPa, cap " << sh.outer_cap << ")";
     os << ", " << s.law.network.l_knots.size() << " loop-length knots";
+    if (std::isfinite(s.objective)) os << ", objective " << s.objective << " from seed " << s.seed;
   } else {
     os << "  energy law (" << s.law.directions.d.rows() << " directions, " << s.law.functions()
        << " functions";

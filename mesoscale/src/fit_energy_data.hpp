@@ -25,9 +25,11 @@ std::vector<double> stress_ranges(const std::vector<Point>& pts, std::size_t loo
 
 /// Fits law.network (law.floor, l_min, l_max, box already set) to the points, with the
 /// squared-residual weights `weight` (one per point), stress scale sS and strain scale sE.
-/// Returns the reason on failure (empty on success); `iterations` counts L-BFGS iterations.
+/// Returns the reason on failure (empty on success); `iterations` counts L-BFGS iterations (of
+/// every start), `objective` is the kept start's final objective and `seed` its seed.
 std::string fit_network(material::EnergyLawData& law, const std::vector<double>& loop_lengths,
                         const std::vector<Point>& pts, const std::vector<double>& weight, double sS,
-                        double sE, const EnergyFitOptions& o, int& iterations);
+                        double sE, const EnergyFitOptions& o, int& iterations, double& objective,
+                        int& seed);
 
 }  // namespace knit::meso::fit::detail

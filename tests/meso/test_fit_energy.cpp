@@ -204,6 +204,57 @@ TEST_CASE("energy fit: the network fit gives the same law for every thread count
   CHECK(o.validate() == "threads must be >= 0 (0: all cores)");
 }
 
+// Session 57: the default law's largest fit error at 6.5 mm was 4.5-7.1 % over seeds 1-6, and
+// the seed with the smallest final objective was the one within 5 % (docs/law-experiments.md,
+// "Multi-start"). starts = K runs the fit from seeds seed ... seed + K - 1 and keeps the start
+// of least objective: the same law, to the last bit, as a single fit from that seed, for every
+// thread count (starts side by side, one thread each), with every start's iterations counted.
+TEST_CASE("energy fit: multi-start keeps the start of least objective", "[unit]") {
+  const Database db = synthetic_coverage_db({4.5, 5.5, 6.5}, 6);
+  EnergyFitOptions o = small_network(4, 3, 150);
+  o.outer = "exp";
+  o.tube = 0.01;
+  o.seed = 3;
+  std::vector<EnergyFitSummary> single;
+  for (int seed = 3; seed < 6; ++seed) {
+    o.seed = seed;
+    single.push_back(fit_energy_law(db, o));
+    REQUIRE(single.back().ok());
+    CHECK(single.back().seed == seed);
+    CHECK(std::isfinite(single.back().objective));
+  }
+  std::size_t least = 0;
+  for (std::size_t k = 1; k < single.size(); ++k)
+    if (single[k].objective < single[least].objective) least = k;
+  // The draws must differ, or the choice is not tested.
+  REQUIRE(single[0].objective != single[1].objective);
+  REQUIRE(single[1].objective != single[2].objective);
+  o.seed = 3;
+  o.starts = 3;
+  for (int threads : {1, 2, 0}) {
+    INFO("threads " << threads);
+    o.threads = threads;
+    const EnergyFitSummary multi = fit_energy_law(db, o);
+    REQUIRE(multi.ok());
+    CHECK(multi.seed == single[least].seed);
+    CHECK(multi.objective == single[least].objective);
+    CHECK(multi.law.network.theta == single[least].law.network.theta);
+    REQUIRE(multi.diagnostics.per_loop.size() == single[least].diagnostics.per_loop.size());
+    for (std::size_t k = 0; k < multi.diagnostics.per_loop.size(); ++k)
+      CHECK(multi.diagnostics.per_loop[k].max_relative ==
+            single[least].diagnostics.per_loop[k].max_relative);
+    CHECK(multi.ceres_iterations ==
+          single[0].ceres_iterations + single[1].ceres_iterations + single[2].ceres_iterations);
+  }
+  o.starts = 0;
+  CHECK(o.validate() == "starts must be in 1..64");
+  o.starts = 65;
+  CHECK(o.validate() == "starts must be in 1..64");
+  o.starts = 2;
+  o.seed = 2147483647;
+  CHECK(o.validate() == "seed + starts - 1 must fit an int");
+}
+
 // Session 55's red team: the default law's pure-shear stiffness was ordered wrongly in l (the
 // paper's shear path, one of 13 paths at weight_paper, is all the pure-shear data). weight_shear
 // weights the pure-shear paths' states alone: here the shear path's stresses are scaled by 1.5

@@ -30,6 +30,7 @@
 // converged step, invalid options.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,11 @@ struct EnergyFitOptions {
   double l_blend = 0.0;
   double l_coupling = 1e-4;
   int seed = 1;
+  /// Network family: multi-start (session 57). The fit runs from the initial draws of seeds
+  /// seed, seed + 1, ..., seed + starts - 1 and keeps the one with the smallest final objective
+  /// (the fit data's, never the held-out states'); each start costs a whole fit. 1: one start,
+  /// the law of sessions 5-56.
+  int starts = 1;
   int network_iterations = 4000;
   /// Network family: a tube around the data (choice, docs/database.md "The tube"). Each stress
   /// component's error beyond tube * (the loop length's stress range) adds
@@ -185,6 +191,10 @@ struct EnergyFitSummary {
   material::EnergyLawData law;
   material::EnergyFitDiagnostics diagnostics;
   int ceres_iterations = 0;  ///< network: Ceres L-BFGS iterations; ridge: active-set solves
+  /// Network family: the kept start's final objective (the smallest of EnergyFitOptions::starts)
+  /// and its seed; NaN and -1 for the ridge family.
+  double objective = std::numeric_limits<double>::quiet_NaN();
+  int seed = -1;
   /// The fitted paths where the cell gave way (EnergyFitOptions::stable_min_cos), as
   /// "/loop_k/raw/path_NN from step s"; those steps are left out of the fit.
   std::vector<std::string> gave_way;
