@@ -363,9 +363,10 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   // smaller seed). The objective is non-convex and its end point chaotic (docs/law-experiments.md,
   // "The end point is chaotic"), so a single start decides the law's largest error by chance;
   // the choice looks at the fit data's objective only, never at the held-out states. One start
-  // spreads its loop lengths over the threads; several run side by side, one thread each (each
-  // with its own objective and scratch). Either way a start's floating-point operations are
-  // the same for every thread count (the file comment), so the kept law is too.
+  // spreads its loop lengths over the threads; several run side by side, one thread each or more
+  // when there are more threads than starts (each with its own objective and scratch). Either way a
+  // start's floating-point operations are the same for every thread count (the file comment), so
+  // the kept law is too.
   struct Start {
     std::vector<double> phi;
     double cost = 0.0;
@@ -410,11 +411,14 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
   if (o.starts == 1) {
     run_start(0, threads, true);
   } else {
+    // As many starts side by side as there are threads; more threads than starts go to the
+    // starts' loop lengths.
+    const int workers = std::min(threads, o.starts), per_start = std::max(1, threads / workers);
     std::atomic<int> next{0};
     std::vector<std::thread> pool;
-    for (int k = 0; k < std::min(threads, o.starts); ++k)
+    for (int k = 0; k < workers; ++k)
       pool.emplace_back([&] {
-        for (int s = next++; s < o.starts; s = next++) run_start(s, 1, false);
+        for (int s = next++; s < o.starts; s = next++) run_start(s, per_start, false);
       });
     for (std::thread& th : pool) th.join();
   }

@@ -231,7 +231,7 @@ TEST_CASE("energy fit: multi-start keeps the start of least objective", "[unit]"
   REQUIRE(single[1].objective != single[2].objective);
   o.seed = 3;
   o.starts = 3;
-  for (int threads : {1, 2, 0}) {
+  for (int threads : {1, 2, 7, 0}) {  // 7: two threads for each of the three starts
     INFO("threads " << threads);
     o.threads = threads;
     const EnergyFitSummary multi = fit_energy_law(db, o);
