@@ -180,6 +180,13 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
   // Friction: return mapping from the anchor of the last converged state.
   const double e = ell * (pr.u - hist.u_anchor);
   out.e = e;
+  // The slave's own slip relative to the master is 1 - q times the closest point's arc,
+  // q = r . x_m,uu / |x_m,u|^2 (the closest point's phi_u = -|x_m,u|^2 (1 - q)): the friction
+  // force f_T = -k_T e works on (1 - q) de. Both the friction work (slip, below) and the elastic
+  // stick energy are counted on that slip (session 56's red team; the stick term since session
+  // 57): for a fixed q the stick force is the derivative of (1 - q) k_T e^2 / 2 along the slip.
+  // Bookkeeping only: the forces and their tangent do not depend on it.
+  const double one_q = 1.0 - r.dot(cp.x_uu) / (ell * ell);
   const double ftr = -fr.k_T * e;
   const double lim = fr.mu * nv.p;
   const double sgn = e >= 0 ? 1.0 : -1.0;
@@ -189,7 +196,7 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
     out.energy = nv.energy;
   } else if (std::abs(ftr) <= lim) {
     out.f_T = ftr;
-    out.energy = nv.energy + 0.5 * fr.k_T * e * e;
+    out.energy = nv.energy + 0.5 * one_q * fr.k_T * e * e;
   } else {
     out.slip = true;
     out.f_T = -lim * sgn;
@@ -199,11 +206,9 @@ PairResult evaluate_pair(const Eigen::Vector3d& xs, const Chain& c, const Projec
     // r from it, slides 1 - q times as far, q = r . x_m,uu / |x_m,u|^2 (the closest point's
     // phi_u = -|x_m,u|^2 (1 - q)), and that slip is what f_T works on. Interlocked loops touch
     // inside each other's bends, q ~ 0.5: without the factor the dissipation was about twice the
-    // net work of closed strain loops (session 56's red team: 0.0921 against 0.0442 N mm). The
-    // elastic stick term of the energy keeps the arc (it is no potential: q varies).
-    const double one_q = 1.0 - r.dot(cp.x_uu) / (ell * ell);
+    // net work of closed strain loops (session 56's red team: 0.0921 against 0.0442 N mm).
     out.dissipation = lim * ell * one_q * std::abs(out.u_anchor_new - hist.u_anchor);
-    out.energy = nv.energy + 0.5 * lim * lim / fr.k_T;
+    out.energy = nv.energy + 0.5 * one_q * lim * lim / fr.k_T;
   }
   out.f = out.p * n + out.f_T * tau;
   const Vector3d nxt = n.cross(tau);

@@ -317,10 +317,11 @@ TEST_CASE("reference pairs: the energy's derivative in the gap is -p, and it is 
 }
 
 TEST_CASE("friction: the stored energy is continuous across the stick/slip limit", "[unit]") {
-  // Below the limit |k_T e| <= mu p the stick spring stores k_T e^2 / 2; beyond it the
-  // return mapping moves the anchor so that k_T |e| = mu p, and the spring stores
-  // (mu p)^2 / (2 k_T), its energy at the limit (and no more however far it slips). So the
-  // energy is continuous at the limit, on either side of the anchor. Session 32, a mutation
+  // Below the limit |k_T e| <= mu p the stick spring stores (1 - q) k_T e^2 / 2 (e on the
+  // closest point's arc, (1 - q) e the slave's own slip; contact_pair.cpp, session 57); beyond
+  // it the return mapping moves the anchor so that k_T |e| = mu p, and the spring stores
+  // (1 - q) (mu p)^2 / (2 k_T), its energy at the limit (and no more however far it slips). So
+  // the energy is continuous at the limit, on either side of the anchor. Session 32, a mutation
   // audit: the slip energy (mu p)^2 / k_T, without the 1/2, survived every test.
   Fixture F;
   const PenaltyLaw law{100.0, 0.1, 0.1, 0.0};  // fixed here, independent of the defaults
@@ -328,8 +329,11 @@ TEST_CASE("friction: the stored energy is continuous across the stick/slip limit
   const Vector3d xs(0.9, 0.1, 0.12);
   const Projection pr = project(F.chain, xs, 0, 0.0, 1.0, 0.4);
   REQUIRE(pr.ok);
-  const double ell = eval_chain(F.chain, pr.u, 0).x_u.norm();
-  auto with_e = [&](double e) {  // the pair with tangential gap e = ell (u - u_anchor)
+  const auto cp = eval_chain(F.chain, pr.u, 0);
+  const double ell = cp.x_u.norm();
+  const double one_q = 1.0 - (xs - cp.x).dot(cp.x_uu) / (ell * ell);
+  REQUIRE(std::abs(1.0 - one_q) > 1e-3);  // a curved master: the factor is seen
+  auto with_e = [&](double e) {           // the pair with tangential gap e = ell (u - u_anchor)
     PairHistory h;
     h.u_anchor = pr.u - e / ell;
     return evaluate_pair(xs, F.chain, pr, 0.38, law, fr, h, false);
@@ -346,7 +350,7 @@ TEST_CASE("friction: the stored energy is continuous across the stick/slip limit
     REQUIRE(far.slip);
     INFO("sign " << sgn << ": below " << below.energy << ", above " << above.energy);
     CHECK(above.energy == Approx(below.energy).epsilon(1e-8));
-    CHECK(above.energy - r0.energy == Approx(0.5 * lim * lim / fr.k_T).epsilon(1e-8));
+    CHECK(above.energy - r0.energy == Approx(0.5 * one_q * lim * lim / fr.k_T).epsilon(1e-8));
     CHECK(far.energy == Approx(above.energy).epsilon(1e-12));
   }
 }
