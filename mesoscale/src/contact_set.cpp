@@ -40,9 +40,9 @@ ContactSet::ContactSet(const rod::RodSystem& sys, int rod, const ContactOptions&
     weight_[g] = rule.weights[g] * (D.row(1) * r0.middleRows(first_[g], p + 1)).norm();
     for (int a = 0; a <= p; ++a) W_[first_[g] + a] += weight_[g] * D(0, a);
   }
-  history_.assign(3 * ns, {});
-  pending_.assign(3 * ns, {});
-  reference_.assign(3 * ns, {});
+  history_.assign(static_cast<std::size_t>(slot(ns, -kMaxCopy)), {});
+  pending_.assign(history_.size(), {});
+  reference_.assign(history_.size(), {});
 }
 
 Eigen::MatrixXd ContactSet::positions(const rod::RodSystem& sys, const Eigen::VectorXd& x) const {
@@ -61,6 +61,24 @@ Chain ContactSet::chain(const Eigen::MatrixXd& Q, int course) const {
   return c;
 }
 
+std::vector<Eigen::Vector2i> ContactSet::copies(const Eigen::MatrixXd& Q, double inflate,
+                                                bool& edge) const {
+  const Eigen::Vector3d lo = Q.colwise().minCoeff().transpose(),
+                        hi = Q.colwise().maxCoeff().transpose();
+  std::vector<Eigen::Vector2i> out;
+  edge = false;
+  for (int course = -kMaxCopy; course <= kMaxCopy; ++course)
+    for (int k = -kMaxCopy; k <= kMaxCopy; ++k) {
+      const Eigen::Vector3d shift = k * a1_ + course * a2_;
+      if ((lo.array() + shift.array() - inflate > hi.array()).any() ||
+          (hi.array() + shift.array() + inflate < lo.array()).any())
+        continue;
+      out.emplace_back(course, k);
+      if (std::abs(course) == kMaxCopy || std::abs(k) == kMaxCopy) edge = true;
+    }
+  return out;
+}
+
 std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, double inflate) const {
   const int n = basis_.size(), p = basis_.degree();
   const std::vector<double> br = spline::unique_knots(basis_.knots());
@@ -75,13 +93,17 @@ std::vector<ContactSet::Found> ContactSet::search(const Eigen::MatrixXd& Q, doub
   std::vector<Found> out;
   const int ns = static_cast<int>(xi_.size());
   (void)n;
+  bool edge = false;
+  const std::vector<Eigen::Vector2i> reach = copies(Q, inflate, edge);
   for (int j = 0; j < ns; ++j) {
     const Eigen::Vector3d xs = (Nc_.row(j) * Q.middleRows(first_[j], p + 1)).transpose();
-    for (int course = -1; course <= 1; ++course) {
+    std::size_t start = out.size();
+    for (std::size_t c = 0; c < reach.size(); ++c) {
+      const int course = reach[c](0), k = reach[c](1);
+      if (c == 0 || reach[c - 1](0) != course) start = out.size();  // dups within a course
       const Chain ch = chain(Q, course);
-      const std::size_t start = out.size();
-      for (int k = -1; k <= 1; ++k) {
-        const Eigen::Vector3d shift = k * a1_ + course * a2_;
+      const Eigen::Vector3d shift = k * a1_ + course * a2_;
+      {
         for (int e = 0; e < ne; ++e) {
           const double ua = k + br[e], ub = k + br[e + 1];
           if (course == 0 &&
@@ -125,7 +147,7 @@ const std::vector<ContactSet::Found>& ContactSet::found(const Eigen::MatrixXd& Q
 }
 
 double ContactSet::anchor_for(const Found& f) {
-  const int key = 3 * f.point + f.course + 1;
+  const int key = slot(f.point, f.course);
   double* best = nullptr;
   double bd = opt_.match_tol;
   for (auto* list : {&history_[key], &pending_[key]})
@@ -150,7 +172,7 @@ constexpr double kReferenceMatchTol = 0.25;
 Eigen::Vector2d* ContactSet::reference_for(const Found& f) {
   Eigen::Vector2d* best = nullptr;
   double bd = kReferenceMatchTol;
-  for (Eigen::Vector2d& r : reference_[3 * f.point + f.course + 1])
+  for (Eigen::Vector2d& r : reference_[slot(f.point, f.course)])
     if (std::abs(r(0) - f.pr.u) < bd) {
       bd = std::abs(r(0) - f.pr.u);
       best = &r;
@@ -165,7 +187,7 @@ int ContactSet::capture_reference(const rod::RodSystem& sys, const Eigen::Vector
   int n = 0;
   for (const Found& f : found(positions(sys, x)))
     if (f.pr.distance < opt_.d) {
-      reference_[3 * f.point + f.course + 1].emplace_back(f.pr.u, f.pr.distance - opt_.d);
+      reference_[slot(f.point, f.course)].emplace_back(f.pr.u, f.pr.distance - opt_.d);
       ++n;
     }
   return n;
@@ -284,7 +306,7 @@ void ContactSet::commit(const rod::RodSystem& sys, const Eigen::VectorXd& x) {
   std::vector<std::vector<double>> next(history_.size());
   double D = 0;
   visit(sys, x, false, [&](const Found& f, const PairResult& r) {
-    next[3 * f.point + f.course + 1].push_back(r.u_anchor_new);
+    next[slot(f.point, f.course)].push_back(r.u_anchor_new);
     D += 0.5 * weight_[f.point] * r.dissipation;  // two passes, half each (as forces, energy)
   });
   history_ = std::move(next);
@@ -335,6 +357,18 @@ std::string ContactSet::guard_refusal(const rod::RodSystem& sys, const Eigen::Ve
     m << "yarns passed through each other (slave point at xi = " << pt->xi << ", course "
       << pt->course << ", " << pt->depth << " mm beyond the master's centerline)";
     return m.str();
+  }
+  // A lattice so compressed or sheared that a course or copy beyond the searched ones could
+  // touch the yarn: its contacts would be missed (session 57's red team: courses +-2 passed
+  // through the yarn when only -1, 0, +1 were searched).
+  {
+    bool edge = false;
+    (void)copies(positions(sys, x), opt_.d + opt_.margin, edge);
+    if (edge) {
+      m << "the lattice is compressed or sheared so far that a course or a copy along it "
+        << kMaxCopy << " periods away could touch the yarn (ContactSet::kMaxCopy)";
+      return m.str();
+    }
   }
   // Sunk into each other short of passing through: the same branch at a smaller depth. The
   // deepest pair of the state (its search is cached from Newton's last residual).

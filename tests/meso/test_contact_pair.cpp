@@ -474,3 +474,38 @@ TEST_CASE("closest point: from a start where the curve bends away, the projectio
   }
   CHECK(bent >= 4);  // starts where Newton would climb
 }
+
+// Session 57's red team: only the courses -1, 0, +1 were searched, so under wale compression
+// and large shear the courses +-2 passed through the yarn with no force (4.5 mm, the paper's
+// 40 deg shear path: S12 1.62 MPa where 2.64 with them). Straight yarns c apart: with 2 c < d
+// the courses +-2 press on the yarn as well as +-1, each pair at its own gap, and the forces
+// balance; a lattice so dense that a course kMaxCopy periods away is within reach is refused.
+TEST_CASE("contact set: every course within reach is searched, a denser lattice is refused",
+          "[unit]") {
+  const double w = 2.0;
+  knit::meso::rod::RodSystem sys;
+  sys.add_rod(knit::meso::rod::straight_rod(Vector3d::Zero(), Vector3d(w, 0, 0), 4, 8));
+  const Eigen::VectorXd x = sys.initial_state();
+  const ContactOptions opt = straight_yarn_contact();
+  ContactSet cs(sys, 0, opt);
+  const double c = 0.15;  // 2 c = 0.30 < d = 0.38 < 3 c = 0.45
+  REQUIRE(2 * c < opt.d);
+  REQUIRE(3 * c > opt.d + opt.margin);
+  cs.set_periods(Vector3d(w, 0, 0), Vector3d(0, c, 0));
+  int per_course[5] = {0, 0, 0, 0, 0};
+  for (const ActivePair& a : cs.active_pairs(sys, x)) {
+    REQUIRE(std::abs(a.course) <= 2);
+    ++per_course[a.course + 2];
+    CHECK(a.gap == Approx(std::abs(a.course) * c - opt.d));
+  }
+  for (int j : {-2, -1, 1, 2}) {
+    INFO("course " << j);
+    CHECK(per_course[j + 2] == cs.num_slave_points());
+  }
+  CHECK(per_course[2] == 0);  // the own course: straight, nothing within reach
+  CHECK(cs.guard_refusal(sys, x).empty());
+  // Courses kMaxCopy periods away within d + margin: refused, naming the bound.
+  cs.set_periods(Vector3d(w, 0, 0),
+                 Vector3d(0, 0.9 * (opt.d + opt.margin) / ContactSet::kMaxCopy, 0));
+  CHECK_THAT(cs.guard_refusal(sys, x), Catch::Contains("periods away could touch the yarn"));
+}

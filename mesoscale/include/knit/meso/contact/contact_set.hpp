@@ -3,30 +3,33 @@
 //
 // Two-pass, point-to-curve: the slaves are Gauss points xi_g (`slave_points_per_element` per
 // element) of the cell's yarn;
-// the masters are the yarn's three courses j_c = -1, 0, +1 as periodic chains (contact/pair.hpp),
-// shifted by j_c F*(0, c). For the own course (j_c = 0) the part of the yarn within
-// `self_exclusion` of xi_j in the loop parameter is not a contact partner. The mirror pair (the
-// image's point against the cell's yarn) is the same contact seen from the other side. Each
-// pass applies half the load: +f/2 at the slave point and the reaction -f/2 at the master's
-// closest point u, which by periodicity is the material point u - k of the cell's own yarn. So
-// action equals reaction exactly and the net contact force on the course vanishes (a plain
-// two-pass point-to-curve law does not balance: the normals from the two sides of curved yarns
-// differ, which left a net force as large as the yarn force).
-// Broad phase: axis-aligned boxes of the control polygons of the elements of the three copies
-// k = -1, 0, 1 of each course chain (convex-hull property), inflated by d + margin; the closest
-// point is searched on every candidate element and kept if it is a true stationary point.
-// Collocated line load (choice): the contact line load f(xi) evaluated at the Gauss points is
-// projected on the collocation rows, nbar_j = (1/W_j) sum_g w_g |r0_xi| N_j(xi_g) f(xi_g) with
-// the tributary lengths W_j = int N_j ds. By the partition of unity sum_j W_j nbar_j = int f ds,
-// so the total contact force is integrated, not sampled at the few collocation points (sampling
-// them made the net force on the course, which must vanish, as large as the yarn force). The
-// same for the friction moment. The end points' balance rows carry the periodicity: loads on them
-// are dropped (the seam is the head top, free of contact).
-// Stress-free reference (issue 11; choice, ContactOptions::reference): the closed-form loops
-// start with overlaps of up to 0.16 mm, so with the plain law the unloaded cell carries contact
-// forces and a residual stress. With Reference::kInitialOverlap, capture_reference() records
-// at the reference state every overlapping pair (slave point, course, master parameter u_r, gap
-// g_r < 0); its line load is then p(g) - p(g_r) while g <= g_r and 0 when it opens (g > g_r):
+// the masters are the yarn's courses j_c as periodic chains (contact/pair.hpp), shifted by
+// j_c F*(0, c): every course and copy along it whose box can reach the yarn's (session 57's red
+// team: with courses -1, 0, +1 alone, the courses +-2 went through the yarn unopposed under wale
+// compression and large shear; 4.5 mm, the paper's 40 deg shear path: S12 1.62 MPa for 2.64). For
+// the own course (j_c = 0) the part of the yarn within `self_exclusion` of xi_j in the loop
+// parameter is not a contact partner. The mirror pair (the image's point against the cell's yarn)
+// is the same contact seen from the other side. Each pass applies half the load: +f/2 at the slave
+// point and the reaction -f/2 at the master's closest point u, which by periodicity is the material
+// point u - k of the cell's own yarn. So action equals reaction exactly and the net contact force
+// on the course vanishes (a plain two-pass point-to-curve law does not balance: the normals from
+// the two sides of curved yarns differ, which left a net force as large as the yarn force). Broad
+// phase: the copies (course j, copy k along it; |j|, |k| <= kMaxCopy) whose whole-yarn box (the
+// control polygon's, convex-hull property), inflated, meets the yarn's; on them the boxes of the
+// elements, inflated by d + margin; the closest point is searched on every candidate element and
+// kept if it is a true stationary point. A state in which a copy at |j| or |k| = kMaxCopy could
+// touch the yarn is refused by the guard (lattice_refusal). Collocated line load (choice): the
+// contact line load f(xi) evaluated at the Gauss points is projected on the collocation rows,
+// nbar_j = (1/W_j) sum_g w_g |r0_xi| N_j(xi_g) f(xi_g) with the tributary lengths W_j = int N_j ds.
+// By the partition of unity sum_j W_j nbar_j = int f ds, so the total contact force is integrated,
+// not sampled at the few collocation points (sampling them made the net force on the course, which
+// must vanish, as large as the yarn force). The same for the friction moment. The end points'
+// balance rows carry the periodicity: loads on them are dropped (the seam is the head top, free of
+// contact). Stress-free reference (issue 11; choice, ContactOptions::reference): the closed-form
+// loops start with overlaps of up to 0.16 mm, so with the plain law the unloaded cell carries
+// contact forces and a residual stress. With Reference::kInitialOverlap, capture_reference()
+// records at the reference state every overlapping pair (slave point, course, master parameter u_r,
+// gap g_r < 0); its line load is then p(g) - p(g_r) while g <= g_r and 0 when it opens (g > g_r):
 // the reference overlap is the stress-free flattening of the yarn sections, so the unloaded
 // cell is in equilibrium with zero force in every pair and zero stress. The stiffness of a
 // pressed pair is the plain law's dp/dg at the same geometric gap. A found pair takes the
@@ -77,8 +80,8 @@ struct ContactOptions {
 struct ActivePair {
   int point = 0;   ///< slave (Gauss) point
   double xi = 0;   ///< its parameter
-  int course = 0;  ///< -1, 0, +1
-  int k = 0;       ///< the master's copy along the course: -1, 0, +1 (its period F* (w, 0, 0))
+  int course = 0;  ///< the master's course j (|j| <= ContactSet::kMaxCopy)
+  int k = 0;       ///< the master's copy along the course (its period F* (w, 0, 0))
   double u = 0, gap = 0, p = 0, f_T = 0;
   bool slip = false;
   Eigen::Vector3d f = Eigen::Vector3d::Zero();  ///< line load on the slave [N/mm]
@@ -126,6 +129,9 @@ class ContactSet : public rod::ExternalContribution {
   /// Pairs farther apart at the last commit are not watched (a step that moves a yarn through
   /// another from farther away is not caught).
   static constexpr double kWatchRadius = 2.0;  ///< in yarn diameters (choice)
+  /// The farthest course and copy along a course searched (a lattice compressed or sheared so
+  /// far that one of them could touch the yarn is refused: guard_refusal).
+  static constexpr int kMaxCopy = 6;
   struct Side {
     int point = 0, course = 0, k = 0;
     double u = 0;
@@ -139,8 +145,9 @@ class ContactSet : public rod::ExternalContribution {
   /// The deepest pass-through of the converged state x against the last commit, or nullopt.
   std::optional<PassThrough> pass_through(const rod::RodSystem& sys,
                                           const Eigen::VectorXd& x) const;
-  /// Why the converged state x is refused by the guard (a pass-through, or a pair overlapping
-  /// more than ContactOptions::max_overlap d), or an empty string.
+  /// Why the converged state x is refused by the guard (a pass-through, a pair overlapping
+  /// more than ContactOptions::max_overlap d, or a copy beyond kMaxCopy within reach), or an
+  /// empty string.
   std::string guard_refusal(const rod::RodSystem& sys, const Eigen::VectorXd& x);
   int num_watched_pairs() const { return static_cast<int>(sides_.size()); }
 
@@ -176,6 +183,11 @@ class ContactSet : public rod::ExternalContribution {
   };
   /// Pairs within `inflate` of each other (d + margin for the contact loads).
   std::vector<Found> search(const Eigen::MatrixXd& Q, double inflate) const;
+  /// The copies (course j, copy k along it) whose whole-yarn box, inflated by `inflate`, meets
+  /// the yarn's, |j|, |k| <= kMaxCopy; `edge` is set when one of them has |j| or |k| = kMaxCopy.
+  std::vector<Eigen::Vector2i> copies(const Eigen::MatrixXd& Q, double inflate, bool& edge) const;
+  /// The slot of (slave point, course) in history_, pending_ and reference_.
+  static int slot(int point, int course) { return (2 * kMaxCopy + 1) * point + course + kMaxCopy; }
   /// search(Q) at the current periods, remembered for the last (Q, a1, a2): a converged state
   /// is searched by the Newton's last residual, commit() (twice) and homogenization
   /// (active_pairs()); the search is a pure function of them, so the result is reused.
@@ -203,9 +215,9 @@ class ContactSet : public rod::ExternalContribution {
   std::vector<double> W_;       // tributary lengths of the collocation points
   Eigen::Vector3d a1_ = Eigen::Vector3d::Zero(), a2_ = Eigen::Vector3d::Zero();
   double scale_ = 1.0;
-  // history_[slave*3 + course+1]: anchors of the last converged state; pending_: new in step
+  // history_[slot(slave, course)]: anchors of the last converged state; pending_: new in step
   std::vector<std::vector<double>> history_, pending_;
-  // reference_[slave*3 + course+1]: (u_r, g_r) of the stress-free reference pairs
+  // reference_[slot(slave, course)]: (u_r, g_r) of the stress-free reference pairs
   std::vector<std::vector<Eigen::Vector2d>> reference_;
   double dissipation_ = 0, last_dissipation_ = 0;
   std::vector<Side> sides_;  // of the last committed state (pass-through guard)
