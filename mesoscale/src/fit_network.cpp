@@ -39,8 +39,10 @@
 #include <cstdio>
 #include <mutex>
 #include <random>
+#include <string>
 #include <system_error>
 #include <thread>
+#include <utility>
 
 #include "fit_energy_data.hpp"
 #include "knit/material/convex_network.hpp"
@@ -254,23 +256,24 @@ std::vector<double> initial_phi(const NetworkShape& sh, int seed) {
 }
 
 /// One line of progress every `every` seconds of L-BFGS (EnergyFitOptions::progress): the
-/// iteration, the objective and the time so far.
+/// iteration, the objective and the time so far; `what` is put before "L-BFGS" (which start).
 class ProgressLines : public ceres::IterationCallback {
  public:
-  ProgressLines(std::FILE* out, int iterations, double every)
+  ProgressLines(std::FILE* out, int iterations, double every, std::string what = {})
       : out_(out),
         iterations_(iterations),
         every_(every),
+        what_(std::move(what)),
         start_(std::chrono::steady_clock::now()),
         last_(start_) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     const auto now = std::chrono::steady_clock::now();
     if (out_ && std::chrono::duration<double>(now - last_).count() >= every_) {
       last_ = now;
-      std::fprintf(out_,
-                   "energy fit: L-BFGS iteration %d of %d (%.0f %%), objective %.6g, %.0f s\n",
-                   s.iteration, iterations_, 100.0 * s.iteration / std::max(1, iterations_), s.cost,
-                   std::chrono::duration<double>(now - start_).count());
+      std::fprintf(
+          out_, "energy fit: %sL-BFGS iteration %d of %d (%.0f %%), objective %.6g, %.0f s\n",
+          what_.c_str(), s.iteration, iterations_, 100.0 * s.iteration / std::max(1, iterations_),
+          s.cost, std::chrono::duration<double>(now - start_).count());
       std::fflush(out_);
     }
     return ceres::SOLVER_CONTINUE;
@@ -280,6 +283,7 @@ class ProgressLines : public ceres::IterationCallback {
   std::FILE* out_;
   int iterations_;
   double every_;
+  std::string what_;
   std::chrono::steady_clock::time_point start_, last_;
 };
 
@@ -385,7 +389,12 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
                                o.tube > 0.0 ? o.tube_weight : 0.0, start_threads);
       ceres::GradientProblem problem(objective);  // takes ownership
       ceres::GradientProblemSolver::Options start_options = so;
-      ProgressLines progress(o.progress, o.network_iterations, o.progress_seconds);
+      ProgressLines progress(o.progress, o.network_iterations, o.progress_seconds,
+                             o.starts > 1 ? "start " + std::to_string(s + 1) + " of " +
+                                                std::to_string(o.starts) +
+                                                " (the others beside "
+                                                "it), "
+                                          : std::string());
       if (o.progress && lines) start_options.callbacks.push_back(&progress);
       const std::vector<double> phi0 = initial_phi(sh, seed);
       r.phi.assign(static_cast<std::size_t>(n * P), 0.0);
@@ -414,12 +423,19 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
     // As many starts side by side as there are threads; more threads than starts go to the
     // starts' loop lengths.
     const int workers = std::min(threads, o.starts), per_start = std::max(1, threads / workers);
+    // Start 0 (the first taken) reports its L-BFGS progress as a single start does.
     std::atomic<int> next{0};
+    const auto work = [&] {
+      for (int s = next++; s < o.starts; s = next++) run_start(s, per_start, s == 0);
+    };
     std::vector<std::thread> pool;
-    for (int k = 0; k < workers; ++k)
-      pool.emplace_back([&] {
-        for (int s = next++; s < o.starts; s = next++) run_start(s, per_start, false);
-      });
+    try {
+      for (int k = 1; k < workers; ++k) pool.emplace_back(work);
+    } catch (const std::system_error&) {
+      // No more threads to be had: the ones started (and this one) run every start, with the
+      // same result.
+    }
+    work();
     for (std::thread& th : pool) th.join();
   }
   int kept = -1;

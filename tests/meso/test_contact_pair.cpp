@@ -477,7 +477,7 @@ TEST_CASE("closest point: from a start where the curve bends away, the projectio
 
 // Session 57's red team: only the courses -1, 0, +1 were searched, so under wale compression
 // and large shear the courses +-2 passed through the yarn with no force (4.5 mm, the paper's
-// 40 deg shear path: S12 1.62 MPa where 2.64 with them). Straight yarns c apart: with 2 c < d
+// 40 deg shear path: S12 1.59 MPa where 2.60 with them). Straight yarns c apart: with 2 c < d
 // the courses +-2 press on the yarn as well as +-1, each pair at its own gap, and the forces
 // balance; a lattice so dense that a course kMaxCopy periods away is within reach is refused.
 TEST_CASE("contact set: every course within reach is searched, a denser lattice is refused",

@@ -208,7 +208,7 @@ TEST_CASE("energy fit: the network fit gives the same law for every thread count
 // the seed with the smallest final objective was the one within 5 % (docs/law-experiments.md,
 // "Multi-start"). starts = K runs the fit from seeds seed ... seed + K - 1 and keeps the start
 // of least objective: the same law, to the last bit, as a single fit from that seed, for every
-// thread count (starts side by side, one thread each), with every start's iterations counted.
+// thread count (starts side by side, threads / starts each), with every start's iterations counted.
 TEST_CASE("energy fit: multi-start keeps the start of least objective", "[unit]") {
   const Database db = synthetic_coverage_db({4.5, 5.5, 6.5}, 6);
   EnergyFitOptions o = small_network(4, 3, 150);

@@ -153,7 +153,7 @@ inline constexpr int kStitchCrossings = 4;
 inline constexpr int kInterlockChords = 300;  ///< polyline of the count (1200 for positions)
 std::optional<std::string> interlock_defect(const LoopShape& shape, double c);
 
-/// Minimum distance between the cell's centerline and its periodic images (i w, j c), |i|,|j| <= 1
+/// Minimum distance between the cell's centerline and its periodic images (i w, j c), |i|,|j| <= 2
 /// (for j = 0 only parts of the yarn more than 0.3 apart in s count), on the closed form.
 struct Clearance {
   double min_distance = 0;  ///< centerline to centerline (mm)

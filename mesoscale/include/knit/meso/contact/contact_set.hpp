@@ -6,7 +6,7 @@
 // the masters are the yarn's courses j_c as periodic chains (contact/pair.hpp), shifted by
 // j_c F*(0, c): every course and copy along it whose box can reach the yarn's (session 57's red
 // team: with courses -1, 0, +1 alone, the courses +-2 went through the yarn unopposed under wale
-// compression and large shear; 4.5 mm, the paper's 40 deg shear path: S12 1.62 MPa for 2.64). For
+// compression and large shear; 4.5 mm, the paper's 40 deg shear path: S12 1.59 MPa for 2.60). For
 // the own course (j_c = 0) the part of the yarn within `self_exclusion` of xi_j in the loop
 // parameter is not a contact partner. The mirror pair (the image's point against the cell's yarn)
 // is the same contact seen from the other side. Each pass applies half the load: +f/2 at the slave
@@ -18,7 +18,7 @@
 // control polygon's, convex-hull property), inflated, meets the yarn's; on them the boxes of the
 // elements, inflated by d + margin; the closest point is searched on every candidate element and
 // kept if it is a true stationary point. A state in which a copy at |j| or |k| = kMaxCopy could
-// touch the yarn is refused by the guard (lattice_refusal). Collocated line load (choice): the
+// touch the yarn is refused by the guard (guard_refusal). Collocated line load (choice): the
 // contact line load f(xi) evaluated at the Gauss points is projected on the collocation rows,
 // nbar_j = (1/W_j) sum_g w_g |r0_xi| N_j(xi_g) f(xi_g) with the tributary lengths W_j = int N_j ds.
 // By the partition of unity sum_j W_j nbar_j = int f ds, so the total contact force is integrated,

@@ -147,13 +147,15 @@ struct EnergyFitOptions {
   /// where the cell is stable). Held-out paths are judged on every converged state. A value
   /// below -1 keeps every state.
   double stable_min_cos = 0.0;
-  /// Network family: worker threads of the fit (0: all cores; at most one per loop length).
+  /// Network family: worker threads of the fit (0: all cores; one start uses at most one per
+  /// loop length; with `starts` > 1 the starts run side by side, threads / starts each).
   /// Not a property of the law: every count gives the same law to the last bit
   /// (mesoscale/src/fit_network.cpp), so it is not in to_json() / from_json().
   int threads = 0;
   /// Network family: where the fit says how far it is, one line every progress_seconds of
   /// L-BFGS (nullptr: silent; session 44's red team: a fit of 45 s said nothing, the sweep's bar
-  /// stood at 100 % meanwhile). Not properties of the law, not in to_json().
+  /// stood at 100 % meanwhile; with `starts` > 1 the first start reports, and each start's end
+  /// is a line). Not properties of the law, not in to_json().
   std::FILE* progress = nullptr;
   double progress_seconds = 5.0;
 
