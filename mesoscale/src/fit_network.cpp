@@ -53,6 +53,25 @@ namespace {
 
 using material::NetworkShape;
 
+/// Runs `item(i)` for i = 0 .. count - 1 on up to `threads` threads (this one included), each
+/// thread taking the next item in turn. A thread that cannot be created leaves its items to the
+/// others; what an item computes does not depend on which thread runs it.
+template <class Item>
+void for_each_on_threads(int count, int threads, const Item& item) {
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int i = next++; i < count; i = next++) item(i);
+  };
+  std::vector<std::thread> pool;
+  try {
+    for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
+  } catch (const std::system_error&) {
+    // No more threads to be had: the ones started (and this one) do every item.
+  }
+  work();
+  for (std::thread& t : pool) t.join();
+}
+
 /// theta of all n knots from phi (squares where nonnegative).
 void phi_to_theta(const NetworkShape& sh, int n, const double* phi, double* theta) {
   const int P = sh.size();
@@ -168,19 +187,7 @@ class NetworkObjective : public ceres::FirstOrderFunction {
     if (threads_ == 1) {
       for (int j = 0; j < n_; ++j) knot_terms(j);
     } else {
-      std::atomic<int> next{0};
-      const auto work = [&] {
-        for (int j = next++; j < n_; j = next++) knot_terms(j);
-      };
-      std::vector<std::thread> pool;
-      try {
-        for (int t = 1; t < threads_; ++t) pool.emplace_back(work);
-      } catch (const std::system_error&) {
-        // No more threads to be had: the ones started (and this one) do all the knots, with
-        // the same result (see the file comment).
-      }
-      work();
-      for (std::thread& t : pool) t.join();
+      for_each_on_threads(n_, threads_, knot_terms);  // the same result (the file comment)
     }
     for (double v : terms_) f += v;  // the serial order: point by point, term by term
     if (grad) {
@@ -424,19 +431,7 @@ std::string fit_network(material::EnergyLawData& law, const std::vector<double>&
     // starts' loop lengths.
     const int workers = std::min(threads, o.starts), per_start = std::max(1, threads / workers);
     // Start 0 (the first taken) reports its L-BFGS progress as a single start does.
-    std::atomic<int> next{0};
-    const auto work = [&] {
-      for (int s = next++; s < o.starts; s = next++) run_start(s, per_start, s == 0);
-    };
-    std::vector<std::thread> pool;
-    try {
-      for (int k = 1; k < workers; ++k) pool.emplace_back(work);
-    } catch (const std::system_error&) {
-      // No more threads to be had: the ones started (and this one) run every start, with the
-      // same result.
-    }
-    work();
-    for (std::thread& th : pool) th.join();
+    for_each_on_threads(o.starts, workers, [&](int s) { run_start(s, per_start, s == 0); });
   }
   int kept = -1;
   for (int s = 0; s < o.starts; ++s) {
