@@ -152,6 +152,7 @@ std::optional<CellOptionError> CellOptions::validate() const {
       {"/solver/max_iterations", double(newton.max_iterations), 1, kMaxIterations, false, false},
       {"/solver/equilibration_steps", double(equilibration_steps), 1, kMaxIterations, false, false},
       {"/solver/max_cutbacks", double(max_cutbacks), 0, kMaxCutbacks, false, false},
+      {"/solver/max_substeps", double(max_substeps), 1, kMaxSubsteps, false, false},
   });
 }
 
@@ -228,13 +229,16 @@ CellOptions cell_options_from_json(const json& j, const std::string& file,
   }
   if (j.contains("solver")) {
     const json& s = j["solver"];
-    R.object(s, "/solver", {"tolerance", "max_iterations", "equilibration_steps", "max_cutbacks"});
+    R.object(
+        s, "/solver",
+        {"tolerance", "max_iterations", "equilibration_steps", "max_cutbacks", "max_substeps"});
     R.num(s, "/solver", "tolerance", o.newton.tol, 0, 0.01, true);
     R.integer(s, "/solver", "max_iterations", o.newton.max_iterations, 1,
               CellOptions::kMaxIterations);
     R.integer(s, "/solver", "equilibration_steps", o.equilibration_steps, 1,
               CellOptions::kMaxIterations);
     R.integer(s, "/solver", "max_cutbacks", o.max_cutbacks, 0, CellOptions::kMaxCutbacks);
+    R.integer(s, "/solver", "max_substeps", o.max_substeps, 1, CellOptions::kMaxSubsteps);
   }
   if (const auto bad = o.validate()) R.fail(bad->pointer, bad->message);
   return o;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "knit/meso/homog/substeps.hpp"
 #include "knit/meso/rod/quaternion.hpp"
 #include "knit/spline/quadrature.hpp"
 
@@ -179,40 +180,36 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
   const auto t0 = std::chrono::steady_clock::now();
   StepResult res;
   const Matrix2d Fa = F_;
-  double lam = 0, inc = 1;
-  int halvings = 0;
-  while (lam < 1 - 1e-14) {
-    const double next = std::min(1.0, lam + inc);
-    const Matrix2d Fn = (next >= 1.0) ? F : Matrix2d(Fa + next * (F - Fa));
-    if (try_solve(Fn, res)) {
-      lam = next;
-      halvings = 0;
-    } else {
-      ++res.cutbacks;
-      if (++halvings > opt_.max_cutbacks) break;
-      inc *= 0.5;
-      // A limit point: each success resets `halvings`, so sub-steps that shrink towards a
-      // load fraction the cell cannot pass never exhaust max_cutbacks; once lam + inc == lam
-      // the same state "converges" for ever (session 12: course compression with shear, 4.5
-      // mm, stuck at 0.94117191743... of a step). Below kMinSubstep of the step: not converged.
-      if (inc < kMinSubstep) {
-        // The last attempt's reason stays in the message (a Newton failure, or the
-        // pass-through guard's refusal).
-        res.message =
-            "sub-steps below " + std::to_string(kMinSubstep) + " of the step, stuck at " +
-            std::to_string(lam) + " of the way from the step's start to its end" +
-            (last_refused_
-                 ? ": the last converged sub-step was refused by the pass-through guard: "
-                 : " (a limit point: the cell does not pass this strain); last attempt: ") +
-            res.message;
-        break;
-      }
-    }
-  }
+  SubstepLimits lim;
+  lim.max_cutbacks = opt_.max_cutbacks;
+  lim.max_substeps = opt_.max_substeps;
+  lim.min_substep = kMinSubstep;
+  const SubstepOutcome m = march_substeps(lim, [&](double next) {
+    return try_solve((next >= 1.0) ? F : Matrix2d(Fa + next * (F - Fa)), res);
+  });
+  const double lam = m.lam;
+  res.cutbacks = m.cutbacks;
+  res.substeps = m.substeps;
+  if (m.stop == SubstepOutcome::Stop::kMinSubstep)
+    // The last attempt's reason stays in the message (a Newton failure, or the pass-through
+    // guard's refusal).
+    res.message =
+        "sub-steps below " + std::to_string(kMinSubstep) + " of the step, stuck at " +
+        std::to_string(lam) + " of the way from the step's start to its end" +
+        (last_refused_ ? ": the last converged sub-step was refused by the pass-through guard: "
+                       : " (a limit point: the cell does not pass this strain); last attempt: ") +
+        res.message;
+  else if (m.stop == SubstepOutcome::Stop::kMaxSubsteps)
+    res.message = "more than max_substeps = " + std::to_string(opt_.max_substeps) +
+                  " sub-steps in one step (stopped at " + std::to_string(lam) +
+                  " of the way from the step's start to its end; /solver/max_substeps of the "
+                  "cell parameters); last attempt: " +
+                  res.message;
   StepResult h = homogenize(F_);
   h.converged = lam >= 1 - 1e-14;
   h.iterations = res.iterations;
   h.cutbacks = res.cutbacks;
+  h.substeps = res.substeps;
   h.pass_throughs = res.pass_throughs;
   h.message = res.message;
   h.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

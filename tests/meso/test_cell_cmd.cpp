@@ -285,15 +285,17 @@ TEST_CASE("knit-meso path: a step that does not converge is reported on stderr",
   const std::string out = std::string(KNIT_BINARY_DIR) + "/test_cell_cmd_diverges";
   fs::remove_all(out);
   const std::string err = out + "_stderr.txt";
-  // Biaxial compression to 10 % of each length: steps 1 and 2 (to 77.5 and 55 %) converge,
-  // step 3 (to 32.5 %) is cut back to the pass-through guard's bound (the yarns sink 0.8 d into
-  // each other at 0.99 of the way). Session 35: before, a stick penalty of 1e308 MPa that
-  // overflowed exactly at step 2, a round-off accident rather than mechanics. Session 57: 2
-  // steps until the courses +-2 were searched (the yarns then passed through them; now the
-  // first step to 55 % stops at 0.70 of the way, and 3 steps stop at a limit point after 8 s,
-  // more than a minute under ASan). 12 elements: the default 32 behave alike in 4 x the time.
+  // Biaxial compression to 10 % of each length in 5 steps: steps 1-3 (to 82, 64 and 46 %)
+  // converge, step 4 (to 28 %) is cut back to the pass-through guard's bound (the yarns sink
+  // 0.8 d into each other at 0.31 of the way; 1.5 s). Until session 58 (a sub-step that grows
+  // back after a cut-back) 4 steps, whose step 3 now ends at a limit point after 5 s. Session 35:
+  // before, a stick penalty of 1e308 MPa that overflowed exactly at step 2, a round-off accident
+  // rather than mechanics. Session 57: 2 steps until the courses +-2 were searched (the yarns then
+  // passed through them; now the first step to 55 % stops at 0.70 of the way, and 3 steps stop at a
+  // limit point after 8 s, more than a minute under ASan). 12 elements: the default 32 behave alike
+  // in 4 x the time.
   const std::string cmd = "timeout 60 " + std::string(KNIT_BIN_DIR) +
-                          "/knit-meso path --loop-length 5 --biaxial -0.9 -0.9 --steps 4 "
+                          "/knit-meso path --loop-length 5 --biaxial -0.9 -0.9 --steps 5 "
                           "--elements 12 --no-vtp --out " +
                           out + " > /dev/null 2> " + err;
   const int rc = std::system(cmd.c_str());
@@ -303,7 +305,7 @@ TEST_CASE("knit-meso path: a step that does not converge is reported on stderr",
   std::stringstream ss;
   ss << in.rdbuf();
   INFO(ss.str());
-  CHECK(ss.str().find("knit-meso path: step 3 did not converge") != std::string::npos);
+  CHECK(ss.str().find("knit-meso path: step 4 did not converge") != std::string::npos);
   CHECK(ss.str().find("refused by the pass-through guard") != std::string::npos);
   CHECK(ss.str().find("kept in " + out) != std::string::npos);
   CHECK(fs::exists(fs::path(out) / "path.csv"));  // the converged step is kept

@@ -7,6 +7,7 @@
 
 #include "knit/core/errors.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
+#include "knit/meso/homog/substeps.hpp"
 #include "knit/meso/homog/uniaxial.hpp"
 #include "knit/meso/sweep/sweep.hpp"
 
@@ -76,6 +77,63 @@ TEST_CASE("cell step: max_cutbacks counts the halvings in a row, not all of a st
   const homog::StepResult none = step(0);
   CHECK_FALSE(none.converged);
   CHECK(none.cutbacks == 1);
+}
+
+TEST_CASE("sub-step schedule: grows back after a hard stretch, stops at max_substeps", "[unit]") {
+  // A stand-in for the cell: sub-steps that end inside (0.1, 0.1 + 1e-3] converge only when
+  // shorter than 1e-3 (one hard stretch); everything else converges. Before session 58 the
+  // halved sub-step never grew again and the rest of the step went at ~1/1024: ~900 sub-steps
+  // (a held-out twin path at 6.5 mm ran > 16 min in one cell step).
+  double lam = 0;
+  auto attempt = [&](double next) {
+    const bool ok = !(next > 0.1 && next <= 0.1 + 1e-3 && next - lam > 1e-3) &&
+                    !(lam < 0.1 && next > 0.1 + 1e-3);
+    if (ok) lam = next;
+    return ok;
+  };
+  homog::SubstepLimits lim;
+  lim.max_cutbacks = 30;
+  const homog::SubstepOutcome m = homog::march_substeps(lim, attempt);
+  INFO(m.substeps << " sub-steps, " << m.cutbacks << " cut-backs");
+  CHECK(m.stop == homog::SubstepOutcome::Stop::kDone);
+  CHECK(m.lam == 1.0);
+  CHECK(m.cutbacks >= 10);  // 2^-10 < 1e-3
+  CHECK(m.substeps <= 80);  // without the growth: > 900
+  // The cap: one sub-step fewer ends the step where it stands, not converged.
+  lam = 0;
+  lim.max_substeps = m.substeps - 1;
+  const homog::SubstepOutcome c = homog::march_substeps(lim, attempt);
+  CHECK(c.stop == homog::SubstepOutcome::Stop::kMaxSubsteps);
+  CHECK(c.substeps == m.substeps - 1);
+  CHECK(c.lam < 1.0);
+  // Halvings in a row past max_cutbacks end it; a sub-step below min_substep too.
+  lam = 0;
+  lim = {};
+  lim.max_cutbacks = 3;
+  CHECK(homog::march_substeps(lim, attempt).stop == homog::SubstepOutcome::Stop::kCutbacks);
+  lam = 0;
+  lim.max_cutbacks = 30;
+  lim.min_substep = 1e-2;
+  CHECK(homog::march_substeps(lim, attempt).stop == homog::SubstepOutcome::Stop::kMinSubstep);
+}
+
+TEST_CASE("cell step: max_substeps ends a step that needs more, and says so", "[unit]") {
+  homog::CellOptions co = fast_options();
+  const Eigen::Matrix2d F = Eigen::Vector2d(1.8, 1.0).asDiagonal();
+  auto step = [&](int max_substeps) {
+    co.max_substeps = max_substeps;
+    homog::PeriodicCell cell(4.5, co);
+    REQUIRE(cell.equilibrate().converged);
+    return cell.solve(F);
+  };
+  const homog::StepResult r = step(homog::CellOptions{}.max_substeps);
+  INFO(r.message << "; " << r.cutbacks << " cut-backs, " << r.substeps << " sub-steps");
+  REQUIRE(r.converged);
+  REQUIRE(r.substeps >= 3);
+  const homog::StepResult cut = step(r.substeps - 1);
+  CHECK_FALSE(cut.converged);
+  CHECK(cut.substeps == r.substeps - 1);
+  CHECK(cut.message.find("max_substeps") != std::string::npos);
 }
 
 TEST_CASE("uniaxial path: the lateral stress vanishes at every converged step", "[unit]") {

@@ -115,7 +115,8 @@ TEST_CASE("cell config: the integer fields have upper bounds, named by pointer",
                           {"analysis", "slave_points_per_element", CellOptions::kMaxSlavePoints},
                           {"solver", "max_iterations", CellOptions::kMaxIterations},
                           {"solver", "equilibration_steps", CellOptions::kMaxIterations},
-                          {"solver", "max_cutbacks", CellOptions::kMaxCutbacks}};
+                          {"solver", "max_cutbacks", CellOptions::kMaxCutbacks},
+                          {"solver", "max_substeps", CellOptions::kMaxSubsteps}};
   for (const Bound& b : bounds) {
     const std::string ptr = std::string("/") + b.section + "/" + b.key;
     auto text = [&](long long v) {

@@ -69,6 +69,10 @@ struct CellOptions {
   }();
   int equilibration_steps = 4;
   int max_cutbacks = 6;
+  /// Sub-steps (converged or not) of one step before the step ends as not converged
+  /// (PeriodicCell::solve; /solver/max_substeps). A failed sub-step halves the next, two
+  /// converged ones in a row double it up to the full step.
+  int max_substeps = 500;
 
   /// Upper bounds of the integer fields (schemas/cell.schema.json "maximum"; session 21: a
   /// value of 123456789 ended in std::bad_alloc or ran for minutes). Far above what the
@@ -76,8 +80,9 @@ struct CellOptions {
   static constexpr int kMaxElements = 1024;
   static constexpr int kMaxDegree = 8;
   static constexpr int kMaxSlavePoints = 16;
-  static constexpr int kMaxIterations = 1000;  ///< max_iterations and equilibration_steps
-  static constexpr int kMaxCutbacks = 30;      ///< 2^-30 of a step
+  static constexpr int kMaxIterations = 1000;   ///< max_iterations and equilibration_steps
+  static constexpr int kMaxCutbacks = 30;       ///< 2^-30 of a step
+  static constexpr int kMaxSubsteps = 1000000;  ///< max_substeps
 
   /// Range of the normal contact penalty k_N (MPa; schemas/cell.schema.json "penalty",
   /// `knit-meso path --penalty`): a factor 10 beyond the range calibrated in docs/unit-cell.md
@@ -129,6 +134,7 @@ struct StepResult {
   Eigen::Vector3d n1 = Eigen::Vector3d::Zero(), n2 = Eigen::Vector3d::Zero();
   int iterations = 0;  ///< Newton iterations (all increments of the step)
   int cutbacks = 0;
+  int substeps = 0;       ///< attempted sub-steps (converged or cut back) of the step
   int pass_throughs = 0;  ///< of the cut-backs: converged increments whose yarns went through
                           ///< (or sank max_overlap d into) each other (contact_set.hpp)
   double seconds = 0;
