@@ -9,9 +9,9 @@
 namespace knit::meso::homog {
 
 struct SubstepLimits {
-  int max_cutbacks = 6;        ///< failed sub-steps in a row before the step ends
-  int max_substeps = 500;      ///< sub-steps (converged or not) of the step
-  double min_substep = 1e-6;   ///< a sub-step below this fraction of the step ends it
+  int max_cutbacks = 6;       ///< failed sub-steps in a row before the step ends
+  int max_substeps = 500;     ///< sub-steps (converged or not) of the step
+  double min_substep = 1e-6;  ///< a sub-step below this fraction of the step ends it
 };
 
 struct SubstepOutcome {
