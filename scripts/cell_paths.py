@@ -141,8 +141,9 @@ def stored_sweep_input(db, path):
 def run_sweep(knit_meso, sweep, work, name, threads, what):
     """Writes `sweep` (a dict) to WORK/NAME.json (WORK: a new kept temporary directory when
     None), runs `knit-meso sweep` on it into WORK/NAME.h5 and returns that path; `what` says
-    what is run, in the line printed before. The sweep's progress lines go to stderr (session
-    58: a twin sweep of 545 cases ran eight minutes without a word, one of its cases hung)."""
+    what is run, in the line printed before. The sweep's output (its progress lines and its
+    closing summary) goes to stderr, the caller's stdout staying the script's own report
+    (session 58: a twin sweep of 545 cases ran eight minutes without a word)."""
     import json
     import os
     import subprocess

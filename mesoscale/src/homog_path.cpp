@@ -62,7 +62,7 @@ std::string csv_header() {
   // dimensionless; session 38's red team: P and S had no unit).
   return "step,lambda,F11,F12,F21,F22,P11_MPa,P12_MPa,P21_MPa,P22_MPa,E11,E22,E12,S11_MPa,"
          "S22_MPa,S12_MPa,S21_MPa,"
-         "newton_iterations,cutbacks,seconds,active_contacts,min_gap_mm,dissipation_Nmm,"
+         "newton_iterations,cutbacks,substeps,seconds,active_contacts,min_gap_mm,dissipation_Nmm,"
          "imbalance_N\n";
 }
 
@@ -70,11 +70,11 @@ std::string csv_row(int step, double lambda, const StepResult& r) {
   char buf[1024];
   std::snprintf(buf, sizeof buf,
                 "%d,%.6g,%.12g,%.12g,%.12g,%.12g,%.10g,%.10g,%.10g,%.10g,%.12g,%.12g,%.12g,"
-                "%.10g,%.10g,%.10g,%.10g,%d,%d,%.4f,%d,%.6g,%.6g,%.3g\n",
+                "%.10g,%.10g,%.10g,%.10g,%d,%d,%d,%.4f,%d,%.6g,%.6g,%.3g\n",
                 step, lambda, r.F(0, 0), r.F(0, 1), r.F(1, 0), r.F(1, 1), r.P(0, 0), r.P(0, 1),
                 r.P(1, 0), r.P(1, 1), r.E(0, 0), r.E(1, 1), r.E(0, 1), r.S(0, 0), r.S(1, 1),
-                r.S(0, 1), r.S(1, 0), r.iterations, r.cutbacks, r.seconds, r.active_contacts,
-                r.min_gap, r.dissipation, r.imbalance);
+                r.S(0, 1), r.S(1, 0), r.iterations, r.cutbacks, r.substeps, r.seconds,
+                r.active_contacts, r.min_gap, r.dissipation, r.imbalance);
   return buf;
 }
 

@@ -184,8 +184,11 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
   lim.max_cutbacks = opt_.max_cutbacks;
   lim.max_substeps = opt_.max_substeps;
   lim.min_substep = kMinSubstep;
+  std::string last_failure;  // a converged attempt's message says nothing of why a step ended
   const SubstepOutcome m = march_substeps(lim, [&](double next) {
-    return try_solve((next >= 1.0) ? F : Matrix2d(Fa + next * (F - Fa)), res);
+    const bool ok = try_solve((next >= 1.0) ? F : Matrix2d(Fa + next * (F - Fa)), res);
+    if (!ok) last_failure = res.message;
+    return ok;
   });
   const double lam = m.lam;
   res.cutbacks = m.cutbacks;
@@ -203,8 +206,8 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
     res.message = "more than max_substeps = " + std::to_string(opt_.max_substeps) +
                   " sub-steps in one step (stopped at " + std::to_string(lam) +
                   " of the way from the step's start to its end; /solver/max_substeps of the "
-                  "cell parameters); last attempt: " +
-                  res.message;
+                  "cell parameters)" +
+                  (last_failure.empty() ? std::string() : "; last failure: " + last_failure);
   StepResult h = homogenize(F_);
   h.converged = lam >= 1 - 1e-14;
   h.iterations = res.iterations;

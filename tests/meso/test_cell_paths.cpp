@@ -4,6 +4,9 @@
 // E computed from F) through the sweep's cell runner.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <iterator>
+#include <utility>
+#include <vector>
 
 #include "knit/core/errors.hpp"
 #include "knit/meso/homog/periodic_cell.hpp"
@@ -106,6 +109,27 @@ TEST_CASE("sub-step schedule: grows back after a hard stretch, stops at max_subs
   CHECK(c.stop == homog::SubstepOutcome::Stop::kMaxSubsteps);
   CHECK(c.substeps == m.substeps - 1);
   CHECK(c.lam < 1.0);
+  // A failure after the sub-step has grown past the rest of the step halves the sub-step
+  // tried: halving a grown `inc` instead retried the clipped last sub-step (0.875 -> 1 twice,
+  // session 58's review). Attempts fail or converge in a given order (then converge).
+  {
+    const bool order[] = {false, false, true, false, false, true, true, true, true, true, false};
+    std::vector<std::pair<double, double>> tries;
+    double at = 0;
+    auto scripted = [&](double next) {
+      const std::size_t k = tries.size();
+      tries.emplace_back(at, next);
+      const bool ok = k >= std::size(order) || order[k];
+      if (ok) at = next;
+      return ok;
+    };
+    const homog::SubstepOutcome g = homog::march_substeps(homog::SubstepLimits{}, scripted);
+    CHECK(g.stop == homog::SubstepOutcome::Stop::kDone);
+    REQUIRE(tries.size() == 13);
+    CHECK(tries[10] == std::make_pair(0.875, 1.0));  // grown to 0.25, clipped to 0.125: fails
+    CHECK(tries[11] == std::make_pair(0.875, 0.9375));
+    for (std::size_t k = 1; k < tries.size(); ++k) CHECK(tries[k] != tries[k - 1]);
+  }
   // Halvings in a row past max_cutbacks end it; a sub-step below min_substep too.
   lam = 0;
   lim = {};

@@ -4,12 +4,11 @@
 #pragma once
 
 #include <algorithm>
-#include <string>
 
 namespace knit::meso::homog {
 
 struct SubstepLimits {
-  int max_cutbacks = 6;       ///< failed sub-steps in a row before the step ends
+  int max_cutbacks = 6;       ///< halvings allowed in a row (the next failure ends the step)
   int max_substeps = 500;     ///< sub-steps (converged or not) of the step
   double min_substep = 1e-6;  ///< a sub-step below this fraction of the step ends it
 };
@@ -22,7 +21,8 @@ struct SubstepOutcome {
 };
 
 /// Marches lam from 0 to 1: `attempt(next)` solves the sub-step to the load fraction `next`
-/// (from the last converged one) and says whether it converged. Why the growth: before
+/// (from the last converged one) and says whether it converged; the same sub-step is never
+/// tried twice in a row. Why the growth: before
 /// session 58 a halved sub-step never grew again, so one hard stretch left the rest of the
 /// step at the smallest sub-step reached (a held-out twin path at 6.5 mm ran > 16 min in one
 /// step). Why the cap: a stretch that keeps failing every third sub-step would still crawl.
@@ -54,7 +54,10 @@ SubstepOutcome march_substeps(const SubstepLimits& lim, Attempt&& attempt) {
         out.stop = SubstepOutcome::Stop::kCutbacks;
         return out;
       }
-      inc *= 0.5;
+      // Half the sub-step just tried (as the rod's solve_path does), not half of `inc`: a
+      // grown `inc` can reach past 1, where `next` was clipped, and half of it past 1 again
+      // would retry the same failed sub-step (session 58's review).
+      inc = 0.5 * (next - out.lam);
       if (inc < lim.min_substep) {
         out.stop = SubstepOutcome::Stop::kMinSubstep;
         return out;
