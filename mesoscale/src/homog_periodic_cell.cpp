@@ -202,6 +202,13 @@ StepResult PeriodicCell::solve(const Matrix2d& F) {
         (last_refused_ ? ": the last converged sub-step was refused by the pass-through guard: "
                        : " (a limit point: the cell does not pass this strain); last attempt: ") +
         res.message;
+  else if (m.stop == SubstepOutcome::Stop::kCutbacks)
+    // Said as the other two stops are (session 58's review: the bare Newton message alone).
+    res.message = std::to_string(opt_.max_cutbacks + 1) +
+                  " failed sub-steps in a row, each half the one before (/solver/max_cutbacks = " +
+                  std::to_string(opt_.max_cutbacks) + " of the cell parameters), at " +
+                  std::to_string(lam) +
+                  " of the way from the step's start to its end; last failure: " + last_failure;
   else if (m.stop == SubstepOutcome::Stop::kMaxSubsteps)
     res.message = "more than max_substeps = " + std::to_string(opt_.max_substeps) +
                   " sub-steps in one step (stopped at " + std::to_string(lam) +

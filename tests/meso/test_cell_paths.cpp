@@ -80,6 +80,10 @@ TEST_CASE("cell step: max_cutbacks counts the halvings in a row, not all of a st
   const homog::StepResult none = step(0);
   CHECK_FALSE(none.converged);
   CHECK(none.cutbacks == 1);
+  INFO(none.message);
+  CHECK(none.message.find("1 failed sub-steps in a row") != std::string::npos);
+  CHECK(none.message.find("/solver/max_cutbacks = 0") != std::string::npos);
+  CHECK(none.message.find("last failure: ") != std::string::npos);
 }
 
 TEST_CASE("sub-step schedule: grows back after a hard stretch, stops at max_substeps", "[unit]") {
