@@ -32,6 +32,9 @@ namespace {
 /// load, and in N.
 constexpr double kMaxRelativeTolerance = 1e-2;
 constexpr double kMaxAbsoluteTolerance = 1e-3;
+/// Upper bound of /solver/extra_quadrature_points (the schema's "maximum"): p + 4 points a
+/// direction integrate polynomials of degree 2p + 7 exactly; more only costs memory and time.
+constexpr int kMaxExtraQuadraturePoints = 3;
 
 /// Bounds of lengths relative to the patch's size D, the diagonal of its control net's bounding
 /// box (the surface lies inside that box). A thickness below 1e-4 D makes every internal force
@@ -509,7 +512,8 @@ void read_solver(const Reader& r, const json& root, Case& c) {
   const json& s = root.at("solver");
   r.keys(s, "/solver",
          {"steps", "tolerance", "absolute_tolerance", "max_iterations", "max_cutbacks",
-          "line_search", "line_search_first", "threads", "thickness_integration", "description"});
+          "line_search", "line_search_first", "threads", "thickness_integration",
+          "extra_quadrature_points", "description"});
   SolverOptions& o = c.solver;
   if (s.contains("steps")) o.steps = r.integer(s.at("steps"), "/solver/steps", 1, 100000);
   // Upper bounds (session 21, found by fuzzing: a tolerance of 1e308 accepted every first
@@ -535,6 +539,10 @@ void read_solver(const Reader& r, const json& root, Case& c) {
   if (s.contains("line_search_first"))
     o.line_search_first = r.boolean(s.at("line_search_first"), "/solver/line_search_first");
   if (s.contains("threads")) c.threads = r.integer(s.at("threads"), "/solver/threads", 1, 64);
+  if (s.contains("extra_quadrature_points"))
+    c.extra_quadrature_points =
+        r.integer(s.at("extra_quadrature_points"), "/solver/extra_quadrature_points", 0,
+                  kMaxExtraQuadraturePoints);
   if (s.contains("thickness_integration")) {
     const std::string ti = r.string(s.at("thickness_integration"), "/solver/thickness_integration");
     if (ti == "gauss3")
@@ -785,6 +793,16 @@ Case parse_case_json(const json& root, const std::string& text, const std::strin
   read_bcs(r, root, c);
   read_loads(r, root, c);
   read_solver(r, root, c);
+  // More Gauss points hold more quadrature data: the memory check of the geometry, again.
+  if (c.extra_quadrature_points > 0) {
+    const MemoryEstimate mem = estimate_shell_memory(c.surface, c.extra_quadrature_points);
+    if (mem.total() > memory_limit_bytes())
+      r.fail("/solver/extra_quadrature_points",
+             std::to_string(c.extra_quadrature_points) +
+                 " extra Gauss points per direction need about " + mem.describe() +
+                 ", more than the " + format_bytes(memory_limit_bytes()) +
+                 " available (KNIT_MAX_MEMORY_MB overrides); use fewer");
+  }
   c.solver.force_unit = unit_labels(c.units).of("N");
   read_output(r, root, c);
   // The columns of load_strain.csv, unit suffixes included, must not repeat (session 48's

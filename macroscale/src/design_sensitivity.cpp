@@ -176,6 +176,7 @@ DesignSolve::DesignSolve(const std::string& text, const std::string& file,
     ShellOptions so;
     so.integration = c_.integration;
     so.threads = c_.threads;
+    so.extra_quadrature_points = c_.extra_quadrature_points;
     dm = std::make_unique<ShellModel>(c_.surface, c_.thickness, deriv, so);
   }
   const ShellModel& m = *problem_->model;

@@ -61,9 +61,9 @@ std::string MemoryEstimate::describe() const {
 }
 
 MemoryEstimate estimate_shell_memory(double pu, double pv, double spans, double size_u,
-                                     double size_v) {
+                                     double size_v, int extra) {
   // Doubles throughout: the counts reach 1e11 for the largest schema-legal refinement.
-  const double nloc = (pu + 1) * (pv + 1), q = nloc;
+  const double nloc = (pu + 1) * (pv + 1), q = (pu + 1 + extra) * (pv + 1 + extra);
   const double N = 3.0 * size_u * size_v;
   MemoryEstimate m;
   m.quadrature = static_cast<std::uint64_t>(spans * q * (11.0 * nloc * 8.0 + 256.0));
@@ -77,11 +77,12 @@ MemoryEstimate estimate_shell_memory(double pu, double pv, double spans, double 
   return m;
 }
 
-MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s) {
+MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s, int extra) {
   return estimate_shell_memory(s.basis_u().degree(), s.basis_v().degree(),
                                static_cast<double>(num_spans(s.basis_u().knots())) *
                                    static_cast<double>(num_spans(s.basis_v().knots())),
-                               static_cast<double>(s.size_u()), static_cast<double>(s.size_v()));
+                               static_cast<double>(s.size_u()), static_cast<double>(s.size_v()),
+                               extra);
 }
 
 MemoryEstimate estimate_refinement_memory(int p, int elements_u, int elements_v) {

@@ -80,6 +80,7 @@ Problem setup_problem(const Case& c) {
   ShellOptions so;
   so.integration = c.integration;
   so.threads = c.threads;
+  so.extra_quadrature_points = c.extra_quadrature_points;
   try {
     p.model = std::make_unique<ShellModel>(c.surface, c.thickness, c.material, so);
   } catch (const DegenerateGeometryError& e) {

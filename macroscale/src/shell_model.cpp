@@ -35,8 +35,9 @@ ShellModel::ShellModel(spline::SplineSurface surface, double thickness,
   const Eigen::MatrixXd& P = surface_.control_points();
   scale_ = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
   if (!(scale_ > 0)) scale_ = 1.0;
-  const int nqu = opt_.quadrature_points > 0 ? opt_.quadrature_points : pu + 1;
-  const int nqv = opt_.quadrature_points > 0 ? opt_.quadrature_points : pv + 1;
+  const int extra = std::max(0, opt_.extra_quadrature_points);
+  const int nqu = opt_.quadrature_points > 0 ? opt_.quadrature_points : pu + 1 + extra;
+  const int nqv = opt_.quadrature_points > 0 ? opt_.quadrature_points : pv + 1 + extra;
   const auto su = spans(surface_.basis_u().knots()), sv = spans(surface_.basis_v().knots());
   const spline::QuadratureRule gu = spline::gauss_legendre(nqu), gv = spline::gauss_legendre(nqv);
   const int nel = static_cast<int>(su.size() * sv.size());

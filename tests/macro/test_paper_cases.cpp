@@ -199,3 +199,38 @@ TEST_CASE("paper cases: 3.2.3 - the hyperbolic paraboloid in mm, reduced tension
         Approx(74.6).margin(0.1));
   CHECK(diagonal_asymmetry(c, r) > 1e-4);
 }
+
+// Session 57's red team: the paper's one- and two-element meshes integrate the knit energy with
+// p + 1 Gauss points per direction, exact for the area of an undistorted patch but not for the
+// energy where l jumps or the strain varies within an element (4-11 % on the hyperbolic
+// paraboloids). /solver/extra_quadrature_points adds points; the default stays p + 1. On 3.2.2
+// (one element of degree 5, smooth fields; the test law, half the displacement) the load goes
+// 1.42928, 1.43021, 1.43060, 1.43071 N with 0-3 extra points. Not on 3.1.3, whose l jumps inside
+// its one element: no Gauss rule converges there (3.471, 3.212, 3.479, 3.272 N).
+TEST_CASE("paper cases: extra Gauss points reach the model, and the load converges with them",
+          "[case]") {
+  std::vector<double> load;
+  for (int extra = 0; extra <= 3; ++extra) {
+    INFO("extra " << extra);
+    const knit::macro::Case c = load_paper_case("s322_curved_horizontal", 0.5, 4, [&](json& j) {
+      j["solver"]["extra_quadrature_points"] = extra;
+    });
+    CHECK(c.extra_quadrature_points == extra);
+    const knit::macro::Problem p = knit::macro::setup_problem(c);
+    CHECK(p.model->num_quadrature_points() == (6 + extra) * (6 + extra));  // degree 5, 1 element
+    load.push_back(run(c).rows.back().reactions[0]);
+  }
+  INFO("loads " << load[0] << ", " << load[1] << ", " << load[2] << ", " << load[3] << " N");
+  CHECK(std::abs(load[0] - load[3]) > 1e-4 * std::abs(load[3]));  // p + 1 is not converged here
+  CHECK(std::abs(load[2] - load[3]) < std::abs(load[0] - load[3]));
+  CHECK(std::abs(load[2] - load[3]) < std::abs(load[1] - load[3]));
+  // Out of range: refused with the pointer.
+  std::string pointer = "<no error>";
+  try {
+    load_paper_case("s322_curved_horizontal", 0.5, 4,
+                    [](json& j) { j["solver"]["extra_quadrature_points"] = 4; });
+  } catch (const knit::InputError& e) {
+    pointer = e.pointer();
+  }
+  CHECK(pointer == "/solver/extra_quadrature_points");
+}

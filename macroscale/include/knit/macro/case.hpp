@@ -101,7 +101,8 @@ struct Case {
   double thickness = 0.0;
   std::shared_ptr<Material> material;
   ThicknessIntegration integration = ThicknessIntegration::kGauss3;
-  int threads = 0;  ///< assembly threads; 0: automatic (ShellOptions::threads)
+  int threads = 0;                  ///< assembly threads; 0: automatic (ShellOptions::threads)
+  int extra_quadrature_points = 0;  ///< ShellOptions::extra_quadrature_points
   std::vector<BoundaryCondition> bcs;
   std::vector<Load> loads;
   SolverOptions solver;

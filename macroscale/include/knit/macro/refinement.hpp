@@ -32,10 +32,11 @@ struct MemoryEstimate {
 };
 /// "207 GB", "12 MB" (decimal units).
 std::string format_bytes(std::uint64_t bytes);
-MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s);
+/// `extra`: Gauss points beyond p + 1 per direction (ShellOptions::extra_quadrature_points).
+MemoryEstimate estimate_shell_memory(const spline::SplineSurface& s, int extra = 0);
 /// The same from degrees, the number of elements (non-empty spans) and of control points.
 MemoryEstimate estimate_shell_memory(double degree_u, double degree_v, double elements,
-                                     double size_u, double size_v);
+                                     double size_u, double size_v, int extra = 0);
 /// A lower bound of estimate_shell_memory(refine_patch(s, p, elements_u, elements_v)) for any
 /// patch s, known before the refinement is made: refine() keeps the patch's breakpoints and adds
 /// uniform ones, so the refined patch has at least elements_u x elements_v elements and

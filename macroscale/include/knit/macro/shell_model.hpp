@@ -46,7 +46,12 @@ struct ShellOptions {
   /// number). 0: automatic, all hardware threads when the tangent's element work exceeds
   /// kAutoThreadWork, one otherwise.
   int threads = 0;
-  int quadrature_points = -1;  ///< per direction and element; -1: p + 1
+  int quadrature_points = -1;  ///< per direction and element; -1: p + 1 + extra_quadrature_points
+  /// Gauss points beyond p + 1 per direction and element (/solver/extra_quadrature_points of a
+  /// case; session 58): p + 1 integrates the area exactly on an undistorted patch but not the
+  /// knit law's energy, whose strain varies within an element (a red team of session 57: 4-11 %
+  /// on the paper's one- and two-element meshes of the hyperbolic paraboloid).
+  int extra_quadrature_points = 0;
   /// Elements with the same basis derivatives at their points share one copy (ShellModel::
   /// distinct_bases()); false: each its own (the reference of the test).
   bool share_bases = true;
